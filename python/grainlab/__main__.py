@@ -1,0 +1,5 @@
+import sys
+
+from grainlab.cli import main
+
+sys.exit(main())

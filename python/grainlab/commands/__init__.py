@@ -1,0 +1,1 @@
+"""Subcommands of the ``grainlab`` command line, one module each."""
