@@ -1,5 +1,31 @@
-//! grainlab-core: a 2D disk discrete element engine.
+//! grainlab-core: a 2D disk discrete element engine (no Python in it).
+//!
+//! The [`pipeline::Simulation`] owns the state and runs whole blocks of steps;
+//! see `pipeline.rs` for the step order and `law.rs` for the contact law.
 #![warn(missing_docs)]
+
+pub mod bond;
+pub mod cell;
+pub mod contact;
+pub mod contact_list;
+pub mod diagnostics;
+pub mod error;
+pub mod integrate;
+pub mod law;
+pub mod material;
+pub mod neighbor;
+pub mod parallel;
+pub mod pipeline;
+pub mod state;
+pub mod vec2;
+pub mod wall;
+
+pub use cell::PeriodicCell;
+pub use error::{EngineError, Result};
+pub use material::ContactModel;
+pub use pipeline::{Simulation, StepParameters};
+pub use state::Particles;
+pub use wall::{ServoControl, Wall, WallControl, WallShape};
 
 /// Version of the engine crate.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

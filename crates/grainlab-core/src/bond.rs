@@ -1,0 +1,59 @@
+//! Permanent bonds: a linear normal and shear spring between two chosen disks
+//! that carries tension and never breaks (the membrane chain uses them).
+//! Bonded pairs are excluded from the frictional contact law.
+use serde::{Deserialize, Serialize};
+
+/// One bond; forces follow the sign conventions of [`crate::law`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Bond {
+    /// First particle.
+    pub i: u32,
+    /// Second particle.
+    pub j: u32,
+    /// Normal stiffness (N/m).
+    pub normal_stiffness: f64,
+    /// Shear stiffness (N/m).
+    pub shear_stiffness: f64,
+    /// Centre distance at which the normal force is zero (m).
+    pub rest_length: f64,
+    /// Shear spring force (N), the bond's history.
+    pub shear: f64,
+}
+
+/// All bonds, plus a sorted pair index for excluding them from contacts.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct Bonds {
+    /// The bonds, in creation order.
+    pub list: Vec<Bond>,
+    sorted_pairs: Vec<(u32, u32)>,
+}
+
+impl Bonds {
+    /// Adds a bond (the caller validates indices and stiffnesses).
+    pub fn push(&mut self, bond: Bond) {
+        let key = (bond.i.min(bond.j), bond.i.max(bond.j));
+        let at = self.sorted_pairs.binary_search(&key).unwrap_or_else(|e| e);
+        self.sorted_pairs.insert(at, key);
+        self.list.push(bond);
+    }
+
+    /// Whether `i` and `j` are bonded.
+    #[inline]
+    pub fn contains(&self, i: u32, j: u32) -> bool {
+        !self.sorted_pairs.is_empty()
+            && self
+                .sorted_pairs
+                .binary_search(&(i.min(j), i.max(j)))
+                .is_ok()
+    }
+
+    /// Number of bonds.
+    pub fn len(&self) -> usize {
+        self.list.len()
+    }
+
+    /// True without bonds.
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+}

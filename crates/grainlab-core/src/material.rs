@@ -1,0 +1,112 @@
+//! Contact models per pair of material groups (particle-particle, particle-wall, ...).
+use serde::{Deserialize, Serialize};
+
+use crate::error::{require_non_negative, require_positive, EngineError, Result};
+use crate::state::MAX_GROUPS;
+
+/// Parameters of the linear contact law with Coulomb friction (DESIGN §3).
+///
+/// `normal_stiffness` and `shear_stiffness` are *contact* stiffnesses (N/m);
+/// the damping ratios are fractions of critical damping of the viscous
+/// dashpots (0 disables them; local damping is separate, per particle).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ContactModel {
+    /// Normal contact stiffness kn (N/m).
+    pub normal_stiffness: f64,
+    /// Shear contact stiffness ks (N/m).
+    pub shear_stiffness: f64,
+    /// Coulomb friction coefficient mu.
+    pub friction: f64,
+    /// Normal viscous damping, fraction of critical `2 sqrt(m* kn)`.
+    pub normal_damping_ratio: f64,
+    /// Shear viscous damping, fraction of critical `2 sqrt(m* ks)`.
+    pub shear_damping_ratio: f64,
+}
+
+impl ContactModel {
+    /// Linear spring model without viscous damping.
+    pub fn linear(normal_stiffness: f64, shear_stiffness: f64, friction: f64) -> Self {
+        ContactModel {
+            normal_stiffness,
+            shear_stiffness,
+            friction,
+            normal_damping_ratio: 0.0,
+            shear_damping_ratio: 0.0,
+        }
+    }
+
+    /// Checks every field's range.
+    pub fn validate(&self, field: &str) -> Result<()> {
+        require_positive(&format!("{field}.normal_stiffness"), self.normal_stiffness)?;
+        require_positive(&format!("{field}.shear_stiffness"), self.shear_stiffness)?;
+        require_non_negative(&format!("{field}.friction"), self.friction)?;
+        require_non_negative(
+            &format!("{field}.normal_damping_ratio"),
+            self.normal_damping_ratio,
+        )?;
+        require_non_negative(
+            &format!("{field}.shear_damping_ratio"),
+            self.shear_damping_ratio,
+        )?;
+        Ok(())
+    }
+}
+
+/// Symmetric table of contact models indexed by the two contacting groups.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct MaterialTable {
+    models: Vec<ContactModel>,
+}
+
+impl MaterialTable {
+    /// Every pair of groups uses `model`.
+    pub fn uniform(model: ContactModel) -> Result<Self> {
+        model.validate("contact_model")?;
+        Ok(MaterialTable {
+            models: vec![model; MAX_GROUPS * MAX_GROUPS],
+        })
+    }
+
+    /// Sets the model between groups `a` and `b` (both orders).
+    pub fn set(&mut self, a: usize, b: usize, model: ContactModel) -> Result<()> {
+        for (name, g) in [("group_a", a), ("group_b", b)] {
+            if g >= MAX_GROUPS {
+                return Err(EngineError::invalid(
+                    name,
+                    format!("group {g} out of range 0..{MAX_GROUPS}"),
+                ));
+            }
+        }
+        model.validate("contact_model")?;
+        self.models[a * MAX_GROUPS + b] = model;
+        self.models[b * MAX_GROUPS + a] = model;
+        Ok(())
+    }
+
+    /// Index of the model between groups `a` and `b`, for [`MaterialTable::by_index`].
+    #[inline(always)]
+    pub fn index(a: u8, b: u8) -> u16 {
+        a as u16 * MAX_GROUPS as u16 + b as u16
+    }
+
+    /// The model between groups `a` and `b`.
+    pub fn get(&self, a: u8, b: u8) -> &ContactModel {
+        &self.models[Self::index(a, b) as usize]
+    }
+
+    /// The model stored at `index`.
+    #[inline(always)]
+    pub fn by_index(&self, index: u16) -> &ContactModel {
+        &self.models[index as usize]
+    }
+
+    /// Largest normal or shear stiffness of any model involving group `g`.
+    pub fn max_stiffness_for_group(&self, g: u8) -> f64 {
+        (0..MAX_GROUPS as u8)
+            .map(|other| {
+                let m = self.get(g, other);
+                m.normal_stiffness.max(m.shear_stiffness)
+            })
+            .fold(0.0, f64::max)
+    }
+}

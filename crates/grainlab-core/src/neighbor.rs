@@ -1,0 +1,472 @@
+//! Verlet pair lists with a skin, built from cell lists, that never miss a contact.
+//!
+//! A pair `(i, j, shift)` is listed when the centre distance of `i` and the
+//! image `x_j + shift . H` of `j` is below `r_i + r_j + skin`. Between builds
+//! every particle's displacement *relative to the homogeneous deformation* is
+//! tracked (`u = x - origin - M_acc (x_ref - origin)`); a listed-out pair's
+//! distance `d` obeys `|d| >= |M_acc d_ref| - |u_i| - |u_j|`, so no contact can
+//! appear unseen while `2 max|u| + |M_acc - I| (2 r_max + skin) < skin`. Walls
+//! use the total displacement of particles plus the wall's own. The list is
+//! rebuilt as soon as either bound could be violated, at the start of a step.
+//!
+//! Pairs are grouped for parallel force evaluation: the particles are split
+//! into `n_blocks` stripes of bin columns with balanced counts; pairs with both
+//! particles in block `b` are stored contiguously (`block_start[b]..block_start[b+1]`)
+//! and may be evaluated concurrently with other blocks; pairs across blocks
+//! come last. Shear history is carried over from the previous list by pair key.
+use std::collections::HashMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::bond::Bonds;
+use crate::cell::PeriodicCell;
+use crate::error::{EngineError, Result};
+use crate::material::MaterialTable;
+use crate::state::Particles;
+use crate::vec2::{add, distance_from_identity, dot, sub, Mat2, Vec2, IDENTITY};
+use crate::wall::Wall;
+
+/// Particle-particle pairs with their contact history.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct PairList {
+    /// First particle of each pair.
+    pub i: Vec<u32>,
+    /// Second particle of each pair.
+    pub j: Vec<u32>,
+    /// Image of `j` in cell vectors.
+    pub shift: Vec<[i8; 2]>,
+    /// Contact model index in the [`MaterialTable`].
+    pub model: Vec<u16>,
+    /// Shear spring force (N): the contact's history, 0 when not in contact.
+    pub shear: Vec<f64>,
+    /// Whether the contact slid in the last step.
+    pub sliding: Vec<bool>,
+    /// Pairs interior to block `b` are `block_start[b]..block_start[b + 1]`;
+    /// cross-block pairs follow from `block_start[n_blocks]`.
+    pub block_start: Vec<usize>,
+}
+
+impl PairList {
+    /// Number of listed pairs.
+    pub fn len(&self) -> usize {
+        self.i.len()
+    }
+
+    /// True when no pair is listed.
+    pub fn is_empty(&self) -> bool {
+        self.i.is_empty()
+    }
+
+    fn push(&mut self, i: u32, j: u32, shift: [i8; 2], model: u16) {
+        self.i.push(i);
+        self.j.push(j);
+        self.shift.push(shift);
+        self.model.push(model);
+        self.shear.push(0.0);
+        self.sliding.push(false);
+    }
+}
+
+/// Particle-wall pairs with their contact history.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct WallPairList {
+    /// Wall index.
+    pub wall: Vec<u32>,
+    /// Particle index.
+    pub particle: Vec<u32>,
+    /// Contact model index.
+    pub model: Vec<u16>,
+    /// Shear spring force (N).
+    pub shear: Vec<f64>,
+    /// Whether the contact slid in the last step.
+    pub sliding: Vec<bool>,
+}
+
+/// The Verlet lists and the bookkeeping that says when to rebuild them.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct NeighborList {
+    /// Verlet skin (m).
+    pub skin: f64,
+    /// Particle pairs.
+    pub pairs: PairList,
+    /// Particle-wall pairs.
+    pub wall_pairs: WallPairList,
+    /// Particles owned by each block.
+    pub block_particles: Vec<Vec<u32>>,
+    /// Number of builds so far.
+    pub build_count: u64,
+    valid: bool,
+    reference: Vec<Vec2>,
+    accumulated_map: Mat2,
+    wall_reference: Vec<Vec2>,
+    max_radius: f64,
+    /// Largest squared displacement relative to the homogeneous deformation since the build.
+    pub max_fluctuation_sq: f64,
+    /// Largest squared total displacement since the build.
+    pub max_displacement_sq: f64,
+}
+
+/// A view of the build reference that the integrator uses to track displacements.
+pub struct DisplacementReference<'a> {
+    /// Positions at the last build.
+    pub reference: &'a [Vec2],
+    /// Accumulated affine map since the build, including the current step.
+    pub accumulated_map: Mat2,
+}
+
+impl NeighborList {
+    /// An empty, invalid list with the given skin.
+    pub fn new(skin: f64) -> Self {
+        NeighborList {
+            skin,
+            pairs: PairList::default(),
+            wall_pairs: WallPairList::default(),
+            block_particles: Vec::new(),
+            build_count: 0,
+            valid: false,
+            reference: Vec::new(),
+            accumulated_map: IDENTITY,
+            wall_reference: Vec::new(),
+            max_radius: 0.0,
+            max_fluctuation_sq: 0.0,
+            max_displacement_sq: 0.0,
+        }
+    }
+
+    /// Forces a rebuild at the next step (after radii, positions or walls changed).
+    pub fn invalidate(&mut self) {
+        self.valid = false;
+    }
+
+    /// Whether the list is currently valid.
+    pub fn is_valid(&self) -> bool {
+        self.valid
+    }
+
+    /// Records one more step of homogeneous deformation and returns the reference
+    /// the integrator measures displacements against.
+    pub fn advance_map(&mut self, step_map: &Mat2) -> DisplacementReference<'_> {
+        self.accumulated_map = PeriodicCell::accumulate(&self.accumulated_map, step_map);
+        DisplacementReference {
+            reference: &self.reference,
+            accumulated_map: self.accumulated_map,
+        }
+    }
+
+    /// The reference without a deformation step.
+    pub fn reference(&self) -> DisplacementReference<'_> {
+        DisplacementReference {
+            reference: &self.reference,
+            accumulated_map: self.accumulated_map,
+        }
+    }
+
+    /// Whether a contact could have been missed if the list were kept.
+    pub fn needs_rebuild(&self, walls: &[Wall]) -> bool {
+        if !self.valid {
+            return true;
+        }
+        let strain = distance_from_identity(&self.accumulated_map);
+        let fluctuation = self.max_fluctuation_sq.sqrt();
+        if 2.0 * fluctuation + strain * (2.0 * self.max_radius + self.skin) >= self.skin {
+            return true;
+        }
+        if !walls.is_empty() {
+            let wall_move = walls
+                .iter()
+                .zip(&self.wall_reference)
+                .map(|(w, r)| {
+                    let d = sub(w.displacement, *r);
+                    dot(d, d).sqrt()
+                })
+                .fold(0.0, f64::max);
+            if self.max_displacement_sq.sqrt() + wall_move >= self.skin {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Rebuilds the lists: wraps particles into the periodic cell, bins them,
+    /// lists pairs and wall pairs, and carries over the contact history.
+    pub fn build(
+        &mut self,
+        particles: &mut Particles,
+        cell: Option<&PeriodicCell>,
+        walls: &[Wall],
+        bonds: &Bonds,
+        n_blocks: usize,
+    ) -> Result<()> {
+        let n = particles.len();
+        let n_blocks = n_blocks.max(1);
+        let r_max = particles.max_radius();
+        let cutoff = 2.0 * r_max + self.skin;
+
+        // 1. wrap, remembering each particle's wrap so old image shifts can be corrected
+        let mut wraps = vec![[0i8; 2]; n];
+        if let Some(cell) = cell {
+            for (x, w) in particles.position.iter_mut().zip(wraps.iter_mut()) {
+                *w = cell.wrap(x);
+            }
+        }
+
+        // 2. bins in fractional coordinates
+        let grid = BinGrid::new(&particles.position, cell, cutoff)?;
+        let bins = grid.assign(&particles.position, cell);
+        let (bin_start, bin_members) = counting_sort(&bins, grid.count());
+
+        // 3. blocks: contiguous ranges of bin columns with balanced particle counts
+        let mut column_counts = vec![0usize; grid.n[0]];
+        for &b in &bins {
+            column_counts[b as usize / grid.n[1]] += 1;
+        }
+        let mut block_of_column = vec![0u8; grid.n[0]];
+        let mut seen = 0usize;
+        for (c, count) in column_counts.iter().enumerate() {
+            let block = ((seen * n_blocks) / n.max(1)).min(n_blocks - 1);
+            block_of_column[c] = block as u8;
+            seen += count;
+        }
+        let block_of = |p: usize| block_of_column[bins[p] as usize / grid.n[1]];
+        let mut block_particles = vec![Vec::new(); n_blocks];
+        for &p in &bin_members {
+            block_particles[block_of(p as usize) as usize].push(p);
+        }
+
+        // 4. pairs, in bin order for locality, sorted into blocks
+        let mut per_block: Vec<Vec<(u32, u32, [i8; 2])>> = vec![Vec::new(); n_blocks + 1];
+        let positions = &particles.position;
+        let radii = &particles.radius;
+        let skin = self.skin;
+        for bx in 0..grid.n[0] {
+            for by in 0..grid.n[1] {
+                let home = bx * grid.n[1] + by;
+                for &pi in &bin_members[bin_start[home]..bin_start[home + 1]] {
+                    let i = pi as usize;
+                    let xi = positions[i];
+                    let ri = radii[i];
+                    for dx in -1i64..=1 {
+                        let Some((nx, sx)) = grid.neighbor(0, bx as i64 + dx) else {
+                            continue;
+                        };
+                        for dy in -1i64..=1 {
+                            let Some((ny, sy)) = grid.neighbor(1, by as i64 + dy) else {
+                                continue;
+                            };
+                            let shift = [sx, sy];
+                            let offset = cell.map_or([0.0; 2], |c| c.image_offset(shift));
+                            let other = nx * grid.n[1] + ny;
+                            for &pj in &bin_members[bin_start[other]..bin_start[other + 1]] {
+                                if pj <= pi {
+                                    continue;
+                                }
+                                let j = pj as usize;
+                                let d = sub(add(positions[j], offset), xi);
+                                let reach = ri + radii[j] + skin;
+                                if dot(d, d) < reach * reach && !bonds.contains(pi, pj) {
+                                    let (bi, bj) = (block_of(i), block_of(j));
+                                    let slot = if bi == bj { bi as usize } else { n_blocks };
+                                    per_block[slot].push((pi, pj, shift));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        // 5. carry the history of touching pairs over, correcting shifts for the wraps
+        let mut history: HashMap<(u32, u32, [i8; 2]), (f64, bool)> = HashMap::new();
+        let old = &self.pairs;
+        for k in 0..old.len() {
+            if old.shear[k] != 0.0 || old.sliding[k] {
+                let (i, j) = (old.i[k] as usize, old.j[k] as usize);
+                let s = old.shift[k];
+                let shift = [
+                    s[0] - wraps[j][0] + wraps[i][0],
+                    s[1] - wraps[j][1] + wraps[i][1],
+                ];
+                history.insert((old.i[k], old.j[k], shift), (old.shear[k], old.sliding[k]));
+            }
+        }
+        let mut pairs = PairList::default();
+        for list in &per_block {
+            pairs.block_start.push(pairs.len());
+            for &(i, j, shift) in list {
+                let model =
+                    MaterialTable::index(particles.group[i as usize], particles.group[j as usize]);
+                pairs.push(i, j, shift, model);
+                if let Some(&(shear, sliding)) = history.get(&(i, j, shift)) {
+                    let k = pairs.len() - 1;
+                    pairs.shear[k] = shear;
+                    pairs.sliding[k] = sliding;
+                }
+            }
+        }
+
+        // 6. wall pairs
+        let mut wall_history: HashMap<(u32, u32), (f64, bool)> = HashMap::new();
+        let old = &self.wall_pairs;
+        for k in 0..old.wall.len() {
+            if old.shear[k] != 0.0 || old.sliding[k] {
+                wall_history.insert(
+                    (old.wall[k], old.particle[k]),
+                    (old.shear[k], old.sliding[k]),
+                );
+            }
+        }
+        let mut wall_pairs = WallPairList::default();
+        for (w, wall) in walls.iter().enumerate() {
+            for p in 0..n {
+                let g = wall.disk_contact(positions[p], radii[p]);
+                if g.overlap > -skin {
+                    let (shear, sliding) = wall_history
+                        .get(&(w as u32, p as u32))
+                        .copied()
+                        .unwrap_or((0.0, false));
+                    wall_pairs.wall.push(w as u32);
+                    wall_pairs.particle.push(p as u32);
+                    wall_pairs
+                        .model
+                        .push(MaterialTable::index(wall.group, particles.group[p]));
+                    wall_pairs.shear.push(shear);
+                    wall_pairs.sliding.push(sliding);
+                }
+            }
+        }
+
+        self.pairs = pairs;
+        self.wall_pairs = wall_pairs;
+        self.block_particles = block_particles;
+        self.reference = particles.position.clone();
+        self.accumulated_map = IDENTITY;
+        self.wall_reference = walls.iter().map(|w| w.displacement).collect();
+        self.max_radius = r_max;
+        self.max_fluctuation_sq = 0.0;
+        self.max_displacement_sq = 0.0;
+        self.valid = true;
+        self.build_count += 1;
+        Ok(())
+    }
+}
+
+/// Uniform bins over fractional coordinates, at least `cutoff` wide.
+struct BinGrid {
+    n: [usize; 2],
+    lo: [f64; 2],
+    span: [f64; 2],
+    periodic: [bool; 2],
+}
+
+impl BinGrid {
+    fn new(positions: &[Vec2], cell: Option<&PeriodicCell>, cutoff: f64) -> Result<Self> {
+        let (periodic, widths) = match cell {
+            Some(c) => (c.periodic, c.widths()),
+            None => ([false; 2], [1.0, 1.0]),
+        };
+        let mut lo = [0.0; 2];
+        let mut span = [1.0; 2];
+        let mut n = [1usize; 2];
+        for k in 0..2 {
+            if !periodic[k] {
+                let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
+                for x in positions {
+                    let f = cell.map_or(*x, |c| c.fractional(*x))[k];
+                    min = min.min(f);
+                    max = max.max(f);
+                }
+                if positions.is_empty() {
+                    (min, max) = (0.0, 0.0);
+                }
+                if !(min.is_finite() && max.is_finite()) {
+                    return Err(EngineError::invalid("position", "positions must be finite"));
+                }
+                let pad = 1e-9 * (max - min).abs().max(1e-300);
+                lo[k] = min - pad;
+                span[k] = (max - min) + 2.0 * pad;
+            }
+            n[k] = ((span[k] * widths[k] / cutoff).floor() as usize).max(1);
+            if periodic[k] && n[k] < 3 {
+                return Err(EngineError::invalid(
+                    "cell",
+                    format!(
+                        "periodic cell width {:.6e} m along {} must be at least 3 x (largest diameter + skin) = {:.6e} m",
+                        widths[k],
+                        if k == 0 { "a" } else { "b" },
+                        3.0 * cutoff
+                    ),
+                ));
+            }
+        }
+        // keep the grid size proportional to the particle count when particles spread out
+        let limit = (4 * positions.len() + 16) as f64;
+        let total = (n[0] * n[1]) as f64;
+        if total > limit {
+            let free: Vec<usize> = (0..2).filter(|&k| !periodic[k]).collect();
+            let factor = (total / limit).powf(1.0 / free.len().max(1) as f64);
+            for k in free {
+                n[k] = ((n[k] as f64 / factor).floor() as usize).max(1);
+            }
+        }
+        Ok(BinGrid {
+            n,
+            lo,
+            span,
+            periodic,
+        })
+    }
+
+    fn count(&self) -> usize {
+        self.n[0] * self.n[1]
+    }
+
+    fn assign(&self, positions: &[Vec2], cell: Option<&PeriodicCell>) -> Vec<u32> {
+        positions
+            .iter()
+            .map(|x| {
+                let f = cell.map_or(*x, |c| c.fractional(*x));
+                let mut b = [0usize; 2];
+                for k in 0..2 {
+                    let t = ((f[k] - self.lo[k]) / self.span[k] * self.n[k] as f64).floor();
+                    b[k] = (t.max(0.0) as usize).min(self.n[k] - 1);
+                }
+                (b[0] * self.n[1] + b[1]) as u32
+            })
+            .collect()
+    }
+
+    /// Neighbouring bin index along `k`, with the image shift when it wraps.
+    #[inline]
+    fn neighbor(&self, k: usize, idx: i64) -> Option<(usize, i8)> {
+        let n = self.n[k] as i64;
+        if (0..n).contains(&idx) {
+            Some((idx as usize, 0))
+        } else if self.periodic[k] {
+            if idx < 0 {
+                Some(((idx + n) as usize, -1))
+            } else {
+                Some(((idx - n) as usize, 1))
+            }
+        } else {
+            None
+        }
+    }
+}
+
+/// Groups item indices by bin: returns CSR offsets and members.
+fn counting_sort(bins: &[u32], n_bins: usize) -> (Vec<usize>, Vec<u32>) {
+    let mut start = vec![0usize; n_bins + 1];
+    for &b in bins {
+        start[b as usize + 1] += 1;
+    }
+    for k in 0..n_bins {
+        start[k + 1] += start[k];
+    }
+    let mut fill = start.clone();
+    let mut members = vec![0u32; bins.len()];
+    for (p, &b) in bins.iter().enumerate() {
+        members[fill[b as usize]] = p as u32;
+        fill[b as usize] += 1;
+    }
+    (start, members)
+}

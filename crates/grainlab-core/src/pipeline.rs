@@ -1,0 +1,937 @@
+//! The simulation and its step, in this order (ARCHITECTURE.md repeats it):
+//!
+//! 1. **Neighbours**: rebuild the Verlet lists if a contact could otherwise be
+//!    missed (wraps particles into the periodic cell, carries contact history over).
+//! 2. **Reset**: resultant = external force + gravity, per block of particles.
+//! 3. **Particle contacts**: linear law with shear history and Coulomb cap,
+//!    blocks in parallel, then the cross-block pairs.
+//! 4. **Bonds**: linear normal and shear springs that carry tension.
+//! 5. **Wall contacts**: the same law against walls; walls sum their force.
+//! 6. **Servo**: servo-controlled walls set their velocity from this step's force.
+//! 7. **Integrate**: leapfrog with local damping, in parallel chunks; the
+//!    periodic cell's affine map is applied to positions; displacements since
+//!    the last build are tracked.
+//! 8. **Move**: walls translate, the cell deforms, time advances.
+//! 9. **Checks**: non-finite state or an overlap beyond the allowed fraction of
+//!    the smaller radius stops the run with an error naming the particles.
+use rayon::ThreadPool;
+use serde::{Deserialize, Serialize};
+
+use crate::bond::{Bond, Bonds};
+use crate::cell::PeriodicCell;
+use crate::contact::disk_disk;
+use crate::diagnostics::{EnergyLedger, Measurements};
+use crate::error::{require_non_negative, require_positive, EngineError, Result};
+use crate::integrate::{
+    integrate_chunk, IntegrationInputs, IntegrationStep, IntegrationTally, MotionChunk,
+};
+use crate::law::{elastic_energy, linear_coulomb};
+use crate::material::{ContactModel, MaterialTable};
+use crate::neighbor::NeighborList;
+use crate::parallel::{even_bounds, map_blocks, split_ranges, DisjointWriter};
+use crate::state::Particles;
+use crate::vec2::{add, dot, mat_vec, norm, perp, scale, sub, Mat2, Vec2};
+use crate::wall::{Wall, WallControl};
+
+/// Tunables of the step, in one place.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct StepParameters {
+    /// Time step (s).
+    pub time_step: f64,
+    /// Local damping coefficient alpha in [0, 1) (paper: 0.8).
+    pub local_damping: f64,
+    /// Gravity (m/s^2).
+    pub gravity: Vec2,
+    /// A contact whose overlap exceeds this fraction of the smaller radius stops the run.
+    pub max_overlap_ratio: f64,
+}
+
+impl StepParameters {
+    /// Checks ranges.
+    pub fn validate(&self) -> Result<()> {
+        require_positive("time_step", self.time_step)?;
+        if !(0.0..1.0).contains(&self.local_damping) {
+            return Err(EngineError::invalid(
+                "local_damping",
+                format!("must be in [0, 1), got {}", self.local_damping),
+            ));
+        }
+        crate::error::require_finite("gravity", self.gravity[0])?;
+        crate::error::require_finite("gravity", self.gravity[1])?;
+        require_positive("max_overlap_ratio", self.max_overlap_ratio)?;
+        Ok(())
+    }
+}
+
+/// Per-block sums of the contact phase.
+#[derive(Debug, Clone, Copy, Default)]
+struct ContactTally {
+    friction: f64,
+    viscous: f64,
+    elastic: f64,
+    force_sum: f64,
+    contacts: usize,
+    overlap_violation: bool,
+}
+
+impl ContactTally {
+    fn merge(&mut self, o: &ContactTally) {
+        self.friction += o.friction;
+        self.viscous += o.viscous;
+        self.elastic += o.elastic;
+        self.force_sum += o.force_sum;
+        self.contacts += o.contacts;
+        self.overlap_violation |= o.overlap_violation;
+    }
+}
+
+/// A 2D disk DEM simulation: particles, walls, bonds, an optional periodic cell.
+#[derive(Serialize, Deserialize)]
+pub struct Simulation {
+    /// The disks.
+    pub particles: Particles,
+    /// Contact models per pair of groups.
+    pub materials: MaterialTable,
+    /// Rigid walls.
+    pub walls: Vec<Wall>,
+    /// Permanent bonds.
+    pub bonds: Bonds,
+    /// Periodic cell, if any.
+    pub cell: Option<PeriodicCell>,
+    /// Step tunables.
+    pub params: StepParameters,
+    /// Verlet lists and contact history.
+    pub neighbors: NeighborList,
+    /// Measurements of the last measured step.
+    pub measurements: Measurements,
+    /// Steps taken.
+    pub step_count: u64,
+    /// Simulated time (s).
+    pub time: f64,
+    ledger: EnergyLedger,
+    half_kick_pending: bool,
+    threads: usize,
+    #[serde(skip)]
+    pool: Option<ThreadPool>,
+}
+
+impl Simulation {
+    /// A simulation of `particles` where every pair of groups uses `model`,
+    /// with time step `time_step` and `threads` worker threads (>= 1).
+    pub fn new(
+        particles: Particles,
+        model: ContactModel,
+        time_step: f64,
+        threads: usize,
+    ) -> Result<Self> {
+        let params = StepParameters {
+            time_step,
+            local_damping: 0.0,
+            gravity: [0.0; 2],
+            max_overlap_ratio: 0.5,
+        };
+        params.validate()?;
+        if threads == 0 {
+            return Err(EngineError::invalid("threads", "must be >= 1"));
+        }
+        let skin = 0.1 * particles.max_radius().max(f64::MIN_POSITIVE);
+        let mut sim = Simulation {
+            particles,
+            materials: MaterialTable::uniform(model)?,
+            walls: Vec::new(),
+            bonds: Bonds::default(),
+            cell: None,
+            params,
+            neighbors: NeighborList::new(skin),
+            measurements: Measurements::default(),
+            step_count: 0,
+            time: 0.0,
+            ledger: EnergyLedger::default(),
+            half_kick_pending: true,
+            threads,
+            pool: None,
+        };
+        sim.make_pool()?;
+        Ok(sim)
+    }
+
+    fn make_pool(&mut self) -> Result<()> {
+        self.pool = if self.threads > 1 {
+            Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(self.threads)
+                    .build()
+                    .map_err(|e| EngineError::invalid("threads", e.to_string()))?,
+            )
+        } else {
+            None
+        };
+        Ok(())
+    }
+
+    /// Worker threads used by the step (results are bitwise reproducible for a given count).
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// Changes the thread count (and so the block partition: results change bitwise).
+    pub fn set_threads(&mut self, threads: usize) -> Result<()> {
+        if threads == 0 {
+            return Err(EngineError::invalid("threads", "must be >= 1"));
+        }
+        self.threads = threads;
+        self.neighbors.invalidate();
+        self.make_pool()
+    }
+
+    /// Sets the step tunables.
+    pub fn set_params(&mut self, params: StepParameters) -> Result<()> {
+        params.validate()?;
+        self.params = params;
+        Ok(())
+    }
+
+    /// Sets the Verlet skin (m, > 0).
+    pub fn set_skin(&mut self, skin: f64) -> Result<()> {
+        require_positive("skin", skin)?;
+        self.neighbors.skin = skin;
+        self.neighbors.invalidate();
+        Ok(())
+    }
+
+    /// Sets the contact model between groups `a` and `b`.
+    pub fn set_contact_model(&mut self, a: usize, b: usize, model: ContactModel) -> Result<()> {
+        self.materials.set(a, b, model)?;
+        self.neighbors.invalidate();
+        Ok(())
+    }
+
+    /// Sets (or removes) the periodic cell.
+    pub fn set_cell(&mut self, cell: Option<PeriodicCell>) -> Result<()> {
+        if let Some(c) = &cell {
+            c.validate()?;
+        }
+        self.cell = cell;
+        self.neighbors.invalidate();
+        Ok(())
+    }
+
+    /// Adds a wall and returns its id.
+    pub fn add_wall(&mut self, wall: Wall) -> usize {
+        self.walls.push(wall);
+        self.neighbors.invalidate();
+        self.walls.len() - 1
+    }
+
+    /// The wall with id `id`, or an error naming the valid range.
+    pub fn wall_mut(&mut self, id: usize) -> Result<&mut Wall> {
+        let n = self.walls.len();
+        self.walls.get_mut(id).ok_or_else(|| {
+            EngineError::invalid(
+                "wall_id",
+                format!("unknown wall {id}; valid ids are 0..{n}"),
+            )
+        })
+    }
+
+    /// Sets a wall's control mode (validated).
+    pub fn set_wall_control(&mut self, id: usize, control: WallControl) -> Result<()> {
+        if let WallControl::Servo(s) = control {
+            s.validate()?;
+        }
+        self.wall_mut(id)?.control = control;
+        Ok(())
+    }
+
+    /// Bonds particles `i` and `j` with a spring of rest length `rest_length`
+    /// (their current distance if `None`).
+    pub fn add_bond(
+        &mut self,
+        i: usize,
+        j: usize,
+        normal_stiffness: f64,
+        shear_stiffness: f64,
+        rest_length: Option<f64>,
+    ) -> Result<()> {
+        self.particles.check_index("bond.i", i)?;
+        self.particles.check_index("bond.j", j)?;
+        if i == j {
+            return Err(EngineError::invalid(
+                "bond",
+                format!("cannot bond particle {i} to itself"),
+            ));
+        }
+        if self.bonds.contains(i as u32, j as u32) {
+            return Err(EngineError::invalid(
+                "bond",
+                format!("particles {i} and {j} are already bonded"),
+            ));
+        }
+        require_positive("bond.normal_stiffness", normal_stiffness)?;
+        require_positive("bond.shear_stiffness", shear_stiffness)?;
+        let rest = match rest_length {
+            Some(r) => {
+                require_non_negative("bond.rest_length", r)?;
+                r
+            }
+            None => norm(self.branch(i, j)),
+        };
+        self.bonds.push(Bond {
+            i: i as u32,
+            j: j as u32,
+            normal_stiffness,
+            shear_stiffness,
+            rest_length: rest,
+            shear: 0.0,
+        });
+        self.neighbors.invalidate();
+        Ok(())
+    }
+
+    /// Branch vector from `i` to the nearest image of `j`.
+    pub fn branch(&self, i: usize, j: usize) -> Vec2 {
+        let d = sub(self.particles.position[j], self.particles.position[i]);
+        minimum_image(self.cell.as_ref(), d)
+    }
+
+    /// Marks the neighbour lists stale (after positions or radii changed).
+    pub fn invalidate_neighbors(&mut self) {
+        self.neighbors.invalidate();
+    }
+
+    /// Velocities were set: they are full-step values, and the next step starts with a half kick.
+    pub fn velocities_changed(&mut self) {
+        self.half_kick_pending = true;
+    }
+
+    /// The energy ledger (kinetic and elastic as of the last measured step).
+    pub fn energy(&self) -> EnergyLedger {
+        self.ledger
+    }
+
+    /// A time step estimate: `safety * min_i min(sqrt(m_i / k_n,i), sqrt(I_i / (k_s,i r_i^2)))`
+    /// where `k_n,i` and `k_s,i` sum the stiffnesses of particle `i`'s current
+    /// contacts and bonds (one contact of its stiffest model when it has none).
+    pub fn critical_time_step(&mut self, safety: f64) -> Result<f64> {
+        require_positive("safety", safety)?;
+        if self.neighbors.needs_rebuild(&self.walls) {
+            self.rebuild()?;
+        }
+        let n = self.particles.len();
+        let mut kn = vec![0.0; n];
+        let mut ks = vec![0.0; n];
+        let p = &self.particles;
+        let pairs = &self.neighbors.pairs;
+        for k in 0..pairs.len() {
+            let (i, j) = (pairs.i[k] as usize, pairs.j[k] as usize);
+            let d = sub(
+                add(p.position[j], self.image_offset(pairs.shift[k])),
+                p.position[i],
+            );
+            if disk_disk(d, p.radius[i], p.radius[j]).overlap > 0.0 {
+                let m = self.materials.by_index(pairs.model[k]);
+                for q in [i, j] {
+                    kn[q] += m.normal_stiffness;
+                    ks[q] += m.shear_stiffness;
+                }
+            }
+        }
+        let wp = &self.neighbors.wall_pairs;
+        for k in 0..wp.wall.len() {
+            let q = wp.particle[k] as usize;
+            if self.walls[wp.wall[k] as usize]
+                .disk_contact(p.position[q], p.radius[q])
+                .overlap
+                > 0.0
+            {
+                let m = self.materials.by_index(wp.model[k]);
+                kn[q] += m.normal_stiffness;
+                ks[q] += m.shear_stiffness;
+            }
+        }
+        for b in &self.bonds.list {
+            for q in [b.i as usize, b.j as usize] {
+                kn[q] += b.normal_stiffness;
+                ks[q] += b.shear_stiffness;
+            }
+        }
+        let mut dt = f64::INFINITY;
+        for q in 0..n {
+            let fallback = self.materials.max_stiffness_for_group(p.group[q]);
+            let kn_q = if kn[q] > 0.0 { kn[q] } else { fallback };
+            let ks_q = if ks[q] > 0.0 { ks[q] } else { fallback };
+            let r = p.radius[q];
+            dt = dt
+                .min((p.mass[q] / kn_q).sqrt())
+                .min((p.inertia[q] / (ks_q * r * r)).sqrt());
+        }
+        Ok(safety * dt)
+    }
+
+    #[inline(always)]
+    fn image_offset(&self, shift: [i8; 2]) -> Vec2 {
+        match &self.cell {
+            Some(c) if shift != [0, 0] => c.image_offset(shift),
+            _ => [0.0; 2],
+        }
+    }
+
+    fn rebuild(&mut self) -> Result<()> {
+        self.neighbors.build(
+            &mut self.particles,
+            self.cell.as_ref(),
+            &self.walls,
+            &self.bonds,
+            self.threads,
+        )
+    }
+
+    /// Runs `n` steps; the last one is measured (see [`Simulation::measurements`]).
+    pub fn run(&mut self, n: u64) -> Result<()> {
+        for k in 0..n {
+            if k + 1 == n {
+                self.step::<true>()?;
+            } else {
+                self.step::<false>()?;
+            }
+        }
+        Ok(())
+    }
+
+    /// One step; `MEASURE` adds kinetic and elastic energy, contact counts and
+    /// the unbalanced force ratio.
+    pub fn step<const MEASURE: bool>(&mut self) -> Result<()> {
+        if self.neighbors.needs_rebuild(&self.walls) {
+            self.rebuild()?;
+        }
+        let dt = self.params.time_step;
+        let mut contacts = self.particle_contacts::<MEASURE>();
+        let bond_tally = self.bond_forces::<MEASURE>();
+        contacts.merge(&bond_tally);
+        let (wall_tally, wall_work) = self.wall_forces::<MEASURE>();
+        for wall in &mut self.walls {
+            wall.update_servo(dt);
+        }
+        let motion = self.integrate::<MEASURE>();
+        for wall in &mut self.walls {
+            let d = scale(wall.velocity, dt);
+            if d != [0.0, 0.0] {
+                wall.translate(d);
+            }
+        }
+        if let Some(cell) = &mut self.cell {
+            if cell.is_deforming() {
+                let m = cell.step_map(dt);
+                cell.deform(&m);
+            }
+        }
+        self.neighbors.max_fluctuation_sq = self
+            .neighbors
+            .max_fluctuation_sq
+            .max(motion.max_fluctuation_sq);
+        self.neighbors.max_displacement_sq = self
+            .neighbors
+            .max_displacement_sq
+            .max(motion.max_displacement_sq);
+
+        let ledger = &mut self.ledger;
+        ledger.friction_dissipated += contacts.friction + wall_tally.friction;
+        ledger.viscous_dissipated += contacts.viscous + wall_tally.viscous;
+        ledger.damping_dissipated += motion.damping_dissipated;
+        ledger.wall_work += wall_work;
+        ledger.external_work += motion.external_work;
+        if MEASURE {
+            ledger.kinetic = motion.kinetic;
+            ledger.elastic = contacts.elastic + wall_tally.elastic;
+            let force_sum = contacts.force_sum + wall_tally.force_sum;
+            let n_forces = contacts.contacts + wall_tally.contacts;
+            let mean_contact = if n_forces > 0 {
+                force_sum / n_forces as f64
+            } else {
+                0.0
+            };
+            let mean_unbalanced = if motion.free_count > 0 {
+                motion.unbalanced_force_sum / motion.free_count as f64
+            } else {
+                0.0
+            };
+            self.measurements = Measurements {
+                step: self.step_count,
+                contact_count: contacts.contacts - bond_tally.contacts,
+                wall_contact_count: wall_tally.contacts,
+                mean_unbalanced_force_ratio: if mean_contact > 0.0 {
+                    mean_unbalanced / mean_contact
+                } else if mean_unbalanced > 0.0 {
+                    f64::INFINITY
+                } else {
+                    0.0
+                },
+                energy: self.ledger,
+            };
+        }
+        self.half_kick_pending = false;
+        self.step_count += 1;
+        self.time += dt;
+
+        if motion.non_finite {
+            return Err(self.non_finite_error());
+        }
+        if contacts.overlap_violation || wall_tally.overlap_violation {
+            return Err(self.overlap_error());
+        }
+        Ok(())
+    }
+
+    /// Steps 2-3: reset resultants, then particle-particle contact forces.
+    fn particle_contacts<const MEASURE: bool>(&mut self) -> ContactTally {
+        let n_blocks = self.neighbors.block_particles.len();
+        let pairs = &mut self.neighbors.pairs;
+        let starts = pairs.block_start.clone();
+        let mut ranges: Vec<(usize, usize)> =
+            (0..n_blocks).map(|b| (starts[b], starts[b + 1])).collect();
+        ranges.push((starts[n_blocks], pairs.len()));
+        let mut shear_parts = split_ranges(&mut pairs.shear, &ranges);
+        let mut sliding_parts = split_ranges(&mut pairs.sliding, &ranges);
+        let cross_shear = shear_parts.pop().unwrap_or_default();
+        let cross_sliding = sliding_parts.pop().unwrap_or_default();
+
+        let p = &mut self.particles;
+        let force = DisjointWriter::new(&mut p.force);
+        let torque = DisjointWriter::new(&mut p.torque);
+        let kernel = PairKernel {
+            position: &p.position,
+            velocity: &p.velocity,
+            angular_velocity: &p.angular_velocity,
+            radius: &p.radius,
+            mass: &p.mass,
+            pair_i: &pairs.i,
+            pair_j: &pairs.j,
+            shift: &pairs.shift,
+            model: &pairs.model,
+            materials: &self.materials,
+            cell: self.cell.as_ref(),
+            velocity_gradient: self
+                .cell
+                .as_ref()
+                .filter(|c| c.is_deforming())
+                .map(|c| c.velocity_gradient),
+            dt: self.params.time_step,
+            max_overlap_ratio: self.params.max_overlap_ratio,
+        };
+        let reset = ResetKernel {
+            external_force: &p.external_force,
+            external_torque: &p.external_torque,
+            mass: &p.mass,
+            gravity: self.params.gravity,
+        };
+        let blocks: Vec<(usize, &mut [f64], &mut [bool])> = shear_parts
+            .into_iter()
+            .zip(sliding_parts)
+            .enumerate()
+            .map(|(b, (s, l))| (b, s, l))
+            .collect();
+        let block_particles = &self.neighbors.block_particles;
+        let tallies = map_blocks(self.pool.as_ref(), blocks, |(b, shear, sliding)| {
+            // SAFETY: block b resets and writes only the forces of its own particles
+            // (pairs in its range have both particles in block b).
+            unsafe {
+                for &q in &block_particles[b] {
+                    reset.apply(q as usize, &force, &torque);
+                }
+                kernel.run::<MEASURE>(ranges[b].0, shear, sliding, &force, &torque)
+            }
+        });
+        let mut tally = ContactTally::default();
+        for t in &tallies {
+            tally.merge(t);
+        }
+        // SAFETY: sequential now; indices come from the pair list and are in bounds.
+        let cross = unsafe {
+            kernel.run::<MEASURE>(
+                ranges[n_blocks].0,
+                cross_shear,
+                cross_sliding,
+                &force,
+                &torque,
+            )
+        };
+        tally.merge(&cross);
+        tally
+    }
+
+    /// Step 4: bonds (sequential; chains of membrane disks are short).
+    fn bond_forces<const MEASURE: bool>(&mut self) -> ContactTally {
+        let mut tally = ContactTally::default();
+        let dt = self.params.time_step;
+        let l = self
+            .cell
+            .as_ref()
+            .filter(|c| c.is_deforming())
+            .map(|c| c.velocity_gradient);
+        let p = &mut self.particles;
+        for bond in &mut self.bonds.list {
+            let (i, j) = (bond.i as usize, bond.j as usize);
+            let d = minimum_image(self.cell.as_ref(), sub(p.position[j], p.position[i]));
+            let dist = norm(d);
+            let n = scale(d, 1.0 / dist);
+            let t = perp(n);
+            let mut dv = sub(p.velocity[j], p.velocity[i]);
+            if let Some(l) = &l {
+                dv = add(dv, mat_vec(l, d));
+            }
+            let (ri, rj) = (p.radius[i], p.radius[j]);
+            let vt = dot(dv, t) - (p.angular_velocity[i] * ri + p.angular_velocity[j] * rj);
+            let fn_ = bond.normal_stiffness * (bond.rest_length - dist);
+            bond.shear -= bond.shear_stiffness * vt * dt;
+            let fs = bond.shear;
+            let f = add(scale(n, fn_), scale(t, fs));
+            p.force[j] = add(p.force[j], f);
+            p.force[i] = sub(p.force[i], f);
+            p.torque[i] -= ri * fs;
+            p.torque[j] -= rj * fs;
+            if MEASURE {
+                tally.elastic +=
+                    0.5 * fn_ * fn_ / bond.normal_stiffness + 0.5 * fs * fs / bond.shear_stiffness;
+                tally.force_sum += (fn_ * fn_ + fs * fs).sqrt();
+                tally.contacts += 1;
+            }
+        }
+        tally
+    }
+
+    /// Step 5: particle-wall contacts; returns the tally and the walls' work.
+    fn wall_forces<const MEASURE: bool>(&mut self) -> (ContactTally, f64) {
+        let mut tally = ContactTally::default();
+        let mut work = 0.0;
+        for wall in &mut self.walls {
+            wall.force = [0.0; 2];
+            wall.contact_count = 0;
+            wall.stiffness_sum = 0.0;
+        }
+        let dt = self.params.time_step;
+        let p = &mut self.particles;
+        let wp = &mut self.neighbors.wall_pairs;
+        for k in 0..wp.wall.len() {
+            let wall = &mut self.walls[wp.wall[k] as usize];
+            let q = wp.particle[k] as usize;
+            let r = p.radius[q];
+            let g = wall.disk_contact(p.position[q], r);
+            if g.overlap <= 0.0 {
+                wp.shear[k] = 0.0;
+                wp.sliding[k] = false;
+                continue;
+            }
+            let model = self.materials.by_index(wp.model[k]);
+            let n = g.normal;
+            let t = perp(n);
+            let dv = sub(p.velocity[q], wall.velocity);
+            let vn = dot(dv, n);
+            let vt = dot(dv, t) - p.angular_velocity[q] * r;
+            let c = linear_coulomb(model, g.overlap, vn, vt, dt, p.mass[q], &mut wp.shear[k]);
+            wp.sliding[k] = c.sliding;
+            let f = add(scale(n, c.normal), scale(t, c.shear));
+            p.force[q] = add(p.force[q], f);
+            p.torque[q] -= r * c.shear;
+            wall.force = sub(wall.force, f);
+            wall.contact_count += 1;
+            wall.stiffness_sum += model.normal_stiffness;
+            work += dot(f, wall.velocity) * dt;
+            tally.friction += c.friction_dissipation;
+            tally.viscous += c.viscous_dissipation;
+            if g.overlap > self.params.max_overlap_ratio * r {
+                tally.overlap_violation = true;
+            }
+            if MEASURE {
+                tally.elastic +=
+                    elastic_energy(model, model.normal_stiffness * g.overlap, wp.shear[k]);
+                tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
+                tally.contacts += 1;
+            }
+        }
+        (tally, work)
+    }
+
+    /// Step 7: leapfrog with local damping in parallel chunks.
+    fn integrate<const MEASURE: bool>(&mut self) -> IntegrationTally {
+        let dt = self.params.time_step;
+        let step_map = self
+            .cell
+            .as_ref()
+            .filter(|c| c.is_deforming())
+            .map(|c| (c.origin, c.step_map(dt)));
+        let accumulated_map: Mat2 = match &step_map {
+            Some((_, m)) => self.neighbors.advance_map(m).accumulated_map,
+            None => self.neighbors.reference().accumulated_map,
+        };
+        let p = &mut self.particles;
+        let has_external = self.params.gravity != [0.0, 0.0]
+            || p.external_force.iter().any(|f| *f != [0.0, 0.0])
+            || p.external_torque.iter().any(|&t| t != 0.0);
+        let step = IntegrationStep {
+            dt,
+            kick: if self.half_kick_pending { 0.5 * dt } else { dt },
+            half_kick: self.half_kick_pending,
+            alpha: self.params.local_damping,
+            gravity: self.params.gravity,
+            has_external,
+            step_map,
+            accumulated_map,
+        };
+        let inputs = IntegrationInputs {
+            force: &p.force,
+            torque: &p.torque,
+            inv_mass: &p.inv_mass,
+            inv_inertia: &p.inv_inertia,
+            mass: &p.mass,
+            inertia: &p.inertia,
+            fixity: &p.fixity,
+            external_force: &p.external_force,
+            external_torque: &p.external_torque,
+            reference: self.neighbors.reference().reference,
+        };
+        let bounds = even_bounds(p.position.len(), self.threads);
+        let chunks: Vec<MotionChunk<'_>> = split_ranges(&mut p.position, &bounds)
+            .into_iter()
+            .zip(split_ranges(&mut p.velocity, &bounds))
+            .zip(split_ranges(&mut p.rotation, &bounds))
+            .zip(split_ranges(&mut p.angular_velocity, &bounds))
+            .zip(&bounds)
+            .map(
+                |((((position, velocity), rotation), angular_velocity), &(lo, _))| MotionChunk {
+                    lo,
+                    position,
+                    velocity,
+                    rotation,
+                    angular_velocity,
+                },
+            )
+            .collect();
+        let tallies = map_blocks(self.pool.as_ref(), chunks, |chunk| {
+            integrate_chunk::<MEASURE>(chunk, &inputs, &step)
+        });
+        let mut total = IntegrationTally::default();
+        for t in &tallies {
+            total.merge(t);
+        }
+        total
+    }
+
+    fn non_finite_error(&self) -> EngineError {
+        let p = &self.particles;
+        let bad: Vec<usize> = (0..p.len())
+            .filter(|&q| {
+                !(p.position[q][0].is_finite()
+                    && p.position[q][1].is_finite()
+                    && p.velocity[q][0].is_finite()
+                    && p.velocity[q][1].is_finite()
+                    && p.angular_velocity[q].is_finite())
+            })
+            .collect();
+        let shown: Vec<String> = bad.iter().take(10).map(|q| q.to_string()).collect();
+        EngineError::Unstable {
+            step: self.step_count,
+            message: format!(
+                "non-finite position or velocity of {} particle(s): {}{}; reduce the time step",
+                bad.len(),
+                shown.join(", "),
+                if bad.len() > 10 { ", ..." } else { "" }
+            ),
+            particles: bad,
+        }
+    }
+
+    fn overlap_error(&self) -> EngineError {
+        let p = &self.particles;
+        let ratio = self.params.max_overlap_ratio;
+        let pairs = &self.neighbors.pairs;
+        let mut worst: Option<(f64, usize, Option<usize>)> = None;
+        for k in 0..pairs.len() {
+            let (i, j) = (pairs.i[k] as usize, pairs.j[k] as usize);
+            let d = sub(
+                add(p.position[j], self.image_offset(pairs.shift[k])),
+                p.position[i],
+            );
+            let g = disk_disk(d, p.radius[i], p.radius[j]);
+            let r = g.overlap / p.radius[i].min(p.radius[j]);
+            if worst.is_none_or(|(w, _, _)| r > w) {
+                worst = Some((r, i, Some(j)));
+            }
+        }
+        let wp = &self.neighbors.wall_pairs;
+        for k in 0..wp.wall.len() {
+            let q = wp.particle[k] as usize;
+            let g = self.walls[wp.wall[k] as usize].disk_contact(p.position[q], p.radius[q]);
+            let r = g.overlap / p.radius[q];
+            if worst.is_none_or(|(w, _, _)| r > w) {
+                worst = Some((r, q, None));
+            }
+        }
+        let (r, i, j) = worst.unwrap_or((0.0, 0, None));
+        let (what, particles) = match j {
+            Some(j) => (format!("particles {i} and {j}"), vec![i, j]),
+            None => (format!("particle {i} and a wall"), vec![i]),
+        };
+        EngineError::Unstable {
+            step: self.step_count,
+            message: format!(
+                "overlap of {what} reached {:.3} of the smaller radius (limit {ratio}); reduce the time step or the loading rate",
+                r
+            ),
+            particles,
+        }
+    }
+
+    /// Serialises the complete state (contact history and neighbour lists included).
+    pub fn to_bytes(&self) -> Result<Vec<u8>> {
+        bincode::serialize(self).map_err(|e| EngineError::invalid("state", e.to_string()))
+    }
+
+    /// Restores a state written by [`Simulation::to_bytes`]; it continues bitwise
+    /// identically with the same thread count.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut sim: Simulation = bincode::deserialize(bytes).map_err(|e| {
+            EngineError::invalid("state", format!("not a grainlab engine state: {e}"))
+        })?;
+        sim.make_pool()?;
+        Ok(sim)
+    }
+}
+
+/// Nearest-image branch vector for bonds.
+pub fn minimum_image(cell: Option<&PeriodicCell>, d: Vec2) -> Vec2 {
+    match cell {
+        Some(c) if c.periodic[0] || c.periodic[1] => {
+            let zero = c.origin;
+            let f = c.fractional(add(zero, d));
+            let mut shift = [0i8; 2];
+            for k in 0..2 {
+                if c.periodic[k] {
+                    shift[k] = -(f[k].round() as i8);
+                }
+            }
+            add(d, c.image_offset(shift))
+        }
+        _ => d,
+    }
+}
+
+struct ResetKernel<'a> {
+    external_force: &'a [Vec2],
+    external_torque: &'a [f64],
+    mass: &'a [f64],
+    gravity: Vec2,
+}
+
+impl ResetKernel<'_> {
+    /// # Safety
+    /// `q` in bounds and owned by the calling task.
+    #[inline(always)]
+    unsafe fn apply(&self, q: usize, force: &DisjointWriter<Vec2>, torque: &DisjointWriter<f64>) {
+        let fe = self.external_force[q];
+        let m = self.mass[q];
+        *force.get(q) = [fe[0] + m * self.gravity[0], fe[1] + m * self.gravity[1]];
+        *torque.get(q) = self.external_torque[q];
+    }
+}
+
+struct PairKernel<'a> {
+    position: &'a [Vec2],
+    velocity: &'a [Vec2],
+    angular_velocity: &'a [f64],
+    radius: &'a [f64],
+    mass: &'a [f64],
+    pair_i: &'a [u32],
+    pair_j: &'a [u32],
+    shift: &'a [[i8; 2]],
+    model: &'a [u16],
+    materials: &'a MaterialTable,
+    cell: Option<&'a PeriodicCell>,
+    velocity_gradient: Option<Mat2>,
+    dt: f64,
+    max_overlap_ratio: f64,
+}
+
+impl PairKernel<'_> {
+    /// Evaluates pairs `first..first + shear.len()`, adding forces to both particles.
+    ///
+    /// # Safety
+    /// Concurrent callers must touch disjoint particles.
+    #[inline(always)]
+    unsafe fn run<const MEASURE: bool>(
+        &self,
+        first: usize,
+        shear: &mut [f64],
+        sliding: &mut [bool],
+        force: &DisjointWriter<Vec2>,
+        torque: &DisjointWriter<f64>,
+    ) -> ContactTally {
+        let mut tally = ContactTally::default();
+        for (k, (spring, slide)) in shear.iter_mut().zip(sliding.iter_mut()).enumerate() {
+            let pair = first + k;
+            let i = self.pair_i[pair] as usize;
+            let j = self.pair_j[pair] as usize;
+            let xi = self.position[i];
+            let mut xj = self.position[j];
+            let s = self.shift[pair];
+            if s != [0, 0] {
+                if let Some(c) = self.cell {
+                    xj = add(xj, c.image_offset(s));
+                }
+            }
+            let d = sub(xj, xi);
+            let (ri, rj) = (self.radius[i], self.radius[j]);
+            let reach = ri + rj;
+            let dist_sq = dot(d, d);
+            if dist_sq >= reach * reach {
+                if *spring != 0.0 || *slide {
+                    *spring = 0.0;
+                    *slide = false;
+                }
+                continue;
+            }
+            let dist = dist_sq.sqrt();
+            let n = scale(d, 1.0 / dist);
+            let overlap = reach - dist;
+            let t = perp(n);
+            let mut dv = sub(self.velocity[j], self.velocity[i]);
+            if let Some(l) = &self.velocity_gradient {
+                dv = add(dv, mat_vec(l, d));
+            }
+            let vn = dot(dv, n);
+            let vt = dot(dv, t) - (self.angular_velocity[i] * ri + self.angular_velocity[j] * rj);
+            let model = self.materials.by_index(self.model[pair]);
+            let reduced_mass =
+                if model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0 {
+                    let (mi, mj) = (self.mass[i], self.mass[j]);
+                    mi * mj / (mi + mj)
+                } else {
+                    0.0
+                };
+            let c = linear_coulomb(model, overlap, vn, vt, self.dt, reduced_mass, spring);
+            *slide = c.sliding;
+            let f = [
+                c.normal * n[0] + c.shear * t[0],
+                c.normal * n[1] + c.shear * t[1],
+            ];
+            let fj = force.get(j);
+            fj[0] += f[0];
+            fj[1] += f[1];
+            let fi = force.get(i);
+            fi[0] -= f[0];
+            fi[1] -= f[1];
+            *torque.get(i) -= ri * c.shear;
+            *torque.get(j) -= rj * c.shear;
+            tally.friction += c.friction_dissipation;
+            tally.viscous += c.viscous_dissipation;
+            if overlap > self.max_overlap_ratio * ri.min(rj) {
+                tally.overlap_violation = true;
+            }
+            if MEASURE {
+                tally.elastic += elastic_energy(model, model.normal_stiffness * overlap, *spring);
+                tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
+                tally.contacts += 1;
+            }
+        }
+        tally
+    }
+}

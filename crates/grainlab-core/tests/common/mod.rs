@@ -1,0 +1,114 @@
+//! Builders shared by the integration tests.
+#![allow(dead_code)]
+use grainlab_core::{ContactModel, Particles, PeriodicCell, Simulation};
+
+/// A tiny deterministic generator (SplitMix64) so tests need no extra crate.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Rng(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
+
+pub const KN: f64 = 8.45e7;
+pub const DENSITY: f64 = 2.0e8;
+
+/// A dense, overlapping packing in a periodic square cell: a jittered square grid
+/// of spacing `s` with radii uniform in `[0.45 s, 0.56 s]`.
+pub fn dense_periodic(
+    n_side: usize,
+    s: f64,
+    friction: f64,
+    seed: u64,
+    threads: usize,
+) -> Simulation {
+    let mut rng = Rng::new(seed);
+    let mut pos = Vec::new();
+    let mut rad = Vec::new();
+    for a in 0..n_side {
+        for b in 0..n_side {
+            pos.push([
+                (a as f64 + 0.5 + rng.uniform(-0.05, 0.05)) * s,
+                (b as f64 + 0.5 + rng.uniform(-0.05, 0.05)) * s,
+            ]);
+            rad.push(rng.uniform(0.45, 0.56) * s);
+        }
+    }
+    let particles = Particles::new(pos, rad, vec![DENSITY]).unwrap();
+    let m_min = DENSITY * std::f64::consts::PI * (0.45 * s).powi(2);
+    let dt = 0.1 * (m_min / KN).sqrt();
+    let mut sim = Simulation::new(
+        particles,
+        ContactModel::linear(KN, KN, friction),
+        dt,
+        threads,
+    )
+    .unwrap();
+    let l = n_side as f64 * s;
+    sim.set_cell(Some(
+        PeriodicCell::rectangle([0.0, 0.0], l, l, [true, true]).unwrap(),
+    ))
+    .unwrap();
+    sim
+}
+
+/// Total kinetic + elastic energy as measured by the engine at its last measured step.
+pub fn mechanical_energy(sim: &Simulation) -> f64 {
+    let e = sim.energy();
+    e.kinetic + e.elastic
+}
+
+/// Two disks or a disk alone: builds a simulation without walls or cell.
+pub fn disks(pos: Vec<[f64; 2]>, rad: Vec<f64>, model: ContactModel, dt: f64) -> Simulation {
+    let particles = Particles::new(pos, rad, vec![DENSITY]).unwrap();
+    Simulation::new(particles, model, dt, 1).unwrap()
+}
+
+/// The common 4,000-disk dense packing (`benchmarks/data/dense-4000-disks.xyr`):
+/// first line the side of the square periodic cell, then `x y radius` per disk.
+pub fn bench_packing(friction: f64, dt_factor: f64, threads: usize) -> Simulation {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../benchmarks/data/dense-4000-disks.xyr"
+    );
+    let text = std::fs::read_to_string(path).expect("benchmarks/data/dense-4000-disks.xyr");
+    let mut lines = text.lines();
+    let l: f64 = lines.next().unwrap().trim().parse().unwrap();
+    let (mut pos, mut rad) = (Vec::new(), Vec::new());
+    for line in lines.filter(|s| !s.trim().is_empty()) {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|t| t.parse().unwrap())
+            .collect();
+        pos.push([v[0], v[1]]);
+        rad.push(v[2]);
+    }
+    let r_min = rad.iter().cloned().fold(f64::INFINITY, f64::min);
+    let m_min = DENSITY * std::f64::consts::PI * r_min * r_min;
+    let dt = dt_factor * (m_min / KN).sqrt();
+    let particles = Particles::new(pos, rad, vec![DENSITY]).unwrap();
+    let mut sim = Simulation::new(
+        particles,
+        ContactModel::linear(KN, KN, friction),
+        dt,
+        threads,
+    )
+    .unwrap();
+    sim.set_cell(Some(
+        PeriodicCell::rectangle([0.0, 0.0], l, l, [true, true]).unwrap(),
+    ))
+    .unwrap();
+    sim
+}

@@ -1,0 +1,119 @@
+//! Conservation laws: energy in a dense frictionless packing without damping,
+//! linear momentum without walls.
+mod common;
+use common::*;
+
+/// Gives the packing random velocities whose kinetic energy equals its elastic energy.
+fn agitate(sim: &mut grainlab_core::Simulation, spin: bool) {
+    sim.run(1).unwrap();
+    let elastic = sim.energy().elastic;
+    let mut rng = Rng::new(5);
+    let p = &mut sim.particles;
+    let mut kinetic = 0.0;
+    for k in 0..p.len() {
+        p.velocity[k] = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
+        p.angular_velocity[k] = if spin {
+            rng.uniform(-1.0, 1.0) / p.radius[k]
+        } else {
+            0.0
+        };
+        let v = p.velocity[k];
+        kinetic += 0.5 * p.mass[k] * (v[0] * v[0] + v[1] * v[1])
+            + 0.5 * p.inertia[k] * p.angular_velocity[k].powi(2);
+    }
+    let s = (elastic / kinetic).sqrt();
+    for k in 0..p.len() {
+        p.velocity[k] = [p.velocity[k][0] * s, p.velocity[k][1] * s];
+        p.angular_velocity[k] *= s;
+    }
+    sim.velocities_changed();
+}
+
+#[test]
+fn energy_is_conserved_in_a_dense_frictionless_packing() {
+    // The common 4,000-disk packing (Z ~ 4), no damping, dt = 0.2 sqrt(m_min/kn):
+    // leapfrog keeps kinetic + elastic energy within 0.1% over 10,000 steps.
+    let mut sim = bench_packing(0.0, 0.2, 1);
+    agitate(&mut sim, false);
+    sim.run(1).unwrap();
+    let e0 = mechanical_energy(&sim);
+    assert!(
+        sim.measurements.contact_count > 7000,
+        "not dense: {} contacts",
+        sim.measurements.contact_count
+    );
+    let mut worst = 0.0f64;
+    for _ in 0..100 {
+        sim.run(100).unwrap();
+        worst = worst.max((mechanical_energy(&sim) / e0 - 1.0).abs());
+    }
+    assert!(worst < 1e-3, "energy drift {worst}");
+    let e = sim.energy();
+    assert!(
+        e.kinetic > 0.1 * e0 && e.elastic > 0.1 * e0,
+        "energy did not move between forms"
+    );
+}
+
+#[test]
+fn energy_ledger_balances_with_friction_and_damping() {
+    // kinetic + elastic + dissipated (friction, local damping) stays constant.
+    let mut sim = bench_packing(0.5, 0.2, 2);
+    agitate(&mut sim, true);
+    let mut params = sim.params;
+    params.local_damping = 0.3;
+    sim.set_params(params).unwrap();
+    sim.run(1).unwrap();
+    let b0 = sim.energy().balance();
+    sim.run(3000).unwrap();
+    let e = sim.energy();
+    assert!(
+        e.friction_dissipated > 0.01 * b0 && e.damping_dissipated > 0.01 * b0,
+        "{e:?}"
+    );
+    assert!(
+        (e.balance() / b0 - 1.0).abs() < 2e-3,
+        "balance drift {}",
+        e.balance() / b0 - 1.0
+    );
+}
+
+#[test]
+fn momentum_is_conserved_without_walls() {
+    // Newton's third law in every contact: total linear momentum is constant.
+    let mut sim = dense_periodic(16, 1.0e-3, 0.9, 21, 2);
+    let mut rng = Rng::new(1);
+    for (v, w) in sim
+        .particles
+        .velocity
+        .iter_mut()
+        .zip(sim.particles.angular_velocity.iter_mut())
+    {
+        *v = [rng.uniform(-0.01, 0.01), rng.uniform(-0.01, 0.01)];
+        *w = rng.uniform(-5.0, 5.0);
+    }
+    sim.velocities_changed();
+    let momentum = |sim: &grainlab_core::Simulation| {
+        let p = &sim.particles;
+        (0..p.len()).fold([0.0, 0.0], |acc, k| {
+            [
+                acc[0] + p.mass[k] * p.velocity[k][0],
+                acc[1] + p.mass[k] * p.velocity[k][1],
+            ]
+        })
+    };
+    let scale: f64 = (0..sim.particles.len())
+        .map(|k| sim.particles.mass[k] * 0.01)
+        .sum();
+    let p0 = momentum(&sim);
+    sim.run(3000).unwrap();
+    let p1 = momentum(&sim);
+    for c in 0..2 {
+        assert!(
+            (p1[c] - p0[c]).abs() < 1e-12 * scale,
+            "momentum component {c}: {} -> {}",
+            p0[c],
+            p1[c]
+        );
+    }
+}
