@@ -1,7 +1,11 @@
 //! The current contacts as parallel arrays, for output and analysis.
 use crate::contact::{contact_point, disk_disk};
+use crate::error::Result;
 use crate::pipeline::{minimum_image, Simulation};
 use crate::vec2::{add, norm, scale, sub, Vec2};
+
+/// One row of the contact table while it is assembled.
+type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool);
 
 /// Particle-particle contacts and bonds, sorted by `(i, j)`.
 ///
@@ -53,57 +57,33 @@ pub struct WallContactList {
 
 impl Simulation {
     /// Current particle-particle contacts (overlap > 0) and all bonds.
-    pub fn contacts(&self) -> ContactList {
+    pub fn contacts(&mut self) -> Result<ContactList> {
+        self.ensure_neighbors()?;
         let p = &self.particles;
         let pairs = &self.neighbors.pairs;
-        let mut rows: Vec<(u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool)> = Vec::new();
-        if self.neighbors.is_valid() {
-            for k in 0..pairs.len() {
-                let (i, j) = (pairs.i[k] as usize, pairs.j[k] as usize);
-                let offset = match &self.cell {
-                    Some(c) => c.image_offset(pairs.shift[k]),
-                    None => [0.0; 2],
-                };
-                let d = sub(add(p.position[j], offset), p.position[i]);
-                let g = disk_disk(d, p.radius[i], p.radius[j]);
-                if g.overlap > 0.0 {
-                    let kn = self.materials.by_index(pairs.model[k]).normal_stiffness;
-                    let point = contact_point(p.position[i], g.normal, p.radius[i], g.overlap);
-                    rows.push((
-                        pairs.i[k],
-                        pairs.j[k],
-                        point,
-                        g.normal,
-                        g.overlap,
-                        kn * g.overlap,
-                        pairs.shear[k],
-                        pairs.sliding[k],
-                        false,
-                    ));
-                }
-            }
-        } else {
-            // no list yet: brute force, so the answer never depends on when the list was built
-            for i in 0..p.len() {
-                for j in i + 1..p.len() {
-                    let d = self.branch(i, j);
-                    let g = disk_disk(d, p.radius[i], p.radius[j]);
-                    if g.overlap > 0.0 && !self.bonds.contains(i as u32, j as u32) {
-                        let kn = self.materials.get(p.group[i], p.group[j]).normal_stiffness;
-                        let point = contact_point(p.position[i], g.normal, p.radius[i], g.overlap);
-                        rows.push((
-                            i as u32,
-                            j as u32,
-                            point,
-                            g.normal,
-                            g.overlap,
-                            kn * g.overlap,
-                            0.0,
-                            false,
-                            false,
-                        ));
-                    }
-                }
+        let mut rows: Vec<ContactRow> = Vec::new();
+        for k in 0..pairs.len() {
+            let (i, j) = (pairs.i[k] as usize, pairs.j[k] as usize);
+            let offset = match &self.cell {
+                Some(c) => c.image_offset(pairs.shift[k]),
+                None => [0.0; 2],
+            };
+            let d = sub(add(p.position[j], offset), p.position[i]);
+            let g = disk_disk(d, p.radius[i], p.radius[j]);
+            if g.overlap > 0.0 {
+                let kn = self.materials.by_index(pairs.model[k]).normal_stiffness;
+                let point = contact_point(p.position[i], g.normal, p.radius[i], g.overlap);
+                rows.push((
+                    pairs.i[k],
+                    pairs.j[k],
+                    point,
+                    g.normal,
+                    g.overlap,
+                    kn * g.overlap,
+                    pairs.shear[k],
+                    pairs.sliding[k],
+                    false,
+                ));
             }
         }
         for b in &self.bonds.list {
@@ -129,23 +109,17 @@ impl Simulation {
             out.sliding.push(r.7);
             out.bonded.push(r.8);
         }
-        out
+        Ok(out)
     }
 
     /// Current particle-wall contacts.
-    pub fn wall_contacts(&self) -> WallContactList {
+    pub fn wall_contacts(&mut self) -> Result<WallContactList> {
+        self.ensure_neighbors()?;
         let p = &self.particles;
         let mut out = WallContactList::default();
         let wp = &self.neighbors.wall_pairs;
-        let candidates: Vec<(u32, u32, f64, bool)> = if self.neighbors.is_valid() {
-            (0..wp.wall.len())
-                .map(|k| (wp.wall[k], wp.particle[k], wp.shear[k], wp.sliding[k]))
-                .collect()
-        } else {
-            (0..self.walls.len() as u32)
-                .flat_map(|w| (0..p.len() as u32).map(move |q| (w, q, 0.0, false)))
-                .collect()
-        };
+        let candidates =
+            (0..wp.wall.len()).map(|k| (wp.wall[k], wp.particle[k], wp.shear[k], wp.sliding[k]));
         for (w, q, shear, sliding) in candidates {
             let wall = &self.walls[w as usize];
             let x = p.position[q as usize];
@@ -167,6 +141,6 @@ impl Simulation {
                 out.sliding.push(sliding);
             }
         }
-        out
+        Ok(out)
     }
 }

@@ -314,9 +314,7 @@ impl Simulation {
     /// contacts and bonds (one contact of its stiffest model when it has none).
     pub fn critical_time_step(&mut self, safety: f64) -> Result<f64> {
         require_positive("safety", safety)?;
-        if self.neighbors.needs_rebuild(&self.walls) {
-            self.rebuild()?;
-        }
+        self.ensure_neighbors()?;
         let n = self.particles.len();
         let mut kn = vec![0.0; n];
         let mut ks = vec![0.0; n];
@@ -376,6 +374,15 @@ impl Simulation {
         }
     }
 
+    /// Rebuilds the neighbour lists if a contact could otherwise be missed. Safe to
+    /// call at any time: it rebuilds exactly when the next step would.
+    pub fn ensure_neighbors(&mut self) -> Result<()> {
+        if self.neighbors.needs_rebuild(&self.walls) {
+            self.rebuild()?;
+        }
+        Ok(())
+    }
+
     fn rebuild(&mut self) -> Result<()> {
         self.neighbors.build(
             &mut self.particles,
@@ -401,9 +408,7 @@ impl Simulation {
     /// One step; `MEASURE` adds kinetic and elastic energy, contact counts and
     /// the unbalanced force ratio.
     pub fn step<const MEASURE: bool>(&mut self) -> Result<()> {
-        if self.neighbors.needs_rebuild(&self.walls) {
-            self.rebuild()?;
-        }
+        self.ensure_neighbors()?;
         let dt = self.params.time_step;
         let mut contacts = self.particle_contacts::<MEASURE>();
         let bond_tally = self.bond_forces::<MEASURE>();
@@ -472,6 +477,9 @@ impl Simulation {
         self.half_kick_pending = false;
         self.step_count += 1;
         self.time += dt;
+        // keep the lists valid between steps, so that queries see every contact;
+        // the rebuild happens at the same state as it would at the next step's start
+        self.ensure_neighbors()?;
 
         if motion.non_finite {
             return Err(self.non_finite_error());
