@@ -1,0 +1,40 @@
+"""Analysis of snapshots: fabric, stability index, strain fields, shear band.
+
+Every measure is a small class in the freud style (parameters in the
+constructor, ``compute(...)`` returns ``self``, results as properties that
+raise until computed, ``plot(ax=None)``) backed by plain NumPy functions.
+:func:`analyze_snapshot` runs them all, as ``grainlab analyze`` does.
+"""
+
+from grainlab.analysis.analyze import AnalysisResult, analyze_snapshot
+from grainlab.analysis.fabric import (
+    ContactAnisotropy,
+    CoordinationNumber,
+    angular_histogram,
+    anisotropy_eq7,
+    anisotropy_fourier,
+    fabric_tensor,
+    rattlers,
+)
+from grainlab.analysis.shear_band import ShearBand
+from grainlab.analysis.stability import StabilityIndex, stability_index, stability_index_of_angles
+from grainlab.analysis.strain import LocalStrain, match_ids, neighbour_pairs
+
+__all__ = [
+    "AnalysisResult",
+    "ContactAnisotropy",
+    "CoordinationNumber",
+    "LocalStrain",
+    "ShearBand",
+    "StabilityIndex",
+    "analyze_snapshot",
+    "angular_histogram",
+    "anisotropy_eq7",
+    "anisotropy_fourier",
+    "fabric_tensor",
+    "match_ids",
+    "neighbour_pairs",
+    "rattlers",
+    "stability_index",
+    "stability_index_of_angles",
+]

@@ -1,0 +1,230 @@
+"""Run every measure on a snapshot and write the results (``grainlab analyze``)."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
+from grainlab.analysis.shear_band import ShearBand
+from grainlab.analysis.stability import StabilityIndex
+from grainlab.analysis.strain import LocalStrain
+from grainlab.snapshot import Snapshot
+
+__all__ = ["AnalysisResult", "analyze_snapshot"]
+
+
+@dataclass
+class AnalysisResult:
+    """Everything :func:`analyze_snapshot` computed, with writers for the files."""
+
+    snapshot: Snapshot
+    coordination: CoordinationNumber
+    anisotropy: ContactAnisotropy
+    force_anisotropy: ContactAnisotropy | None
+    stability: StabilityIndex
+    strain: LocalStrain | None = None
+    band: ShearBand | None = None
+    notes: list[str] = field(default_factory=list)
+
+    def summary(self) -> dict[str, Any]:
+        """The scalar results, as written to ``fabric.json`` (angles in degrees)."""
+
+        def num(x: float | None) -> float | None:
+            return None if x is None or not math.isfinite(x) else float(x)
+
+        a = self.anisotropy
+        fa = self.force_anisotropy
+        b = self.band
+        out: dict[str, Any] = {
+            "n_particles": self.coordination.n_particles,
+            "n_contacts": self.coordination.n_contacts_total,
+            "Z": num(self.coordination.coordination_number),
+            "mechanical_Z": num(self.coordination.mechanical_coordination_number),
+            "n_rattlers": int(self.coordination.rattlers.sum()),
+            "rattler_rule": (
+                f"iteratively remove particles with < {self.coordination.min_contacts} contacts"
+            ),
+            "contact_count_distribution": [float(v) for v in self.coordination.count_distribution],
+            "bins": a.bins,
+            "a": num(a.anisotropy),
+            "theta_a_deg": num(np.degrees(a.direction)),
+            "a_fourier": num(a.anisotropy_fourier),
+            "theta_a_fourier_deg": num(np.degrees(a.direction_fourier)),
+            "fabric_tensor": a.fabric_tensor.tolist()
+            if np.all(np.isfinite(a.fabric_tensor))
+            else None,
+            "a_n": num(fa.anisotropy) if fa else None,
+            "theta_n_deg": num(np.degrees(fa.direction)) if fa else None,
+            "a_n_fourier": num(fa.anisotropy_fourier) if fa else None,
+            "theta_n_fourier_deg": num(np.degrees(fa.direction_fourier)) if fa else None,
+            "mean_lambda": num(self.stability.mean),
+            "mean_lambda_all": num(self.stability.mean_all),
+            "lambda_includes_boundary_contacts": self.stability.include_boundary,
+            "band_angle_deg": num(b.angle_degrees) if b else None,
+            "band_thickness_m": num(b.thickness) if b else None,
+            "band_thickness_diameters": num(b.thickness_diameters) if b else None,
+            "band_n_particles": int(b.members.sum()) if b else None,
+            "band_contrast": num(b.contrast) if b else None,
+            "mean_lambda_in_band": num(b.mean_lambda_inside) if b else None,
+            "mean_lambda_outside_band": num(b.mean_lambda_outside) if b else None,
+            "has_reference": self.strain is not None,
+            "time": self.snapshot.time,
+            "axial_strain": self.snapshot.axial_strain,
+            "source": self.snapshot.metadata.get("source"),
+            "timestep": self.snapshot.metadata.get("timestep"),
+            "contacts": self.snapshot.metadata.get("contacts"),
+            "notes": list(self.notes),
+        }
+        return out
+
+    def particle_table(self) -> dict[str, NDArray[Any]]:
+        """Per-particle columns for ``particles.csv`` (beyond id,x,y,radius)."""
+        n = self.snapshot.n_particles
+        nan = np.full(n, np.nan)
+        s = self.strain
+        cols: dict[str, NDArray[Any]] = {
+            "n_contacts": self.stability.n_contacts,
+            "stability_index": self.stability.stability_index,
+            "displacement": s.displacement_magnitude if s else nan,
+            "local_shear_strain": s.shear_strain if s else nan,
+            "in_shear_band": self.band.members.astype(np.int64) if self.band else nan,
+        }
+        if s:
+            cols["displacement_x"] = s.displacement[:, 0]
+            cols["displacement_y"] = s.displacement[:, 1]
+            cols["rotation"] = s.rotation
+            cols["excess_shear_strain"] = s.excess_shear_strain
+            cols["volumetric_strain"] = s.volumetric_strain
+            cols["d2min"] = s.d2min
+        cols["rattler"] = self.coordination.rattlers.astype(np.int64)
+        return cols
+
+    def write(self, out_dir: str | Path, *, figures: bool = True) -> list[Path]:
+        """Write ``particles.csv``, ``fabric.json`` and the figures into ``out_dir``."""
+        from grainlab import plot
+        from grainlab.io.csv import write_particles_csv
+
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        written = [write_particles_csv(out / "particles.csv", self.snapshot, self.particle_table())]
+        path = out / "fabric.json"
+        path.write_text(json.dumps(self.summary(), indent=2) + "\n", encoding="utf-8")
+        written.append(path)
+        if not figures:
+            return written
+        snap = self.snapshot
+        written += plot.save_figure(self.anisotropy.plot(), out / "contact_normals")
+        if self.force_anisotropy is not None:
+            written += plot.save_figure(self.force_anisotropy.plot(), out / "normal_forces")
+        written += plot.save_figure(
+            self.stability.plot(band=self.band), out / "map_stability_index"
+        )
+        ax = plot.particle_map(
+            snap.positions,
+            snap.radii,
+            np.where(snap.is_sample, self.stability.n_contacts, np.nan),
+            discrete=True,
+            cmap="viridis",
+            label="number of contacts",
+            band=self.band,
+        )
+        written += plot.save_figure(ax, out / "map_contacts")
+        if self.strain is not None:
+            written += plot.save_figure(self.strain.plot(band=self.band), out / "map_displacement")
+            written += plot.save_figure(
+                self.strain.plot(quantity="shear_strain", band=self.band), out / "map_shear_strain"
+            )
+        return written
+
+
+def analyze_snapshot(
+    snapshot: Snapshot,
+    reference: Snapshot | None = None,
+    *,
+    bins: int = 18,
+    min_contacts: int = 2,
+    lambda_include_boundary: bool = True,
+    fabric_include_boundary: bool = False,
+    strain_neighbours: str = "radius",
+    strain_cutoff: float | None = None,
+    out_dir: str | Path | None = None,
+    figures: bool = True,
+) -> AnalysisResult:
+    """Compute the fabric measures, lambda, and (with a reference) strain and shear band.
+
+    Parameters
+    ----------
+    snapshot
+        The state to analyse.
+    reference
+        An earlier state of the same particles (matched by id) for
+        displacements, local strain and the shear band; without it those are
+        NaN / absent and the summary says so.
+    bins
+        Angular bins over 360° for Eq. 7–8 and the polar diagrams.
+    min_contacts
+        Rattler threshold for the mechanical coordination number.
+    lambda_include_boundary, fabric_include_boundary
+        Whether wall / membrane contacts count for lambda (default yes) and
+        for Z and the anisotropies (default no).
+    strain_neighbours, strain_cutoff
+        Neighbourhood of the local strain fit (see :class:`LocalStrain`).
+    out_dir
+        If given, write ``particles.csv``, ``fabric.json`` and figures there.
+    figures
+        Draw the PNG + SVG figures when writing.
+
+    Returns
+    -------
+    AnalysisResult
+    """
+    notes: list[str] = []
+    coordination = CoordinationNumber(
+        min_contacts=min_contacts, include_boundary=fabric_include_boundary
+    ).compute(snapshot)
+    anisotropy = ContactAnisotropy(bins=bins, include_boundary=fabric_include_boundary).compute(
+        snapshot
+    )
+    force_anisotropy = None
+    if snapshot.normal_force is not None:
+        force_anisotropy = ContactAnisotropy(
+            bins=bins, weight="normal_force", include_boundary=fabric_include_boundary
+        ).compute(snapshot)
+    else:
+        notes.append("no contact forces in the input: a_n not computed")
+    stability = StabilityIndex(include_boundary=lambda_include_boundary).compute(snapshot)
+    strain = band = None
+    if reference is None:
+        notes.append(
+            "no reference snapshot: displacement, local_shear_strain and in_shear_band are empty, "
+            "and no shear band was detected"
+        )
+    else:
+        strain = LocalStrain(neighbours=strain_neighbours, cutoff=strain_cutoff).compute(
+            reference, snapshot
+        )
+        missing = int((reference.index_of(snapshot.ids) < 0).sum())
+        if missing:
+            notes.append(f"{missing} particles have no match (by id) in the reference snapshot")
+        if int(np.isfinite(strain.excess_shear_strain[snapshot.is_sample]).sum()) >= 10:
+            band = ShearBand().compute(
+                snapshot,
+                strain.excess_shear_strain,
+                stability_index=stability.stability_index,
+                n_contacts=stability.n_contacts,
+            )
+        else:
+            notes.append("fewer than 10 particles with a local strain: no shear band detected")
+    result = AnalysisResult(
+        snapshot, coordination, anisotropy, force_anisotropy, stability, strain, band, notes
+    )
+    if out_dir is not None:
+        result.write(out_dir, figures=figures)
+    return result

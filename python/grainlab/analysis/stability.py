@@ -1,0 +1,220 @@
+r"""The geometrical stability index lambda (paper Sec. 5, DESIGN.md §4).
+
+For a particle with ``n`` contacts at angles sorted counter-clockwise,
+:math:`\phi_0 \le \phi_1 \le \dots \le \phi_{n-1}` in :math:`[0, 2\pi)`:
+
+* ``n = 0`` or ``n = 1``: :math:`\lambda = 1` (the particle cannot be stable);
+* ``n >= 2``: take each contact ``k`` in turn as the reference. The stable
+  arrangement :math:`S_n` from it puts ``n`` positions at
+  :math:`\phi_k + 2\pi m/n`, ``m = 0 .. n-1``, and the contact ``m`` places
+  after ``k`` in angular order is compared with position ``m``. The deviation
+  is the sum of the minimum angles between each contact and its stable
+  position (Eq. 9),
+
+  .. math::
+
+     d S_n^{(k)} = \sum_{m=0}^{n-1}
+        \left| \operatorname{wrap}\!\left(\phi_{(k+m) \bmod n} - \phi_k
+        - \tfrac{2\pi m}{n}\right) \right|,
+
+  with :math:`|\operatorname{wrap}(x)| \in [0, \pi]` the minimum angle.
+  :math:`D = \min_k d S_n^{(k)}` (Eq. 10) and :math:`\lambda = D / 2\pi`
+  (Eq. 11, ``D / 360°``).
+
+Equal spacing gives 0; contacts at 0° and 90° give 1/4; at 0°, 60°, 120° give
+1/3, the largest value three equal disks around a fourth can reach.
+
+Implementation: writing :math:`e_j = \phi_j - 2\pi j/n`, the deviation of
+contact ``j`` from reference ``k`` is :math:`|\operatorname{wrap}(e_j - e_k)|`
+for every ``j`` (also past the wrap-around), and :math:`|e_j - e_k| < 2\pi`,
+so the minimum angle is :math:`\min(|x|, 2\pi - |x|)`. Particles are grouped
+by their number of contacts and each group is one ``(m, n, n)`` array
+operation: no Python loop over particles or contacts.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from grainlab.analysis._util import TWO_PI, Computable, contact_ends, finite_mean
+from grainlab.snapshot import Snapshot
+
+__all__ = ["StabilityIndex", "stability_index", "stability_index_of_angles"]
+
+#: Rows per block in the (m, n, n) kernel, to bound temporary memory.
+_BLOCK_ELEMENTS = 1 << 21
+
+
+def _group_deviation(angles: NDArray[np.float64], n: int) -> NDArray[np.float64]:
+    """D (rad) for an (m, n) block of contact angles, rows in any order."""
+    a = np.sort(angles, axis=1)
+    a -= (TWO_PI / n) * np.arange(n)
+    diff = a[:, :, None] - a[:, None, :]
+    np.abs(diff, out=diff)
+    np.minimum(diff, TWO_PI - diff, out=diff)
+    return diff.sum(axis=2).min(axis=1)
+
+
+def stability_index(
+    owner: ArrayLike, angles: ArrayLike, n_particles: int
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Stability index of every particle from its contact ends.
+
+    Parameters
+    ----------
+    owner : (K,) int
+        Particle index (``0 <= owner < n_particles``) of each contact end.
+        A particle–particle contact contributes two ends (one per particle).
+    angles : (K,) float, rad
+        Angle of each end on its particle, CCW from +x (any real value; taken
+        modulo 2 pi).
+    n_particles : int
+
+    Returns
+    -------
+    lam : (n_particles,) float
+        lambda in [0, 1]; 1 for particles with 0 or 1 contact.
+    counts : (n_particles,) int
+        Number of contacts of each particle.
+    """
+    owner = np.asarray(owner, dtype=np.int64).reshape(-1)
+    ang = np.mod(np.asarray(angles, dtype=np.float64).reshape(-1), TWO_PI)
+    if owner.shape != ang.shape:
+        raise ValueError(f"angles: expected shape {owner.shape}, got {ang.shape}")
+    if owner.size and (owner.min() < 0 or owner.max() >= n_particles):
+        raise ValueError(f"owner: indices must be in [0, {n_particles})")
+    counts = np.bincount(owner, minlength=n_particles)
+    lam = np.ones(n_particles, dtype=np.float64)
+    if owner.size == 0:
+        return lam, counts
+    order = np.argsort(owner)
+    ang_sorted = ang[order]
+    offsets = np.cumsum(counts) - counts
+    degrees = np.unique(counts)
+    for n in degrees[degrees >= 2]:  # one pass per distinct contact count
+        n = int(n)
+        rows = np.flatnonzero(counts == n)
+        block = max(1, _BLOCK_ELEMENTS // (n * n))
+        cols = np.arange(n)
+        for start in range(0, rows.size, block):
+            r = rows[start : start + block]
+            group = ang_sorted[offsets[r][:, None] + cols]
+            lam[r] = _group_deviation(group, n) / TWO_PI
+    return lam, counts
+
+
+def stability_index_of_angles(angles: ArrayLike, *, degrees: bool = False) -> float:
+    """lambda of one particle with contacts at ``angles`` (rad, or degrees).
+
+    >>> stability_index_of_angles([0, 60, 120], degrees=True)
+    0.3333333333333333
+    >>> stability_index_of_angles([0, 90], degrees=True)
+    0.25
+    """
+    a = np.asarray(angles, dtype=np.float64).reshape(-1)
+    if degrees:
+        a = np.radians(a)
+    lam, _ = stability_index(np.zeros(a.size, np.int64), a, 1)
+    return float(lam[0])
+
+
+class StabilityIndex(Computable):
+    r"""Geometrical stability index lambda of every particle (paper Sec. 5).
+
+    See the module docstring for the formula. Contact angles come from the
+    snapshot's contact normals (direction from the particle's centre towards
+    the other particle or the wall, DESIGN.md §2).
+
+    Parameters
+    ----------
+    include_boundary : bool, default True
+        Count contacts with walls and membrane particles among a particle's
+        contacts. The default follows the paper's algorithm, which takes all
+        active contacts of a particle: a platen or membrane supports a grain
+        as a neighbour does. With False, only contacts between sample
+        particles count.
+
+    Attributes (after :meth:`compute`)
+    ----------------------------------
+    stability_index : (N,) float
+        lambda in [0, 1]; NaN for membrane particles (not part of the sample).
+    n_contacts : (N,) int
+        Number of contacts used for each particle (0 for membrane particles).
+    mean : float
+        Mean lambda over sample particles with at least 2 contacts (the paper
+        filters out particles with 0 or 1 contact, whose lambda is 1 by
+        definition).
+    mean_all : float
+        Mean lambda over all sample particles, 0/1-contact ones counted as 1.
+
+    Example
+    -------
+    >>> from grainlab.snapshot import Snapshot
+    >>> import numpy as np
+    >>> angles = np.radians([0.0, 60.0, 120.0])
+    >>> snap = Snapshot.from_geometry(
+    ...     np.vstack([[0.0, 0.0], 2.0 * np.c_[np.cos(angles), np.sin(angles)]]),
+    ...     np.ones(4), tolerance=1e-9)
+    >>> round(float(StabilityIndex().compute(snap).stability_index[0]), 12)
+    0.333333333333
+    """
+
+    def __init__(self, include_boundary: bool = True) -> None:
+        self.include_boundary = bool(include_boundary)
+
+    def compute(self, snapshot: Snapshot) -> StabilityIndex:
+        """Compute lambda for every particle of ``snapshot``; returns ``self``."""
+        owner, ends, _ = contact_ends(snapshot, include_boundary=self.include_boundary)
+        lam, counts = stability_index(owner, ends, snapshot.n_particles)
+        sample = snapshot.is_sample
+        lam[~sample] = np.nan
+        self._store(
+            stability_index=lam,
+            n_contacts=counts,
+            mean=finite_mean(lam, sample & (counts >= 2)),
+            mean_all=finite_mean(lam, sample),
+            snapshot=snapshot,
+        )
+        return self
+
+    @property
+    def stability_index(self) -> NDArray[np.float64]:
+        """(N,) lambda per particle; NaN for membrane particles."""
+        return self._result("stability_index")
+
+    @property
+    def n_contacts(self) -> NDArray[np.int64]:
+        """(N,) number of contacts per particle used for lambda."""
+        return self._result("n_contacts")
+
+    @property
+    def mean(self) -> float:
+        """Mean lambda over sample particles with >= 2 contacts."""
+        return self._result("mean")
+
+    @property
+    def mean_all(self) -> float:
+        """Mean lambda over all sample particles (0/1 contact counted as 1)."""
+        return self._result("mean_all")
+
+    def plot(self, ax: Any = None, **kwargs: Any) -> Any:
+        """Particle map coloured by lambda (paper Fig. 12); returns the axes."""
+        from grainlab import plot
+
+        snap = self._result("snapshot")
+        return plot.particle_map(
+            snap.positions,
+            snap.radii,
+            self.stability_index,
+            ax=ax,
+            label=r"geometrical stability index $\lambda$",
+            vmin=0.0,
+            vmax=1.0,
+            **kwargs,
+        )
+
+    def __repr__(self) -> str:
+        return f"StabilityIndex(include_boundary={self.include_boundary})"

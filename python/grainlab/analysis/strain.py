@@ -1,0 +1,321 @@
+r"""Kinematics between two snapshots: displacement, rotation, local strain, D2min.
+
+Particles are matched by :attr:`Snapshot.ids`; results are indexed like the
+*current* snapshot and are NaN for particles absent from the reference.
+
+Local deformation gradient (Falk & Langer 1998)
+    For particle ``i`` with neighbours ``j`` in the *reference* snapshot
+    (centres within ``cutoff``, or its contacts), :math:`d^0_{ij} = X_j - X_i`
+    and :math:`d_{ij} = x_j - x_i` (minimum image in periodic directions).
+    The best-fit :math:`F_i` minimises :math:`\sum_j |d_{ij} - F_i d^0_{ij}|^2`:
+
+    .. math::
+
+       F_i = X_i Y_i^{-1},\quad X_i = \sum_j d_{ij} \otimes d^0_{ij},\quad
+       Y_i = \sum_j d^0_{ij} \otimes d^0_{ij},
+
+    and the residual is the non-affine measure
+    :math:`D^2_{min,i} = \sum_j |d_{ij} - F_i d^0_{ij}|^2` (m²). Particles with
+    fewer than 2 non-collinear neighbours get NaN.
+
+Strain (compression positive, DESIGN.md §2)
+    small: :math:`\varepsilon = I - \tfrac12(F + F^T)`;
+    green: :math:`\varepsilon = -\tfrac12(F^T F - I)`.
+    Volumetric strain :math:`\varepsilon_v = \varepsilon_{xx} +
+    \varepsilon_{yy}` (compression positive). The 2D shear strain invariant is
+    the maximum engineering shear strain (the diameter of Mohr's circle),
+
+    .. math::
+
+       \gamma = \sqrt{(\varepsilon_{xx} - \varepsilon_{yy})^2
+                      + 4 \varepsilon_{xy}^2},
+
+    so a simple shear of amount :math:`\gamma` gives :math:`\gamma`.
+
+Excess shear strain
+    The same invariant of :math:`\varepsilon_i - \bar\varepsilon`, where
+    the background strain :math:`\bar\varepsilon` is the component-wise
+    median of the finite local strains: the part of the local deformation
+    that the sample as a whole does not share. A shear band in an otherwise
+    homogeneously deforming sample stands out in it cleanly; it is the field
+    :class:`~grainlab.analysis.shear_band.ShearBand` is given by default.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+
+from grainlab.analysis._util import Computable
+from grainlab.snapshot import Snapshot
+
+__all__ = ["LocalStrain", "match_ids", "neighbour_pairs"]
+
+
+def match_ids(reference: Snapshot, current: Snapshot) -> NDArray[np.int64]:
+    """(N_current,) index in ``reference`` of each current particle, -1 if absent."""
+    return reference.index_of(current.ids)
+
+
+def neighbour_pairs(
+    snapshot: Snapshot, cutoff: float
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Unordered pairs ``i < j`` of particles with centre distance < ``cutoff`` (m)."""
+    if not np.isfinite(cutoff) or cutoff <= 0:
+        raise ValueError(f"cutoff: must be a positive length in m, got {cutoff!r}")
+    pos = np.asarray(snapshot.positions, dtype=np.float64)
+    boxsize = None
+    if any(snapshot.periodic):
+        box = np.asarray(snapshot.box)
+        lengths = box[:, 1] - box[:, 0]
+        pos = pos.copy()
+        boxsize = np.zeros(2)
+        for axis in (0, 1):
+            if snapshot.periodic[axis]:
+                pos[:, axis] = np.mod(pos[:, axis] - box[axis, 0], lengths[axis])
+                pos[pos[:, axis] >= lengths[axis], axis] = 0.0
+                boxsize[axis] = lengths[axis]
+    pairs = (
+        cKDTree(pos, boxsize=boxsize).query_pairs(cutoff, output_type="ndarray").astype(np.int64)
+    )
+    if pairs.size == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    return pairs[:, 0], pairs[:, 1]
+
+
+class LocalStrain(Computable):
+    r"""Displacement, rotation, best-fit local strain and D2min between two snapshots.
+
+    See the module docstring for the formulas and sign conventions.
+
+    Parameters
+    ----------
+    neighbours : {"radius", "contacts"}, default "radius"
+        Neighbourhood of each particle in the reference snapshot: all centres
+        within ``cutoff``, or its particle–particle contacts.
+    cutoff : float, m, optional
+        Neighbour radius for ``"radius"``; default 2 mean diameters of the
+        reference snapshot (about the second shell of neighbours).
+    strain : {"small", "green"}, default "small"
+        Infinitesimal strain from sym(F) or Green–Lagrange strain.
+
+    Attributes (after :meth:`compute`)
+    ----------------------------------
+    displacement : (N, 2) float, m
+    displacement_magnitude : (N,) float, m
+    rotation : (N,) float, rad (NaN unless both snapshots have rotations)
+    deformation_gradient : (N, 2, 2) float
+    strain : (N, 2, 2) float, compression positive
+    shear_strain : (N,) float
+    excess_shear_strain : (N,) float
+    background_strain : (2, 2) float
+    volumetric_strain : (N,) float, compression positive
+    d2min : (N,) float, m²
+    n_neighbours : (N,) int
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> from grainlab.snapshot import Snapshot
+    >>> x, y = np.meshgrid(np.arange(8.0), np.arange(8.0))
+    >>> ref = Snapshot(np.c_[x.ravel(), y.ravel()], np.full(64, 0.5))
+    >>> F = np.array([[1.0, 0.02], [0.0, 1.0]])            # simple shear 0.02
+    >>> cur = Snapshot(ref.positions @ F.T, ref.radii)
+    >>> s = LocalStrain(cutoff=1.5).compute(ref, cur)
+    >>> bool(np.allclose(s.shear_strain, 0.02)) and bool(np.allclose(s.d2min, 0.0))
+    True
+    """
+
+    def __init__(
+        self, neighbours: str = "radius", cutoff: float | None = None, strain: str = "small"
+    ) -> None:
+        if neighbours not in ("radius", "contacts"):
+            raise ValueError(f"neighbours: must be 'radius' or 'contacts', got {neighbours!r}")
+        if strain not in ("small", "green"):
+            raise ValueError(f"strain: must be 'small' or 'green', got {strain!r}")
+        if cutoff is not None and (not np.isfinite(cutoff) or cutoff <= 0):
+            raise ValueError(f"cutoff: must be a positive length in m, got {cutoff!r}")
+        self.neighbours = neighbours
+        self.cutoff = cutoff
+        self.strain_measure = strain
+
+    def compute(self, reference: Snapshot, current: Snapshot) -> LocalStrain:
+        """Compute the fields of ``current`` relative to ``reference``; returns ``self``."""
+        n = current.n_particles
+        to_ref = match_ids(reference, current)  # (n,) ref index or -1
+        matched = to_ref >= 0
+        # current index of each reference particle
+        to_cur = np.full(reference.n_particles, -1, np.int64)
+        to_cur[to_ref[matched]] = np.flatnonzero(matched)
+
+        disp = np.full((n, 2), np.nan)
+        disp[matched] = current.minimum_image(
+            current.positions[matched] - reference.positions[to_ref[matched]]
+        )
+        rot = np.full(n, np.nan)
+        if reference.rotations is not None and current.rotations is not None:
+            rot[matched] = current.rotations[matched] - reference.rotations[to_ref[matched]]
+
+        # neighbour pairs in the reference, mapped to current indices
+        if self.neighbours == "contacts":
+            ri, rj = np.asarray(reference.contact_i), np.asarray(reference.contact_j)
+            pp = rj >= 0
+            ri, rj = ri[pp], rj[pp]
+            cutoff = float("nan")
+        else:
+            cutoff = (
+                self.cutoff
+                if self.cutoff is not None
+                else 2.0 * float(np.mean(reference.diameters))
+            )
+            ri, rj = neighbour_pairs(reference, cutoff)
+        a, b = to_cur[ri], to_cur[rj]
+        ok = (a >= 0) & (b >= 0)
+        ri, rj, a, b = ri[ok], rj[ok], a[ok], b[ok]
+        # both directions: (owner, other)
+        own = np.concatenate([a, b])
+        d0 = reference.minimum_image(reference.positions[rj] - reference.positions[ri])
+        d = current.minimum_image(current.positions[b] - current.positions[a])
+        d0 = np.concatenate([d0, -d0])
+        d = np.concatenate([d, -d])
+
+        def acc(w: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.bincount(own, weights=w, minlength=n).astype(np.float64)
+
+        x = np.stack(
+            [
+                acc(d[:, 0] * d0[:, 0]),
+                acc(d[:, 0] * d0[:, 1]),
+                acc(d[:, 1] * d0[:, 0]),
+                acc(d[:, 1] * d0[:, 1]),
+            ],
+            axis=1,
+        ).reshape(n, 2, 2)
+        y00, y01, y11 = acc(d0[:, 0] ** 2), acc(d0[:, 0] * d0[:, 1]), acc(d0[:, 1] ** 2)
+        det = y00 * y11 - y01 * y01
+        count = np.bincount(own, minlength=n)
+        good = (count >= 2) & (det > 1e-10 * (y00 + y11) ** 2) & matched
+        inv = np.zeros((n, 2, 2))
+        safe = np.where(good, det, 1.0)
+        inv[:, 0, 0] = y11 / safe
+        inv[:, 1, 1] = y00 / safe
+        inv[:, 0, 1] = inv[:, 1, 0] = -y01 / safe
+        F = np.einsum("nij,njk->nik", x, inv)
+        F[~good] = np.nan
+
+        resid = d - np.einsum("kij,kj->ki", F[own], d0)
+        d2min = np.bincount(own, weights=np.einsum("ki,ki->k", resid, resid), minlength=n).astype(
+            np.float64
+        )
+        d2min[~good] = np.nan
+
+        eye = np.eye(2)
+        if self.strain_measure == "small":
+            eps = eye - 0.5 * (F + np.swapaxes(F, 1, 2))
+        else:
+            eps = -0.5 * (np.einsum("nki,nkj->nij", F, F) - eye)
+        shear = np.hypot(eps[:, 0, 0] - eps[:, 1, 1], 2.0 * eps[:, 0, 1])
+        finite = np.isfinite(eps[:, 0, 0])
+        background = np.median(eps[finite], axis=0) if finite.any() else np.full((2, 2), np.nan)
+        dev = eps - background
+        excess = np.hypot(dev[:, 0, 0] - dev[:, 1, 1], 2.0 * dev[:, 0, 1])
+        self._store(
+            displacement=disp,
+            rotation=rot,
+            deformation_gradient=F,
+            strain=eps,
+            shear_strain=shear,
+            excess_shear_strain=excess,
+            background_strain=background,
+            volumetric_strain=eps[:, 0, 0] + eps[:, 1, 1],
+            d2min=d2min,
+            n_neighbours=count,
+            cutoff=cutoff,
+            current=current,
+        )
+        return self
+
+    @property
+    def displacement(self) -> NDArray[np.float64]:
+        """(N, 2) displacement from the reference, m."""
+        return self._result("displacement")
+
+    @property
+    def displacement_magnitude(self) -> NDArray[np.float64]:
+        """(N,) |displacement|, m."""
+        d = self.displacement
+        return np.hypot(d[:, 0], d[:, 1])
+
+    @property
+    def rotation(self) -> NDArray[np.float64]:
+        """(N,) rotation increment, rad, CCW positive."""
+        return self._result("rotation")
+
+    @property
+    def deformation_gradient(self) -> NDArray[np.float64]:
+        """(N, 2, 2) best-fit local deformation gradient F."""
+        return self._result("deformation_gradient")
+
+    @property
+    def strain(self) -> NDArray[np.float64]:
+        """(N, 2, 2) local strain tensor, compression positive."""
+        return self._result("strain")
+
+    @property
+    def shear_strain(self) -> NDArray[np.float64]:
+        """(N,) maximum engineering shear strain (2D shear invariant)."""
+        return self._result("shear_strain")
+
+    @property
+    def excess_shear_strain(self) -> NDArray[np.float64]:
+        """(N,) shear invariant of the local strain minus the background strain."""
+        return self._result("excess_shear_strain")
+
+    @property
+    def background_strain(self) -> NDArray[np.float64]:
+        """(2, 2) component-wise median of the local strains (compression positive)."""
+        return self._result("background_strain")
+
+    @property
+    def volumetric_strain(self) -> NDArray[np.float64]:
+        """(N,) volumetric strain, compression positive."""
+        return self._result("volumetric_strain")
+
+    @property
+    def d2min(self) -> NDArray[np.float64]:
+        """(N,) Falk–Langer D2min, m²."""
+        return self._result("d2min")
+
+    @property
+    def n_neighbours(self) -> NDArray[np.int64]:
+        """(N,) number of reference neighbours used in the fit."""
+        return self._result("n_neighbours")
+
+    @property
+    def cutoff_used(self) -> float:
+        """Neighbour radius used, m (NaN for neighbours='contacts')."""
+        return self._result("cutoff")
+
+    def plot(self, ax: Any = None, quantity: str = "displacement", **kwargs: Any) -> Any:
+        """Particle map coloured by displacement magnitude (Fig. 11) or shear strain."""
+        from grainlab import plot
+
+        snap = self._result("current")
+        if quantity == "displacement":
+            values, label = self.displacement_magnitude, "displacement magnitude (m)"
+        elif quantity == "shear_strain":
+            values, label = self.shear_strain, r"local shear strain $\gamma$"
+        else:
+            raise ValueError(
+                f"quantity: must be 'displacement' or 'shear_strain', got {quantity!r}"
+            )
+        return plot.particle_map(snap.positions, snap.radii, values, ax=ax, label=label, **kwargs)
+
+    def __repr__(self) -> str:
+        return (
+            f"LocalStrain(neighbours={self.neighbours!r}, cutoff={self.cutoff!r}, "
+            f"strain={self.strain_measure!r})"
+        )

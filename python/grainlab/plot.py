@@ -1,0 +1,301 @@
+"""Figures for papers: polar fabric diagrams, particle maps, time series.
+
+All functions draw on a given matplotlib ``Axes`` (``ax=None`` creates a new
+figure with the paper style, without pyplot, so nothing global changes and
+any backend works) and return the axes; :func:`save_figure` writes PNG and
+SVG. Angles in the figures are in degrees; strains in percent, compression
+positive (DESIGN.md §2).
+
+Paper figures: :func:`polar_distribution` (Figs. 6–7), :func:`particle_map`
+coloured by displacement (Fig. 11), lambda (Fig. 12) or contact count
+(Fig. 13, ``discrete=True``) with :func:`outline_shear_band`,
+:func:`anisotropy_series` (Fig. 9) and :func:`mean_lambda_series` (Fig. 14).
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import matplotlib as mpl
+import numpy as np
+from matplotlib.collections import EllipseCollection
+from matplotlib.colors import BoundaryNorm, Normalize
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
+
+__all__ = [
+    "PAPER_STYLE",
+    "anisotropy_series",
+    "contact_count_distribution",
+    "mean_lambda_series",
+    "new_axes",
+    "outline_shear_band",
+    "paper_style",
+    "particle_map",
+    "polar_distribution",
+    "save_figure",
+]
+
+#: rcParams for paper figures: serif text, small sizes, thin lines, no clutter.
+PAPER_STYLE: dict[str, Any] = {
+    "font.family": "serif",
+    "font.size": 9,
+    "axes.labelsize": 9,
+    "axes.titlesize": 9,
+    "legend.fontsize": 8,
+    "xtick.labelsize": 8,
+    "ytick.labelsize": 8,
+    "axes.linewidth": 0.8,
+    "lines.linewidth": 1.2,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "savefig.bbox": "tight",
+    "savefig.dpi": 300,
+    "svg.fonttype": "none",
+    "figure.dpi": 100,
+}
+
+
+@contextlib.contextmanager
+def paper_style() -> Iterator[None]:
+    """Context manager applying :data:`PAPER_STYLE`."""
+    with mpl.rc_context(PAPER_STYLE):
+        yield
+
+
+def new_axes(
+    ax: Any = None, *, polar: bool = False, figsize: tuple[float, float] = (3.5, 3.0)
+) -> Any:
+    """``ax`` itself, or new axes on a new paper-style figure (no pyplot)."""
+    if ax is not None:
+        return ax
+    with paper_style():
+        fig = Figure(figsize=figsize, layout="constrained")
+        return fig.add_subplot(projection="polar" if polar else None)
+
+
+def save_figure(
+    fig_or_ax: Any, path: str | Path, formats: Sequence[str] = ("png", "svg")
+) -> list[Path]:
+    """Write the figure as ``path`` with each suffix in ``formats``; returns the paths."""
+    fig = (
+        fig_or_ax.figure
+        if hasattr(fig_or_ax, "figure") and not isinstance(fig_or_ax, Figure)
+        else fig_or_ax
+    )
+    base = Path(path)
+    base.parent.mkdir(parents=True, exist_ok=True)
+    written = []
+    with paper_style():
+        for fmt in formats:
+            out = base.with_suffix("." + fmt.lstrip("."))
+            fig.savefig(out, format=fmt.lstrip("."))
+            written.append(out)
+    return written
+
+
+def polar_distribution(
+    values: ArrayLike,
+    *,
+    anisotropy: float | None = None,
+    direction: float | None = None,
+    ax: Any = None,
+    kind: str = "contacts",
+    title: str | None = None,
+) -> Any:
+    """Rose diagram of a binned contact-normal or normal-force distribution (Figs. 6–7).
+
+    ``values`` (ng,) are the bin contents over [0, 2 pi) (bin g starting at
+    ``g * 2pi/ng``). With ``anisotropy`` a and ``direction`` theta_a (rad) the
+    fitted Eq. 6 is drawn on the same scale as the bins:
+    ``mean(values) * (1 + a cos 2(theta - theta_a))``.
+    """
+    v = np.asarray(values, dtype=np.float64).reshape(-1)
+    ng = v.size
+    ax = new_axes(ax, polar=True)
+    width = 2 * np.pi / ng
+    with paper_style():
+        ax.bar(
+            np.arange(ng) * width,
+            v,
+            width=width,
+            align="edge",
+            facecolor="0.85",
+            edgecolor="0.25",
+            linewidth=0.6,
+            label="contacts per bin" if kind == "contacts" else "normal force per bin (N)",
+        )
+        if anisotropy is not None and direction is not None and np.isfinite(anisotropy):
+            th = np.linspace(0.0, 2 * np.pi, 361)
+            fit = v.mean() * (1.0 + anisotropy * np.cos(2.0 * (th - direction)))
+            name = "E" if kind == "contacts" else r"F_n"
+            sym = "a" if kind == "contacts" else "a_n"
+            ax.plot(
+                th,
+                fit,
+                color="C3",
+                label=rf"${name}(\theta)$, ${sym}$ = {anisotropy:.3f}, "
+                rf"$\theta_a$ = {np.degrees(direction):.1f}°",
+            )
+            ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), frameon=False)
+        ax.set_theta_zero_location("E")
+        ax.set_theta_direction(1)
+        ax.set_thetagrids(np.arange(0, 360, 45))
+        ax.tick_params(axis="y", labelsize=7)
+        if title is None:
+            title = (
+                "Contact normal distribution"
+                if kind == "contacts"
+                else "Normal contact force distribution"
+            )
+        ax.set_title(title)
+    return ax
+
+
+def particle_map(
+    positions: ArrayLike,
+    radii: ArrayLike,
+    values: ArrayLike,
+    *,
+    ax: Any = None,
+    cmap: str = "viridis",
+    label: str | None = None,
+    vmin: float | None = None,
+    vmax: float | None = None,
+    discrete: bool = False,
+    nan_color: str = "0.85",
+    colorbar: bool = True,
+    band: Any = None,
+) -> Any:
+    """Disks drawn to scale (one ``EllipseCollection``) coloured by ``values``.
+
+    ``discrete=True`` uses one colour per integer value (contact counts,
+    Fig. 13). NaN values are drawn in ``nan_color``. ``band`` (a computed
+    :class:`~grainlab.analysis.shear_band.ShearBand`) is outlined on top.
+    """
+    pos = np.asarray(positions, dtype=np.float64)
+    rad = np.asarray(radii, dtype=np.float64)
+    val = np.asarray(values, dtype=np.float64)
+    height = float(np.ptp(pos[:, 1])) if pos.size else 1.0
+    span = float(np.ptp(pos[:, 0])) if pos.size else 1.0
+    aspect = (height + 1e-300) / (span + 1e-300)
+    ax = new_axes(ax, figsize=(3.5, float(np.clip(3.0 * aspect, 2.0, 7.0))))
+    with paper_style():
+        finite = np.isfinite(val)
+        if discrete:
+            lo = int(np.nanmin(val[finite])) if finite.any() else 0
+            hi = int(np.nanmax(val[finite])) if finite.any() else 1
+            lo = int(vmin) if vmin is not None else lo
+            hi = max(int(vmax) if vmax is not None else hi, lo + 1)
+            colormap = mpl.colormaps[cmap].resampled(hi - lo + 1)
+            norm: Normalize = BoundaryNorm(np.arange(lo - 0.5, hi + 1.0), colormap.N)
+        else:
+            colormap = mpl.colormaps[cmap]
+            lo = vmin if vmin is not None else (float(np.min(val[finite])) if finite.any() else 0.0)
+            hi = vmax if vmax is not None else (float(np.max(val[finite])) if finite.any() else 1.0)
+            if hi <= lo:
+                hi = lo + 1.0
+            norm = Normalize(lo, hi)
+        colormap = colormap.with_extremes(bad=nan_color)
+        coll = EllipseCollection(
+            widths=2 * rad,
+            heights=2 * rad,
+            angles=np.zeros_like(rad),
+            units="xy",
+            offsets=pos,
+            offset_transform=ax.transData,
+            cmap=colormap,
+            norm=norm,
+            edgecolors="none",
+        )
+        coll.set_array(np.ma.masked_invalid(val))
+        ax.add_collection(coll)
+        if pos.size:
+            pad = float(rad.max())
+            ax.set_xlim(pos[:, 0].min() - pad, pos[:, 0].max() + pad)
+            ax.set_ylim(pos[:, 1].min() - pad, pos[:, 1].max() + pad)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        if colorbar:
+            cb = ax.figure.colorbar(coll, ax=ax, shrink=0.8)
+            if discrete:
+                cb.set_ticks(
+                    np.arange(int(norm.boundaries[0] + 0.5), int(norm.boundaries[-1] + 0.5))
+                )
+            if label:
+                cb.set_label(label)
+        if band is not None:
+            outline_shear_band(ax, band)
+    return ax
+
+
+def outline_shear_band(ax: Any, band: Any, **line_style: Any) -> Any:
+    """Draw the two edges of a computed ShearBand on ``ax``; returns the axes."""
+    style = {"color": "crimson", "linestyle": "--", "linewidth": 1.0}
+    style.update(line_style)
+    for k, seg in enumerate(band.outline()):
+        ax.plot(seg[:, 0], seg[:, 1], label="shear band" if k == 0 else None, **style)
+    return ax
+
+
+def contact_count_distribution(fractions: ArrayLike, *, ax: Any = None) -> Any:
+    """Bar chart of the fraction of particles with 0, 1, 2, ... contacts."""
+    f = np.asarray(fractions, dtype=np.float64).reshape(-1)
+    ax = new_axes(ax)
+    with paper_style():
+        ax.bar(np.arange(f.size), f, color="0.6", edgecolor="0.2", linewidth=0.6)
+        ax.set_xlabel("number of contacts")
+        ax.set_ylabel("fraction of particles")
+        ax.set_xticks(np.arange(f.size))
+    return ax
+
+
+def _strain_axis(ax: Any) -> None:
+    ax.set_xlabel(r"axial strain $\varepsilon_{11}$ (%, compression positive)")
+
+
+def anisotropy_series(
+    axial_strain: ArrayLike,
+    anisotropy: ArrayLike,
+    *,
+    normal_force: ArrayLike | None = None,
+    ax: Any = None,
+) -> Any:
+    """Fabric anisotropy a (and a_n) against axial strain (Fig. 9).
+
+    ``axial_strain`` is a fraction (0.01 = 1 %), compression positive.
+    """
+    eps = 100.0 * np.asarray(axial_strain, dtype=np.float64)
+    a = np.asarray(anisotropy, dtype=np.float64)
+    if eps.shape != a.shape:
+        raise ValueError(f"anisotropy: expected shape {eps.shape}, got {a.shape}")
+    ax = new_axes(ax)
+    with paper_style():
+        ax.plot(eps, a, marker="o", markersize=2.5, label="$a$ (contact normals)")
+        if normal_force is not None:
+            an = np.asarray(normal_force, dtype=np.float64)
+            if an.shape != eps.shape:
+                raise ValueError(f"normal_force: expected shape {eps.shape}, got {an.shape}")
+            ax.plot(eps, an, marker="s", markersize=2.5, label="$a_n$ (normal forces)")
+            ax.legend(frameon=False)
+        _strain_axis(ax)
+        ax.set_ylabel("fabric anisotropy")
+    return ax
+
+
+def mean_lambda_series(axial_strain: ArrayLike, mean_lambda: ArrayLike, *, ax: Any = None) -> Any:
+    """Mean geometrical stability index against axial strain (Fig. 14)."""
+    eps = 100.0 * np.asarray(axial_strain, dtype=np.float64)
+    lam = np.asarray(mean_lambda, dtype=np.float64)
+    if eps.shape != lam.shape:
+        raise ValueError(f"mean_lambda: expected shape {eps.shape}, got {lam.shape}")
+    ax = new_axes(ax)
+    with paper_style():
+        ax.plot(eps, lam, marker="o", markersize=2.5, color="C2")
+        _strain_axis(ax)
+        ax.set_ylabel(r"mean stability index $\bar\lambda$")
+    return ax

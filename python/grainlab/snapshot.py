@@ -1,0 +1,701 @@
+"""The common data model between the engine, files and analysis: :class:`Snapshot`.
+
+A snapshot is one state of a 2D assembly of disks: the particles as one array
+per property (structure of arrays) and the contacts as parallel arrays.
+
+Conventions (DESIGN.md §2):
+
+* SI units: positions and radii in m, rotations in rad, forces in N (per unit
+  out-of-plane thickness t = 1 m), time in s.
+* Particles are addressed by *index* ``0 .. N-1`` inside a snapshot; ``ids``
+  are the stable labels used to match particles between snapshots and files.
+* Contacts are parallel arrays of length ``Nc``. ``contact_i`` is the index of
+  the first particle. ``contact_j`` is the index of the second particle for a
+  particle–particle contact, or a *negative* code ``-1 - wall_id`` for a
+  contact between particle ``contact_i`` and wall (or other non-particle
+  boundary) ``wall_id >= 0``. Use :func:`wall_code` / :attr:`Snapshot.wall_ids`
+  rather than doing the arithmetic by hand.
+* ``contact_normal`` is the unit vector from particle i towards particle j, or
+  for a wall contact from particle i towards the wall. ``normal_force`` is the
+  normal force magnitude, compression (repulsion) positive. ``shear_force`` is
+  the signed tangential force acting on particle i along ``t = rot90(n) =
+  (-n_y, n_x)``.
+* Particle ``kind`` codes (:class:`ParticleKind`): ``SOIL`` grains,
+  ``MEMBRANE`` disks of a flexible boundary chain (not part of the sample), and
+  ``BOUNDARY`` soil grains that currently act as the flexible boundary
+  (DESIGN.md §3, variant B). Analysis treats ``SOIL`` and ``BOUNDARY`` as the
+  sample and excludes ``MEMBRANE`` particles; a *boundary contact* is a contact
+  with a wall or with a membrane particle.
+
+Example
+-------
+>>> import numpy as np
+>>> from grainlab.snapshot import Snapshot
+>>> snap = Snapshot.from_geometry(
+...     positions=[[0.0, 0.0], [2.0, 0.0], [1.0, 3.0**0.5]],
+...     radii=[1.0, 1.0, 1.0],
+...     tolerance=1e-9,
+... )
+>>> snap.n_contacts
+3
+>>> np.degrees(snap.contact_angles()).round(6).tolist()
+[0.0, 60.0, 120.0]
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import cKDTree
+
+__all__ = [
+    "ParticleKind",
+    "Snapshot",
+    "detect_contacts",
+    "wall_code",
+]
+
+TWO_PI = 2.0 * np.pi
+
+
+class ParticleKind(enum.IntEnum):
+    """Per-particle role codes stored in :attr:`Snapshot.kind`."""
+
+    #: An ordinary soil grain.
+    SOIL = 0
+    #: A disk of a flexible membrane / boundary chain; not part of the sample.
+    MEMBRANE = 1
+    #: A soil grain currently acting as the flexible boundary (variant B).
+    BOUNDARY = 2
+
+
+def wall_code(wall_id: ArrayLike) -> NDArray[np.int64]:
+    """The ``contact_j`` value that denotes wall ``wall_id`` (``-1 - wall_id``).
+
+    >>> wall_code([0, 3]).tolist()
+    [-1, -4]
+    """
+    w = np.asarray(wall_id, dtype=np.int64)
+    if np.any(w < 0):
+        raise ValueError("wall_id: wall ids must be >= 0")
+    return -1 - w
+
+
+def _readonly(a: NDArray[Any]) -> NDArray[Any]:
+    """A read-only view (the caller's array keeps its own flags)."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
+def _as_float(name: str, value: ArrayLike, shape: tuple[int | None, ...]) -> NDArray[np.float64]:
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name}: cannot convert to float64 ({error})") from None
+    _check_shape(name, a, shape)
+    bad = ~np.isfinite(a)
+    if bad.any():
+        first = np.argwhere(bad)[0]
+        where = first[0] if a.ndim == 1 else tuple(int(k) for k in first)
+        raise ValueError(f"{name}: non-finite value (NaN or inf) at index {where}")
+    return a
+
+
+def _as_int(name: str, value: ArrayLike, shape: tuple[int | None, ...]) -> NDArray[np.int64]:
+    a = np.asarray(value)
+    if a.size and not (np.issubdtype(a.dtype, np.integer) or a.dtype == bool):
+        if (
+            np.issubdtype(a.dtype, np.floating)
+            and np.all(np.isfinite(a))
+            and np.all(a == np.round(a))
+        ):
+            pass
+        else:
+            raise ValueError(f"{name}: must hold integers, got dtype {a.dtype}")
+    a = a.astype(np.int64, copy=False)
+    _check_shape(name, a, shape)
+    return a
+
+
+def _check_shape(name: str, a: NDArray[Any], shape: tuple[int | None, ...]) -> None:
+    ok = a.ndim == len(shape) and all(
+        s is None or s == d for s, d in zip(shape, a.shape, strict=True)
+    )
+    if not ok:
+        want = (
+            "("
+            + ", ".join("*" if s is None else str(s) for s in shape)
+            + ("," if len(shape) == 1 else "")
+            + ")"
+        )
+        raise ValueError(f"{name}: expected shape {want}, got {a.shape}")
+
+
+@dataclass(frozen=True, eq=False)
+class Snapshot:
+    """One state of a 2D disk assembly: particles and their contacts.
+
+    Parameters
+    ----------
+    positions : (N, 2) float, m
+        Disk centres.
+    radii : (N,) float, m
+        Disk radii, > 0.
+    ids : (N,) int, optional
+        Stable particle labels, unique. Default ``arange(N)``.
+    rotations : (N,) float, rad, optional
+        Accumulated rotation of each disk, counter-clockwise positive.
+    kind : (N,) int, optional
+        :class:`ParticleKind` code per particle. Default all ``SOIL``.
+    contact_i : (Nc,) int, optional
+        Index of the first particle of each contact, ``0 <= i < N``.
+    contact_j : (Nc,) int, optional
+        Index of the second particle (``0 <= j < N``, ``j != i``), or
+        ``-1 - wall_id`` for a contact with wall ``wall_id``.
+    normal_force : (Nc,) float, N, optional
+        Normal force magnitude, repulsion positive.
+    shear_force : (Nc,) float, N, optional
+        Signed tangential force on particle i along ``rot90(normal)``.
+    contact_normal : (Nc, 2) float, optional
+        Unit normal from i towards j (or towards the wall). When omitted,
+        particle–particle normals are computed from the centres (minimum
+        image in periodic directions) and wall normals from ``contact_point``.
+    contact_point : (Nc, 2) float, m, optional
+        Contact point.
+    contact_fields : mapping of str to (Nc, ...) arrays, optional
+        Further per-contact data, e.g. ``overlap``, ``sliding``, ``bonded``.
+    particle_fields : mapping of str to (N, ...) arrays, optional
+        Further per-particle data, e.g. ``velocity`` (N, 2), ``force`` (N, 2).
+    box : (2, 2) float, m, optional
+        ``[[xlo, xhi], [ylo, yhi]]`` of the simulation box.
+    periodic : (bool, bool)
+        Periodicity in x and y; a periodic direction needs ``box``.
+    time : float, s, optional
+    axial_strain : float, optional
+        Axial strain eps_11 of the run at this snapshot, compression positive.
+    metadata : mapping, optional
+        Free-form provenance (source file, timestep, code, ...).
+
+    Raises
+    ------
+    ValueError
+        On construction, naming the field: wrong shape, NaN / inf, radius
+        <= 0, duplicate ids, contact index out of range, self contact, a
+        wall contact without normal or contact point, a normal that is not
+        of unit length.
+
+    Notes
+    -----
+    Arrays are stored as read-only views; build a new snapshot (for example
+    with :func:`dataclasses.replace` or :meth:`with_contacts`) to change one.
+    """
+
+    positions: NDArray[np.float64]
+    radii: NDArray[np.float64]
+    ids: NDArray[np.int64] | None = None
+    rotations: NDArray[np.float64] | None = None
+    kind: NDArray[np.int8] | None = None
+    contact_i: NDArray[np.int64] | None = None
+    contact_j: NDArray[np.int64] | None = None
+    normal_force: NDArray[np.float64] | None = None
+    shear_force: NDArray[np.float64] | None = None
+    contact_normal: NDArray[np.float64] | None = None
+    contact_point: NDArray[np.float64] | None = None
+    contact_fields: Mapping[str, NDArray[Any]] = field(default_factory=dict)
+    particle_fields: Mapping[str, NDArray[Any]] = field(default_factory=dict)
+    box: NDArray[np.float64] | None = None
+    periodic: tuple[bool, bool] = (False, False)
+    time: float | None = None
+    axial_strain: float | None = None
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+    _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    # ------------------------------------------------------------------ build
+    def __post_init__(self) -> None:
+        put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+
+        positions = _as_float("positions", self.positions, (None, 2))
+        n = positions.shape[0]
+        radii = _as_float("radii", self.radii, (n,))
+        if np.any(radii <= 0.0):
+            k = int(np.argmax(radii <= 0.0))
+            raise ValueError(f"radii: must be > 0, got {radii[k]!r} at index {k}")
+        ids = np.arange(n, dtype=np.int64) if self.ids is None else _as_int("ids", self.ids, (n,))
+        if n > 1:
+            order = np.argsort(ids, kind="stable")
+            dup = ids[order[1:]] == ids[order[:-1]]
+            if dup.any():
+                raise ValueError(f"ids: duplicate id {int(ids[order[1:]][dup][0])}")
+        put("positions", _readonly(positions))
+        put("radii", _readonly(radii))
+        put("ids", _readonly(ids))
+
+        if self.rotations is not None:
+            put("rotations", _readonly(_as_float("rotations", self.rotations, (n,))))
+        if self.kind is None:
+            kind = np.zeros(n, dtype=np.int8)
+        else:
+            kind = _as_int("kind", self.kind, (n,))
+            allowed = [int(k) for k in ParticleKind]
+            bad = ~np.isin(kind, allowed)
+            if bad.any():
+                raise ValueError(f"kind: unknown code {int(kind[bad][0])} (allowed {allowed})")
+            kind = kind.astype(np.int8)
+        put("kind", _readonly(kind))
+
+        if (self.contact_i is None) != (self.contact_j is None):
+            raise ValueError("contact_i / contact_j: give both or neither")
+        ci = (
+            np.zeros(0, np.int64)
+            if self.contact_i is None
+            else _as_int("contact_i", self.contact_i, (None,))
+        )
+        nc = ci.shape[0]
+        cj = (
+            np.zeros(0, np.int64)
+            if self.contact_j is None
+            else _as_int("contact_j", self.contact_j, (nc,))
+        )
+        if nc:
+            if ci.min() < 0 or ci.max() >= n:
+                k = int(np.argmax((ci < 0) | (ci >= n)))
+                raise ValueError(
+                    f"contact_i: index {int(ci[k])} out of range [0, {n}) at contact {k}"
+                )
+            if cj.max() >= n:
+                k = int(np.argmax(cj >= n))
+                raise ValueError(
+                    f"contact_j: index {int(cj[k])} out of range [0, {n}) at contact {k}"
+                )
+            if np.any(ci == cj):
+                k = int(np.argmax(ci == cj))
+                raise ValueError(
+                    f"contact_j: particle {int(ci[k])} in contact with itself at contact {k}"
+                )
+        put("contact_i", _readonly(ci))
+        put("contact_j", _readonly(cj))
+
+        for name in ("normal_force", "shear_force"):
+            value = getattr(self, name)
+            if value is not None:
+                put(name, _readonly(_as_float(name, value, (nc,))))
+        if self.contact_point is not None:
+            put("contact_point", _readonly(_as_float("contact_point", self.contact_point, (nc, 2))))
+        if self.contact_normal is not None:
+            normal = _as_float("contact_normal", self.contact_normal, (nc, 2))
+            length = np.hypot(normal[:, 0], normal[:, 1])
+            bad = np.abs(length - 1.0) > 1e-6
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise ValueError(
+                    f"contact_normal: not a unit vector at contact {k} (length {length[k]:.6g})"
+                )
+            put("contact_normal", _readonly(normal))
+        elif nc and np.any(cj < 0) and self.contact_point is None:
+            raise ValueError(
+                "contact_normal: wall contacts (contact_j < 0) need contact_normal or contact_point"
+            )
+
+        put(
+            "contact_fields",
+            {
+                k: _readonly(self._field(k, v, nc, "contact_fields"))
+                for k, v in dict(self.contact_fields).items()
+            },
+        )
+        put(
+            "particle_fields",
+            {
+                k: _readonly(self._field(k, v, n, "particle_fields"))
+                for k, v in dict(self.particle_fields).items()
+            },
+        )
+
+        periodic = tuple(bool(p) for p in self.periodic)
+        if len(periodic) != 2:
+            raise ValueError(f"periodic: expected two flags (x, y), got {self.periodic!r}")
+        put("periodic", periodic)
+        if self.box is not None:
+            box = _as_float("box", self.box, (2, 2))
+            if np.any(box[:, 1] <= box[:, 0]):
+                raise ValueError(f"box: need xlo < xhi and ylo < yhi, got {box.tolist()}")
+            put("box", _readonly(box))
+        elif any(periodic):
+            raise ValueError("box: a periodic direction needs the box bounds")
+        for name in ("time", "axial_strain"):
+            value = getattr(self, name)
+            if value is not None:
+                value = float(value)
+                if not np.isfinite(value):
+                    raise ValueError(f"{name}: must be finite, got {value}")
+                put(name, value)
+        put("metadata", dict(self.metadata))
+
+    @staticmethod
+    def _field(key: str, value: ArrayLike, length: int, owner: str) -> NDArray[Any]:
+        a = np.asarray(value)
+        if a.ndim == 0 or a.shape[0] != length:
+            raise ValueError(f"{owner}[{key!r}]: expected length {length}, got shape {a.shape}")
+        if np.issubdtype(a.dtype, np.floating) and not np.all(np.isfinite(a)):
+            raise ValueError(f"{owner}[{key!r}]: non-finite value (NaN or inf)")
+        return a
+
+    @classmethod
+    def from_geometry(
+        cls,
+        positions: ArrayLike,
+        radii: ArrayLike,
+        ids: ArrayLike | None = None,
+        *,
+        tolerance: float = 0.0,
+        **kwargs: Any,
+    ) -> Snapshot:
+        """A snapshot whose contacts are detected from the geometry.
+
+        A pair is in contact when its centre distance is ``< r_i + r_j +
+        tolerance`` (``tolerance`` in m, >= 0; use a small positive value for
+        lattices of exactly touching disks). Uses a k-d tree, O(N log N).
+        ``box`` / ``periodic`` in ``kwargs`` are honoured (minimum image).
+        """
+        pos = _as_float("positions", positions, (None, 2))
+        rad = _as_float("radii", radii, (pos.shape[0],))
+        i, j = detect_contacts(
+            pos,
+            rad,
+            tolerance=tolerance,
+            box=kwargs.get("box"),
+            periodic=kwargs.get("periodic", (False, False)),
+        )
+        metadata = dict(kwargs.pop("metadata", {}) or {})
+        metadata.setdefault("contacts", f"detected from geometry (tolerance {tolerance:g} m)")
+        return cls(pos, rad, ids, contact_i=i, contact_j=j, metadata=metadata, **kwargs)
+
+    @classmethod
+    def from_engine_arrays(
+        cls,
+        positions: ArrayLike,
+        radii: ArrayLike,
+        ids: ArrayLike | None = None,
+        *,
+        contact_i: ArrayLike,
+        contact_j: ArrayLike,
+        contact_point: ArrayLike | None = None,
+        contact_normal: ArrayLike | None = None,
+        normal_force: ArrayLike | None = None,
+        shear_force: ArrayLike | None = None,
+        overlap: ArrayLike | None = None,
+        sliding: ArrayLike | None = None,
+        bonded: ArrayLike | None = None,
+        wall_i: ArrayLike | None = None,
+        wall_id: ArrayLike | None = None,
+        wall_point: ArrayLike | None = None,
+        wall_normal: ArrayLike | None = None,
+        wall_normal_force: ArrayLike | None = None,
+        wall_shear_force: ArrayLike | None = None,
+        wall_overlap: ArrayLike | None = None,
+        wall_sliding: ArrayLike | None = None,
+        **kwargs: Any,
+    ) -> Snapshot:
+        """Build a snapshot from separate particle–particle and wall contact arrays.
+
+        This is the constructor for the engine: particle–particle contacts
+        (``contact_*`` plus ``overlap``, ``sliding``, ``bonded`` and forces,
+        all of length K) and particle–wall contacts (``wall_*``, length W, with
+        the particle index ``wall_i`` and ``wall_id >= 0``) are concatenated
+        into one contact list, particle contacts first; wall contacts get
+        ``contact_j = -1 - wall_id``. ``overlap`` / ``sliding`` / ``bonded``
+        go into :attr:`contact_fields` (``bonded`` is False for wall
+        contacts). An optional per-contact array must be given for both kinds
+        or neither, except that wall arrays default to zeros / False when the
+        particle array is given and the wall one is not.
+        """
+        ci = np.asarray(contact_i, dtype=np.int64).reshape(-1)
+        cj = np.asarray(contact_j, dtype=np.int64).reshape(-1)
+        if wall_i is None:
+            wi = np.zeros(0, np.int64)
+            wj = np.zeros(0, np.int64)
+        else:
+            if wall_id is None:
+                raise ValueError("wall_id: required with wall_i")
+            wi = np.asarray(wall_i, dtype=np.int64).reshape(-1)
+            wj = wall_code(np.asarray(wall_id, dtype=np.int64).reshape(-1))
+            if wj.shape != wi.shape:
+                raise ValueError(f"wall_id: expected shape {wi.shape}, got {wj.shape}")
+        nw = wi.shape[0]
+
+        def join(
+            name: str,
+            particle: ArrayLike | None,
+            wall: ArrayLike | None,
+            width: int | None,
+            fill: Any,
+        ):
+            if particle is None and wall is None:
+                return None
+            if particle is None:
+                raise ValueError(f"{name}: wall values given but no particle-contact values")
+            p = np.asarray(particle)
+            if wall is None:
+                if nw and fill is None:
+                    raise ValueError(f"{name}: needs the wall-contact values too (wall_*)")
+                shape = (nw,) if width is None else (nw, width)
+                w = np.full(shape, fill, dtype=p.dtype)
+            else:
+                w = np.asarray(wall, dtype=p.dtype)
+            return np.concatenate([p, w])
+
+        normals = join("contact_normal", contact_normal, wall_normal, 2, None)
+        points = join("contact_point", contact_point, wall_point, 2, None)
+        fields = dict(kwargs.pop("contact_fields", {}) or {})
+        for name, p, w, fill in (
+            ("overlap", overlap, wall_overlap, 0.0),
+            ("sliding", sliding, wall_sliding, False),
+            ("bonded", bonded, None, False),
+        ):
+            joined = join(name, p, w, None, fill)
+            if joined is not None:
+                fields[name] = joined
+        return cls(
+            positions,
+            radii,
+            ids,
+            contact_i=np.concatenate([ci, wi]),
+            contact_j=np.concatenate([cj, wj]),
+            contact_normal=normals,
+            contact_point=points,
+            normal_force=join("normal_force", normal_force, wall_normal_force, None, None),
+            shear_force=join("shear_force", shear_force, wall_shear_force, None, None),
+            contact_fields=fields,
+            **kwargs,
+        )
+
+    def with_contacts(
+        self, contact_i: ArrayLike, contact_j: ArrayLike, **contact_arrays: Any
+    ) -> Snapshot:
+        """The same particles with a new contact list (other contact arrays reset)."""
+        reset = dict(
+            normal_force=None,
+            shear_force=None,
+            contact_normal=None,
+            contact_point=None,
+            contact_fields={},
+        )
+        reset.update(contact_arrays)
+        return dataclasses.replace(self, contact_i=contact_i, contact_j=contact_j, **reset)
+
+    def select_contacts(self, mask: ArrayLike) -> Snapshot:
+        """The same particles with only the contacts where ``mask`` is true."""
+        m = np.asarray(mask, dtype=bool)
+        if m.shape != (self.n_contacts,):
+            raise ValueError(f"mask: expected shape ({self.n_contacts},), got {m.shape}")
+        take = lambda a: None if a is None else np.asarray(a)[m]  # noqa: E731
+        return dataclasses.replace(
+            self,
+            contact_i=self.contact_i[m],
+            contact_j=self.contact_j[m],
+            normal_force=take(self.normal_force),
+            shear_force=take(self.shear_force),
+            contact_normal=take(self.contact_normal),
+            contact_point=take(self.contact_point),
+            contact_fields={k: v[m] for k, v in self.contact_fields.items()},
+        )
+
+    # ------------------------------------------------------------- properties
+    @property
+    def n_particles(self) -> int:
+        """Number of particles N (all kinds)."""
+        return int(self.positions.shape[0])
+
+    @property
+    def n_contacts(self) -> int:
+        """Number of contacts Nc (particle–particle and wall)."""
+        return int(self.contact_i.shape[0])
+
+    @property
+    def diameters(self) -> NDArray[np.float64]:
+        """Disk diameters 2 r, m."""
+        return 2.0 * self.radii
+
+    @property
+    def is_sample(self) -> NDArray[np.bool_]:
+        """(N,) mask of the particles that belong to the sample (kind != MEMBRANE)."""
+        return np.asarray(self.kind) != ParticleKind.MEMBRANE
+
+    @property
+    def is_wall_contact(self) -> NDArray[np.bool_]:
+        """(Nc,) mask of the contacts with a wall (``contact_j < 0``)."""
+        return np.asarray(self.contact_j) < 0
+
+    @property
+    def wall_ids(self) -> NDArray[np.int64]:
+        """(Nc,) wall id of each contact, -1 for particle–particle contacts."""
+        cj = np.asarray(self.contact_j)
+        return np.where(cj < 0, -1 - cj, -1)
+
+    @property
+    def is_boundary_contact(self) -> NDArray[np.bool_]:
+        """(Nc,) mask of contacts with a wall or with a membrane particle."""
+        cj = np.asarray(self.contact_j)
+        membrane = np.asarray(self.kind) == ParticleKind.MEMBRANE
+        wall = cj < 0
+        partner = np.where(wall, 0, cj)
+        return wall | (membrane[partner] & ~wall) | membrane[self.contact_i]
+
+    def index_of(self, ids: ArrayLike) -> NDArray[np.int64]:
+        """Indices of the particles with the given ids; -1 where an id is absent."""
+        want = np.asarray(ids, dtype=np.int64)
+        if self.n_particles == 0:
+            return np.full(want.shape, -1, dtype=np.int64)
+        order = self._id_order()
+        sorted_ids = self.ids[order]
+        pos = np.minimum(np.searchsorted(sorted_ids, want), len(sorted_ids) - 1)
+        return np.where(sorted_ids[pos] == want, order[pos], -1).astype(np.int64)
+
+    def _id_order(self) -> NDArray[np.int64]:
+        if "id_order" not in self._cache:
+            self._cache["id_order"] = np.argsort(self.ids, kind="stable")
+        return self._cache["id_order"]
+
+    def minimum_image(self, d: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Apply the minimum-image convention to separation vectors ``d`` (..., 2)."""
+        if not any(self.periodic):
+            return d
+        d = np.array(d, dtype=np.float64, copy=True)
+        lengths = self.box[:, 1] - self.box[:, 0]
+        for axis in (0, 1):
+            if self.periodic[axis]:
+                d[..., axis] -= lengths[axis] * np.round(d[..., axis] / lengths[axis])
+        return d
+
+    def contact_normals(self) -> NDArray[np.float64]:
+        """(Nc, 2) unit normals from particle i towards j (or towards the wall).
+
+        The stored :attr:`contact_normal` when given; otherwise computed from
+        the centres (particle–particle) and from ``contact_point`` (walls).
+        """
+        if self.contact_normal is not None:
+            return np.asarray(self.contact_normal)
+        if "normals" in self._cache:
+            return self._cache["normals"]
+        ci = self.contact_i
+        cj = self.contact_j
+        wall = cj < 0
+        other = np.where(wall, ci, cj)
+        d = self.positions[other] - self.positions[ci]
+        d = self.minimum_image(d)
+        if wall.any():
+            d[wall] = self.minimum_image(
+                np.asarray(self.contact_point)[wall] - self.positions[ci[wall]]
+            )
+        length = np.hypot(d[:, 0], d[:, 1])
+        if np.any(length == 0.0):
+            k = int(np.argmax(length == 0.0))
+            raise ValueError(
+                f"contact_normal: undefined for contact {k} "
+                "(coincident centres or contact point at the centre)"
+            )
+        normals = _readonly(d / length[:, None])
+        self._cache["normals"] = normals
+        return normals
+
+    def contact_angles(self) -> NDArray[np.float64]:
+        """(Nc,) angle of each contact on particle i, rad in [0, 2 pi), CCW from +x.
+
+        The angle on particle j of a particle–particle contact is this plus pi.
+        """
+        if "angles" not in self._cache:
+            n = self.contact_normals()
+            a = np.arctan2(n[:, 1], n[:, 0])
+            a = np.where(a < 0.0, a + TWO_PI, a)
+            a[a >= TWO_PI] = 0.0
+            self._cache["angles"] = _readonly(a)
+        return self._cache["angles"]
+
+    def contact_counts(self, *, include_boundary: bool = True) -> NDArray[np.int64]:
+        """(N,) number of contacts of each particle (each contact counts for both ends).
+
+        With ``include_boundary=False`` contacts with walls and membrane
+        particles are not counted.
+        """
+        ci = self.contact_i
+        cj = self.contact_j
+        keep = np.ones(ci.shape, bool) if include_boundary else ~self.is_boundary_contact
+        pp = keep & (cj >= 0)
+        n = self.n_particles
+        return np.bincount(ci[keep], minlength=n) + np.bincount(cj[pp], minlength=n)
+
+    def __repr__(self) -> str:
+        return (
+            f"Snapshot(n_particles={self.n_particles}, n_contacts={self.n_contacts}, "
+            f"time={self.time}, axial_strain={self.axial_strain})"
+        )
+
+
+def detect_contacts(
+    positions: ArrayLike,
+    radii: ArrayLike,
+    *,
+    tolerance: float = 0.0,
+    box: ArrayLike | None = None,
+    periodic: tuple[bool, bool] = (False, False),
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Pairs of disks in contact: centre distance ``< r_i + r_j + tolerance``.
+
+    Parameters
+    ----------
+    positions : (N, 2) float, m
+    radii : (N,) float, m
+    tolerance : float, m, >= 0
+        Touching tolerance added to the radius sum.
+    box, periodic
+        As in :class:`Snapshot`; periodic directions use the minimum image.
+
+    Returns
+    -------
+    i, j : (Nc,) int64
+        Particle indices with ``i < j``, sorted by ``i`` then ``j``.
+    """
+    pos = np.asarray(positions, dtype=np.float64)
+    rad = np.asarray(radii, dtype=np.float64)
+    if tolerance < 0 or not np.isfinite(tolerance):
+        raise ValueError(f"tolerance: must be a finite value >= 0, got {tolerance}")
+    if pos.shape[0] < 2:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    periodic = tuple(bool(p) for p in periodic)
+    boxsize = None
+    if any(periodic):
+        if box is None:
+            raise ValueError("box: a periodic direction needs the box bounds")
+        b = np.asarray(box, dtype=np.float64)
+        lengths = b[:, 1] - b[:, 0]
+        pos = pos.copy()
+        boxsize = np.zeros(2)
+        for axis in (0, 1):
+            if periodic[axis]:
+                pos[:, axis] = np.mod(pos[:, axis] - b[axis, 0], lengths[axis])
+                pos[pos[:, axis] >= lengths[axis], axis] = 0.0
+                boxsize[axis] = lengths[axis]
+    cutoff = 2.0 * float(rad.max()) + tolerance
+    tree = cKDTree(pos, boxsize=boxsize)
+    pairs = tree.query_pairs(cutoff, output_type="ndarray").astype(np.int64)
+    if pairs.size == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    i, j = pairs[:, 0], pairs[:, 1]
+    d = pos[j] - pos[i]
+    if boxsize is not None:
+        for axis in (0, 1):
+            if boxsize[axis] > 0:
+                d[:, axis] -= boxsize[axis] * np.round(d[:, axis] / boxsize[axis])
+    dist = np.hypot(d[:, 0], d[:, 1])
+    touching = dist < rad[i] + rad[j] + tolerance
+    i, j = i[touching], j[touching]
+    lo, hi = np.minimum(i, j), np.maximum(i, j)
+    order = np.argsort(lo * np.int64(pos.shape[0]) + hi)
+    return lo[order], hi[order]

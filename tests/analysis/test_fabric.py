@@ -1,0 +1,173 @@
+"""Coordination numbers, contact-normal distribution and anisotropy (Eq. 6-8)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from factories_analysis import hex_lattice, square_lattice
+from grainlab.analysis import (
+    ContactAnisotropy,
+    CoordinationNumber,
+    angular_histogram,
+    anisotropy_eq7,
+    anisotropy_fourier,
+    fabric_tensor,
+    rattlers,
+)
+from grainlab.snapshot import ParticleKind, Snapshot
+
+
+def sample_eq6(rng, n, a, theta_a):
+    """Angles drawn from E(theta) = (1 + a cos 2(theta - theta_a)) / 2pi by rejection."""
+    out = np.empty(0)
+    while out.size < n:
+        t = rng.uniform(0, 2 * np.pi, 4 * n)
+        keep = rng.uniform(0, 1 + a, t.size) < 1 + a * np.cos(2 * (t - theta_a))
+        out = np.r_[out, t[keep]]
+    return out[:n]
+
+
+def snapshot_with_normals(angles, rng, forces=None):
+    """Contacts with the given normal angles between random pairs of 500 particles."""
+    n = 500
+    i = rng.integers(0, n, angles.size)
+    j = (i + rng.integers(1, n, angles.size)) % n
+    return Snapshot(
+        rng.uniform(0, 0.1, (n, 2)),
+        np.full(n, 1e-3),
+        contact_i=i,
+        contact_j=j,
+        contact_normal=np.c_[np.cos(angles), np.sin(angles)],
+        normal_force=forces,
+    )
+
+
+def test_hex_lattice_z6_and_isotropic():
+    snap = hex_lattice(rotation_deg=7.0)  # away from bin edges
+    z = CoordinationNumber().compute(snap)
+    assert z.coordination_number == 6.0
+    assert z.mechanical_coordination_number == 6.0
+    assert not z.rattlers.any()
+    np.testing.assert_allclose(z.count_distribution, [0, 0, 0, 0, 0, 0, 1.0])
+    an = ContactAnisotropy().compute(snap)
+    assert an.anisotropy == pytest.approx(0.0, abs=1e-12)
+    assert an.anisotropy_fourier == pytest.approx(0.0, abs=1e-12)
+    np.testing.assert_allclose(an.fabric_tensor, 0.5 * np.eye(2), atol=1e-12)
+    # each contact counted in both directions: 6 directions x 64 particles / 2 x 2
+    assert an.histogram.sum() == 2 * snap.n_contacts == 6 * 64
+
+
+def test_unrotated_hex_lattice_fourier_isotropic_and_z6():
+    snap = hex_lattice()
+    assert CoordinationNumber().compute(snap).coordination_number == 6.0
+    assert ContactAnisotropy().compute(snap).anisotropy_fourier == pytest.approx(0.0, abs=1e-12)
+
+
+def test_square_lattice_z4():
+    assert CoordinationNumber().compute(square_lattice()).coordination_number == 4.0
+
+
+def test_rattlers_removed_iteratively():
+    # triangle 0-1-2 plus a dangling chain 2-3-4: 4 then 3 are removed
+    i = np.array([0, 1, 2, 2, 3])
+    j = np.array([1, 2, 0, 3, 4])
+    np.testing.assert_array_equal(rattlers(i, j, 5), [False, False, False, True, True])
+    np.testing.assert_array_equal(rattlers(i, j, 5, min_contacts=3), [True] * 5)
+    snap = Snapshot(np.c_[np.arange(5.0), np.zeros(5)], np.full(5, 0.6), contact_i=i, contact_j=j)
+    z = CoordinationNumber().compute(snap)
+    assert z.coordination_number == pytest.approx(2.0)
+    assert z.mechanical_coordination_number == pytest.approx(2.0)  # 3 contacts, 3 particles
+    np.testing.assert_allclose(z.count_distribution, [0, 0.2, 0.6, 0.2])  # 4 | 0,1,3 | 2
+    z3 = CoordinationNumber(min_contacts=3).compute(snap)
+    assert np.isnan(z3.mechanical_coordination_number)
+
+
+def test_rattler_next_to_a_rigid_core():
+    # square lattice (Z = 4) plus one extra particle touching a single lattice particle
+    sq = square_lattice(4, 4)
+    pos = np.vstack([sq.positions, [[-1e-3, 0.0]]])
+    i = np.r_[sq.contact_i, 16]
+    j = np.r_[sq.contact_j, 0]
+    snap = Snapshot(pos, np.full(17, 0.5e-3), contact_i=i, contact_j=j)
+    z = CoordinationNumber().compute(snap)
+    assert z.coordination_number == pytest.approx(2 * 33 / 17)
+    assert z.mechanical_coordination_number == pytest.approx(4.0)
+    assert z.rattlers.sum() == 1 and z.rattlers[16]
+
+
+def test_boundary_contacts_excluded_from_z_by_default():
+    snap = Snapshot(
+        [[0, 0], [1e-3, 0], [2e-3, 0]],
+        np.full(3, 0.5e-3),
+        kind=[0, 0, ParticleKind.MEMBRANE],
+        contact_i=[0, 1, 0],
+        contact_j=[1, 2, -1],
+        contact_normal=[[1, 0], [1, 0], [-1, 0]],
+    )
+    z = CoordinationNumber().compute(snap)
+    assert z.n_particles == 2  # the membrane disk is not part of the sample
+    assert z.coordination_number == pytest.approx(1.0)
+    zb = CoordinationNumber(include_boundary=True).compute(snap)
+    assert zb.coordination_number == pytest.approx((2 + 2) / 2)
+
+
+@pytest.mark.parametrize(("a", "theta_deg"), [(0.0, 0.0), (0.2, 30.0), (0.5, 120.0)])
+def test_recovers_eq6_parameters(rng, a, theta_deg):
+    n = 40_000
+    angles = sample_eq6(rng, n, a, np.radians(theta_deg))
+    an = ContactAnisotropy(bins=18).compute(snapshot_with_normals(angles, rng))
+    sigma = np.sqrt(2.0 / n)  # standard error of a from n contacts
+    assert an.anisotropy_fourier == pytest.approx(a, abs=4 * sigma)
+    # Eq. 7 as printed carries the binning factor (sin dt / dt)^2 = 0.960 at 18 bins
+    dt = np.radians(20.0)
+    assert an.anisotropy == pytest.approx(a * (np.sin(dt) / dt) ** 2, abs=4 * sigma)
+    # the fabric tensor gives the same a as the Fourier estimate
+    w = np.linalg.eigvalsh(an.fabric_tensor)
+    assert 2 * (w[1] - w[0]) == pytest.approx(an.anisotropy_fourier, rel=1e-9)
+    if a > 0:
+        tol = np.degrees(4 * sigma / (2 * a))
+        for theta in (an.direction, an.direction_fourier):
+            diff = (np.degrees(theta) - theta_deg + 90) % 180 - 90
+            assert abs(diff) < tol
+
+
+def test_eq7_single_direction_closed_form():
+    # all contacts along the centre of bin 3 of 18: a = 2 sin(dt)/dt, theta_a = that centre
+    dt = 2 * np.pi / 18
+    centre = 3.5 * dt
+    values, edges = angular_histogram(np.full(10, centre), 18)
+    assert values[3] == 10 and values[12] == 10 and values.sum() == 20
+    a, theta = anisotropy_eq7(values)
+    assert a == pytest.approx(2 * np.sin(dt) / dt, rel=1e-12)
+    assert theta == pytest.approx(centre, abs=1e-12)
+    np.testing.assert_allclose(edges, np.linspace(0, 2 * np.pi, 19))
+
+
+def test_force_weighted_anisotropy():
+    # horizontal contacts carry 2 N, vertical ones 1 N: a_n = 2 (2n - n) / 3n = 2/3
+    ang = np.radians(np.r_[np.full(50, 5.0), np.full(50, 95.0)])
+    forces = np.r_[np.full(50, 2.0), np.full(50, 1.0)]
+    snap = snapshot_with_normals(ang, np.random.default_rng(1), forces)
+    an = ContactAnisotropy(weight="normal_force").compute(snap)
+    assert an.anisotropy_fourier == pytest.approx(2 / 3, rel=1e-12)
+    assert np.degrees(an.direction_fourier) == pytest.approx(5.0, abs=1e-9)
+    assert an.total == pytest.approx(150.0)
+    assert an.histogram.sum() == pytest.approx(300.0)
+    # counts alone are isotropic in the second harmonic sense: equal numbers at 5 and 95 deg
+    assert ContactAnisotropy().compute(snap).anisotropy_fourier == pytest.approx(0.0, abs=1e-12)
+
+
+def test_force_anisotropy_needs_forces(rng):
+    snap = snapshot_with_normals(np.zeros(3), rng)
+    with pytest.raises(ValueError, match="normal_force"):
+        ContactAnisotropy(weight="normal_force").compute(snap)
+
+
+def test_functions_validate_and_handle_empty():
+    with pytest.raises(ValueError, match="bins"):
+        angular_histogram([0.1], bins=1)
+    assert np.isnan(anisotropy_eq7(np.zeros(18))[0])
+    assert np.isnan(anisotropy_fourier([])[0])
+    assert np.isnan(fabric_tensor(np.zeros((0, 2)))).all()
+    phi = fabric_tensor([[1, 0], [0, 1], [1, 0]], weights=[1, 2, 1])
+    np.testing.assert_allclose(phi, [[0.5, 0], [0, 0.5]])
