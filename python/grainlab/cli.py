@@ -16,7 +16,7 @@ from collections.abc import Sequence
 import grainlab
 
 #: Subcommand modules, in the order ``grainlab --help`` lists them.
-COMMAND_MODULES: tuple[str, ...] = ("grainlab.commands.demo",)
+COMMAND_MODULES: tuple[str, ...] = ("grainlab.commands.demo", "grainlab.commands.analyze")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,152 @@
+"""``grainlab analyze``: fabric, stability index, strain and shear band of a snapshot.
+
+Everything here is a thin wrapper around :func:`grainlab.io.read_snapshot`
+and :func:`grainlab.analysis.analyze_snapshot`, which scripts can call
+directly.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+__all__ = ["parse_columns", "register", "run"]
+
+
+def parse_columns(text: str | None) -> dict[str, str] | None:
+    """``"i=c_ids[1],j=c_ids[2],normal_force=c_pl[2]"`` -> a role -> column dict."""
+    if not text:
+        return None
+    out: dict[str, str] = {}
+    for item in text.split(","):
+        role, sep, name = item.partition("=")
+        if not sep or not role.strip() or not name.strip():
+            raise ValueError(
+                f"--contact-columns: expected ROLE=COLUMN items separated by commas, got {item!r}"
+            )
+        out[role.strip()] = name.strip()
+    return out
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``analyze`` subcommand."""
+    p = subparsers.add_parser(
+        "analyze",
+        help="fabric, stability index, strain and shear band of a snapshot",
+        description=(
+            "Analyse a snapshot (particles CSV id,x,y,radius or LAMMPS dump, detected from "
+            "the content): coordination numbers, contact anisotropy (Eq. 6-8), geometrical "
+            "stability index lambda, and, with --reference, displacements, local strain and "
+            "the shear band. Writes particles.csv, "
+            "fabric.json and PNG + SVG figures into --out."
+        ),
+    )
+    p.add_argument("input", metavar="INPUT", help="particles CSV or LAMMPS atoms dump")
+    p.add_argument(
+        "--contacts", metavar="FILE", help="contacts CSV (i,j by id) or LAMMPS local dump"
+    )
+    p.add_argument(
+        "--reference", metavar="SNAPSHOT_FILE", help="earlier snapshot for displacement and strain"
+    )
+    p.add_argument(
+        "--reference-contacts", metavar="FILE", help="contacts file of the reference snapshot"
+    )
+    p.add_argument(
+        "--timestep", type=int, metavar="N", help="frame of a multi-frame dump (default: last)"
+    )
+    p.add_argument(
+        "--reference-timestep",
+        type=int,
+        metavar="N",
+        help="frame of the reference dump (default: the first)",
+    )
+    p.add_argument(
+        "--bins", type=int, default=18, help="angular bins over 360 degrees (default 18)"
+    )
+    p.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.0,
+        metavar="METRES",
+        help="touching tolerance (m) when contacts are detected from geometry (default 0)",
+    )
+    p.add_argument(
+        "--contact-columns",
+        metavar="ROLE=COLUMN,...",
+        help="column roles of a LAMMPS local dump, e.g. i=c_ids[1],j=c_ids[2],normal_force=c_pl[2]",
+    )
+    p.add_argument(
+        "--min-contacts", type=int, default=2, help="rattler threshold for mechanical Z (default 2)"
+    )
+    p.add_argument(
+        "--lambda-exclude-boundary",
+        action="store_true",
+        help="leave wall and membrane contacts out of lambda (default: counted)",
+    )
+    p.add_argument(
+        "--no-figures", action="store_true", help="write only particles.csv and fabric.json"
+    )
+    p.add_argument(
+        "--out", metavar="DIR", default="analysis", help="output folder (default ./analysis)"
+    )
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry point of ``grainlab analyze``; returns the exit code."""
+    from grainlab.analysis import analyze_snapshot
+    from grainlab.io import detect_format, list_timesteps, read_snapshot
+
+    if args.bins < 2:
+        raise ValueError(f"--bins: must be >= 2, got {args.bins}")
+    if args.tolerance < 0:
+        raise ValueError(f"--tolerance: must be >= 0 m, got {args.tolerance}")
+    columns = parse_columns(args.contact_columns)
+    snapshot = read_snapshot(
+        args.input,
+        contacts=args.contacts,
+        timestep=args.timestep,
+        tolerance=args.tolerance,
+        columns=columns,
+    )
+    reference = None
+    if args.reference:
+        ref_step = args.reference_timestep
+        if ref_step is None and detect_format(args.reference) == "lammps-dump":
+            ref_step = list_timesteps(args.reference)[0]
+        reference = read_snapshot(
+            args.reference,
+            contacts=args.reference_contacts,
+            timestep=ref_step,
+            tolerance=args.tolerance,
+            columns=columns if args.reference_contacts else None,
+        )
+    result = analyze_snapshot(
+        snapshot,
+        reference,
+        bins=args.bins,
+        min_contacts=args.min_contacts,
+        lambda_include_boundary=not args.lambda_exclude_boundary,
+        out_dir=Path(args.out),
+        figures=not args.no_figures,
+    )
+    s = result.summary()
+
+    def f(x: float | None, fmt: str = ".3f") -> str:
+        return "n/a" if x is None else format(x, fmt)
+
+    line = (
+        f"grainlab analyze: {s['n_particles']} particles, {s['n_contacts']} contacts, "
+        f"Z = {f(s['Z'])}, "
+        f"Zm = {f(s['mechanical_Z'])}, a = {f(s['a'])}, a_n = {f(s['a_n'])}, "
+        f"mean lambda = {f(s['mean_lambda'])}"
+    )
+    if s["band_angle_deg"] is not None:
+        line += (
+            f", band {f(s['band_angle_deg'], '.1f')} deg x "
+            f"{f(s['band_thickness_diameters'], '.1f')} d, "
+            f"lambda in/out {f(s['mean_lambda_in_band'])}/{f(s['mean_lambda_outside_band'])}"
+        )
+    print(line + f" -> {args.out}")
+    return 0

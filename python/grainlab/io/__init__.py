@@ -1,0 +1,138 @@
+"""Reading and writing snapshots: particles CSV, LAMMPS/LIGGGHTS dumps.
+
+:func:`read_snapshot` recognises the format of a file from its content and
+dispatches to the reader registered for it in :data:`READERS`. A grainlab
+HDF5 reader (``format = "grainlab-hdf5"``) plugs in by adding an entry there.
+
+All readers raise :class:`FileFormatError` (a ``ValueError``) whose message
+names the file, the line and the problem.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+from grainlab.io._table import FileFormatError
+from grainlab.io.csv import (
+    read_contacts_csv,
+    read_particles_csv,
+    write_contacts_csv,
+    write_particles_csv,
+)
+from grainlab.io.lammps_dump import list_timesteps, read_lammps_dump
+from grainlab.snapshot import Snapshot
+
+__all__ = [
+    "READERS",
+    "FileFormatError",
+    "detect_format",
+    "list_timesteps",
+    "read_contacts_csv",
+    "read_lammps_dump",
+    "read_particles_csv",
+    "read_snapshot",
+    "write_contacts_csv",
+    "write_particles_csv",
+]
+
+_HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
+
+
+def detect_format(path: str | Path) -> str:
+    """``"particles-csv"``, ``"lammps-dump"`` or ``"grainlab-hdf5"``, from the file's content.
+
+    HDF5 by its signature; a LAMMPS dump by a first line ``ITEM: TIMESTEP``;
+    a particles CSV by a header with the columns ``id,x,y,radius``.
+    """
+    p = Path(path)
+    try:
+        with p.open("rb") as fh:
+            head = fh.read(4096)
+    except FileNotFoundError:
+        raise FileFormatError(p, None, "file not found") from None
+    except IsADirectoryError:
+        raise FileFormatError(p, None, "is a directory, not a file") from None
+    if head.startswith(_HDF5_MAGIC):
+        return "grainlab-hdf5"
+    text = head.decode("utf-8", errors="replace")
+    lines = [
+        ln.strip() for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")
+    ]
+    if not lines:
+        raise FileFormatError(p, None, "empty file: cannot tell its format")
+    if lines[0].startswith("ITEM: TIMESTEP"):
+        return "lammps-dump"
+    header = {h.strip().lower() for h in lines[0].split(",")}
+    if {"id", "x", "y", "radius"} <= header:
+        return "particles-csv"
+    raise FileFormatError(
+        p,
+        None,
+        "unknown format: expected a particles CSV (header id,x,y,radius) or a LAMMPS dump "
+        f"(first line 'ITEM: TIMESTEP'); the first line is {lines[0][:60]!r}",
+    )
+
+
+def _read_csv(path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None) -> Snapshot:
+    if timestep is not None:
+        raise ValueError("timestep: only applies to LAMMPS dumps, not to a particles CSV")
+    if columns:
+        raise ValueError("contact columns: only apply to LAMMPS local dumps")
+    return read_particles_csv(path, contacts=contacts, tolerance=tolerance)
+
+
+def _read_dump(
+    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None
+) -> Snapshot:
+    return read_lammps_dump(
+        path, timestep=timestep, contacts=contacts, columns=columns, tolerance=tolerance
+    )
+
+
+def _read_hdf5(path: Path, **_: Any) -> Snapshot:
+    raise ValueError(
+        f"{path}: grainlab HDF5 snapshots are not readable yet (the engine's writer comes first)"
+    )
+
+
+#: Reader per format name: ``reader(path, *, contacts, timestep, tolerance, columns) -> Snapshot``.
+READERS: dict[str, Callable[..., Snapshot]] = {
+    "particles-csv": _read_csv,
+    "lammps-dump": _read_dump,
+    "grainlab-hdf5": _read_hdf5,
+}
+
+
+def read_snapshot(
+    path: str | Path,
+    *,
+    contacts: str | Path | None = None,
+    timestep: int | None = None,
+    tolerance: float = 0.0,
+    columns: Mapping[str, str] | None = None,
+    format: str | None = None,
+) -> Snapshot:
+    """Read a snapshot from any supported file.
+
+    Parameters
+    ----------
+    path
+        Particles CSV or LAMMPS atoms dump (format detected, or ``format``).
+    contacts
+        Contacts file: a contacts CSV for a particles CSV, a ``dump local``
+        file for a LAMMPS dump. Without it contacts are detected from the
+        geometry (centre distance < r_i + r_j + ``tolerance``, m).
+    timestep
+        Frame of a multi-frame dump (default the last).
+    columns
+        Column roles of a LAMMPS local dump (see :mod:`grainlab.io.lammps_dump`).
+    """
+    p = Path(path)
+    fmt = format or detect_format(p)
+    if fmt not in READERS:
+        raise ValueError(f"format: unknown {fmt!r} (known: {', '.join(READERS)})")
+    return READERS[fmt](
+        p, contacts=contacts, timestep=timestep, tolerance=tolerance, columns=columns
+    )

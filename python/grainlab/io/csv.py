@@ -1,0 +1,253 @@
+"""Particles and contacts as CSV files.
+
+Particles CSV
+    A header line, then one row per particle, comma separated. Required
+    columns ``id,x,y,radius`` (SI units: m); optional ``rotation`` (rad) and
+    ``kind`` (:class:`~grainlab.snapshot.ParticleKind` code); any other
+    numeric column is kept in :attr:`Snapshot.particle_fields`. Column order
+    is free, names are case-insensitive; blank lines and lines starting with
+    ``#`` are skipped.
+
+Contacts CSV
+    Header and rows ``i,j[,normal_force,shear_force]`` where ``i`` and ``j``
+    are particle *ids* from the particles file (not row numbers); forces in N
+    (normal force repulsion positive, shear force signed along rot90 of the
+    normal from i to j). Only particle–particle contacts.
+
+Errors raise :class:`~grainlab.io.FileFormatError` (a ``ValueError``) with
+the message ``FILE:LINE: problem``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from grainlab.io._table import (
+    FileFormatError,
+    check_unique_ids,
+    integral_column,
+    parse_float_table,
+    read_lines,
+)
+from grainlab.snapshot import ParticleKind, Snapshot
+
+__all__ = ["read_contacts_csv", "read_particles_csv", "write_contacts_csv", "write_particles_csv"]
+
+PARTICLE_COLUMNS = ("id", "x", "y", "radius")
+CONTACT_COLUMNS = ("i", "j")
+
+
+def _read_csv(
+    path: str | Path, required: tuple[str, ...]
+) -> tuple[list[str], NDArray[np.float64], NDArray[np.int64]]:
+    lines = read_lines(path)
+    keep = [
+        (k + 1, text)
+        for k, text in enumerate(lines)
+        if text.strip() and not text.lstrip().startswith("#")
+    ]
+    if not keep:
+        raise FileFormatError(
+            path, None, "empty file: expected a header line " + ",".join(required)
+        )
+    header_line, header = keep[0]
+    names = [h.strip().lower() for h in header.split(",")]
+    trailing = len(names) > 1 and names[-1] == ""  # tolerate a trailing comma on every line
+    if trailing:
+        names = names[:-1]
+    seen: set[str] = set()
+    for name in names:
+        if name == "":
+            raise FileFormatError(path, header_line, "empty column name in the header")
+        if name in seen:
+            raise FileFormatError(path, header_line, f"duplicate column {name!r} in the header")
+        seen.add(name)
+    missing = [c for c in required if c not in seen]
+    if missing:
+        raise FileFormatError(
+            path,
+            header_line,
+            f"missing column(s) {', '.join(missing)} "
+            f"(header has {', '.join(names)}; need {','.join(required)})",
+        )
+    rows = keep[1:]
+    numbers = np.array([k for k, _ in rows], dtype=np.int64)
+    texts = [t.rstrip()[:-1] if trailing and t.rstrip().endswith(",") else t for _, t in rows]
+    data = parse_float_table(path, texts, numbers, len(names), delimiter=",", column_names=names)
+    return names, data, numbers
+
+
+def read_particles_csv(
+    path: str | Path,
+    *,
+    contacts: str | Path | None = None,
+    tolerance: float = 0.0,
+    detect: bool = True,
+) -> Snapshot:
+    """Read a particles CSV (and optionally a contacts CSV) into a :class:`Snapshot`.
+
+    Without ``contacts`` and with ``detect=True`` contacts are detected from
+    the geometry (centre distance < r_i + r_j + ``tolerance``).
+    """
+    names, data, numbers = _read_csv(path, PARTICLE_COLUMNS)
+    if data.shape[0] == 0:
+        raise FileFormatError(path, None, "no particle rows after the header")
+    col = {n: data[:, k] for k, n in enumerate(names)}
+    ids = integral_column(path, col["id"], numbers, "id")
+    check_unique_ids(path, ids, numbers)
+    radius = col["radius"]
+    bad = radius <= 0
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise FileFormatError(path, int(numbers[k]), f"column 'radius': {radius[k]!r} is not > 0")
+    kind = None
+    if "kind" in col:
+        kind = integral_column(path, col["kind"], numbers, "kind")
+        bad = ~np.isin(kind, [int(k) for k in ParticleKind])
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(
+                path, int(numbers[k]), f"column 'kind': unknown code {int(kind[k])}"
+            )
+    extra = {n: v for n, v in col.items() if n not in PARTICLE_COLUMNS + ("rotation", "kind")}
+    positions = np.c_[col["x"], col["y"]]
+    metadata: dict[str, Any] = {"source": str(path), "format": "particles-csv"}
+    kwargs: dict[str, Any] = dict(
+        ids=ids, rotations=col.get("rotation"), kind=kind, particle_fields=extra, metadata=metadata
+    )
+    if contacts is not None:
+        snap = Snapshot(positions, radius, **kwargs)
+        return attach_contacts_csv(snap, contacts)
+    if detect:
+        return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **kwargs)
+    return Snapshot(positions, radius, **kwargs)
+
+
+def read_contacts_csv(path: str | Path) -> dict[str, NDArray[Any]]:
+    """Read a contacts CSV: a dict with ``i``, ``j`` (ids) and the optional force columns.
+
+    Also returns ``line`` (the file line of each row) for error messages.
+    """
+    names, data, numbers = _read_csv(path, CONTACT_COLUMNS)
+    col = {n: data[:, k] for k, n in enumerate(names)}
+    out: dict[str, NDArray[Any]] = {
+        "i": integral_column(path, col["i"], numbers, "i"),
+        "j": integral_column(path, col["j"], numbers, "j"),
+        "line": numbers,
+    }
+    for name in ("normal_force", "shear_force"):
+        if name in col:
+            out[name] = col[name]
+    return out
+
+
+def attach_contacts_csv(snapshot: Snapshot, path: str | Path) -> Snapshot:
+    """The snapshot with the contacts read from a contacts CSV (ids -> indices)."""
+    c = read_contacts_csv(path)
+    i = snapshot.index_of(c["i"])
+    j = snapshot.index_of(c["j"])
+    for name, idx, ids in (("i", i, c["i"]), ("j", j, c["j"])):
+        bad = idx < 0
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(
+                path, int(c["line"][k]), f"column {name!r}: unknown particle id {int(ids[k])}"
+            )
+    self_contact = i == j
+    if self_contact.any():
+        k = int(np.argmax(self_contact))
+        raise FileFormatError(
+            path, int(c["line"][k]), f"particle id {int(c['i'][k])} in contact with itself"
+        )
+    metadata = dict(snapshot.metadata)
+    metadata["contacts"] = f"read from {path}"
+    return dataclasses.replace(
+        snapshot,
+        contact_i=i,
+        contact_j=j,
+        normal_force=c.get("normal_force"),
+        shear_force=c.get("shear_force"),
+        contact_normal=None,
+        contact_point=None,
+        contact_fields={},
+        metadata=metadata,
+    )
+
+
+def write_particles_csv(
+    path: str | Path,
+    snapshot: Snapshot,
+    columns: Mapping[str, ArrayLike] | None = None,
+    *,
+    float_format: str = "%.17g",
+) -> Path:
+    """Write ``id,x,y,radius`` (+ rotation, kind when set, + ``columns``) as CSV.
+
+    Extra ``columns`` are (N,) arrays; NaN is written as an empty field.
+    Integer and bool columns are written as integers. Returns the path.
+    """
+    cols: dict[str, NDArray[Any]] = {
+        "id": np.asarray(snapshot.ids),
+        "x": snapshot.positions[:, 0],
+        "y": snapshot.positions[:, 1],
+        "radius": np.asarray(snapshot.radii),
+    }
+    if snapshot.rotations is not None:
+        cols["rotation"] = np.asarray(snapshot.rotations)
+    if np.any(np.asarray(snapshot.kind) != ParticleKind.SOIL):
+        cols["kind"] = np.asarray(snapshot.kind)
+    for name, values in (columns or {}).items():
+        v = np.asarray(values)
+        if v.shape != (snapshot.n_particles,):
+            raise ValueError(
+                f"columns[{name!r}]: expected shape ({snapshot.n_particles},), got {v.shape}"
+            )
+        cols[name] = v
+    return _write_table(path, cols, float_format)
+
+
+def write_contacts_csv(
+    path: str | Path, snapshot: Snapshot, *, float_format: str = "%.17g"
+) -> Path:
+    """Write the particle–particle contacts as ``i,j[,normal_force,shear_force]`` (by id)."""
+    pp = np.asarray(snapshot.contact_j) >= 0
+    cols: dict[str, NDArray[Any]] = {
+        "i": np.asarray(snapshot.ids)[snapshot.contact_i[pp]],
+        "j": np.asarray(snapshot.ids)[snapshot.contact_j[pp]],
+    }
+    if snapshot.normal_force is not None:
+        cols["normal_force"] = np.asarray(snapshot.normal_force)[pp]
+    if snapshot.shear_force is not None:
+        cols["shear_force"] = np.asarray(snapshot.shear_force)[pp]
+    return _write_table(path, cols, float_format)
+
+
+def _write_table(path: str | Path, cols: Mapping[str, NDArray[Any]], float_format: str) -> Path:
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    rendered = []
+    for v in cols.values():
+        if v.dtype == bool:
+            v = v.astype(np.int64)
+        if np.issubdtype(v.dtype, np.integer):
+            rendered.append(v.astype(str))
+        else:
+            f = np.asarray(v, dtype=np.float64)
+            text = np.char.mod(float_format, f)
+            rendered.append(np.where(np.isfinite(f), text, ""))
+    header = ",".join(cols)
+    if rendered and rendered[0].size:
+        body = rendered[0].astype(object)
+        for r in rendered[1:]:
+            body = body + "," + r.astype(object)
+        text = header + "\n" + "\n".join(body.tolist()) + "\n"
+    else:
+        text = header + "\n"
+    p.write_text(text, encoding="utf-8")
+    return p

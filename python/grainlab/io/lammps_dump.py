@@ -1,0 +1,491 @@
+"""LAMMPS / LIGGGHTS text dump files: atoms (``dump custom``) and contacts (``dump local``).
+
+Atoms dump (``dump ID group custom N file id x y radius ...``)
+    Frames of ``ITEM: TIMESTEP``, ``ITEM: NUMBER OF ATOMS``, ``ITEM: BOX
+    BOUNDS`` (orthogonal: ``xx yy zz`` boundary flags, ``pp`` = periodic),
+    ``ITEM: ATOMS <columns>`` and one row per atom; ``ITEM: TIME`` and
+    ``ITEM: UNITS`` are accepted. Required columns: ``id``; positions ``x y``
+    (else ``xu yu``, else scaled ``xs ys`` / ``xsu ysu``); ``radius`` (else
+    ``diameter``). ``type``, ``vx vy``, ``fx fy``, ``omegaz`` and any other
+    column are kept in :attr:`Snapshot.particle_fields` under their dump names
+    (velocities as ``velocity`` (N, 2), forces as ``force`` (N, 2)). ``z`` is
+    ignored (2D). The file's units are taken as given: use ``units si``.
+
+Contacts dump (``dump ID group local N file ...``)
+    Frames with ``ITEM: NUMBER OF ENTRIES`` and ``ITEM: ENTRIES <columns>``,
+    typically from ``compute property/local patom1 patom2`` (the two atom
+    ids) and ``compute pair/local dist force p1 p2 p4`` (for
+    ``gran/hooke/history``: ``force`` is the normal force, repulsion
+    positive; ``p1 p2`` the tangential force on the first atom; ``p4`` its
+    magnitude). Column roles:
+
+    ``i``, ``j``
+        atom ids of the pair (required);
+    ``normal_force``
+        normal force, repulsion positive;
+    ``fx``, ``fy``
+        the pair force on atom i (LAMMPS ``fx fy`` of ``pair/local``; for
+        granular styles the normal part only): normal force = -F.n;
+    ``shear_x``, ``shear_y``
+        tangential force on atom i: shear force = F_t . rot90(n);
+    ``shear_force``
+        signed shear force (or a magnitude, e.g. ``p4``);
+    ``dist``
+        centre distance.
+
+    Roles are found from the column names ``patom1 patom2`` / ``id1 id2`` /
+    ``atom1 atom2`` / ``i j`` (ids), ``force`` / ``fn`` / ``normal_force``,
+    ``fx fy``, ``fs`` / ``shear_force``, ``dist``; otherwise the ids are the
+    first compute whose columns ``c_NAME[1] c_NAME[2]`` hold integer atom ids.
+    Pass ``columns={"i": "c_ids[1]", "normal_force": "c_pl[2]", ...}`` to
+    say which column is which. A granular ``pair/local`` also lists pairs
+    within the force cut-off that do not touch: entries with centre distance
+    >= r_i + r_j (from ``dist`` or recomputed from the atoms with the minimum
+    image) are dropped.
+
+Multi-frame files: ``timestep=None`` takes the last frame of the atoms dump,
+and the contacts frame with the same timestep.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.io._table import (
+    FileFormatError,
+    check_unique_ids,
+    integral_column,
+    parse_float_table,
+    read_lines,
+)
+from grainlab.snapshot import Snapshot
+
+__all__ = [
+    "DumpFrame",
+    "attach_lammps_contacts",
+    "list_timesteps",
+    "read_dump_frames",
+    "read_lammps_dump",
+]
+
+
+@dataclasses.dataclass
+class DumpFrame:
+    """One frame of a dump file: header values and the raw table."""
+
+    timestep: int
+    kind: str  # "ATOMS" or "ENTRIES"
+    columns: list[str]
+    data: NDArray[np.float64]
+    line_numbers: NDArray[np.int64]  # 1-based file line of each row
+    box: NDArray[np.float64] | None
+    boundary: list[str]
+    time: float | None
+    header_line: int
+
+
+def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
+    """Walk the frames using the counts in their headers (no scan of data rows)."""
+    frames = []
+    k = 0
+    n_lines = len(lines)
+    while k < n_lines:
+        if not lines[k].strip():
+            k += 1
+            continue
+        if not lines[k].startswith("ITEM: TIMESTEP"):
+            raise FileFormatError(
+                path, k + 1, f"expected 'ITEM: TIMESTEP', found {lines[k][:60]!r}"
+            )
+        frame: dict[str, Any] = {"box": None, "boundary": [], "time": None, "count": None}
+        try:
+            frame["timestep"] = int(lines[k + 1].split()[0])
+        except (IndexError, ValueError):
+            raise FileFormatError(path, k + 2, "expected the timestep number") from None
+        k += 2
+        while True:
+            if k >= n_lines:
+                raise FileFormatError(
+                    path, k, "file ends inside a frame header (no ITEM: ATOMS / ENTRIES)"
+                )
+            item = lines[k]
+            if not item.startswith("ITEM:"):
+                raise FileFormatError(path, k + 1, f"expected an 'ITEM:' line, found {item[:60]!r}")
+            if item.startswith("ITEM: NUMBER OF"):
+                try:
+                    frame["count"] = int(lines[k + 1].split()[0])
+                except (IndexError, ValueError):
+                    raise FileFormatError(
+                        path, k + 2, "expected the number of atoms / entries"
+                    ) from None
+                k += 2
+            elif item.startswith("ITEM: BOX BOUNDS"):
+                flags = item.split()[3:]
+                if "xy" in flags:
+                    raise FileFormatError(path, k + 1, "triclinic boxes are not supported")
+                try:
+                    frame["box"] = np.array(
+                        [[float(v) for v in lines[k + 1 + a].split()[:2]] for a in range(3)]
+                    )
+                except (IndexError, ValueError):
+                    raise FileFormatError(
+                        path, k + 2, "expected three lines of box bounds 'lo hi'"
+                    ) from None
+                frame["boundary"] = flags
+                k += 4
+            elif item.startswith("ITEM: TIME"):
+                try:
+                    frame["time"] = float(lines[k + 1].split()[0])
+                except (IndexError, ValueError):
+                    raise FileFormatError(path, k + 2, "expected the simulation time") from None
+                k += 2
+            elif item.startswith("ITEM: UNITS"):
+                frame["units"] = lines[k + 1].strip() if k + 1 < n_lines else ""
+                k += 2
+            elif item.startswith("ITEM: ATOMS") or item.startswith("ITEM: ENTRIES"):
+                kind = item.split()[1]
+                if frame["count"] is None:
+                    raise FileFormatError(
+                        path, k + 1, f"'ITEM: {kind}' before 'ITEM: NUMBER OF ...'"
+                    )
+                frame["kind"] = kind
+                frame["columns"] = item.split()[2:]
+                frame["header_line"] = k + 1
+                frame["first"] = k + 1
+                k += 1 + frame["count"]
+                if k > n_lines:
+                    raise FileFormatError(
+                        path,
+                        n_lines,
+                        f"file ends inside a frame: expected {frame['count']} rows "
+                        f"after line {frame['header_line']}",
+                    )
+                break
+            else:
+                raise FileFormatError(path, k + 1, f"unknown dump item {item[:60]!r}")
+        frames.append(frame)
+    if not frames:
+        raise FileFormatError(path, None, "empty file: no 'ITEM: TIMESTEP' frame")
+    return frames
+
+
+def list_timesteps(path: str | Path) -> list[int]:
+    """The timesteps of the frames in a dump file, in file order."""
+    return [f["timestep"] for f in _frame_index(path, read_lines(path))]
+
+
+def read_dump_frames(path: str | Path, timestep: int | None = None) -> DumpFrame:
+    """Parse one frame of a dump (the last one when ``timestep`` is None)."""
+    lines = read_lines(path)
+    frames = _frame_index(path, lines)
+    if timestep is None:
+        f = frames[-1]
+    else:
+        match = [fr for fr in frames if fr["timestep"] == int(timestep)]
+        if not match:
+            steps = [fr["timestep"] for fr in frames]
+            shown = ", ".join(map(str, steps[:20])) + (" ..." if len(steps) > 20 else "")
+            raise FileFormatError(
+                path, None, f"no frame with timestep {timestep} (timesteps: {shown})"
+            )
+        f = match[-1]
+    first, count = f["first"], f["count"]
+    rows = lines[first : first + count]
+    numbers = np.arange(first + 1, first + count + 1, dtype=np.int64)
+    columns = f["columns"]
+    if len(set(columns)) != len(columns):
+        raise FileFormatError(path, f["header_line"], "duplicate column names in the header")
+    data = parse_float_table(
+        path, rows, numbers, len(columns), delimiter=None, column_names=columns
+    )
+    return DumpFrame(
+        timestep=f["timestep"],
+        kind=f["kind"],
+        columns=columns,
+        data=data,
+        line_numbers=numbers,
+        box=f["box"],
+        boundary=f["boundary"],
+        time=f["time"],
+        header_line=f["header_line"],
+    )
+
+
+def read_lammps_dump(
+    path: str | Path,
+    *,
+    timestep: int | None = None,
+    contacts: str | Path | None = None,
+    columns: Mapping[str, str] | None = None,
+    tolerance: float = 0.0,
+    detect: bool = True,
+) -> Snapshot:
+    """Read one frame of a LAMMPS atoms dump (and its contacts) into a :class:`Snapshot`.
+
+    ``contacts`` is a ``dump local`` file (see the module docstring;
+    ``columns`` maps its roles to column names). Without it and with
+    ``detect=True``, contacts are detected from the geometry
+    (``tolerance`` in m).
+    """
+    frame = read_dump_frames(path, timestep)
+    if frame.kind != "ATOMS":
+        raise FileFormatError(
+            path,
+            frame.header_line,
+            f"expected an atoms dump ('ITEM: ATOMS'), found 'ITEM: {frame.kind}'",
+        )
+    col = {name: frame.data[:, k] for k, name in enumerate(frame.columns)}
+    where = frame.header_line
+    if "id" not in col:
+        raise FileFormatError(
+            path, where, f"missing column 'id' (columns: {' '.join(frame.columns)})"
+        )
+    numbers = frame.line_numbers
+    if frame.data.shape[0] == 0:
+        raise FileFormatError(path, where, "the frame has no atoms")
+    ids = integral_column(path, col["id"], numbers, "id")
+    check_unique_ids(path, ids, numbers)
+    box2 = None if frame.box is None else frame.box[:2].copy()
+    used = {"id", "z", "zu", "zs", "zsu", "vz", "fz", "omegax", "omegay", "ix", "iy", "iz"}
+    for xn, yn, scaled in (
+        ("x", "y", False),
+        ("xu", "yu", False),
+        ("xs", "ys", True),
+        ("xsu", "ysu", True),
+    ):
+        if xn in col and yn in col:
+            x, y = col[xn].copy(), col[yn].copy()
+            if scaled:
+                if box2 is None:
+                    raise FileFormatError(path, where, "scaled coordinates need the box bounds")
+                x = box2[0, 0] + x * (box2[0, 1] - box2[0, 0])
+                y = box2[1, 0] + y * (box2[1, 1] - box2[1, 0])
+            used |= {xn, yn}
+            position_columns = f"{xn} {yn}"
+            break
+    else:
+        raise FileFormatError(
+            path,
+            where,
+            "missing position columns 'x y' (or xu yu, xs ys) "
+            f"(columns: {' '.join(frame.columns)})",
+        )
+    if "radius" in col:
+        radius = col["radius"]
+        used.add("radius")
+        rname = "radius"
+    elif "diameter" in col:
+        radius = 0.5 * col["diameter"]
+        used.add("diameter")
+        rname = "diameter"
+    else:
+        raise FileFormatError(
+            path,
+            where,
+            f"missing column 'radius' (or 'diameter') (columns: {' '.join(frame.columns)})",
+        )
+    bad = radius <= 0
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise FileFormatError(
+            path, int(numbers[k]), f"column {rname!r}: {col[rname][k]!r} is not > 0"
+        )
+    fields: dict[str, NDArray[Any]] = {}
+    for pair, name in ((("vx", "vy"), "velocity"), (("fx", "fy"), "force")):
+        if pair[0] in col and pair[1] in col:
+            fields[name] = np.c_[col[pair[0]], col[pair[1]]]
+            used |= set(pair)
+    for name, values in col.items():
+        if name not in used:
+            fields[name] = values
+    periodic = (False, False)
+    if frame.boundary:
+        periodic = (frame.boundary[0] == "pp", frame.boundary[1] == "pp")
+    metadata = {
+        "source": str(path),
+        "format": "lammps-dump",
+        "timestep": frame.timestep,
+        "positions": position_columns,
+    }
+    snap_kwargs: dict[str, Any] = dict(
+        ids=ids,
+        particle_fields=fields,
+        box=box2,
+        periodic=periodic if box2 is not None else (False, False),
+        time=frame.time,
+        metadata=metadata,
+    )
+    positions = np.c_[x, y]
+    if contacts is not None:
+        snap = Snapshot(positions, radius, **snap_kwargs)
+        return attach_lammps_contacts(snap, contacts, timestep=frame.timestep, columns=columns)
+    if detect:
+        return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **snap_kwargs)
+    return Snapshot(positions, radius, **snap_kwargs)
+
+
+_ID_NAMES = (("patom1", "patom2"), ("id1", "id2"), ("atom1", "atom2"), ("i", "j"))
+_ROLE_NAMES = {
+    "normal_force": ("normal_force", "fn", "force"),
+    "shear_force": ("shear_force", "fs"),
+    "dist": ("dist",),
+    "fx": ("fx",),
+    "fy": ("fy",),
+}
+_ROLES = ("i", "j", "normal_force", "shear_force", "fx", "fy", "shear_x", "shear_y", "dist")
+
+
+def _resolve_columns(
+    path: str | Path,
+    frame: DumpFrame,
+    columns: Mapping[str, str] | None,
+    atom_ids: NDArray[np.int64],
+) -> dict[str, int]:
+    names = frame.columns
+    lower = [c.lower() for c in names]
+    roles: dict[str, int] = {}
+    for role, name in (columns or {}).items():
+        if role not in _ROLES:
+            raise ValueError(f"columns: unknown role {role!r} (roles: {', '.join(_ROLES)})")
+        if name not in names:
+            raise FileFormatError(
+                path,
+                frame.header_line,
+                f"no column {name!r} for role {role!r} (columns: {' '.join(names)})",
+            )
+        roles[role] = names.index(name)
+    if "i" not in roles or "j" not in roles:
+        for a, b in _ID_NAMES:
+            if a in lower and b in lower:
+                roles.setdefault("i", lower.index(a))
+                roles.setdefault("j", lower.index(b))
+                break
+        else:
+            roles.update(_guess_id_columns(frame, atom_ids))
+    for role, options in _ROLE_NAMES.items():
+        if role not in roles:
+            for opt in options:
+                if opt in lower:
+                    roles[role] = lower.index(opt)
+                    break
+    if "i" not in roles or "j" not in roles:
+        raise FileFormatError(
+            path,
+            frame.header_line,
+            "cannot tell which columns hold the two atom ids; name them with "
+            "columns={'i': ..., 'j': ...} (columns: " + " ".join(names) + ")",
+        )
+    return roles
+
+
+def _guess_id_columns(frame: DumpFrame, atom_ids: NDArray[np.int64]) -> dict[str, int]:
+    """First c_NAME[1], c_NAME[2] pair of columns whose values are all atom ids."""
+    pattern = re.compile(r"^(c_[^\[]+)\[1\]$")
+    for k, name in enumerate(frame.columns):
+        m = pattern.match(name)
+        if not m:
+            continue
+        second = f"{m.group(1)}[2]"
+        if second not in frame.columns:
+            continue
+        k2 = frame.columns.index(second)
+        a, b = frame.data[:, k], frame.data[:, k2]
+        if (
+            np.all(a == np.round(a))
+            and np.all(b == np.round(b))
+            and np.all(np.isin(a, atom_ids))
+            and np.all(np.isin(b, atom_ids))
+        ):
+            return {"i": k, "j": k2}
+    return {}
+
+
+def attach_lammps_contacts(
+    snapshot: Snapshot,
+    path: str | Path,
+    *,
+    timestep: int | None = None,
+    columns: Mapping[str, str] | None = None,
+) -> Snapshot:
+    """The snapshot with contacts from a LAMMPS ``dump local`` file (see module docstring)."""
+    if timestep is None:
+        timestep = snapshot.metadata.get("timestep")
+    frame = read_dump_frames(path, timestep)
+    if frame.kind != "ENTRIES":
+        raise FileFormatError(
+            path,
+            frame.header_line,
+            f"expected a local dump ('ITEM: ENTRIES'), found 'ITEM: {frame.kind}'",
+        )
+    ids = np.asarray(snapshot.ids)
+    roles = _resolve_columns(path, frame, columns, ids)
+    data, numbers = frame.data, frame.line_numbers
+    id_i = integral_column(path, data[:, roles["i"]], numbers, frame.columns[roles["i"]])
+    id_j = integral_column(path, data[:, roles["j"]], numbers, frame.columns[roles["j"]])
+    i = snapshot.index_of(id_i)
+    j = snapshot.index_of(id_j)
+    for role, idx, vals in (("i", i, id_i), ("j", j, id_j)):
+        bad = idx < 0
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(
+                path,
+                int(numbers[k]),
+                f"column {frame.columns[roles[role]]!r}: unknown atom id {int(vals[k])}",
+            )
+    same = i == j
+    if same.any():
+        k = int(np.argmax(same))
+        raise FileFormatError(path, int(numbers[k]), f"atom id {int(id_i[k])} paired with itself")
+
+    d = snapshot.minimum_image(snapshot.positions[j] - snapshot.positions[i])
+    dist_geom = np.hypot(d[:, 0], d[:, 1])
+    dist = data[:, roles["dist"]] if "dist" in roles else dist_geom
+    touching = dist < snapshot.radii[i] + snapshot.radii[j]
+    if np.any(dist_geom == 0.0):
+        k = int(np.argmax(dist_geom == 0.0))
+        raise FileFormatError(
+            path, int(numbers[k]), "the two atoms of this pair have the same position"
+        )
+    n_hat = d / dist_geom[:, None]
+    t_hat = np.c_[-n_hat[:, 1], n_hat[:, 0]]
+
+    normal_force = None
+    if "normal_force" in roles:
+        normal_force = data[:, roles["normal_force"]]
+    elif "fx" in roles and "fy" in roles:
+        normal_force = -(data[:, roles["fx"]] * n_hat[:, 0] + data[:, roles["fy"]] * n_hat[:, 1])
+    shear_force = None
+    if "shear_x" in roles and "shear_y" in roles:
+        shear_force = (
+            data[:, roles["shear_x"]] * t_hat[:, 0] + data[:, roles["shear_y"]] * t_hat[:, 1]
+        )
+    elif "shear_force" in roles:
+        shear_force = data[:, roles["shear_force"]]
+
+    keep = touching
+    metadata = dict(snapshot.metadata)
+    metadata["contacts"] = (
+        f"read from {path} (timestep {frame.timestep}); {int((~keep).sum())} listed pairs "
+        "not touching were dropped"
+    )
+    metadata["contact_columns"] = {role: frame.columns[k] for role, k in roles.items()}
+    sel = lambda a: None if a is None else a[keep]  # noqa: E731
+    return dataclasses.replace(
+        snapshot,
+        contact_i=i[keep],
+        contact_j=j[keep],
+        normal_force=sel(normal_force),
+        shear_force=sel(shear_force),
+        contact_normal=None,
+        contact_point=None,
+        contact_fields={},
+        metadata=metadata,
+    )
