@@ -1,5 +1,30 @@
-"""grainlab: a 2D discrete element laboratory for granular soils."""
+"""grainlab: a 2D discrete element laboratory for granular soils.
 
-from grainlab._core import __version__
+The engine is Rust (:mod:`grainlab._core`); :class:`Simulation` drives it from NumPy.
+"""
 
-__all__ = ["__version__"]
+from grainlab._core import SimulationUnstableError, __version__, density_scaling_factor
+from grainlab.simulation import (
+    FIX_ROTATION,
+    FIX_X,
+    FIX_Y,
+    ContactModel,
+    Contacts,
+    Simulation,
+    Wall,
+    WallContacts,
+)
+
+__all__ = [
+    "FIX_ROTATION",
+    "FIX_X",
+    "FIX_Y",
+    "ContactModel",
+    "Contacts",
+    "Simulation",
+    "SimulationUnstableError",
+    "Wall",
+    "WallContacts",
+    "__version__",
+    "density_scaling_factor",
+]

@@ -33,6 +33,11 @@ use crate::state::Particles;
 use crate::vec2::{add, dot, mat_vec, norm, perp, scale, sub, Mat2, Vec2};
 use crate::wall::{Wall, WallControl};
 
+/// Below this many particles the blocks run one after another on the calling
+/// thread: the same partition and order, so the same bits, without the
+/// hand-over cost that would dominate a tiny system.
+const PARALLEL_MIN_PARTICLES: usize = 1024;
+
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct StepParameters {
@@ -393,6 +398,14 @@ impl Simulation {
         )
     }
 
+    /// Runs `n` steps without measuring any of them (faster; dissipation is still tallied).
+    pub fn advance(&mut self, n: u64) -> Result<()> {
+        for _ in 0..n {
+            self.step::<false>()?;
+        }
+        Ok(())
+    }
+
     /// Runs `n` steps; the last one is measured (see [`Simulation::measurements`]).
     pub fn run(&mut self, n: u64) -> Result<()> {
         for k in 0..n {
@@ -493,6 +506,10 @@ impl Simulation {
     /// Steps 2-3: reset resultants, then particle-particle contact forces.
     fn particle_contacts<const MEASURE: bool>(&mut self) -> ContactTally {
         let n_blocks = self.neighbors.block_particles.len();
+        let pool = self
+            .pool
+            .as_ref()
+            .filter(|_| self.particles.len() >= PARALLEL_MIN_PARTICLES);
         let pairs = &mut self.neighbors.pairs;
         let starts = pairs.block_start.clone();
         let mut ranges: Vec<(usize, usize)> =
@@ -539,7 +556,7 @@ impl Simulation {
             .map(|(b, (s, l))| (b, s, l))
             .collect();
         let block_particles = &self.neighbors.block_particles;
-        let tallies = map_blocks(self.pool.as_ref(), blocks, |(b, shear, sliding)| {
+        let tallies = map_blocks(pool, blocks, |(b, shear, sliding)| {
             // SAFETY: block b resets and writes only the forces of its own particles
             // (pairs in its range have both particles in block b).
             unsafe {
@@ -671,6 +688,10 @@ impl Simulation {
             Some((_, m)) => self.neighbors.advance_map(m).accumulated_map,
             None => self.neighbors.reference().accumulated_map,
         };
+        let pool = self
+            .pool
+            .as_ref()
+            .filter(|_| self.particles.len() >= PARALLEL_MIN_PARTICLES);
         let p = &mut self.particles;
         let has_external = self.params.gravity != [0.0, 0.0]
             || p.external_force.iter().any(|f| *f != [0.0, 0.0])
@@ -714,7 +735,7 @@ impl Simulation {
                 },
             )
             .collect();
-        let tallies = map_blocks(self.pool.as_ref(), chunks, |chunk| {
+        let tallies = map_blocks(pool, chunks, |chunk| {
             integrate_chunk::<MEASURE>(chunk, &inputs, &step)
         });
         let mut total = IntegrationTally::default();

@@ -1,0 +1,638 @@
+//! `grainlab._core.Engine`: the engine's simulation, method for method.
+use grainlab_core::{
+    ContactModel, Particles, PeriodicCell, ServoControl, Simulation, Wall, WallControl, WallShape,
+};
+use numpy::{PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+
+use crate::convert::{points, points_to_py, same_length, to_py_err, values, values_to_py};
+
+/// Steps run between checks for Ctrl-C.
+const STEPS_PER_SIGNAL_CHECK: u64 = 2000;
+
+/// The engine's simulation state and step.
+#[pyclass(module = "grainlab._core")]
+pub struct Engine {
+    sim: Simulation,
+}
+
+fn point(field: &str, v: Vec<f64>) -> PyResult<[f64; 2]> {
+    match v.as_slice() {
+        [x, y] => Ok([*x, *y]),
+        _ => Err(PyValueError::new_err(format!(
+            "{field}: expected 2 numbers, got {}",
+            v.len()
+        ))),
+    }
+}
+
+#[pymethods]
+impl Engine {
+    #[new]
+    #[pyo3(signature = (positions, radii, density, normal_stiffness, shear_stiffness, friction, time_step, threads))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        positions: PyReadonlyArray2<'_, f64>,
+        radii: PyReadonlyArray1<'_, f64>,
+        density: PyReadonlyArray1<'_, f64>,
+        normal_stiffness: f64,
+        shear_stiffness: f64,
+        friction: f64,
+        time_step: f64,
+        threads: usize,
+    ) -> PyResult<Self> {
+        let particles = Particles::new(
+            points("positions", &positions)?,
+            values(&radii),
+            values(&density),
+        )
+        .map_err(to_py_err)?;
+        let model = ContactModel::linear(normal_stiffness, shear_stiffness, friction);
+        let sim = Simulation::new(particles, model, time_step, threads).map_err(to_py_err)?;
+        Ok(Engine { sim })
+    }
+
+    // ---- running ----
+
+    /// Runs `steps` steps with the GIL released; the last step is measured.
+    fn run(&mut self, py: Python<'_>, steps: u64) -> PyResult<()> {
+        let mut left = steps;
+        while left > 0 {
+            let chunk = left.min(STEPS_PER_SIGNAL_CHECK);
+            let last = chunk == left;
+            let sim = &mut self.sim;
+            py.detach(|| {
+                if last {
+                    sim.run(chunk)
+                } else {
+                    sim.advance(chunk)
+                }
+            })
+            .map_err(to_py_err)?;
+            left -= chunk;
+            py.check_signals()?;
+        }
+        Ok(())
+    }
+
+    fn critical_time_step(&mut self, safety: f64) -> PyResult<f64> {
+        self.sim.critical_time_step(safety).map_err(to_py_err)
+    }
+
+    #[getter]
+    fn step_count(&self) -> u64 {
+        self.sim.step_count
+    }
+
+    #[getter]
+    fn time(&self) -> f64 {
+        self.sim.time
+    }
+
+    #[getter]
+    fn threads(&self) -> usize {
+        self.sim.threads()
+    }
+
+    fn set_threads(&mut self, threads: usize) -> PyResult<()> {
+        self.sim.set_threads(threads).map_err(to_py_err)
+    }
+
+    #[getter]
+    fn neighbor_builds(&self) -> u64 {
+        self.sim.neighbors.build_count
+    }
+
+    #[getter]
+    fn n_particles(&self) -> usize {
+        self.sim.particles.len()
+    }
+
+    // ---- parameters ----
+
+    #[getter]
+    fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let p = self.sim.params;
+        let d = PyDict::new(py);
+        d.set_item("time_step", p.time_step)?;
+        d.set_item("local_damping", p.local_damping)?;
+        d.set_item("gravity", (p.gravity[0], p.gravity[1]))?;
+        d.set_item("max_overlap_ratio", p.max_overlap_ratio)?;
+        d.set_item("skin", self.sim.neighbors.skin)?;
+        Ok(d)
+    }
+
+    #[pyo3(signature = (time_step, local_damping, gravity, max_overlap_ratio))]
+    fn set_parameters(
+        &mut self,
+        time_step: f64,
+        local_damping: f64,
+        gravity: Vec<f64>,
+        max_overlap_ratio: f64,
+    ) -> PyResult<()> {
+        let params = grainlab_core::StepParameters {
+            time_step,
+            local_damping,
+            gravity: point("gravity", gravity)?,
+            max_overlap_ratio,
+        };
+        self.sim.set_params(params).map_err(to_py_err)
+    }
+
+    fn set_skin(&mut self, skin: f64) -> PyResult<()> {
+        self.sim.set_skin(skin).map_err(to_py_err)
+    }
+
+    #[pyo3(signature = (group_a, group_b, normal_stiffness, shear_stiffness, friction, normal_damping_ratio, shear_damping_ratio))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_contact_model(
+        &mut self,
+        group_a: usize,
+        group_b: usize,
+        normal_stiffness: f64,
+        shear_stiffness: f64,
+        friction: f64,
+        normal_damping_ratio: f64,
+        shear_damping_ratio: f64,
+    ) -> PyResult<()> {
+        let model = ContactModel {
+            normal_stiffness,
+            shear_stiffness,
+            friction,
+            normal_damping_ratio,
+            shear_damping_ratio,
+        };
+        self.sim
+            .set_contact_model(group_a, group_b, model)
+            .map_err(to_py_err)
+    }
+
+    fn contact_model<'py>(
+        &self,
+        py: Python<'py>,
+        group_a: u8,
+        group_b: u8,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        if group_a as usize >= grainlab_core::state::MAX_GROUPS
+            || group_b as usize >= grainlab_core::state::MAX_GROUPS
+        {
+            return Err(PyValueError::new_err("group: out of range 0..16"));
+        }
+        let m = self.sim.materials.get(group_a, group_b);
+        let d = PyDict::new(py);
+        d.set_item("normal_stiffness", m.normal_stiffness)?;
+        d.set_item("shear_stiffness", m.shear_stiffness)?;
+        d.set_item("friction", m.friction)?;
+        d.set_item("normal_damping_ratio", m.normal_damping_ratio)?;
+        d.set_item("shear_damping_ratio", m.shear_damping_ratio)?;
+        Ok(d)
+    }
+
+    // ---- particle state ----
+
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        points_to_py(py, &self.sim.particles.position)
+    }
+    #[getter]
+    fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        points_to_py(py, &self.sim.particles.velocity)
+    }
+    #[getter]
+    fn forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        points_to_py(py, &self.sim.particles.force)
+    }
+    #[getter]
+    fn external_forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        points_to_py(py, &self.sim.particles.external_force)
+    }
+    #[getter]
+    fn rotations<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.rotation)
+    }
+    #[getter]
+    fn angular_velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.angular_velocity)
+    }
+    #[getter]
+    fn torques<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.torque)
+    }
+    #[getter]
+    fn external_torques<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.external_torque)
+    }
+    #[getter]
+    fn radii<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.radius)
+    }
+    #[getter]
+    fn densities<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.density)
+    }
+    #[getter]
+    fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.mass)
+    }
+    #[getter]
+    fn inertias<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.inertia)
+    }
+    #[getter]
+    fn groups<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.group)
+    }
+    #[getter]
+    fn fixity<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.particles.fixity)
+    }
+
+    fn set_positions(&mut self, positions: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let v = points("positions", &positions)?;
+        same_length("positions", v.len(), self.sim.particles.len())?;
+        check_finite_points("positions", &v)?;
+        self.sim.particles.position = v;
+        self.sim.invalidate_neighbors();
+        Ok(())
+    }
+
+    fn set_velocities(&mut self, velocities: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let v = points("velocities", &velocities)?;
+        same_length("velocities", v.len(), self.sim.particles.len())?;
+        check_finite_points("velocities", &v)?;
+        self.sim.particles.velocity = v;
+        self.sim.velocities_changed();
+        Ok(())
+    }
+
+    fn set_external_forces(&mut self, forces: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let v = points("external_forces", &forces)?;
+        same_length("external_forces", v.len(), self.sim.particles.len())?;
+        check_finite_points("external_forces", &v)?;
+        self.sim.particles.external_force = v;
+        Ok(())
+    }
+
+    fn set_rotations(&mut self, rotations: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        let v = values(&rotations);
+        same_length("rotations", v.len(), self.sim.particles.len())?;
+        check_finite("rotations", &v)?;
+        self.sim.particles.rotation = v;
+        Ok(())
+    }
+
+    fn set_angular_velocities(&mut self, omega: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        let v = values(&omega);
+        same_length("angular_velocities", v.len(), self.sim.particles.len())?;
+        check_finite("angular_velocities", &v)?;
+        self.sim.particles.angular_velocity = v;
+        self.sim.velocities_changed();
+        Ok(())
+    }
+
+    fn set_external_torques(&mut self, torques: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        let v = values(&torques);
+        same_length("external_torques", v.len(), self.sim.particles.len())?;
+        check_finite("external_torques", &v)?;
+        self.sim.particles.external_torque = v;
+        Ok(())
+    }
+
+    fn set_radii(&mut self, radii: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        let v = values(&radii);
+        same_length("radii", v.len(), self.sim.particles.len())?;
+        for (k, &r) in v.iter().enumerate() {
+            grainlab_core::error::require_positive(&format!("radii[{k}]"), r).map_err(to_py_err)?;
+        }
+        self.sim.particles.radius = v;
+        self.sim.particles.update_mass_properties();
+        self.sim.invalidate_neighbors();
+        Ok(())
+    }
+
+    fn set_densities(&mut self, densities: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        let v = values(&densities);
+        same_length("densities", v.len(), self.sim.particles.len())?;
+        for (k, &r) in v.iter().enumerate() {
+            grainlab_core::error::require_positive(&format!("densities[{k}]"), r)
+                .map_err(to_py_err)?;
+        }
+        self.sim.particles.density = v;
+        self.sim.particles.update_mass_properties();
+        Ok(())
+    }
+
+    fn set_groups(&mut self, groups: PyReadonlyArray1<'_, u8>) -> PyResult<()> {
+        let v = values(&groups);
+        same_length("groups", v.len(), self.sim.particles.len())?;
+        if let Some((k, g)) = v
+            .iter()
+            .enumerate()
+            .find(|(_, &g)| g as usize >= grainlab_core::state::MAX_GROUPS)
+        {
+            return Err(PyValueError::new_err(format!(
+                "groups[{k}]: group {g} out of range 0..16"
+            )));
+        }
+        self.sim.particles.group = v;
+        self.sim.invalidate_neighbors();
+        Ok(())
+    }
+
+    fn set_fixity(&mut self, fixity: PyReadonlyArray1<'_, u8>) -> PyResult<()> {
+        let v = values(&fixity);
+        same_length("fixity", v.len(), self.sim.particles.len())?;
+        if let Some((k, f)) = v.iter().enumerate().find(|(_, &f)| f > 7) {
+            return Err(PyValueError::new_err(format!(
+                "fixity[{k}]: {f} is not a combination of 1 (x), 2 (y), 4 (rotation)"
+            )));
+        }
+        self.sim.particles.fixity = v;
+        Ok(())
+    }
+
+    // ---- periodic cell ----
+
+    #[pyo3(signature = (origin, a, b, periodic))]
+    fn set_cell(
+        &mut self,
+        origin: Vec<f64>,
+        a: Vec<f64>,
+        b: Vec<f64>,
+        periodic: (bool, bool),
+    ) -> PyResult<()> {
+        let cell = PeriodicCell {
+            origin: point("cell.origin", origin)?,
+            a: point("cell.a", a)?,
+            b: point("cell.b", b)?,
+            periodic: [periodic.0, periodic.1],
+            velocity_gradient: self
+                .sim
+                .cell
+                .as_ref()
+                .map_or([[0.0; 2]; 2], |c| c.velocity_gradient),
+        };
+        self.sim.set_cell(Some(cell)).map_err(to_py_err)
+    }
+
+    fn clear_cell(&mut self) -> PyResult<()> {
+        self.sim.set_cell(None).map_err(to_py_err)
+    }
+
+    fn set_velocity_gradient(&mut self, gradient: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let g = gradient.as_array();
+        if g.shape() != [2, 2] {
+            return Err(PyValueError::new_err(format!(
+                "velocity_gradient: expected shape (2, 2), got {:?}",
+                g.shape()
+            )));
+        }
+        let Some(cell) = self.sim.cell.clone() else {
+            return Err(PyValueError::new_err(
+                "velocity_gradient: set a periodic cell first",
+            ));
+        };
+        let mut cell = cell;
+        cell.velocity_gradient = [[g[[0, 0]], g[[0, 1]]], [g[[1, 0]], g[[1, 1]]]];
+        self.sim.set_cell(Some(cell)).map_err(to_py_err)
+    }
+
+    #[getter]
+    fn cell<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(c) = &self.sim.cell else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("origin", (c.origin[0], c.origin[1]))?;
+        d.set_item("a", (c.a[0], c.a[1]))?;
+        d.set_item("b", (c.b[0], c.b[1]))?;
+        d.set_item("periodic", (c.periodic[0], c.periodic[1]))?;
+        let l = c.velocity_gradient;
+        d.set_item(
+            "velocity_gradient",
+            ((l[0][0], l[0][1]), (l[1][0], l[1][1])),
+        )?;
+        d.set_item("area", c.area())?;
+        Ok(Some(d))
+    }
+
+    // ---- walls ----
+
+    fn add_segment_wall(&mut self, a: Vec<f64>, b: Vec<f64>, group: u8) -> PyResult<usize> {
+        let shape = WallShape::Segment {
+            a: point("a", a)?,
+            b: point("b", b)?,
+        };
+        Ok(self
+            .sim
+            .add_wall(Wall::new(shape, group).map_err(to_py_err)?))
+    }
+
+    fn add_line_wall(
+        &mut self,
+        point_on_line: Vec<f64>,
+        normal: Vec<f64>,
+        group: u8,
+    ) -> PyResult<usize> {
+        let shape = WallShape::Line {
+            point: point("point", point_on_line)?,
+            normal: point("normal", normal)?,
+        };
+        Ok(self
+            .sim
+            .add_wall(Wall::new(shape, group).map_err(to_py_err)?))
+    }
+
+    #[getter]
+    fn n_walls(&self) -> usize {
+        self.sim.walls.len()
+    }
+
+    fn set_wall_velocity(&mut self, wall_id: usize, velocity: Vec<f64>) -> PyResult<()> {
+        let v = point("velocity", velocity)?;
+        for c in v {
+            grainlab_core::error::require_finite("velocity", c).map_err(to_py_err)?;
+        }
+        let wall = self.sim.wall_mut(wall_id).map_err(to_py_err)?;
+        wall.control = WallControl::Velocity;
+        wall.velocity = v;
+        Ok(())
+    }
+
+    fn set_wall_servo(
+        &mut self,
+        wall_id: usize,
+        target_stress: f64,
+        loaded_length: f64,
+        relaxation: f64,
+        max_speed: f64,
+    ) -> PyResult<()> {
+        let servo = ServoControl {
+            target_stress,
+            loaded_length,
+            relaxation,
+            max_speed,
+        };
+        self.sim
+            .set_wall_control(wall_id, WallControl::Servo(servo))
+            .map_err(to_py_err)
+    }
+
+    fn move_wall(&mut self, wall_id: usize, displacement: Vec<f64>) -> PyResult<()> {
+        let d = point("displacement", displacement)?;
+        self.sim.wall_mut(wall_id).map_err(to_py_err)?.translate(d);
+        Ok(())
+    }
+
+    fn wall_state<'py>(&mut self, py: Python<'py>, wall_id: usize) -> PyResult<Bound<'py, PyDict>> {
+        let wall = self.sim.wall_mut(wall_id).map_err(to_py_err)?.clone();
+        let d = PyDict::new(py);
+        match wall.shape {
+            WallShape::Segment { a, b } => {
+                d.set_item("kind", "segment")?;
+                d.set_item("a", (a[0], a[1]))?;
+                d.set_item("b", (b[0], b[1]))?;
+            }
+            WallShape::Line { point, normal } => {
+                d.set_item("kind", "line")?;
+                d.set_item("point", (point[0], point[1]))?;
+                d.set_item("normal", (normal[0], normal[1]))?;
+            }
+        }
+        let n = wall.inward_normal();
+        d.set_item("inward_normal", (n[0], n[1]))?;
+        d.set_item("velocity", (wall.velocity[0], wall.velocity[1]))?;
+        d.set_item("force", (wall.force[0], wall.force[1]))?;
+        d.set_item("contact_count", wall.contact_count)?;
+        d.set_item("displacement", (wall.displacement[0], wall.displacement[1]))?;
+        d.set_item("group", wall.group)?;
+        match wall.control {
+            WallControl::Velocity => d.set_item("control", "velocity")?,
+            WallControl::Servo(s) => {
+                d.set_item("control", "servo")?;
+                d.set_item("target_stress", s.target_stress)?;
+                d.set_item("loaded_length", s.loaded_length)?;
+                d.set_item("relaxation", s.relaxation)?;
+                d.set_item("max_speed", s.max_speed)?;
+            }
+        }
+        Ok(d)
+    }
+
+    // ---- bonds ----
+
+    #[pyo3(signature = (i, j, normal_stiffness, shear_stiffness, rest_length=None))]
+    fn add_bond(
+        &mut self,
+        i: usize,
+        j: usize,
+        normal_stiffness: f64,
+        shear_stiffness: f64,
+        rest_length: Option<f64>,
+    ) -> PyResult<()> {
+        self.sim
+            .add_bond(i, j, normal_stiffness, shear_stiffness, rest_length)
+            .map_err(to_py_err)
+    }
+
+    #[getter]
+    fn n_bonds(&self) -> usize {
+        self.sim.bonds.len()
+    }
+
+    // ---- contacts and diagnostics ----
+
+    fn contacts<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = self.sim.contacts().map_err(to_py_err)?;
+        let d = PyDict::new(py);
+        d.set_item("i", values_to_py(py, &c.i))?;
+        d.set_item("j", values_to_py(py, &c.j))?;
+        d.set_item("point", points_to_py(py, &c.point)?)?;
+        d.set_item("normal", points_to_py(py, &c.normal)?)?;
+        d.set_item("overlap", values_to_py(py, &c.overlap))?;
+        d.set_item("normal_force", values_to_py(py, &c.normal_force))?;
+        d.set_item("shear_force", values_to_py(py, &c.shear_force))?;
+        d.set_item("sliding", values_to_py(py, &c.sliding))?;
+        d.set_item("bonded", values_to_py(py, &c.bonded))?;
+        Ok(d)
+    }
+
+    fn wall_contacts<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = self.sim.wall_contacts().map_err(to_py_err)?;
+        let d = PyDict::new(py);
+        d.set_item("wall", values_to_py(py, &c.wall))?;
+        d.set_item("particle", values_to_py(py, &c.particle))?;
+        d.set_item("point", points_to_py(py, &c.point)?)?;
+        d.set_item("normal", points_to_py(py, &c.normal)?)?;
+        d.set_item("overlap", values_to_py(py, &c.overlap))?;
+        d.set_item("normal_force", values_to_py(py, &c.normal_force))?;
+        d.set_item("shear_force", values_to_py(py, &c.shear_force))?;
+        d.set_item("sliding", values_to_py(py, &c.sliding))?;
+        Ok(d)
+    }
+
+    #[getter]
+    fn measurements<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let m = self.sim.measurements;
+        let d = PyDict::new(py);
+        d.set_item("step", m.step)?;
+        d.set_item("contact_count", m.contact_count)?;
+        d.set_item("wall_contact_count", m.wall_contact_count)?;
+        d.set_item("mean_unbalanced_force_ratio", m.mean_unbalanced_force_ratio)?;
+        Ok(d)
+    }
+
+    #[getter]
+    fn energy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let e = self.sim.energy();
+        let d = PyDict::new(py);
+        d.set_item("kinetic", e.kinetic)?;
+        d.set_item("elastic", e.elastic)?;
+        d.set_item("friction_dissipated", e.friction_dissipated)?;
+        d.set_item("viscous_dissipated", e.viscous_dissipated)?;
+        d.set_item("damping_dissipated", e.damping_dissipated)?;
+        d.set_item("wall_work", e.wall_work)?;
+        d.set_item("external_work", e.external_work)?;
+        d.set_item("balance", e.balance())?;
+        Ok(d)
+    }
+
+    // ---- state ----
+
+    fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = self.sim.to_bytes().map_err(to_py_err)?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+        Ok(Engine {
+            sim: Simulation::from_bytes(data).map_err(to_py_err)?,
+        })
+    }
+}
+
+fn check_finite_points(field: &str, v: &[[f64; 2]]) -> PyResult<()> {
+    if let Some(k) = v
+        .iter()
+        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return Err(PyValueError::new_err(format!(
+            "{field}[{k}]: must be finite, got {:?}",
+            v[k]
+        )));
+    }
+    Ok(())
+}
+
+fn check_finite(field: &str, v: &[f64]) -> PyResult<()> {
+    if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "{field}[{k}]: must be finite, got {}",
+            v[k]
+        )));
+    }
+    Ok(())
+}

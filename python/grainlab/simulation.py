@@ -1,0 +1,691 @@
+"""The engine from Python: build a simulation from NumPy arrays and run it.
+
+All per-step work happens in the Rust engine (:mod:`grainlab._core`); this
+module validates input, converts arrays and gives the state friendly names.
+Conventions (DESIGN.md §2): SI units, 2D disks of unit thickness
+(``m = rho pi r^2``, ``I = m r^2 / 2``), angles in radians counter-clockwise,
+stresses compression positive.
+
+Example
+-------
+>>> import numpy as np
+>>> from grainlab import Simulation
+>>> sim = Simulation(positions=[[0.0, 0.0], [1.9e-3, 0.0]], radii=[1e-3, 1e-3])
+>>> sim.velocities = [[0.01, 0.0], [-0.01, 0.0]]
+>>> sim.run(10_000)
+>>> bool(sim.velocities[0, 0] < 0)  # the disks bounced apart
+True
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from grainlab import _core
+
+#: Table 1 of the paper: contact stiffnesses (N/m), particle friction, density (kg/m^3).
+TABLE1_STIFFNESS_N_PER_M = 8.45e7
+TABLE1_FRICTION = 0.9
+TABLE1_DENSITY_KG_PER_M3 = 2.0e8
+TABLE1_LOCAL_DAMPING = 0.8
+
+#: Bits of :attr:`Simulation.fixity`.
+FIX_X, FIX_Y, FIX_ROTATION = 1, 2, 4
+
+#: Number of material groups (contact models are set per pair of groups).
+MAX_GROUPS = 16
+
+#: Group that walls get by default, so particle-wall contacts can differ from particle-particle ones.
+WALL_GROUP = 1
+
+_STATE_MAGIC = b"GRAINLAB-ENGINE-STATE\n"
+
+
+@dataclass(frozen=True)
+class ContactModel:
+    """Linear contact law with Coulomb friction between two material groups.
+
+    ``normal_stiffness`` and ``shear_stiffness`` are *contact* stiffnesses kn, ks
+    (N/m): ``Fn = kn * overlap``, ``dFs = -ks * ds`` (paper Eq. 2-4). The damping
+    ratios are fractions of critical damping of optional viscous dashpots
+    (``2 sqrt(m* k)``); they are independent of local damping.
+    """
+
+    normal_stiffness: float = TABLE1_STIFFNESS_N_PER_M
+    shear_stiffness: float = TABLE1_STIFFNESS_N_PER_M
+    friction: float = TABLE1_FRICTION
+    normal_damping_ratio: float = 0.0
+    shear_damping_ratio: float = 0.0
+
+
+@dataclass(frozen=True)
+class Contacts:
+    """Particle-particle contacts (and bonds) as parallel arrays, sorted by ``(i, j)``.
+
+    ``normal`` is the unit vector from ``i`` to ``j``; ``normal_force`` (N, >= 0
+    unless bonded) and ``shear_force`` (N, along ``(-n_y, n_x)``) act on ``j``,
+    their opposites on ``i``. Forces are the elastic parts (no dashpot forces).
+    """
+
+    i: NDArray[np.uint32]
+    j: NDArray[np.uint32]
+    point: NDArray[np.float64]
+    normal: NDArray[np.float64]
+    overlap: NDArray[np.float64]
+    normal_force: NDArray[np.float64]
+    shear_force: NDArray[np.float64]
+    sliding: NDArray[np.bool_]
+    bonded: NDArray[np.bool_]
+
+    def __len__(self) -> int:
+        return len(self.i)
+
+
+@dataclass(frozen=True)
+class WallContacts:
+    """Particle-wall contacts; ``normal`` points from the wall to the particle and
+    the forces act on the particle."""
+
+    wall: NDArray[np.uint32]
+    particle: NDArray[np.uint32]
+    point: NDArray[np.float64]
+    normal: NDArray[np.float64]
+    overlap: NDArray[np.float64]
+    normal_force: NDArray[np.float64]
+    shear_force: NDArray[np.float64]
+    sliding: NDArray[np.bool_]
+
+    def __len__(self) -> int:
+        return len(self.wall)
+
+
+def _readonly(array: Any) -> NDArray[Any]:
+    array.flags.writeable = False
+    return array
+
+
+def _points(name: str, value: ArrayLike, n: int | None = None) -> NDArray[np.float64]:
+    try:
+        array = np.ascontiguousarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name}: expected an (N, 2) array of numbers ({error})") from None
+    if array.ndim != 2 or array.shape[1] != 2:
+        raise ValueError(f"{name}: expected shape (N, 2), got {array.shape}")
+    if n is not None and len(array) != n:
+        raise ValueError(f"{name}: has {len(array)} rows but there are {n} particles")
+    if not np.all(np.isfinite(array)):
+        k = int(np.argwhere(~np.isfinite(array))[0, 0])
+        raise ValueError(f"{name}[{k}]: must be finite, got {array[k].tolist()}")
+    return array
+
+
+def _values(name: str, value: ArrayLike, n: int, dtype: Any = np.float64) -> NDArray[Any]:
+    array = np.asarray(value)
+    if array.ndim == 0:
+        array = np.full(n, array)
+    try:
+        array = np.ascontiguousarray(array, dtype=dtype)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name}: expected {n} numbers ({error})") from None
+    if array.ndim != 1 or len(array) != n:
+        raise ValueError(f"{name}: expected a scalar or {n} values, got shape {array.shape}")
+    if array.dtype.kind == "f" and not np.all(np.isfinite(array)):
+        k = int(np.argwhere(~np.isfinite(array))[0, 0])
+        raise ValueError(f"{name}[{k}]: must be finite, got {array[k]}")
+    return array
+
+
+def _vector(name: str, value: ArrayLike) -> tuple[float, float]:
+    array = np.asarray(value, dtype=np.float64)
+    if array.shape != (2,) or not np.all(np.isfinite(array)):
+        raise ValueError(f"{name}: expected two finite numbers, got {value!r}")
+    return float(array[0]), float(array[1])
+
+
+class Wall:
+    """A handle on one wall of a :class:`Simulation` (walls are owned by the engine).
+
+    The *inward normal* points to the particles' side: for a segment ``a -> b``
+    it is the left normal; for a line, the normal given. Stresses are compression
+    positive along it.
+    """
+
+    def __init__(self, engine: _core.Engine, wall_id: int) -> None:
+        self._engine = engine
+        self.id = wall_id
+
+    def _state(self) -> dict[str, Any]:
+        return self._engine.wall_state(self.id)
+
+    @property
+    def kind(self) -> str:
+        """``"segment"`` or ``"line"``."""
+        return str(self._state()["kind"])
+
+    @property
+    def points(self) -> NDArray[np.float64]:
+        """End points ``[[ax, ay], [bx, by]]`` of a segment, or ``[point]`` of a line (m)."""
+        s = self._state()
+        return np.array([s["a"], s["b"]] if s["kind"] == "segment" else [s["point"]])
+
+    @property
+    def inward_normal(self) -> NDArray[np.float64]:
+        return np.array(self._state()["inward_normal"])
+
+    @property
+    def force(self) -> NDArray[np.float64]:
+        """Force exerted by the particles on the wall in the last step (N per m thickness)."""
+        return np.array(self._state()["force"])
+
+    @property
+    def contact_count(self) -> int:
+        """Particles touching the wall in the last step."""
+        return int(self._state()["contact_count"])
+
+    @property
+    def displacement(self) -> NDArray[np.float64]:
+        """Total displacement since the wall was created (m)."""
+        return np.array(self._state()["displacement"])
+
+    @property
+    def velocity(self) -> NDArray[np.float64]:
+        """Current velocity (m/s); setting it switches the wall to velocity control."""
+        return np.array(self._state()["velocity"])
+
+    @velocity.setter
+    def velocity(self, value: ArrayLike) -> None:
+        self._engine.set_wall_velocity(self.id, list(_vector("velocity", value)))
+
+    @property
+    def control(self) -> str:
+        """``"velocity"`` or ``"servo"``."""
+        return str(self._state()["control"])
+
+    def normal_stress(self, loaded_length_m: float) -> float:
+        """Normal stress from the last step's force over ``loaded_length_m``, compression positive (Pa)."""
+        if not loaded_length_m > 0:
+            raise ValueError(f"loaded_length_m: must be > 0, got {loaded_length_m}")
+        return float(-np.dot(self.force, self.inward_normal) / loaded_length_m)
+
+    def servo(
+        self,
+        target_stress_pa: float,
+        loaded_length_m: float,
+        *,
+        relaxation: float = 0.5,
+        max_speed_m_per_s: float = 0.1,
+    ) -> None:
+        """Drives the wall along its inward normal to the target normal stress.
+
+        PFC-style: each step ``u = G (sigma_target - sigma)``, with
+        ``G = relaxation * length / (sum of contact kn * dt)``, capped at ``max_speed``.
+        """
+        self._engine.set_wall_servo(
+            self.id, float(target_stress_pa), float(loaded_length_m), float(relaxation), float(max_speed_m_per_s)
+        )
+
+    def translate(self, displacement: ArrayLike) -> None:
+        """Moves the wall at once by ``displacement`` (m), between steps."""
+        self._engine.move_wall(self.id, list(_vector("displacement", displacement)))
+
+    def __repr__(self) -> str:
+        return f"Wall(id={self.id}, kind={self.kind!r}, control={self.control!r})"
+
+
+class Simulation:
+    """A 2D disk DEM simulation (linear contacts with shear history and Coulomb
+    friction, PFC local damping, leapfrog integration) run by the Rust engine.
+
+    Parameters
+    ----------
+    positions : (N, 2) array, m
+    radii : (N,) array, m, all > 0
+    density : scalar or (N,) array, kg/m^3 (Table 1: 2e8, a scaled density)
+    contact_model : model used between every pair of groups until
+        :meth:`set_contact_model` says otherwise
+    time_step : s; ``None`` picks ``time_step_safety`` times the critical step
+        (:meth:`critical_time_step`)
+    threads : worker threads (default: all cores); results are bitwise
+        reproducible for a given count
+    local_damping : alpha of paper Eq. 5, in [0, 1)
+    gravity : (gx, gy), m/s^2
+    """
+
+    def __init__(
+        self,
+        positions: ArrayLike,
+        radii: ArrayLike,
+        density: ArrayLike = TABLE1_DENSITY_KG_PER_M3,
+        *,
+        contact_model: ContactModel | None = None,
+        time_step: float | None = None,
+        time_step_safety: float = 0.5,
+        threads: int | None = None,
+        local_damping: float = 0.0,
+        gravity: ArrayLike = (0.0, 0.0),
+    ) -> None:
+        positions = _points("positions", positions)
+        n = len(positions)
+        radii = _values("radii", radii, n)
+        density = _values("density", density, n)
+        model = contact_model or ContactModel()
+        threads = os.cpu_count() or 1 if threads is None else int(threads)
+        if threads < 1:
+            raise ValueError(f"threads: must be >= 1, got {threads}")
+        provisional = 1.0 if time_step is None else float(time_step)
+        self._engine = _core.Engine(
+            positions,
+            radii,
+            density,
+            float(model.normal_stiffness),
+            float(model.shear_stiffness),
+            float(model.friction),
+            provisional,
+            threads,
+        )
+        if model.normal_damping_ratio or model.shear_damping_ratio:
+            for a in range(MAX_GROUPS):
+                for b in range(a, MAX_GROUPS):
+                    self.set_contact_model(a, b, model)
+        self._set_parameters(local_damping=local_damping, gravity=_vector("gravity", gravity))
+        if time_step is None:
+            self.time_step = self.critical_time_step(time_step_safety)
+
+    # ---- construction helpers ----
+
+    @classmethod
+    def _from_engine(cls, engine: _core.Engine) -> Simulation:
+        sim = cls.__new__(cls)
+        sim._engine = engine
+        return sim
+
+    def _set_parameters(self, **changes: Any) -> None:
+        p = dict(self._engine.parameters)
+        p.pop("skin")
+        p.update(changes)
+        self._engine.set_parameters(
+            float(p["time_step"]), float(p["local_damping"]), list(p["gravity"]), float(p["max_overlap_ratio"])
+        )
+
+    # ---- running ----
+
+    def run(self, steps: int) -> None:
+        """Runs ``steps`` steps in the engine (the loop stays in Rust; Ctrl-C
+        interrupts between blocks of steps). The last step is measured:
+        :attr:`energy`, :attr:`contact_count` and :attr:`unbalanced_force_ratio`
+        refer to it."""
+        steps = int(steps)
+        if steps < 0:
+            raise ValueError(f"steps: must be >= 0, got {steps}")
+        self._engine.run(steps)
+
+    def critical_time_step(self, safety: float = 0.5) -> float:
+        """``safety * min_i min(sqrt(m_i / k_n,i), sqrt(I_i / (k_s,i r_i^2)))`` with the
+        stiffnesses of each particle's current contacts summed (one contact of its
+        stiffest model when it has none)."""
+        return float(self._engine.critical_time_step(float(safety)))
+
+    # ---- scalars ----
+
+    @property
+    def n_particles(self) -> int:
+        return int(self._engine.n_particles)
+
+    def __len__(self) -> int:
+        return self.n_particles
+
+    @property
+    def time(self) -> float:
+        """Simulated time (s)."""
+        return float(self._engine.time)
+
+    @property
+    def step_count(self) -> int:
+        return int(self._engine.step_count)
+
+    @property
+    def threads(self) -> int:
+        return int(self._engine.threads)
+
+    @threads.setter
+    def threads(self, value: int) -> None:
+        self._engine.set_threads(int(value))
+
+    @property
+    def time_step(self) -> float:
+        """Time step (s)."""
+        return float(self._engine.parameters["time_step"])
+
+    @time_step.setter
+    def time_step(self, value: float) -> None:
+        self._set_parameters(time_step=float(value))
+
+    @property
+    def local_damping(self) -> float:
+        """Local damping coefficient alpha (paper Eq. 5), in [0, 1)."""
+        return float(self._engine.parameters["local_damping"])
+
+    @local_damping.setter
+    def local_damping(self, value: float) -> None:
+        self._set_parameters(local_damping=float(value))
+
+    @property
+    def gravity(self) -> NDArray[np.float64]:
+        return np.array(self._engine.parameters["gravity"])
+
+    @gravity.setter
+    def gravity(self, value: ArrayLike) -> None:
+        self._set_parameters(gravity=_vector("gravity", value))
+
+    @property
+    def max_overlap_ratio(self) -> float:
+        """An overlap above this fraction of the smaller radius stops the run."""
+        return float(self._engine.parameters["max_overlap_ratio"])
+
+    @max_overlap_ratio.setter
+    def max_overlap_ratio(self, value: float) -> None:
+        self._set_parameters(max_overlap_ratio=float(value))
+
+    @property
+    def skin(self) -> float:
+        """Verlet skin (m); default 0.1 x the largest radius."""
+        return float(self._engine.parameters["skin"])
+
+    @skin.setter
+    def skin(self, value: float) -> None:
+        self._engine.set_skin(float(value))
+
+    @property
+    def neighbor_builds(self) -> int:
+        """How many times the neighbour lists were built."""
+        return int(self._engine.neighbor_builds)
+
+    # ---- particle arrays (read-only copies; assign a whole array to change) ----
+
+    @property
+    def positions(self) -> NDArray[np.float64]:
+        """(N, 2) centres (m). Inside a periodic cell they are wrapped when the
+        neighbour lists are rebuilt, so they may stray slightly outside between builds."""
+        return _readonly(self._engine.positions)
+
+    @positions.setter
+    def positions(self, value: ArrayLike) -> None:
+        self._engine.set_positions(_points("positions", value, self.n_particles))
+
+    @property
+    def velocities(self) -> NDArray[np.float64]:
+        """(N, 2) velocities (m/s): half-step values v(n - 1/2) once stepped. Values
+        you set are taken as full-step values, and the next step kicks by dt/2."""
+        return _readonly(self._engine.velocities)
+
+    @velocities.setter
+    def velocities(self, value: ArrayLike) -> None:
+        self._engine.set_velocities(_points("velocities", value, self.n_particles))
+
+    @property
+    def rotations(self) -> NDArray[np.float64]:
+        """(N,) rotation angles (rad, counter-clockwise)."""
+        return _readonly(self._engine.rotations)
+
+    @rotations.setter
+    def rotations(self, value: ArrayLike) -> None:
+        self._engine.set_rotations(_values("rotations", value, self.n_particles))
+
+    @property
+    def angular_velocities(self) -> NDArray[np.float64]:
+        """(N,) angular velocities (rad/s, counter-clockwise)."""
+        return _readonly(self._engine.angular_velocities)
+
+    @angular_velocities.setter
+    def angular_velocities(self, value: ArrayLike) -> None:
+        self._engine.set_angular_velocities(_values("angular_velocities", value, self.n_particles))
+
+    @property
+    def radii(self) -> NDArray[np.float64]:
+        """(N,) radii (m); setting them updates masses and inertias."""
+        return _readonly(self._engine.radii)
+
+    @radii.setter
+    def radii(self, value: ArrayLike) -> None:
+        self._engine.set_radii(_values("radii", value, self.n_particles))
+
+    @property
+    def densities(self) -> NDArray[np.float64]:
+        """(N,) densities (kg/m^3)."""
+        return _readonly(self._engine.densities)
+
+    @densities.setter
+    def densities(self, value: ArrayLike) -> None:
+        self._engine.set_densities(_values("densities", value, self.n_particles))
+
+    @property
+    def masses(self) -> NDArray[np.float64]:
+        """(N,) masses ``rho pi r^2`` (kg per m thickness)."""
+        return _readonly(self._engine.masses)
+
+    @property
+    def inertias(self) -> NDArray[np.float64]:
+        """(N,) moments of inertia ``m r^2 / 2`` (kg m^2 per m thickness)."""
+        return _readonly(self._engine.inertias)
+
+    @property
+    def forces(self) -> NDArray[np.float64]:
+        """(N, 2) resultant forces of the last step before damping (N)."""
+        return _readonly(self._engine.forces)
+
+    @property
+    def torques(self) -> NDArray[np.float64]:
+        """(N,) resultant torques of the last step before damping (N m)."""
+        return _readonly(self._engine.torques)
+
+    @property
+    def external_forces(self) -> NDArray[np.float64]:
+        """(N, 2) constant external forces applied every step (N)."""
+        return _readonly(self._engine.external_forces)
+
+    @external_forces.setter
+    def external_forces(self, value: ArrayLike) -> None:
+        self._engine.set_external_forces(_points("external_forces", value, self.n_particles))
+
+    @property
+    def external_torques(self) -> NDArray[np.float64]:
+        """(N,) constant external torques (N m)."""
+        return _readonly(self._engine.external_torques)
+
+    @external_torques.setter
+    def external_torques(self, value: ArrayLike) -> None:
+        self._engine.set_external_torques(_values("external_torques", value, self.n_particles))
+
+    @property
+    def groups(self) -> NDArray[np.uint8]:
+        """(N,) material groups in 0..15 (contact models are set per pair of groups)."""
+        return _readonly(self._engine.groups)
+
+    @groups.setter
+    def groups(self, value: ArrayLike) -> None:
+        array = _values("groups", value, self.n_particles, dtype=np.int64)
+        if np.any((array < 0) | (array >= MAX_GROUPS)):
+            k = int(np.argwhere((array < 0) | (array >= MAX_GROUPS))[0, 0])
+            raise ValueError(f"groups[{k}]: group {array[k]} out of range 0..{MAX_GROUPS - 1}")
+        self._engine.set_groups(array.astype(np.uint8))
+
+    @property
+    def fixity(self) -> NDArray[np.uint8]:
+        """(N,) prescribed degrees of freedom: sums of FIX_X (1), FIX_Y (2),
+        FIX_ROTATION (4). A prescribed velocity keeps the value it has."""
+        return _readonly(self._engine.fixity)
+
+    @fixity.setter
+    def fixity(self, value: ArrayLike) -> None:
+        array = _values("fixity", value, self.n_particles, dtype=np.int64)
+        if np.any((array < 0) | (array > 7)):
+            k = int(np.argwhere((array < 0) | (array > 7))[0, 0])
+            raise ValueError(f"fixity[{k}]: {array[k]} is not a sum of 1 (x), 2 (y), 4 (rotation)")
+        self._engine.set_fixity(array.astype(np.uint8))
+
+    # ---- contact models ----
+
+    def set_contact_model(self, group_a: int, group_b: int, model: ContactModel) -> None:
+        """Sets the contact model between two material groups (both orders)."""
+        self._engine.set_contact_model(
+            int(group_a),
+            int(group_b),
+            float(model.normal_stiffness),
+            float(model.shear_stiffness),
+            float(model.friction),
+            float(model.normal_damping_ratio),
+            float(model.shear_damping_ratio),
+        )
+
+    def contact_model(self, group_a: int, group_b: int) -> ContactModel:
+        return ContactModel(**self._engine.contact_model(int(group_a), int(group_b)))
+
+    # ---- periodic cell ----
+
+    def set_periodic_cell(
+        self,
+        lower: ArrayLike,
+        upper: ArrayLike,
+        periodic: tuple[bool, bool] = (True, True),
+    ) -> None:
+        """An axis-aligned periodic cell ``[lower, upper)``; each side at least 3 x
+        (largest diameter + skin) wide along its periodic directions."""
+        lo = _vector("lower", lower)
+        hi = _vector("upper", upper)
+        if not (hi[0] > lo[0] and hi[1] > lo[1]):
+            raise ValueError(f"upper: must exceed lower in x and y, got lower={lo}, upper={hi}")
+        self._engine.set_cell(list(lo), [hi[0] - lo[0], 0.0], [0.0, hi[1] - lo[1]], tuple(map(bool, periodic)))
+
+    def set_velocity_gradient(self, gradient: ArrayLike) -> None:
+        """Imposes a homogeneous deformation of the periodic cell: ``L[i][j] = dv_i/dx_j``
+        (1/s). Particles are remapped affinely every step; their velocities are
+        fluctuations about the flow ``L (x - origin)``."""
+        g = np.ascontiguousarray(gradient, dtype=np.float64)
+        if g.shape != (2, 2):
+            raise ValueError(f"velocity_gradient: expected shape (2, 2), got {g.shape}")
+        self._engine.set_velocity_gradient(g)
+
+    @property
+    def cell(self) -> dict[str, Any] | None:
+        """The periodic cell (origin, cell vectors a and b, periodicity, velocity gradient, area), or None."""
+        return self._engine.cell
+
+    # ---- walls ----
+
+    def add_segment_wall(self, a: ArrayLike, b: ArrayLike, *, group: int = WALL_GROUP) -> Wall:
+        """A straight wall from ``a`` to ``b`` (m); particles belong on its left side."""
+        return Wall(self._engine, self._engine.add_segment_wall(list(_vector("a", a)), list(_vector("b", b)), int(group)))
+
+    def add_line_wall(self, point: ArrayLike, normal: ArrayLike, *, group: int = WALL_GROUP) -> Wall:
+        """An infinite one-sided wall through ``point`` with unit ``normal`` towards the particles."""
+        return Wall(
+            self._engine,
+            self._engine.add_line_wall(list(_vector("point", point)), list(_vector("normal", normal)), int(group)),
+        )
+
+    @property
+    def walls(self) -> list[Wall]:
+        return [Wall(self._engine, k) for k in range(self._engine.n_walls)]
+
+    def wall(self, wall_id: int) -> Wall:
+        """The wall with id ``wall_id``."""
+        n = self._engine.n_walls
+        if not 0 <= int(wall_id) < n:
+            raise ValueError(f"wall_id: unknown wall {wall_id}; valid ids are 0..{n - 1}")
+        return Wall(self._engine, int(wall_id))
+
+    # ---- bonds ----
+
+    def add_bond(
+        self,
+        i: int,
+        j: int,
+        normal_stiffness: float,
+        shear_stiffness: float,
+        rest_length: float | None = None,
+    ) -> None:
+        """Bonds particles ``i`` and ``j`` with linear normal and shear springs
+        (N/m) that carry tension and never break; rest length defaults to their
+        current distance. Bonded pairs are excluded from the frictional contact law."""
+        self._engine.add_bond(int(i), int(j), float(normal_stiffness), float(shear_stiffness), rest_length)
+
+    @property
+    def n_bonds(self) -> int:
+        return int(self._engine.n_bonds)
+
+    # ---- contacts and diagnostics ----
+
+    def contacts(self) -> Contacts:
+        """Current particle-particle contacts (overlap > 0) and bonds."""
+        d = self._engine.contacts()
+        return Contacts(**{k: _readonly(v) for k, v in d.items()})
+
+    def wall_contacts(self) -> WallContacts:
+        """Current particle-wall contacts."""
+        d = self._engine.wall_contacts()
+        return WallContacts(**{k: _readonly(v) for k, v in d.items()})
+
+    @property
+    def contact_count(self) -> int:
+        """Particle-particle contacts at the last measured step."""
+        return int(self._engine.measurements["contact_count"])
+
+    @property
+    def coordination_number(self) -> float:
+        """``2 Nc / Np`` at the last measured step (particle-particle contacts only)."""
+        return 2.0 * self.contact_count / max(self.n_particles, 1)
+
+    @property
+    def unbalanced_force_ratio(self) -> float:
+        """Mean |resultant| over free particles / mean |contact force| (PFC's ratio), last measured step."""
+        return float(self._engine.measurements["mean_unbalanced_force_ratio"])
+
+    @property
+    def energy(self) -> dict[str, float]:
+        """Energy ledger (J per m thickness): ``kinetic`` and ``elastic`` at the last
+        measured step; ``friction_dissipated``, ``viscous_dissipated``,
+        ``damping_dissipated``, ``wall_work``, ``external_work`` summed since step 0;
+        ``balance`` = kinetic + elastic + dissipated - work, constant in exact arithmetic."""
+        return dict(self._engine.energy)
+
+    # ---- state ----
+
+    def to_bytes(self) -> bytes:
+        """The complete engine state (contact history and neighbour lists included)."""
+        return bytes(self._engine.to_bytes())
+
+    @classmethod
+    def from_bytes(cls, data: bytes) -> Simulation:
+        """Restores :meth:`to_bytes`; the run continues bitwise identically (same thread count)."""
+        return cls._from_engine(_core.Engine.from_bytes(data))
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Writes the complete state to ``path`` atomically (a temporary file, then a rename)."""
+        path = Path(path)
+        tmp = path.with_name(path.name + ".tmp")
+        with open(tmp, "wb") as f:
+            f.write(_STATE_MAGIC)
+            f.write(self.to_bytes())
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Simulation:
+        """Reads a state written by :meth:`save`."""
+        data = Path(path).read_bytes()
+        if not data.startswith(_STATE_MAGIC):
+            raise ValueError(f"{path}: not a grainlab engine state file")
+        return cls.from_bytes(data[len(_STATE_MAGIC) :])
+
+    def __repr__(self) -> str:
+        return (
+            f"Simulation(n_particles={self.n_particles}, time_step={self.time_step:.3e}, "
+            f"threads={self.threads}, step_count={self.step_count})"
+        )

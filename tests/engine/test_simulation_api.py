@@ -1,0 +1,189 @@
+"""The Python API of the engine: input validation, read-only state, contacts,
+walls, bonds, fixity, the periodic cell, save/load and determinism."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import grainlab
+from grainlab import ContactModel, Simulation
+
+
+def two_disks(**kwargs) -> Simulation:
+    return Simulation([[0.0, 0.0], [2.5e-3, 0.0]], [1e-3, 1e-3], **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"positions": [[0, 0], [1, 0]], "radii": [1e-3, -1e-3]}, "radius[1]"),
+        ({"positions": [[0, 0], [1, 0]], "radii": [0.0, 1e-3]}, "radius[0]"),
+        ({"positions": [[0, np.nan], [1, 0]], "radii": [1e-3, 1e-3]}, "positions[0]"),
+        ({"positions": [[0, 0], [1, 0]], "radii": [1e-3, 1e-3, 1e-3]}, "radii"),
+        ({"positions": [[0, 0, 0]], "radii": [1e-3]}, "positions"),
+        ({"positions": [[0, 0]], "radii": [1e-3], "density": -1.0}, "density[0]"),
+        ({"positions": [[0, 0]], "radii": [1e-3], "contact_model": ContactModel(normal_stiffness=0.0)}, "normal_stiffness"),
+        ({"positions": [[0, 0]], "radii": [1e-3], "contact_model": ContactModel(shear_stiffness=-5.0)}, "shear_stiffness"),
+        ({"positions": [[0, 0]], "radii": [1e-3], "local_damping": 1.0}, "local_damping"),
+        ({"positions": [[0, 0]], "radii": [1e-3], "time_step": 0.0}, "time_step"),
+    ],
+)
+def test_bad_input_names_the_field(kwargs, field):
+    with pytest.raises(ValueError, match=field.replace("[", r"\[").replace("]", r"\]")):
+        Simulation(**kwargs)
+
+
+def test_bad_input_after_construction_names_the_field():
+    sim = two_disks()
+    with pytest.raises(ValueError, match="wall_id"):
+        sim.wall(3)
+    with pytest.raises(ValueError, match=r"radii\[1\]"):
+        sim.radii = [1e-3, -2e-3]
+    with pytest.raises(ValueError, match="velocities"):
+        sim.velocities = [[0.0, 0.0]]
+    with pytest.raises(ValueError, match="groups"):
+        sim.groups = [0, 16]
+    with pytest.raises(ValueError, match="normal_stiffness"):
+        sim.set_contact_model(0, 1, ContactModel(normal_stiffness=-1.0))
+    wall = sim.add_segment_wall((0, -1e-3), (1e-2, -1e-3))
+    with pytest.raises(ValueError, match="relaxation"):
+        wall.servo(1e5, 1e-2, relaxation=2.0)
+    with pytest.raises(ValueError, match="bond"):
+        sim.add_bond(0, 0, 1e6, 1e6)
+
+
+def test_state_arrays_are_read_only_copies():
+    sim = two_disks()
+    pos = sim.positions
+    with pytest.raises(ValueError):
+        pos[0, 0] = 1.0
+    assert pos.shape == (2, 2) and sim.radii.shape == (2,)
+    sim.positions = [[0.0, 0.0], [3e-3, 0.0]]
+    assert sim.positions[1, 0] == 3e-3
+
+
+def test_masses_are_those_of_unit_thickness_disks():
+    sim = Simulation([[0, 0], [1, 0]], [1e-3, 2e-3], density=[2e8, 1e3])
+    np.testing.assert_allclose(sim.masses, [2e8 * np.pi * 1e-6, 1e3 * np.pi * 4e-6], rtol=1e-15)
+    np.testing.assert_allclose(sim.inertias, 0.5 * sim.masses * sim.radii**2, rtol=1e-15)
+
+
+def test_free_fall_is_exact_from_full_step_velocities():
+    # constant force: leapfrog started with a half kick gives x = x0 + v0 t + g t^2 / 2 exactly
+    sim = Simulation([[0.0, 0.0]], [1e-3], time_step=1e-4, gravity=(0.0, -9.81))
+    sim.velocities = [[0.5, 1.0]]
+    sim.run(1000)
+    t = sim.time
+    np.testing.assert_allclose(sim.positions[0], [0.5 * t, 1.0 * t - 0.5 * 9.81 * t * t], rtol=1e-12)
+
+
+def test_contacts_are_consistent(dense_periodic):
+    sim = dense_periodic()
+    sim.run(50)
+    c = sim.contacts()
+    assert len(c) > 100
+    assert np.all(c.i < c.j)
+    order = np.lexsort((c.j, c.i))
+    np.testing.assert_array_equal(order, np.arange(len(c)))
+    np.testing.assert_allclose(np.linalg.norm(c.normal, axis=1), 1.0, rtol=1e-14)
+    np.testing.assert_allclose(c.normal_force, 8.45e7 * c.overlap, rtol=1e-14)
+    # the contact point lies between the centres, r_i - overlap/2 from i
+    branch = c.point - sim.positions[c.i]
+    arm = np.einsum("ij,ij->i", branch, c.normal)
+    np.testing.assert_allclose(arm, sim.radii[c.i] - c.overlap / 2, rtol=1e-9)
+
+
+def test_resultants_are_the_sums_of_contact_forces(dense_periodic):
+    # frictionless: the next step's resultant on each particle is the sum of kn * overlap * n
+    sim = dense_periodic(friction=0.0)
+    sim.run(30)
+    c = sim.contacts()
+    sim.run(1)
+    expected = np.zeros((sim.n_particles, 2))
+    f = c.normal_force[:, None] * c.normal
+    np.add.at(expected, c.j, f)
+    np.add.at(expected, c.i, -f)
+    scale = np.abs(f).max()
+    np.testing.assert_allclose(sim.forces, expected, rtol=0, atol=1e-12 * scale)
+    assert sim.contact_count == len(c)
+
+
+def test_bond_carries_tension():
+    # two bonded disks pulled apart by +-F settle at extension F / kn_bond
+    sim = Simulation([[0.0, 0.0], [2e-3, 0.0]], [1e-3, 1e-3], local_damping=0.7, time_step=1e-5, threads=1)
+    sim.add_bond(0, 1, normal_stiffness=1e6, shear_stiffness=1e6)
+    force = 50.0
+    sim.external_forces = [[-force, 0.0], [force, 0.0]]
+    sim.run(300_000)
+    gap = sim.positions[1, 0] - sim.positions[0, 0]
+    assert gap - 2e-3 == pytest.approx(force / 1e6, rel=1e-6)
+    c = sim.contacts()
+    assert c.bonded.tolist() == [True]
+    assert c.normal_force[0] == pytest.approx(-force, rel=1e-6)
+
+
+def test_prescribed_velocity_ignores_forces():
+    sim = Simulation([[0.0, 0.0], [1.8e-3, 0.0]], [1e-3, 1e-3], time_step=1e-5)
+    sim.fixity = [grainlab.FIX_X | grainlab.FIX_Y | grainlab.FIX_ROTATION, 0]
+    sim.velocities = [[0.01, 0.0], [0.0, 0.0]]
+    sim.run(100)
+    np.testing.assert_allclose(sim.positions[0], [100 * 1e-5 * 0.01, 0.0], rtol=1e-12)
+    assert sim.velocities[1, 0] > 0  # pushed away by the overlap
+
+
+def test_homogeneous_deformation_maps_a_particle_affinely():
+    # a lone disk with no fluctuation follows x_n = (I + dt L)^n x_0 about the cell origin
+    sim = Simulation([[0.02, 0.03]], [1e-3], time_step=1e-3)
+    sim.set_periodic_cell((0.0, 0.0), (0.05, 0.05))
+    grad = np.array([[-0.2, 0.1], [0.0, 0.2]])
+    sim.set_velocity_gradient(grad)
+    sim.run(100)
+    step = np.eye(2) + 1e-3 * grad
+    expected = np.linalg.matrix_power(step, 100) @ np.array([0.02, 0.03])
+    np.testing.assert_allclose(sim.positions[0], expected, rtol=1e-12)
+    cell = sim.cell
+    np.testing.assert_allclose(cell["a"], np.linalg.matrix_power(step, 100) @ [0.05, 0.0], rtol=1e-12)
+
+
+def test_periodic_images_interact_across_the_boundary():
+    sim = Simulation([[0.0005, 0.01], [0.0195, 0.01]], [1e-3, 1e-3], time_step=1e-5)
+    sim.set_periodic_cell((0.0, 0.0), (0.02, 0.02))
+    c = sim.contacts()
+    assert len(c) == 1
+    assert c.overlap[0] == pytest.approx(1e-3, rel=1e-9)
+
+
+def test_save_and_load_continue_bitwise(tmp_path, dense_periodic):
+    sim = dense_periodic(threads=2)
+    sim.run(200)
+    path = tmp_path / "state.bin"
+    sim.save(path)
+    sim.run(300)
+    resumed = Simulation.load(path)
+    resumed.run(300)
+    assert resumed.threads == 2
+    np.testing.assert_array_equal(sim.positions, resumed.positions)
+    np.testing.assert_array_equal(sim.velocities, resumed.velocities)
+    np.testing.assert_array_equal(sim.contacts().shear_force, resumed.contacts().shear_force)
+    assert sim.energy == resumed.energy
+
+
+def test_a_file_that_is_not_a_state_is_refused(tmp_path):
+    path = tmp_path / "junk.bin"
+    path.write_bytes(b"hello")
+    with pytest.raises(ValueError, match="not a grainlab engine state"):
+        Simulation.load(path)
+
+
+def test_blow_up_stops_with_the_particles_named(dense_periodic):
+    # a dense packing at 10x the critical time step: leapfrog is unstable and the overlap runs away
+    sim = dense_periodic()
+    sim.time_step = 10 * sim.time_step
+    with pytest.raises(grainlab.SimulationUnstableError, match=r"overlap of particles \d+ and \d+ reached"):
+        sim.run(1000)
+
+
+def test_density_scaling_factor_matches_eq16():
+    i = grainlab.density_scaling_factor(0.02 / 60, 2e8, 0.25e-3, 1e5)
+    assert i == pytest.approx(0.02 / 60 * np.sqrt(2e8 * 0.25e-3**2 / 1e5), rel=1e-15)
