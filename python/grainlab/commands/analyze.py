@@ -11,7 +11,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-__all__ = ["parse_columns", "register", "run"]
+__all__ = ["parse_columns", "parse_types", "register", "run"]
 
 
 def parse_columns(text: str | None) -> dict[str, str] | None:
@@ -27,6 +27,18 @@ def parse_columns(text: str | None) -> dict[str, str] | None:
             )
         out[role.strip()] = name.strip()
     return out
+
+
+def parse_types(text: str | None) -> tuple[int, ...]:
+    """``"2,3"`` -> ``(2, 3)``."""
+    if not text:
+        return ()
+    try:
+        return tuple(int(t) for t in text.split(","))
+    except ValueError:
+        raise ValueError(
+            f"--boundary-types: expected integers separated by commas, got {text!r}"
+        ) from None
 
 
 def register(subparsers: Any) -> None:
@@ -77,6 +89,11 @@ def register(subparsers: Any) -> None:
         help="column roles of a LAMMPS local dump, e.g. i=c_ids[1],j=c_ids[2],normal_force=c_pl[2]",
     )
     p.add_argument(
+        "--boundary-types",
+        metavar="T1,T2",
+        help="LAMMPS atom types that bound the sample (e.g. frozen wall disks): not part of it",
+    )
+    p.add_argument(
         "--min-contacts", type=int, default=2, help="rattler threshold for mechanical Z (default 2)"
     )
     p.add_argument(
@@ -103,12 +120,14 @@ def run(args: argparse.Namespace) -> int:
     if args.tolerance < 0:
         raise ValueError(f"--tolerance: must be >= 0 m, got {args.tolerance}")
     columns = parse_columns(args.contact_columns)
+    boundary_types = parse_types(args.boundary_types)
     snapshot = read_snapshot(
         args.input,
         contacts=args.contacts,
         timestep=args.timestep,
         tolerance=args.tolerance,
         columns=columns,
+        boundary_types=boundary_types,
     )
     reference = None
     if args.reference:
@@ -121,6 +140,7 @@ def run(args: argparse.Namespace) -> int:
             timestep=ref_step,
             tolerance=args.tolerance,
             columns=columns if args.reference_contacts else None,
+            boundary_types=boundary_types,
         )
     result = analyze_snapshot(
         snapshot,

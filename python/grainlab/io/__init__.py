@@ -10,7 +10,7 @@ names the file, the line and the problem.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -75,19 +75,30 @@ def detect_format(path: str | Path) -> str:
     )
 
 
-def _read_csv(path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None) -> Snapshot:
+def _read_csv(
+    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=()
+) -> Snapshot:
     if timestep is not None:
         raise ValueError("timestep: only applies to LAMMPS dumps, not to a particles CSV")
     if columns:
         raise ValueError("contact columns: only apply to LAMMPS local dumps")
+    if len(boundary_types):
+        raise ValueError(
+            "boundary types: only apply to LAMMPS dumps (use a 'kind' column in a CSV)"
+        )
     return read_particles_csv(path, contacts=contacts, tolerance=tolerance)
 
 
 def _read_dump(
-    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None
+    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=()
 ) -> Snapshot:
     return read_lammps_dump(
-        path, timestep=timestep, contacts=contacts, columns=columns, tolerance=tolerance
+        path,
+        timestep=timestep,
+        contacts=contacts,
+        columns=columns,
+        tolerance=tolerance,
+        boundary_types=boundary_types,
     )
 
 
@@ -97,7 +108,8 @@ def _read_hdf5(path: Path, **_: Any) -> Snapshot:
     )
 
 
-#: Reader per format name: ``reader(path, *, contacts, timestep, tolerance, columns) -> Snapshot``.
+#: Reader per format name:
+#: ``reader(path, *, contacts, timestep, tolerance, columns, boundary_types) -> Snapshot``.
 READERS: dict[str, Callable[..., Snapshot]] = {
     "particles-csv": _read_csv,
     "lammps-dump": _read_dump,
@@ -112,6 +124,7 @@ def read_snapshot(
     timestep: int | None = None,
     tolerance: float = 0.0,
     columns: Mapping[str, str] | None = None,
+    boundary_types: Sequence[int] = (),
     format: str | None = None,
 ) -> Snapshot:
     """Read a snapshot from any supported file.
@@ -128,11 +141,18 @@ def read_snapshot(
         Frame of a multi-frame dump (default the last).
     columns
         Column roles of a LAMMPS local dump (see :mod:`grainlab.io.lammps_dump`).
+    boundary_types
+        LAMMPS atom types that bound the sample (wall disks): kind MEMBRANE.
     """
     p = Path(path)
     fmt = format or detect_format(p)
     if fmt not in READERS:
         raise ValueError(f"format: unknown {fmt!r} (known: {', '.join(READERS)})")
     return READERS[fmt](
-        p, contacts=contacts, timestep=timestep, tolerance=tolerance, columns=columns
+        p,
+        contacts=contacts,
+        timestep=timestep,
+        tolerance=tolerance,
+        columns=columns,
+        boundary_types=boundary_types,
     )

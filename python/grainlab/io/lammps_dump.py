@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -65,7 +65,7 @@ from grainlab.io._table import (
     parse_float_table,
     read_lines,
 )
-from grainlab.snapshot import Snapshot
+from grainlab.snapshot import ParticleKind, Snapshot
 
 __all__ = [
     "DumpFrame",
@@ -226,13 +226,16 @@ def read_lammps_dump(
     columns: Mapping[str, str] | None = None,
     tolerance: float = 0.0,
     detect: bool = True,
+    boundary_types: Sequence[int] = (),
 ) -> Snapshot:
     """Read one frame of a LAMMPS atoms dump (and its contacts) into a :class:`Snapshot`.
 
     ``contacts`` is a ``dump local`` file (see the module docstring;
     ``columns`` maps its roles to column names). Without it and with
     ``detect=True``, contacts are detected from the geometry
-    (``tolerance`` in m).
+    (``tolerance`` in m). Atoms whose ``type`` is in ``boundary_types``
+    (e.g. frozen wall disks) get ``kind = MEMBRANE``: they bound the sample
+    but are not part of it, and contacts with them are boundary contacts.
     """
     frame = read_dump_frames(path, timestep)
     if frame.kind != "ATOMS":
@@ -305,6 +308,15 @@ def read_lammps_dump(
     for name, values in col.items():
         if name not in used:
             fields[name] = values
+    kind = None
+    if len(boundary_types):
+        if "type" not in col:
+            raise FileFormatError(path, where, "boundary_types needs a 'type' column in the dump")
+        kind = np.where(
+            np.isin(col["type"], np.asarray(boundary_types, dtype=np.float64)),
+            ParticleKind.MEMBRANE,
+            ParticleKind.SOIL,
+        )
     periodic = (False, False)
     if frame.boundary:
         periodic = (frame.boundary[0] == "pp", frame.boundary[1] == "pp")
@@ -316,6 +328,7 @@ def read_lammps_dump(
     }
     snap_kwargs: dict[str, Any] = dict(
         ids=ids,
+        kind=kind,
         particle_fields=fields,
         box=box2,
         periodic=periodic if box2 is not None else (False, False),
