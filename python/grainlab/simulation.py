@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core
+from grainlab.snapshot import Snapshot
 
 #: Table 1 of the paper: contact stiffnesses (N/m), particle friction, density (kg/m^3).
 TABLE1_STIFFNESS_N_PER_M = 8.45e7
@@ -653,6 +654,44 @@ class Simulation:
         ``damping_dissipated``, ``wall_work``, ``external_work`` summed since step 0;
         ``balance`` = kinetic + elastic + dissipated - work, constant in exact arithmetic."""
         return dict(self._engine.energy)
+
+    def snapshot(self, **metadata: Any) -> Snapshot:
+        """The current state as an analysis :class:`~grainlab.snapshot.Snapshot`.
+
+        Converts the engine's conventions to the snapshot's: shear forces are
+        given on particle ``i`` (the engine reports them on ``j``), and wall
+        normals point from the particle to the wall. ``metadata`` may set
+        ``time`` and ``axial_strain`` and any other key.
+        """
+        c = self.contacts()
+        w = self.wall_contacts()
+        time = metadata.pop("time", self.time)
+        axial_strain = metadata.pop("axial_strain", None)
+        return Snapshot.from_engine_arrays(
+            self.positions,
+            self.radii,
+            rotations=self.rotations,
+            contact_i=c.i,
+            contact_j=c.j,
+            contact_point=c.point,
+            contact_normal=c.normal,
+            normal_force=c.normal_force,
+            shear_force=-c.shear_force,
+            overlap=c.overlap,
+            sliding=c.sliding,
+            bonded=c.bonded,
+            wall_i=w.particle,
+            wall_id=w.wall,
+            wall_point=w.point,
+            wall_normal=-w.normal,
+            wall_normal_force=w.normal_force,
+            wall_shear_force=-w.shear_force,
+            wall_overlap=w.overlap,
+            wall_sliding=w.sliding,
+            time=time,
+            axial_strain=axial_strain,
+            metadata=metadata,
+        )
 
     # ---- state ----
 

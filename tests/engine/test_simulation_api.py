@@ -187,3 +187,24 @@ def test_blow_up_stops_with_the_particles_named(dense_periodic):
 def test_density_scaling_factor_matches_eq16():
     i = grainlab.density_scaling_factor(0.02 / 60, 2e8, 0.25e-3, 1e5)
     assert i == pytest.approx(0.02 / 60 * np.sqrt(2e8 * 0.25e-3**2 / 1e5), rel=1e-15)
+
+
+def test_snapshot_carries_the_contacts_with_the_analysis_conventions(dense_periodic):
+    from grainlab.analysis import CoordinationNumber
+
+    sim = dense_periodic(friction=0.5)
+    sim.run(40)
+    c = sim.contacts()
+    snap = sim.snapshot(axial_strain=0.0)
+    z = CoordinationNumber().compute(snap)
+    assert z.coordination_number == pytest.approx(2 * len(c) / sim.n_particles, rel=1e-12)
+    # the snapshot's shear force acts on i: its opposite is the engine's (on j)
+    np.testing.assert_array_equal(snap.shear_force[: len(c)], -c.shear_force)
+
+
+def test_snapshot_wall_contacts_point_to_the_wall():
+    sim = Simulation([[0.0, 0.9e-3]], [1e-3], time_step=1e-6)
+    sim.add_line_wall((0.0, 0.0), (0.0, 1.0))
+    snap = sim.snapshot()
+    assert snap.contact_j.tolist() == [-1]
+    np.testing.assert_allclose(snap.contact_normal[0], [0.0, -1.0])

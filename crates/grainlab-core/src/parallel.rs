@@ -2,21 +2,20 @@
 //! blocks on the simulation's own thread pool (or inline with one thread),
 //! results returned in block order so reductions are deterministic.
 use rayon::prelude::*;
-use rayon::ThreadPool;
 
-/// Applies `f` to every item, in parallel on `pool` when there is one; the
-/// results come back in item order.
-pub fn map_blocks<T, R, F>(pool: Option<&ThreadPool>, items: Vec<T>, f: F) -> Vec<R>
+/// Applies `f` to every item, in parallel on the current rayon pool when
+/// `parallel` is set (the caller runs inside the simulation's pool, see
+/// `Simulation::run`); the results come back in item order.
+pub fn map_blocks<T, R, F>(parallel: bool, items: Vec<T>, f: F) -> Vec<R>
 where
     T: Send,
     R: Send,
     F: Fn(T) -> R + Sync + Send,
 {
-    match pool {
-        Some(pool) if items.len() > 1 => {
-            pool.install(|| items.into_par_iter().with_max_len(1).map(f).collect())
-        }
-        _ => items.into_iter().map(f).collect(),
+    if parallel && items.len() > 1 {
+        items.into_par_iter().with_max_len(1).map(f).collect()
+    } else {
+        items.into_iter().map(f).collect()
     }
 }
 

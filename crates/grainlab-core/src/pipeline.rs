@@ -400,27 +400,49 @@ impl Simulation {
 
     /// Runs `n` steps without measuring any of them (faster; dissipation is still tallied).
     pub fn advance(&mut self, n: u64) -> Result<()> {
-        for _ in 0..n {
-            self.step::<false>()?;
-        }
-        Ok(())
+        self.in_pool(|sim| {
+            for _ in 0..n {
+                sim.step::<false>()?;
+            }
+            Ok(())
+        })
     }
 
     /// Runs `n` steps; the last one is measured (see [`Simulation::measurements`]).
     pub fn run(&mut self, n: u64) -> Result<()> {
-        for k in 0..n {
-            if k + 1 == n {
-                self.step::<true>()?;
-            } else {
-                self.step::<false>()?;
+        self.in_pool(|sim| {
+            for k in 0..n {
+                if k + 1 == n {
+                    sim.step::<true>()?;
+                } else {
+                    sim.step::<false>()?;
+                }
             }
+            Ok(())
+        })
+    }
+
+    /// Runs `f` inside the simulation's thread pool, so that the parallel phases
+    /// of every step reuse the same workers without handing the loop over each time.
+    fn in_pool<R: Send>(&mut self, f: impl FnOnce(&mut Self) -> R + Send) -> R {
+        match self.pool.take() {
+            Some(pool) => {
+                let out = pool.install(|| f(self));
+                self.pool = Some(pool);
+                out
+            }
+            None => f(self),
         }
-        Ok(())
+    }
+
+    /// Whether the parallel phases fan out: a pool is running this step and the system is large enough.
+    fn parallel(&self) -> bool {
+        self.threads > 1 && self.particles.len() >= PARALLEL_MIN_PARTICLES && rayon::current_thread_index().is_some()
     }
 
     /// One step; `MEASURE` adds kinetic and elastic energy, contact counts and
     /// the unbalanced force ratio.
-    pub fn step<const MEASURE: bool>(&mut self) -> Result<()> {
+    fn step<const MEASURE: bool>(&mut self) -> Result<()> {
         self.ensure_neighbors()?;
         let dt = self.params.time_step;
         let mut contacts = self.particle_contacts::<MEASURE>();
@@ -506,10 +528,7 @@ impl Simulation {
     /// Steps 2-3: reset resultants, then particle-particle contact forces.
     fn particle_contacts<const MEASURE: bool>(&mut self) -> ContactTally {
         let n_blocks = self.neighbors.block_particles.len();
-        let pool = self
-            .pool
-            .as_ref()
-            .filter(|_| self.particles.len() >= PARALLEL_MIN_PARTICLES);
+        let parallel = self.parallel();
         let pairs = &mut self.neighbors.pairs;
         let starts = pairs.block_start.clone();
         let mut ranges: Vec<(usize, usize)> =
@@ -556,7 +575,7 @@ impl Simulation {
             .map(|(b, (s, l))| (b, s, l))
             .collect();
         let block_particles = &self.neighbors.block_particles;
-        let tallies = map_blocks(pool, blocks, |(b, shear, sliding)| {
+        let tallies = map_blocks(parallel, blocks, |(b, shear, sliding)| {
             // SAFETY: block b resets and writes only the forces of its own particles
             // (pairs in its range have both particles in block b).
             unsafe {
@@ -688,10 +707,7 @@ impl Simulation {
             Some((_, m)) => self.neighbors.advance_map(m).accumulated_map,
             None => self.neighbors.reference().accumulated_map,
         };
-        let pool = self
-            .pool
-            .as_ref()
-            .filter(|_| self.particles.len() >= PARALLEL_MIN_PARTICLES);
+        let parallel = self.parallel();
         let p = &mut self.particles;
         let has_external = self.params.gravity != [0.0, 0.0]
             || p.external_force.iter().any(|f| *f != [0.0, 0.0])
@@ -735,7 +751,7 @@ impl Simulation {
                 },
             )
             .collect();
-        let tallies = map_blocks(pool, chunks, |chunk| {
+        let tallies = map_blocks(parallel, chunks, |chunk| {
             integrate_chunk::<MEASURE>(chunk, &inputs, &step)
         });
         let mut total = IntegrationTally::default();
