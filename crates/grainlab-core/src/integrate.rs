@@ -104,23 +104,21 @@ impl IntegrationTally {
     }
 }
 
+/// `sign(v)` with `sign(0) = 0`, without branches.
 #[inline(always)]
 fn signum0(v: f64) -> f64 {
-    if v > 0.0 {
-        1.0
-    } else if v < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
+    ((v > 0.0) as i32 - (v < 0.0) as i32) as f64
 }
 
-/// One damped kick of one degree of freedom; returns `(v_new, damping power * dt)`.
+/// One kick of one degree of freedom with local damping; returns `(v_new, F_d)`.
 #[inline(always)]
-fn kick(v: f64, f: f64, inv_m: f64, alpha: f64, kick: f64) -> (f64, f64) {
-    let fd = -alpha * f.abs() * signum0(v);
-    let v_new = v + kick * (f + fd) * inv_m;
-    (v_new, fd)
+fn kick<const DAMPED: bool>(v: f64, f: f64, inv_m: f64, alpha: f64, kick: f64) -> (f64, f64) {
+    let fd = if DAMPED {
+        -alpha * f.abs() * signum0(v)
+    } else {
+        0.0
+    };
+    (v + kick * (f + fd) * inv_m, fd)
 }
 
 /// Integrates one chunk of particles over one step.
@@ -129,51 +127,66 @@ pub fn integrate_chunk<const MEASURE: bool>(
     inputs: &IntegrationInputs<'_>,
     step: &IntegrationStep,
 ) -> IntegrationTally {
+    match (step.alpha > 0.0, step.step_map.is_some()) {
+        (false, false) => integrate_kernel::<MEASURE, false, false>(chunk, inputs, step),
+        (false, true) => integrate_kernel::<MEASURE, false, true>(chunk, inputs, step),
+        (true, false) => integrate_kernel::<MEASURE, true, false>(chunk, inputs, step),
+        (true, true) => integrate_kernel::<MEASURE, true, true>(chunk, inputs, step),
+    }
+}
+
+/// The loop of [`integrate_chunk`], specialised on local damping and on the
+/// periodic cell's deformation so that neither costs anything when absent.
+#[inline(always)]
+fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bool>(
+    chunk: MotionChunk<'_>,
+    inputs: &IntegrationInputs<'_>,
+    step: &IntegrationStep,
+) -> IntegrationTally {
     let mut tally = IntegrationTally::default();
     let dt = step.dt;
     let alpha = step.alpha;
-    for k in 0..chunk.position.len() {
-        let p = chunk.lo + k;
-        let fix = inputs.fixity[p];
-        let f = inputs.force[p];
+    let (origin, map) = step
+        .step_map
+        .unwrap_or(([0.0; 2], [[1.0, 0.0], [0.0, 1.0]]));
+    let acc = step.accumulated_map;
+    // affine image of a reference point: origin + M_acc (x_ref - origin) = shift + M_acc x_ref
+    let acc_shift = sub(origin, mat_vec(&acc, origin));
+    let map_shift = sub(origin, mat_vec(&map, origin));
+    let n = chunk.position.len();
+    let lo = chunk.lo;
+    let force = &inputs.force[lo..lo + n];
+    let torque = &inputs.torque[lo..lo + n];
+    let inv_mass = &inputs.inv_mass[lo..lo + n];
+    let inv_inertia = &inputs.inv_inertia[lo..lo + n];
+    let fixity = &inputs.fixity[lo..lo + n];
+    let reference = &inputs.reference[lo..lo + n];
+    let mut damping_work = 0.0;
+    let mut max_fluctuation_sq = 0.0f64;
+    let mut max_displacement_sq = 0.0f64;
+    let mut finite = true;
+    for k in 0..n {
+        let fix = fixity[k];
+        let f = force[k];
         let v_old = chunk.velocity[k];
         let w_old = chunk.angular_velocity[k];
-        let mut v = v_old;
-        let mut w = w_old;
-        let mut damping_work = 0.0;
-        let inv_m = inputs.inv_mass[p];
-        if fix & FIX_X == 0 {
-            let (vn, fd) = kick(v_old[0], f[0], inv_m, alpha, step.kick);
-            v[0] = vn;
-            damping_work += fd
-                * if step.half_kick {
-                    v_old[0]
-                } else {
-                    0.5 * (v_old[0] + vn)
-                };
+        let (mut v, mut w) = (v_old, w_old);
+        let mut fd = [0.0; 3];
+        if fix == 0 {
+            (v[0], fd[0]) = kick::<DAMPED>(v_old[0], f[0], inv_mass[k], alpha, step.kick);
+            (v[1], fd[1]) = kick::<DAMPED>(v_old[1], f[1], inv_mass[k], alpha, step.kick);
+            (w, fd[2]) = kick::<DAMPED>(w_old, torque[k], inv_inertia[k], alpha, step.kick);
+        } else {
+            if fix & FIX_X == 0 {
+                (v[0], fd[0]) = kick::<DAMPED>(v_old[0], f[0], inv_mass[k], alpha, step.kick);
+            }
+            if fix & FIX_Y == 0 {
+                (v[1], fd[1]) = kick::<DAMPED>(v_old[1], f[1], inv_mass[k], alpha, step.kick);
+            }
+            if fix & FIX_ROTATION == 0 {
+                (w, fd[2]) = kick::<DAMPED>(w_old, torque[k], inv_inertia[k], alpha, step.kick);
+            }
         }
-        if fix & FIX_Y == 0 {
-            let (vn, fd) = kick(v_old[1], f[1], inv_m, alpha, step.kick);
-            v[1] = vn;
-            damping_work += fd
-                * if step.half_kick {
-                    v_old[1]
-                } else {
-                    0.5 * (v_old[1] + vn)
-                };
-        }
-        if fix & FIX_ROTATION == 0 {
-            let tq = inputs.torque[p];
-            let (wn, td) = kick(w_old, tq, inputs.inv_inertia[p], alpha, step.kick);
-            w = wn;
-            damping_work += td
-                * if step.half_kick {
-                    w_old
-                } else {
-                    0.5 * (w_old + wn)
-                };
-        }
-        tally.damping_dissipated -= damping_work * dt;
         let (v_full, w_full) = if step.half_kick {
             (v_old, w_old)
         } else {
@@ -182,7 +195,11 @@ pub fn integrate_chunk<const MEASURE: bool>(
                 0.5 * (w_old + w),
             )
         };
+        if DAMPED {
+            damping_work += fd[0] * v_full[0] + fd[1] * v_full[1] + fd[2] * w_full;
+        }
         if step.has_external {
+            let p = lo + k;
             let m = inputs.mass[p];
             let fe = inputs.external_force[p];
             let fx = if fix & FIX_X == 0 {
@@ -205,6 +222,7 @@ pub fn integrate_chunk<const MEASURE: bool>(
         if MEASURE {
             // 1/2 m v(n-1/2).v(n+1/2): with the elastic energy of linear springs this
             // sum is exactly conserved by leapfrog (away from contact onsets)
+            let p = lo + k;
             let (vk, wk) = if step.half_kick {
                 (v_old, w_old)
             } else {
@@ -220,27 +238,28 @@ pub fn integrate_chunk<const MEASURE: bool>(
         let mut x = chunk.position[k];
         x[0] += dt * v[0];
         x[1] += dt * v[1];
-        let reference = inputs.reference[p];
-        if let Some((origin, m)) = step.step_map {
-            x = crate::vec2::add(origin, mat_vec(&m, sub(x, origin)));
-            let affine = crate::vec2::add(
-                origin,
-                mat_vec(&step.accumulated_map, sub(reference, origin)),
-            );
-            let u = sub(x, affine);
-            tally.max_fluctuation_sq = tally.max_fluctuation_sq.max(u[0] * u[0] + u[1] * u[1]);
+        let r = reference[k];
+        if DEFORMING {
+            x = crate::vec2::add(map_shift, mat_vec(&map, x));
+            let u = sub(x, crate::vec2::add(acc_shift, mat_vec(&acc, r)));
+            max_fluctuation_sq = max_fluctuation_sq.max(u[0] * u[0] + u[1] * u[1]);
         }
-        let d = sub(x, reference);
+        let d = sub(x, r);
         let d2 = d[0] * d[0] + d[1] * d[1];
-        tally.max_displacement_sq = tally.max_displacement_sq.max(d2);
-        if step.step_map.is_none() {
-            tally.max_fluctuation_sq = tally.max_fluctuation_sq.max(d2);
-        }
-        tally.non_finite |= !(x[0].is_finite() && x[1].is_finite() && w.is_finite());
+        max_displacement_sq = max_displacement_sq.max(d2);
+        finite &= x[0].is_finite() & x[1].is_finite() & w.is_finite();
         chunk.position[k] = x;
         chunk.velocity[k] = v;
         chunk.angular_velocity[k] = w;
         chunk.rotation[k] += dt * w;
     }
+    tally.damping_dissipated = -damping_work * dt;
+    tally.max_displacement_sq = max_displacement_sq;
+    tally.max_fluctuation_sq = if DEFORMING {
+        max_fluctuation_sq
+    } else {
+        max_displacement_sq
+    };
+    tally.non_finite = !finite;
     tally
 }

@@ -1,21 +1,149 @@
-//! The little parallel machinery the step needs: map a function over work
-//! blocks on the simulation's own thread pool (or inline with one thread),
-//! results returned in block order so reductions are deterministic.
-use rayon::prelude::*;
+//! The little parallel machinery the step needs.
+//!
+//! A DEM step has two short parallel phases (contact forces per block,
+//! integration per chunk) separated by short sequential work, thousands of
+//! times per second. Handing each phase to a thread pool costs a wake-up per
+//! phase, as long as the phase itself on a 2-core machine. So `Simulation::run`
+//! enters its rayon pool *once* per call with a broadcast: worker 0 runs the
+//! step loop, the other workers wait for phases in a [`Team`], spinning, and
+//! each phase is handed to them with one atomic store. Results of a phase come
+//! back in block order, so every reduction is deterministic.
+use std::cell::UnsafeCell;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
 
-/// Applies `f` to every item, in parallel on the current rayon pool when
-/// `parallel` is set (the caller runs inside the simulation's pool, see
-/// `Simulation::run`); the results come back in item order.
-pub fn map_blocks<T, R, F>(parallel: bool, items: Vec<T>, f: F) -> Vec<R>
+/// Spins before a waiting worker starts yielding its core.
+const SPINS_BEFORE_YIELD: u32 = 1 << 14;
+
+type Job = dyn Fn(usize) + Sync;
+
+/// Workers of one `run` call, waiting for phases from worker 0.
+pub struct Team {
+    size: usize,
+    epoch: AtomicUsize,
+    pending: AtomicUsize,
+    quit: AtomicBool,
+    panicked: AtomicBool,
+    job: UnsafeCell<Option<*const Job>>,
+}
+
+// SAFETY: `job` is written only by worker 0 while no other worker reads it
+// (before publishing a new epoch, after all workers finished the previous one).
+unsafe impl Sync for Team {}
+
+impl Team {
+    /// A team of `size` workers (worker 0 included).
+    pub fn new(size: usize) -> Self {
+        Team {
+            size,
+            epoch: AtomicUsize::new(0),
+            pending: AtomicUsize::new(0),
+            quit: AtomicBool::new(false),
+            panicked: AtomicBool::new(false),
+            job: UnsafeCell::new(None),
+        }
+    }
+
+    /// Number of workers.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+
+    /// Runs `job(k)` on every worker `k` (worker 0 is the caller) and waits for all.
+    pub fn run<'a>(&self, job: &'a (dyn Fn(usize) + Sync + 'a)) {
+        // SAFETY: the lifetime is erased only until this function returns, and it
+        // returns after every worker finished with the job.
+        let erased: *const Job =
+            unsafe { std::mem::transmute::<&'a (dyn Fn(usize) + Sync + 'a), &'static Job>(job) };
+        unsafe { *self.job.get() = Some(erased) };
+        self.pending.store(self.size - 1, Ordering::Release);
+        self.epoch.fetch_add(1, Ordering::AcqRel);
+        job(0);
+        let mut spins = 0u32;
+        while self.pending.load(Ordering::Acquire) != 0 {
+            wait(&mut spins);
+        }
+        if self.panicked.load(Ordering::Acquire) {
+            panic!("a grainlab worker thread panicked");
+        }
+    }
+
+    /// Worker `index` (>= 1) serves phases until [`Team::dismiss`].
+    pub fn serve(&self, index: usize) {
+        let mut seen = 0usize;
+        loop {
+            let mut spins = 0u32;
+            loop {
+                let epoch = self.epoch.load(Ordering::Acquire);
+                if epoch != seen {
+                    seen = epoch;
+                    break;
+                }
+                if self.quit.load(Ordering::Acquire) {
+                    return;
+                }
+                wait(&mut spins);
+            }
+            // SAFETY: published before the epoch we just observed (Acquire).
+            let job = unsafe { (*self.job.get()).expect("a job with the epoch") };
+            if catch_unwind(AssertUnwindSafe(|| unsafe { (*job)(index) })).is_err() {
+                self.panicked.store(true, Ordering::Release);
+            }
+            self.pending.fetch_sub(1, Ordering::AcqRel);
+        }
+    }
+
+    /// Lets the serving workers return.
+    pub fn dismiss(&self) {
+        self.quit.store(true, Ordering::Release);
+    }
+}
+
+#[inline]
+fn wait(spins: &mut u32) {
+    if *spins < SPINS_BEFORE_YIELD {
+        *spins += 1;
+        std::hint::spin_loop();
+    } else {
+        std::thread::yield_now();
+    }
+}
+
+/// Applies `f` to every item, item `k` on worker `k` of the team when there is
+/// one (and as many items as workers), otherwise in order on this thread; the
+/// results come back in item order either way.
+pub fn map_blocks<T, R, F>(team: Option<&Team>, items: Vec<T>, f: F) -> Vec<R>
 where
     T: Send,
     R: Send,
-    F: Fn(T) -> R + Sync + Send,
+    F: Fn(T) -> R + Sync,
 {
-    if parallel && items.len() > 1 {
-        items.into_par_iter().with_max_len(1).map(f).collect()
-    } else {
-        items.into_iter().map(f).collect()
+    match team {
+        Some(team) if items.len() == team.size() && items.len() > 1 => {
+            let slots: Vec<Mutex<Option<T>>> =
+                items.into_iter().map(|t| Mutex::new(Some(t))).collect();
+            let results: Vec<Mutex<Option<R>>> =
+                (0..slots.len()).map(|_| Mutex::new(None)).collect();
+            team.run(&|k| {
+                let item = slots[k]
+                    .lock()
+                    .expect("block slot")
+                    .take()
+                    .expect("one item per worker");
+                let r = f(item);
+                *results[k].lock().expect("result slot") = Some(r);
+            });
+            results
+                .into_iter()
+                .map(|m| {
+                    m.into_inner()
+                        .expect("result slot")
+                        .expect("every worker ran")
+                })
+                .collect()
+        }
+        _ => items.into_iter().map(f).collect(),
     }
 }
 

@@ -28,10 +28,11 @@ use crate::integrate::{
 use crate::law::{elastic_energy, linear_coulomb};
 use crate::material::{ContactModel, MaterialTable};
 use crate::neighbor::NeighborList;
-use crate::parallel::{even_bounds, map_blocks, split_ranges, DisjointWriter};
+use crate::parallel::{even_bounds, map_blocks, split_ranges, DisjointWriter, Team};
 use crate::state::Particles;
 use crate::vec2::{add, dot, mat_vec, norm, perp, scale, sub, Mat2, Vec2};
 use crate::wall::{Wall, WallControl};
+use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 
 /// Below this many particles the blocks run one after another on the calling
 /// thread: the same partition and order, so the same bits, without the
@@ -400,59 +401,70 @@ impl Simulation {
 
     /// Runs `n` steps without measuring any of them (faster; dissipation is still tallied).
     pub fn advance(&mut self, n: u64) -> Result<()> {
-        self.in_pool(|sim| {
-            for _ in 0..n {
-                sim.step::<false>()?;
-            }
-            Ok(())
-        })
+        self.run_steps(n, false)
     }
 
     /// Runs `n` steps; the last one is measured (see [`Simulation::measurements`]).
     pub fn run(&mut self, n: u64) -> Result<()> {
-        self.in_pool(|sim| {
+        self.run_steps(n, true)
+    }
+
+    /// The step loop, on the simulation's pool when it has one and the system is
+    /// large enough: one broadcast per call, worker 0 steps, the others serve phases.
+    fn run_steps(&mut self, n: u64, measure_last: bool) -> Result<()> {
+        let steps = |sim: &mut Simulation, team: Option<&Team>| -> Result<()> {
             for k in 0..n {
-                if k + 1 == n {
-                    sim.step::<true>()?;
+                if measure_last && k + 1 == n {
+                    sim.step::<true>(team)?;
                 } else {
-                    sim.step::<false>()?;
+                    sim.step::<false>(team)?;
                 }
             }
             Ok(())
-        })
-    }
-
-    /// Runs `f` inside the simulation's thread pool, so that the parallel phases
-    /// of every step reuse the same workers without handing the loop over each time.
-    fn in_pool<R: Send>(&mut self, f: impl FnOnce(&mut Self) -> R + Send) -> R {
-        match self.pool.take() {
-            Some(pool) => {
-                let out = pool.install(|| f(self));
-                self.pool = Some(pool);
-                out
+        };
+        let pool = match self.pool.take() {
+            Some(pool) if self.particles.len() >= PARALLEL_MIN_PARTICLES && n > 0 => pool,
+            other => {
+                self.pool = other;
+                return steps(self, None);
             }
-            None => f(self),
+        };
+        let team = Team::new(self.threads);
+        let this = SimPtr(self as *mut Simulation);
+        let results = pool.broadcast(|ctx| {
+            if ctx.index() == 0 {
+                // SAFETY: only worker 0 touches the simulation outside of team
+                // phases, and the phases obey the block ownership rules.
+                let sim = unsafe { &mut *this.get() };
+                let out = catch_unwind(AssertUnwindSafe(|| steps(sim, Some(&team))));
+                team.dismiss();
+                Some(out)
+            } else {
+                team.serve(ctx.index());
+                None
+            }
+        });
+        self.pool = Some(pool);
+        match results.into_iter().next().flatten() {
+            Some(Ok(result)) => result,
+            Some(Err(panic)) => resume_unwind(panic),
+            None => unreachable!("worker 0 always reports"),
         }
-    }
-
-    /// Whether the parallel phases fan out: a pool is running this step and the system is large enough.
-    fn parallel(&self) -> bool {
-        self.threads > 1 && self.particles.len() >= PARALLEL_MIN_PARTICLES && rayon::current_thread_index().is_some()
     }
 
     /// One step; `MEASURE` adds kinetic and elastic energy, contact counts and
     /// the unbalanced force ratio.
-    fn step<const MEASURE: bool>(&mut self) -> Result<()> {
+    fn step<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Result<()> {
         self.ensure_neighbors()?;
         let dt = self.params.time_step;
-        let mut contacts = self.particle_contacts::<MEASURE>();
+        let mut contacts = self.particle_contacts::<MEASURE>(team);
         let bond_tally = self.bond_forces::<MEASURE>();
         contacts.merge(&bond_tally);
         let (wall_tally, wall_work) = self.wall_forces::<MEASURE>();
         for wall in &mut self.walls {
             wall.update_servo(dt);
         }
-        let motion = self.integrate::<MEASURE>();
+        let motion = self.integrate::<MEASURE>(team);
         for wall in &mut self.walls {
             let d = scale(wall.velocity, dt);
             if d != [0.0, 0.0] {
@@ -526,9 +538,8 @@ impl Simulation {
     }
 
     /// Steps 2-3: reset resultants, then particle-particle contact forces.
-    fn particle_contacts<const MEASURE: bool>(&mut self) -> ContactTally {
+    fn particle_contacts<const MEASURE: bool>(&mut self, team: Option<&Team>) -> ContactTally {
         let n_blocks = self.neighbors.block_particles.len();
-        let parallel = self.parallel();
         let pairs = &mut self.neighbors.pairs;
         let starts = pairs.block_start.clone();
         let mut ranges: Vec<(usize, usize)> =
@@ -575,7 +586,7 @@ impl Simulation {
             .map(|(b, (s, l))| (b, s, l))
             .collect();
         let block_particles = &self.neighbors.block_particles;
-        let tallies = map_blocks(parallel, blocks, |(b, shear, sliding)| {
+        let tallies = map_blocks(team, blocks, |(b, shear, sliding)| {
             // SAFETY: block b resets and writes only the forces of its own particles
             // (pairs in its range have both particles in block b).
             unsafe {
@@ -696,7 +707,7 @@ impl Simulation {
     }
 
     /// Step 7: leapfrog with local damping in parallel chunks.
-    fn integrate<const MEASURE: bool>(&mut self) -> IntegrationTally {
+    fn integrate<const MEASURE: bool>(&mut self, team: Option<&Team>) -> IntegrationTally {
         let dt = self.params.time_step;
         let step_map = self
             .cell
@@ -707,7 +718,6 @@ impl Simulation {
             Some((_, m)) => self.neighbors.advance_map(m).accumulated_map,
             None => self.neighbors.reference().accumulated_map,
         };
-        let parallel = self.parallel();
         let p = &mut self.particles;
         let has_external = self.params.gravity != [0.0, 0.0]
             || p.external_force.iter().any(|f| *f != [0.0, 0.0])
@@ -751,7 +761,7 @@ impl Simulation {
                 },
             )
             .collect();
-        let tallies = map_blocks(parallel, chunks, |chunk| {
+        let tallies = map_blocks(team, chunks, |chunk| {
             integrate_chunk::<MEASURE>(chunk, &inputs, &step)
         });
         let mut total = IntegrationTally::default();
@@ -839,6 +849,20 @@ impl Simulation {
         })?;
         sim.make_pool()?;
         Ok(sim)
+    }
+}
+
+/// The simulation handed to worker 0 of a broadcast.
+struct SimPtr(*mut Simulation);
+
+// SAFETY: the pointer is dereferenced by worker 0 only, while `run_steps` holds
+// the exclusive borrow it came from.
+unsafe impl Send for SimPtr {}
+unsafe impl Sync for SimPtr {}
+
+impl SimPtr {
+    fn get(&self) -> *mut Simulation {
+        self.0
     }
 }
 
