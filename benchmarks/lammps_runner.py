@@ -18,6 +18,7 @@ Importable:
 CLI:
     python3 benchmarks/lammps_runner.py [--np 1 2] [--repeat 3] [--steps 20000]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -34,14 +35,14 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_PACKING = os.path.join(HERE, "data", "dense-4000-disks.xyr")
 
 # Case parameters (SI units)
-KN = 8.45e7           # N/m, normal contact stiffness
-KT = 8.45e7           # N/m, tangential contact stiffness (used as given by LAMMPS)
+KN = 8.45e7  # N/m, normal contact stiffness
+KT = 8.45e7  # N/m, tangential contact stiffness (used as given by LAMMPS)
 FRICTION = 0.9
-DENSITY = 2.0e8       # kg/m^3, unit thickness
-DT = 1.36e-4          # s, 0.2*sqrt(m_min/kn)
+DENSITY = 2.0e8  # kg/m^3, unit thickness
+DT = 1.36e-4  # s, 0.2*sqrt(m_min/kn)
 STRAIN_RATE = 3.676e-3  # 1/s, true strain rate; x compressed, y extended
-SKIN = 3.0e-4         # m, neighbour skin (10% of the largest diameter)
-THERMO_EVERY = 1000   # coordination sampled every this many steps
+SKIN = 3.0e-4  # m, neighbour skin (10% of the largest diameter)
+THERMO_EVERY = 1000  # coordination sampled every this many steps
 
 
 def find_lammps() -> str | None:
@@ -80,12 +81,12 @@ def write_data_file(path, L, disks, zhalf):
     with open(path, "w") as fh:
         fh.write("grainlab throughput case: %d disks in a periodic square cell\n\n" % len(disks))
         fh.write("%d atoms\n1 atom types\n\n" % len(disks))
-        fh.write("0 %.17g xlo xhi\n0 %.17g ylo yhi\n%.17g %.17g zlo zhi\n\n"
-                 % (L, L, -zhalf, zhalf))
+        fh.write(f"0 {L:.17g} xlo xhi\n0 {L:.17g} ylo yhi\n{-zhalf:.17g} {zhalf:.17g} zlo zhi\n\n")
         fh.write("Atoms # sphere\n\n")
-        for k, (x, y, r) in enumerate(disks, start=1):
-            # the density column is replaced by `set density/disc` in the input
-            fh.write("%d 1 %.17g %.17g %.17g %.17g 0\n" % (k, 2 * r, DENSITY, x % L, y % L))
+        fh.writelines(
+            "%d 1 %.17g %.17g %.17g %.17g 0\n" % (k, 2 * r, DENSITY, x % L, y % L)
+            for k, (x, y, r) in enumerate(disks, start=1)
+        )
 
 
 def lammps_input(data_name, steps, warmup):
@@ -154,8 +155,15 @@ def parse_log(text):
             continue
         m = _LOOP_RE.search(line)
         if m:
-            runs.append(dict(loop_time=float(m.group(1)), procs=int(m.group(2)),
-                             steps=int(m.group(3)), atoms=int(m.group(4)), thermo=thermo_rows))
+            runs.append(
+                {
+                    "loop_time": float(m.group(1)),
+                    "procs": int(m.group(2)),
+                    "steps": int(m.group(3)),
+                    "atoms": int(m.group(4)),
+                    "thermo": thermo_rows,
+                }
+            )
             header = None
             continue
         if header is not None and len(s) == len(header):
@@ -167,8 +175,9 @@ def parse_log(text):
     return runs, version
 
 
-def run_lammps_throughput(packing_path, n_procs, steps=20000, warmup=100, workdir=None,
-                          lmp=None, keep=False):
+def run_lammps_throughput(
+    packing_path, n_procs, steps=20000, warmup=100, workdir=None, lmp=None, keep=False
+):
     """Run the case once with `n_procs` MPI processes; return measurements.
 
     Returns a dict with particle_steps_per_s, loop_time_s, mean coordination at the
@@ -192,20 +201,28 @@ def run_lammps_throughput(packing_path, n_procs, steps=20000, warmup=100, workdi
             fh.write(lammps_input("data.dense", steps, warmup))
 
         env = dict(os.environ)
-        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-                   OMP_NUM_THREADS="1")
+        env.update(
+            OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1"
+        )
         cmd = [lmp, "-in", "in.throughput", "-log", "log.lammps", "-screen", "none"]
         mpirun = find_mpirun()
         if mpirun is not None:
             cmd = [mpirun, "-np", str(n_procs)] + cmd
         elif n_procs != 1:
             raise RuntimeError("mpirun not found; cannot run with %d processes" % n_procs)
-        proc = subprocess.run(cmd, cwd=workdir, env=env, capture_output=True, text=True)
+        proc = subprocess.run(
+            cmd, cwd=workdir, env=env, capture_output=True, text=True, check=False
+        )
         logpath = os.path.join(workdir, "log.lammps")
-        log = open(logpath).read() if os.path.exists(logpath) else ""
+        log = ""
+        if os.path.exists(logpath):
+            with open(logpath) as fh:
+                log = fh.read()
         if proc.returncode != 0:
-            raise RuntimeError("LAMMPS failed (%d):\n%s\n%s\n%s" % (
-                proc.returncode, proc.stdout[-3000:], proc.stderr[-3000:], log[-3000:]))
+            raise RuntimeError(
+                "LAMMPS failed (%d):\n%s\n%s\n%s"
+                % (proc.returncode, proc.stdout[-3000:], proc.stderr[-3000:], log[-3000:])
+            )
         runs, version = parse_log(log)
         if len(runs) != 2:
             raise RuntimeError("expected 2 runs in the LAMMPS log, found %d" % len(runs))
@@ -257,15 +274,31 @@ def main(argv=None):
     for nprocs in args.np:
         results = []
         for k in range(args.repeat):
-            res = run_lammps_throughput(args.packing, nprocs, steps=args.steps,
-                                        warmup=args.warmup, lmp=lmp, keep=args.keep)
+            res = run_lammps_throughput(
+                args.packing, nprocs, steps=args.steps, warmup=args.warmup, lmp=lmp, keep=args.keep
+            )
             results.append(res)
-            print("np=%d run %d: %.4g particle-steps/s (loop %.3f s, CPU use %s%%, "
-                  "Z %.3f -> %.3f)"
-                  % (nprocs, k + 1, res["particle_steps_per_s"], res["loop_time_s"],
-                     res.get("cpu_use_percent"),
-                     res.get("mean_coordination_number_start", float("nan")),
-                     res.get("mean_coordination_number_end", float("nan"))), flush=True)
+            print(
+                "np=%d run %d: %.4g particle-steps/s (loop %.3f s, CPU use %s%%, "
+                "Z %.3f -> %.3f)"
+                % (
+                    nprocs,
+                    k + 1,
+                    res["particle_steps_per_s"],
+                    res["loop_time_s"],
+                    res.get("cpu_use_percent"),
+                    res.get("mean_coordination_number_start", float("nan")),
+                    res.get("mean_coordination_number_end", float("nan")),
+                ),
+                flush=True,
+            )
+            cpu = res.get("cpu_use_percent")
+            if cpu is not None and cpu < 90.0:
+                print(
+                    f"  warning: LAMMPS used only {cpu:.0f}% of its cores' time: other work was "
+                    "running on the machine, this run is not representative",
+                    flush=True,
+                )
         med = statistics.median(r["particle_steps_per_s"] for r in results)
         print("np=%d median of %d: %.4g particle-steps/s" % (nprocs, len(results), med))
         allres[str(nprocs)] = {"median_particle_steps_per_s": med, "runs": results}

@@ -20,6 +20,7 @@ Steps:
 
 Usage:  python3 make_fixture.py [--lmp /usr/bin/lmp]
 """
+
 import argparse
 import math
 import os
@@ -33,24 +34,24 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 SEED = 7
 N_MOBILE = 250
-D_MIN, D_MAX = 0.5e-3, 3.0e-3     # mobile disk diameters (m)
-WIDTH = 30.0e-3                   # inner width of the box (m)
-FILL_HEIGHT = 45.0e-3             # height of the region the disks start in (m)
-WALL_R = 1.0e-3                   # radius of the frozen wall disks (m)
-WALL_GAP = 0.02e-3                # gap between neighbouring wall disks (m)
-RHO = 2650.0                      # kg/m^3, unit thickness: m = rho*pi*r^2
-KN = 8.45e7                       # N/m
-KT = 8.45e7                       # N/m
-MU = 0.5                          # friction coefficient
-GAMMA_N = 1.0e5                   # 1/s, normal damping while settling (gamma_t = gamma_n/2)
-G = 9.81                          # m/s^2, along -y
+D_MIN, D_MAX = 0.5e-3, 3.0e-3  # mobile disk diameters (m)
+WIDTH = 30.0e-3  # inner width of the box (m)
+FILL_HEIGHT = 45.0e-3  # height of the region the disks start in (m)
+WALL_R = 1.0e-3  # radius of the frozen wall disks (m)
+WALL_GAP = 0.02e-3  # gap between neighbouring wall disks (m)
+RHO = 2650.0  # kg/m^3, unit thickness: m = rho*pi*r^2
+KN = 8.45e7  # N/m
+KT = 8.45e7  # N/m
+MU = 0.5  # friction coefficient
+GAMMA_N = 1.0e5  # 1/s, normal damping while settling (gamma_t = gamma_n/2)
+G = 9.81  # m/s^2, along -y
 SETTLE_STEPS = 600000
 RELAX_STEPS = 50000
 RUN2 = 2000
 
 
 def fmt(v):
-    return "%.17g" % v
+    return f"{v:.17g}"
 
 
 def place_mobile(rng):
@@ -60,8 +61,7 @@ def place_mobile(rng):
     pos = np.zeros((N_MOBILE, 2))
     for k in range(N_MOBILE):
         for _attempt in range(100000):
-            p = np.array([rng.uniform(r[k], WIDTH - r[k]),
-                          rng.uniform(r[k], FILL_HEIGHT - r[k])])
+            p = np.array([rng.uniform(r[k], WIDTH - r[k]), rng.uniform(r[k], FILL_HEIGHT - r[k])])
             if k == 0:
                 break
             dist = np.hypot(*(pos[:k] - p).T)
@@ -70,7 +70,7 @@ def place_mobile(rng):
         else:
             raise RuntimeError("could not place disk %d" % k)
         pos[k] = p
-    order = rng.permutation(N_MOBILE)          # ids not sorted by size
+    order = rng.permutation(N_MOBILE)  # ids not sorted by size
     return pos[order], r[order]
 
 
@@ -78,12 +78,12 @@ def wall_disks():
     """Frozen disks: a bottom row at y = -WALL_R and two side columns."""
     step = 2 * WALL_R + WALL_GAP
     pts = []
-    nb = int(math.ceil((WIDTH + 2 * WALL_R) / step)) + 1
+    nb = math.ceil((WIDTH + 2 * WALL_R) / step) + 1
     x0 = -WALL_R
     for k in range(nb):
         pts.append((x0 + k * step, -WALL_R))
     x_right = x0 + (nb - 1) * step
-    ns = int(math.ceil((FILL_HEIGHT + 2 * WALL_R) / step))
+    ns = math.ceil((FILL_HEIGHT + 2 * WALL_R) / step)
     for k in range(1, ns + 1):
         pts.append((x0, -WALL_R + k * step))
         pts.append((x_right, -WALL_R + k * step))
@@ -94,11 +94,14 @@ def write_data(path, pos, r, wpos, box):
     xlo, xhi, ylo, yhi = box
     n = len(r) + len(wpos)
     with open(path, "w") as fh:
-        fh.write("LAMMPS data file: grainlab dump fixture, mobile disks (type 1) and "
-                 "frozen wall disks (type 2), seed %d\n\n" % SEED)
+        fh.write(
+            "LAMMPS data file: grainlab dump fixture, mobile disks (type 1) and "
+            "frozen wall disks (type 2), seed %d\n\n" % SEED
+        )
         fh.write("%d atoms\n2 atom types\n\n" % n)
-        fh.write("%s %s xlo xhi\n%s %s ylo yhi\n%s %s zlo zhi\n\n"
-                 % (fmt(xlo), fmt(xhi), fmt(ylo), fmt(yhi), fmt(-WALL_R * 1.5), fmt(WALL_R * 1.5)))
+        fh.write(
+            f"{fmt(xlo)} {fmt(xhi)} xlo xhi\n{fmt(ylo)} {fmt(yhi)} ylo yhi\n{fmt(-WALL_R * 1.5)} {fmt(WALL_R * 1.5)} zlo zhi\n\n"
+        )
         fh.write("Atoms # sphere\n\n")
         # atom-ID atom-type diameter density x y z (density replaced by set density/disc)
         k = 0
@@ -191,7 +194,7 @@ def read_frames(path):
         n = int(lines[k + 3])
         box = [tuple(float(v) for v in lines[k + 5 + d].split()[:2]) for d in range(3)]
         cols = lines[k + 8].split()[2:]
-        arr = np.array([[float(v) for v in ln.split()] for ln in lines[k + 9:k + 9 + n]])
+        arr = np.array([[float(v) for v in ln.split()] for ln in lines[k + 9 : k + 9 + n]])
         frames.append((step, cols, arr.reshape(n, len(cols)), box))
         k += 9 + n
     return frames
@@ -229,15 +232,25 @@ def check(atoms_path, contacts_path):
         res_y = A["fy"][mob] - (sy[mob] - m[mob] * G)
         scale = np.abs(fn).max()
         err = max(np.abs(res_x).max(), np.abs(res_y).max()) / scale
-        assert err < 1e-9, "per-atom forces do not match contact sums (rel %g)" % err
+        assert err < 1e-9, f"per-atom forces do not match contact sums (rel {err:g})"
         slip = c[:, 9] / (MU * fn)
         n_wall = int(np.sum((A["type"][i] == 2) | (A["type"][j] == 2)))
-        z = 2 * len(c) / n  # all atoms
+        2 * len(c) / n  # all atoms
         zm = (np.bincount(i, minlength=n) + np.bincount(j, minlength=n))[mob].mean()
-        out.append(dict(step=sa, n_atoms=n, n_contacts=len(c), n_wall_contacts=n_wall,
-                        z_mobile=zm, fn_min=fn.min(), fn_max=fn.max(),
-                        max_ft_over_mu_fn=slip.max(), n_sliding=int(np.sum(slip > 1 - 1e-9)),
-                        force_balance_rel_err=err))
+        out.append(
+            {
+                "step": sa,
+                "n_atoms": n,
+                "n_contacts": len(c),
+                "n_wall_contacts": n_wall,
+                "z_mobile": zm,
+                "fn_min": fn.min(),
+                "fn_max": fn.max(),
+                "max_ft_over_mu_fn": slip.max(),
+                "n_sliding": int(np.sum(slip > 1 - 1e-9)),
+                "force_balance_rel_err": err,
+            }
+        )
     return out
 
 
@@ -249,8 +262,9 @@ def find_lmp(explicit=None):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     ap.add_argument("--lmp")
     args = ap.parse_args()
     lmp = find_lmp(args.lmp)
@@ -267,19 +281,34 @@ def main():
     dt = 0.2 * math.sqrt(m_min / KN)
     print("N mobile %d, N wall %d, dt %s s" % (len(r), len(wpos), fmt(dt)))
     with open(os.path.join(HERE, "in.settle"), "w") as fh:
-        fh.write(IN_TEMPLATE.format(rho=fmt(RHO), kn=fmt(KN), kt=fmt(KT), gn=fmt(GAMMA_N),
-                                    gt=fmt(GAMMA_N / 2), mu=fmt(MU), g=fmt(G), dt=fmt(dt),
-                                    settle=SETTLE_STEPS, relax=RELAX_STEPS, run2=RUN2,
-                                    visc=fmt(0.05 * RHO * np.pi * r.mean() ** 2 * 1e3)))
+        fh.write(
+            IN_TEMPLATE.format(
+                rho=fmt(RHO),
+                kn=fmt(KN),
+                kt=fmt(KT),
+                gn=fmt(GAMMA_N),
+                gt=fmt(GAMMA_N / 2),
+                mu=fmt(MU),
+                g=fmt(G),
+                dt=fmt(dt),
+                settle=SETTLE_STEPS,
+                relax=RELAX_STEPS,
+                run2=RUN2,
+                visc=fmt(0.05 * RHO * np.pi * r.mean() ** 2 * 1e3),
+            )
+        )
     for f in ("atoms.dump", "contacts.dump", "atoms_2frames.dump", "contacts_2frames.dump"):
         p = os.path.join(HERE, f)
         if os.path.exists(p):
             os.remove(p)
     env = dict(os.environ, OMP_NUM_THREADS="1")
-    subprocess.run([lmp, "-in", "in.settle", "-log", "log.lammps", "-screen", "none"],
-                   cwd=HERE, env=env, check=True)
-    for a, c in (("atoms.dump", "contacts.dump"),
-                 ("atoms_2frames.dump", "contacts_2frames.dump")):
+    subprocess.run(
+        [lmp, "-in", "in.settle", "-log", "log.lammps", "-screen", "none"],
+        cwd=HERE,
+        env=env,
+        check=True,
+    )
+    for a, c in (("atoms.dump", "contacts.dump"), ("atoms_2frames.dump", "contacts_2frames.dump")):
         for res in check(os.path.join(HERE, a), os.path.join(HERE, c)):
             print(a, c, res)
 

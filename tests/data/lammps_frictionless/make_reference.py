@@ -17,6 +17,7 @@ Steps (all deterministic for a given seed):
 Usage:  python3 make_reference.py [--lmp /usr/bin/lmp]
 Needs numpy and a LAMMPS binary with the GRANULAR package.
 """
+
 import argparse
 import glob
 import math
@@ -31,20 +32,21 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 SEED = 20261121
 N = 300
-D_MIN, D_MAX = 0.5e-3, 3.0e-3      # diameters uniform in [D_MIN, D_MAX] (m)
-PHI = 0.875                        # packing fraction (disk area / cell area), above jamming
-RHO = 2.0e8                        # kg/m^3, disks of unit thickness: m = rho*pi*r^2
-KN = 8.45e7                        # N/m, contact normal stiffness
+D_MIN, D_MAX = 0.5e-3, 3.0e-3  # diameters uniform in [D_MIN, D_MAX] (m)
+PHI = 0.875  # packing fraction (disk area / cell area), above jamming
+RHO = 2.0e8  # kg/m^3, disks of unit thickness: m = rho*pi*r^2
+KN = 8.45e7  # N/m, contact normal stiffness
 N_STEPS = 1000
-V_RMS = 3.0e-3                     # m/s, rms of each initial velocity component
-X_JITTER = 2.0e-6                  # m, rms of a random shift of each jammed position
+V_RMS = 3.0e-3  # m/s, rms of each initial velocity component
+X_JITTER = 2.0e-6  # m, rms of a random shift of each jammed position
 DUMP_STEPS = [0, 1, 10] + list(range(100, N_STEPS + 1, 100))
-SKIN = 1.0e-3                      # neighbour skin (m)
+SKIN = 1.0e-3  # neighbour skin (m)
 
 
 # ---------------------------------------------------------------------------
 # packing
 # ---------------------------------------------------------------------------
+
 
 def pair_terms(x, r, L):
     """All overlapping pairs (i<j) under the minimum-image convention.
@@ -61,13 +63,14 @@ def pair_terms(x, r, L):
 
 def harmonic_forces(x, r, L, k=1.0):
     i, j, d, dist, ov = pair_terms(x, r, L)
-    fpair = (k * ov / dist)[:, None] * d          # force on i, along x_i - x_j
+    fpair = (k * ov / dist)[:, None] * d  # force on i, along x_i - x_j
     n = len(r)
     f = np.empty_like(x)
     for c in range(2):
-        f[:, c] = (np.bincount(i, fpair[:, c], minlength=n)
-                   - np.bincount(j, fpair[:, c], minlength=n))
-    energy = 0.5 * k * (ov ** 2).sum()
+        f[:, c] = np.bincount(i, fpair[:, c], minlength=n) - np.bincount(
+            j, fpair[:, c], minlength=n
+        )
+    energy = 0.5 * k * (ov**2).sum()
     return f, energy, len(i)
 
 
@@ -107,11 +110,11 @@ def fire_minimise(x, r, L, ftol, max_iter=200000):
 def make_packing(rng):
     d = rng.uniform(D_MIN, D_MAX, N)
     r = 0.5 * d
-    L = math.sqrt(np.pi * (r ** 2).sum() / PHI)
+    L = math.sqrt(np.pi * (r**2).sum() / PHI)
     x = rng.uniform(0.0, L, (N, 2))
     # minimise overlaps to a force-balanced (jammed) state; the tolerance is a
     # small fraction of the typical overlap, in length units (k = 1)
-    x, e, nc, it, fres = fire_minimise(x, r, L, ftol=1e-9 * L)
+    x, _e, nc, it, fres = fire_minimise(x, r, L, ftol=1e-9 * L)
     # then shift every disk a little so that the initial net forces are not zero
     # (this makes the first half step, dt/2 * F(x0)/m, matter in a comparison)
     x = (x + rng.normal(0.0, X_JITTER, x.shape)) % L
@@ -123,40 +126,57 @@ def make_packing(rng):
 # files
 # ---------------------------------------------------------------------------
 
+
 def fmt(v):
-    return "%.17g" % v
+    return f"{v:.17g}"
 
 
 def write_initial(path, x, r, v, w, L, dt):
     with open(path, "w") as fh:
-        fh.write("# cell xlo %s xhi %s ylo %s yhi %s periodic; density %s kg/m^3 "
-                 "(unit thickness, m = rho*pi*r^2, I = m*r^2/2); kn %s N/m; dt %s s; "
-                 "n_steps %d; seed %d\n"
-                 % (fmt(0.0), fmt(L), fmt(0.0), fmt(L), fmt(RHO), fmt(KN), fmt(dt),
-                    N_STEPS, SEED))
+        fh.write(
+            "# cell xlo %s xhi %s ylo %s yhi %s periodic; density %s kg/m^3 "
+            "(unit thickness, m = rho*pi*r^2, I = m*r^2/2); kn %s N/m; dt %s s; "
+            "n_steps %d; seed %d\n"
+            % (fmt(0.0), fmt(L), fmt(0.0), fmt(L), fmt(RHO), fmt(KN), fmt(dt), N_STEPS, SEED)
+        )
         fh.write("# id x y radius vx vy omega\n")
-        for k in range(len(r)):
-            fh.write(" ".join([str(k + 1), fmt(x[k, 0]), fmt(x[k, 1]), fmt(r[k]),
-                               fmt(v[k, 0]), fmt(v[k, 1]), fmt(w[k])]) + "\n")
+        fh.writelines(
+            " ".join(
+                [
+                    str(k + 1),
+                    fmt(x[k, 0]),
+                    fmt(x[k, 1]),
+                    fmt(r[k]),
+                    fmt(v[k, 0]),
+                    fmt(v[k, 1]),
+                    fmt(w[k]),
+                ]
+            )
+            + "\n"
+            for k in range(len(r))
+        )
 
 
 def write_data(path, x, r, v, w, L, zhalf):
     with open(path, "w") as fh:
         fh.write("LAMMPS data file for grainlab frictionless reference (seed %d)\n\n" % SEED)
         fh.write("%d atoms\n1 atom types\n\n" % len(r))
-        fh.write("%s %s xlo xhi\n" % (fmt(0.0), fmt(L)))
-        fh.write("%s %s ylo yhi\n" % (fmt(0.0), fmt(L)))
-        fh.write("%s %s zlo zhi\n\n" % (fmt(-zhalf), fmt(zhalf)))
+        fh.write(f"{fmt(0.0)} {fmt(L)} xlo xhi\n")
+        fh.write(f"{fmt(0.0)} {fmt(L)} ylo yhi\n")
+        fh.write(f"{fmt(-zhalf)} {fmt(zhalf)} zlo zhi\n\n")
         # atom_style sphere: atom-ID atom-type diameter density x y z
         # (the density column here is overwritten by `set density/disc`)
         fh.write("Atoms # sphere\n\n")
-        for k in range(len(r)):
-            fh.write("%d 1 %s %s %s %s 0\n" % (k + 1, fmt(2 * r[k]), fmt(RHO),
-                                               fmt(x[k, 0]), fmt(x[k, 1])))
+        fh.writelines(
+            "%d 1 %s %s %s %s 0\n" % (k + 1, fmt(2 * r[k]), fmt(RHO), fmt(x[k, 0]), fmt(x[k, 1]))
+            for k in range(len(r))
+        )
         # sphere: atom-ID vx vy vz wx wy wz
         fh.write("\nVelocities\n\n")
-        for k in range(len(r)):
-            fh.write("%d %s %s 0 0 0 %s\n" % (k + 1, fmt(v[k, 0]), fmt(v[k, 1]), fmt(w[k])))
+        fh.writelines(
+            "%d %s %s 0 0 0 %s\n" % (k + 1, fmt(v[k, 0]), fmt(v[k, 1]), fmt(w[k]))
+            for k in range(len(r))
+        )
 
 
 IN_TEMPLATE = """\
@@ -205,8 +225,9 @@ run             {nsteps}
 
 def write_input(path, dt):
     with open(path, "w") as fh:
-        fh.write(IN_TEMPLATE.format(rho=fmt(RHO), kn=fmt(KN), skin=fmt(SKIN), dt=fmt(dt),
-                                    nsteps=N_STEPS))
+        fh.write(
+            IN_TEMPLATE.format(rho=fmt(RHO), kn=fmt(KN), skin=fmt(SKIN), dt=fmt(dt), nsteps=N_STEPS)
+        )
 
 
 def read_dump(path):
@@ -220,20 +241,20 @@ def read_dump(path):
 
 def contact_energy(x, r, L):
     _, _, _, _, ov = pair_terms(x, r, L)
-    return 0.5 * KN * (ov ** 2).sum(), len(ov)
+    return 0.5 * KN * (ov**2).sum(), len(ov)
 
 
 def find_lmp(explicit=None):
-    for cand in [explicit, os.environ.get("LAMMPS_BIN"), "lmp", "lmp_serial", "lmp_mpi",
-                 "lammps"]:
+    for cand in [explicit, os.environ.get("LAMMPS_BIN"), "lmp", "lmp_serial", "lmp_mpi", "lammps"]:
         if cand and shutil.which(cand):
             return shutil.which(cand)
     return None
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     ap.add_argument("--lmp", help="LAMMPS binary (default: lmp on PATH)")
     args = ap.parse_args()
     lmp = find_lmp(args.lmp)
@@ -243,15 +264,17 @@ def main():
     rng = np.random.default_rng(SEED)
     x, r, L, nc, it, fres = make_packing(rng)
     z = 2.0 * nc / N
-    print("packing: N=%d L=%.6g m phi=%.4f contacts=%d Z=%.3f (FIRE %d iterations, "
-          "residual %.3g)" % (N, L, np.pi * (r ** 2).sum() / L ** 2, nc, z, it, fres))
+    print(
+        "packing: N=%d L=%.6g m phi=%.4f contacts=%d Z=%.3f (FIRE %d iterations, "
+        "residual %.3g)" % (N, L, np.pi * (r**2).sum() / L**2, nc, z, it, fres)
+    )
 
-    m = RHO * np.pi * r ** 2
+    m = RHO * np.pi * r**2
     v = rng.normal(0.0, V_RMS, (N, 2))
-    v -= (m[:, None] * v).sum(axis=0) / m.sum()          # zero total momentum
-    w = rng.normal(0.0, 1.0, N) * V_RMS / r              # spin ~ v/r
+    v -= (m[:, None] * v).sum(axis=0) / m.sum()  # zero total momentum
+    w = rng.normal(0.0, 1.0, N) * V_RMS / r  # spin ~ v/r
     dt = 0.2 * math.sqrt(m.min() / KN)
-    print("dt = 0.2*sqrt(m_min/kn) = %s s (m_min = %s kg)" % (fmt(dt), fmt(m.min())))
+    print(f"dt = 0.2*sqrt(m_min/kn) = {fmt(dt)} s (m_min = {fmt(m.min())} kg)")
 
     for old in glob.glob(os.path.join(HERE, "dump.*.txt")):
         os.remove(old)
@@ -260,32 +283,42 @@ def main():
     write_input(os.path.join(HERE, "in.frictionless"), dt)
 
     env = dict(os.environ, OMP_NUM_THREADS="1")
-    subprocess.run([lmp, "-in", "in.frictionless", "-log", "log.lammps", "-screen", "none"],
-                   cwd=HERE, env=env, check=True)
+    subprocess.run(
+        [lmp, "-in", "in.frictionless", "-log", "log.lammps", "-screen", "none"],
+        cwd=HERE,
+        env=env,
+        check=True,
+    )
 
     rows = []
     for s in DUMP_STEPS:
         step, d = read_dump(os.path.join(HERE, "dump.%04d.txt" % s))
         assert step == s, (step, s)
         rad = r[d["id"].astype(int) - 1]
-        mass = RHO * np.pi * rad ** 2
+        mass = RHO * np.pi * rad**2
         ke_t = 0.5 * (mass * (d["vx"] ** 2 + d["vy"] ** 2)).sum()
-        ke_r = 0.5 * (0.5 * mass * rad ** 2 * d["omegaz"] ** 2).sum()
+        ke_r = 0.5 * (0.5 * mass * rad**2 * d["omegaz"] ** 2).sum()
         pe, ncon = contact_energy(np.column_stack([d["x"], d["y"]]), rad, L)
         rows.append((s, ke_t, ke_r, pe, ke_t + ke_r + pe, ncon))
     with open(os.path.join(HERE, "kinetic_energy.txt"), "w") as fh:
-        fh.write("# disk energies from the dumped full-step velocities (J per unit thickness): "
-                 "KE_trans = sum m v^2/2, KE_rot = sum (m r^2/2) omega^2/2; "
-                 "PE_contact = sum over overlapping pairs kn*overlap^2/2 from dumped positions; "
-                 "n_contacts = overlapping pairs\n")
+        fh.write(
+            "# disk energies from the dumped full-step velocities (J per unit thickness): "
+            "KE_trans = sum m v^2/2, KE_rot = sum (m r^2/2) omega^2/2; "
+            "PE_contact = sum over overlapping pairs kn*overlap^2/2 from dumped positions; "
+            "n_contacts = overlapping pairs\n"
+        )
         fh.write("# step KE_trans KE_rot PE_contact E_total n_contacts\n")
-        for row in rows:
-            fh.write("%d %s %s %s %s %d\n" % (row[0], fmt(row[1]), fmt(row[2]), fmt(row[3]),
-                                             fmt(row[4]), row[5]))
+        fh.writelines(
+            "%d %s %s %s %s %d\n"
+            % (row[0], fmt(row[1]), fmt(row[2]), fmt(row[3]), fmt(row[4]), row[5])
+            for row in rows
+        )
     e0 = rows[0][4]
     for row in rows:
-        print("step %5d  KE_t %.6e  KE_r %.6e  PE %.6e  E %.10e  (dE/E0 %+.2e)  contacts %d"
-              % (row[0], row[1], row[2], row[3], row[4], (row[4] - e0) / e0, row[5]))
+        print(
+            "step %5d  KE_t %.6e  KE_r %.6e  PE %.6e  E %.10e  (dE/E0 %+.2e)  contacts %d"
+            % (row[0], row[1], row[2], row[3], row[4], (row[4] - e0) / e0, row[5])
+        )
 
 
 if __name__ == "__main__":
