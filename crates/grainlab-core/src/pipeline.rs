@@ -119,6 +119,8 @@ pub struct Simulation {
     threads: usize,
     #[serde(skip)]
     pool: Option<ThreadPool>,
+    #[serde(skip)]
+    cross_forces: Vec<PairForce>,
 }
 
 impl Simulation {
@@ -156,6 +158,7 @@ impl Simulation {
             half_kick_pending: true,
             threads,
             pool: None,
+            cross_forces: Vec::new(),
         };
         sim.make_pool()?;
         Ok(sim)
@@ -541,14 +544,24 @@ impl Simulation {
     fn particle_contacts<const MEASURE: bool>(&mut self, team: Option<&Team>) -> ContactTally {
         let n_blocks = self.neighbors.block_particles.len();
         let pairs = &mut self.neighbors.pairs;
-        let starts = pairs.block_start.clone();
-        let mut ranges: Vec<(usize, usize)> =
-            (0..n_blocks).map(|b| (starts[b], starts[b + 1])).collect();
-        ranges.push((starts[n_blocks], pairs.len()));
+        let starts = &pairs.block_start;
+        // interior pairs of each block, then the cross-block pairs shared out evenly
+        let cross_start = starts[n_blocks];
+        let n_pairs = pairs.len();
+        let cross_ranges: Vec<(usize, usize)> = even_bounds(n_pairs - cross_start, n_blocks)
+            .into_iter()
+            .map(|(lo, hi)| (cross_start + lo, cross_start + hi))
+            .collect();
+        let mut ranges: Vec<(usize, usize)> = (0..n_blocks).map(|b| (starts[b], starts[b + 1])).collect();
+        ranges.extend(&cross_ranges);
         let mut shear_parts = split_ranges(&mut pairs.shear, &ranges);
         let mut sliding_parts = split_ranges(&mut pairs.sliding, &ranges);
-        let cross_shear = shear_parts.pop().unwrap_or_default();
-        let cross_sliding = sliding_parts.pop().unwrap_or_default();
+        let cross_shear = shear_parts.split_off(n_blocks);
+        let cross_sliding = sliding_parts.split_off(n_blocks);
+        self.cross_forces.clear();
+        self.cross_forces.resize(n_pairs - cross_start, PairForce::NONE);
+        let local: Vec<(usize, usize)> = cross_ranges.iter().map(|&(lo, hi)| (lo - cross_start, hi - cross_start)).collect();
+        let cross_buffers = split_ranges(&mut self.cross_forces, &local);
 
         let p = &mut self.particles;
         let force = DisjointWriter::new(&mut p.force);
@@ -565,11 +578,7 @@ impl Simulation {
             model: &pairs.model,
             materials: &self.materials,
             cell: self.cell.as_ref(),
-            velocity_gradient: self
-                .cell
-                .as_ref()
-                .filter(|c| c.is_deforming())
-                .map(|c| c.velocity_gradient),
+            velocity_gradient: self.cell.as_ref().filter(|c| c.is_deforming()).map(|c| c.velocity_gradient),
             dt: self.params.time_step,
             max_overlap_ratio: self.params.max_overlap_ratio,
         };
@@ -579,38 +588,63 @@ impl Simulation {
             mass: &p.mass,
             gravity: self.params.gravity,
         };
-        let blocks: Vec<(usize, &mut [f64], &mut [bool])> = shear_parts
+        let blocks: Vec<BlockWork<'_>> = shear_parts
             .into_iter()
             .zip(sliding_parts)
+            .zip(cross_shear.into_iter().zip(cross_sliding))
+            .zip(cross_buffers)
             .enumerate()
-            .map(|(b, (s, l))| (b, s, l))
+            .map(|(b, (((shear, sliding), (cross_shear, cross_sliding)), cross_forces))| BlockWork {
+                block: b,
+                shear,
+                sliding,
+                cross_shear,
+                cross_sliding,
+                cross_forces,
+            })
             .collect();
         let block_particles = &self.neighbors.block_particles;
-        let tallies = map_blocks(team, blocks, |(b, shear, sliding)| {
+        let tallies = map_blocks(team, blocks, |work| {
+            let b = work.block;
+            let mut direct = DirectSink { force: &force, torque: &torque };
             // SAFETY: block b resets and writes only the forces of its own particles
-            // (pairs in its range have both particles in block b).
+            // (interior pairs have both particles in block b); cross pairs only
+            // write their own slots of the buffer.
             unsafe {
                 for &q in &block_particles[b] {
                     reset.apply(q as usize, &force, &torque);
                 }
-                kernel.run::<MEASURE>(ranges[b].0, shear, sliding, &force, &torque)
+                let mut tally = kernel.run::<MEASURE, _>(ranges[b].0, work.shear, work.sliding, &mut direct);
+                let mut buffered = BufferSink { slots: work.cross_forces };
+                let cross = kernel.run::<MEASURE, _>(
+                    ranges[n_blocks + b].0,
+                    work.cross_shear,
+                    work.cross_sliding,
+                    &mut buffered,
+                );
+                tally.merge(&cross);
+                tally
             }
         });
         let mut tally = ContactTally::default();
         for t in &tallies {
             tally.merge(t);
         }
-        // SAFETY: sequential now; indices come from the pair list and are in bounds.
-        let cross = unsafe {
-            kernel.run::<MEASURE>(
-                ranges[n_blocks].0,
-                cross_shear,
-                cross_sliding,
-                &force,
-                &torque,
-            )
-        };
-        tally.merge(&cross);
+        // cross-block forces, applied in pair order on this thread
+        for (k, c) in self.cross_forces.iter().enumerate() {
+            if c.active {
+                let pair = cross_start + k;
+                let (i, j) = (pairs.i[pair] as usize, pairs.j[pair] as usize);
+                let fj = &mut p.force[j];
+                fj[0] += c.force[0];
+                fj[1] += c.force[1];
+                let fi = &mut p.force[i];
+                fi[0] -= c.force[0];
+                fi[1] -= c.force[1];
+                p.torque[i] += c.torque_i;
+                p.torque[j] += c.torque_j;
+            }
+        }
         tally
     }
 
@@ -884,6 +918,78 @@ pub fn minimum_image(cell: Option<&PeriodicCell>, d: Vec2) -> Vec2 {
     }
 }
 
+/// Where a pair's force goes: straight onto the particles, or into a buffer slot.
+trait ForceSink {
+    /// Adds force `f` on `j` (its opposite on `i`) and the torques, for local pair `k`.
+    ///
+    /// # Safety
+    /// The caller owns `i` and `j` (direct sink) or slot `k` (buffer).
+    unsafe fn add(&mut self, k: usize, i: usize, j: usize, f: Vec2, torque_i: f64, torque_j: f64);
+    /// Local pair `k` is not in contact.
+    fn skip(&mut self, k: usize);
+}
+
+struct DirectSink<'a> {
+    force: &'a DisjointWriter<Vec2>,
+    torque: &'a DisjointWriter<f64>,
+}
+
+impl ForceSink for DirectSink<'_> {
+    #[inline(always)]
+    unsafe fn add(&mut self, _k: usize, i: usize, j: usize, f: Vec2, torque_i: f64, torque_j: f64) {
+        let fj = self.force.get(j);
+        fj[0] += f[0];
+        fj[1] += f[1];
+        let fi = self.force.get(i);
+        fi[0] -= f[0];
+        fi[1] -= f[1];
+        *self.torque.get(i) += torque_i;
+        *self.torque.get(j) += torque_j;
+    }
+
+    #[inline(always)]
+    fn skip(&mut self, _k: usize) {}
+}
+
+struct BufferSink<'a> {
+    slots: &'a mut [PairForce],
+}
+
+impl ForceSink for BufferSink<'_> {
+    #[inline(always)]
+    unsafe fn add(&mut self, k: usize, _i: usize, _j: usize, f: Vec2, torque_i: f64, torque_j: f64) {
+        self.slots[k] = PairForce { force: f, torque_i, torque_j, active: true };
+    }
+
+    #[inline(always)]
+    fn skip(&mut self, k: usize) {
+        self.slots[k].active = false;
+    }
+}
+
+/// A cross-block pair's force, computed in parallel and applied afterwards.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PairForce {
+    force: Vec2,
+    torque_i: f64,
+    torque_j: f64,
+    active: bool,
+}
+
+impl PairForce {
+    const NONE: PairForce = PairForce { force: [0.0; 2], torque_i: 0.0, torque_j: 0.0, active: false };
+}
+
+/// One block's share of the contact phase.
+struct BlockWork<'a> {
+    block: usize,
+    shear: &'a mut [f64],
+    sliding: &'a mut [bool],
+    cross_shear: &'a mut [f64],
+    cross_sliding: &'a mut [bool],
+    cross_forces: &'a mut [PairForce],
+}
+
 struct ResetKernel<'a> {
     external_force: &'a [Vec2],
     external_torque: &'a [f64],
@@ -926,13 +1032,12 @@ impl PairKernel<'_> {
     /// # Safety
     /// Concurrent callers must touch disjoint particles.
     #[inline(always)]
-    unsafe fn run<const MEASURE: bool>(
+    unsafe fn run<const MEASURE: bool, S: ForceSink>(
         &self,
         first: usize,
         shear: &mut [f64],
         sliding: &mut [bool],
-        force: &DisjointWriter<Vec2>,
-        torque: &DisjointWriter<f64>,
+        sink: &mut S,
     ) -> ContactTally {
         let mut tally = ContactTally::default();
         for (k, (spring, slide)) in shear.iter_mut().zip(sliding.iter_mut()).enumerate() {
@@ -956,6 +1061,7 @@ impl PairKernel<'_> {
                     *spring = 0.0;
                     *slide = false;
                 }
+                sink.skip(k);
                 continue;
             }
             let dist = dist_sq.sqrt();
@@ -982,14 +1088,7 @@ impl PairKernel<'_> {
                 c.normal * n[0] + c.shear * t[0],
                 c.normal * n[1] + c.shear * t[1],
             ];
-            let fj = force.get(j);
-            fj[0] += f[0];
-            fj[1] += f[1];
-            let fi = force.get(i);
-            fi[0] -= f[0];
-            fi[1] -= f[1];
-            *torque.get(i) -= ri * c.shear;
-            *torque.get(j) -= rj * c.shear;
+            sink.add(k, i, j, f, -ri * c.shear, -rj * c.shear);
             tally.friction += c.friction_dissipation;
             tally.viscous += c.viscous_dissipation;
             if overlap > self.max_overlap_ratio * ri.min(rj) {
