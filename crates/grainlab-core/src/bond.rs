@@ -37,6 +37,23 @@ impl Bonds {
         self.list.push(bond);
     }
 
+    /// Renumbers the particles: `new_of_old[old] = new`.
+    pub fn remap(&mut self, new_of_old: &[u32]) {
+        if self.list.is_empty() {
+            return;
+        }
+        for b in self.list.iter_mut() {
+            b.i = new_of_old[b.i as usize];
+            b.j = new_of_old[b.j as usize];
+        }
+        self.sorted_pairs = self
+            .list
+            .iter()
+            .map(|b| (b.i.min(b.j), b.i.max(b.j)))
+            .collect();
+        self.sorted_pairs.sort_unstable();
+    }
+
     /// Whether `i` and `j` are bonded.
     #[inline]
     pub fn contains(&self, i: u32, j: u32) -> bool {

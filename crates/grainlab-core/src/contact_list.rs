@@ -7,7 +7,8 @@ use crate::vec2::{add, norm, scale, sub, Vec2};
 /// One row of the contact table while it is assembled.
 type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool);
 
-/// Particle-particle contacts and bonds, sorted by `(i, j)`.
+/// Particle-particle contacts and bonds, sorted by `(i, j)` with `i < j`,
+/// in external (user) particle indices.
 ///
 /// `normal` points from `i` to `j`; `normal_force` (N, >= 0 unless bonded) and
 /// `shear_force` (N, along `perp(normal)`) are the forces on `j`, elastic parts
@@ -34,7 +35,8 @@ pub struct ContactList {
     pub bonded: Vec<bool>,
 }
 
-/// Particle-wall contacts, sorted by `(wall, particle)`; `normal` points from the wall to the particle.
+/// Particle-wall contacts, sorted by `(wall, particle)` (external particle
+/// indices); `normal` points from the wall to the particle.
 #[derive(Debug, Clone, Default)]
 pub struct WallContactList {
     /// Wall id.
@@ -96,6 +98,21 @@ impl Simulation {
             let fn_ = b.normal_stiffness * (b.rest_length - dist);
             rows.push((b.i, b.j, point, normal, overlap, fn_, b.shear, false, true));
         }
+        // external indices, i < j: swapping a pair flips its normal, and nothing
+        // else (the shear force on the new j along the new tangent is unchanged,
+        // and the contact point, mid-overlap, is the same seen from either disk)
+        for r in rows.iter_mut() {
+            let (i, j) = (
+                self.external_index(r.0 as usize) as u32,
+                self.external_index(r.1 as usize) as u32,
+            );
+            if i < j {
+                (r.0, r.1) = (i, j);
+            } else {
+                (r.0, r.1) = (j, i);
+                r.3 = [-r.3[0], -r.3[1]];
+            }
+        }
         rows.sort_by_key(|r| (r.0, r.1));
         let mut out = ContactList::default();
         for r in rows {
@@ -131,7 +148,7 @@ impl Simulation {
                     .get(wall.group, p.group[q as usize])
                     .normal_stiffness;
                 out.wall.push(w);
-                out.particle.push(q);
+                out.particle.push(self.external_index(q as usize) as u32);
                 out.point
                     .push(contact_point(x, scale(g.normal, -1.0), r, g.overlap));
                 out.normal.push(g.normal);
@@ -141,6 +158,17 @@ impl Simulation {
                 out.sliding.push(sliding);
             }
         }
-        Ok(out)
+        let mut idx: Vec<usize> = (0..out.wall.len()).collect();
+        idx.sort_by_key(|&k| (out.wall[k], out.particle[k]));
+        Ok(WallContactList {
+            wall: idx.iter().map(|&k| out.wall[k]).collect(),
+            particle: idx.iter().map(|&k| out.particle[k]).collect(),
+            point: idx.iter().map(|&k| out.point[k]).collect(),
+            normal: idx.iter().map(|&k| out.normal[k]).collect(),
+            overlap: idx.iter().map(|&k| out.overlap[k]).collect(),
+            normal_force: idx.iter().map(|&k| out.normal_force[k]).collect(),
+            shear_force: idx.iter().map(|&k| out.shear_force[k]).collect(),
+            sliding: idx.iter().map(|&k| out.sliding[k]).collect(),
+        })
     }
 }

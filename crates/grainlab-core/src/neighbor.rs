@@ -57,6 +57,24 @@ impl PairList {
         self.i.is_empty()
     }
 
+    /// Renumbers particles (`new_of_old[old] = new`), keeping `i < j` by swapping
+    /// the pair and reversing its image shift (the shear spring, a force on `j`
+    /// along `perp(n)`, is unchanged by the swap since both `n` and `perp(n)` flip).
+    pub fn remap(&mut self, new_of_old: &[u32]) {
+        for k in 0..self.len() {
+            let (i, j) = (
+                new_of_old[self.i[k] as usize],
+                new_of_old[self.j[k] as usize],
+            );
+            if i < j {
+                (self.i[k], self.j[k]) = (i, j);
+            } else {
+                (self.i[k], self.j[k]) = (j, i);
+                self.shift[k] = [-self.shift[k][0], -self.shift[k][1]];
+            }
+        }
+    }
+
     fn push(&mut self, i: u32, j: u32, shift: [i8; 2], model: u16) {
         self.i.push(i);
         self.j.push(j);
@@ -91,8 +109,8 @@ pub struct NeighborList {
     pub pairs: PairList,
     /// Particle-wall pairs.
     pub wall_pairs: WallPairList,
-    /// Particles owned by each block.
-    pub block_particles: Vec<Vec<u32>>,
+    /// Internal index range of the particles owned by each block.
+    pub block_ranges: Vec<(usize, usize)>,
     /// Number of builds so far.
     pub build_count: u64,
     valid: bool,
@@ -121,7 +139,7 @@ impl NeighborList {
             skin,
             pairs: PairList::default(),
             wall_pairs: WallPairList::default(),
-            block_particles: Vec::new(),
+            block_ranges: Vec::new(),
             build_count: 0,
             valid: false,
             reference: Vec::new(),
@@ -189,12 +207,19 @@ impl NeighborList {
 
     /// Rebuilds the lists: wraps particles into the periodic cell, bins them,
     /// lists pairs and wall pairs, and carries over the contact history.
+    ///
+    /// The particles are also put in *spatial order* (by bin, bins column by
+    /// column): each block is then a contiguous index range, which keeps the
+    /// threads' writes apart in memory and a pair's two particles close in cache.
+    /// `order` maps internal to external (user) indices and is permuted along,
+    /// as are the bonds and the old lists' indices.
     pub fn build(
         &mut self,
         particles: &mut Particles,
+        order: &mut Vec<u32>,
         cell: Option<&PeriodicCell>,
         walls: &[Wall],
-        bonds: &Bonds,
+        bonds: &mut Bonds,
         n_blocks: usize,
     ) -> Result<()> {
         let n = particles.len();
@@ -213,7 +238,23 @@ impl NeighborList {
         // 2. bins in fractional coordinates
         let grid = BinGrid::new(&particles.position, cell, cutoff)?;
         let bins = grid.assign(&particles.position, cell);
-        let (bin_start, bin_members) = counting_sort(&bins, grid.count());
+        let (bin_start, perm) = counting_sort(&bins, grid.count());
+
+        // 2b. spatial order: new index k is old index perm[k]
+        let mut new_of_old = vec![0u32; n];
+        for (k, &o) in perm.iter().enumerate() {
+            new_of_old[o as usize] = k as u32;
+        }
+        particles.permute(&perm);
+        *order = perm.iter().map(|&o| order[o as usize]).collect();
+        let wraps: Vec<[i8; 2]> = perm.iter().map(|&o| wraps[o as usize]).collect();
+        let bins: Vec<u32> = perm.iter().map(|&o| bins[o as usize]).collect();
+        bonds.remap(&new_of_old);
+        self.pairs.remap(&new_of_old);
+        for q in self.wall_pairs.particle.iter_mut() {
+            *q = new_of_old[*q as usize];
+        }
+        let bin_members: Vec<u32> = (0..n as u32).collect();
 
         // 3. blocks: contiguous ranges of bin columns with balanced particle counts
         let mut column_counts = vec![0usize; grid.n[0]];
@@ -228,10 +269,18 @@ impl NeighborList {
             seen += count;
         }
         let block_of = |p: usize| block_of_column[bins[p] as usize / grid.n[1]];
-        let mut block_particles = vec![Vec::new(); n_blocks];
-        for &p in &bin_members {
-            block_particles[block_of(p as usize) as usize].push(p);
+        // blocks are contiguous in the spatial order
+        let mut block_ranges = vec![(0usize, 0usize); n_blocks];
+        let mut start = 0usize;
+        for (b, range) in block_ranges.iter_mut().enumerate() {
+            let mut end = start;
+            while end < n && block_of(end) as usize == b {
+                end += 1;
+            }
+            *range = (start, end);
+            start = end;
         }
+        debug_assert_eq!(start, n);
 
         // 4. pairs, in bin order for locality, sorted into blocks
         let mut per_block: Vec<Vec<(u32, u32, [i8; 2])>> = vec![Vec::new(); n_blocks + 1];
@@ -337,7 +386,7 @@ impl NeighborList {
 
         self.pairs = pairs;
         self.wall_pairs = wall_pairs;
-        self.block_particles = block_particles;
+        self.block_ranges = block_ranges;
         self.reference = particles.position.clone();
         self.accumulated_map = IDENTITY;
         self.wall_reference = walls.iter().map(|w| w.displacement).collect();

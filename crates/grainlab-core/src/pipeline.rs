@@ -114,6 +114,11 @@ pub struct Simulation {
     pub step_count: u64,
     /// Simulated time (s).
     pub time: f64,
+    /// External (user) index of each internal particle slot: the engine keeps
+    /// particles in spatial order, renumbered at every neighbour-list build.
+    order: Vec<u32>,
+    /// Internal slot of each external index (the inverse of `order`).
+    rank: Vec<u32>,
     ledger: EnergyLedger,
     half_kick_pending: bool,
     threads: usize,
@@ -143,6 +148,7 @@ impl Simulation {
             return Err(EngineError::invalid("threads", "must be >= 1"));
         }
         let skin = 0.1 * particles.max_radius().max(f64::MIN_POSITIVE);
+        let identity: Vec<u32> = (0..particles.len() as u32).collect();
         let mut sim = Simulation {
             particles,
             materials: MaterialTable::uniform(model)?,
@@ -154,6 +160,8 @@ impl Simulation {
             measurements: Measurements::default(),
             step_count: 0,
             time: 0.0,
+            order: identity.clone(),
+            rank: identity,
             ledger: EnergyLedger::default(),
             half_kick_pending: true,
             threads,
@@ -264,6 +272,7 @@ impl Simulation {
     ) -> Result<()> {
         self.particles.check_index("bond.i", i)?;
         self.particles.check_index("bond.j", j)?;
+        let (i, j) = (self.internal_index(i), self.internal_index(j));
         if i == j {
             return Err(EngineError::invalid(
                 "bond",
@@ -273,7 +282,11 @@ impl Simulation {
         if self.bonds.contains(i as u32, j as u32) {
             return Err(EngineError::invalid(
                 "bond",
-                format!("particles {i} and {j} are already bonded"),
+                format!(
+                    "particles {} and {} are already bonded",
+                    self.external_index(i),
+                    self.external_index(j)
+                ),
             ));
         }
         require_positive("bond.normal_stiffness", normal_stiffness)?;
@@ -297,8 +310,8 @@ impl Simulation {
         Ok(())
     }
 
-    /// Branch vector from `i` to the nearest image of `j`.
-    pub fn branch(&self, i: usize, j: usize) -> Vec2 {
+    /// Branch vector from internal slot `i` to the nearest image of internal slot `j`.
+    pub(crate) fn branch(&self, i: usize, j: usize) -> Vec2 {
         let d = sub(self.particles.position[j], self.particles.position[i]);
         minimum_image(self.cell.as_ref(), d)
     }
@@ -395,11 +408,38 @@ impl Simulation {
     fn rebuild(&mut self) -> Result<()> {
         self.neighbors.build(
             &mut self.particles,
+            &mut self.order,
             self.cell.as_ref(),
             &self.walls,
-            &self.bonds,
+            &mut self.bonds,
             self.threads,
-        )
+        )?;
+        for (k, &e) in self.order.iter().enumerate() {
+            self.rank[e as usize] = k as u32;
+        }
+        Ok(())
+    }
+
+    /// External (user) index of internal particle slot `k`. The engine keeps
+    /// [`Simulation::particles`] in spatial order; every index that leaves the
+    /// engine through the public methods below is external.
+    pub fn external_index(&self, k: usize) -> usize {
+        self.order[k] as usize
+    }
+
+    /// Internal slot of external particle `e`.
+    pub fn internal_index(&self, e: usize) -> usize {
+        self.rank[e] as usize
+    }
+
+    /// A per-particle array in external order, from the internal one.
+    pub fn to_external<T: Copy>(&self, internal: &[T]) -> Vec<T> {
+        self.rank.iter().map(|&k| internal[k as usize]).collect()
+    }
+
+    /// A per-particle array in internal order, from an external one.
+    pub fn to_internal<T: Copy>(&self, external: &[T]) -> Vec<T> {
+        self.order.iter().map(|&e| external[e as usize]).collect()
     }
 
     /// Runs `n` steps without measuring any of them (faster; dissipation is still tallied).
@@ -542,7 +582,7 @@ impl Simulation {
 
     /// Steps 2-3: reset resultants, then particle-particle contact forces.
     fn particle_contacts<const MEASURE: bool>(&mut self, team: Option<&Team>) -> ContactTally {
-        let n_blocks = self.neighbors.block_particles.len();
+        let n_blocks = self.neighbors.block_ranges.len();
         let pairs = &mut self.neighbors.pairs;
         let starts = &pairs.block_start;
         // interior pairs of each block, then the cross-block pairs shared out evenly
@@ -552,15 +592,20 @@ impl Simulation {
             .into_iter()
             .map(|(lo, hi)| (cross_start + lo, cross_start + hi))
             .collect();
-        let mut ranges: Vec<(usize, usize)> = (0..n_blocks).map(|b| (starts[b], starts[b + 1])).collect();
+        let mut ranges: Vec<(usize, usize)> =
+            (0..n_blocks).map(|b| (starts[b], starts[b + 1])).collect();
         ranges.extend(&cross_ranges);
         let mut shear_parts = split_ranges(&mut pairs.shear, &ranges);
         let mut sliding_parts = split_ranges(&mut pairs.sliding, &ranges);
         let cross_shear = shear_parts.split_off(n_blocks);
         let cross_sliding = sliding_parts.split_off(n_blocks);
         self.cross_forces.clear();
-        self.cross_forces.resize(n_pairs - cross_start, PairForce::NONE);
-        let local: Vec<(usize, usize)> = cross_ranges.iter().map(|&(lo, hi)| (lo - cross_start, hi - cross_start)).collect();
+        self.cross_forces
+            .resize(n_pairs - cross_start, PairForce::NONE);
+        let local: Vec<(usize, usize)> = cross_ranges
+            .iter()
+            .map(|&(lo, hi)| (lo - cross_start, hi - cross_start))
+            .collect();
         let cross_buffers = split_ranges(&mut self.cross_forces, &local);
 
         let p = &mut self.particles;
@@ -578,7 +623,11 @@ impl Simulation {
             model: &pairs.model,
             materials: &self.materials,
             cell: self.cell.as_ref(),
-            velocity_gradient: self.cell.as_ref().filter(|c| c.is_deforming()).map(|c| c.velocity_gradient),
+            velocity_gradient: self
+                .cell
+                .as_ref()
+                .filter(|c| c.is_deforming())
+                .map(|c| c.velocity_gradient),
             dt: self.params.time_step,
             max_overlap_ratio: self.params.max_overlap_ratio,
         };
@@ -594,28 +643,37 @@ impl Simulation {
             .zip(cross_shear.into_iter().zip(cross_sliding))
             .zip(cross_buffers)
             .enumerate()
-            .map(|(b, (((shear, sliding), (cross_shear, cross_sliding)), cross_forces))| BlockWork {
-                block: b,
-                shear,
-                sliding,
-                cross_shear,
-                cross_sliding,
-                cross_forces,
-            })
+            .map(
+                |(b, (((shear, sliding), (cross_shear, cross_sliding)), cross_forces))| BlockWork {
+                    block: b,
+                    shear,
+                    sliding,
+                    cross_shear,
+                    cross_sliding,
+                    cross_forces,
+                },
+            )
             .collect();
-        let block_particles = &self.neighbors.block_particles;
+        let block_ranges = &self.neighbors.block_ranges;
         let tallies = map_blocks(team, blocks, |work| {
             let b = work.block;
-            let mut direct = DirectSink { force: &force, torque: &torque };
+            let mut direct = DirectSink {
+                force: &force,
+                torque: &torque,
+            };
             // SAFETY: block b resets and writes only the forces of its own particles
             // (interior pairs have both particles in block b); cross pairs only
             // write their own slots of the buffer.
             unsafe {
-                for &q in &block_particles[b] {
-                    reset.apply(q as usize, &force, &torque);
+                let (lo, hi) = block_ranges[b];
+                for q in lo..hi {
+                    reset.apply(q, &force, &torque);
                 }
-                let mut tally = kernel.run::<MEASURE, _>(ranges[b].0, work.shear, work.sliding, &mut direct);
-                let mut buffered = BufferSink { slots: work.cross_forces };
+                let mut tally =
+                    kernel.run::<MEASURE, _>(ranges[b].0, work.shear, work.sliding, &mut direct);
+                let mut buffered = BufferSink {
+                    slots: work.cross_forces,
+                };
                 let cross = kernel.run::<MEASURE, _>(
                     ranges[n_blocks + b].0,
                     work.cross_shear,
@@ -778,7 +836,12 @@ impl Simulation {
             external_torque: &p.external_torque,
             reference: self.neighbors.reference().reference,
         };
-        let bounds = even_bounds(p.position.len(), self.threads);
+        // each worker integrates the block whose contacts it just computed
+        let bounds = if self.neighbors.block_ranges.len() == self.threads {
+            self.neighbors.block_ranges.clone()
+        } else {
+            even_bounds(p.position.len(), self.threads)
+        };
         let chunks: Vec<MotionChunk<'_>> = split_ranges(&mut p.position, &bounds)
             .into_iter()
             .zip(split_ranges(&mut p.velocity, &bounds))
@@ -815,6 +878,7 @@ impl Simulation {
                     && p.velocity[q][1].is_finite()
                     && p.angular_velocity[q].is_finite())
             })
+            .map(|q| self.external_index(q))
             .collect();
         let shown: Vec<String> = bad.iter().take(10).map(|q| q.to_string()).collect();
         EngineError::Unstable {
@@ -856,6 +920,8 @@ impl Simulation {
             }
         }
         let (r, i, j) = worst.unwrap_or((0.0, 0, None));
+        let i = self.external_index(i);
+        let j = j.map(|j| self.external_index(j));
         let (what, particles) = match j {
             Some(j) => (format!("particles {i} and {j}"), vec![i, j]),
             None => (format!("particle {i} and a wall"), vec![i]),
@@ -957,8 +1023,21 @@ struct BufferSink<'a> {
 
 impl ForceSink for BufferSink<'_> {
     #[inline(always)]
-    unsafe fn add(&mut self, k: usize, _i: usize, _j: usize, f: Vec2, torque_i: f64, torque_j: f64) {
-        self.slots[k] = PairForce { force: f, torque_i, torque_j, active: true };
+    unsafe fn add(
+        &mut self,
+        k: usize,
+        _i: usize,
+        _j: usize,
+        f: Vec2,
+        torque_i: f64,
+        torque_j: f64,
+    ) {
+        self.slots[k] = PairForce {
+            force: f,
+            torque_i,
+            torque_j,
+            active: true,
+        };
     }
 
     #[inline(always)]
@@ -977,7 +1056,12 @@ pub(crate) struct PairForce {
 }
 
 impl PairForce {
-    const NONE: PairForce = PairForce { force: [0.0; 2], torque_i: 0.0, torque_j: 0.0, active: false };
+    const NONE: PairForce = PairForce {
+        force: [0.0; 2],
+        torque_i: 0.0,
+        torque_j: 0.0,
+        active: false,
+    };
 }
 
 /// One block's share of the contact phase.

@@ -131,6 +131,29 @@ impl Particles {
         }
     }
 
+    /// Reorders every array: new index `k` takes old index `perm[k]`.
+    pub fn permute(&mut self, perm: &[u32]) {
+        fn gather<T: Copy>(v: &mut Vec<T>, perm: &[u32]) {
+            *v = perm.iter().map(|&o| v[o as usize]).collect();
+        }
+        gather(&mut self.position, perm);
+        gather(&mut self.velocity, perm);
+        gather(&mut self.rotation, perm);
+        gather(&mut self.angular_velocity, perm);
+        gather(&mut self.radius, perm);
+        gather(&mut self.density, perm);
+        gather(&mut self.mass, perm);
+        gather(&mut self.inertia, perm);
+        gather(&mut self.inv_mass, perm);
+        gather(&mut self.inv_inertia, perm);
+        gather(&mut self.group, perm);
+        gather(&mut self.fixity, perm);
+        gather(&mut self.external_force, perm);
+        gather(&mut self.external_torque, perm);
+        gather(&mut self.force, perm);
+        gather(&mut self.torque, perm);
+    }
+
     /// Checks that `index` names a particle.
     pub fn check_index(&self, field: &str, index: usize) -> Result<()> {
         if index < self.len() {

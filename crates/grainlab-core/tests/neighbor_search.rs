@@ -9,7 +9,8 @@ use grainlab_core::{
 };
 use std::collections::BTreeSet;
 
-/// Contacts by brute force over all pairs and all images within one cell.
+/// Contacts by brute force over all pairs and all images within one cell, as
+/// external index pairs.
 fn brute_force(sim: &Simulation) -> BTreeSet<(u32, u32)> {
     let p = &sim.particles;
     let mut out = BTreeSet::new();
@@ -38,7 +39,9 @@ fn brute_force(sim: &Simulation) -> BTreeSet<(u32, u32)> {
                 let d = sub(add(p.position[j], off), p.position[i]);
                 let reach = p.radius[i] + p.radius[j];
                 if dot(d, d) < reach * reach {
-                    out.insert((i as u32, j as u32));
+                    // the engine reports external (user) indices
+                    let (a, b) = (sim.external_index(i) as u32, sim.external_index(j) as u32);
+                    out.insert((a.min(b), a.max(b)));
                 }
             }
         }
@@ -159,7 +162,7 @@ fn moving_walls_never_miss_a_contact() {
                     .overlap
                     > 0.0
             })
-            .map(|q| q as u32)
+            .map(|q| sim.external_index(q) as u32)
             .collect();
         assert_eq!(got, expected, "step {step}");
     }

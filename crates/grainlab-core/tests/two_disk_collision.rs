@@ -42,7 +42,8 @@ fn collide(alpha: f64) -> (f64, f64) {
         }
     }
     let duration = end.unwrap() - start.unwrap();
-    let v_after = sim.particles.velocity[1][0] - sim.particles.velocity[0][0];
+    let v = sim.to_external(&sim.particles.velocity); // the engine keeps its own order
+    let v_after = v[1][0] - v[0][0];
     (duration, v_after / (2.0 * v0))
 }
 

@@ -194,66 +194,75 @@ impl Engine {
 
     #[getter]
     fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        points_to_py(py, &self.sim.particles.position)
+        points_to_py(py, &self.sim.to_external(&self.sim.particles.position))
     }
     #[getter]
     fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        points_to_py(py, &self.sim.particles.velocity)
+        points_to_py(py, &self.sim.to_external(&self.sim.particles.velocity))
     }
     #[getter]
     fn forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        points_to_py(py, &self.sim.particles.force)
+        points_to_py(py, &self.sim.to_external(&self.sim.particles.force))
     }
     #[getter]
     fn external_forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        points_to_py(py, &self.sim.particles.external_force)
+        points_to_py(
+            py,
+            &self.sim.to_external(&self.sim.particles.external_force),
+        )
     }
     #[getter]
     fn rotations<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.rotation)
+        values_to_py(py, &self.sim.to_external(&self.sim.particles.rotation))
     }
     #[getter]
     fn angular_velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.angular_velocity)
+        values_to_py(
+            py,
+            &self.sim.to_external(&self.sim.particles.angular_velocity),
+        )
     }
     #[getter]
     fn torques<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.torque)
+        values_to_py(py, &self.sim.to_external(&self.sim.particles.torque))
     }
     #[getter]
     fn external_torques<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.external_torque)
+        values_to_py(
+            py,
+            &self.sim.to_external(&self.sim.particles.external_torque),
+        )
     }
     #[getter]
     fn radii<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.radius)
+        values_to_py(py, &self.sim.to_external(&self.sim.particles.radius))
     }
     #[getter]
     fn densities<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.density)
+        values_to_py(py, &self.sim.to_external(&self.sim.particles.density))
     }
     #[getter]
     fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.mass)
+        values_to_py(py, &self.sim.to_external(&self.sim.particles.mass))
     }
     #[getter]
     fn inertias<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.inertia)
+        values_to_py(py, &self.sim.to_external(&self.sim.particles.inertia))
     }
     #[getter]
     fn groups<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.group)
+        values_to_py(py, &self.sim.to_external(&self.sim.particles.group))
     }
     #[getter]
     fn fixity<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.particles.fixity)
+        values_to_py(py, &self.sim.to_external(&self.sim.particles.fixity))
     }
 
     fn set_positions(&mut self, positions: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
         let v = points("positions", &positions)?;
         same_length("positions", v.len(), self.sim.particles.len())?;
         check_finite_points("positions", &v)?;
-        self.sim.particles.position = v;
+        self.sim.particles.position = self.sim.to_internal(&v);
         self.sim.invalidate_neighbors();
         Ok(())
     }
@@ -262,7 +271,7 @@ impl Engine {
         let v = points("velocities", &velocities)?;
         same_length("velocities", v.len(), self.sim.particles.len())?;
         check_finite_points("velocities", &v)?;
-        self.sim.particles.velocity = v;
+        self.sim.particles.velocity = self.sim.to_internal(&v);
         self.sim.velocities_changed();
         Ok(())
     }
@@ -271,7 +280,7 @@ impl Engine {
         let v = points("external_forces", &forces)?;
         same_length("external_forces", v.len(), self.sim.particles.len())?;
         check_finite_points("external_forces", &v)?;
-        self.sim.particles.external_force = v;
+        self.sim.particles.external_force = self.sim.to_internal(&v);
         Ok(())
     }
 
@@ -279,7 +288,7 @@ impl Engine {
         let v = values(&rotations);
         same_length("rotations", v.len(), self.sim.particles.len())?;
         check_finite("rotations", &v)?;
-        self.sim.particles.rotation = v;
+        self.sim.particles.rotation = self.sim.to_internal(&v);
         Ok(())
     }
 
@@ -287,7 +296,7 @@ impl Engine {
         let v = values(&omega);
         same_length("angular_velocities", v.len(), self.sim.particles.len())?;
         check_finite("angular_velocities", &v)?;
-        self.sim.particles.angular_velocity = v;
+        self.sim.particles.angular_velocity = self.sim.to_internal(&v);
         self.sim.velocities_changed();
         Ok(())
     }
@@ -296,7 +305,7 @@ impl Engine {
         let v = values(&torques);
         same_length("external_torques", v.len(), self.sim.particles.len())?;
         check_finite("external_torques", &v)?;
-        self.sim.particles.external_torque = v;
+        self.sim.particles.external_torque = self.sim.to_internal(&v);
         Ok(())
     }
 
@@ -306,7 +315,7 @@ impl Engine {
         for (k, &r) in v.iter().enumerate() {
             grainlab_core::error::require_positive(&format!("radii[{k}]"), r).map_err(to_py_err)?;
         }
-        self.sim.particles.radius = v;
+        self.sim.particles.radius = self.sim.to_internal(&v);
         self.sim.particles.update_mass_properties();
         self.sim.invalidate_neighbors();
         Ok(())
@@ -319,7 +328,7 @@ impl Engine {
             grainlab_core::error::require_positive(&format!("densities[{k}]"), r)
                 .map_err(to_py_err)?;
         }
-        self.sim.particles.density = v;
+        self.sim.particles.density = self.sim.to_internal(&v);
         self.sim.particles.update_mass_properties();
         Ok(())
     }
@@ -336,7 +345,7 @@ impl Engine {
                 "groups[{k}]: group {g} out of range 0..16"
             )));
         }
-        self.sim.particles.group = v;
+        self.sim.particles.group = self.sim.to_internal(&v);
         self.sim.invalidate_neighbors();
         Ok(())
     }
@@ -349,7 +358,7 @@ impl Engine {
                 "fixity[{k}]: {f} is not a combination of 1 (x), 2 (y), 4 (rotation)"
             )));
         }
-        self.sim.particles.fixity = v;
+        self.sim.particles.fixity = self.sim.to_internal(&v);
         Ok(())
     }
 
