@@ -11,10 +11,15 @@
 use std::cell::UnsafeCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
+use std::thread::Thread;
+use std::time::{Duration, Instant};
 
-/// Spins before a waiting worker starts yielding its core.
-const SPINS_BEFORE_YIELD: u32 = 1 << 14;
+/// How long a waiting thread spins before it parks. About one phase: spinning
+/// keeps the hand-over fast, parking frees the core when the machine is shared
+/// (a spinning waiter could otherwise keep the very thread it waits for off
+/// the CPU for a whole scheduler time slice).
+const SPIN_BEFORE_PARK: Duration = Duration::from_micros(50);
 
 type Job = dyn Fn(usize) + Sync;
 
@@ -26,6 +31,8 @@ pub struct Team {
     quit: AtomicBool,
     panicked: AtomicBool,
     job: UnsafeCell<Option<*const Job>>,
+    leader: OnceLock<Thread>,
+    workers: Mutex<Vec<Thread>>,
 }
 
 // SAFETY: `job` is written only by worker 0 while no other worker reads it
@@ -42,6 +49,8 @@ impl Team {
             quit: AtomicBool::new(false),
             panicked: AtomicBool::new(false),
             job: UnsafeCell::new(None),
+            leader: OnceLock::new(),
+            workers: Mutex::new(Vec::new()),
         }
     }
 
@@ -52,6 +61,7 @@ impl Team {
 
     /// Runs `job(k)` on every worker `k` (worker 0 is the caller) and waits for all.
     pub fn run<'a>(&self, job: &'a (dyn Fn(usize) + Sync + 'a)) {
+        self.leader.get_or_init(std::thread::current);
         // SAFETY: the lifetime is erased only until this function returns, and it
         // returns after every worker finished with the job.
         let erased: *const Job =
@@ -59,11 +69,9 @@ impl Team {
         unsafe { *self.job.get() = Some(erased) };
         self.pending.store(self.size - 1, Ordering::Release);
         self.epoch.fetch_add(1, Ordering::AcqRel);
+        self.wake_workers();
         job(0);
-        let mut spins = 0u32;
-        while self.pending.load(Ordering::Acquire) != 0 {
-            wait(&mut spins);
-        }
+        wait_until(|| self.pending.load(Ordering::Acquire) == 0);
         if self.panicked.load(Ordering::Acquire) {
             panic!("a grainlab worker thread panicked");
         }
@@ -71,42 +79,60 @@ impl Team {
 
     /// Worker `index` (>= 1) serves phases until [`Team::dismiss`].
     pub fn serve(&self, index: usize) {
+        self.workers
+            .lock()
+            .expect("worker list")
+            .push(std::thread::current());
         let mut seen = 0usize;
         loop {
-            let mut spins = 0u32;
-            loop {
-                let epoch = self.epoch.load(Ordering::Acquire);
-                if epoch != seen {
-                    seen = epoch;
-                    break;
-                }
-                if self.quit.load(Ordering::Acquire) {
-                    return;
-                }
-                wait(&mut spins);
+            let mut next = seen;
+            wait_until(|| {
+                next = self.epoch.load(Ordering::Acquire);
+                next != seen || self.quit.load(Ordering::Acquire)
+            });
+            if next == seen {
+                return; // dismissed
             }
+            seen = next;
             // SAFETY: published before the epoch we just observed (Acquire).
             let job = unsafe { (*self.job.get()).expect("a job with the epoch") };
             if catch_unwind(AssertUnwindSafe(|| unsafe { (*job)(index) })).is_err() {
                 self.panicked.store(true, Ordering::Release);
             }
-            self.pending.fetch_sub(1, Ordering::AcqRel);
+            if self.pending.fetch_sub(1, Ordering::AcqRel) == 1 {
+                if let Some(leader) = self.leader.get() {
+                    leader.unpark();
+                }
+            }
         }
     }
 
     /// Lets the serving workers return.
     pub fn dismiss(&self) {
         self.quit.store(true, Ordering::Release);
+        self.wake_workers();
+    }
+
+    fn wake_workers(&self) {
+        for worker in self.workers.lock().expect("worker list").iter() {
+            worker.unpark();
+        }
     }
 }
 
+/// Spins on `ready` for a while, then parks between checks (an `unpark` from
+/// the thread that makes it true, or a short timeout, ends each park).
 #[inline]
-fn wait(spins: &mut u32) {
-    if *spins < SPINS_BEFORE_YIELD {
-        *spins += 1;
-        std::hint::spin_loop();
-    } else {
-        std::thread::yield_now();
+fn wait_until(mut ready: impl FnMut() -> bool) {
+    let start = Instant::now();
+    let mut spins = 0u32;
+    while !ready() {
+        spins += 1;
+        if spins % 64 != 0 || start.elapsed() < SPIN_BEFORE_PARK {
+            std::hint::spin_loop();
+        } else {
+            std::thread::park_timeout(Duration::from_micros(200));
+        }
     }
 }
 
