@@ -1,8 +1,8 @@
 """Reading and writing snapshots: particles CSV, LAMMPS/LIGGGHTS dumps.
 
 :func:`read_snapshot` recognises the format of a file from its content and
-dispatches to the reader registered for it in :data:`READERS`. A grainlab
-HDF5 reader (``format = "grainlab-hdf5"``) plugs in by adding an entry there.
+dispatches to the reader registered for it in :data:`READERS`; grainlab's
+HDF5 results files (``run.h5``) are read by :mod:`grainlab.io.hdf5`.
 
 All readers raise :class:`FileFormatError` (a ``ValueError``) whose message
 names the file, the line and the problem.
@@ -21,6 +21,7 @@ from grainlab.io.csv import (
     write_contacts_csv,
     write_particles_csv,
 )
+from grainlab.io.hdf5 import read_hdf5_snapshot
 from grainlab.io.lammps_dump import list_timesteps, read_lammps_dump
 from grainlab.snapshot import Snapshot
 
@@ -102,18 +103,12 @@ def _read_dump(
     )
 
 
-def _read_hdf5(path: Path, **_: Any) -> Snapshot:
-    raise ValueError(
-        f"{path}: grainlab HDF5 snapshots are not readable yet (the engine's writer comes first)"
-    )
-
-
 #: Reader per format name:
 #: ``reader(path, *, contacts, timestep, tolerance, columns, boundary_types) -> Snapshot``.
 READERS: dict[str, Callable[..., Snapshot]] = {
     "particles-csv": _read_csv,
     "lammps-dump": _read_dump,
-    "grainlab-hdf5": _read_hdf5,
+    "grainlab-hdf5": read_hdf5_snapshot,
 }
 
 
@@ -126,28 +121,38 @@ def read_snapshot(
     columns: Mapping[str, str] | None = None,
     boundary_types: Sequence[int] = (),
     format: str | None = None,
+    snapshot: str | int | None = None,
 ) -> Snapshot:
     """Read a snapshot from any supported file.
 
     Parameters
     ----------
     path
-        Particles CSV or LAMMPS atoms dump (format detected, or ``format``).
+        Particles CSV, LAMMPS atoms dump or grainlab results file ``run.h5``
+        (format detected, or ``format``).
     contacts
         Contacts file: a contacts CSV for a particles CSV, a ``dump local``
         file for a LAMMPS dump. Without it contacts are detected from the
         geometry (centre distance < r_i + r_j + ``tolerance``, m).
     timestep
-        Frame of a multi-frame dump (default the last).
+        Frame of a multi-frame dump (default the last); for ``run.h5`` the
+        snapshot recorded at that engine step.
     columns
         Column roles of a LAMMPS local dump (see :mod:`grainlab.io.lammps_dump`).
     boundary_types
         LAMMPS atom types that bound the sample (wall disks): kind MEMBRANE.
+    snapshot
+        Snapshot of a grainlab results file ``run.h5``, by name
+        (``"strain_0.0150"``) or position (``-1`` the last, the default);
+        ``timestep`` selects one by its engine step instead.
     """
     p = Path(path)
     fmt = format or detect_format(p)
     if fmt not in READERS:
         raise ValueError(f"format: unknown {fmt!r} (known: {', '.join(READERS)})")
+    if snapshot is not None and fmt != "grainlab-hdf5":
+        raise ValueError(f"snapshot: only applies to grainlab HDF5 results files, not a {fmt}")
+    extra: dict[str, Any] = {} if snapshot is None else {"snapshot": snapshot}
     return READERS[fmt](
         p,
         contacts=contacts,
@@ -155,4 +160,5 @@ def read_snapshot(
         tolerance=tolerance,
         columns=columns,
         boundary_types=boundary_types,
+        **extra,
     )

@@ -1,0 +1,156 @@
+"""Files of a results folder written so that a crash never leaves half a file.
+
+A run writes its outputs (``run.h5``, ``timeseries.csv``, ``summary.json``,
+``checkpoint.h5``) into one folder. Every file a reader may pick up is
+*published atomically*: the content goes to a temporary file in the same
+folder, is flushed to disk (``fsync``), and is then renamed over the final
+name with :func:`os.replace`, which is atomic on POSIX and Windows when both
+names are on the same file system. A reader therefore sees either the old
+file or the new one, never a mixture; a killed writer leaves at most a stray
+temporary file (``.NAME.*.tmp``), never a truncated ``NAME``.
+
+Example
+-------
+>>> import tempfile, pathlib
+>>> from grainlab.io.results import write_json_atomic, write_text_atomic
+>>> folder = pathlib.Path(tempfile.mkdtemp())
+>>> write_text_atomic(folder / "timeseries.csv", "axial_strain,q\\n0.0,0.0\\n").name
+'timeseries.csv'
+>>> (folder / "timeseries.csv").read_text().splitlines()[0]
+'axial_strain,q'
+>>> write_json_atomic(folder / "summary.json", {"peak": 1.5, "missing": float("nan")}).name
+'summary.json'
+>>> (folder / "summary.json").read_text()
+'{\\n  "peak": 1.5,\\n  "missing": null\\n}\\n'
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "CHECKPOINT_FILE",
+    "RESULTS_FILE",
+    "atomic_path",
+    "fsync_directory",
+    "fsync_file",
+    "write_bytes_atomic",
+    "write_json_atomic",
+    "write_text_atomic",
+]
+
+#: Name of the results file of a run folder.
+RESULTS_FILE = "run.h5"
+#: Name of the checkpoint file of a run folder.
+CHECKPOINT_FILE = "checkpoint.h5"
+
+
+def fsync_file(path: str | os.PathLike[str]) -> None:
+    """Flush a closed file's content to the storage device (``fsync``)."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def fsync_directory(path: str | os.PathLike[str]) -> None:
+    """Make a rename inside folder ``path`` durable (``fsync`` of the folder).
+
+    A no-op where folders cannot be opened (Windows).
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Context manager: a temporary path to write, published as ``path`` on success.
+
+    The temporary file is created empty in ``path``'s folder. When the block
+    ends without an exception the file is fsynced and renamed over ``path``
+    (:func:`os.replace`) and the folder is fsynced; on an exception the
+    temporary file is removed and ``path`` is left as it was.
+
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "out.bin"
+    >>> with atomic_path(target) as tmp:
+    ...     _ = tmp.write_bytes(b"\\x00\\x01")
+    >>> target.read_bytes()
+    b'\\x00\\x01'
+    """
+    final = Path(path)
+    folder = final.parent
+    fd, name = tempfile.mkstemp(prefix=f".{final.name}.", suffix=".tmp", dir=folder)
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        yield tmp
+        fsync_file(tmp)
+        os.replace(tmp, final)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+        raise
+    fsync_directory(folder)
+
+
+def _write_atomic(path: str | os.PathLike[str], write: Callable[[Path], Any]) -> Path:
+    final = Path(path)
+    with atomic_path(final) as tmp:
+        write(tmp)
+    return final
+
+
+def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically (temporary file, fsync, rename); returns ``path``."""
+    return _write_atomic(path, lambda tmp: tmp.write_bytes(bytes(data)))
+
+
+def write_text_atomic(path: str | os.PathLike[str], text: str, *, encoding: str = "utf-8") -> Path:
+    """Write ``text`` to ``path`` atomically (temporary file, fsync, rename); returns ``path``.
+
+    Line endings are written as given (no newline translation), so a file
+    written on Windows is byte-identical to one written on Linux.
+    """
+    data = text.encode(encoding)
+    return _write_atomic(path, lambda tmp: tmp.write_bytes(data))
+
+
+def _json_safe(value: Any) -> Any:
+    """Non-finite floats -> None, recursively (strict JSON has no NaN / inf)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _json_safe(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_json_safe(v) for v in value]
+    if hasattr(value, "tolist") and hasattr(value, "dtype"):  # NumPy scalars and arrays
+        return _json_safe(value.tolist())
+    return value
+
+
+def write_json_atomic(path: str | os.PathLike[str], value: Any, *, indent: int | None = 2) -> Path:
+    """Write ``value`` as strict JSON (UTF-8) to ``path`` atomically; returns ``path``.
+
+    NaN and infinities, which JSON cannot represent, are written as ``null``;
+    NumPy scalars and arrays are written as numbers and lists. A trailing
+    newline ends the file.
+    """
+    text = json.dumps(_json_safe(value), indent=indent, ensure_ascii=False, allow_nan=False)
+    return write_text_atomic(path, text + "\n")
