@@ -1113,7 +1113,13 @@ def _open_results(
             raise IncompleteResultsError(
                 p, f"{why}; pass allow_incomplete=True to read what it wrote"
             )
-        yield f, _READERS_BY_VERSION[version]
+        try:
+            yield f, _READERS_BY_VERSION[version]
+        except (OSError, KeyError) as error:  # damaged, or caught mid-write by a live reader
+            raise ResultsFileError(
+                p,
+                f"cannot be read: the file is corrupt, or is being written ({error!r})",
+            ) from None
     finally:
         f.close()
 
