@@ -149,6 +149,22 @@ def _vector(name: str, value: ArrayLike) -> tuple[float, float]:
     return float(array[0]), float(array[1])
 
 
+def _index_list(name: str, value: ArrayLike, n: int) -> list[int]:
+    array = np.asarray(value)
+    if array.ndim != 1 or array.size == 0 or array.dtype.kind not in "iu":
+        raise ValueError(f"{name}: expected a non-empty 1D array of particle indices")
+    if np.any((array < 0) | (array >= n)):
+        k = int(np.argwhere((array < 0) | (array >= n))[0, 0])
+        raise ValueError(f"{name}[{k}]: particle index {array[k]} out of range 0..{n - 1}")
+    return [int(v) for v in array]
+
+
+def _wall_id(wall: Wall | int | None) -> int | None:
+    if wall is None:
+        return None
+    return wall.id if isinstance(wall, Wall) else int(wall)
+
+
 class Wall:
     """A handle on one wall of a :class:`Simulation` (walls are owned by the engine).
 
@@ -202,6 +218,15 @@ class Wall:
     @velocity.setter
     def velocity(self, value: ArrayLike) -> None:
         self._engine.set_wall_velocity(self.id, list(_vector("velocity", value)))
+
+    @property
+    def active(self) -> bool:
+        """An inactive wall has no contacts and stays put (e.g. side walls replaced by a membrane)."""
+        return bool(self._state()["active"])
+
+    @active.setter
+    def active(self, value: bool) -> None:
+        self._engine.set_wall_active(self.id, bool(value))
 
     @property
     def control(self) -> str:
@@ -601,6 +626,55 @@ class Simulation:
             raise ValueError(f"wall_id: unknown wall {wall_id}; valid ids are 0..{n - 1}")
         return Wall(self._engine, int(wall_id))
 
+    # ---- follower loads ----
+
+    def add_pressure_chain(
+        self,
+        particles: ArrayLike,
+        pressure_pa: float,
+        *,
+        start_wall: Wall | int | None = None,
+        end_wall: Wall | int | None = None,
+    ) -> int:
+        """A confining pressure on a chain of boundary particles that follows the
+        boundary as it deforms (DESIGN §3): particle ``k`` of the chain gets
+        ``p / 2 * rotCW(x[k+1] - x[k-1])`` every step, pointing to the sample,
+        which lies on the chain's right (walk the chain clockwise around the
+        sample). The end particles carry the segment to their projection on
+        ``start_wall`` / ``end_wall`` (e.g. the platens), so the loads sum to the
+        pressure on the whole span. Returns the chain id."""
+        return int(
+            self._engine.add_pressure_chain(
+                _index_list("particles", particles, self.n_particles),
+                float(pressure_pa),
+                _wall_id(start_wall),
+                _wall_id(end_wall),
+            )
+        )
+
+    def set_pressure_chain(
+        self,
+        chain_id: int,
+        particles: ArrayLike,
+        pressure_pa: float,
+        *,
+        start_wall: Wall | int | None = None,
+        end_wall: Wall | int | None = None,
+    ) -> None:
+        """Replaces a pressure chain's particles, pressure and anchors (e.g. when the
+        boundary particles are re-identified)."""
+        self._engine.set_pressure_chain(
+            int(chain_id),
+            _index_list("particles", particles, self.n_particles),
+            float(pressure_pa),
+            _wall_id(start_wall),
+            _wall_id(end_wall),
+        )
+
+    def pressure_chain(self, chain_id: int) -> dict[str, Any]:
+        """A chain's ``particles`` (in order), ``pressure`` (Pa), ``start_wall``, ``end_wall``."""
+        return dict(self._engine.pressure_chain(int(chain_id)))
+
     # ---- bonds ----
 
     def add_bond(
@@ -651,8 +725,9 @@ class Simulation:
     def energy(self) -> dict[str, float]:
         """Energy ledger (J per m thickness): ``kinetic`` and ``elastic`` at the last
         measured step; ``friction_dissipated``, ``viscous_dissipated``,
-        ``damping_dissipated``, ``wall_work``, ``external_work`` summed since step 0;
-        ``balance`` = kinetic + elastic + dissipated - work, constant in exact arithmetic."""
+        ``damping_dissipated``, ``wall_work``, ``external_work``, ``boundary_work``
+        (pressure chains) summed since step 0; ``balance`` = kinetic + elastic +
+        dissipated - work, constant in exact arithmetic."""
         return dict(self._engine.energy)
 
     def snapshot(self, **metadata: Any) -> Snapshot:

@@ -208,3 +208,35 @@ def test_snapshot_wall_contacts_point_to_the_wall():
     snap = sim.snapshot()
     assert snap.contact_j.tolist() == [-1]
     np.testing.assert_allclose(snap.contact_normal[0], [0.0, -1.0])
+
+
+def test_pressure_chain_pushes_with_pressure_times_span():
+    # ten touching disks in a column between a floor and a ceiling, pressed by a follower
+    # pressure against a wall on their right: the wall carries p * H at equilibrium
+    r, height, pressure = 1e-3, 20e-3, 1e5
+    y = r + 2 * r * np.arange(10)
+    sim = Simulation(np.column_stack([np.zeros(10), y]), np.full(10, r), local_damping=0.7, threads=1)
+    sim.set_contact_model(0, 1, ContactModel(friction=0.0))
+    floor = sim.add_line_wall((0, 0), (0, 1))
+    ceiling = sim.add_line_wall((0, height), (0, -1))
+    wall = sim.add_line_wall((r, 0), (-1, 0))  # particles on its left
+    chain = sim.add_pressure_chain(np.arange(10), pressure, start_wall=floor, end_wall=ceiling)
+    sim.run(20_000)
+    assert wall.force[0] == pytest.approx(pressure * height, rel=1e-6)
+    assert wall.normal_stress(height) == pytest.approx(pressure, rel=1e-6)
+    assert sim.pressure_chain(chain)["particles"] == list(range(10))
+    # the follower load did the work stored in the contacts and lost to damping
+    e = sim.energy
+    assert e["boundary_work"] > 0
+    assert e["balance"] == pytest.approx(0.0, abs=1e-3 * e["boundary_work"])
+
+
+def test_inactive_wall_lets_particles_through():
+    sim = Simulation([[0.0, 0.5e-3]], [1e-3], time_step=1e-6)
+    floor = sim.add_line_wall((0, 0), (0, 1))
+    sim.run(1)
+    assert floor.contact_count == 1
+    floor.active = False
+    sim.run(1)
+    assert floor.contact_count == 0 and not floor.active
+    assert len(sim.wall_contacts()) == 0

@@ -252,7 +252,7 @@ def test_read_snapshot_dispatch(tmp_path):
     h5 = tmp_path / "run.h5"
     h5.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
     assert detect_format(h5) == "grainlab-hdf5"
-    with pytest.raises(ValueError, match="HDF5 snapshots are not readable yet"):
+    with pytest.raises(ValueError, match="cannot be read as HDF5: the file is truncated or corrupt"):
         read_snapshot(h5)
     other = write(tmp_path, "x.txt", "hello,world\n")
     with pytest.raises(FileFormatError, match="unknown format"):

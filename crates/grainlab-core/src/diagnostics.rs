@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 /// last measured step (full-step velocities); the rest accumulate from step 0.
 ///
 /// Balance: `kinetic + elastic + friction + viscous + damping - wall_work -
-/// external_work` stays constant, up to the work of prescribed velocities and
+/// external_work - boundary_work` stays constant, up to the work of prescribed velocities and
 /// of the periodic cell's imposed deformation, which are not counted.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnergyLedger {
@@ -24,6 +24,8 @@ pub struct EnergyLedger {
     pub wall_work: f64,
     /// Work done by external forces and torques and by gravity.
     pub external_work: f64,
+    /// Work done by the follower loads of pressure chains (the confining pressure).
+    pub boundary_work: f64,
 }
 
 impl EnergyLedger {
@@ -36,6 +38,7 @@ impl EnergyLedger {
             + self.damping_dissipated
             - self.wall_work
             - self.external_work
+            - self.boundary_work
     }
 }
 

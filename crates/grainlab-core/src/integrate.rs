@@ -30,6 +30,8 @@ pub struct IntegrationInputs<'a> {
     pub external_force: &'a [Vec2],
     /// External torques (N m).
     pub external_torque: &'a [f64],
+    /// Follower loads of pressure chains (N), when there are chains.
+    pub boundary_load: Option<&'a [Vec2]>,
     /// Positions at the last neighbour-list build.
     pub reference: &'a [Vec2],
 }
@@ -76,6 +78,8 @@ pub struct IntegrationTally {
     pub damping_dissipated: f64,
     /// Work of external forces and gravity (J).
     pub external_work: f64,
+    /// Work of the pressure chains' follower loads (J).
+    pub boundary_work: f64,
     /// Kinetic energy at the full step (J), `1/2 m v(n-1/2).v(n+1/2)`, measured steps only.
     pub kinetic: f64,
     /// Sum of |resultant force| over free particles, measured steps only.
@@ -95,6 +99,7 @@ impl IntegrationTally {
     pub fn merge(&mut self, o: &IntegrationTally) {
         self.damping_dissipated += o.damping_dissipated;
         self.external_work += o.external_work;
+        self.boundary_work += o.boundary_work;
         self.kinetic += o.kinetic;
         self.unbalanced_force_sum += o.unbalanced_force_sum;
         self.free_count += o.free_count;
@@ -187,14 +192,11 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
                 (w, fd[2]) = kick::<DAMPED>(w_old, torque[k], inv_inertia[k], alpha, step.kick);
             }
         }
-        let (v_full, w_full) = if step.half_kick {
-            (v_old, w_old)
-        } else {
-            (
-                [0.5 * (v_old[0] + v[0]), 0.5 * (v_old[1] + v[1])],
-                0.5 * (w_old + w),
-            )
-        };
+        // the work of a force F(n) in leapfrog's exact energy identity (with the
+        // kinetic energy below) is F(n) . (v(n-1/2) + v(n+1/2)) / 2 * kick, where the
+        // kick is dt, or dt/2 on the first step from full-step velocities
+        let v_full = [0.5 * (v_old[0] + v[0]), 0.5 * (v_old[1] + v[1])];
+        let w_full = 0.5 * (w_old + w);
         if DAMPED {
             damping_work += fd[0] * v_full[0] + fd[1] * v_full[1] + fd[2] * w_full;
         }
@@ -217,7 +219,7 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
             } else {
                 0.0
             };
-            tally.external_work += (fx * v_full[0] + fy * v_full[1] + te * w_full) * dt;
+            tally.external_work += (fx * v_full[0] + fy * v_full[1] + te * w_full) * step.kick;
         }
         if MEASURE {
             // 1/2 m v(n-1/2).v(n+1/2): with the elastic energy of linear springs this
@@ -234,6 +236,12 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
                 tally.unbalanced_force_sum += (f[0] * f[0] + f[1] * f[1]).sqrt();
                 tally.free_count += 1;
             }
+        }
+        if let Some(load) = inputs.boundary_load {
+            let fb = load[lo + k];
+            let fx = if fix & FIX_X == 0 { fb[0] } else { 0.0 };
+            let fy = if fix & FIX_Y == 0 { fb[1] } else { 0.0 };
+            tally.boundary_work += (fx * v_full[0] + fy * v_full[1]) * step.kick;
         }
         let mut x = chunk.position[k];
         x[0] += dt * v[0];
@@ -253,7 +261,7 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
         chunk.angular_velocity[k] = w;
         chunk.rotation[k] += dt * w;
     }
-    tally.damping_dissipated = -damping_work * dt;
+    tally.damping_dissipated = -damping_work * step.kick;
     tally.max_displacement_sq = max_displacement_sq;
     tally.max_fluctuation_sq = if DEFORMING {
         max_fluctuation_sq

@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod bond;
+pub mod boundary;
 pub mod cell;
 pub mod contact;
 pub mod contact_list;

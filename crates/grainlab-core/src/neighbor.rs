@@ -212,7 +212,8 @@ impl NeighborList {
     /// column): each block is then a contiguous index range, which keeps the
     /// threads' writes apart in memory and a pair's two particles close in cache.
     /// `order` maps internal to external (user) indices and is permuted along,
-    /// as are the bonds and the old lists' indices.
+    /// as are the bonds and the old lists' indices. Returns the renumbering
+    /// `new_of_old[old] = new` for the caller's other per-particle references.
     pub fn build(
         &mut self,
         particles: &mut Particles,
@@ -221,7 +222,7 @@ impl NeighborList {
         walls: &[Wall],
         bonds: &mut Bonds,
         n_blocks: usize,
-    ) -> Result<()> {
+    ) -> Result<Vec<u32>> {
         let n = particles.len();
         let n_blocks = n_blocks.max(1);
         let r_max = particles.max_radius();
@@ -365,7 +366,7 @@ impl NeighborList {
             }
         }
         let mut wall_pairs = WallPairList::default();
-        for (w, wall) in walls.iter().enumerate() {
+        for (w, wall) in walls.iter().enumerate().filter(|(_, w)| w.active) {
             for p in 0..n {
                 let g = wall.disk_contact(positions[p], radii[p]);
                 if g.overlap > -skin {
@@ -395,7 +396,7 @@ impl NeighborList {
         self.max_displacement_sq = 0.0;
         self.valid = true;
         self.build_count += 1;
-        Ok(())
+        Ok(new_of_old)
     }
 }
 

@@ -18,6 +18,7 @@ use rayon::ThreadPool;
 use serde::{Deserialize, Serialize};
 
 use crate::bond::{Bond, Bonds};
+use crate::boundary::PressureChain;
 use crate::cell::PeriodicCell;
 use crate::contact::disk_disk;
 use crate::diagnostics::{EnergyLedger, Measurements};
@@ -102,6 +103,8 @@ pub struct Simulation {
     pub walls: Vec<Wall>,
     /// Permanent bonds.
     pub bonds: Bonds,
+    /// Chains of boundary particles under a follower pressure.
+    pub chains: Vec<PressureChain>,
     /// Periodic cell, if any.
     pub cell: Option<PeriodicCell>,
     /// Step tunables.
@@ -126,6 +129,9 @@ pub struct Simulation {
     pool: Option<ThreadPool>,
     #[serde(skip)]
     cross_forces: Vec<PairForce>,
+    /// Follower loads of this step, per internal particle (recomputed every step).
+    #[serde(skip)]
+    boundary_load: Vec<Vec2>,
 }
 
 impl Simulation {
@@ -154,6 +160,7 @@ impl Simulation {
             materials: MaterialTable::uniform(model)?,
             walls: Vec::new(),
             bonds: Bonds::default(),
+            chains: Vec::new(),
             cell: None,
             params,
             neighbors: NeighborList::new(skin),
@@ -167,6 +174,7 @@ impl Simulation {
             threads,
             pool: None,
             cross_forces: Vec::new(),
+            boundary_load: Vec::new(),
         };
         sim.make_pool()?;
         Ok(sim)
@@ -316,6 +324,132 @@ impl Simulation {
         minimum_image(self.cell.as_ref(), d)
     }
 
+    /// Adds a chain of boundary particles (external indices, in order with the
+    /// sample on their right) under a follower `pressure` (Pa); the ends are
+    /// anchored on the lines of `start_wall` and `end_wall` if given. Returns its id.
+    pub fn add_pressure_chain(
+        &mut self,
+        particles: &[usize],
+        pressure: f64,
+        start_wall: Option<usize>,
+        end_wall: Option<usize>,
+    ) -> Result<usize> {
+        let chain = self.make_chain(particles, pressure, start_wall, end_wall)?;
+        self.chains.push(chain);
+        Ok(self.chains.len() - 1)
+    }
+
+    /// Replaces chain `id` (its particles, pressure and anchors).
+    pub fn set_pressure_chain(
+        &mut self,
+        id: usize,
+        particles: &[usize],
+        pressure: f64,
+        start_wall: Option<usize>,
+        end_wall: Option<usize>,
+    ) -> Result<()> {
+        let n = self.chains.len();
+        if id >= n {
+            return Err(EngineError::invalid(
+                "chain_id",
+                format!("unknown chain {id}; valid ids are 0..{n}"),
+            ));
+        }
+        self.chains[id] = self.make_chain(particles, pressure, start_wall, end_wall)?;
+        Ok(())
+    }
+
+    /// Chain `id`: its particles (external indices), pressure and anchors.
+    pub fn pressure_chain(
+        &self,
+        id: usize,
+    ) -> Result<(Vec<usize>, f64, Option<usize>, Option<usize>)> {
+        let c = self.chains.get(id).ok_or_else(|| {
+            EngineError::invalid(
+                "chain_id",
+                format!("unknown chain {id}; valid ids are 0..{}", self.chains.len()),
+            )
+        })?;
+        Ok((
+            c.particles
+                .iter()
+                .map(|&q| self.external_index(q as usize))
+                .collect(),
+            c.pressure,
+            c.start_wall.map(|w| w as usize),
+            c.end_wall.map(|w| w as usize),
+        ))
+    }
+
+    fn make_chain(
+        &self,
+        particles: &[usize],
+        pressure: f64,
+        start_wall: Option<usize>,
+        end_wall: Option<usize>,
+    ) -> Result<PressureChain> {
+        require_non_negative("pressure", pressure)?;
+        if particles.is_empty() {
+            return Err(EngineError::invalid(
+                "particles",
+                "a pressure chain needs at least one particle",
+            ));
+        }
+        for (k, &q) in particles.iter().enumerate() {
+            self.particles.check_index(&format!("particles[{k}]"), q)?;
+        }
+        for (name, w) in [("start_wall", start_wall), ("end_wall", end_wall)] {
+            if let Some(w) = w {
+                if w >= self.walls.len() {
+                    return Err(EngineError::invalid(
+                        name,
+                        format!("unknown wall {w}; valid ids are 0..{}", self.walls.len()),
+                    ));
+                }
+            }
+        }
+        Ok(PressureChain {
+            particles: particles
+                .iter()
+                .map(|&q| self.internal_index(q) as u32)
+                .collect(),
+            pressure,
+            start_wall: start_wall.map(|w| w as u32),
+            end_wall: end_wall.map(|w| w as u32),
+        })
+    }
+
+    /// Step 2a: the follower loads of the pressure chains at the current positions.
+    fn boundary_loads(&mut self) {
+        if self.chains.is_empty() {
+            return;
+        }
+        self.boundary_load.clear();
+        self.boundary_load.resize(self.particles.len(), [0.0; 2]);
+        for chain in &self.chains {
+            chain.apply(
+                &self.particles.position,
+                &self.walls,
+                &mut self.boundary_load,
+            );
+        }
+    }
+
+    /// Switches a wall on or off; an inactive wall has no contacts and stays put.
+    pub fn set_wall_active(&mut self, id: usize, active: bool) -> Result<()> {
+        let wall = self.wall_mut(id)?;
+        wall.active = active;
+        if !active {
+            wall.velocity = [0.0; 2];
+            wall.control = WallControl::Velocity;
+            wall.force = [0.0; 2];
+            wall.contact_count = 0;
+            wall.stiffness_sum = 0.0;
+        }
+        self.neighbors.invalidate();
+        Ok(())
+    }
+
     /// Marks the neighbour lists stale (after positions or radii changed).
     pub fn invalidate_neighbors(&mut self) {
         self.neighbors.invalidate();
@@ -406,7 +540,7 @@ impl Simulation {
     }
 
     fn rebuild(&mut self) -> Result<()> {
-        self.neighbors.build(
+        let new_of_old = self.neighbors.build(
             &mut self.particles,
             &mut self.order,
             self.cell.as_ref(),
@@ -414,6 +548,9 @@ impl Simulation {
             &mut self.bonds,
             self.threads,
         )?;
+        for chain in self.chains.iter_mut() {
+            chain.remap(&new_of_old);
+        }
         for (k, &e) in self.order.iter().enumerate() {
             self.rank[e as usize] = k as u32;
         }
@@ -500,15 +637,16 @@ impl Simulation {
     fn step<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Result<()> {
         self.ensure_neighbors()?;
         let dt = self.params.time_step;
+        self.boundary_loads();
         let mut contacts = self.particle_contacts::<MEASURE>(team);
         let bond_tally = self.bond_forces::<MEASURE>();
         contacts.merge(&bond_tally);
         let (wall_tally, wall_work) = self.wall_forces::<MEASURE>();
-        for wall in &mut self.walls {
+        for wall in self.walls.iter_mut().filter(|w| w.active) {
             wall.update_servo(dt);
         }
         let motion = self.integrate::<MEASURE>(team);
-        for wall in &mut self.walls {
+        for wall in self.walls.iter_mut().filter(|w| w.active) {
             let d = scale(wall.velocity, dt);
             if d != [0.0, 0.0] {
                 wall.translate(d);
@@ -535,6 +673,7 @@ impl Simulation {
         ledger.damping_dissipated += motion.damping_dissipated;
         ledger.wall_work += wall_work;
         ledger.external_work += motion.external_work;
+        ledger.boundary_work += motion.boundary_work;
         if MEASURE {
             ledger.kinetic = motion.kinetic;
             ledger.elastic = contacts.elastic + wall_tally.elastic;
@@ -632,6 +771,7 @@ impl Simulation {
             max_overlap_ratio: self.params.max_overlap_ratio,
         };
         let reset = ResetKernel {
+            boundary_load: (!self.chains.is_empty()).then_some(self.boundary_load.as_slice()),
             external_force: &p.external_force,
             external_torque: &p.external_torque,
             mass: &p.mass,
@@ -834,6 +974,7 @@ impl Simulation {
             fixity: &p.fixity,
             external_force: &p.external_force,
             external_torque: &p.external_torque,
+            boundary_load: (!self.chains.is_empty()).then_some(self.boundary_load.as_slice()),
             reference: self.neighbors.reference().reference,
         };
         // each worker integrates the block whose contacts it just computed
@@ -1075,6 +1216,7 @@ struct BlockWork<'a> {
 }
 
 struct ResetKernel<'a> {
+    boundary_load: Option<&'a [Vec2]>,
     external_force: &'a [Vec2],
     external_torque: &'a [f64],
     mass: &'a [f64],
@@ -1088,7 +1230,11 @@ impl ResetKernel<'_> {
     unsafe fn apply(&self, q: usize, force: &DisjointWriter<Vec2>, torque: &DisjointWriter<f64>) {
         let fe = self.external_force[q];
         let m = self.mass[q];
-        *force.get(q) = [fe[0] + m * self.gravity[0], fe[1] + m * self.gravity[1]];
+        let mut f = [fe[0] + m * self.gravity[0], fe[1] + m * self.gravity[1]];
+        if let Some(load) = self.boundary_load {
+            f = add(f, load[q]);
+        }
+        *force.get(q) = f;
         *torque.get(q) = self.external_torque[q];
     }
 }

@@ -94,6 +94,9 @@ pub struct Wall {
     pub stiffness_sum: f64,
     /// Total displacement since the wall was created (m).
     pub displacement: Vec2,
+    /// An inactive wall has no contacts and does not move (e.g. the rigid side
+    /// walls once a flexible boundary replaced them).
+    pub active: bool,
 }
 
 impl Wall {
@@ -136,6 +139,7 @@ impl Wall {
             contact_count: 0,
             stiffness_sum: 0.0,
             displacement: [0.0; 2],
+            active: true,
         })
     }
 

@@ -517,6 +517,7 @@ impl Engine {
         d.set_item("contact_count", wall.contact_count)?;
         d.set_item("displacement", (wall.displacement[0], wall.displacement[1]))?;
         d.set_item("group", wall.group)?;
+        d.set_item("active", wall.active)?;
         match wall.control {
             WallControl::Velocity => d.set_item("control", "velocity")?,
             WallControl::Servo(s) => {
@@ -528,6 +529,59 @@ impl Engine {
             }
         }
         Ok(d)
+    }
+
+    fn set_wall_active(&mut self, wall_id: usize, active: bool) -> PyResult<()> {
+        self.sim.set_wall_active(wall_id, active).map_err(to_py_err)
+    }
+
+    // ---- pressure chains ----
+
+    #[pyo3(signature = (particles, pressure, start_wall=None, end_wall=None))]
+    fn add_pressure_chain(
+        &mut self,
+        particles: Vec<usize>,
+        pressure: f64,
+        start_wall: Option<usize>,
+        end_wall: Option<usize>,
+    ) -> PyResult<usize> {
+        self.sim
+            .add_pressure_chain(&particles, pressure, start_wall, end_wall)
+            .map_err(to_py_err)
+    }
+
+    #[pyo3(signature = (chain_id, particles, pressure, start_wall=None, end_wall=None))]
+    fn set_pressure_chain(
+        &mut self,
+        chain_id: usize,
+        particles: Vec<usize>,
+        pressure: f64,
+        start_wall: Option<usize>,
+        end_wall: Option<usize>,
+    ) -> PyResult<()> {
+        self.sim
+            .set_pressure_chain(chain_id, &particles, pressure, start_wall, end_wall)
+            .map_err(to_py_err)
+    }
+
+    fn pressure_chain<'py>(
+        &self,
+        py: Python<'py>,
+        chain_id: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (particles, pressure, start_wall, end_wall) =
+            self.sim.pressure_chain(chain_id).map_err(to_py_err)?;
+        let d = PyDict::new(py);
+        d.set_item("particles", particles)?;
+        d.set_item("pressure", pressure)?;
+        d.set_item("start_wall", start_wall)?;
+        d.set_item("end_wall", end_wall)?;
+        Ok(d)
+    }
+
+    #[getter]
+    fn n_pressure_chains(&self) -> usize {
+        self.sim.chains.len()
     }
 
     // ---- bonds ----
@@ -604,6 +658,7 @@ impl Engine {
         d.set_item("damping_dissipated", e.damping_dissipated)?;
         d.set_item("wall_work", e.wall_work)?;
         d.set_item("external_work", e.external_work)?;
+        d.set_item("boundary_work", e.boundary_work)?;
         d.set_item("balance", e.balance())?;
         Ok(d)
     }
