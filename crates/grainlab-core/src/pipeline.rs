@@ -359,26 +359,19 @@ impl Simulation {
         Ok(())
     }
 
-    /// Chain `id`: its particles (external indices), pressure and anchors.
-    pub fn pressure_chain(
-        &self,
-        id: usize,
-    ) -> Result<(Vec<usize>, f64, Option<usize>, Option<usize>)> {
+    /// Chain `id`, with its particles as external indices.
+    pub fn pressure_chain(&self, id: usize) -> Result<PressureChain> {
         let c = self.chains.get(id).ok_or_else(|| {
             EngineError::invalid(
                 "chain_id",
                 format!("unknown chain {id}; valid ids are 0..{}", self.chains.len()),
             )
         })?;
-        Ok((
-            c.particles
-                .iter()
-                .map(|&q| self.external_index(q as usize))
-                .collect(),
-            c.pressure,
-            c.start_wall.map(|w| w as usize),
-            c.end_wall.map(|w| w as usize),
-        ))
+        let mut chain = c.clone();
+        for q in chain.particles.iter_mut() {
+            *q = self.external_index(*q as usize) as u32;
+        }
+        Ok(chain)
     }
 
     fn make_chain(

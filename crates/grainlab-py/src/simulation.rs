@@ -569,13 +569,12 @@ impl Engine {
         py: Python<'py>,
         chain_id: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (particles, pressure, start_wall, end_wall) =
-            self.sim.pressure_chain(chain_id).map_err(to_py_err)?;
+        let chain = self.sim.pressure_chain(chain_id).map_err(to_py_err)?;
         let d = PyDict::new(py);
-        d.set_item("particles", particles)?;
-        d.set_item("pressure", pressure)?;
-        d.set_item("start_wall", start_wall)?;
-        d.set_item("end_wall", end_wall)?;
+        d.set_item("particles", chain.particles)?;
+        d.set_item("pressure", chain.pressure)?;
+        d.set_item("start_wall", chain.start_wall)?;
+        d.set_item("end_wall", chain.end_wall)?;
         Ok(d)
     }
 
