@@ -339,6 +339,15 @@ class Simulation:
             float(p["time_step"]), float(p["local_damping"]), list(p["gravity"]), float(p["max_overlap_ratio"])
         )
 
+    def add_particles(self, positions: ArrayLike, radii: ArrayLike, density: ArrayLike) -> NDArray[np.int64]:
+        """Appends disks at rest; returns their indices (the next ones). Existing
+        contacts keep their history."""
+        positions = _points("positions", positions)
+        n = len(positions)
+        first = self.n_particles
+        self._engine.add_particles(positions, _values("radii", radii, n), _values("density", density, n))
+        return np.arange(first, first + n)
+
     # ---- running ----
 
     def run(self, steps: int) -> None:

@@ -240,3 +240,16 @@ def test_inactive_wall_lets_particles_through():
     sim.run(1)
     assert floor.contact_count == 0 and not floor.active
     assert len(sim.wall_contacts()) == 0
+
+
+def test_added_particles_join_and_old_contacts_keep_their_history(dense_periodic):
+    sim = dense_periodic(friction=0.5)
+    sim.run(50)
+    before = sim.contacts()
+    new = sim.add_particles([[1e-4, 1e-4]], [1e-4], 2e8)
+    assert new.tolist() == [sim.n_particles - 1]
+    after = sim.contacts()
+    old_rows = after.j < new[0]
+    np.testing.assert_array_equal(after.shear_force[old_rows], before.shear_force)
+    assert sim.masses[-1] == pytest.approx(2e8 * np.pi * 1e-8)
+    sim.run(10)

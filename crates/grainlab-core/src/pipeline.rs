@@ -324,6 +324,24 @@ impl Simulation {
         minimum_image(self.cell.as_ref(), d)
     }
 
+    /// Appends disks at rest (one density or one per disk); they get the next
+    /// external indices. Contact history of the existing particles is kept.
+    pub fn add_particles(
+        &mut self,
+        position: Vec<Vec2>,
+        radius: Vec<f64>,
+        density: Vec<f64>,
+    ) -> Result<()> {
+        let added = Particles::new(position, radius, density)?;
+        let first = self.particles.len() as u32;
+        let count = added.len() as u32;
+        self.particles.extend(added);
+        self.order.extend(first..first + count);
+        self.rank.extend(first..first + count);
+        self.neighbors.invalidate();
+        Ok(())
+    }
+
     /// Adds a chain of boundary particles (external indices, in order with the
     /// sample on their right) under a follower `pressure` (Pa); the ends are
     /// anchored on the lines of `start_wall` and `end_wall` if given. Returns its id.

@@ -108,6 +108,44 @@ impl Particles {
         Ok(particles)
     }
 
+    /// Appends disks at rest (validated like [`Particles::new`]).
+    pub fn extend(&mut self, other: Particles) {
+        let Particles {
+            position,
+            velocity,
+            rotation,
+            angular_velocity,
+            radius,
+            density,
+            mass,
+            inertia,
+            inv_mass,
+            inv_inertia,
+            group,
+            fixity,
+            external_force,
+            external_torque,
+            force,
+            torque,
+        } = other;
+        self.position.extend(position);
+        self.velocity.extend(velocity);
+        self.rotation.extend(rotation);
+        self.angular_velocity.extend(angular_velocity);
+        self.radius.extend(radius);
+        self.density.extend(density);
+        self.mass.extend(mass);
+        self.inertia.extend(inertia);
+        self.inv_mass.extend(inv_mass);
+        self.inv_inertia.extend(inv_inertia);
+        self.group.extend(group);
+        self.fixity.extend(fixity);
+        self.external_force.extend(external_force);
+        self.external_torque.extend(external_torque);
+        self.force.extend(force);
+        self.torque.extend(torque);
+    }
+
     /// Number of disks.
     pub fn len(&self) -> usize {
         self.position.len()

@@ -54,6 +54,21 @@ impl Engine {
         Ok(Engine { sim })
     }
 
+    fn add_particles(
+        &mut self,
+        positions: PyReadonlyArray2<'_, f64>,
+        radii: PyReadonlyArray1<'_, f64>,
+        density: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<()> {
+        self.sim
+            .add_particles(
+                points("positions", &positions)?,
+                values(&radii),
+                values(&density),
+            )
+            .map_err(to_py_err)
+    }
+
     // ---- running ----
 
     /// Runs `steps` steps with the GIL released; the last step is measured.
