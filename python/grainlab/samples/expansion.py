@@ -1,0 +1,502 @@
+"""Radius expansion: the paper's way of making a dense sample inside rigid walls.
+
+The procedure (paper Sec. 6; docs/samples.md gives the details and the reasons):
+
+1. Draw ``N`` diameters from the grading (``N`` from :func:`particle_count` unless
+   given) and scale them all by one factor ``f`` (close to 1) so that the final
+   nominal porosity is exactly the target.
+2. Place the disks at random, without overlap, at ``initial_scale`` (0.5) of
+   their final radii (:func:`random_placement`), inside four rigid segment
+   walls on the box edges.
+3. Grow all radii by a common factor, one small increment at a time, with
+   ``steps_per_increment`` DEM steps (in Rust) after each. The increment in
+   ``ln r`` is ``growth_per_increment / (1 + sigma / growth_stress_scale_pa)``,
+   with ``sigma`` the mean wall stress just measured: fast while the packing is
+   loose, slow once it carries stress.
+4. At the final radii, cycle until the mean unbalanced force ratio is below
+   ``equilibrium_ratio`` (default 1e-4).
+
+Stress bound: whenever the mean wall stress exceeds ``max_stress_pa``, growth
+stops and the packing is cycled to equilibrium at its current radii; if it
+still exceeds the bound, :class:`ExpansionError` reports the densest nominal
+porosity reached and the stress it needed.
+
+While generating, every disk is given the mass of the largest one (density
+scaling for a static solution, as PFC's ``timestep scale``): the static
+equilibrium does not depend on the masses, and the time step, set by the
+lightest disk, grows by ``d_max / d_min``. The Table 1 density is restored at
+the end, velocities are zeroed, and the time step is reset to half the
+critical one.
+
+Example
+-------
+>>> from grainlab.samples import expand_to_porosity, UniformByNumber
+>>> s = expand_to_porosity((0.0, 0.0, 0.012, 0.012), 0.16, UniformByNumber(0.5e-3, 1.0e-3),
+...                        seed=1, progress=False)
+>>> abs(s.porosity - 0.16) < 1e-12
+True
+>>> s.coordination_number > 3
+True
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from grainlab.samples.grading import PAPER_GRADING, Grading
+from grainlab.samples.placement import random_placement
+from grainlab.samples.porosity import (
+    check_box,
+    nominal_porosity,
+    overlap_corrected_porosity,
+    particle_count,
+)
+
+__all__ = ["WALL_NAMES", "ExpansionError", "Sample", "expand_to_porosity"]
+
+#: Order of the four walls in :attr:`Sample.wall_points` and in the returned simulation.
+WALL_NAMES = ("bottom", "right", "top", "left")
+
+#: Table 1 of the paper.
+_KN = 8.45e7
+_DENSITY = 2.0e8
+_DAMPING = 0.8
+
+
+class ExpansionError(ValueError):
+    """The target porosity could not be reached within the stress bound.
+
+    Attributes give where the expansion stopped: ``porosity`` (nominal),
+    ``porosity_overlap_corrected``, ``stress_pa`` (mean wall stress it needed,
+    in equilibrium when ``equilibrium`` is true) and ``target``.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        porosity: float,
+        porosity_overlap_corrected: float,
+        stress_pa: float,
+        target: float,
+        equilibrium: bool,
+    ) -> None:
+        super().__init__(message)
+        self.porosity = porosity
+        self.porosity_overlap_corrected = porosity_overlap_corrected
+        self.stress_pa = stress_pa
+        self.target = target
+        self.equilibrium = equilibrium
+
+
+@dataclass(frozen=True)
+class Sample:
+    """A generated sample: where it really is, and how it got there.
+
+    Positions and radii are in the order of the drawn diameters; particle ``k``
+    here is particle ``k`` of :attr:`simulation`. Walls are, in order,
+    :data:`WALL_NAMES` (ids 0..3 of the simulation), each a segment
+    ``[[ax, ay], [bx, by]]`` with the particles on its left.
+    """
+
+    positions: NDArray[np.float64]
+    """(N, 2) centres, m."""
+    radii: NDArray[np.float64]
+    """(N,) radii, m."""
+    box: tuple[float, float, float, float]
+    """``(xmin, ymin, xmax, ymax)``, m: the walls' lines."""
+    wall_points: NDArray[np.float64]
+    """(4, 2, 2) wall end points (bottom, right, top, left), m."""
+    porosity_target: float
+    """The nominal porosity asked for."""
+    porosity: float
+    """Nominal porosity ``1 - sum(pi r^2) / A`` reached."""
+    porosity_overlap_corrected: float
+    """``1 - |union of disks| / A`` (see :func:`overlap_corrected_porosity`)."""
+    wall_stresses_pa: NDArray[np.float64]
+    """(4,) normal stress on each wall (compression positive), Pa."""
+    mean_wall_stress_pa: float
+    """Mean of :attr:`wall_stresses_pa`, Pa: the stress locked in by the expansion."""
+    coordination_number: float
+    """``2 Nc / N`` (particle-particle contacts, rattlers included)."""
+    mean_overlap_ratio: float
+    """Mean contact overlap over the smallest radius."""
+    max_overlap_ratio: float
+    """Largest contact overlap over the smaller radius of its pair."""
+    unbalanced_force_ratio: float
+    """Mean unbalanced force ratio at the end."""
+    equilibrium_reached: bool
+    """Whether :attr:`unbalanced_force_ratio` went below the threshold asked for."""
+    radius_factor: float
+    """``f``: final radii are ``f * d / 2`` of the drawn diameters ``d``."""
+    seed: int | None
+    grading: str
+    """Name of the grading the diameters came from."""
+    friction: float
+    """Particle-particle friction during generation."""
+    wall_friction: float
+    threads: int
+    steps: int
+    """DEM steps run (growth and equilibrium)."""
+    wall_time_s: float
+    simulation: Any = field(default=None, repr=False, compare=False)
+    """The live :class:`grainlab.Simulation` when asked for (``keep_simulation=True``)."""
+
+    @property
+    def n_particles(self) -> int:
+        return len(self.radii)
+
+    def summary(self) -> str:
+        """One line: where the sample is."""
+        return (
+            f"{self.n_particles} disks, porosity {self.porosity:.4f} nominal / "
+            f"{self.porosity_overlap_corrected:.4f} overlap-corrected (target {self.porosity_target:.4f}), "
+            f"wall stress {self.mean_wall_stress_pa / 1e3:.1f} kPa, Z {self.coordination_number:.2f}, "
+            f"mean overlap {100 * self.mean_overlap_ratio:.1f}% of r_min, "
+            f"unbalanced {self.unbalanced_force_ratio:.1e}, {self.wall_time_s:.1f} s"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scalar results (JSON-ready), without positions, radii or the simulation."""
+        return {
+            "n_particles": self.n_particles,
+            "box": list(self.box),
+            "porosity_target": self.porosity_target,
+            "porosity": self.porosity,
+            "porosity_overlap_corrected": self.porosity_overlap_corrected,
+            "wall_stresses_pa": self.wall_stresses_pa.tolist(),
+            "mean_wall_stress_pa": self.mean_wall_stress_pa,
+            "coordination_number": self.coordination_number,
+            "mean_overlap_ratio": self.mean_overlap_ratio,
+            "max_overlap_ratio": self.max_overlap_ratio,
+            "unbalanced_force_ratio": self.unbalanced_force_ratio,
+            "equilibrium_reached": self.equilibrium_reached,
+            "radius_factor": self.radius_factor,
+            "seed": self.seed,
+            "grading": self.grading,
+            "friction": self.friction,
+            "wall_friction": self.wall_friction,
+            "threads": self.threads,
+            "steps": self.steps,
+            "wall_time_s": self.wall_time_s,
+        }
+
+
+def _positive(name: str, value: float, allow_zero: bool = False) -> float:
+    value = float(value)
+    ok = value >= 0 if allow_zero else value > 0
+    if not (math.isfinite(value) and ok):
+        raise ValueError(f"{name}: must be a finite number {'>= 0' if allow_zero else '> 0'}, got {value}")
+    return value
+
+
+def _wall_points(box: tuple[float, float, float, float]) -> NDArray[np.float64]:
+    x0, y0, x1, y1 = box
+    # each segment runs counter-clockwise around the box, so the inside is on its left
+    return np.array(
+        [
+            [[x0, y0], [x1, y0]],
+            [[x1, y0], [x1, y1]],
+            [[x1, y1], [x0, y1]],
+            [[x0, y1], [x0, y0]],
+        ]
+    )
+
+
+class _Box:
+    """The rigid box around a simulation, and the measurements taken through it."""
+
+    def __init__(self, sim: Any, box: tuple[float, float, float, float]) -> None:
+        self.sim = sim
+        self.box = box
+        x0, y0, x1, y1 = box
+        self.area = (x1 - x0) * (y1 - y0)
+        self.lengths = (x1 - x0, y1 - y0, x1 - x0, y1 - y0)
+        self.walls = [sim.add_segment_wall(a, b) for a, b in _wall_points(box)]
+
+    def wall_stresses(self) -> NDArray[np.float64]:
+        return np.array([w.normal_stress(length) for w, length in zip(self.walls, self.lengths)])
+
+    def mean_stress(self) -> float:
+        return float(self.wall_stresses().mean())
+
+    def porosities(self) -> tuple[float, float]:
+        r = self.sim.radii
+        return nominal_porosity(r, self.area), overlap_corrected_porosity(self.sim.positions, r, self.box)
+
+
+def expand_to_porosity(
+    box: ArrayLike = (0.0, 0.0, 0.075, 0.15),
+    porosity: float = 0.12,
+    grading: Grading = PAPER_GRADING,
+    *,
+    seed: int | None = 0,
+    n_particles: int | None = None,
+    diameters: ArrayLike | None = None,
+    friction: float = 0.0,
+    wall_friction: float = 0.0,
+    normal_stiffness: float = _KN,
+    shear_stiffness: float = _KN,
+    density: float = _DENSITY,
+    local_damping: float = _DAMPING,
+    initial_scale: float = 0.5,
+    growth_per_increment: float = 1.0e-2,
+    steps_per_increment: int = 50,
+    growth_stress_scale_pa: float = 1.0e5,
+    equilibrium_ratio: float = 1.0e-4,
+    max_equilibrium_steps: int = 300_000,
+    max_stress_pa: float = 5.0e6,
+    time_step_safety: float = 0.8,
+    density_scaling: bool = True,
+    threads: int = 1,
+    progress: bool = True,
+    keep_simulation: bool = False,
+) -> Sample:
+    """Generates a sample by radius expansion inside rigid walls to a target nominal porosity.
+
+    Parameters
+    ----------
+    box : ``(xmin, ymin, xmax, ymax)``, m (Table 1: 75 x 150 mm)
+    porosity : target *nominal* porosity, in (0, 1) (Table 1: 0.12)
+    grading : where diameters come from (default :data:`PAPER_GRADING`)
+    seed : seeds ``numpy.random.default_rng``; with the same ``threads`` the
+        same seed gives the same sample bit for bit
+    n_particles : default :func:`particle_count` of the box, porosity and grading
+    diameters : (N,) m, drawn beforehand (then ``grading`` only names them and
+        ``n_particles`` must be None)
+    friction, wall_friction : particle-particle and particle-wall friction
+        while generating (the issue's default: 0 for both)
+    normal_stiffness, shear_stiffness : contact kn, ks (N/m; Table 1: 8.45e7)
+    density : kg/m^3 (Table 1: 2e8); local_damping : alpha (Table 1: 0.8)
+    initial_scale : placed radius over final radius (the paper halves: 0.5)
+    growth_per_increment : largest increment of ``ln r`` per growth step
+    steps_per_increment : DEM steps after each growth increment
+    growth_stress_scale_pa : the increment is divided by ``1 + sigma / this``
+    equilibrium_ratio : stop cycling when the mean unbalanced force ratio is below this
+    max_equilibrium_steps : give up cycling to equilibrium after this many steps
+        (the sample is returned with ``equilibrium_reached = False`` and a warning)
+    max_stress_pa : stress bound (mean wall stress in equilibrium), Pa
+    time_step_safety : time step = this x the critical step, re-evaluated every increment
+    density_scaling : give every disk the largest disk's mass while generating
+    threads : engine worker threads (part of what makes a sample reproducible)
+    progress : show a progress bar (tqdm, on stderr)
+    keep_simulation : return the live simulation in :attr:`Sample.simulation`
+        (walls 0..3 are bottom, right, top, left; particle-particle friction is
+        still the generation friction: set the test's own contact models)
+
+    Raises
+    ------
+    ValueError
+        bad input, naming the field, before any work.
+    PlacementError
+        (a ValueError) random placement at ``initial_scale`` could not fit the disks.
+    ExpansionError
+        (a ValueError) the target needs a mean wall stress above
+        ``max_stress_pa`` (or overlaps beyond the engine's limit): the message
+        gives the densest nominal porosity reached and the stress it needed.
+    """
+    import grainlab
+    from grainlab.simulation import WALL_GROUP
+
+    started = time.perf_counter()
+    box = check_box(box)
+    porosity = float(porosity)
+    if not (0.0 < porosity < 1.0):
+        raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+    if not isinstance(grading, Grading):
+        raise TypeError(f"grading: expected a Grading (UniformByNumber, UniformByMass, GradingCurve), got {grading!r}")
+    friction = _positive("friction", friction, allow_zero=True)
+    wall_friction = _positive("wall_friction", wall_friction, allow_zero=True)
+    normal_stiffness = _positive("normal_stiffness", normal_stiffness)
+    shear_stiffness = _positive("shear_stiffness", shear_stiffness)
+    density = _positive("density", density)
+    local_damping = float(local_damping)
+    if not (0.0 <= local_damping < 1.0):
+        raise ValueError(f"local_damping: must be in [0, 1), got {local_damping}")
+    initial_scale = float(initial_scale)
+    if not (0.0 < initial_scale <= 1.0):
+        raise ValueError(f"initial_scale: must be in (0, 1], got {initial_scale}")
+    growth_per_increment = _positive("growth_per_increment", growth_per_increment)
+    growth_stress_scale_pa = _positive("growth_stress_scale_pa", growth_stress_scale_pa)
+    steps_per_increment = int(steps_per_increment)
+    if steps_per_increment < 1:
+        raise ValueError(f"steps_per_increment: must be >= 1, got {steps_per_increment}")
+    equilibrium_ratio = _positive("equilibrium_ratio", equilibrium_ratio)
+    max_equilibrium_steps = int(max_equilibrium_steps)
+    if max_equilibrium_steps < 0:
+        raise ValueError(f"max_equilibrium_steps: must be >= 0, got {max_equilibrium_steps}")
+    max_stress_pa = _positive("max_stress_pa", max_stress_pa)
+    time_step_safety = float(time_step_safety)
+    if not (0.0 < time_step_safety <= 1.0):
+        raise ValueError(f"time_step_safety: must be in (0, 1], got {time_step_safety}")
+    threads = int(threads)
+    if threads < 1:
+        raise ValueError(f"threads: must be >= 1, got {threads}")
+
+    x0, y0, x1, y1 = box
+    area = (x1 - x0) * (y1 - y0)
+    rng = np.random.default_rng(seed)
+    if diameters is not None:
+        if n_particles is not None:
+            raise ValueError("n_particles: give either n_particles or diameters, not both")
+        d = np.array(diameters, dtype=np.float64)
+        if d.ndim != 1 or len(d) == 0:
+            raise ValueError(f"diameters: expected a non-empty 1-D array, got shape {d.shape}")
+        if not np.all(np.isfinite(d)) or np.any(d <= 0):
+            k = int(np.argmax(~np.isfinite(d) | (d <= 0)))
+            raise ValueError(f"diameters[{k}]: must be a finite diameter > 0 (m), got {d[k]}")
+    else:
+        n = particle_count(area, porosity, grading) if n_particles is None else int(n_particles)
+        if n < 1:
+            raise ValueError(f"n_particles: must be >= 1, got {n}")
+        d = grading.sample(n, rng)
+
+    # one common factor so that the final nominal porosity is exactly the target
+    radius_factor = math.sqrt((1.0 - porosity) * area / (math.pi * float(np.sum((0.5 * d) ** 2))))
+    final_radii = radius_factor * 0.5 * d
+    if 2.0 * final_radii.max() > min(x1 - x0, y1 - y0):
+        raise ValueError(
+            f"box: the largest final disk (diameter {2 * final_radii.max():.4g} m) does not fit in "
+            f"the box ({x1 - x0:.4g} x {y1 - y0:.4g} m)"
+        )
+    positions, _ = random_placement(box, 2.0 * final_radii, rng, scale=initial_scale)
+    scale = initial_scale
+    placed_radii = scale * final_radii
+
+    model = grainlab.ContactModel(normal_stiffness, shear_stiffness, friction)
+    sim = grainlab.Simulation(
+        positions, placed_radii, density=density, contact_model=model, threads=threads, local_damping=local_damping
+    )
+    sim.set_contact_model(0, WALL_GROUP, grainlab.ContactModel(normal_stiffness, shear_stiffness, wall_friction))
+    walls = _Box(sim, box)
+    if density_scaling:
+        sim.densities = density * (final_radii.max() / final_radii) ** 2
+
+    steps = 0
+    from tqdm.auto import tqdm
+
+    ticks = 1000
+    total_growth = -math.log(scale)
+    bar = tqdm(total=ticks, desc="radius expansion", unit="‰", disable=not progress, leave=False)
+
+    def relax(limit: int) -> tuple[bool, int]:
+        """Cycles at fixed radii until the unbalanced force ratio is below the threshold."""
+        done = 0
+        while done < limit:
+            chunk = min(4 * steps_per_increment, limit - done)
+            sim.time_step = sim.critical_time_step(time_step_safety)
+            sim.run(chunk)
+            done += chunk
+            ratio = sim.unbalanced_force_ratio
+            bar.set_postfix_str(f"unbalanced {ratio:.1e}, stress {walls.mean_stress() / 1e3:.0f} kPa")
+            if ratio < equilibrium_ratio:
+                return True, done
+        return False, done
+
+    def fail(stress: float, equilibrium: bool, cause: str) -> ExpansionError:
+        n_nom, n_cor = walls.porosities()
+        state = "in equilibrium" if equilibrium else "while growing"
+        return ExpansionError(
+            f"porosity: cannot reach nominal porosity {porosity:.4f} within max_stress_pa = "
+            f"{max_stress_pa / 1e6:.3g} MPa: the densest packing reached has nominal porosity {n_nom:.4f} "
+            f"(overlap-corrected {n_cor:.4f}) and needed a mean wall stress of {stress / 1e6:.3g} MPa "
+            f"{state}{cause}. Raise max_stress_pa or aim for a higher porosity.",
+            porosity=n_nom,
+            porosity_overlap_corrected=n_cor,
+            stress_pa=stress,
+            target=porosity,
+            equilibrium=equilibrium,
+        )
+
+    try:
+        stress = 0.0
+        while scale < 1.0:
+            growth = growth_per_increment / (1.0 + max(stress, 0.0) / growth_stress_scale_pa)
+            scale = min(1.0, scale * math.exp(growth))
+            sim.radii = final_radii if scale == 1.0 else scale * final_radii
+            sim.time_step = sim.critical_time_step(time_step_safety)
+            sim.run(steps_per_increment)
+            steps += steps_per_increment
+            stress = walls.mean_stress()
+            bar.n = int(ticks * (1.0 - math.log(1.0 / scale) / total_growth)) if total_growth > 0 else ticks
+            bar.set_postfix_str(f"stress {stress / 1e3:.0f} kPa, Z {sim.coordination_number:.2f}")
+            if stress > max_stress_pa:
+                settled, used = relax(max_equilibrium_steps)
+                steps += used
+                stress = walls.mean_stress()
+                if stress > max_stress_pa:
+                    raise fail(stress, settled, "")
+        bar.n = ticks
+        bar.set_description_str("equilibrium")
+        settled, used = relax(max_equilibrium_steps)
+        steps += used
+    except grainlab.SimulationUnstableError as error:
+        bar.close()
+        raise fail(walls.mean_stress(), False, f" (stopped by the engine: {error})") from error
+    bar.close()
+
+    wall_stresses = walls.wall_stresses()
+    stress = float(wall_stresses.mean())
+    if stress > max_stress_pa:
+        raise fail(stress, settled, "")
+    ratio = sim.unbalanced_force_ratio
+    if not settled:
+        warnings.warn(
+            f"expand_to_porosity: unbalanced force ratio {ratio:.2e} still above equilibrium_ratio = "
+            f"{equilibrium_ratio:.1e} after max_equilibrium_steps = {max_equilibrium_steps}",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    contacts = sim.contacts()
+    radii = sim.radii
+    if len(contacts):
+        mean_overlap = float(contacts.overlap.mean() / radii.min())
+        max_overlap = float(np.max(contacts.overlap / np.minimum(radii[contacts.i], radii[contacts.j])))
+    else:
+        mean_overlap = max_overlap = 0.0
+    n_nom, n_cor = walls.porosities()
+    coordination = sim.coordination_number
+
+    # hand over a clean state: Table 1 density back, at rest, a time step for the real masses
+    if density_scaling:
+        sim.densities = np.full(len(radii), density)
+    sim.velocities = np.zeros((len(radii), 2))
+    sim.angular_velocities = np.zeros(len(radii))
+    sim.time_step = sim.critical_time_step(0.5)
+
+    positions_out = np.array(sim.positions)
+    radii_out = np.array(radii)
+    for array in (positions_out, radii_out, wall_stresses):
+        array.flags.writeable = False
+    return Sample(
+        positions=positions_out,
+        radii=radii_out,
+        box=box,
+        wall_points=_wall_points(box),
+        porosity_target=porosity,
+        porosity=n_nom,
+        porosity_overlap_corrected=n_cor,
+        wall_stresses_pa=wall_stresses,
+        mean_wall_stress_pa=stress,
+        coordination_number=coordination,
+        mean_overlap_ratio=mean_overlap,
+        max_overlap_ratio=max_overlap,
+        unbalanced_force_ratio=ratio,
+        equilibrium_reached=settled,
+        radius_factor=radius_factor,
+        seed=seed,
+        grading=grading.name,
+        friction=friction,
+        wall_friction=wall_friction,
+        threads=threads,
+        steps=steps,
+        wall_time_s=time.perf_counter() - started,
+        simulation=sim if keep_simulation else None,
+    )

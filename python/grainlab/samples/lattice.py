@@ -1,0 +1,340 @@
+"""Regular packings of equal disks: hexagonal and square lattices at a given porosity.
+
+At contact (spacing ``a`` = diameter ``d``) an infinite lattice has porosity
+
+- hexagonal: ``1 - pi / (2 sqrt 3) = 0.093100...`` (each disk owns ``sqrt(3)/2 a^2``),
+- square: ``1 - pi / 4 = 0.214602...`` (each disk owns ``a^2``).
+
+Other porosities are made the two ways the paper's packing study allows:
+
+- **above** the contact value: random sites are left empty (vacancies), as
+  many as the target needs (rounded to a whole disk);
+- **below** it: the lattice is compressed uniformly, ``a = d sqrt((1 - n_contact) / (1 - n))``,
+  so neighbours overlap by ``d - a``; the nominal porosity is then exactly the
+  target and the overlap-corrected one is higher (each overlap is counted once).
+
+Two boundaries:
+
+- ``"periodic"`` (default): the box is a whole number of lattice periods and
+  is meant as a periodic cell; porosities are those of the infinite lattice
+  (0.0931 and 0.2146 exactly at contact). A given box is rounded to whole
+  periods (the returned :attr:`Lattice.box` is the cell used).
+- ``"walls"``: the disks sit inside a rigid box, the first row and column
+  touching the bottom and left walls; porosities are those of the box, which
+  include the gaps along the walls. With ``box`` given, as many sites as fit
+  are used: the lattice is compressed just enough for the full lattice to reach
+  the target or below, and vacancies make up the rest. With ``n_rows``/``n_cols``
+  the box is fitted around the lattice, the spacing solved so that the full
+  lattice has the target porosity in it (or the contact spacing and vacancies
+  above the contact value).
+
+:attr:`Lattice.note` says what was done.
+
+Example
+-------
+>>> from grainlab.samples import hexagonal_lattice
+>>> lat = hexagonal_lattice(1e-3, n_rows=4, n_cols=3)
+>>> round(lat.porosity, 6), round(lat.porosity_overlap_corrected, 6)
+(0.0931, 0.0931)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from grainlab.samples.porosity import check_box, nominal_porosity, overlap_corrected_porosity
+
+__all__ = [
+    "HEXAGONAL_CONTACT_POROSITY",
+    "SQUARE_CONTACT_POROSITY",
+    "Lattice",
+    "hexagonal_lattice",
+    "square_lattice",
+]
+
+#: ``1 - pi / (2 sqrt 3)``: porosity of the hexagonal lattice of touching equal disks.
+HEXAGONAL_CONTACT_POROSITY = 1.0 - math.pi / (2.0 * math.sqrt(3.0))
+#: ``1 - pi / 4``: porosity of the square lattice of touching equal disks.
+SQUARE_CONTACT_POROSITY = 1.0 - math.pi / 4.0
+
+_GEOMETRY = {
+    # row spacing over a, x offset of odd rows over a, contact porosity of the infinite lattice
+    "hexagonal": (math.sqrt(3.0) / 2.0, 0.5, HEXAGONAL_CONTACT_POROSITY),
+    "square": (1.0, 0.0, SQUARE_CONTACT_POROSITY),
+}
+
+
+@dataclass(frozen=True)
+class Lattice:
+    """A lattice packing and where it really is."""
+
+    kind: str
+    """``"hexagonal"`` or ``"square"``."""
+    boundary: str
+    """``"periodic"`` (the box is a periodic cell) or ``"walls"``."""
+    positions: NDArray[np.float64]
+    """(N, 2) centres, m."""
+    radii: NDArray[np.float64]
+    """(N,) radii, all ``diameter / 2``, m."""
+    box: tuple[float, float, float, float]
+    """``(xmin, ymin, xmax, ymax)`` used, m."""
+    diameter: float
+    spacing: float
+    """Centre distance of lattice neighbours ``a``, m (``< diameter``: compressed)."""
+    porosity_target: float | None
+    porosity: float
+    """Nominal porosity ``1 - N pi r^2 / A``."""
+    porosity_overlap_corrected: float
+    """``1 - |union of disks| / A``."""
+    contact_porosity: float
+    """Porosity of the full lattice at contact in this box (the infinite lattice's value when periodic)."""
+    n_sites: int
+    n_vacancies: int
+    note: str
+    """What was done to reach the target."""
+
+    @property
+    def n_particles(self) -> int:
+        return len(self.radii)
+
+
+def _sites_in_box(
+    kind: str, spacing: float, radius: float, box: tuple[float, float, float, float]
+) -> NDArray[np.float64]:
+    """Lattice sites inside a walled box, first row and column touching the bottom and left walls."""
+    row, offset, _ = _GEOMETRY[kind]
+    x0, y0, x1, y1 = box
+    tol = 1e-12 * spacing
+    n_rows = math.floor((y1 - y0 - 2.0 * radius + tol) / (row * spacing)) + 1
+    n_cols = math.floor((x1 - x0 - 2.0 * radius + tol) / spacing) + 1
+    if y1 - y0 < 2.0 * radius - tol or x1 - x0 < 2.0 * radius - tol:
+        return np.zeros((0, 2))
+    j, i = np.meshgrid(np.arange(n_rows), np.arange(n_cols), indexing="ij")
+    x = x0 + radius + (i + offset * (j % 2)) * spacing
+    y = y0 + radius + j * row * spacing
+    keep = x <= x1 - radius + tol
+    return np.column_stack([x[keep], y[keep]])
+
+
+def _check_rng(rng: np.random.Generator | int | None) -> np.random.Generator:
+    if isinstance(rng, np.random.Generator):
+        return rng
+    return np.random.default_rng(0 if rng is None else rng)
+
+
+def _make(
+    kind: str,
+    diameter: float,
+    porosity: float | None,
+    box: ArrayLike | None,
+    n_rows: int | None,
+    n_cols: int | None,
+    boundary: str,
+    rng: np.random.Generator | int | None,
+) -> Lattice:
+    row, offset, contact = _GEOMETRY[kind]
+    d = float(diameter)
+    if not (math.isfinite(d) and d > 0):
+        raise ValueError(f"diameter: must be a finite diameter > 0 (m), got {diameter}")
+    if porosity is not None:
+        porosity = float(porosity)
+        if not (0.0 < porosity < 1.0):
+            raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+    if boundary not in ("periodic", "walls"):
+        raise ValueError(f"boundary: must be 'periodic' or 'walls', got {boundary!r}")
+    if (box is None) == (n_rows is None and n_cols is None):
+        raise ValueError("box: give either box or n_rows and n_cols")
+    if box is None:
+        if n_rows is None or n_cols is None:
+            raise ValueError("n_rows: give both n_rows and n_cols")
+        n_rows, n_cols = int(n_rows), int(n_cols)
+        if n_rows < 1 or n_cols < 1:
+            raise ValueError(f"n_rows, n_cols: must be >= 1, got {n_rows}, {n_cols}")
+        if boundary == "periodic" and offset and n_rows % 2:
+            raise ValueError(f"n_rows: a periodic hexagonal lattice needs an even number of rows, got {n_rows}")
+    r = 0.5 * d
+    disk = math.pi * r * r
+    rng = _check_rng(rng)
+    what = f"{kind} lattice of {d * 1e3:g} mm disks"
+
+    if boundary == "periodic":
+        if porosity is None or porosity >= contact:
+            a = d
+        else:
+            a = d * math.sqrt((1.0 - contact) / (1.0 - porosity))
+        if box is None:
+            x0 = y0 = 0.0
+        else:
+            bx = check_box(box)
+            x0, y0 = bx[0], bx[1]
+            n_cols = max(1, round((bx[2] - bx[0]) / a))
+            periods = (bx[3] - bx[1]) / (row * a)
+            # hexagonal rows repeat every two rows
+            n_rows = max(2, 2 * round(periods / 2)) if offset else max(1, round(periods))
+        assert n_rows is not None and n_cols is not None
+        cell = (x0, y0, x0 + n_cols * a, y0 + n_rows * row * a)
+        j, i = np.meshgrid(np.arange(n_rows), np.arange(n_cols), indexing="ij")
+        sites = np.column_stack(
+            [(x0 + (i + 0.5 + offset * (j % 2)) * a).ravel(), (y0 + (j + 0.5) * row * a).ravel()]
+        )
+        note = f"{what}, periodic cell of {n_cols} x {n_rows} sites ({cell[2] - x0:.6g} x {cell[3] - y0:.6g} m)"
+        if box is not None and not np.allclose(cell, check_box(box), rtol=0.0, atol=1e-12 * d):
+            note += ", the box rounded to whole lattice periods"
+        full_contact = contact
+    else:
+        if box is None:
+            assert n_rows is not None and n_cols is not None
+            nr, nc = n_rows, n_cols
+            n_sites = nc * nr - (nr // 2 if offset else 0)
+
+            def box_porosity(a: float) -> float:
+                width = (nc - 1) * a + d
+                height = (nr - 1) * row * a + d
+                return 1.0 - n_sites * disk / (width * height)
+
+            full_contact = box_porosity(d)
+            if porosity is None or porosity >= full_contact:
+                a = d
+            else:
+                a = _bisect(box_porosity, porosity, d)
+            cell = (0.0, 0.0, (nc - 1) * a + d, (nr - 1) * row * a + d)
+            sites = _sites_in_box(kind, a, r, cell)
+            note = f"{what} in a walled box fitted around {nc} x {nr} rows"
+        else:
+            cell = check_box(box)
+            area = (cell[2] - cell[0]) * (cell[3] - cell[1])
+
+            def box_porosity(a: float) -> float:
+                return 1.0 - len(_sites_in_box(kind, a, r, cell)) * disk / area
+
+            full_contact = box_porosity(d)
+            if len(_sites_in_box(kind, d, r, cell)) == 0:
+                raise ValueError(f"box: a {d:g} m disk does not fit in {cell}")
+            if porosity is None or porosity >= full_contact:
+                a = d
+            else:
+                a = _largest_spacing_at_most(box_porosity, porosity, d)
+            sites = _sites_in_box(kind, a, r, cell)
+            note = f"{what} in a walled box"
+        if kind == "hexagonal":
+            note += f"; this box's contact porosity is {full_contact:.4f} (the infinite lattice's {contact:.4f})"
+
+    area = (cell[2] - cell[0]) * (cell[3] - cell[1])
+    n_sites = len(sites)
+    n_vac = 0
+    if a < d:
+        note += (
+            f"; compressed uniformly to spacing {a / d:.6f} d (overlap {100 * (d - a) / d:.3g}% of d per "
+            "neighbour pair)"
+        )
+    if porosity is not None:
+        keep = round((1.0 - porosity) * area / disk)
+        n_vac = max(0, n_sites - keep)
+        if n_vac:
+            chosen = np.sort(rng.choice(n_sites, n_sites - n_vac, replace=False))
+            sites = sites[chosen]
+            note += f"; {n_vac} of {n_sites} sites left vacant at random to reach porosity {porosity:g}"
+    if len(sites) == 0:
+        raise ValueError(f"porosity: {porosity} leaves no disk in the box")
+    radii = np.full(len(sites), r)
+    periodic = boundary == "periodic"
+    n_nom = nominal_porosity(radii, area)
+    n_cor = overlap_corrected_porosity(sites, radii, cell, periodic=periodic)
+    note += f"; porosity {n_nom:.4f} nominal, {n_cor:.4f} overlap-corrected"
+    for array in (sites, radii):
+        array.flags.writeable = False
+    return Lattice(
+        kind=kind,
+        boundary=boundary,
+        positions=sites,
+        radii=radii,
+        box=(float(cell[0]), float(cell[1]), float(cell[2]), float(cell[3])),
+        diameter=d,
+        spacing=a,
+        porosity_target=porosity,
+        porosity=n_nom,
+        porosity_overlap_corrected=n_cor,
+        contact_porosity=full_contact,
+        n_sites=n_sites,
+        n_vacancies=n_vac,
+        note=note,
+    )
+
+
+def _bisect(f, target: float, d: float) -> float:  # type: ignore[no-untyped-def]
+    """Spacing ``a <= d`` with ``f(a) = target`` for ``f`` increasing in ``a``."""
+    lo, hi = 0.5 * d, d
+    if f(lo) > target:
+        raise ValueError(f"porosity: {target} needs a lattice compressed beyond half its contact spacing")
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid in (lo, hi):
+            break
+        if f(mid) < target:
+            lo = mid
+        else:
+            hi = mid
+    return lo if abs(f(lo) - target) <= abs(f(hi) - target) else hi
+
+
+def _largest_spacing_at_most(f, target: float, d: float) -> float:  # type: ignore[no-untyped-def]
+    """Largest spacing ``a <= d`` whose (stepwise, non-decreasing in ``a``) porosity ``f(a) <= target``."""
+    lo, hi = 0.5 * d, d
+    if f(lo) > target:
+        raise ValueError(f"porosity: {target} needs a lattice compressed beyond half its contact spacing")
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid in (lo, hi):
+            break
+        if f(mid) <= target:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def hexagonal_lattice(
+    diameter: float,
+    porosity: float | None = None,
+    *,
+    box: ArrayLike | None = None,
+    n_rows: int | None = None,
+    n_cols: int | None = None,
+    boundary: str = "periodic",
+    rng: np.random.Generator | int | None = None,
+) -> Lattice:
+    """Equal disks on a hexagonal (triangular) lattice, rows along x, odd rows shifted by ``a/2``.
+
+    Parameters
+    ----------
+    diameter : m (the paper's Table 3 prints 0.875 mm; see docs/samples.md)
+    porosity : target nominal porosity in (0, 1); ``None``: the lattice at contact.
+        Above the contact porosity (0.0931 periodic) random vacancies, below it a
+        uniform compression (module docstring).
+    box : ``(xmin, ymin, xmax, ymax)``, m; or ``n_rows`` and ``n_cols`` (even
+        ``n_rows`` when periodic)
+    boundary : ``"periodic"`` or ``"walls"``
+    rng : a Generator or a seed for the vacancies (None: seed 0)
+    """
+    return _make("hexagonal", diameter, porosity, box, n_rows, n_cols, boundary, rng)
+
+
+def square_lattice(
+    diameter: float,
+    porosity: float | None = None,
+    *,
+    box: ArrayLike | None = None,
+    n_rows: int | None = None,
+    n_cols: int | None = None,
+    boundary: str = "periodic",
+    rng: np.random.Generator | int | None = None,
+) -> Lattice:
+    """Equal disks on a square lattice; contact porosity ``1 - pi/4 = 0.2146``.
+
+    Parameters as :func:`hexagonal_lattice`.
+    """
+    return _make("square", diameter, porosity, box, n_rows, n_cols, boundary, rng)
