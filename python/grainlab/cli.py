@@ -16,7 +16,11 @@ from collections.abc import Sequence
 import grainlab
 
 #: Subcommand modules, in the order ``grainlab --help`` lists them.
-COMMAND_MODULES: tuple[str, ...] = ("grainlab.commands.demo", "grainlab.commands.analyze")
+COMMAND_MODULES: tuple[str, ...] = (
+    "grainlab.commands.biaxial",
+    "grainlab.commands.analyze",
+    "grainlab.commands.demo",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -299,3 +299,55 @@ def mean_lambda_series(axial_strain: ArrayLike, mean_lambda: ArrayLike, *, ax: A
         _strain_axis(ax)
         ax.set_ylabel(r"mean stability index $\bar\lambda$")
     return ax
+
+
+def strain_series(
+    axial_strain: ArrayLike,
+    values: ArrayLike,
+    ylabel: str,
+    *,
+    percent: bool = False,
+    reference: float | None = None,
+    ax: Any = None,
+) -> Any:
+    """One quantity against axial strain (the paper's Figs. 8, 10, 18).
+
+    ``axial_strain`` is a fraction, compression positive; ``percent`` shows
+    ``values`` (a fraction) in %; ``reference`` draws a horizontal line.
+    """
+    eps = 100.0 * np.asarray(axial_strain, dtype=np.float64)
+    y = np.asarray(values, dtype=np.float64) * (100.0 if percent else 1.0)
+    if eps.shape != y.shape:
+        raise ValueError(f"values: expected shape {eps.shape}, got {y.shape}")
+    ax = new_axes(ax)
+    with paper_style():
+        ax.plot(eps, y, color="C0")
+        if reference is not None:
+            ax.axhline(reference, color="0.6", linewidth=0.8, linestyle="--")
+        _strain_axis(ax)
+        ax.set_ylabel(ylabel)
+    return ax
+
+
+def biaxial_curves(timeseries: dict[str, Any], out_dir: str | Path) -> list[Path]:
+    """The macro curves of a biaxial test, PNG and SVG, into ``out_dir``:
+    ``stress_ratio`` (Fig. 8), ``volumetric_strain`` (Fig. 10) and
+    ``coordination_number`` (Fig. 18) against axial strain."""
+    out = Path(out_dir)
+    eps = timeseries["axial_strain"]
+    written: list[Path] = []
+    figures = (
+        ("fig08_stress_ratio", timeseries["stress_ratio"], r"stress ratio $\sigma_1/\sigma_3$", False, 1.0),
+        (
+            "fig10_volumetric_strain",
+            timeseries["volumetric_strain"],
+            r"volumetric strain $\varepsilon_v$ (%, compression positive)",
+            True,
+            0.0,
+        ),
+        ("fig18_coordination_number", timeseries["coordination_number"], "coordination number $Z$", False, None),
+    )
+    for name, values, label, percent, reference in figures:
+        ax = strain_series(eps, values, label, percent=percent, reference=reference)
+        written += save_figure(ax, out / name)
+    return written

@@ -38,7 +38,7 @@ use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 /// Below this many particles the blocks run one after another on the calling
 /// thread: the same partition and order, so the same bits, without the
 /// hand-over cost that would dominate a tiny system.
-const PARALLEL_MIN_PARTICLES: usize = 1024;
+const PARALLEL_MIN_PARTICLES: usize = 3000;
 
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

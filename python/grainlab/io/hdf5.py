@@ -671,6 +671,12 @@ class ResultsWriter:
         """Number of time series rows written."""
         return int(self._f["timeseries"].attrs["n_rows"])
 
+    def read_timeseries(self) -> dict[str, NDArray[np.float64]]:
+        """The time series written so far, column by column."""
+        ts = self._f["timeseries"]
+        n = self.n_rows if "n_rows" in ts.attrs else 0
+        return {name: np.asarray(ts[name][:n], dtype=np.float64) for name in self.columns}
+
     @property
     def snapshot_names(self) -> list[str]:
         """Names of the snapshots written, in the order written."""

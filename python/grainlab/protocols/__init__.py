@@ -1,0 +1,1 @@
+"""Protocols: what drives the engine through a test (sample, consolidation, boundary, shearing)."""

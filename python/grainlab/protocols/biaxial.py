@@ -1,0 +1,654 @@
+"""The paper's biaxial test, end to end (Sec. 6, Table 1).
+
+Phases, each run by the engine in blocks of steps:
+
+1. **generate**: random placement at half radii inside four rigid walls and
+   radius expansion to the target nominal porosity (:mod:`grainlab.samples`).
+2. **consolidate**: Table 1 friction; the four walls are servo-controlled to
+   ``sigma_0`` until every wall stress is within the tolerance and the mean
+   unbalanced force ratio is below its threshold.
+3. **boundary**: the side walls are switched off and replaced by the bonded
+   membrane chains under the confining pressure (follower load); the sample
+   re-equilibrates with the platens held.
+4. **shear**: the platens approach each other at a constant axial strain rate
+   to the final strain while the confining pressure stays constant; a record
+   every ``shear.record_interval`` of axial strain, full snapshots at the
+   chosen strains.
+
+Everything lands in one results folder: ``run.h5`` (config, time series,
+snapshots, summary, phase times), ``timeseries.csv``, ``summary.json`` and the
+figures. A ``checkpoint.h5`` is written after each phase and during shearing;
+``run_biaxial(..., resume=True)`` continues a killed run and ends with the same
+results as an uninterrupted one (same config, same thread count).
+
+Sign conventions: stresses and strains compression positive; axial strain
+``(H0 - H) / H0``, volumetric (area) strain ``(A0 - A) / A0`` from the
+membrane polygon, both from the start of shearing.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from tqdm import tqdm
+
+import grainlab
+from grainlab.analysis.stress import love_weber_stress
+from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, snapshot_name, write_checkpoint
+from grainlab.io.results import write_json_atomic, write_text_atomic
+from grainlab.protocols.boundary import (
+    MEMBRANE_GROUP,
+    Membrane,
+    install_membrane,
+    sample_area,
+    set_platen_velocity,
+)
+from grainlab.protocols.config import BiaxialConfig
+from grainlab.samples import (
+    PAPER_GRADING,
+    UniformByMass,
+    UniformByNumber,
+    expand_to_porosity,
+    overlap_corrected_porosity,
+)
+from grainlab.simulation import ContactModel, Simulation
+from grainlab.snapshot import ParticleKind
+
+#: Steps per engine call while a phase waits for a condition.
+CHUNK_STEPS = 2000
+
+#: The paper's reported values, for the summary and the docs.
+PAPER_VALUES = {
+    "coordination_number_initial": 3.9,
+    "coordination_number_at_peak": 3.0,
+    "axial_strain_at_peak": 0.015,
+}
+
+TIMESERIES_UNITS = {
+    "step": "1",
+    "time_s": "s",
+    "axial_strain": "1",
+    "axial_stress_pa": "Pa",
+    "confining_pressure_pa": "Pa",
+    "confining_stress_felt_pa": "Pa",
+    "stress_ratio": "1",
+    "stress_ratio_mobilised": "1",
+    "volumetric_strain": "1",
+    "area_m2": "m^2",
+    "height_m": "m",
+    "love_weber_xx_pa": "Pa",
+    "love_weber_yy_pa": "Pa",
+    "love_weber_xy_pa": "Pa",
+    "coordination_number": "1",
+    "unbalanced_force_ratio": "1",
+    "kinetic_energy_j": "J",
+    "elastic_energy_j": "J",
+    "friction_dissipated_j": "J",
+    "damping_dissipated_j": "J",
+    "boundary_work_j": "J",
+    "wall_work_j": "J",
+}
+
+
+class BiaxialError(RuntimeError):
+    """The test could not proceed (e.g. consolidation did not converge)."""
+
+
+@dataclass
+class _Run:
+    """What a run carries from phase to phase, saved in every checkpoint."""
+
+    phase: str
+    n_grains: int
+    grain_density: float
+    walls: dict[str, int]
+    wall_time: dict[str, float]
+    sample: dict[str, Any]
+    consolidation: dict[str, Any]
+    membrane: dict[str, Any] | None = None
+    shear: dict[str, Any] | None = None
+    rows: int = 0
+    snapshots: list[str] | None = None
+    peak: dict[str, float] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+def _grading(config: BiaxialConfig):
+    kind = config["sample.grading"]
+    d_min, d_max = config["sample.d_min"], config["sample.d_max"]
+    if kind == "uniform_by_number":
+        return UniformByNumber(d_min, d_max)
+    if kind == "uniform_by_mass":
+        return UniformByMass(d_min, d_max)
+    if (d_min, d_max) != (PAPER_GRADING.d_min, PAPER_GRADING.d_max):
+        raise ValueError(
+            "sample.grading: 'paper' is the 0.5-3 mm curve; with other sample.d_min/d_max "
+            "choose 'uniform_by_number' or 'uniform_by_mass'"
+        )
+    return PAPER_GRADING
+
+
+def _threads(config: BiaxialConfig) -> int:
+    threads = config["run.threads"]
+    return (os.cpu_count() or 1) if threads == "auto" else int(threads)
+
+
+def _grain_model(config: BiaxialConfig) -> ContactModel:
+    return ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.friction"]
+    )
+
+
+def _platen_model(config: BiaxialConfig) -> ContactModel:
+    return ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.platen_friction"]
+    )
+
+
+def default_strain_rate(config: BiaxialConfig, mean_diameter: float, min_radius: float) -> float:
+    """The fastest axial strain rate with the inertial number
+    ``I = rate * d_mean * sqrt(rho / sigma_3)`` and the paper's Eq. 16 factor
+    ``rate * r_min * sqrt(rho / sigma_3)`` both at most ``shear.inertial_number``."""
+    root = math.sqrt(config["material.density"] / config["consolidation.pressure"])
+    return config["shear.inertial_number"] / (max(mean_diameter, min_radius) * root)
+
+
+# ---- measurements -----------------------------------------------------------
+
+
+def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, float]:
+    """One record of the shearing phase."""
+    membrane = Membrane.from_dict(run.membrane)
+    shear = run.shear
+    bottom, top = sim.wall(membrane.bottom_wall), sim.wall(membrane.top_wall)
+    height = float(top.points[0, 1] - bottom.points[0, 1])
+    area = sample_area(sim, membrane)
+    width = area / height
+    axial_force = 0.5 * (float(top.force[1]) - float(bottom.force[1]))
+    sigma_1 = axial_force / width
+    sigma_3 = config["consolidation.pressure"]
+
+    c = sim.contacts()
+    w = sim.wall_contacts()
+    n = run.n_grains
+    f_on_j = c.normal_force[:, None] * c.normal + c.shear_force[:, None] * np.column_stack(
+        [-c.normal[:, 1], c.normal[:, 0]]
+    )
+    # confining stress the grains feel: force of the grains on the membrane, per side, over the height
+    left = np.zeros(sim.n_particles, dtype=bool)
+    left[membrane.left] = True
+    right = np.zeros(sim.n_particles, dtype=bool)
+    right[membrane.right] = True
+    grain_i, grain_j = c.i < n, c.j < n
+    on_membrane = np.zeros((len(c), 2))
+    on_membrane[grain_i & ~grain_j] = f_on_j[grain_i & ~grain_j]
+    on_membrane[~grain_i & grain_j] = -f_on_j[~grain_i & grain_j]
+    membrane_particle = np.where(grain_i, c.j, c.i)
+    felt_left = -on_membrane[left[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
+    felt_right = on_membrane[right[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
+    wall_force = w.normal_force[:, None] * w.normal + w.shear_force[:, None] * np.column_stack(
+        [-w.normal[:, 1], w.normal[:, 0]]
+    )
+    grains = np.zeros(sim.n_particles, dtype=bool)
+    grains[:n] = True
+    lw = love_weber_stress(
+        sim.positions,
+        c.i,
+        c.j,
+        c.point,
+        f_on_j,
+        area,
+        grains,
+        wall_particle=w.particle,
+        wall_point=w.point,
+        wall_force_on_particle=wall_force,
+    )
+    grain_contacts = int(np.count_nonzero(grain_i & grain_j & ~c.bonded))
+    energy = sim.energy
+    return {
+        "step": float(sim.step_count),
+        "time_s": sim.time,
+        "axial_strain": (shear["height0"] - height) / shear["height0"],
+        "axial_stress_pa": sigma_1,
+        "confining_pressure_pa": sigma_3,
+        "confining_stress_felt_pa": 0.5 * (felt_left + felt_right),
+        "stress_ratio": sigma_1 / sigma_3,
+        "stress_ratio_mobilised": (sigma_1 - sigma_3) / (sigma_1 + sigma_3),
+        "volumetric_strain": (shear["area0"] - area) / shear["area0"],
+        "area_m2": area,
+        "height_m": height,
+        "love_weber_xx_pa": float(lw[0, 0]),
+        "love_weber_yy_pa": float(lw[1, 1]),
+        "love_weber_xy_pa": float(lw[0, 1]),
+        "coordination_number": 2.0 * grain_contacts / n,
+        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
+        "kinetic_energy_j": energy["kinetic"],
+        "elastic_energy_j": energy["elastic"],
+        "friction_dissipated_j": energy["friction_dissipated"],
+        "damping_dissipated_j": energy["damping_dissipated"],
+        "boundary_work_j": energy["boundary_work"],
+        "wall_work_j": energy["wall_work"],
+    }
+
+
+def _snapshot(sim: Simulation, run: _Run, strain: float):
+    kind = np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8)
+    kind[run.n_grains :] = int(ParticleKind.MEMBRANE)
+    snap = sim.snapshot(axial_strain=strain, step=sim.step_count)
+    return type(snap)(
+        snap.positions,
+        snap.radii,
+        snap.ids,
+        rotations=snap.rotations,
+        kind=kind,
+        contact_i=snap.contact_i,
+        contact_j=snap.contact_j,
+        normal_force=snap.normal_force,
+        shear_force=snap.shear_force,
+        contact_normal=snap.contact_normal,
+        contact_point=snap.contact_point,
+        contact_fields=dict(snap.contact_fields),
+        time=snap.time,
+        axial_strain=strain,
+        metadata=dict(snap.metadata),
+    )
+
+
+# ---- phases -----------------------------------------------------------------
+
+
+def _generate(config: BiaxialConfig, threads: int, progress: bool) -> tuple[Simulation, _Run]:
+    start = time.perf_counter()
+    box = (0.0, 0.0, config["sample.width"], config["sample.height"])
+    sample = expand_to_porosity(
+        box,
+        config["sample.porosity"],
+        _grading(config),
+        seed=config["sample.seed"],
+        friction=config["sample.generation_friction"],
+        wall_friction=config["material.platen_friction"],
+        normal_stiffness=config["material.normal_stiffness"],
+        shear_stiffness=config["material.shear_stiffness"],
+        density=config["material.density"],
+        local_damping=config["material.local_damping"],
+        max_stress_pa=config["sample.max_generation_stress"],
+        threads=threads,
+        progress=progress,
+        keep_simulation=True,
+    )
+    sim = sample.simulation
+    n = sim.n_particles
+    sim.densities = np.full(n, config["material.density"])  # generation may scale densities
+    info = {k: v for k, v in sample.to_dict().items() if isinstance(v, int | float | str | bool) or v is None}
+    run = _Run(
+        phase="consolidate",
+        n_grains=n,
+        grain_density=config["material.density"],
+        walls={"bottom": 0, "right": 1, "top": 2, "left": 3},
+        wall_time={"generate": time.perf_counter() - start},
+        sample=info,
+        consolidation={},
+    )
+    return sim, run
+
+
+def _box_stresses(sim: Simulation, run: _Run) -> tuple[float, float, float, float]:
+    """(sigma_xx, sigma_yy, width, height) from the four walls."""
+    w = run.walls
+    bottom, right, top, left = (sim.wall(w[k]) for k in ("bottom", "right", "top", "left"))
+    width = float(right.points[0, 0] - left.points[0, 0])
+    height = float(top.points[0, 1] - bottom.points[0, 1])
+    sxx = 0.5 * (left.normal_stress(height) + right.normal_stress(height))
+    syy = 0.5 * (bottom.normal_stress(width) + top.normal_stress(width))
+    return sxx, syy, width, height
+
+
+def _consolidate(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
+    start = time.perf_counter()
+    consolidation_model = ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["consolidation.friction"]
+    )
+    sim.set_contact_model(0, 0, consolidation_model)
+    sim.set_contact_model(0, 1, _platen_model(config))
+    sim.local_damping = config["material.local_damping"]
+    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+    target = config["consolidation.pressure"]
+    tolerance = config["consolidation.tolerance"]
+    limit = config["consolidation.unbalanced_force_ratio"]
+    max_steps = config["consolidation.max_steps"]
+    speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
+    steps = 0
+    bar = tqdm(total=max_steps, desc="consolidating", unit="step", disable=not progress, leave=False)
+    while True:
+        sxx, syy, width, height = _box_stresses(sim, run)
+        for name, length in (("bottom", width), ("top", width), ("left", height), ("right", height)):
+            sim.wall(run.walls[name]).servo(target, length, relaxation=0.5, max_speed_m_per_s=speed)
+        sim.run(CHUNK_STEPS)
+        steps += CHUNK_STEPS
+        bar.update(CHUNK_STEPS)
+        sxx, syy, width, height = _box_stresses(sim, run)
+        ratio = sim.unbalanced_force_ratio
+        bar.set_postfix(sxx=f"{sxx / 1e3:.1f}kPa", syy=f"{syy / 1e3:.1f}kPa", ubf=f"{ratio:.1e}")
+        if abs(sxx / target - 1) < tolerance and abs(syy / target - 1) < tolerance and ratio < limit:
+            break
+        if steps >= max_steps:
+            bar.close()
+            raise BiaxialError(
+                f"consolidation did not converge in {steps} steps: wall stresses {sxx / 1e3:.1f} / "
+                f"{syy / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa +- {tolerance:.0%}), unbalanced "
+                f"force ratio {ratio:.2e} (limit {limit:.0e}); raise consolidation.max_steps"
+            )
+    bar.close()
+    grains = np.arange(run.n_grains)
+    radii = sim.radii[grains]
+    area = width * height
+    box = (float(sim.wall(run.walls["left"]).points[0, 0]), float(sim.wall(run.walls["bottom"]).points[0, 1]))
+    run.consolidation = {
+        "steps": steps,
+        "stress_xx_pa": sxx,
+        "stress_yy_pa": syy,
+        "width_m": width,
+        "height_m": height,
+        "porosity": 1.0 - float(np.pi * np.sum(radii**2)) / area,
+        "porosity_overlap_corrected": overlap_corrected_porosity(
+            sim.positions[grains], radii, (box[0], box[1], box[0] + width, box[1] + height)
+        ),
+        "coordination_number": sim.coordination_number,
+        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
+        "time_step_s": sim.time_step,
+    }
+    run.wall_time["consolidate"] = time.perf_counter() - start
+    run.phase = "boundary"
+
+
+def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
+    start = time.perf_counter()
+    if config["boundary.kind"] != "membrane":
+        raise BiaxialError(f"boundary.kind {config['boundary.kind']!r} is not available yet; use 'membrane'")
+    walls = run.walls
+    left_x = float(sim.wall(walls["left"]).points[0, 0])
+    right_x = float(sim.wall(walls["right"]).points[0, 0])
+    y_bottom = float(sim.wall(walls["bottom"]).points[0, 1])
+    y_top = float(sim.wall(walls["top"]).points[0, 1])
+    # the rigid box goes; platens three sample widths long take the place of its
+    # top and bottom, so that the sample can bulge and still bear on them
+    for name in ("left", "right", "bottom", "top"):
+        sim.wall(walls[name]).active = False
+    reach = left_x - (right_x - left_x), right_x + (right_x - left_x)
+    bottom = sim.add_segment_wall((reach[1], y_bottom), (reach[0], y_bottom))
+    top = sim.add_segment_wall((reach[0], y_top), (reach[1], y_top))
+    walls["bottom"], walls["top"] = bottom.id, top.id
+    sim.set_contact_model(0, 0, _grain_model(config))  # Table 1 friction from here on
+    membrane = install_membrane(
+        sim,
+        left_x=left_x,
+        right_x=right_x,
+        bottom=bottom,
+        top=top,
+        diameter=config["boundary.membrane_diameter"],
+        overlap=config["boundary.membrane_overlap"],
+        bond_stiffness=config["boundary.membrane_stiffness"],
+        friction=config["boundary.membrane_friction"],
+        grain_model=_grain_model(config),
+        density=config["material.density"],
+        pressure=config["consolidation.pressure"],
+    )
+    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+    limit = config["consolidation.unbalanced_force_ratio"]
+    steps = 0
+    while True:
+        sim.run(CHUNK_STEPS)
+        steps += CHUNK_STEPS
+        if sim.unbalanced_force_ratio < limit or steps >= config["consolidation.max_steps"]:
+            break
+    run.membrane = membrane.to_dict()
+    run.consolidation["boundary_steps"] = steps
+    run.consolidation["membrane_disks"] = len(membrane.left) + len(membrane.right)
+    run.wall_time["boundary"] = time.perf_counter() - start
+    run.phase = "shear"
+
+
+def _start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
+    membrane = Membrane.from_dict(run.membrane)
+    grains = np.arange(run.n_grains)
+    radii = sim.radii[grains]
+    rate = config["shear.strain_rate"]
+    mean_d = float(2 * radii.mean())
+    if rate == "auto":
+        rate = default_strain_rate(config, mean_d, float(radii.min()))
+    bottom, top = sim.wall(membrane.bottom_wall), sim.wall(membrane.top_wall)
+    height0 = float(top.points[0, 1] - bottom.points[0, 1])
+    area0 = sample_area(sim, membrane)
+    speed = 0.5 * rate * height0
+    set_platen_velocity(sim, membrane, speed)
+    dt = sim.time_step
+    steps_per_strain = 1.0 / (rate * dt)
+    final = config["shear.final_strain"]
+    interval = config["shear.record_interval"]
+    targets = {round(k * interval * steps_per_strain) for k in range(1, int(round(final / interval)) + 1)}
+    snaps = [s for s in config["shear.snapshot_strains"] if s <= final + 1e-12]
+    targets |= {round(s * steps_per_strain) for s in snaps if s > 0}
+    root = math.sqrt(config["material.density"] / config["consolidation.pressure"])
+    run.shear = {
+        "strain_rate": rate,
+        "platen_speed_m_per_s": speed,
+        "height0": height0,
+        "area0": area0,
+        "start_step": sim.step_count,
+        "record_steps": sorted(targets),
+        "snapshot_steps": {str(round(s * steps_per_strain)): s for s in snaps},
+        "next": 0,
+        "inertial_number": rate * mean_d * root,
+        "density_scaling_factor": grainlab.density_scaling_factor(
+            rate, config["material.density"], float(radii.min()), config["consolidation.pressure"]
+        ),
+        "porosity_initial": 1.0 - float(np.pi * np.sum(radii**2)) / area0,
+    }
+
+
+def _shear(
+    sim: Simulation,
+    run: _Run,
+    config: BiaxialConfig,
+    writer: ResultsWriter,
+    save: Callable[[], None],
+    progress: bool,
+) -> None:
+    start = time.perf_counter() - run.wall_time.get("shear", 0.0)
+    shear = run.shear
+    steps = shear["record_steps"]
+    snap_steps = shear["snapshot_steps"]
+    final = config["shear.final_strain"]
+    if shear["next"] == 0 and "0" in snap_steps and writer.n_rows == 0:
+        record = _measure(sim, run, config)
+        writer.append_timeseries(record, units=TIMESERIES_UNITS)
+        writer.write_snapshot(snapshot_name(0.0), _snapshot(sim, run, 0.0), step=sim.step_count)
+    last_checkpoint = time.perf_counter()
+    bar = tqdm(
+        total=round(100 * final, 3),
+        desc="shearing",
+        unit="% strain",
+        disable=not progress,
+        leave=False,
+        bar_format="{l_bar}{bar}| {n:.2f}/{total:.1f} % [{elapsed}<{remaining}{postfix}]",
+    )
+    done_strain = 0.0
+    while shear["next"] < len(steps):
+        target = shear["start_step"] + steps[shear["next"]]
+        sim.run(target - sim.step_count)
+        record = _measure(sim, run, config)
+        writer.append_timeseries(record, units=TIMESERIES_UNITS)
+        key = str(steps[shear["next"]])
+        if key in snap_steps:
+            strain = snap_steps[key]
+            writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record["axial_strain"]), step=sim.step_count)
+        peak = run.peak or {"stress_ratio": -math.inf}
+        if record["stress_ratio"] > peak["stress_ratio"]:
+            run.peak = {
+                "stress_ratio": record["stress_ratio"],
+                "axial_strain": record["axial_strain"],
+                "coordination_number": record["coordination_number"],
+                "volumetric_strain": record["volumetric_strain"],
+            }
+        shear["next"] += 1
+        bar.update(100 * record["axial_strain"] - done_strain)
+        done_strain = 100 * record["axial_strain"]
+        bar.set_postfix_str(f"ratio {record['stress_ratio']:.2f}")
+        if time.perf_counter() - last_checkpoint > config["run.checkpoint_interval"]:
+            run.wall_time["shear"] = time.perf_counter() - start
+            save()
+            last_checkpoint = time.perf_counter()
+    bar.close()
+    run.wall_time["shear"] = time.perf_counter() - start
+    run.phase = "done"
+
+
+# ---- outputs ----------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class BiaxialResult:
+    """What ``grainlab biaxial`` reports: the summary and where the files are."""
+
+    out_dir: Path
+    summary: dict[str, Any]
+
+    def one_line(self) -> str:
+        s = self.summary
+        return (
+            f"grainlab biaxial: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}, "
+            f"Z0 {s['coordination_number_initial']:.2f}; peak sigma1/sigma3 {s['peak_stress_ratio']:.2f} "
+            f"at {100 * s['axial_strain_at_peak']:.2f} % axial strain; strain rate {s['strain_rate']:.3g} 1/s; "
+            f"{s['wall_time_s']:.1f} s -> {self.out_dir}"
+        )
+
+
+def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
+    shear = run.shear
+    first = {k: float(v[0]) for k, v in timeseries.items()}
+    last = {k: float(v[-1]) for k, v in timeseries.items()}
+    peak = run.peak or {}
+    return {
+        "n_particles": run.n_grains,
+        "n_membrane_disks": run.consolidation.get("membrane_disks", 0),
+        "porosity_initial": shear["porosity_initial"],
+        "porosity_after_consolidation": run.consolidation["porosity"],
+        "porosity_after_consolidation_overlap_corrected": run.consolidation["porosity_overlap_corrected"],
+        "porosity_generated": run.sample.get("porosity"),
+        "porosity_generated_overlap_corrected": run.sample.get("porosity_overlap_corrected"),
+        "generation_stress_pa": run.sample.get("mean_wall_stress_pa"),
+        "coordination_number_initial": first["coordination_number"],
+        "coordination_number_at_peak": peak.get("coordination_number"),
+        "coordination_number_final": last["coordination_number"],
+        "peak_stress_ratio": peak.get("stress_ratio"),
+        "axial_strain_at_peak": peak.get("axial_strain"),
+        "volumetric_strain_at_peak": peak.get("volumetric_strain"),
+        "final_stress_ratio": last["stress_ratio"],
+        "final_volumetric_strain": last["volumetric_strain"],
+        "max_contraction": float(np.max(timeseries["volumetric_strain"])),
+        "strain_rate": shear["strain_rate"],
+        "inertial_number": shear["inertial_number"],
+        "density_scaling_factor": shear["density_scaling_factor"],
+        "time_step_s": run.consolidation["time_step_s"],
+        "records": len(timeseries["axial_strain"]),
+        "wall_time_s": total_s,
+        "wall_time_by_phase_s": dict(run.wall_time),
+        "paper": PAPER_VALUES,
+        "grainlab_version": grainlab.__version__,
+    }
+
+
+def _csv(timeseries: dict[str, np.ndarray]) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer)
+    names = list(timeseries)
+    writer.writerow(names)
+    for row in zip(*(timeseries[k] for k in names), strict=True):
+        writer.writerow([repr(float(v)) for v in row])
+    return buffer.getvalue()
+
+
+def _figures(timeseries: dict[str, np.ndarray], out: Path) -> list[Path]:
+    from grainlab.plot import biaxial_curves
+
+    return biaxial_curves(timeseries, out)
+
+
+# ---- the driver ---------------------------------------------------------------
+
+
+def run_biaxial(
+    config: BiaxialConfig,
+    out_dir: str | os.PathLike[str],
+    *,
+    resume: bool = False,
+    progress: bool = True,
+) -> BiaxialResult:
+    """Runs (or, with ``resume``, continues) the biaxial test into ``out_dir``."""
+    out = Path(out_dir)
+    checkpoint_path = out / "checkpoint.h5"
+    started = time.perf_counter()
+    threads = _threads(config)
+    if resume:
+        if not checkpoint_path.exists():
+            raise ValueError(f"--resume: {checkpoint_path} not found; nothing to resume")
+        checkpoint = read_checkpoint(checkpoint_path)
+        saved = dict(checkpoint.protocol_state)
+        if saved.get("config") != config.to_dict():
+            raise ValueError(f"--resume: the configuration differs from the one {out} was started with")
+        sim = Simulation.from_bytes(checkpoint.engine_state)
+        run = _Run(**{k: v for k, v in saved.items() if k != "config" and k != "elapsed_s"})
+        writer = ResultsWriter.resume(out, timeseries_rows=run.rows, snapshots=run.snapshots or [])
+        elapsed_before = float(saved.get("elapsed_s", 0.0))
+    else:
+        if (out / "run.h5").exists() or checkpoint_path.exists() or (out / "run.h5.partial").exists():
+            raise ValueError(f"--out: {out} already holds a run; use --resume to continue it or choose another folder")
+        out.mkdir(parents=True, exist_ok=True)
+        writer = ResultsWriter(out, kind="biaxial")
+        writer.write_config(config.to_dict())
+        sim, run = _generate(config, threads, progress)
+        elapsed_before = 0.0
+
+    def save() -> None:
+        state = run.to_dict()
+        state["config"] = config.to_dict()
+        state["elapsed_s"] = elapsed_before + time.perf_counter() - started
+        writer.flush()
+        state["rows"] = writer.n_rows
+        state["snapshots"] = list(writer.snapshot_names)
+        write_checkpoint(checkpoint_path, sim.to_bytes(), state)
+
+    if not resume:
+        save()
+    if run.phase == "consolidate":
+        _consolidate(sim, run, config, progress)
+        save()
+    if run.phase == "boundary":
+        _install_boundary(sim, run, config, progress)
+        _start_shear(sim, run, config)
+        save()
+    if run.phase == "shear":
+        _shear(sim, run, config, writer, save, progress)
+        save()
+    total = elapsed_before + time.perf_counter() - started
+    timeseries = writer.read_timeseries()
+    summary = _summary(run, config, timeseries, total)
+    writer.write_summary(summary)
+    writer.write_phases(run.wall_time)
+    writer.finalize()
+    write_text_atomic(out / "timeseries.csv", _csv(timeseries))
+    write_json_atomic(out / "summary.json", summary)
+    _figures(timeseries, out)
+    checkpoint_path.unlink(missing_ok=True)
+    return BiaxialResult(out, summary)

@@ -1,0 +1,172 @@
+"""The flexible lateral boundary of the biaxial test (DESIGN §3, variant A):
+a chain of small bonded membrane disks along each side of the sample, ends
+tied to the platens, loaded by the confining pressure as a follower load.
+
+Geometry: the left chain runs bottom to top just outside the sample's left
+face, the right chain top to bottom outside its right face, so that walking
+either chain the sample lies on the right (clockwise), as the engine's pressure
+chains expect. Each membrane disk of radius ``r_m`` sits with its centre
+``r_m`` outside the face it replaces, neighbours overlapping by a fraction of
+their diameter and bonded at that distance (bonded pairs do not repel), so the
+chain is a smooth, closed skin that grains cannot pass through until it has
+stretched by that fraction. The end disks have a prescribed vertical velocity,
+that of their platen; horizontally they slide freely on the frictionless platens.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.simulation import FIX_Y, ContactModel, Simulation, Wall
+
+#: Material group of membrane disks (grains are group 0, walls group 1).
+MEMBRANE_GROUP = 2
+
+
+@dataclass(frozen=True)
+class Membrane:
+    """The two membrane chains of a biaxial sample."""
+
+    left: list[int]
+    """Particle indices of the left chain, bottom to top."""
+    right: list[int]
+    """Particle indices of the right chain, top to bottom."""
+    radius: float
+    """Membrane disk radius, m."""
+    chains: tuple[int, int]
+    """Engine pressure-chain ids of the left and right chains."""
+    bottom_wall: int
+    top_wall: int
+
+    @property
+    def particles(self) -> NDArray[np.int64]:
+        return np.array(self.left + self.right, dtype=np.int64)
+
+    @property
+    def ends(self) -> list[int]:
+        """The four end disks tied to the platens."""
+        return [self.left[0], self.left[-1], self.right[0], self.right[-1]]
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Membrane:
+        return cls(
+            left=list(d["left"]),
+            right=list(d["right"]),
+            radius=float(d["radius"]),
+            chains=(int(d["chains"][0]), int(d["chains"][1])),
+            bottom_wall=int(d["bottom_wall"]),
+            top_wall=int(d["top_wall"]),
+        )
+
+
+def _column(x: float, y0: float, y1: float, radius: float, spacing: float) -> NDArray[np.float64]:
+    """Centres from ``y0 + r`` to ``y1 - r`` at most ``spacing`` apart."""
+    span = (y1 - radius) - (y0 + radius)
+    count = max(int(np.ceil(span / spacing)) + 1, 2)
+    y = np.linspace(y0 + radius, y1 - radius, count)
+    return np.column_stack([np.full(count, x), y])
+
+
+def install_membrane(
+    sim: Simulation,
+    *,
+    left_x: float,
+    right_x: float,
+    bottom: Wall,
+    top: Wall,
+    diameter: float,
+    overlap: float,
+    bond_stiffness: float,
+    friction: float,
+    grain_model: ContactModel,
+    density: float,
+    pressure: float,
+) -> Membrane:
+    """Adds the two membrane chains outside the faces ``x = left_x`` and
+    ``x = right_x`` between the platens, bonds them, ties their ends to the
+    platens (prescribed vertical velocity, currently zero) and loads them with
+    the follower ``pressure``. The side walls must already be inactive."""
+    r = 0.5 * diameter
+    y0 = float(bottom.points[0, 1])
+    y1 = float(top.points[0, 1])
+    spacing = diameter * (1.0 - overlap)
+    left = _column(left_x - r, y0, y1, r, spacing)
+    right = _column(right_x + r, y0, y1, r, spacing)[::-1]
+    first = sim.n_particles
+    new = sim.add_particles(np.vstack([left, right]), np.full(len(left) + len(right), r), density)
+    left_ids = [int(k) for k in new[: len(left)]]
+    right_ids = [int(k) for k in new[len(left) :]]
+    groups = sim.groups.copy()
+    groups[first:] = MEMBRANE_GROUP
+    sim.groups = groups
+    for chain in (left_ids, right_ids):
+        for a, b in zip(chain[:-1], chain[1:], strict=True):
+            sim.add_bond(a, b, bond_stiffness, bond_stiffness)
+    membrane_grain = ContactModel(
+        grain_model.normal_stiffness, grain_model.shear_stiffness, friction
+    )
+    sim.set_contact_model(0, MEMBRANE_GROUP, membrane_grain)
+    sim.set_contact_model(1, MEMBRANE_GROUP, ContactModel(grain_model.normal_stiffness, grain_model.shear_stiffness, 0.0))
+    sim.set_contact_model(MEMBRANE_GROUP, MEMBRANE_GROUP, membrane_grain)
+    fixity = sim.fixity.copy()
+    ends = [left_ids[0], left_ids[-1], right_ids[0], right_ids[-1]]
+    fixity[ends] |= FIX_Y
+    sim.fixity = fixity
+    left_chain = sim.add_pressure_chain(left_ids, pressure, start_wall=bottom, end_wall=top)
+    right_chain = sim.add_pressure_chain(right_ids, pressure, start_wall=top, end_wall=bottom)
+    return Membrane(left_ids, right_ids, r, (left_chain, right_chain), bottom.id, top.id)
+
+
+def set_platen_velocity(sim: Simulation, membrane: Membrane, speed: float) -> None:
+    """Platens approach each other at ``speed`` each (m/s); the membrane's end
+    disks follow their platen vertically."""
+    sim.wall(membrane.bottom_wall).velocity = (0.0, speed)
+    sim.wall(membrane.top_wall).velocity = (0.0, -speed)
+    v = sim.velocities.copy()
+    v[[membrane.left[0], membrane.right[-1]], 1] = speed
+    v[[membrane.left[-1], membrane.right[0]], 1] = -speed
+    sim.velocities = v
+
+
+def boundary_polygon(sim: Simulation, membrane: Membrane) -> NDArray[np.float64]:
+    """The clockwise polygon around the sample: left chain (bottom to top), its
+    anchors on the platens, right chain (top to bottom), its anchors."""
+    x = sim.positions
+    y_bottom = float(sim.wall(membrane.bottom_wall).points[0, 1])
+    y_top = float(sim.wall(membrane.top_wall).points[0, 1])
+    left = x[membrane.left]
+    right = x[membrane.right]
+    return np.vstack(
+        [
+            [[left[0, 0], y_bottom]],
+            left,
+            [[left[-1, 0], y_top]],
+            [[right[0, 0], y_top]],
+            right,
+            [[right[-1, 0], y_bottom]],
+        ]
+    )
+
+
+def shoelace_area(polygon: NDArray[np.float64]) -> float:
+    """Area of a simple polygon (either orientation)."""
+    x, y = polygon[:, 0], polygon[:, 1]
+    return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+
+
+def sample_area(sim: Simulation, membrane: Membrane) -> float:
+    """Area enclosed by the membrane's inner surface: the polygon through the
+    chains' centres, less the membrane radius times the chains' length."""
+    polygon = boundary_polygon(sim, membrane)
+    x = sim.positions
+    length = sum(
+        float(np.sum(np.linalg.norm(np.diff(x[chain], axis=0), axis=1))) for chain in (membrane.left, membrane.right)
+    )
+    return shoelace_area(polygon) - membrane.radius * length

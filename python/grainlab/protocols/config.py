@@ -1,0 +1,310 @@
+"""Configuration of the biaxial test: defaults from the paper's Table 1, TOML
+files, ``key=value`` overrides, units at the edge, validation before any work.
+
+A configuration is a flat mapping of dotted keys (``sample.porosity``,
+``shear.strain_rate``, ...) to values in SI units. Files and overrides may give
+numbers (SI) or strings with a unit: ``"75 mm"``, ``"100 kPa"``, ``"2 %/min"``,
+``"0.5 %"``. Every key has a kind that says which units it accepts and which
+range is allowed; a bad key or value raises :class:`ConfigError` (a
+``ValueError``) naming the key and the allowed values.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+
+class ConfigError(ValueError):
+    """A configuration key or value is not allowed."""
+
+
+_UNITS: dict[str, dict[str, float]] = {
+    "length": {"m": 1.0, "mm": 1e-3, "um": 1e-6, "cm": 1e-2},
+    "stress": {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9},
+    "strain_rate": {"1/s": 1.0, "/s": 1.0, "%/s": 1e-2, "%/min": 1e-2 / 60.0, "1/min": 1.0 / 60.0},
+    "strain": {"": 1.0, "%": 1e-2},
+    "stiffness": {"N/m": 1.0, "kN/m": 1e3, "MN/m": 1e6},
+    "density": {"kg/m^3": 1.0, "kg/m3": 1.0},
+    "number": {"": 1.0},
+    "time": {"s": 1.0, "min": 60.0, "h": 3600.0},
+}
+
+
+@dataclass(frozen=True)
+class Field:
+    """One configuration key: its kind (units), default, allowed range and help."""
+
+    kind: str
+    default: Any
+    help: str
+    minimum: float | None = None
+    maximum: float | None = None
+    exclusive_minimum: bool = False
+    exclusive_maximum: bool = False
+    choices: tuple[str, ...] = ()
+    allow_auto: bool = False
+
+    def describe_range(self) -> str:
+        if self.choices:
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        lo = "(" if self.exclusive_minimum else "["
+        hi = ")" if self.exclusive_maximum else "]"
+        lo_v = "-inf" if self.minimum is None else f"{self.minimum:g}"
+        hi_v = "inf" if self.maximum is None else f"{self.maximum:g}"
+        units = ", ".join(u for u in _UNITS.get(self.kind, {}) if u) if self.kind in _UNITS else ""
+        text = f"a number in {lo}{lo_v}, {hi_v}{hi}"
+        if units:
+            text += f" (SI, or a string with a unit: {units})"
+        if self.allow_auto:
+            text += ' or "auto"'
+        return text
+
+
+_POSITIVE = {"minimum": 0.0, "exclusive_minimum": True}
+
+#: Every key, with the paper's Table 1 values as defaults.
+FIELDS: dict[str, Field] = {
+    "sample.width": Field("length", 0.075, "sample width (Table 1: 75 mm)", **_POSITIVE),
+    "sample.height": Field("length", 0.150, "sample height (Table 1: 150 mm)", **_POSITIVE),
+    "sample.porosity": Field(
+        "strain", 0.12, "target nominal porosity of the radius expansion (Table 1: 0.12)",
+        minimum=0.0, maximum=1.0, exclusive_minimum=True, exclusive_maximum=True,
+    ),
+    "sample.d_min": Field("length", 0.5e-3, "smallest grain diameter (Table 1: 0.5 mm)", **_POSITIVE),
+    "sample.d_max": Field("length", 3.0e-3, "largest grain diameter (Table 1: 3 mm)", **_POSITIVE),
+    "sample.grading": Field(
+        "choice", "paper", "grain size distribution", choices=("paper", "uniform_by_number", "uniform_by_mass")
+    ),
+    "sample.seed": Field("integer", 1, "random seed of the sample", minimum=0),
+    "sample.generation_friction": Field("number", 0.0, "particle friction during radius expansion", minimum=0.0),
+    "sample.max_generation_stress": Field(
+        "stress", 5.0e6, "stress bound of the radius expansion", **_POSITIVE
+    ),
+    "material.normal_stiffness": Field("stiffness", 8.45e7, "contact kn (Table 1)", **_POSITIVE),
+    "material.shear_stiffness": Field("stiffness", 8.45e7, "contact ks (Table 1)", **_POSITIVE),
+    "material.friction": Field("number", 0.9, "particle friction (Table 1: 0.9)", minimum=0.0),
+    "material.platen_friction": Field("number", 0.0, "particle-platen friction (Table 1: 0)", minimum=0.0),
+    "material.density": Field("density", 2.0e8, "scaled particle density (Table 1: 2e8 kg/m^3)", **_POSITIVE),
+    "material.local_damping": Field(
+        "number", 0.8, "local damping alpha (Table 1: 0.8)", minimum=0.0, maximum=1.0, exclusive_maximum=True
+    ),
+    "consolidation.pressure": Field("stress", 1.0e5, "isotropic consolidation stress sigma_0 = sigma_3", **_POSITIVE),
+    "consolidation.friction": Field(
+        "number", 0.0,
+        "grain friction while consolidating (the generation's; Table 1 friction acts from the membrane on)",
+        minimum=0.0,
+    ),
+    "consolidation.tolerance": Field(
+        "strain", 0.01, "wall stresses within this fraction of sigma_0", minimum=0.0, exclusive_minimum=True
+    ),
+    "consolidation.unbalanced_force_ratio": Field(
+        "number", 1.0e-3, "equilibrium: mean unbalanced force ratio below this", **_POSITIVE
+    ),
+    "consolidation.max_steps": Field("integer", 2_000_000, "give up consolidating after this many steps", minimum=1),
+    "boundary.kind": Field(
+        "choice", "membrane", "flexible lateral boundary (DESIGN §3)", choices=("membrane", "outer_particles")
+    ),
+    "boundary.membrane_diameter": Field("length", 0.5e-3, "diameter of the membrane disks", **_POSITIVE),
+    "boundary.membrane_overlap": Field(
+        "strain", 0.5, "rest overlap of neighbouring membrane disks, fraction of their diameter",
+        minimum=0.0, maximum=0.9,
+    ),
+    "boundary.membrane_stiffness": Field(
+        "stiffness", 8.45e5, "normal and shear stiffness of the membrane bonds", **_POSITIVE
+    ),
+    "boundary.membrane_friction": Field("number", 0.0, "friction between grains and membrane disks", minimum=0.0),
+    "shear.strain_rate": Field(
+        "strain_rate", "auto",
+        "axial strain rate; auto = the fastest with inertial number and Eq. 16 factor <= 1e-3",
+        **_POSITIVE, allow_auto=True,
+    ),
+    "shear.final_strain": Field("strain", 0.10, "final axial strain", minimum=0.0, maximum=0.5, exclusive_minimum=True),
+    "shear.record_interval": Field(
+        "strain", 0.0005, "axial strain between two records (<= 0.05 %)", minimum=0.0, maximum=0.0005,
+        exclusive_minimum=True,
+    ),
+    "shear.snapshot_strains": Field(
+        "strain_list", [0.0, 0.005, 0.007, 0.009, 0.015, 0.10],
+        "axial strains of the full snapshots (the paper's 0, 0.5, 0.7, 0.9, 1.5 and 10 %)",
+    ),
+    "shear.inertial_number": Field(
+        "number", 1.0e-3, "bound on the inertial number and Eq. 16 factor for the auto strain rate", **_POSITIVE
+    ),
+    "run.threads": Field("integer", "auto", "engine threads (auto: all cores)", minimum=1, allow_auto=True),
+    "run.time_step_safety": Field(
+        "number", 0.5, "time step = this x the critical time step", minimum=0.0, maximum=1.0,
+        exclusive_minimum=True,
+    ),
+    "run.checkpoint_interval": Field("time", 30.0, "wall-clock time between checkpoints", **_POSITIVE),
+}
+
+#: Overrides of ``--quick``: a small sample of a few hundred disks, for demos and CI.
+QUICK: dict[str, Any] = {"sample.width": 0.03, "sample.height": 0.06}
+
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S*)\s*$")
+
+
+def _parse_quantity(key: str, field: Field, value: Any) -> float:
+    if isinstance(value, bool):
+        raise ConfigError(f"{key}: expected {field.describe_range()}, got {value!r}")
+    if isinstance(value, int | float):
+        return float(value)
+    if isinstance(value, str):
+        match = _QUANTITY.match(value)
+        if match:
+            number, unit = float(match.group(1)), match.group(2)
+            units = _UNITS.get(field.kind, {"": 1.0})
+            if unit in units:
+                return number * units[unit]
+            allowed = ", ".join(repr(u) for u in units if u) or "none"
+            raise ConfigError(f"{key}: unknown unit {unit!r} in {value!r}; allowed units: {allowed}")
+    raise ConfigError(f"{key}: expected {field.describe_range()}, got {value!r}")
+
+
+def _check_range(key: str, field: Field, number: float) -> float:
+    if not math.isfinite(number):
+        raise ConfigError(f"{key}: expected {field.describe_range()}, got {number!r}")
+    low_bad = field.minimum is not None and (
+        number <= field.minimum if field.exclusive_minimum else number < field.minimum
+    )
+    high_bad = field.maximum is not None and (
+        number >= field.maximum if field.exclusive_maximum else number > field.maximum
+    )
+    if low_bad or high_bad:
+        raise ConfigError(f"{key}: {number:g} is out of range; expected {field.describe_range()}")
+    return number
+
+
+def coerce(key: str, value: Any) -> Any:
+    """Converts ``value`` for ``key`` to SI and checks its range."""
+    if key not in FIELDS:
+        close = [k for k in FIELDS if k.split(".")[-1] == key.split(".")[-1]]
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise ConfigError(f"unknown configuration key {key!r}{hint}; known keys: {', '.join(sorted(FIELDS))}")
+    field = FIELDS[key]
+    if field.allow_auto and value == "auto":
+        return "auto"
+    if field.kind == "choice":
+        if value not in field.choices:
+            raise ConfigError(f"{key}: {value!r} is not {field.describe_range()}")
+        return value
+    if field.kind == "integer":
+        if isinstance(value, bool) or not (
+            isinstance(value, int) or (isinstance(value, str) and value.strip().lstrip("+").isdigit())
+        ):
+            raise ConfigError(f"{key}: expected an integer >= {field.minimum:g}, got {value!r}")
+        return int(_check_range(key, field, float(int(value))))
+    if field.kind == "strain_list":
+        items = value
+        if isinstance(value, str):
+            items = [v for v in value.strip("[]").split(",") if v.strip()]
+        if not isinstance(items, list | tuple):
+            raise ConfigError(f"{key}: expected a list of strains, got {value!r}")
+        strain = Field("strain", 0.0, "", minimum=0.0, maximum=0.5)
+        return sorted(_check_range(key, strain, _parse_quantity(key, strain, v)) for v in items)
+    return _check_range(key, field, _parse_quantity(key, field, value))
+
+
+def _flatten(table: Mapping[str, Any], prefix: str = "") -> Iterable[tuple[str, Any]]:
+    for name, value in table.items():
+        key = f"{prefix}{name}"
+        if isinstance(value, Mapping):
+            yield from _flatten(value, key + ".")
+        else:
+            yield key, value
+
+
+def _parse_override(text: str) -> tuple[str, Any]:
+    if "=" not in text:
+        raise ConfigError(f"--set {text!r}: expected key=value, e.g. shear.final_strain=5%")
+    key, raw = (part.strip() for part in text.split("=", 1))
+    try:
+        value: Any = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw  # a bare string such as 100kPa or auto
+    return key, value
+
+
+@dataclass(frozen=True)
+class BiaxialConfig:
+    """A resolved, validated configuration: ``values`` maps every key to SI values."""
+
+    values: dict[str, Any]
+
+    def __getitem__(self, key: str) -> Any:
+        return self.values[key]
+
+    def to_dict(self) -> dict[str, Any]:
+        """Nested ``{section: {name: value}}``, as written to ``run.h5`` and TOML."""
+        nested: dict[str, dict[str, Any]] = {}
+        for key, value in self.values.items():
+            section, name = key.split(".", 1)
+            nested.setdefault(section, {})[name] = value
+        return nested
+
+    @classmethod
+    def from_dict(cls, nested: Mapping[str, Any]) -> BiaxialConfig:
+        return resolve(overrides=dict(_flatten(nested)))
+
+
+def resolve(
+    config_file: str | Path | None = None,
+    overrides: Mapping[str, Any] | Iterable[str] | None = None,
+    *,
+    quick: bool = False,
+) -> BiaxialConfig:
+    """Defaults (Table 1), then ``--quick``, then the TOML file, then overrides
+    (a mapping, or ``key=value`` strings), all validated before anything runs."""
+    values = {key: field.default for key, field in FIELDS.items()}
+    layers: list[dict[str, Any]] = []
+    if quick:
+        layers.append(dict(QUICK))
+    if config_file is not None:
+        path = Path(config_file)
+        try:
+            table = tomllib.loads(path.read_text())
+        except FileNotFoundError:
+            raise ConfigError(f"{path}: configuration file not found") from None
+        except tomllib.TOMLDecodeError as error:
+            raise ConfigError(f"{path}: not valid TOML ({error})") from None
+        layers.append(dict(_flatten(table)))
+    if overrides is not None:
+        if isinstance(overrides, Mapping):
+            layers.append(dict(overrides))
+        else:
+            layers.append(dict(_parse_override(text) for text in overrides))
+    for layer in layers:
+        for key, value in layer.items():
+            values[key] = value
+    resolved = {key: coerce(key, value) for key, value in values.items()}
+    _check_consistency(resolved)
+    return BiaxialConfig(resolved)
+
+
+def _check_consistency(v: dict[str, Any]) -> None:
+    if v["sample.d_min"] > v["sample.d_max"]:
+        raise ConfigError(
+            f"sample.d_min: {v['sample.d_min']:g} m exceeds sample.d_max {v['sample.d_max']:g} m"
+        )
+    if 10 * v["sample.d_max"] > min(v["sample.width"], v["sample.height"]):
+        raise ConfigError(
+            f"sample.width/height: the sample must be at least 10 largest diameters wide "
+            f"({10 * v['sample.d_max']:g} m), got {v['sample.width']:g} x {v['sample.height']:g} m"
+        )
+    positive = [s for s in v["shear.snapshot_strains"] if s > 0]
+    if positive and positive[0] > v["shear.final_strain"] + 1e-12:
+        raise ConfigError(
+            f"shear.final_strain: {v['shear.final_strain']:g} is below the first snapshot strain "
+            f"{positive[0]:g} (shear.snapshot_strains); raise it or change the snapshots"
+        )
+    if v["shear.final_strain"] < v["shear.record_interval"]:
+        raise ConfigError(
+            f"shear.final_strain: {v['shear.final_strain']:g} is below one record interval "
+            f"({v['shear.record_interval']:g})"
+        )
