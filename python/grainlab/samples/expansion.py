@@ -96,7 +96,7 @@ class ExpansionError(ValueError):
         self.equilibrium = equilibrium
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Sample:
     """A generated sample: where it really is, and how it got there.
 
@@ -384,7 +384,13 @@ def expand_to_porosity(
 
     ticks = 1000
     total_growth = -math.log(scale)
-    bar = tqdm(total=ticks, desc="radius expansion", unit="‰", disable=not progress, leave=False)
+    bar = tqdm(
+        total=ticks,
+        desc="radius expansion",
+        disable=not progress,
+        leave=False,
+        bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}{postfix}",
+    )
 
     def relax(limit: int) -> tuple[bool, int]:
         """Cycles at fixed radii until the unbalanced force ratio is below the threshold."""

@@ -68,7 +68,7 @@ _GEOMETRY = {
 }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Lattice:
     """A lattice packing and where it really is."""
 
