@@ -42,6 +42,7 @@ import numpy as np
 from tqdm import tqdm
 
 import grainlab
+from grainlab.analysis import ContactAnisotropy, CoordinationNumber, StabilityIndex
 from grainlab.analysis.stress import love_weber_stress
 from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, snapshot_name, write_checkpoint
 from grainlab.io.results import write_json_atomic, write_text_atomic
@@ -74,6 +75,12 @@ PAPER_VALUES = {
 }
 
 TIMESERIES_UNITS = {
+    "anisotropy": "1",
+    "anisotropy_direction_rad": "rad",
+    "anisotropy_fourier": "1",
+    "force_anisotropy": "1",
+    "mean_stability_index": "1",
+    "mechanical_coordination_number": "1",
     "step": "1",
     "time_s": "s",
     "axial_strain": "1",
@@ -215,6 +222,7 @@ def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, flo
         wall_force_on_particle=wall_force,
     )
     grain_contacts = int(np.count_nonzero(grain_i & grain_j & ~c.bonded))
+    fabric = _fabric(sim, run)
     energy = sim.energy
     return {
         "step": float(sim.step_count),
@@ -239,6 +247,26 @@ def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, flo
         "damping_dissipated_j": energy["damping_dissipated"],
         "boundary_work_j": energy["boundary_work"],
         "wall_work_j": energy["wall_work"],
+        **fabric,
+    }
+
+
+def _fabric(sim: Simulation, run: _Run) -> dict[str, float]:
+    """Fabric measures of the grains (membrane disks excluded as particles):
+    anisotropy of contact normals and normal forces (Eq. 7-8 and the unbinned
+    estimate), the mean stability index (Sec. 5) and the mechanical coordination number."""
+    snap = _snapshot(sim, run, 0.0)
+    normals = ContactAnisotropy().compute(snap)
+    forces = ContactAnisotropy(weight="normal_force").compute(snap)
+    stability = StabilityIndex().compute(snap)
+    z = CoordinationNumber().compute(snap)
+    return {
+        "anisotropy": normals.anisotropy,
+        "anisotropy_direction_rad": normals.direction,
+        "anisotropy_fourier": normals.anisotropy_fourier,
+        "force_anisotropy": forces.anisotropy,
+        "mean_stability_index": stability.mean,
+        "mechanical_coordination_number": z.mechanical_coordination_number,
     }
 
 

@@ -1,0 +1,130 @@
+"""The biaxial test end to end on the quick sample: a dense soil's behaviour,
+the results folder, resuming a killed run, bad input before any work."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import grainlab.protocols.biaxial as biaxial
+from grainlab.cli import main
+from grainlab.io.hdf5 import read_results
+from grainlab.protocols.config import resolve
+
+
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("biaxial") / "quick"
+    assert main(["biaxial", "--quick", "--out", str(out), "--no-progress"]) == 0
+    return out
+
+
+@pytest.mark.slow
+def test_quick_run_behaves_like_a_dense_granular_soil(quick_run):
+    summary = json.loads((quick_run / "summary.json").read_text())
+    results = read_results(quick_run / "run.h5")
+    ts = results.timeseries
+    eps, ratio, ev, z = ts["axial_strain"], ts["stress_ratio"], ts["volumetric_strain"], ts["coordination_number"]
+    # starts isotropic at sigma_0: the membrane carries the confining pressure
+    assert ratio[0] == pytest.approx(1.0, abs=0.05)
+    assert ts["confining_stress_felt_pa"][0] == pytest.approx(1e5, rel=0.05)
+    # a peak, then softening
+    peak = int(np.argmax(ratio))
+    assert 0.005 < eps[peak] < 0.08
+    assert ratio[peak] > 2.5 and ratio[-1] < 0.85 * ratio[peak]
+    # contraction first, dilation after
+    assert ev[: peak + 1].max() > 0 and ev[-1] < 0
+    # coordination number falls from its initial value
+    assert z[-20:].mean() < z[0] - 0.3
+    # the Love-Weber average stress agrees with the boundary stresses at the start
+    assert ts["love_weber_yy_pa"][0] == pytest.approx(ts["axial_stress_pa"][0], rel=0.1)
+    assert ts["love_weber_xx_pa"][0] == pytest.approx(1e5, rel=0.1)
+    assert summary["peak_stress_ratio"] == pytest.approx(ratio[peak])
+    # records at least every 0.05 % of axial strain
+    assert np.diff(eps).max() < 0.0005 * 1.05
+
+
+@pytest.mark.slow
+def test_results_folder_holds_everything(quick_run):
+    names = {p.name for p in quick_run.iterdir()}
+    for name in ("run.h5", "timeseries.csv", "summary.json", "fig08_stress_ratio.png", "fig08_stress_ratio.svg",
+                 "fig10_volumetric_strain.png", "fig18_coordination_number.svg"):
+        assert name in names
+    assert "checkpoint.h5" not in names and "run.h5.partial" not in names
+    summary = json.loads((quick_run / "summary.json").read_text())
+    for key in ("n_particles", "porosity_initial", "coordination_number_initial", "peak_stress_ratio",
+                "axial_strain_at_peak", "strain_rate", "wall_time_s", "wall_time_by_phase_s"):
+        assert summary[key] is not None, key
+    with open(quick_run / "timeseries.csv") as f:
+        rows = list(csv.DictReader(f))
+    for column in ("axial_strain", "stress_ratio", "volumetric_strain", "coordination_number"):
+        assert column in rows[0]
+    results = read_results(quick_run / "run.h5")
+    assert results.status == "complete"
+    assert results.snapshot_names == [f"strain_{s:.4f}" for s in (0, 0.005, 0.007, 0.009, 0.015, 0.10)]
+    snap = results.snapshot("strain_0.0150")
+    assert snap.axial_strain == pytest.approx(0.015, abs=1e-4)
+    assert results.config["sample"]["porosity"] == 0.12
+
+
+@pytest.mark.slow
+def test_resumed_run_ends_with_the_same_results(tmp_path, monkeypatch):
+    overrides = ["shear.final_strain=0.02", "run.checkpoint_interval=1e-9", "run.threads=2"]
+    config = resolve(overrides=overrides, quick=True)
+    straight = biaxial.run_biaxial(config, tmp_path / "straight", progress=False)
+
+    real_measure = biaxial._measure
+    calls = {"n": 0}
+
+    def dying_measure(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 17:
+            raise KeyboardInterrupt("simulated kill during shearing")
+        return real_measure(*args, **kwargs)
+
+    monkeypatch.setattr(biaxial, "_measure", dying_measure)
+    killed = tmp_path / "killed"
+    with pytest.raises(KeyboardInterrupt):
+        biaxial.run_biaxial(config, killed, progress=False)
+    # a killed run leaves nothing that looks complete
+    assert not (killed / "run.h5").exists() and not (killed / "summary.json").exists()
+    assert (killed / "checkpoint.h5").exists()
+    monkeypatch.setattr(biaxial, "_measure", real_measure)
+    resumed = biaxial.run_biaxial(config, killed, resume=True, progress=False)
+
+    a = read_results(straight.out_dir / "run.h5")
+    b = read_results(resumed.out_dir / "run.h5")
+    assert set(a.timeseries) == set(b.timeseries)
+    for name in a.timeseries:
+        np.testing.assert_array_equal(a.timeseries[name], b.timeseries[name], err_msg=name)
+    assert a.snapshot_names == b.snapshot_names
+    np.testing.assert_array_equal(a.snapshot(-1).positions, b.snapshot(-1).positions)
+    for key in ("peak_stress_ratio", "axial_strain_at_peak", "porosity_initial", "coordination_number_initial"):
+        assert straight.summary[key] == resumed.summary[key]
+
+
+def test_bad_configuration_fails_before_any_work(tmp_path, capsys):
+    out = tmp_path / "never"
+    assert main(["biaxial", "--out", str(out), "--set", "sample.porosity=1.5"]) == 2
+    assert "sample.porosity" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_an_existing_run_is_not_overwritten(tmp_path):
+    (tmp_path / "run.h5").write_bytes(b"")
+    with pytest.raises(ValueError, match="already holds a run"):
+        biaxial.run_biaxial(resolve(quick=True), tmp_path, progress=False)
+    with pytest.raises(ValueError, match="nothing to resume"):
+        biaxial.run_biaxial(resolve(quick=True), tmp_path / "empty", resume=True, progress=False)
+
+
+def test_default_strain_rate_keeps_inertial_number_at_the_bound():
+    config = resolve()
+    rate = biaxial.default_strain_rate(config, mean_diameter=1.5e-3, min_radius=0.25e-3)
+    inertial = rate * 1.5e-3 * np.sqrt(2e8 / 1e5)
+    assert inertial == pytest.approx(1e-3)
+    eq16 = rate * 0.25e-3 * np.sqrt(2e8 / 1e5)
+    assert eq16 <= 1e-3

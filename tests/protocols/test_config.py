@@ -1,0 +1,69 @@
+"""Biaxial configuration: Table 1 defaults, units at the edge, errors naming the key."""
+
+from __future__ import annotations
+
+import pytest
+
+from grainlab.protocols.config import ConfigError, resolve
+
+
+def test_defaults_are_table_1():
+    c = resolve()
+    assert c["sample.width"] == 0.075 and c["sample.height"] == 0.150
+    assert c["sample.porosity"] == 0.12
+    assert c["material.normal_stiffness"] == c["material.shear_stiffness"] == 8.45e7
+    assert c["material.friction"] == 0.9 and c["material.platen_friction"] == 0.0
+    assert c["material.local_damping"] == 0.8 and c["material.density"] == 2e8
+    assert c["consolidation.pressure"] == 1e5
+    assert c["shear.final_strain"] == 0.10
+    assert c["shear.snapshot_strains"] == [0.0, 0.005, 0.007, 0.009, 0.015, 0.10]
+
+
+def test_units_are_converted_to_si():
+    c = resolve(overrides=["shear.strain_rate=2%/min", 'consolidation.pressure="0.2 MPa"', "sample.width=80mm"])
+    assert c["shear.strain_rate"] == pytest.approx(0.02 / 60)
+    assert c["consolidation.pressure"] == pytest.approx(2e5)
+    assert c["sample.width"] == pytest.approx(0.08)
+
+
+def test_toml_file_and_override_order(tmp_path):
+    path = tmp_path / "test.toml"
+    path.write_text('[sample]\nporosity = 0.15\nseed = 7\n[shear]\nfinal_strain = "5 %"\n')
+    c = resolve(path, ["sample.seed=9"])
+    assert c["sample.porosity"] == 0.15 and c["sample.seed"] == 9 and c["shear.final_strain"] == pytest.approx(0.05)
+    assert resolve(path, quick=True)["sample.width"] == 0.03
+
+
+@pytest.mark.parametrize(
+    ("override", "message"),
+    [
+        ("sample.porosty=0.1", "unknown configuration key 'sample.porosty'"),
+        ("sample.porosity=1.2", r"sample.porosity: 1.2 is out of range; expected a number in \(0, 1\)"),
+        ("sample.porosity=0", "sample.porosity: 0 is out of range"),
+        ("consolidation.pressure=-5", "consolidation.pressure: -5 is out of range"),
+        ('consolidation.pressure="100 kPsi"', "consolidation.pressure: unknown unit 'kPsi'"),
+        ("shear.strain_rate=2%/fortnight", "shear.strain_rate: unknown unit"),
+        ("shear.final_strain=0.004", "shear.final_strain: 0.004 is below the first snapshot strain 0.005"),
+        ("sample.grading=sandy", "sample.grading: 'sandy' is not one of"),
+        ("run.threads=0", "run.threads"),
+        ("sample.d_min=4mm", "sample.d_min"),
+        ("novalue", "expected key=value"),
+    ],
+)
+def test_bad_configuration_names_the_key(override, message):
+    with pytest.raises(ConfigError, match=message):
+        resolve(overrides=[override])
+
+
+def test_missing_or_broken_file(tmp_path):
+    with pytest.raises(ConfigError, match="not found"):
+        resolve(tmp_path / "nope.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[sample\nwidth = ")
+    with pytest.raises(ConfigError, match="not valid TOML"):
+        resolve(bad)
+
+
+def test_round_trip_through_nested_dict():
+    c = resolve(overrides=["shear.final_strain=0.05"])
+    assert type(c).from_dict(c.to_dict()).values == c.values
