@@ -123,8 +123,11 @@ def test_an_existing_run_is_not_overwritten(tmp_path):
 
 def test_default_strain_rate_keeps_inertial_number_at_the_bound():
     config = resolve()
-    rate = biaxial.default_strain_rate(config, mean_diameter=1.5e-3, min_radius=0.25e-3)
-    inertial = rate * 1.5e-3 * np.sqrt(2e8 / 1e5)
+    rate = biaxial.default_strain_rate(config, max_diameter=3e-3, min_radius=0.25e-3)
+    # heaviest grain, effective mass m / (1 - alpha) under local damping alpha = 0.8
+    inertial = rate * 3e-3 * np.sqrt(2e8 / (0.2 * 1e5))
     assert inertial == pytest.approx(1e-3)
+    assert biaxial.inertial_number(config, rate, 3e-3) == pytest.approx(1e-3)
     eq16 = rate * 0.25e-3 * np.sqrt(2e8 / 1e5)
     assert eq16 <= 1e-3
+    assert rate == pytest.approx(3.33e-3, rel=0.01)
