@@ -30,9 +30,10 @@ sim = grainlab.Simulation(
     gravity=(0.0, -9.81),
 )
 width = n_side * spacing
-floor = sim.add_segment_wall((width, 0.0), (0.0, 0.0))  # particles on the left of a -> b: above
-sim.add_segment_wall((0.0, 0.0), (0.0, 4 * width))  # left side wall, particles to its right
-sim.add_segment_wall((width, 4 * width), (width, 0.0))  # right side wall
+# walls are oriented: the particles lie on the left of a -> b (counter-clockwise around them)
+floor = sim.add_segment_wall((0.0, 0.0), (width, 0.0))
+sim.add_segment_wall((0.0, 4 * width), (0.0, 0.0))  # left side wall
+sim.add_segment_wall((width, 0.0), (width, 4 * width))  # right side wall
 print(sim)
 
 for _ in range(10):

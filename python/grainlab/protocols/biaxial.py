@@ -433,8 +433,8 @@ def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progres
     for name in ("left", "right", "bottom", "top"):
         sim.wall(walls[name]).active = False
     reach = left_x - (right_x - left_x), right_x + (right_x - left_x)
-    bottom = sim.add_segment_wall((reach[1], y_bottom), (reach[0], y_bottom))
-    top = sim.add_segment_wall((reach[0], y_top), (reach[1], y_top))
+    bottom = sim.add_segment_wall((reach[0], y_bottom), (reach[1], y_bottom))  # sample on the left
+    top = sim.add_segment_wall((reach[1], y_top), (reach[0], y_top))
     walls["bottom"], walls["top"] = bottom.id, top.id
     sim.set_contact_model(0, 0, _grain_model(config))  # Table 1 friction from here on
     membrane = install_membrane(
