@@ -103,11 +103,19 @@ def test_stress_bound_error_names_the_densest_porosity_reached():
     assert isinstance(e, ValueError)
 
 
-def test_a_loose_target_needs_little_stress():
-    s = expand_to_porosity(SMALL, 0.20, seed=1, progress=False)
-    assert s.porosity == pytest.approx(0.20, abs=1e-12)
-    # above the jamming porosity the disks do not fill the box: nothing to compress
-    assert s.mean_wall_stress_pa < 1e4
+@pytest.mark.parametrize("target", [0.20, 0.30])
+def test_a_target_looser_than_jamming_gives_a_stress_free_sample(target):
+    s = expand_to_porosity(SMALL, target, seed=1, progress=False)
+    assert s.porosity == pytest.approx(target, abs=1e-12)
+    # above the jamming porosity the disks do not fill the box: nothing carries load
+    assert not s.jammed and s.equilibrium_reached
+    assert s.mean_wall_stress_pa < 1e3
+    assert "not jammed" in s.summary()
+
+
+def test_the_dense_sample_is_jammed(small_sample):
+    assert small_sample.jammed
+    assert "not jammed" not in small_sample.summary()
 
 
 def test_other_grading_explicit_diameters_friction_and_count():

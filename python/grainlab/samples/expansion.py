@@ -14,7 +14,10 @@ The procedure (paper Sec. 6; docs/samples.md gives the details and the reasons):
    with ``sigma`` the mean wall stress just measured: fast while the packing is
    loose, slow once it carries stress.
 4. At the final radii, cycle until the mean unbalanced force ratio is below
-   ``equilibrium_ratio`` (default 1e-4).
+   ``equilibrium_ratio`` (default 1e-4), or, for a target looser than the
+   jamming porosity, until the contacts carry no load (rms overlap below
+   ``stress_free_overlap`` = 1e-5 of the smallest radius; ``Sample.jammed`` is
+   then False).
 
 Stress bound: whenever the mean wall stress exceeds ``max_stress_pa``, growth
 stops and the packing is cycled to equilibrium at its current radii; if it
@@ -133,7 +136,13 @@ class Sample:
     unbalanced_force_ratio: float
     """Mean unbalanced force ratio at the end."""
     equilibrium_reached: bool
-    """Whether :attr:`unbalanced_force_ratio` went below the threshold asked for."""
+    """Whether cycling ended at rest: the unbalanced force ratio below the threshold asked
+    for, or a stress-free packing (see :attr:`jammed`)."""
+    jammed: bool
+    """Whether the packing carries load. False when the disks at this porosity do not
+    fill the box under load (a target looser than the protocol's jamming porosity):
+    cycling then stops once the contacts' rms overlap is below
+    ``stress_free_overlap`` times the smallest radius."""
     radius_factor: float
     """``f``: final radii are ``f * d / 2`` of the drawn diameters ``d``."""
     seed: int | None
@@ -161,6 +170,7 @@ class Sample:
             f"wall stress {self.mean_wall_stress_pa / 1e3:.1f} kPa, Z {self.coordination_number:.2f}, "
             f"mean overlap {100 * self.mean_overlap_ratio:.1f}% of r_min, "
             f"unbalanced {self.unbalanced_force_ratio:.1e}, {self.wall_time_s:.1f} s"
+            + ("" if self.jammed else " (not jammed: stress-free at this porosity)")
         )
 
     def to_dict(self) -> dict[str, Any]:
@@ -178,6 +188,7 @@ class Sample:
             "max_overlap_ratio": self.max_overlap_ratio,
             "unbalanced_force_ratio": self.unbalanced_force_ratio,
             "equilibrium_reached": self.equilibrium_reached,
+            "jammed": self.jammed,
             "radius_factor": self.radius_factor,
             "seed": self.seed,
             "grading": self.grading,
@@ -251,6 +262,7 @@ def expand_to_porosity(
     steps_per_increment: int = 50,
     growth_stress_scale_pa: float = 1.0e5,
     equilibrium_ratio: float = 1.0e-4,
+    stress_free_overlap: float = 1.0e-5,
     max_equilibrium_steps: int = 300_000,
     max_stress_pa: float = 5.0e6,
     time_step_safety: float = 0.8,
@@ -280,6 +292,8 @@ def expand_to_porosity(
     steps_per_increment : DEM steps after each growth increment
     growth_stress_scale_pa : the increment is divided by ``1 + sigma / this``
     equilibrium_ratio : stop cycling when the mean unbalanced force ratio is below this
+    stress_free_overlap : also stop (an unjammed, stress-free packing) when the rms
+        contact overlap falls below this fraction of the smallest radius
     max_equilibrium_steps : give up cycling to equilibrium after this many steps
         (the sample is returned with ``equilibrium_reached = False`` and a warning)
     max_stress_pa : stress bound (mean wall stress in equilibrium), Pa
@@ -329,6 +343,7 @@ def expand_to_porosity(
     if steps_per_increment < 1:
         raise ValueError(f"steps_per_increment: must be >= 1, got {steps_per_increment}")
     equilibrium_ratio = _positive("equilibrium_ratio", equilibrium_ratio)
+    stress_free_overlap = _positive("stress_free_overlap", stress_free_overlap)
     max_equilibrium_steps = int(max_equilibrium_steps)
     if max_equilibrium_steps < 0:
         raise ValueError(f"max_equilibrium_steps: must be >= 0, got {max_equilibrium_steps}")
@@ -392,8 +407,11 @@ def expand_to_porosity(
         bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}{postfix}",
     )
 
-    def relax(limit: int) -> tuple[bool, int]:
-        """Cycles at fixed radii until the unbalanced force ratio is below the threshold."""
+    r_min = float(final_radii.min())
+
+    def relax(limit: int) -> tuple[str, int]:
+        """Cycles at fixed radii until equilibrium (``"equilibrium"``), until the contacts
+        carry no load (``"stress-free"``), or for ``limit`` steps (``"unsettled"``)."""
         done = 0
         while done < limit:
             chunk = min(4 * steps_per_increment, limit - done)
@@ -403,17 +421,40 @@ def expand_to_porosity(
             ratio = sim.unbalanced_force_ratio
             bar.set_postfix_str(f"unbalanced {ratio:.1e}, stress {walls.mean_stress() / 1e3:.0f} kPa")
             if ratio < equilibrium_ratio:
-                return True, done
-        return False, done
+                return "equilibrium", done
+            energy = sim.energy
+            # rms overlap of the linear contacts from their elastic energy sum(kn delta^2 / 2)
+            n_contacts = sim.contact_count + sum(w.contact_count for w in walls.walls)
+            rms_overlap = math.sqrt(2.0 * max(energy["elastic"], 0.0) / (normal_stiffness * max(n_contacts, 1)))
+            if rms_overlap < stress_free_overlap * r_min:
+                return "stress-free", done
+            if energy["kinetic"] > energy["elastic"]:
+                # no load-bearing network: free disks feel no local damping and would fly
+                # for ever; stop them, and let the remaining contacts push apart
+                sim.velocities = np.zeros((sim.n_particles, 2))
+                sim.angular_velocities = np.zeros(sim.n_particles)
+        return "unsettled", done
 
-    def fail(stress: float, equilibrium: bool, cause: str) -> ExpansionError:
+    def fail(stress: float, equilibrium: bool, engine_error: Exception | None = None) -> ExpansionError:
         n_nom, n_cor = walls.porosities()
-        state = "in equilibrium" if equilibrium else "while growing"
+        reached = (
+            f"the densest packing reached has nominal porosity {n_nom:.4f} (overlap-corrected {n_cor:.4f})"
+        )
+        if engine_error is None:
+            state = "in equilibrium" if equilibrium else "while growing"
+            message = (
+                f"porosity: cannot reach nominal porosity {porosity:.4f} within max_stress_pa = "
+                f"{max_stress_pa / 1e6:.3g} MPa: {reached} and needed a mean wall stress of "
+                f"{stress / 1e6:.3g} MPa {state}. Raise max_stress_pa or aim for a higher porosity."
+            )
+        else:
+            message = (
+                f"porosity: cannot reach nominal porosity {porosity:.4f}: {reached}, at a mean wall "
+                f"stress of {stress / 1e6:.3g} MPa, when the engine stopped ({engine_error}). "
+                "Aim for a higher porosity or generate with less friction."
+            )
         return ExpansionError(
-            f"porosity: cannot reach nominal porosity {porosity:.4f} within max_stress_pa = "
-            f"{max_stress_pa / 1e6:.3g} MPa: the densest packing reached has nominal porosity {n_nom:.4f} "
-            f"(overlap-corrected {n_cor:.4f}) and needed a mean wall stress of {stress / 1e6:.3g} MPa "
-            f"{state}{cause}. Raise max_stress_pa or aim for a higher porosity.",
+            message,
             porosity=n_nom,
             porosity_overlap_corrected=n_cor,
             stress_pa=stress,
@@ -434,24 +475,25 @@ def expand_to_porosity(
             bar.n = int(ticks * (1.0 - math.log(1.0 / scale) / total_growth)) if total_growth > 0 else ticks
             bar.set_postfix_str(f"stress {stress / 1e3:.0f} kPa, Z {sim.coordination_number:.2f}")
             if stress > max_stress_pa:
-                settled, used = relax(max_equilibrium_steps)
+                status, used = relax(max_equilibrium_steps)
                 steps += used
                 stress = walls.mean_stress()
                 if stress > max_stress_pa:
-                    raise fail(stress, settled, "")
+                    raise fail(stress, status == "equilibrium")
         bar.n = ticks
         bar.set_description_str("equilibrium")
-        settled, used = relax(max_equilibrium_steps)
+        status, used = relax(max_equilibrium_steps)
         steps += used
     except grainlab.SimulationUnstableError as error:
         bar.close()
-        raise fail(walls.mean_stress(), False, f" (stopped by the engine: {error})") from error
+        raise fail(walls.mean_stress(), False, error) from error
     bar.close()
 
     wall_stresses = walls.wall_stresses()
     stress = float(wall_stresses.mean())
+    settled = status != "unsettled"
     if stress > max_stress_pa:
-        raise fail(stress, settled, "")
+        raise fail(stress, status == "equilibrium")
     ratio = sim.unbalanced_force_ratio
     if not settled:
         warnings.warn(
@@ -496,6 +538,7 @@ def expand_to_porosity(
         max_overlap_ratio=max_overlap,
         unbalanced_force_ratio=ratio,
         equilibrium_reached=settled,
+        jammed=status == "equilibrium" and len(contacts) > 0 and stress > 0.0,
         radius_factor=radius_factor,
         seed=seed,
         grading=grading.name,
