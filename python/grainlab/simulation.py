@@ -63,6 +63,8 @@ class ContactModel:
     friction: float = TABLE1_FRICTION
     normal_damping_ratio: float = 0.0
     shear_damping_ratio: float = 0.0
+    enabled: bool = True
+    """False: the two groups do not interact at all (they pass through each other)."""
 
 
 @dataclass(frozen=True)
@@ -576,6 +578,7 @@ class Simulation:
             float(model.friction),
             float(model.normal_damping_ratio),
             float(model.shear_damping_ratio),
+            bool(model.enabled),
         )
 
     def contact_model(self, group_a: int, group_b: int) -> ContactModel:

@@ -253,3 +253,14 @@ def test_added_particles_join_and_old_contacts_keep_their_history(dense_periodic
     np.testing.assert_array_equal(after.shear_force[old_rows], before.shear_force)
     assert sim.masses[-1] == pytest.approx(2e8 * np.pi * 1e-8)
     sim.run(10)
+
+
+def test_groups_that_do_not_interact_pass_through_each_other():
+    sim = Simulation([[0.0, 0.0], [1.5e-3, 0.0]], [1e-3, 1e-3], time_step=1e-5, threads=1)
+    sim.groups = [0, 2]
+    sim.set_contact_model(0, 2, ContactModel(enabled=False))
+    sim.velocities = [[0.1, 0.0], [-0.1, 0.0]]
+    sim.run(100)
+    assert len(sim.contacts()) == 0
+    np.testing.assert_allclose(sim.velocities, [[0.1, 0.0], [-0.1, 0.0]])
+    assert sim.contact_model(2, 0).enabled is False

@@ -21,6 +21,9 @@ pub struct ContactModel {
     pub normal_damping_ratio: f64,
     /// Shear viscous damping, fraction of critical `2 sqrt(m* ks)`.
     pub shear_damping_ratio: f64,
+    /// Whether the two groups interact at all; `false` lets them pass through
+    /// each other (e.g. the disks of a membrane chain, held together by bonds).
+    pub enabled: bool,
 }
 
 impl ContactModel {
@@ -32,6 +35,7 @@ impl ContactModel {
             friction,
             normal_damping_ratio: 0.0,
             shear_damping_ratio: 0.0,
+            enabled: true,
         }
     }
 
@@ -81,6 +85,12 @@ impl MaterialTable {
         self.models[a * MAX_GROUPS + b] = model;
         self.models[b * MAX_GROUPS + a] = model;
         Ok(())
+    }
+
+    /// Whether groups `a` and `b` interact.
+    #[inline(always)]
+    pub fn interacts(&self, a: u8, b: u8) -> bool {
+        self.models[Self::index(a, b) as usize].enabled
     }
 
     /// Index of the model between groups `a` and `b`, for [`MaterialTable::by_index`].

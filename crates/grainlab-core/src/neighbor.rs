@@ -221,6 +221,7 @@ impl NeighborList {
         cell: Option<&PeriodicCell>,
         walls: &[Wall],
         bonds: &mut Bonds,
+        materials: &MaterialTable,
         n_blocks: usize,
     ) -> Result<Vec<u32>> {
         let n = particles.len();
@@ -287,6 +288,7 @@ impl NeighborList {
         let mut per_block: Vec<Vec<(u32, u32, [i8; 2])>> = vec![Vec::new(); n_blocks + 1];
         let positions = &particles.position;
         let radii = &particles.radius;
+        let groups = &particles.group;
         let skin = self.skin;
         for bx in 0..grid.n[0] {
             for by in 0..grid.n[1] {
@@ -313,7 +315,10 @@ impl NeighborList {
                                 let j = pj as usize;
                                 let d = sub(add(positions[j], offset), xi);
                                 let reach = ri + radii[j] + skin;
-                                if dot(d, d) < reach * reach && !bonds.contains(pi, pj) {
+                                if dot(d, d) < reach * reach
+                                    && !bonds.contains(pi, pj)
+                                    && materials.interacts(groups[i], groups[j])
+                                {
                                     let (bi, bj) = (block_of(i), block_of(j));
                                     let slot = if bi == bj { bi as usize } else { n_blocks };
                                     per_block[slot].push((pi, pj, shift));
@@ -369,7 +374,7 @@ impl NeighborList {
         for (w, wall) in walls.iter().enumerate().filter(|(_, w)| w.active) {
             for p in 0..n {
                 let g = wall.disk_contact(positions[p], radii[p]);
-                if g.overlap > -skin {
+                if g.overlap > -skin && materials.interacts(wall.group, particles.group[p]) {
                     let (shear, sliding) = wall_history
                         .get(&(w as u32, p as u32))
                         .copied()

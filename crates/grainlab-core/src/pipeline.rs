@@ -557,6 +557,7 @@ impl Simulation {
             self.cell.as_ref(),
             &self.walls,
             &mut self.bonds,
+            &self.materials,
             self.threads,
         )?;
         for chain in self.chains.iter_mut() {

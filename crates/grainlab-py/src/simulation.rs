@@ -160,7 +160,7 @@ impl Engine {
         self.sim.set_skin(skin).map_err(to_py_err)
     }
 
-    #[pyo3(signature = (group_a, group_b, normal_stiffness, shear_stiffness, friction, normal_damping_ratio, shear_damping_ratio))]
+    #[pyo3(signature = (group_a, group_b, normal_stiffness, shear_stiffness, friction, normal_damping_ratio, shear_damping_ratio, enabled=true))]
     #[allow(clippy::too_many_arguments)]
     fn set_contact_model(
         &mut self,
@@ -171,6 +171,7 @@ impl Engine {
         friction: f64,
         normal_damping_ratio: f64,
         shear_damping_ratio: f64,
+        enabled: bool,
     ) -> PyResult<()> {
         let model = ContactModel {
             normal_stiffness,
@@ -178,6 +179,7 @@ impl Engine {
             friction,
             normal_damping_ratio,
             shear_damping_ratio,
+            enabled,
         };
         self.sim
             .set_contact_model(group_a, group_b, model)
@@ -202,6 +204,7 @@ impl Engine {
         d.set_item("friction", m.friction)?;
         d.set_item("normal_damping_ratio", m.normal_damping_ratio)?;
         d.set_item("shear_damping_ratio", m.shear_damping_ratio)?;
+        d.set_item("enabled", m.enabled)?;
         Ok(d)
     }
 

@@ -114,9 +114,11 @@ def install_membrane(
     )
     sim.set_contact_model(0, MEMBRANE_GROUP, membrane_grain)
     sim.set_contact_model(1, MEMBRANE_GROUP, ContactModel(grain_model.normal_stiffness, grain_model.shear_stiffness, 0.0))
-    # the membrane resists stretching through its bonds, not shortening: its disks
-    # push on one another (non-bonded neighbours) only through soft, frictionless contacts
-    sim.set_contact_model(MEMBRANE_GROUP, MEMBRANE_GROUP, ContactModel(bond_stiffness, bond_stiffness, 0.0))
+    # the membrane's disks do not touch one another: the chain holds together by its
+    # bonds and may wrinkle as the sample shortens, as a latex membrane does
+    sim.set_contact_model(
+        MEMBRANE_GROUP, MEMBRANE_GROUP, ContactModel(bond_stiffness, bond_stiffness, 0.0, enabled=False)
+    )
     fixity = sim.fixity.copy()
     ends = [left_ids[0], left_ids[-1], right_ids[0], right_ids[-1]]
     fixity[ends] |= FIX_Y
