@@ -421,8 +421,6 @@ def _consolidate(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bo
 
 def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
     start = time.perf_counter()
-    if config["boundary.kind"] != "membrane":
-        raise BiaxialError(f"boundary.kind {config['boundary.kind']!r} is not available yet; use 'membrane'")
     walls = run.walls
     left_x = float(sim.wall(walls["left"]).points[0, 0])
     right_x = float(sim.wall(walls["right"]).points[0, 0])

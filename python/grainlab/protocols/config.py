@@ -108,7 +108,7 @@ FIELDS: dict[str, Field] = {
     ),
     "consolidation.max_steps": Field("integer", 2_000_000, "give up consolidating after this many steps", minimum=1),
     "boundary.kind": Field(
-        "choice", "membrane", "flexible lateral boundary (DESIGN §3)", choices=("membrane", "outer_particles")
+        "choice", "membrane", "flexible lateral boundary (DESIGN §3, variant A)", choices=("membrane",)
     ),
     "boundary.membrane_diameter": Field("length", 0.5e-3, "diameter of the membrane disks", **_POSITIVE),
     "boundary.membrane_overlap": Field(
