@@ -131,3 +131,23 @@ def test_default_strain_rate_keeps_inertial_number_at_the_bound():
     eq16 = rate * 0.25e-3 * np.sqrt(2e8 / 1e5)
     assert eq16 <= 1e-3
     assert rate == pytest.approx(3.33e-3, rel=0.01)
+
+
+@pytest.mark.slow
+def test_outer_grain_boundary_variant(tmp_path):
+    out = tmp_path / "b"
+    config = resolve(overrides=["boundary.kind=outer_particles", "shear.final_strain=0.04"], quick=True)
+    result = biaxial.run_biaxial(config, out, progress=False)
+    results = read_results(out / "run.h5")
+    ts = results.timeseries
+    # the follower load on the outermost grains confines the sample: the grains'
+    # own average stress carries sigma_3 horizontally throughout
+    np.testing.assert_allclose(ts["love_weber_xx_pa"], 1e5, rtol=0.1)
+    assert result.summary["peak_stress_ratio"] > 2.0
+    assert result.summary["n_membrane_disks"] == 0
+    snap = results.snapshot(-1)
+    boundary = snap.kind == 2
+    assert boundary.sum() > 20
+    # the boundary grains are the outermost ones on each side
+    x = snap.positions[:, 0] - snap.radii
+    assert x[boundary].min() == pytest.approx(x.min())

@@ -47,8 +47,9 @@ from grainlab.analysis.stress import love_weber_stress
 from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, snapshot_name, write_checkpoint
 from grainlab.io.results import write_json_atomic, write_text_atomic
 from grainlab.protocols.boundary import (
-    MEMBRANE_GROUP,
+    GrainBoundary,
     Membrane,
+    install_grain_boundary,
     install_membrane,
     sample_area,
     set_platen_velocity,
@@ -195,11 +196,11 @@ def inertial_number(config: BiaxialConfig, rate: float, diameter: float) -> floa
 
 def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, float]:
     """One record of the shearing phase."""
-    membrane = Membrane.from_dict(run.membrane)
+    boundary = _boundary(run)
     shear = run.shear
-    bottom, top = sim.wall(membrane.bottom_wall), sim.wall(membrane.top_wall)
+    bottom, top = sim.wall(boundary.bottom_wall), sim.wall(boundary.top_wall)
     height = float(top.points[0, 1] - bottom.points[0, 1])
-    area = sample_area(sim, membrane)
+    area = _area(sim, boundary)
     width = area / height
     axial_force = 0.5 * (float(top.force[1]) - float(bottom.force[1]))
     sigma_1 = axial_force / width
@@ -211,18 +212,22 @@ def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, flo
     f_on_j = c.normal_force[:, None] * c.normal + c.shear_force[:, None] * np.column_stack(
         [-c.normal[:, 1], c.normal[:, 0]]
     )
-    # confining stress the grains feel: force of the grains on the membrane, per side, over the height
-    left = np.zeros(sim.n_particles, dtype=bool)
-    left[membrane.left] = True
-    right = np.zeros(sim.n_particles, dtype=bool)
-    right[membrane.right] = True
     grain_i, grain_j = c.i < n, c.j < n
-    on_membrane = np.zeros((len(c), 2))
-    on_membrane[grain_i & ~grain_j] = f_on_j[grain_i & ~grain_j]
-    on_membrane[~grain_i & grain_j] = -f_on_j[~grain_i & grain_j]
-    membrane_particle = np.where(grain_i, c.j, c.i)
-    felt_left = -on_membrane[left[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
-    felt_right = on_membrane[right[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
+    if isinstance(boundary, Membrane):
+        # confining stress the grains feel: force of the grains on the membrane, per side, over the height
+        left = np.zeros(sim.n_particles, dtype=bool)
+        left[boundary.left] = True
+        right = np.zeros(sim.n_particles, dtype=bool)
+        right[boundary.right] = True
+        on_membrane = np.zeros((len(c), 2))
+        on_membrane[grain_i & ~grain_j] = f_on_j[grain_i & ~grain_j]
+        on_membrane[~grain_i & grain_j] = -f_on_j[~grain_i & grain_j]
+        membrane_particle = np.where(grain_i, c.j, c.i)
+        felt_left = -on_membrane[left[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
+        felt_right = on_membrane[right[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
+    else:
+        # the follower loads act on the grains themselves: the pressure over the full height
+        felt_left = felt_right = boundary.pressure
     wall_force = w.normal_force[:, None] * w.normal + w.shear_force[:, None] * np.column_stack(
         [-w.normal[:, 1], w.normal[:, 0]]
     )
@@ -289,9 +294,21 @@ def _fabric(sim: Simulation, run: _Run) -> dict[str, float]:
     }
 
 
+def _boundary(run: _Run) -> Membrane | GrainBoundary:
+    if run.membrane.get("kind") == GrainBoundary.kind:
+        return GrainBoundary.from_dict(run.membrane)
+    return Membrane.from_dict(run.membrane)
+
+
+def _area(sim: Simulation, boundary: Membrane | GrainBoundary) -> float:
+    return sample_area(sim, boundary) if isinstance(boundary, Membrane) else boundary.area(sim)
+
+
 def _snapshot(sim: Simulation, run: _Run, strain: float):
     kind = np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8)
     kind[run.n_grains :] = int(ParticleKind.MEMBRANE)
+    if run.membrane is not None and run.membrane.get("kind") == GrainBoundary.kind:
+        kind[run.membrane["left"] + run.membrane["right"]] = int(ParticleKind.BOUNDARY)
     snap = sim.snapshot(axial_strain=strain, step=sim.step_count)
     return type(snap)(
         snap.positions,
@@ -435,48 +452,71 @@ def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progres
     top = sim.add_segment_wall((reach[1], y_top), (reach[0], y_top))
     walls["bottom"], walls["top"] = bottom.id, top.id
     sim.set_contact_model(0, 0, _grain_model(config))  # Table 1 friction from here on
-    membrane = install_membrane(
-        sim,
-        left_x=left_x,
-        right_x=right_x,
-        bottom=bottom,
-        top=top,
-        diameter=config["boundary.membrane_diameter"],
-        overlap=config["boundary.membrane_overlap"],
-        bond_stiffness=config["boundary.membrane_stiffness"],
-        friction=config["boundary.membrane_friction"],
-        grain_model=_grain_model(config),
-        density=config["material.density"],
-        pressure=config["consolidation.pressure"],
-    )
-    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+    sim.set_contact_model(0, 1, _platen_model(config))
     limit = config["consolidation.unbalanced_force_ratio"]
     steps = 0
-    while True:
-        sim.run(CHUNK_STEPS)
-        steps += CHUNK_STEPS
-        if sim.unbalanced_force_ratio < limit or steps >= config["consolidation.max_steps"]:
-            break
-    run.membrane = membrane.to_dict()
+    if config["boundary.kind"] == "membrane":
+        membrane = install_membrane(
+            sim,
+            left_x=left_x,
+            right_x=right_x,
+            bottom=bottom,
+            top=top,
+            diameter=config["boundary.membrane_diameter"],
+            overlap=config["boundary.membrane_overlap"],
+            bond_stiffness=config["boundary.membrane_stiffness"],
+            friction=config["boundary.membrane_friction"],
+            grain_model=_grain_model(config),
+            density=config["material.density"],
+            pressure=config["consolidation.pressure"],
+        )
+        run.consolidation["membrane_disks"] = len(membrane.left) + len(membrane.right)
+        run.membrane = membrane.to_dict()
+        sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+        while True:
+            sim.run(CHUNK_STEPS)
+            steps += CHUNK_STEPS
+            if sim.unbalanced_force_ratio < limit or steps >= config["consolidation.max_steps"]:
+                break
+    else:
+        radii = sim.radii[: run.n_grains]
+        grains = install_grain_boundary(
+            sim,
+            n_grains=run.n_grains,
+            bottom=bottom,
+            top=top,
+            pressure=config["consolidation.pressure"],
+            bin_height=float(2 * radii.mean()),
+        )
+        while True:
+            sim.run(CHUNK_STEPS)
+            steps += CHUNK_STEPS
+            grains = grains.identify(sim)
+            if sim.unbalanced_force_ratio < limit or steps >= config["consolidation.max_steps"]:
+                break
+        run.membrane = grains.to_dict()
     run.consolidation["boundary_steps"] = steps
-    run.consolidation["membrane_disks"] = len(membrane.left) + len(membrane.right)
     run.wall_time["boundary"] = time.perf_counter() - start
     run.phase = "shear"
 
 
 def _start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
-    membrane = Membrane.from_dict(run.membrane)
+    boundary = _boundary(run)
     grains = np.arange(run.n_grains)
     radii = sim.radii[grains]
     rate = config["shear.strain_rate"]
     max_d = float(2 * radii.max())
     if rate == "auto":
         rate = default_strain_rate(config, max_d, float(radii.min()))
-    bottom, top = sim.wall(membrane.bottom_wall), sim.wall(membrane.top_wall)
+    bottom, top = sim.wall(boundary.bottom_wall), sim.wall(boundary.top_wall)
     height0 = float(top.points[0, 1] - bottom.points[0, 1])
-    area0 = sample_area(sim, membrane)
+    area0 = _area(sim, boundary)
     speed = 0.5 * rate * height0
-    set_platen_velocity(sim, membrane, speed)
+    if isinstance(boundary, Membrane):
+        set_platen_velocity(sim, boundary, speed)
+    else:
+        bottom.velocity = (0.0, speed)
+        top.velocity = (0.0, -speed)
     dt = sim.time_step
     steps_per_strain = 1.0 / (rate * dt)
     final = config["shear.final_strain"]
@@ -547,6 +587,8 @@ def _shear(
                 "coordination_number": record["coordination_number"],
                 "volumetric_strain": record["volumetric_strain"],
             }
+        if run.membrane.get("kind") == GrainBoundary.kind:
+            run.membrane = GrainBoundary.from_dict(run.membrane).identify(sim).to_dict()
         shear["next"] += 1
         bar.update(100 * record["axial_strain"] - done_strain)
         done_strain = 100 * record["axial_strain"]

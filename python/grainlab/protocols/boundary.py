@@ -174,3 +174,108 @@ def sample_area(sim: Simulation, membrane: Membrane) -> float:
         float(np.sum(np.linalg.norm(np.diff(x[chain], axis=0), axis=1))) for chain in (membrane.left, membrane.right)
     )
     return shoelace_area(polygon) - membrane.radius * length
+
+
+# ---- variant B: the sample's own outermost grains -----------------------------
+
+
+def outer_grains(
+    positions: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    grains: NDArray[np.int64],
+    y0: float,
+    y1: float,
+    side: str,
+    bin_height: float,
+) -> list[int]:
+    """The outermost grain of each horizontal slice ``bin_height`` high between
+    ``y0`` and ``y1``: smallest ``x - r`` on the ``"left"``, largest ``x + r`` on
+    the ``"right"``. Ordered clockwise around the sample (left: bottom to top,
+    right: top to bottom), each grain once."""
+    x = positions[grains]
+    r = radii[grains]
+    n_bins = max(int(np.ceil((y1 - y0) / bin_height)), 1)
+    bins = np.clip(((x[:, 1] - y0) / (y1 - y0) * n_bins).astype(np.int64), 0, n_bins - 1)
+    edge = x[:, 0] - r if side == "left" else -(x[:, 0] + r)
+    order = np.lexsort((edge, bins))  # by bin, then most outward first
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = bins[order][1:] != bins[order][:-1]
+    chosen = grains[order[first]]  # one per occupied bin, bottom to top
+    if side == "right":
+        chosen = chosen[::-1]
+    _, keep = np.unique(chosen, return_index=True)
+    return [int(g) for g in chosen[np.sort(keep)]]
+
+
+@dataclass(frozen=True)
+class GrainBoundary:
+    """Variant B: the confining pressure acts on the sample's outermost grains,
+    re-identified as the boundary changes (Kuhn 1995; Cheung & O'Sullivan 2008)."""
+
+    chains: tuple[int, int]
+    bottom_wall: int
+    top_wall: int
+    n_grains: int
+    bin_height: float
+    pressure: float
+    left: list[int]
+    right: list[int]
+
+    kind = "outer_particles"
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["kind"] = self.kind
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> GrainBoundary:
+        return cls(
+            chains=(int(d["chains"][0]), int(d["chains"][1])),
+            bottom_wall=int(d["bottom_wall"]),
+            top_wall=int(d["top_wall"]),
+            n_grains=int(d["n_grains"]),
+            bin_height=float(d["bin_height"]),
+            pressure=float(d["pressure"]),
+            left=list(d["left"]),
+            right=list(d["right"]),
+        )
+
+    def identify(self, sim: Simulation) -> GrainBoundary:
+        """Re-identifies the outermost grains and moves the follower loads onto them."""
+        grains = np.arange(self.n_grains)
+        y0 = float(sim.wall(self.bottom_wall).points[0, 1])
+        y1 = float(sim.wall(self.top_wall).points[0, 1])
+        x, r = sim.positions, sim.radii
+        left = outer_grains(x, r, grains, y0, y1, "left", self.bin_height)
+        right = outer_grains(x, r, grains, y0, y1, "right", self.bin_height)
+        sim.set_pressure_chain(self.chains[0], left, self.pressure, start_wall=self.bottom_wall, end_wall=self.top_wall)
+        sim.set_pressure_chain(self.chains[1], right, self.pressure, start_wall=self.top_wall, end_wall=self.bottom_wall)
+        return GrainBoundary(
+            self.chains, self.bottom_wall, self.top_wall, self.n_grains, self.bin_height, self.pressure, left, right
+        )
+
+    def polygon(self, sim: Simulation) -> NDArray[np.float64]:
+        """Clockwise polygon through the chains' outer edges and their anchors on the platens."""
+        x, r = sim.positions, sim.radii
+        y_bottom = float(sim.wall(self.bottom_wall).points[0, 1])
+        y_top = float(sim.wall(self.top_wall).points[0, 1])
+        left = x[self.left] - np.column_stack([r[self.left], np.zeros(len(self.left))])
+        right = x[self.right] + np.column_stack([r[self.right], np.zeros(len(self.right))])
+        return np.vstack(
+            [[[left[0, 0], y_bottom]], left, [[left[-1, 0], y_top]], [[right[0, 0], y_top]], right, [[right[-1, 0], y_bottom]]]
+        )
+
+    def area(self, sim: Simulation) -> float:
+        return shoelace_area(self.polygon(sim))
+
+
+def install_grain_boundary(
+    sim: Simulation, *, n_grains: int, bottom: Wall, top: Wall, pressure: float, bin_height: float
+) -> GrainBoundary:
+    """Variant B: pressure chains on the outermost grains of each side."""
+    placeholder = [0]
+    left = sim.add_pressure_chain(placeholder, pressure, start_wall=bottom, end_wall=top)
+    right = sim.add_pressure_chain(placeholder, pressure, start_wall=top, end_wall=bottom)
+    boundary = GrainBoundary((left, right), bottom.id, top.id, n_grains, bin_height, pressure, [], [])
+    return boundary.identify(sim)

@@ -108,7 +108,9 @@ FIELDS: dict[str, Field] = {
     ),
     "consolidation.max_steps": Field("integer", 2_000_000, "give up consolidating after this many steps", minimum=1),
     "boundary.kind": Field(
-        "choice", "membrane", "flexible lateral boundary (DESIGN §3, variant A)", choices=("membrane",)
+        "choice", "membrane",
+        "flexible lateral boundary (DESIGN §3): a bonded membrane (A) or the outermost grains (B)",
+        choices=("membrane", "outer_particles"),
     ),
     "boundary.membrane_diameter": Field("length", 0.5e-3, "diameter of the membrane disks", **_POSITIVE),
     "boundary.membrane_overlap": Field(
