@@ -15,11 +15,11 @@ use std::sync::{Mutex, OnceLock};
 use std::thread::Thread;
 use std::time::{Duration, Instant};
 
-/// How long a waiting thread spins before it parks. About one phase: spinning
-/// keeps the hand-over fast, parking frees the core when the machine is shared
-/// (a spinning waiter could otherwise keep the very thread it waits for off
-/// the CPU for a whole scheduler time slice).
-const SPIN_BEFORE_PARK: Duration = Duration::from_micros(50);
+/// How long a waiting thread spins before it parks: many phases. Spinning
+/// keeps the hand-over fast (a wake-up costs as much as a phase); parking after
+/// a long wait (a serial rebuild, a descheduled worker) frees the core, so a
+/// spinning waiter cannot keep the thread it waits for off the CPU for long.
+const SPIN_BEFORE_PARK: Duration = Duration::from_millis(2);
 
 type Job = dyn Fn(usize) + Sync;
 
