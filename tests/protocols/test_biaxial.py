@@ -53,6 +53,9 @@ def test_results_folder_holds_everything(quick_run):
     for name in ("run.h5", "timeseries.csv", "summary.json", "fig08_stress_ratio.png", "fig08_stress_ratio.svg",
                  "fig10_volumetric_strain.png", "fig18_coordination_number.svg"):
         assert name in names
+    # the paper's fabric figures from the snapshots
+    for number in ("06", "07", "09", "11", "12", "13", "14"):
+        assert any(n.startswith(f"fig{number}_") and n.endswith(".png") for n in names), number
     assert "checkpoint.h5" not in names and "run.h5.partial" not in names
     summary = json.loads((quick_run / "summary.json").read_text())
     for key in ("n_particles", "porosity_initial", "coordination_number_initial", "peak_stress_ratio",
@@ -60,8 +63,11 @@ def test_results_folder_holds_everything(quick_run):
         assert summary[key] is not None, key
     with open(quick_run / "timeseries.csv") as f:
         rows = list(csv.DictReader(f))
-    for column in ("axial_strain", "stress_ratio", "volumetric_strain", "coordination_number"):
+    for column in ("axial_strain", "stress_ratio", "volumetric_strain", "coordination_number", "anisotropy",
+                   "force_anisotropy", "mean_stability_index"):
         assert column in rows[0]
+    assert 0 < float(rows[0]["mean_stability_index"]) < 1
+    assert summary["fabric"]["states"]["initial"]["a"] < summary["fabric"]["a_at_peak"]
     results = read_results(quick_run / "run.h5")
     assert results.status == "complete"
     assert results.snapshot_names == [f"strain_{s:.4f}" for s in (0, 0.005, 0.007, 0.009, 0.015, 0.10)]

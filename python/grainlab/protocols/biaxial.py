@@ -737,7 +737,11 @@ def run_biaxial(
     writer.write_phases(run.wall_time)
     writer.finalize()
     write_text_atomic(out / "timeseries.csv", _csv(timeseries))
-    write_json_atomic(out / "summary.json", summary)
     _figures(timeseries, out)
+    # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
+    from grainlab.analysis.biaxial_figures import fabric_figures
+
+    summary["fabric"] = fabric_figures(out).numbers.summary()
+    write_json_atomic(out / "summary.json", summary)
     checkpoint_path.unlink(missing_ok=True)
     return BiaxialResult(out, summary)
