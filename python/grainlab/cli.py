@@ -20,6 +20,8 @@ COMMAND_MODULES: tuple[str, ...] = (
     "grainlab.commands.biaxial",
     "grainlab.commands.analyze",
     "grainlab.commands.demo",
+    "grainlab.commands.study",
+    "grainlab.commands.sweep",
 )
 
 

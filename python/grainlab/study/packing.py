@@ -1,0 +1,276 @@
+"""One packing of the paper's Sec. 7 study, made and measured.
+
+Two kinds (Tables 2 and 3):
+
+- ``irregular``: radius expansion (:func:`grainlab.samples.expand_to_porosity`)
+  to a target *nominal* porosity inside the rigid box, Table 1/2 contact
+  properties, diameters 0.5-3 mm (radii 0.25-1.5 mm); the packing is the
+  equilibrium state at the target. Generation is frictionless (the library's
+  and the biaxial protocol's default); switching Table 2's mu = 0.9 on at rest
+  changes nothing (shear springs start at zero and the packing is already in
+  equilibrium), so it is not cycled again.
+- ``hexagonal``: equal disks (Table 3's 0.875 mm read as a radius: 1.75 mm
+  diameter) on a hexagonal lattice in a periodic cell of the box's size:
+  random vacancies above the contact porosity 0.0931, uniform compression
+  below it. Both are static: a compressed full lattice is in equilibrium by
+  symmetry, a lattice at contact carries no load. Contacts come from the
+  geometry (touching within 1e-9 d), normal forces from the linear law
+  ``kn * overlap``.
+
+:func:`run_packing` returns a flat dict of measures (:data:`MEASURES`) plus
+``status`` and ``note``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from grainlab.analysis import ContactAnisotropy, CoordinationNumber, StabilityIndex
+from grainlab.snapshot import Snapshot
+
+#: The measured columns of one packing, in table order.
+MEASURES: tuple[str, ...] = (
+    "porosity",
+    "porosity_overlap_corrected",
+    "coordination_number",
+    "mechanical_coordination_number",
+    "mean_stability_index",
+    "anisotropy",
+    "anisotropy_fourier",
+    "force_anisotropy",
+    "n_particles",
+    "mean_wall_stress_pa",
+)
+
+#: Statuses a packing row can have.
+STATUSES = ("ok", "unjammed", "densest_reached", "failed")
+
+
+@dataclass(frozen=True)
+class PackingParams:
+    """Parameters of one packing run (SI units; defaults: the paper's Tables 2-3)."""
+
+    kind: str = "irregular"
+    """``"irregular"`` (radius expansion) or ``"hexagonal"`` (lattice)."""
+    porosity: float = 0.12
+    """Target nominal porosity, in (0, 1)."""
+    width: float = 0.075
+    height: float = 0.150
+    d_min: float = 0.5e-3
+    """Smallest diameter of the irregular packings (Table 2: 0.5 mm)."""
+    d_max: float = 3.0e-3
+    diameter: float = 1.75e-3
+    """Diameter of the hexagonal packings' disks (Table 3's 0.875 mm read as a radius)."""
+    generation_friction: float = 0.0
+    """Particle friction during the radius expansion."""
+    friction: float = 0.9
+    """Table 2's mu (recorded; see the module docstring)."""
+    platen_friction: float = 0.0
+    normal_stiffness: float = 8.45e7
+    shear_stiffness: float = 8.45e7
+    density: float = 2.0e8
+    local_damping: float = 0.8
+    max_stress: float = 5.0e6
+    """Stress bound of the radius expansion, Pa (the samples library default)."""
+    lattice_boundary: str = "periodic"
+    """Hexagonal packings: ``"periodic"`` or ``"walls"``."""
+    threads: int = 1
+    seed: int = 0
+
+    def validate(self) -> PackingParams:
+        """Checks every field; raises ``ValueError`` naming it."""
+        if self.kind not in ("irregular", "hexagonal"):
+            raise ValueError(f"kind: expected 'irregular' or 'hexagonal', got {self.kind!r}")
+        if self.lattice_boundary not in ("periodic", "walls"):
+            raise ValueError(f"lattice_boundary: expected 'periodic' or 'walls', got {self.lattice_boundary!r}")
+        for name in ("porosity",):
+            value = getattr(self, name)
+            if not (0.0 < value < 1.0):
+                raise ValueError(f"{name}: expected a number in (0, 1), got {value!r}")
+        for name in ("width", "height", "d_min", "d_max", "diameter", "normal_stiffness", "shear_stiffness",
+                     "density", "max_stress"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name}: expected a number > 0, got {value!r}")
+        for name in ("generation_friction", "friction", "platen_friction"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name}: expected a number >= 0, got {value!r}")
+        if not (0.0 <= self.local_damping < 1.0):
+            raise ValueError(f"local_damping: expected a number in [0, 1), got {self.local_damping!r}")
+        if self.d_min > self.d_max:
+            raise ValueError(f"d_min: {self.d_min:g} m exceeds d_max {self.d_max:g} m")
+        if int(self.threads) != self.threads or self.threads < 1:
+            raise ValueError(f"threads: expected an integer >= 1, got {self.threads!r}")
+        if int(self.seed) != self.seed or self.seed < 0:
+            raise ValueError(f"seed: expected an integer >= 0, got {self.seed!r}")
+        return self
+
+    @classmethod
+    def from_mapping(cls, values: Mapping[str, Any]) -> PackingParams:
+        """From a plain mapping; an unknown key raises ``ValueError`` naming it."""
+        known = {f.name: f for f in fields(cls)}
+        kwargs: dict[str, Any] = {}
+        for key, value in values.items():
+            if key not in known:
+                raise ValueError(f"unknown packing parameter {key!r}; known: {', '.join(known)}")
+            default = getattr(cls, key)
+            if isinstance(default, str):
+                if not isinstance(value, str):
+                    raise ValueError(f"{key}: expected a string, got {value!r}")
+            elif isinstance(default, int) and not isinstance(default, bool):
+                if isinstance(value, bool) or not isinstance(value, int | float) or int(value) != value:
+                    raise ValueError(f"{key}: expected an integer, got {value!r}")
+                value = int(value)
+            else:
+                if isinstance(value, bool) or not isinstance(value, int | float):
+                    raise ValueError(f"{key}: expected a number, got {value!r}")
+                value = float(value)
+            kwargs[key] = value
+        return cls(**kwargs).validate()
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def measure(snapshot: Snapshot) -> dict[str, float]:
+    """Z, Z_m, mean lambda, anisotropies of a snapshot (library defaults: boundary
+    contacts excluded from Z and the anisotropies, included in lambda)."""
+    z = CoordinationNumber().compute(snapshot)
+    normals = ContactAnisotropy().compute(snapshot)
+    out = {
+        "coordination_number": z.coordination_number,
+        "mechanical_coordination_number": z.mechanical_coordination_number,
+        "mean_stability_index": StabilityIndex().compute(snapshot).mean,
+        "anisotropy": normals.anisotropy,
+        "anisotropy_fourier": normals.anisotropy_fourier,
+        "force_anisotropy": float("nan"),
+    }
+    if snapshot.normal_force is not None and float(np.sum(snapshot.normal_force)) > 0.0:
+        out["force_anisotropy"] = ContactAnisotropy(weight="normal_force").compute(snapshot).anisotropy
+    return {k: float(v) for k, v in out.items()}
+
+
+def _irregular(p: PackingParams) -> dict[str, Any]:
+    from grainlab.samples import ExpansionError, UniformByNumber, expand_to_porosity
+
+    box = (0.0, 0.0, p.width, p.height)
+    grading = UniformByNumber(p.d_min, p.d_max)
+    common = dict(
+        seed=p.seed,
+        friction=p.generation_friction,
+        wall_friction=p.platen_friction,
+        normal_stiffness=p.normal_stiffness,
+        shear_stiffness=p.shear_stiffness,
+        density=p.density,
+        local_damping=p.local_damping,
+        max_stress_pa=p.max_stress,
+        threads=p.threads,
+        progress=False,
+        keep_simulation=True,
+    )
+    status, note = "ok", ""
+    try:
+        sample = expand_to_porosity(box, p.porosity, grading, **common)
+    except ExpansionError as error:
+        # the densest packing the bound allows: aim just above where this expansion stopped
+        fallback = math.ceil(error.porosity * 1000.0) / 1000.0 + 0.001
+        sample = expand_to_porosity(box, fallback, grading, **common)
+        status = "densest_reached"
+        note = (
+            f"target {p.porosity:.4f} not reached within the stress bound {p.max_stress / 1e6:.3g} MPa "
+            f"({error}); measured instead the packing expanded to {fallback:.4f}, just above the densest "
+            f"one reached ({error.porosity:.4f})"
+        )
+    sim = sample.simulation
+    snap = sim.snapshot()
+    result = measure(snap)
+    if not sample.jammed:
+        status = "unjammed" if status == "ok" else status
+        note = (note + "; " if note else "") + (
+            f"stress-free at nominal porosity {sample.porosity:.4f}: the frictionless radius expansion "
+            f"jams denser than this in this box, so the disks do not fill it under load "
+            f"(mean wall stress {sample.mean_wall_stress_pa:.3g} Pa); contacts are the near-touching ones "
+            "left at rest"
+        )
+    elif status == "ok":
+        note = (
+            f"equilibrium after radius expansion, locked-in mean wall stress "
+            f"{sample.mean_wall_stress_pa / 1e3:.0f} kPa, {sample.steps} DEM steps"
+        )
+    result.update(
+        porosity=sample.porosity,
+        porosity_overlap_corrected=sample.porosity_overlap_corrected,
+        n_particles=float(len(sample.radii)),
+        mean_wall_stress_pa=sample.mean_wall_stress_pa,
+    )
+    return {**result, "status": status, "note": note}
+
+
+def _hexagonal(p: PackingParams) -> dict[str, Any]:
+    from grainlab.samples import hexagonal_lattice
+
+    lattice = hexagonal_lattice(
+        p.diameter, p.porosity, box=(0.0, 0.0, p.width, p.height), boundary=p.lattice_boundary, rng=p.seed
+    )
+    x0, y0, x1, y1 = lattice.box
+    periodic = lattice.boundary == "periodic"
+    tol = 1e-9 * p.diameter
+    snap = Snapshot.from_geometry(
+        lattice.positions,
+        lattice.radii,
+        tolerance=tol,
+        box=[[x0, x1], [y0, y1]],
+        periodic=(periodic, periodic),
+    )
+    i, j = np.asarray(snap.contact_i), np.asarray(snap.contact_j)
+    d = snap.minimum_image(lattice.positions[j] - lattice.positions[i])
+    dist = np.hypot(d[:, 0], d[:, 1])
+    overlap = np.maximum(lattice.radii[i] + lattice.radii[j] - dist, 0.0)
+    normal = d / dist[:, None]
+    if not periodic:
+        # walls as contacts: a disk touching a box side (within tol)
+        walls_i, walls_id, walls_n, walls_ov = [], [], [], []
+        pos, r = lattice.positions, lattice.radii
+        for wid, (axis, side, sign) in enumerate(((1, y0, -1), (0, x1, 1), (1, y1, 1), (0, x0, -1))):
+            gap = sign * (side - pos[:, axis]) - r
+            hit = np.flatnonzero(gap < tol)
+            n = np.zeros((hit.size, 2))
+            n[:, axis] = sign
+            walls_i.append(hit)
+            walls_id.append(np.full(hit.size, -1 - wid))
+            walls_n.append(n)
+            walls_ov.append(np.maximum(-gap[hit], 0.0))
+        i = np.concatenate([i, *walls_i])
+        j = np.concatenate([j, *walls_id])
+        normal = np.concatenate([normal, *walls_n])
+        overlap = np.concatenate([overlap, *walls_ov])
+    overlap = np.where(overlap > tol, overlap, 0.0)  # touching lattice neighbours: round-off, no load
+    snap = snap.with_contacts(i, j, contact_normal=normal, normal_force=p.normal_stiffness * overlap)
+    result = measure(snap)
+    result.update(
+        porosity=lattice.porosity,
+        porosity_overlap_corrected=lattice.porosity_overlap_corrected,
+        n_particles=float(lattice.n_particles),
+        mean_wall_stress_pa=float("nan"),
+    )
+    note = lattice.note
+    if not overlap.any():
+        note += "; the lattice at contact carries no load, so the force anisotropy is undefined (NaN)"
+    return {**result, "status": "ok", "note": note}
+
+
+def run_packing(params: PackingParams | Mapping[str, Any]) -> dict[str, Any]:
+    """Makes and measures one packing; returns :data:`MEASURES` + ``status``, ``note``, ``wall_time_s``."""
+    p = params if isinstance(params, PackingParams) else PackingParams.from_mapping(params)
+    p.validate()
+    started = time.perf_counter()
+    result = _irregular(p) if p.kind == "irregular" else _hexagonal(p)
+    result["wall_time_s"] = time.perf_counter() - started
+    return result

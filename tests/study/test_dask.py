@@ -1,0 +1,41 @@
+"""A small sweep through a real dask.distributed.LocalCluster."""
+
+import pytest
+
+distributed = pytest.importorskip("dask.distributed")
+
+from grainlab.study import read_table, run_sweep  # noqa: E402
+
+PLAN = """
+base = "packing"
+mode = "zip"
+seed = 1
+[fixed]
+width = 0.02
+height = 0.04
+[vary]
+kind = ["hexagonal", "irregular", "irregular"]
+porosity = [0.12, 0.18, 2.0]
+"""
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")
+@pytest.mark.filterwarnings("ignore::ResourceWarning")
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_sweep_on_local_cluster(tmp_path):
+    from grainlab.study.plan import parse_plan
+
+    with pytest.raises(ValueError, match="vary.porosity"):
+        parse_plan(PLAN)  # the out-of-range value is caught before anything runs
+    plan = parse_plan(PLAN.replace("2.0]", "0.2]"))
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        result = run_sweep(plan, tmp_path, scheduler=cluster.scheduler_address, progress=False)
+        assert result.failed == []
+        rows = read_table(tmp_path / "sweep.csv")
+        assert [r["name"] for r in rows] == ["run_0000", "run_0001", "run_0002"]
+        assert [r["kind"] for r in rows] == ["hexagonal", "irregular", "irregular"]
+        assert all((tmp_path / "runs" / r["name"] / "result.json").exists() for r in rows)
+        # resumed on the cluster: nothing left to do
+        again = run_sweep(plan, tmp_path, scheduler=cluster.scheduler_address, progress=False)
+        assert sorted(again.skipped) == ["run_0000", "run_0001", "run_0002"] and again.executed == []
