@@ -23,15 +23,15 @@ from grainlab.study.paper import (
 from grainlab.study.plan import Plan, PlanError, load_plan, parse_plan, run_sweep
 
 __all__ = [
-    "CampaignResult",
     "HEXAGONAL_POROSITIES",
     "IRREGULAR_POROSITIES",
     "MEASURES",
+    "STUDY_COLUMNS",
+    "CampaignResult",
     "PackingParams",
     "Plan",
     "PlanError",
     "Run",
-    "STUDY_COLUMNS",
     "derive_seed",
     "execute_run",
     "load_plan",

@@ -69,12 +69,12 @@ def _series(rows: Sequence[Mapping[str, Any]], kind: str, x: str, y: str) -> tup
 def linear_fit(x: np.ndarray, y: np.ndarray) -> dict[str, float]:
     """Least-squares ``y = slope x + intercept`` and its R^2 (NaN with fewer than 3 points)."""
     if len(x) < 3 or np.ptp(x) == 0:
-        return {"slope": float("nan"), "intercept": float("nan"), "r2": float("nan"), "n": int(len(x))}
+        return {"slope": float("nan"), "intercept": float("nan"), "r2": float("nan"), "n": len(x)}
     slope, intercept = np.polyfit(x, y, 1)
     resid = y - (slope * x + intercept)
     ss_tot = float(np.sum((y - y.mean()) ** 2))
     r2 = 1.0 - float(np.sum(resid**2)) / ss_tot if ss_tot > 0 else float("nan")
-    return {"slope": float(slope), "intercept": float(intercept), "r2": r2, "n": int(len(x))}
+    return {"slope": float(slope), "intercept": float(intercept), "r2": r2, "n": len(x)}
 
 
 _STYLE = {"irregular": dict(marker="o", color="tab:blue", label="irregular"),
@@ -127,6 +127,14 @@ def trends(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
         fit = linear_fit(z, lam)
         out[f"{kind}_lambda_vs_z_slope"] = fit["slope"]
         out[f"{kind}_lambda_vs_z_r2"] = fit["r2"]
+    for x_key in ("anisotropy", "anisotropy_fourier"):
+        for kind in ("irregular", "hexagonal"):
+            x, lam = _series(rows, kind, x_key, "mean_stability_index")
+            out[f"{kind}_lambda_vs_{x_key}_r2"] = linear_fit(x, lam)["r2"]
+        xs = [_series(rows, kind, x_key, "mean_stability_index") for kind in ("irregular", "hexagonal")]
+        fit = linear_fit(np.concatenate([x for x, _ in xs]), np.concatenate([y for _, y in xs]))
+        out[f"all_lambda_vs_{x_key}_slope"] = fit["slope"]
+        out[f"all_lambda_vs_{x_key}_r2"] = fit["r2"]
     zi, li = _series(rows, "irregular", "coordination_number", "mean_stability_index")
     zh, lh = _series(rows, "hexagonal", "coordination_number", "mean_stability_index")
     if len(zi) >= 2 and len(zh):
