@@ -244,8 +244,8 @@ def run_campaign(
         rows[run.name] = row
         if row.get("status") == "failed":
             failed.append(run.name)
+        bar.set_postfix_str(f"failed {len(failed)}, skipped {len(skipped)}", refresh=False)
         bar.update(1)
-        bar.set_postfix_str(f"failed {len(failed)}, skipped {len(skipped)}")
         # the table so far, so an interrupted campaign leaves a consistent one
         write_table(out / table_name, [rows[r.name] for r in runs if r.name in rows], columns)
 
