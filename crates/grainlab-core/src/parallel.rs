@@ -15,11 +15,13 @@ use std::sync::{Mutex, OnceLock};
 use std::thread::Thread;
 use std::time::{Duration, Instant};
 
-/// How long a waiting thread spins before it parks: many phases. Spinning
-/// keeps the hand-over fast (a wake-up costs as much as a phase); parking after
-/// a long wait (a serial rebuild, a descheduled worker) frees the core, so a
-/// spinning waiter cannot keep the thread it waits for off the CPU for long.
-const SPIN_BEFORE_PARK: Duration = Duration::from_millis(2);
+/// A waiting thread spins for `SPIN` (the hand-over of a phase is then a
+/// cache-line transfer), then yields its core between checks until `YIELD`
+/// (on a shared machine the thread it waits for may need that core), then
+/// parks until woken. A wake-up from a park costs as much as a phase, so the
+/// first two stages cover the ordinary waits of a step.
+const SPIN: Duration = Duration::from_micros(20);
+const YIELD: Duration = Duration::from_millis(2);
 
 type Job = dyn Fn(usize) + Sync;
 
@@ -120,16 +122,26 @@ impl Team {
     }
 }
 
-/// Spins on `ready` for a while, then parks between checks (an `unpark` from
-/// the thread that makes it true, or a short timeout, ends each park).
+/// Waits for `ready`: spins, then yields, then parks between checks (an
+/// `unpark` from the thread that makes it true, or a short timeout, ends each park).
 #[inline]
 fn wait_until(mut ready: impl FnMut() -> bool) {
+    if ready() {
+        return;
+    }
     let start = Instant::now();
     let mut spins = 0u32;
     while !ready() {
         spins += 1;
-        if spins % 64 != 0 || start.elapsed() < SPIN_BEFORE_PARK {
+        if spins % 64 != 0 {
             std::hint::spin_loop();
+            continue;
+        }
+        let waited = start.elapsed();
+        if waited < SPIN {
+            std::hint::spin_loop();
+        } else if waited < YIELD {
+            std::thread::yield_now();
         } else {
             std::thread::park_timeout(Duration::from_micros(200));
         }
