@@ -214,6 +214,7 @@ impl NeighborList {
     /// `order` maps internal to external (user) indices and is permuted along,
     /// as are the bonds and the old lists' indices. Returns the renumbering
     /// `new_of_old[old] = new` for the caller's other per-particle references.
+    #[allow(clippy::too_many_arguments)]
     pub fn build(
         &mut self,
         particles: &mut Particles,

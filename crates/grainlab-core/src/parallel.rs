@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 /// (on a shared machine the thread it waits for may need that core), then
 /// parks until woken. A wake-up from a park costs as much as a phase, so the
 /// first two stages cover the ordinary waits of a step.
-const SPIN: Duration = Duration::from_micros(20);
+const SPIN: Duration = Duration::from_micros(200);
 const YIELD: Duration = Duration::from_millis(2);
 
 type Job = dyn Fn(usize) + Sync;
@@ -148,9 +148,10 @@ fn wait_until(mut ready: impl FnMut() -> bool) {
     }
 }
 
-/// Applies `f` to every item, item `k` on worker `k` of the team when there is
-/// one (and as many items as workers), otherwise in order on this thread; the
-/// results come back in item order either way.
+/// Applies `f` to every item; with a team, the workers claim items one at a
+/// time (so a slow item or a slow core does not hold the others up), otherwise
+/// in order on this thread. Results come back in item order either way, so
+/// every reduction over them is deterministic whichever worker ran what.
 pub fn map_blocks<T, R, F>(team: Option<&Team>, items: Vec<T>, f: F) -> Vec<R>
 where
     T: Send,
@@ -158,17 +159,22 @@ where
     F: Fn(T) -> R + Sync,
 {
     match team {
-        Some(team) if items.len() == team.size() && items.len() > 1 => {
+        Some(team) if items.len() > 1 => {
             let slots: Vec<Mutex<Option<T>>> =
                 items.into_iter().map(|t| Mutex::new(Some(t))).collect();
             let results: Vec<Mutex<Option<R>>> =
                 (0..slots.len()).map(|_| Mutex::new(None)).collect();
-            team.run(&|k| {
+            let next = AtomicUsize::new(0);
+            team.run(&|_worker| loop {
+                let k = next.fetch_add(1, Ordering::Relaxed);
+                if k >= slots.len() {
+                    break;
+                }
                 let item = slots[k]
                     .lock()
                     .expect("block slot")
                     .take()
-                    .expect("one item per worker");
+                    .expect("each item claimed once");
                 let r = f(item);
                 *results[k].lock().expect("result slot") = Some(r);
             });
@@ -177,7 +183,7 @@ where
                 .map(|m| {
                     m.into_inner()
                         .expect("result slot")
-                        .expect("every worker ran")
+                        .expect("every item ran")
                 })
                 .collect()
         }
@@ -185,6 +191,18 @@ where
     }
 }
 
+/// Work blocks per worker thread: a few, so that workers balance their load
+/// by claiming blocks, while cross-block pairs stay few.
+pub const BLOCKS_PER_THREAD: usize = 4;
+
+/// Number of work blocks for `threads` threads (one block without parallelism).
+pub fn block_count(threads: usize) -> usize {
+    if threads <= 1 {
+        1
+    } else {
+        threads * BLOCKS_PER_THREAD
+    }
+}
 /// A raw pointer that may be shared between threads that write *disjoint*
 /// elements: each particle belongs to exactly one block, and a block's task
 /// only writes forces of its own particles.

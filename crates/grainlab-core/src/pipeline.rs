@@ -29,7 +29,7 @@ use crate::integrate::{
 use crate::law::{elastic_energy, linear_coulomb};
 use crate::material::{ContactModel, MaterialTable};
 use crate::neighbor::NeighborList;
-use crate::parallel::{even_bounds, map_blocks, split_ranges, DisjointWriter, Team};
+use crate::parallel::{block_count, even_bounds, map_blocks, split_ranges, DisjointWriter, Team};
 use crate::state::Particles;
 use crate::vec2::{add, dot, mat_vec, norm, perp, scale, sub, Mat2, Vec2};
 use crate::wall::{Wall, WallControl};
@@ -558,7 +558,7 @@ impl Simulation {
             &self.walls,
             &mut self.bonds,
             &self.materials,
-            self.threads,
+            block_count(self.threads),
         )?;
         for chain in self.chains.iter_mut() {
             chain.remap(&new_of_old);
@@ -990,10 +990,10 @@ impl Simulation {
             reference: self.neighbors.reference().reference,
         };
         // each worker integrates the block whose contacts it just computed
-        let bounds = if self.neighbors.block_ranges.len() == self.threads {
+        let bounds = if self.neighbors.block_ranges.len() == block_count(self.threads) {
             self.neighbors.block_ranges.clone()
         } else {
-            even_bounds(p.position.len(), self.threads)
+            even_bounds(p.position.len(), block_count(self.threads))
         };
         let chunks: Vec<MotionChunk<'_>> = split_ranges(&mut p.position, &bounds)
             .into_iter()
