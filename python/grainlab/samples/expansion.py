@@ -106,7 +106,8 @@ class Sample:
     Positions and radii are in the order of the drawn diameters; particle ``k``
     here is particle ``k`` of :attr:`simulation`. Walls are, in order,
     :data:`WALL_NAMES` (ids 0..3 of the simulation), each a segment
-    ``[[ax, ay], [bx, by]]`` with the particles on its left.
+    ``[[ax, ay], [bx, by]]`` with the particles on its left, reaching
+    :data:`WALL_OVERHANG` of the box's shorter side beyond its corners.
     """
 
     positions: NDArray[np.float64]
@@ -208,15 +209,23 @@ def _positive(name: str, value: float, allow_zero: bool = False) -> float:
     return value
 
 
+#: Each wall reaches this fraction of the box's shorter side beyond its corners,
+#: so that walls moved by a servo (consolidation) still close the corners.
+WALL_OVERHANG = 0.2
+
+
 def _wall_points(box: tuple[float, float, float, float]) -> NDArray[np.float64]:
     x0, y0, x1, y1 = box
-    # each segment runs counter-clockwise around the box, so the inside is on its left
+    e = WALL_OVERHANG * min(x1 - x0, y1 - y0)
+    # each segment runs counter-clockwise around the box, so the inside is on its
+    # left; each overhangs its corners by e, so that the corners stay closed when
+    # the walls move apart
     return np.array(
         [
-            [[x0, y0], [x1, y0]],
-            [[x1, y0], [x1, y1]],
-            [[x1, y1], [x0, y1]],
-            [[x0, y1], [x0, y0]],
+            [[x0 - e, y0], [x1 + e, y0]],
+            [[x1, y0 - e], [x1, y1 + e]],
+            [[x1 + e, y1], [x0 - e, y1]],
+            [[x0, y1 + e], [x0, y0 - e]],
         ]
     )
 
