@@ -132,6 +132,9 @@ pub struct Simulation {
     /// Follower loads of this step, per internal particle (recomputed every step).
     #[serde(skip)]
     boundary_load: Vec<Vec2>,
+    /// Whether any particle has an external force or torque (scanned once per run call).
+    #[serde(skip)]
+    external_loads: bool,
 }
 
 impl Simulation {
@@ -175,6 +178,7 @@ impl Simulation {
             pool: None,
             cross_forces: Vec::new(),
             boundary_load: Vec::new(),
+            external_loads: false,
         };
         sim.make_pool()?;
         Ok(sim)
@@ -604,6 +608,10 @@ impl Simulation {
     /// The step loop, on the simulation's pool when it has one and the system is
     /// large enough: one broadcast per call, worker 0 steps, the others serve phases.
     fn run_steps(&mut self, n: u64, measure_last: bool) -> Result<()> {
+        // external loads cannot change during a run call: scan them once, not every step
+        let p = &self.particles;
+        self.external_loads = p.external_force.iter().any(|f| *f != [0.0, 0.0])
+            || p.external_torque.iter().any(|&t| t != 0.0);
         let steps = |sim: &mut Simulation, team: Option<&Team>| -> Result<()> {
             for k in 0..n {
                 if measure_last && k + 1 == n {
@@ -963,9 +971,7 @@ impl Simulation {
             None => self.neighbors.reference().accumulated_map,
         };
         let p = &mut self.particles;
-        let has_external = self.params.gravity != [0.0, 0.0]
-            || p.external_force.iter().any(|f| *f != [0.0, 0.0])
-            || p.external_torque.iter().any(|&t| t != 0.0);
+        let has_external = self.params.gravity != [0.0, 0.0] || self.external_loads;
         let step = IntegrationStep {
             dt,
             kick: if self.half_kick_pending { 0.5 * dt } else { dt },
