@@ -160,34 +160,50 @@ where
 {
     match team {
         Some(team) if items.len() > 1 => {
-            let slots: Vec<Mutex<Option<T>>> =
-                items.into_iter().map(|t| Mutex::new(Some(t))).collect();
-            let results: Vec<Mutex<Option<R>>> =
-                (0..slots.len()).map(|_| Mutex::new(None)).collect();
+            let slots: Vec<ClaimSlot<T, R>> = items.into_iter().map(ClaimSlot::new).collect();
             let next = AtomicUsize::new(0);
             team.run(&|_worker| loop {
                 let k = next.fetch_add(1, Ordering::Relaxed);
                 if k >= slots.len() {
                     break;
                 }
-                let item = slots[k]
-                    .lock()
-                    .expect("block slot")
-                    .take()
-                    .expect("each item claimed once");
-                let r = f(item);
-                *results[k].lock().expect("result slot") = Some(r);
+                // SAFETY: the atomic counter hands each index to exactly one worker
+                unsafe { slots[k].run(&f) };
             });
-            results
-                .into_iter()
-                .map(|m| {
-                    m.into_inner()
-                        .expect("result slot")
-                        .expect("every item ran")
-                })
-                .collect()
+            // `team.run` returned: every worker is done with the slots
+            slots.into_iter().map(ClaimSlot::into_result).collect()
         }
         _ => items.into_iter().map(f).collect(),
+    }
+}
+
+/// An item and, once it has run, its result; each is claimed by exactly one
+/// worker (through an atomic counter), so it needs no lock.
+struct ClaimSlot<T, R> {
+    item: UnsafeCell<Option<T>>,
+    result: UnsafeCell<Option<R>>,
+}
+
+// SAFETY: a slot is touched by one worker at a time (see `map_blocks`).
+unsafe impl<T: Send, R: Send> Sync for ClaimSlot<T, R> {}
+
+impl<T, R> ClaimSlot<T, R> {
+    fn new(item: T) -> Self {
+        ClaimSlot {
+            item: UnsafeCell::new(Some(item)),
+            result: UnsafeCell::new(None),
+        }
+    }
+
+    /// # Safety
+    /// Only the worker that claimed this slot may call it, once.
+    unsafe fn run(&self, f: &impl Fn(T) -> R) {
+        let item = (*self.item.get()).take().expect("each item claimed once");
+        *self.result.get() = Some(f(item));
+    }
+
+    fn into_result(self) -> R {
+        self.result.into_inner().expect("every item ran")
     }
 }
 

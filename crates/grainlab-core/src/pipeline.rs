@@ -758,7 +758,7 @@ impl Simulation {
         let mut sliding_parts = split_ranges(&mut pairs.sliding, &ranges);
         let cross_shear = shear_parts.split_off(n_blocks);
         let cross_sliding = sliding_parts.split_off(n_blocks);
-        self.cross_forces.clear();
+        // every slot is rewritten by the kernel (a force or `skip`), so no clearing
         self.cross_forces
             .resize(n_pairs - cross_start, PairForce::NONE);
         let local: Vec<(usize, usize)> = cross_ranges
