@@ -12,10 +12,6 @@ use crate::vec2::{mat_vec, sub, Mat2, Vec2};
 
 /// Read-only inputs of the integration of one chunk of particles.
 pub struct IntegrationInputs<'a> {
-    /// Resultant forces (N), whole array.
-    pub force: &'a [Vec2],
-    /// Resultant torques (N m).
-    pub torque: &'a [f64],
     /// `1/m`.
     pub inv_mass: &'a [f64],
     /// `1/I`.
@@ -69,6 +65,10 @@ pub struct MotionChunk<'a> {
     pub rotation: &'a mut [f64],
     /// Angular velocities.
     pub angular_velocity: &'a mut [f64],
+    /// Resultant forces of this step (N), complete when integration starts.
+    pub force: &'a [Vec2],
+    /// Resultant torques (N m).
+    pub torque: &'a [f64],
 }
 
 /// What the integration of a chunk adds to the step's diagnostics.
@@ -160,8 +160,8 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
     let map_shift = sub(origin, mat_vec(&map, origin));
     let n = chunk.position.len();
     let lo = chunk.lo;
-    let force = &inputs.force[lo..lo + n];
-    let torque = &inputs.torque[lo..lo + n];
+    let force = chunk.force;
+    let torque = chunk.torque;
     let inv_mass = &inputs.inv_mass[lo..lo + n];
     let inv_inertia = &inputs.inv_inertia[lo..lo + n];
     let fixity = &inputs.fixity[lo..lo + n];

@@ -111,6 +111,12 @@ pub struct NeighborList {
     pub wall_pairs: WallPairList,
     /// Internal index range of the particles owned by each block.
     pub block_ranges: Vec<(usize, usize)>,
+    /// For each block, the cross-block pairs that touch its particles, as
+    /// `(local cross index << 1) | side` (side 0: the pair's `i`, 1: its `j`),
+    /// in pair order: CSR offsets in `cross_touch_start`.
+    pub cross_touch: Vec<u32>,
+    /// Offsets of each block's entries in `cross_touch` (`n_blocks + 1`).
+    pub cross_touch_start: Vec<usize>,
     /// Number of builds so far.
     pub build_count: u64,
     valid: bool,
@@ -140,6 +146,8 @@ impl NeighborList {
             pairs: PairList::default(),
             wall_pairs: WallPairList::default(),
             block_ranges: Vec::new(),
+            cross_touch: Vec::new(),
+            cross_touch_start: Vec::new(),
             build_count: 0,
             valid: false,
             reference: Vec::new(),
@@ -393,6 +401,21 @@ impl NeighborList {
 
         self.pairs = pairs;
         self.wall_pairs = wall_pairs;
+        // which block applies each cross pair's force to each of its particles
+        let cross_first = self.pairs.block_start[n_blocks];
+        let mut touches: Vec<Vec<u32>> = vec![Vec::new(); n_blocks];
+        for c in 0..self.pairs.len() - cross_first {
+            let k = cross_first + c;
+            touches[block_of(self.pairs.i[k] as usize) as usize].push((c as u32) << 1);
+            touches[block_of(self.pairs.j[k] as usize) as usize].push(((c as u32) << 1) | 1);
+        }
+        self.cross_touch_start = std::iter::once(0)
+            .chain(touches.iter().scan(0usize, |acc, t| {
+                *acc += t.len();
+                Some(*acc)
+            }))
+            .collect();
+        self.cross_touch = touches.concat();
         self.block_ranges = block_ranges;
         self.reference = particles.position.clone();
         self.accumulated_map = IDENTITY;

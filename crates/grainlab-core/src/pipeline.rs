@@ -848,21 +848,7 @@ impl Simulation {
         for t in &tallies {
             tally.merge(t);
         }
-        // cross-block forces, applied in pair order on this thread
-        for (k, c) in self.cross_forces.iter().enumerate() {
-            if c.active {
-                let pair = cross_start + k;
-                let (i, j) = (pairs.i[pair] as usize, pairs.j[pair] as usize);
-                let fj = &mut p.force[j];
-                fj[0] += c.force[0];
-                fj[1] += c.force[1];
-                let fi = &mut p.force[i];
-                fi[0] -= c.force[0];
-                fi[1] -= c.force[1];
-                p.torque[i] += c.torque_i;
-                p.torque[j] += c.torque_j;
-            }
-        }
+        // the cross-block forces are applied by each block's integration (step 7)
         tally
     }
 
@@ -983,8 +969,6 @@ impl Simulation {
             accumulated_map,
         };
         let inputs = IntegrationInputs {
-            force: &p.force,
-            torque: &p.torque,
             inv_mass: &p.inv_mass,
             inv_inertia: &p.inv_inertia,
             mass: &p.mass,
@@ -1001,25 +985,87 @@ impl Simulation {
         } else {
             even_bounds(p.position.len(), block_count(self.threads))
         };
-        let chunks: Vec<MotionChunk<'_>> = split_ranges(&mut p.position, &bounds)
+        let cross = CrossForces {
+            pair_i: &self.neighbors.pairs.i,
+            pair_j: &self.neighbors.pairs.j,
+            first: self
+                .neighbors
+                .pairs
+                .block_start
+                .last()
+                .copied()
+                .unwrap_or(0),
+            forces: &self.cross_forces,
+            touch: &self.neighbors.cross_touch,
+            touch_start: &self.neighbors.cross_touch_start,
+        };
+        let per_block = bounds == self.neighbors.block_ranges;
+        if !per_block {
+            for b in 0..self.neighbors.block_ranges.len() {
+                cross.apply(b, 0, &mut p.force, &mut p.torque);
+            }
+        }
+        type Work<'w> = (
+            usize,
+            usize,
+            &'w mut [Vec2],
+            &'w mut [Vec2],
+            &'w mut [f64],
+            &'w mut [f64],
+            &'w mut [Vec2],
+            &'w mut [f64],
+        );
+        let chunks: Vec<Work<'_>> = split_ranges(&mut p.position, &bounds)
             .into_iter()
             .zip(split_ranges(&mut p.velocity, &bounds))
             .zip(split_ranges(&mut p.rotation, &bounds))
             .zip(split_ranges(&mut p.angular_velocity, &bounds))
+            .zip(split_ranges(&mut p.force, &bounds))
+            .zip(split_ranges(&mut p.torque, &bounds))
             .zip(&bounds)
+            .enumerate()
             .map(
-                |((((position, velocity), rotation), angular_velocity), &(lo, _))| MotionChunk {
+                |(
+                    b,
+                    (
+                        (((((position, velocity), rotation), angular_velocity), force), torque),
+                        &(lo, _),
+                    ),
+                )| {
+                    (
+                        b,
+                        lo,
+                        position,
+                        velocity,
+                        rotation,
+                        angular_velocity,
+                        force,
+                        torque,
+                    )
+                },
+            )
+            .collect();
+        let tallies = map_blocks(
+            team,
+            chunks,
+            |(b, lo, position, velocity, rotation, angular_velocity, force, torque)| {
+                if per_block {
+                    // the cross-block pairs touching this block, in pair order, as a
+                    // sequential pass over all of them would have added them
+                    cross.apply(b, lo, force, torque);
+                }
+                let chunk = MotionChunk {
                     lo,
                     position,
                     velocity,
                     rotation,
                     angular_velocity,
-                },
-            )
-            .collect();
-        let tallies = map_blocks(team, chunks, |chunk| {
-            integrate_chunk::<MEASURE>(chunk, &inputs, &step)
-        });
+                    force,
+                    torque,
+                };
+                integrate_chunk::<MEASURE>(chunk, &inputs, &step)
+            },
+        );
         let mut total = IntegrationTally::default();
         for t in &tallies {
             total.merge(t);
@@ -1202,6 +1248,44 @@ impl ForceSink for BufferSink<'_> {
     #[inline(always)]
     fn skip(&mut self, k: usize) {
         self.slots[k].active = false;
+    }
+}
+
+/// The buffered forces of cross-block pairs and, per block, which of them touch it.
+struct CrossForces<'a> {
+    pair_i: &'a [u32],
+    pair_j: &'a [u32],
+    first: usize,
+    forces: &'a [PairForce],
+    touch: &'a [u32],
+    touch_start: &'a [usize],
+}
+
+impl CrossForces<'_> {
+    /// Adds block `b`'s cross-pair forces to `force`/`torque`, which start at particle `lo`.
+    fn apply(&self, b: usize, lo: usize, force: &mut [Vec2], torque: &mut [f64]) {
+        if self.touch_start.len() <= b + 1 {
+            return;
+        }
+        for &entry in &self.touch[self.touch_start[b]..self.touch_start[b + 1]] {
+            let c = (entry >> 1) as usize;
+            let pf = &self.forces[c];
+            if !pf.active {
+                continue;
+            }
+            let k = self.first + c;
+            if entry & 1 == 1 {
+                let q = self.pair_j[k] as usize - lo;
+                force[q][0] += pf.force[0];
+                force[q][1] += pf.force[1];
+                torque[q] += pf.torque_j;
+            } else {
+                let q = self.pair_i[k] as usize - lo;
+                force[q][0] -= pf.force[0];
+                force[q][1] -= pf.force[1];
+                torque[q] += pf.torque_i;
+            }
+        }
     }
 }
 
