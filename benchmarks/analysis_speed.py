@@ -22,6 +22,7 @@ import time
 from collections.abc import Callable
 
 import numpy as np
+
 from grainlab.analysis import ContactAnisotropy, CoordinationNumber, StabilityIndex
 from grainlab.snapshot import Snapshot
 

@@ -171,7 +171,7 @@ def parse_log(text):
                 vals = [float(v) for v in s]
             except ValueError:
                 continue
-            thermo_rows.append(dict(zip(header, vals)))
+            thermo_rows.append(dict(zip(header, vals, strict=False)))
     return runs, version
 
 

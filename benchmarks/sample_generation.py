@@ -17,6 +17,7 @@ import statistics
 import time
 
 import numpy as np
+
 from grainlab.samples import (
     PAPER_GRADING,
     expand_to_porosity,

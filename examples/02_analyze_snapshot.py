@@ -15,6 +15,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+
 from grainlab.analysis import ContactAnisotropy, StabilityIndex, analyze_snapshot
 from grainlab.io import read_snapshot, write_particles_csv
 from grainlab.snapshot import Snapshot

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+
 from grainlab.snapshot import Snapshot
 
 D = 1.0e-3  # particle diameter used by the lattices, m

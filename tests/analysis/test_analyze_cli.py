@@ -9,6 +9,7 @@ import json
 import numpy as np
 import pytest
 from factories_analysis import hex_lattice
+
 from grainlab import cli
 from grainlab.analysis import analyze_snapshot
 from grainlab.io import write_contacts_csv, write_particles_csv

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from grainlab import plot
 from grainlab.analysis import biaxial_figures
 from grainlab.analysis.biaxial_figures import (

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from factories_analysis import hex_lattice, square_lattice
+
 from grainlab.analysis import (
     ContactAnisotropy,
     CoordinationNumber,

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from factories_analysis import hex_lattice, jittered_packing
+from matplotlib.collections import EllipseCollection
+
 from grainlab import plot
 from grainlab.analysis import (
     ContactAnisotropy,
@@ -13,7 +15,6 @@ from grainlab.analysis import (
     ShearBand,
     StabilityIndex,
 )
-from matplotlib.collections import EllipseCollection
 
 
 def test_particle_map_draws_disks_to_scale_in_one_collection(tmp_path):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from grainlab.snapshot import ParticleKind, Snapshot, detect_contacts, wall_code
 
 

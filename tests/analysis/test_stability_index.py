@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from factories_analysis import hex_lattice, ring, square_lattice
+
 from grainlab.analysis import StabilityIndex, stability_index, stability_index_of_angles
 from grainlab.analysis._util import NotComputedError
 from grainlab.snapshot import ParticleKind, Snapshot

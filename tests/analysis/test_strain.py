@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from factories_analysis import jittered_packing
+
 from grainlab.analysis import LocalStrain, match_ids
 from grainlab.snapshot import Snapshot
 

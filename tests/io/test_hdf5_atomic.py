@@ -11,6 +11,7 @@ import textwrap
 
 import numpy as np
 import pytest
+
 from grainlab.io import read_snapshot
 from grainlab.io.hdf5 import (
     IncompleteResultsError,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import h5py
 import numpy as np
 import pytest
+
 from grainlab.io.hdf5 import (
     CHECKPOINT_FORMAT_VERSION,
     CheckpointError,

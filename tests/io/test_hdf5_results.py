@@ -7,6 +7,7 @@ import json
 import h5py
 import numpy as np
 import pytest
+
 from grainlab.io import FileFormatError, read_snapshot
 from grainlab.io.hdf5 import (
     _READERS_BY_VERSION,

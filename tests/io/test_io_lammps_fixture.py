@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from grainlab import cli
 from grainlab.io import FileFormatError, list_timesteps, read_lammps_dump, read_snapshot
 

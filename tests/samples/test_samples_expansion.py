@@ -5,9 +5,10 @@ from __future__ import annotations
 import json
 import math
 
-import grainlab
 import numpy as np
 import pytest
+
+import grainlab
 from grainlab.samples import (
     PAPER_GRADING,
     WALL_NAMES,

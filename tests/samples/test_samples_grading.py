@@ -6,8 +6,9 @@ import math
 
 import numpy as np
 import pytest
-from grainlab.samples import PAPER_GRADING, GradingCurve, UniformByMass, UniformByNumber
 from scipy import stats
+
+from grainlab.samples import PAPER_GRADING, GradingCurve, UniformByMass, UniformByNumber
 
 A, B = 0.5e-3, 3.0e-3
 N = 20_000

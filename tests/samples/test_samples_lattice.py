@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial.distance import pdist
+
 from grainlab.samples import (
     HEXAGONAL_CONTACT_POROSITY,
     SQUARE_CONTACT_POROSITY,
@@ -13,7 +15,6 @@ from grainlab.samples import (
     lens_area,
     square_lattice,
 )
-from scipy.spatial.distance import pdist
 
 D = 0.875e-3
 

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from grainlab.samples import PAPER_GRADING, PlacementError, particle_count, random_placement
 from scipy.spatial.distance import pdist
+
+from grainlab.samples import PAPER_GRADING, PlacementError, particle_count, random_placement
 
 BOX = (0.01, -0.02, 0.04, 0.04)
 

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+
 from grainlab.samples import (
     PAPER_GRADING,
     UniformByMass,
@@ -24,7 +25,7 @@ def grid_area(centres, radii, box, n=1500):
     y = y0 + (np.arange(n) + 0.5) * (y1 - y0) / n
     gx, gy = np.meshgrid(x, y)
     covered = np.zeros_like(gx, dtype=bool)
-    for (cx, cy), r in zip(centres, radii):
+    for (cx, cy), r in zip(centres, radii, strict=True):
         covered |= (gx - cx) ** 2 + (gy - cy) ** 2 < r * r
     return covered.mean() * (x1 - x0) * (y1 - y0)
 

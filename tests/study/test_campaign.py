@@ -4,6 +4,7 @@ import json
 import math
 
 import pytest
+
 from grainlab.study import derive_seed, execute_run, make_run, read_table, run_campaign
 from grainlab.study.campaign import RESULT_FILE
 

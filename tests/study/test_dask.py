@@ -4,7 +4,7 @@ import pytest
 
 distributed = pytest.importorskip("dask.distributed")
 
-from grainlab.study import read_table, run_sweep
+from grainlab.study import read_table, run_sweep  # noqa: E402 - after the skip
 
 PLAN = """
 base = "packing"

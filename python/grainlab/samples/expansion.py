@@ -242,7 +242,7 @@ class _Box:
         self.walls = [sim.add_segment_wall(a, b) for a, b in _wall_points(box)]
 
     def wall_stresses(self) -> NDArray[np.float64]:
-        return np.array([w.normal_stress(length) for w, length in zip(self.walls, self.lengths)])
+        return np.array([w.normal_stress(length) for w, length in zip(self.walls, self.lengths, strict=True)])
 
     def mean_stress(self) -> float:
         return float(self.wall_stresses().mean())
