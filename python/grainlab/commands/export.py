@@ -1,0 +1,46 @@
+"""``grainlab export``: convert a run folder for other tools (``--vtk``: ParaView).
+
+A thin wrapper around :func:`grainlab.io.vtk.export_vtk`, which scripts can call directly.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+__all__ = ["register", "run"]
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``export`` subcommand."""
+    p = subparsers.add_parser(
+        "export",
+        help="export a run folder for other tools (--vtk: ParaView time series)",
+        description=(
+            "Export the snapshots of a run folder DIR/run.h5. With --vtk: one VTK XML "
+            "UnstructuredGrid file (.vtu) per snapshot (particles as points with radius, "
+            "displacement, rotation, n_contacts, stability_index, local_shear_strain, "
+            "in_shear_band, kind; contacts as lines with normal_force) and a run.pvd "
+            "collection whose time is the axial strain, for ParaView's time slider."
+        ),
+    )
+    p.add_argument("dir", metavar="DIR", help="run folder holding run.h5 (or the run.h5 itself)")
+    p.add_argument("--vtk", action="store_true", help="write .vtu files and a .pvd for ParaView")
+    p.add_argument("--out", metavar="FOLDER", help="output folder (default: DIR/vtk)")
+    p.add_argument(
+        "--ascii", action="store_true", help="write ASCII data arrays instead of base64 binary"
+    )
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if not args.vtk:
+        raise ValueError("nothing to export: give a format, e.g. --vtk")
+    from grainlab.io.vtk import export_vtk
+
+    done = export_vtk(args.dir, args.out, binary=not args.ascii)
+    print(
+        f"grainlab export: {len(done.files)} snapshot(s) -> {done.pvd} "
+        f"(time = {done.time_quantity}); open it in ParaView"
+    )
+    return 0
