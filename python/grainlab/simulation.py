@@ -742,12 +742,13 @@ class Simulation:
         dissipated - work, constant in exact arithmetic."""
         return dict(self._engine.energy)
 
-    def snapshot(self, **metadata: Any) -> Snapshot:
+    def snapshot(self, *, kind: ArrayLike | None = None, **metadata: Any) -> Snapshot:
         """The current state as an analysis :class:`~grainlab.snapshot.Snapshot`.
 
         Converts the engine's conventions to the snapshot's: shear forces are
         given on particle ``i`` (the engine reports them on ``j``), and wall
-        normals point from the particle to the wall. ``metadata`` may set
+        normals point from the particle to the wall. ``kind`` gives each
+        particle's :class:`~grainlab.snapshot.ParticleKind`; ``metadata`` may set
         ``time`` and ``axial_strain`` and any other key.
         """
         c = self.contacts()
@@ -777,6 +778,7 @@ class Simulation:
             wall_sliding=w.sliding,
             time=time,
             axial_strain=axial_strain,
+            kind=kind,
             metadata=metadata,
         )
 

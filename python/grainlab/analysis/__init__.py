@@ -6,7 +6,7 @@ raise until computed, ``plot(ax=None)``) backed by plain NumPy functions.
 :func:`analyze_snapshot` runs them all, as ``grainlab analyze`` does.
 """
 
-from grainlab.analysis.analyze import AnalysisResult, analyze_snapshot
+from grainlab.analysis.analyze import AnalysisResult, analyze_snapshot, fabric_summary
 from grainlab.analysis.fabric import (
     ContactAnisotropy,
     CoordinationNumber,
@@ -31,6 +31,7 @@ __all__ = [
     "angular_histogram",
     "anisotropy_eq7",
     "anisotropy_fourier",
+    "fabric_summary",
     "fabric_tensor",
     "match_ids",
     "neighbour_pairs",

@@ -17,7 +17,7 @@ from grainlab.analysis.stability import StabilityIndex
 from grainlab.analysis.strain import LocalStrain
 from grainlab.snapshot import Snapshot
 
-__all__ = ["AnalysisResult", "analyze_snapshot"]
+__all__ = ["AnalysisResult", "analyze_snapshot", "fabric_summary"]
 
 
 @dataclass
@@ -142,6 +142,29 @@ class AnalysisResult:
                 self.strain.plot(quantity="shear_strain", band=self.band), out / "map_shear_strain"
             )
         return written
+
+
+def fabric_summary(snapshot: Snapshot) -> dict[str, float]:
+    """The scalar fabric of a snapshot with the library's defaults (boundary
+    contacts excluded from Z and the anisotropies, included in lambda):
+    ``coordination_number``, ``mechanical_coordination_number``,
+    ``mean_stability_index``, ``anisotropy`` and ``anisotropy_direction_rad``
+    (Eq. 7-8), ``anisotropy_fourier`` (unbinned) and ``force_anisotropy``
+    (NaN when no contact carries a force)."""
+    z = CoordinationNumber().compute(snapshot)
+    normals = ContactAnisotropy().compute(snapshot)
+    out = {
+        "coordination_number": z.coordination_number,
+        "mechanical_coordination_number": z.mechanical_coordination_number,
+        "mean_stability_index": StabilityIndex().compute(snapshot).mean,
+        "anisotropy": normals.anisotropy,
+        "anisotropy_direction_rad": normals.direction,
+        "anisotropy_fourier": normals.anisotropy_fourier,
+        "force_anisotropy": math.nan,
+    }
+    if snapshot.normal_force is not None and float(np.sum(snapshot.normal_force)) > 0.0:
+        out["force_anisotropy"] = ContactAnisotropy(weight="normal_force").compute(snapshot).anisotropy
+    return {k: float(v) for k, v in out.items()}
 
 
 def analyze_snapshot(

@@ -42,7 +42,7 @@ import numpy as np
 from tqdm import tqdm
 
 import grainlab
-from grainlab.analysis import ContactAnisotropy, CoordinationNumber, StabilityIndex
+from grainlab.analysis import fabric_summary
 from grainlab.analysis.stress import love_weber_stress
 from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, snapshot_name, write_checkpoint
 from grainlab.io.results import write_json_atomic, write_text_atomic
@@ -279,19 +279,9 @@ def _fabric(sim: Simulation, run: _Run) -> dict[str, float]:
     """Fabric measures of the grains (membrane disks excluded as particles):
     anisotropy of contact normals and normal forces (Eq. 7-8 and the unbinned
     estimate), the mean stability index (Sec. 5) and the mechanical coordination number."""
-    snap = _snapshot(sim, run, 0.0)
-    normals = ContactAnisotropy().compute(snap)
-    forces = ContactAnisotropy(weight="normal_force").compute(snap)
-    stability = StabilityIndex().compute(snap)
-    z = CoordinationNumber().compute(snap)
-    return {
-        "anisotropy": normals.anisotropy,
-        "anisotropy_direction_rad": normals.direction,
-        "anisotropy_fourier": normals.anisotropy_fourier,
-        "force_anisotropy": forces.anisotropy,
-        "mean_stability_index": stability.mean,
-        "mechanical_coordination_number": z.mechanical_coordination_number,
-    }
+    summary = fabric_summary(_snapshot(sim, run, 0.0))
+    summary.pop("coordination_number")  # the record's own, grain-grain contacts
+    return summary
 
 
 def _boundary(run: _Run) -> Membrane | GrainBoundary:
@@ -309,24 +299,7 @@ def _snapshot(sim: Simulation, run: _Run, strain: float):
     kind[run.n_grains :] = int(ParticleKind.MEMBRANE)
     if run.membrane is not None and run.membrane.get("kind") == GrainBoundary.kind:
         kind[run.membrane["left"] + run.membrane["right"]] = int(ParticleKind.BOUNDARY)
-    snap = sim.snapshot(axial_strain=strain, step=sim.step_count)
-    return type(snap)(
-        snap.positions,
-        snap.radii,
-        snap.ids,
-        rotations=snap.rotations,
-        kind=kind,
-        contact_i=snap.contact_i,
-        contact_j=snap.contact_j,
-        normal_force=snap.normal_force,
-        shear_force=snap.shear_force,
-        contact_normal=snap.contact_normal,
-        contact_point=snap.contact_point,
-        contact_fields=dict(snap.contact_fields),
-        time=snap.time,
-        axial_strain=strain,
-        metadata=dict(snap.metadata),
-    )
+    return sim.snapshot(kind=kind, axial_strain=strain, step=sim.step_count)
 
 
 # ---- phases -----------------------------------------------------------------

@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from grainlab.analysis import ContactAnisotropy, CoordinationNumber, StabilityIndex
+from grainlab.analysis import fabric_summary
 from grainlab.snapshot import Snapshot
 
 #: The measured columns of one packing, in table order.
@@ -142,19 +142,10 @@ class PackingParams:
 def measure(snapshot: Snapshot) -> dict[str, float]:
     """Z, Z_m, mean lambda, anisotropies of a snapshot (library defaults: boundary
     contacts excluded from Z and the anisotropies, included in lambda)."""
-    z = CoordinationNumber().compute(snapshot)
-    normals = ContactAnisotropy().compute(snapshot)
-    out = {
-        "coordination_number": z.coordination_number,
-        "mechanical_coordination_number": z.mechanical_coordination_number,
-        "mean_stability_index": StabilityIndex().compute(snapshot).mean,
-        "anisotropy": normals.anisotropy,
-        "anisotropy_fourier": normals.anisotropy_fourier,
-        "force_anisotropy": float("nan"),
-    }
-    if snapshot.normal_force is not None and float(np.sum(snapshot.normal_force)) > 0.0:
-        out["force_anisotropy"] = ContactAnisotropy(weight="normal_force").compute(snapshot).anisotropy
-    return {k: float(v) for k, v in out.items()}
+    summary = fabric_summary(snapshot)
+    keys = ("coordination_number", "mechanical_coordination_number", "mean_stability_index",
+            "anisotropy", "anisotropy_fourier", "force_anisotropy")
+    return {k: summary[k] for k in keys}
 
 
 def _irregular(p: PackingParams) -> dict[str, Any]:
