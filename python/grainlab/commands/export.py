@@ -18,14 +18,23 @@ def register(subparsers: Any) -> None:
         help="export a run folder for other tools (--vtk: ParaView time series)",
         description=(
             "Export the snapshots of a run folder DIR/run.h5. With --vtk: one VTK XML "
-            "UnstructuredGrid file (.vtu) per snapshot (particles as points with radius, "
-            "displacement, rotation, n_contacts, stability_index, local_shear_strain, "
-            "in_shear_band, kind; contacts as lines with normal_force) and a run.pvd "
-            "collection whose time is the axial strain, for ParaView's time slider."
+            "PolyData file per snapshot (snapshot_0000.vtp, ...) and a run.pvd time series, "
+            "in DIR/vtk or --out FOLDER. The time is the axial strain (else the time in s, "
+            "else the snapshot index), for ParaView's time slider. Particles are points with "
+            "a vertex cell and the point data id, kind, radius, displacement, rotation, "
+            "n_contacts, stability_index, local_shear_strain, in_shear_band and the stored "
+            "per-particle fields (velocity, ...); particle-particle contacts are lines between "
+            "the two centres with the cell data normal_force, shear_force and the stored "
+            "contact fields (overlap, sliding, bonded), NaN or -1 on the vertex cells "
+            "(cell_kind: 0 particle, 1 contact). Wall contacts and contacts across a "
+            "periodic boundary have no line. In ParaView: open run.pvd, add a Glyph "
+            "filter (2D Glyph, Circle, filled; Scale Array radius, Scale Factor 2; "
+            "Glyph Mode All Points) and colour by stability_index; see "
+            "docs/file-formats.md, section ParaView."
         ),
     )
     p.add_argument("dir", metavar="DIR", help="run folder holding run.h5 (or the run.h5 itself)")
-    p.add_argument("--vtk", action="store_true", help="write .vtu files and a .pvd for ParaView")
+    p.add_argument("--vtk", action="store_true", help="write .vtp files and a .pvd for ParaView")
     p.add_argument("--out", metavar="FOLDER", help="output folder (default: DIR/vtk)")
     p.add_argument(
         "--ascii", action="store_true", help="write ASCII data arrays instead of base64 binary"

@@ -1,28 +1,41 @@
-"""ParaView export: VTK XML UnstructuredGrid (``.vtu``) files and a ``.pvd`` time series.
+"""ParaView export: VTK XML PolyData (``.vtp``) files and a ``.pvd`` time series.
 
-Each snapshot of a run becomes one ``.vtu`` file (VTK XML UnstructuredGrid,
-written here by a small writer, no VTK needed):
+Each snapshot of a run becomes one ``.vtp`` file, written here by a small
+writer (:func:`write_vtp`; no VTK needed to write, VTK's own reader in the tests):
 
-* every particle is a point (z = 0) with a ``VTK_VERTEX`` cell, and carries the
-  point data ``id``, ``radius`` (m), ``kind`` (:class:`~grainlab.snapshot.ParticleKind`
-  code: 0 grain, 1 membrane, 2 boundary grain), ``velocity`` (m/s, only when the
-  snapshot has a ``velocity`` particle field), ``displacement`` (m, from the first
-  snapshot, matched by id; NaN for particles absent from it), ``rotation`` (rad,
-  accumulated; only when the snapshot has rotations), ``n_contacts`` (all
-  contacts of the particle, walls included), ``stability_index`` (lambda; NaN for
-  membrane disks), ``local_shear_strain`` (:class:`~grainlab.analysis.LocalStrain`
-  against the first snapshot; NaN in the first snapshot) and ``in_shear_band``
-  (1 for the members of the band :class:`~grainlab.analysis.ShearBand` finds in
-  the excess shear strain, else 0; all 0 in the first snapshot or when no band
-  can be located);
-* every particle–particle contact is a ``VTK_LINE`` cell between its two
-  particles, with the cell data ``normal_force`` (N; NaN on the vertex cells).
-  Wall contacts (``contact_j < 0``) have no second point and are left out.
+* every particle is a point (z = 0) with one vertex cell (``Verts``), carrying
+  the point data of :func:`snapshot_arrays` (radius, kind, displacement,
+  rotation, n_contacts, stability_index, local_shear_strain, in_shear_band, the
+  snapshot's per-particle fields such as velocity, ...);
+* every particle–particle contact is a line cell (``Lines``) between the two
+  particle centres, carrying the cell data of :func:`contact_lines`
+  (normal_force, shear_force, and the stored contact fields such as overlap,
+  sliding, bonded).
 
-The ``.pvd`` collection lists the files with their time value: the snapshot's
-axial strain when every snapshot has one, else its time in s, else its index.
-The ``.vtu`` format is used rather than ``.vtp`` so that independent readers
-such as meshio can read the files back; ParaView opens both alike.
+VTK numbers the cells of a PolyData vertices first, then lines, and a cell
+array covers all of them. The writer therefore adds ``cell_kind`` (0 particle
+vertex, 1 contact line) and fills the contact arrays on the vertex cells with
+NaN (floating point) or -1 (integers and flags), so that a *Threshold* on
+``cell_kind`` or on a force keeps only the contacts.
+
+Contacts that cannot be drawn as a line between two centres are left out of
+the lines (they still count in ``n_contacts`` and the stability index), and
+their numbers are stored in the file's field data: wall contacts
+(``contact_j < 0``, no second particle) as ``n_wall_contacts``, contacts
+across a periodic boundary (a line between the stored centres would cross the
+box) as ``n_periodic_contacts``.
+
+The ``.pvd`` collection lists the files with their time value: the
+snapshots' axial strain when it is known for every snapshot and strictly
+increasing, else their time in s under the same condition, else their index.
+(ParaView merges datasets that share a time value into one step, so a
+repeated value would overlay two snapshots.)
+
+Binary files hold each array as base64 of the raw little-endian values with a
+UInt64 byte-count header, so float64 values (NaN, inf and -0.0 included) are
+read back bit for bit. ASCII files write floats with :func:`repr`, which VTK
+reads back to the same values, except that its ASCII parser turns ``-inf`` into
+``+inf``: the ASCII writer refuses ``-inf`` (no exported array holds one).
 """
 
 from __future__ import annotations
@@ -39,45 +52,55 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
-    "VTK_LINE",
-    "VTK_VERTEX",
+    "CELL_CONTACT",
+    "CELL_PARTICLE",
     "VtkExport",
+    "contact_lines",
     "export_vtk",
     "snapshot_arrays",
     "write_pvd",
-    "write_vtu",
+    "write_vtp",
 ]
 
-VTK_VERTEX = 1
-VTK_LINE = 3
+#: ``cell_kind`` of the vertex cell of a particle.
+CELL_PARTICLE = 0
+#: ``cell_kind`` of the line cell of a particle–particle contact.
+CELL_CONTACT = 1
 
 _VTK_TYPES = {
     np.dtype(np.float32): "Float32",
     np.dtype(np.float64): "Float64",
     np.dtype(np.int8): "Int8",
     np.dtype(np.uint8): "UInt8",
+    np.dtype(np.int16): "Int16",
+    np.dtype(np.uint16): "UInt16",
     np.dtype(np.int32): "Int32",
+    np.dtype(np.uint32): "UInt32",
     np.dtype(np.int64): "Int64",
+    np.dtype(np.uint64): "UInt64",
 }
 
 
 def _prepare(name: str, value: ArrayLike, length: int) -> NDArray[Any]:
+    """``value`` as a little-endian array of a VTK type, shape (length,) or (length, k)."""
     a = np.asarray(value)
     if a.dtype == np.bool_:
-        a = a.astype(np.uint8)
-    elif np.issubdtype(a.dtype, np.integer) and a.dtype not in _VTK_TYPES:
+        a = a.astype(np.int32)
+    elif np.issubdtype(a.dtype, np.integer) and a.dtype.newbyteorder("=") not in _VTK_TYPES:
         a = a.astype(np.int64)
-    elif np.issubdtype(a.dtype, np.floating) and a.dtype not in _VTK_TYPES:
+    elif np.issubdtype(a.dtype, np.floating) and a.dtype.newbyteorder("=") not in _VTK_TYPES:
         a = a.astype(np.float64)
-    if a.dtype not in _VTK_TYPES:
+    if a.dtype.newbyteorder("=") not in _VTK_TYPES:
         raise ValueError(f"{name}: unsupported dtype {a.dtype}")
     if a.ndim not in (1, 2) or a.shape[0] != length:
         raise ValueError(f"{name}: expected shape ({length},) or ({length}, k), got {a.shape}")
     return np.ascontiguousarray(a.astype(a.dtype.newbyteorder("<")))
 
 
-def _data_array(parent: ET.Element, name: str, a: NDArray[Any], binary: bool) -> None:
+def _data_array(parent: ET.Element, name: str, a: NDArray[Any], binary: bool, **attrs: str) -> None:
     el = ET.SubElement(parent, "DataArray", type=_VTK_TYPES[a.dtype.newbyteorder("=")], Name=name)
+    for key, value in attrs.items():
+        el.set(key, value)
     if a.ndim == 2:
         el.set("NumberOfComponents", str(a.shape[1]))
     if binary:
@@ -88,26 +111,61 @@ def _data_array(parent: ET.Element, name: str, a: NDArray[Any], binary: bool) ->
         el.set("format", "ascii")
         flat = a.ravel()
         if np.issubdtype(a.dtype, np.floating):
-            el.text = " ".join(repr(float(v)) for v in flat)
+            if np.any(np.isneginf(flat)):
+                raise ValueError(f"{name}: -inf cannot be written as ASCII (VTK reads it as +inf)")
+            text = " ".join(repr(float(v)) for v in flat)
         else:
-            el.text = " ".join(str(int(v)) for v in flat)
+            text = " ".join(str(int(v)) for v in flat)
+        # VTK's ASCII parser drops a final nan / inf unless whitespace follows it
+        el.text = text + "\n"
 
 
-def write_vtu(
+def _fill_value(a: NDArray[Any]) -> tuple[NDArray[Any], float | int]:
+    """The array in a dtype that can hold the vertex-cell fill, and that fill."""
+    if np.issubdtype(a.dtype, np.floating):
+        return a, np.nan
+    if np.issubdtype(a.dtype, np.unsignedinteger):
+        a = a.astype("<i8")
+    return a, -1
+
+
+def write_vtp(
     path: str | os.PathLike[str],
     points: ArrayLike,
     *,
     lines: ArrayLike | None = None,
     point_data: Mapping[str, ArrayLike] | None = None,
     line_data: Mapping[str, ArrayLike] | None = None,
+    field_data: Mapping[str, ArrayLike] | None = None,
     binary: bool = True,
 ) -> Path:
-    """Write points (one ``VTK_VERTEX`` cell each) and lines to a ``.vtu`` file.
+    """Write points, one vertex cell per point, and lines to a VTK XML PolyData file.
 
-    ``points`` (N, 2) or (N, 3); ``lines`` (M, 2) point indices; ``point_data``
-    arrays of length N; ``line_data`` arrays of length M (stored as cell data,
-    NaN / 0 on the vertex cells). ``binary`` selects base64 raw data (UInt64
-    headers) over ASCII. Returns the path.
+    Parameters
+    ----------
+    path : path of the ``.vtp`` file (parent folders are created).
+    points : (N, 2) or (N, 3) float
+        Coordinates; z = 0 when two columns are given.
+    lines : (M, 2) int, optional
+        Point indices of the two ends of each line.
+    point_data : mapping of str to (N,) or (N, k) arrays, optional
+    line_data : mapping of str to (M,) or (M, k) arrays, optional
+        Stored as cell data over the N vertex cells followed by the M lines,
+        with NaN (floats) or -1 (integers; unsigned become Int64) on the
+        vertex cells. An Int32 ``cell_kind`` array (:data:`CELL_PARTICLE` on
+        vertices, :data:`CELL_CONTACT` on lines) is always added.
+    field_data : mapping of str to arrays, optional
+        Whole-file values (any length, flattened to one component).
+    binary : bool, default True
+        Base64 raw arrays with UInt64 headers; False writes ASCII (no ``-inf``).
+
+    Booleans are stored as Int32 0 / 1. Returns the path.
+
+    Raises
+    ------
+    ValueError
+        On a wrong shape, a line index out of range, an unsupported dtype,
+        a line array named ``cell_kind`` or ``-inf`` in an ASCII file.
     """
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] not in (2, 3):
@@ -121,38 +179,48 @@ def write_vtu(
     if seg.size and (seg.min() < 0 or seg.max() >= n):
         raise ValueError(f"lines: point index out of range [0, {n})")
     m = seg.shape[0]
+    if line_data and "cell_kind" in line_data:
+        raise ValueError("line_data: 'cell_kind' is reserved for the writer")
 
     root = ET.Element(
-        "VTKFile",
-        type="UnstructuredGrid",
-        version="1.0",
-        byte_order="LittleEndian",
-        header_type="UInt64",
+        "VTKFile", type="PolyData", version="1.0", byte_order="LittleEndian", header_type="UInt64"
     )
+    poly = ET.SubElement(root, "PolyData")
+    if field_data:
+        fd = ET.SubElement(poly, "FieldData")
+        for name, value in field_data.items():
+            a = np.asarray(value).ravel()
+            a = _prepare(name, a, a.shape[0])
+            _data_array(fd, name, a, binary, NumberOfTuples=str(a.shape[0]))
     piece = ET.SubElement(
-        ET.SubElement(root, "UnstructuredGrid"),
+        poly,
         "Piece",
         NumberOfPoints=str(n),
-        NumberOfCells=str(n + m),
+        NumberOfVerts=str(n),
+        NumberOfLines=str(m),
+        NumberOfStrips="0",
+        NumberOfPolys="0",
     )
     pd = ET.SubElement(piece, "PointData")
     for name, value in (point_data or {}).items():
         _data_array(pd, name, _prepare(name, value, n), binary)
     cd = ET.SubElement(piece, "CellData")
+    kind = np.r_[np.full(n, CELL_PARTICLE, "<i4"), np.full(m, CELL_CONTACT, "<i4")]
+    _data_array(cd, "cell_kind", kind, binary)
     for name, value in (line_data or {}).items():
-        a = _prepare(name, value, m)
-        fill = np.nan if np.issubdtype(a.dtype, np.floating) else 0
+        a, fill = _fill_value(_prepare(name, value, m))
         full = np.full((n + m, *a.shape[1:]), fill, dtype=a.dtype)
         full[n:] = a
         _data_array(cd, name, full, binary)
     _data_array(ET.SubElement(piece, "Points"), "Points", _prepare("points", pts, n), binary)
-    cells = ET.SubElement(piece, "Cells")
-    connectivity = np.r_[np.arange(n, dtype=np.int64), seg.ravel()]
-    offsets = np.r_[np.arange(1, n + 1, dtype=np.int64), n + 2 * np.arange(1, m + 1)]
-    types = np.r_[np.full(n, VTK_VERTEX, np.uint8), np.full(m, VTK_LINE, np.uint8)]
-    _data_array(cells, "connectivity", connectivity.astype("<i8"), binary)
-    _data_array(cells, "offsets", offsets.astype("<i8"), binary)
-    _data_array(cells, "types", types, binary)
+    for tag, connectivity, size in (
+        ("Verts", np.arange(n, dtype="<i8"), 1),
+        ("Lines", seg.ravel().astype("<i8"), 2),
+    ):
+        el = ET.SubElement(piece, tag)
+        count = connectivity.shape[0] // size
+        _data_array(el, "connectivity", connectivity, binary)
+        _data_array(el, "offsets", size * np.arange(1, count + 1, dtype="<i8"), binary)
 
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -183,31 +251,45 @@ def write_pvd(
     return out
 
 
+def _as_vector3(a: NDArray[Any]) -> NDArray[Any]:
+    """(N, 2) vectors padded with z = 0, so that ParaView's vector filters apply."""
+    if a.ndim == 2 and a.shape[1] == 2:
+        return np.c_[a, np.zeros(a.shape[0], a.dtype)]
+    return a
+
+
+def _exportable(a: NDArray[Any]) -> bool:
+    numeric = a.dtype == np.bool_ or np.issubdtype(a.dtype, np.number)
+    return numeric and not np.iscomplexobj(a) and a.ndim in (1, 2)
+
+
 def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArray[Any]]:
     """Point data of one :class:`~grainlab.snapshot.Snapshot` for the export.
 
     ``reference`` is the run's first snapshot (``None`` or ``snap`` itself for
     the first one): displacement, local shear strain and shear band are taken
-    against it. See the module docstring for the fields.
+    against it. Keys, in order (units in docs/file-formats.md, "ParaView"):
+
+    ``id``, ``kind``, ``radius``, ``displacement`` (N, 3) (matched by id, NaN
+    for particles absent from the reference, 0 in the first snapshot),
+    ``rotation`` (only when the snapshot has rotations), ``n_contacts`` (walls
+    included), ``stability_index``, ``local_shear_strain`` (NaN in the first
+    snapshot), ``in_shear_band`` (0 / 1), then every numeric per-particle field
+    of the snapshot (``velocity``, ...) under its own name, 2-vectors padded to
+    (N, 3); a field whose name is already taken above is left out.
     """
     from grainlab.analysis import LocalStrain, ShearBand, StabilityIndex, match_ids
 
     n = snap.n_particles
-    ci, cj = np.asarray(snap.contact_i), np.asarray(snap.contact_j)
-    counts = np.bincount(ci, minlength=n) + np.bincount(cj[cj >= 0], minlength=n)
     out: dict[str, NDArray[Any]] = {
         "id": np.asarray(snap.ids, np.int64),
-        "radius": np.asarray(snap.radii, np.float64),
         "kind": np.asarray(snap.kind, np.int32),
+        "radius": np.asarray(snap.radii, np.float64),
     }
-    velocity = snap.particle_fields.get("velocity")
-    if velocity is not None:
-        v = np.asarray(velocity, np.float64).reshape(n, -1)
-        out["velocity"] = np.c_[v, np.zeros((n, 3 - v.shape[1]))] if v.shape[1] < 3 else v
     first = reference is None or reference is snap
     disp = np.zeros((n, 3))
     gamma = np.full(n, np.nan)
-    band = np.zeros(n, np.uint8)
+    band = np.zeros(n, np.int32)
     if not first:
         to_ref = match_ids(reference, snap)
         ok = to_ref >= 0
@@ -217,17 +299,62 @@ def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArra
         gamma = np.asarray(strain.shear_strain, np.float64)
         try:
             found = ShearBand().compute(snap, strain.excess_shear_strain)
-            band = np.asarray(found.members, bool).astype(np.uint8)
+            band = np.asarray(found.members, bool).astype(np.int32)
         except ValueError:  # too few particles with a finite strain: no band
             pass
     out["displacement"] = disp
     if snap.rotations is not None:
         out["rotation"] = np.asarray(snap.rotations, np.float64)
-    out["n_contacts"] = counts.astype(np.int32)
+    out["n_contacts"] = snap.contact_counts().astype(np.int32)
     out["stability_index"] = np.asarray(StabilityIndex().compute(snap).stability_index, float)
     out["local_shear_strain"] = gamma
     out["in_shear_band"] = band
+    for name, value in snap.particle_fields.items():
+        a = np.asarray(value)
+        if name not in out and _exportable(a):
+            out[name] = _as_vector3(a)
     return out
+
+
+def contact_lines(snap: Any) -> tuple[NDArray[np.int64], dict[str, NDArray[Any]], dict[str, int]]:
+    """The drawable contacts of a snapshot: ``(lines, line_data, n_left_out)``.
+
+    ``lines`` (M, 2) holds the particle indices ``(contact_i, contact_j)`` of
+    every particle–particle contact whose centres are not separated by a
+    periodic boundary, in the snapshot's contact order. ``line_data`` has, for
+    those contacts, ``normal_force`` and ``shear_force`` (N, only when the
+    snapshot stores them) and every numeric contact field (``overlap``,
+    ``sliding``, ``bonded``, ...) under its own name. ``n_left_out`` counts the
+    contacts without a line: ``n_wall_contacts`` and ``n_periodic_contacts``.
+    """
+    ci = np.asarray(snap.contact_i, np.int64)
+    cj = np.asarray(snap.contact_j, np.int64)
+    wall = cj < 0
+    partner = np.where(wall, ci, cj)
+    d = snap.positions[partner] - snap.positions[ci]
+    crosses = ~wall & np.any(snap.minimum_image(d) != d, axis=1)
+    keep = ~wall & ~crosses
+    data: dict[str, NDArray[Any]] = {}
+    for name in ("normal_force", "shear_force"):
+        value = getattr(snap, name)
+        if value is not None:
+            data[name] = np.asarray(value, np.float64)[keep]
+    for name, value in snap.contact_fields.items():
+        a = np.asarray(value)
+        if name not in data and name != "cell_kind" and _exportable(a):
+            data[name] = _as_vector3(a[keep])
+    left_out = {"n_wall_contacts": int(wall.sum()), "n_periodic_contacts": int(crosses.sum())}
+    return np.c_[ci[keep], cj[keep]], data, left_out
+
+
+def _time_axis(snaps: Sequence[Any]) -> tuple[str, list[float]]:
+    for quantity in ("axial_strain", "time"):
+        values = [getattr(s, quantity) for s in snaps]
+        if all(v is not None for v in values):
+            t = np.asarray(values, np.float64)
+            if np.all(np.diff(t) > 0):
+                return quantity, [float(v) for v in t]
+    return "index", [float(k) for k in range(len(snaps))]
 
 
 @dataclass(frozen=True)
@@ -246,10 +373,12 @@ def export_vtk(
     *,
     binary: bool = True,
 ) -> VtkExport:
-    """Write one ``.vtu`` per snapshot of ``run`` (a run folder or its ``run.h5``) and a ``.pvd``.
+    """Write one ``.vtp`` per snapshot of ``run`` (a run folder or its ``run.h5``) and a ``.pvd``.
 
-    Files go to ``out_dir`` (default ``<run folder>/vtk``) as ``snapshot_0000.vtu``, ...
-    and ``run.pvd``. Raises ValueError when the run has no snapshots.
+    Files go to ``out_dir`` (default ``<run folder>/vtk``) as ``snapshot_0000.vtp``, ...
+    (in the run's snapshot order) and ``run.pvd``. Each file's field data holds
+    ``axial_strain`` and ``time`` (when the snapshot has them) and the counts
+    of :func:`contact_lines`. Raises ValueError when the run has no snapshots.
     """
     from grainlab.io.hdf5 import read_results
 
@@ -261,28 +390,24 @@ def export_vtk(
     if not names:
         raise ValueError(f"{h5}: the run has no snapshots to export")
     snaps = [results.snapshot(name) for name in names]
-    if all(s.axial_strain is not None for s in snaps):
-        quantity, times = "axial_strain", [float(s.axial_strain) for s in snaps]
-    elif all(s.time is not None for s in snaps):
-        quantity, times = "time", [float(s.time) for s in snaps]
-    else:
-        quantity, times = "index", [float(k) for k in range(len(snaps))]
+    quantity, times = _time_axis(snaps)
     files = []
     for k, snap in enumerate(snaps):
-        pp = np.asarray(snap.contact_j) >= 0
-        lines = np.c_[np.asarray(snap.contact_i)[pp], np.asarray(snap.contact_j)[pp]]
-        force = (
-            np.full(int(pp.sum()), np.nan)
-            if snap.normal_force is None
-            else np.asarray(snap.normal_force)[pp]
-        )
+        lines, line_data, left_out = contact_lines(snap)
+        field_data: dict[str, ArrayLike] = {
+            name: [getattr(snap, name)]
+            for name in ("axial_strain", "time")
+            if getattr(snap, name) is not None
+        }
+        field_data.update({name: [count] for name, count in left_out.items()})
         files.append(
-            write_vtu(
-                folder / f"snapshot_{k:04d}.vtu",
+            write_vtp(
+                folder / f"snapshot_{k:04d}.vtp",
                 snap.positions,
                 lines=lines,
                 point_data=snapshot_arrays(snap, snaps[0]),
-                line_data={"normal_force": force},
+                line_data=line_data,
+                field_data=field_data,
                 binary=binary,
             )
         )
