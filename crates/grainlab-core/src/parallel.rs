@@ -10,7 +10,7 @@
 //! back in block order, so every reduction is deterministic.
 use std::cell::UnsafeCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, OnceLock};
 use std::thread::Thread;
 use std::time::{Duration, Instant};
@@ -148,10 +148,13 @@ fn wait_until(mut ready: impl FnMut() -> bool) {
     }
 }
 
-/// Applies `f` to every item; with a team, the workers claim items one at a
-/// time (so a slow item or a slow core does not hold the others up), otherwise
-/// in order on this thread. Results come back in item order either way, so
-/// every reduction over them is deterministic whichever worker ran what.
+/// Applies `f` to every item; with a team, each worker first runs the items
+/// of its own home share (the same share in every phase and every step, so a
+/// worker keeps finding its particles in its own cache), then helps the others
+/// by taking items from the far end of their shares (so a slow core does not
+/// hold the step up). Without a team the items run in order on this thread.
+/// Results come back in item order either way, so every reduction over them is
+/// deterministic whichever worker ran what.
 pub fn map_blocks<T, R, F>(team: Option<&Team>, items: Vec<T>, f: F) -> Vec<R>
 where
     T: Send,
@@ -161,19 +164,69 @@ where
     match team {
         Some(team) if items.len() > 1 => {
             let slots: Vec<ClaimSlot<T, R>> = items.into_iter().map(ClaimSlot::new).collect();
-            let next = AtomicUsize::new(0);
-            team.run(&|_worker| loop {
-                let k = next.fetch_add(1, Ordering::Relaxed);
-                if k >= slots.len() {
-                    break;
+            let shares = HomeShares::new(slots.len(), team.size());
+            team.run(&|worker| {
+                while let Some(k) = shares.claim(worker) {
+                    // SAFETY: `claim` hands each index to exactly one worker
+                    unsafe { slots[k].run(&f) };
                 }
-                // SAFETY: the atomic counter hands each index to exactly one worker
-                unsafe { slots[k].run(&f) };
             });
             // `team.run` returned: every worker is done with the slots
             slots.into_iter().map(ClaimSlot::into_result).collect()
         }
         _ => items.into_iter().map(f).collect(),
+    }
+}
+
+/// The items of a phase shared out in contiguous home ranges, one per worker.
+/// Each range is one atomic word `(front << 32) | back`: the owner takes items
+/// from the front, the others take them from the back, and a compare-exchange
+/// makes sure every item is taken exactly once.
+struct HomeShares {
+    ranges: Vec<AtomicU64>,
+}
+
+impl HomeShares {
+    fn new(items: usize, workers: usize) -> Self {
+        let workers = workers.max(1);
+        let ranges = (0..workers)
+            .map(|w| {
+                let (lo, hi) = (w * items / workers, (w + 1) * items / workers);
+                AtomicU64::new(((lo as u64) << 32) | hi as u64)
+            })
+            .collect();
+        HomeShares { ranges }
+    }
+
+    /// The next item for `worker`: its own next one, or else one from the end
+    /// of another worker's share; `None` once every item is taken.
+    fn claim(&self, worker: usize) -> Option<usize> {
+        let n = self.ranges.len();
+        let own = worker % n;
+        if let Some(k) = self.take(own, true) {
+            return Some(k);
+        }
+        (1..n).find_map(|v| self.take((own + v) % n, false))
+    }
+
+    fn take(&self, share: usize, from_front: bool) -> Option<usize> {
+        let word = &self.ranges[share];
+        let mut current = word.load(Ordering::Acquire);
+        loop {
+            let (front, back) = (current >> 32, current & 0xffff_ffff);
+            if front >= back {
+                return None;
+            }
+            let (next, item) = if from_front {
+                (((front + 1) << 32) | back, front)
+            } else {
+                ((front << 32) | (back - 1), back - 1)
+            };
+            match word.compare_exchange_weak(current, next, Ordering::AcqRel, Ordering::Acquire) {
+                Ok(_) => return Some(item as usize),
+                Err(seen) => current = seen,
+            }
+        }
     }
 }
 
@@ -267,4 +320,69 @@ pub fn split_ranges<'a, T>(mut slice: &'a mut [T], ranges: &[(usize, usize)]) ->
         consumed = hi;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::AtomicU32;
+
+    #[test]
+    fn home_shares_start_with_each_workers_own_range() {
+        let shares = HomeShares::new(8, 2);
+        assert_eq!(shares.claim(0), Some(0));
+        assert_eq!(shares.claim(1), Some(4));
+        assert_eq!(shares.claim(0), Some(1));
+        // worker 1 drains its own share front to back ...
+        assert_eq!(shares.claim(1), Some(5));
+        assert_eq!(shares.claim(1), Some(6));
+        assert_eq!(shares.claim(1), Some(7));
+        // ... then takes from the far end of worker 0's share
+        assert_eq!(shares.claim(1), Some(3));
+        assert_eq!(shares.claim(0), Some(2));
+        assert_eq!(shares.claim(0), None);
+        assert_eq!(shares.claim(1), None);
+    }
+
+    #[test]
+    fn every_item_is_claimed_exactly_once_under_contention() {
+        for (items, workers) in [(8, 2), (13, 3), (1, 4), (64, 4)] {
+            for _ in 0..200 {
+                let shares = HomeShares::new(items, workers);
+                let hits: Vec<AtomicU32> = (0..items).map(|_| AtomicU32::new(0)).collect();
+                std::thread::scope(|s| {
+                    for w in 0..workers {
+                        let (shares, hits) = (&shares, &hits);
+                        s.spawn(move || {
+                            while let Some(k) = shares.claim(w) {
+                                hits[k].fetch_add(1, Ordering::Relaxed);
+                            }
+                        });
+                    }
+                });
+                assert!(hits.iter().all(|h| h.load(Ordering::Relaxed) == 1));
+            }
+        }
+    }
+
+    #[test]
+    fn map_blocks_returns_results_in_item_order_with_a_team() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let team = Team::new(2);
+        let out = pool.broadcast(|ctx| {
+            if ctx.index() == 0 {
+                let r = map_blocks(Some(&team), (0..37u64).collect(), |k| k * k);
+                team.dismiss();
+                Some(r)
+            } else {
+                team.serve(ctx.index());
+                None
+            }
+        });
+        let squares = out.into_iter().next().flatten().unwrap();
+        assert_eq!(squares, (0..37u64).map(|k| k * k).collect::<Vec<_>>());
+    }
 }
