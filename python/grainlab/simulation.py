@@ -749,7 +749,9 @@ class Simulation:
         given on particle ``i`` (the engine reports them on ``j``), and wall
         normals point from the particle to the wall. ``kind`` gives each
         particle's :class:`~grainlab.snapshot.ParticleKind`; ``metadata`` may set
-        ``time`` and ``axial_strain`` and any other key.
+        ``time`` and ``axial_strain`` and any other key. The particles'
+        ``velocity`` (m/s, (N, 2)) and ``angular_velocity`` (rad/s, (N,)) travel
+        as ``particle_fields``.
         """
         c = self.contacts()
         w = self.wall_contacts()
@@ -779,6 +781,10 @@ class Simulation:
             time=time,
             axial_strain=axial_strain,
             kind=kind,
+            particle_fields={
+                "velocity": self.velocities,
+                "angular_velocity": self.angular_velocities,
+            },
             metadata=metadata,
         )
 
