@@ -49,7 +49,9 @@ pub fn linear_coulomb(
     if model.normal_damping_ratio > 0.0 {
         let c_n = 2.0 * model.normal_damping_ratio * (reduced_mass * model.normal_stiffness).sqrt();
         let damped = (normal - c_n * normal_velocity).max(0.0);
-        viscous_dissipation += (damped - normal) * normal_velocity * dt;
+        // the dashpot's force (damped - normal) opposes the normal velocity; the
+        // energy it takes out of the system is its negative power
+        viscous_dissipation += (normal - damped) * normal_velocity * dt;
         normal = damped;
     }
     let trial = *shear_spring - model.shear_stiffness * tangential_velocity * dt;
@@ -136,5 +138,26 @@ mod tests {
         // separating fast: the dashpot would make the force attractive; it is clipped to 0
         let f = linear_coulomb(&m, 1.0e-9, 10.0, 0.0, 1e-6, 1.0, &mut s);
         assert_eq!(f.normal, 0.0);
+    }
+
+    #[test]
+    fn normal_dashpot_dissipates_its_power() {
+        let mut m = model(0.0);
+        m.normal_damping_ratio = 0.3;
+        let (mass, vn, dt) = (2.0, -0.4, 1e-6);
+        let c_n = 2.0 * 0.3 * (mass * m.normal_stiffness).sqrt();
+        let mut s = 0.0;
+        // approaching: the dashpot pushes harder and takes c_n vn^2 dt out of the system
+        let f = linear_coulomb(&m, 1.0e-3, vn, 0.0, dt, mass, &mut s);
+        assert!((f.normal - (1000.0 - c_n * vn)).abs() < 1e-9);
+        assert!((f.viscous_dissipation - c_n * vn * vn * dt).abs() < 1e-15);
+        // separating: the dashpot holds back and still dissipates c_n vn^2 dt
+        let f = linear_coulomb(&m, 1.0e-3, -vn, 0.0, dt, mass, &mut s);
+        assert!(f.normal < 1000.0 && f.normal > 0.0);
+        assert!((f.viscous_dissipation - c_n * vn * vn * dt).abs() < 1e-15);
+        // clipped at zero (no pull): it takes out the work of the spring force it removed
+        let f = linear_coulomb(&m, 1.0e-6, -vn, 0.0, dt, mass, &mut s);
+        assert_eq!(f.normal, 0.0);
+        assert!((f.viscous_dissipation - 1.0 * -vn * dt).abs() < 1e-18);
     }
 }
