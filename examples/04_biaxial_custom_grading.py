@@ -1,11 +1,12 @@
 """A biaxial test on a sample with your own grading, and the grading it really got.
 
 The biaxial protocol (docs/biaxial.md) generates its sample from the grading
-its configuration names: ``sample.grading`` (``uniform_by_mass``,
-``uniform_by_number`` or ``paper``) between ``sample.d_min`` and
-``sample.d_max``. Here the grading is a straight grading curve by mass from
-0.8 to 2 mm (``uniform_by_mass``: equal mass in every size interval), unlike
-the paper's 0.5-3 mm sand. The script runs the test through the Python API
+its configuration names: ``sample.grading`` (``paper``, ``uniform_by_number``,
+``uniform_by_mass`` or ``curve``). Here it is a sieve table, the way a
+laboratory reports a sand: ``sample.grading = "curve"`` with
+``sample.sieve_sizes`` 0.8, 1.0, 1.4 and 2 mm passing 0, 20, 60 and 100 % by
+mass (straight lines in log d between sieves), unlike the paper's 0.5-3 mm
+sand. The script runs the test through the Python API
 (``resolve`` + ``run_biaxial``, what ``grainlab biaxial --set ...`` does),
 then reads the grains back from ``run.h5`` and compares their grading curve
 (percent passing by mass, 2D mass ~ d^2) with the one asked for: D10, D30,
@@ -22,9 +23,11 @@ Run it::
     python examples/04_biaxial_custom_grading.py --small    # 20 x 40 mm to 5 % strain, about 10 s
     python examples/04_biaxial_custom_grading.py --out DIR  # keep the results folder
 
-A sieve-table grading (``grainlab.samples.GradingCurve``) makes samples on
-its own (examples/03_custom_sample.py); the biaxial configuration has no key
-for one yet.
+The same from the command line::
+
+    grainlab biaxial --set 'sample.grading="curve"' \
+        --set 'sample.sieve_sizes=["0.8 mm", "1.0 mm", "1.4 mm", "2 mm"]' \
+        --set 'sample.percent_passing=[0, 20, 60, 100]'
 """
 
 from __future__ import annotations
@@ -38,11 +41,15 @@ import numpy as np
 from grainlab.io.hdf5 import read_results
 from grainlab.protocols.biaxial import run_biaxial
 from grainlab.protocols.config import resolve
-from grainlab.samples import UniformByMass
+from grainlab.samples import GradingCurve
 from grainlab.snapshot import ParticleKind
 
-#: The grading asked for: a straight grading curve by mass, 0.8-2 mm.
-GRADING = {"sample.grading": "uniform_by_mass", "sample.d_min": "0.8 mm", "sample.d_max": "2 mm"}
+#: The grading asked for: a sieve table (sizes, percent passing by mass).
+GRADING = {
+    "sample.grading": "curve",
+    "sample.sieve_sizes": ["0.8 mm", "1.0 mm", "1.4 mm", "2 mm"],
+    "sample.percent_passing": [0, 20, 60, 100],
+}
 
 FULL = {"sample.width": "50 mm", "sample.height": "100 mm"}
 SMALL = {
@@ -77,7 +84,7 @@ def coefficients(sizes: dict[int, float]) -> tuple[float, float]:
 def main(out: Path, small: bool = False) -> dict[str, float]:
     overrides = {**GRADING, **(SMALL if small else FULL), "run.threads": 1}
     config = resolve(overrides=overrides)  # validated before any work: units, ranges, d_max vs box
-    target = UniformByMass(config["sample.d_min"], config["sample.d_max"])
+    target = GradingCurve(config["sample.sieve_sizes"], config["sample.percent_passing"])
     print(
         f"grading asked for: {target.name}; sample {config['sample.width'] * 1e3:g} x "
         f"{config['sample.height'] * 1e3:g} mm, porosity {config['sample.porosity']:g}, "

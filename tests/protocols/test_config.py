@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
-from grainlab.protocols.config import ConfigError, resolve
+from grainlab.protocols.config import BiaxialConfig, ConfigError, resolve
 
 
 def test_defaults_are_table_1():
@@ -67,3 +69,40 @@ def test_missing_or_broken_file(tmp_path):
 def test_round_trip_through_nested_dict():
     c = resolve(overrides=["shear.final_strain=0.05"])
     assert type(c).from_dict(c.to_dict()).values == c.values
+
+
+def test_sieve_table_grading_sets_the_size_range():
+    config = resolve(
+        overrides=[
+            'sample.grading="curve"',
+            'sample.sieve_sizes=["0.8 mm", "1.2 mm", "2 mm"]',
+            "sample.percent_passing=[0, 40, 100]",
+        ]
+    )
+    assert config["sample.sieve_sizes"] == pytest.approx([0.8e-3, 1.2e-3, 2.0e-3])
+    assert config["sample.percent_passing"] == [0.0, 40.0, 100.0]
+    assert (config["sample.d_min"], config["sample.d_max"]) == pytest.approx((0.8e-3, 2.0e-3))
+    # the resolved configuration round-trips through its nested form (run.h5, TOML)
+    assert BiaxialConfig.from_dict(config.to_dict()).values == config.values
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        (["sample.sieve_sizes=[1e-3, 2e-3]"], "only used with sample.grading = 'curve'"),
+        (['sample.grading="curve"'], "at least 2 sieve sizes"),
+        (['sample.grading="curve"', "sample.sieve_sizes=[1e-3, 2e-3]", "sample.percent_passing=[0]"],
+         "one percentage per size"),
+        (['sample.grading="curve"', "sample.sieve_sizes=[2e-3, 1e-3]", "sample.percent_passing=[0, 100]"],
+         "sample.sieve_sizes[1]: sizes must strictly increase"),
+        (['sample.grading="curve"', "sample.sieve_sizes=[1e-3, 2e-3]", "sample.percent_passing=[0, 90]"],
+         "percent_passing[1]: the largest sieve must pass 100%"),
+        (['sample.grading="curve"', "sample.sieve_sizes=[1e-3, 2e-3]", "sample.percent_passing=[0, 120]"],
+         "sample.percent_passing: 120 is out of range"),
+        (['sample.grading="curve"', 'sample.sieve_sizes=["1 mm", "2 kg"]', "sample.percent_passing=[0, 100]"],
+         "unknown unit 'kg'"),
+    ],
+)
+def test_bad_sieve_tables_are_refused_before_any_work(overrides, message):
+    with pytest.raises(ConfigError, match=re.escape(message)):
+        resolve(overrides=overrides)

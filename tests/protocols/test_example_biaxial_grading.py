@@ -30,7 +30,7 @@ def run(tmp_path_factory):
 
 def test_generated_sample_has_the_requested_grading(run):
     out, result, text = run
-    d_min, d_max = 0.8e-3, 2.0e-3  # the example's uniform_by_mass grading
+    d_min, d_max = 0.8e-3, 2.0e-3  # the example's sieve table: 0.8, 1.0, 1.4, 2 mm pass 0, 20, 60, 100 %
     # Independent reading of run.h5: the grains' diameters and their mass (2D: ~ d^2).
     snap = read_results(out / "run.h5").snapshot(0)
     d = 2.0 * np.asarray(snap.radii)[np.asarray(snap.kind) == ParticleKind.SOIL]
@@ -41,13 +41,17 @@ def test_generated_sample_has_the_requested_grading(run):
     order = np.sort(d)
     cum = np.cumsum(order**2) / np.sum(order**2)
     d50 = order[np.searchsorted(cum, 0.5)]
-    target_d50 = d_min + 0.5 * (d_max - d_min)  # uniform by mass: a straight grading curve
+    # 50 % lies between the 1.0 mm (20 %) and 1.4 mm (60 %) sieves, straight in log d
+    target_d50 = 1.0e-3 * 1.4 ** ((50 - 20) / (60 - 20))
     # Sampling scatter of a mass percentile with ~560 grains is about 2 %, the radius factor about 1 %.
     assert d50 == pytest.approx(target_d50, rel=0.05)
     assert result["D50"] == pytest.approx(d50, rel=0.01)
     for p in (10, 30, 50, 60):
         assert result[f"D{p}"] == pytest.approx(result[f"target_D{p}"], rel=0.05), p
-        assert result[f"target_D{p}"] == pytest.approx(d_min + p / 100 * (d_max - d_min), rel=1e-3)
+    # the target sizes, read off the sieve table by hand (log-linear between sieves)
+    expected = {10: 0.8e-3 * 1.25 ** 0.5, 30: 1.0e-3 * 1.4**0.25, 50: target_d50, 60: 1.4e-3}
+    for p, size in expected.items():
+        assert result[f"target_D{p}"] == pytest.approx(size, rel=2e-3), p
     # The whole curve: a Dvoretzky-Kiefer-Wolfowitz band at 99.9 % for ~560 draws is about
     # 8 percentage points (wider by mass, which weights the coarse grains); 10 leaves margin.
     assert result["max_curve_gap_percent"] < 10.0
@@ -59,8 +63,10 @@ def test_biaxial_response_is_that_of_a_dense_soil(run):
     out, result, text = run
     ts = read_results(out / "run.h5").timeseries
     ratio, eps = ts["stress_ratio"], ts["axial_strain"]
-    # isotropic at the start of shearing: the membrane carries sigma_3 = sigma_1
-    assert ratio[0] == pytest.approx(1.0, abs=0.1)
+    # near-isotropic at the start of shearing: the walls consolidate to sigma_0 on both axes,
+    # then the platens hold still while the membrane takes over and friction switches on,
+    # which moves sigma_1 by up to ~11 % on a sample this small (0.5 % on the default one)
+    assert ratio[0] == pytest.approx(1.0, abs=0.15)
     # a peak well above 1 inside the run, then softening
     peak = int(np.argmax(ratio))
     assert result["peak_stress_ratio"] == pytest.approx(ratio[peak])

@@ -57,6 +57,7 @@ from grainlab.protocols.boundary import (
 from grainlab.protocols.config import BiaxialConfig
 from grainlab.samples import (
     PAPER_GRADING,
+    GradingCurve,
     UniformByMass,
     UniformByNumber,
     expand_to_porosity,
@@ -139,6 +140,8 @@ def _grading(config: BiaxialConfig):
         return UniformByNumber(d_min, d_max)
     if kind == "uniform_by_mass":
         return UniformByMass(d_min, d_max)
+    if kind == "curve":
+        return GradingCurve(config["sample.sieve_sizes"], config["sample.percent_passing"])
     if (d_min, d_max) != (PAPER_GRADING.d_min, PAPER_GRADING.d_max):
         raise ValueError(
             "sample.grading: 'paper' is the 0.5-3 mm curve; with other sample.d_min/d_max "
@@ -706,6 +709,7 @@ def run_biaxial(
     total = elapsed_before + time.perf_counter() - started
     timeseries = writer.read_timeseries()
     summary = _summary(run, config, timeseries, total)
+    summary["threads"] = threads  # "auto" resolved: the same count reruns bitwise (DESIGN §6)
     writer.write_summary(summary)
     writer.write_phases(run.wall_time)
     writer.finalize()

@@ -79,7 +79,17 @@ FIELDS: dict[str, Field] = {
     "sample.d_min": Field("length", 0.5e-3, "smallest grain diameter (Table 1: 0.5 mm)", **_POSITIVE),
     "sample.d_max": Field("length", 3.0e-3, "largest grain diameter (Table 1: 3 mm)", **_POSITIVE),
     "sample.grading": Field(
-        "choice", "paper", "grain size distribution", choices=("paper", "uniform_by_number", "uniform_by_mass")
+        "choice", "paper",
+        "grain size distribution; 'curve' takes sample.sieve_sizes and sample.percent_passing",
+        choices=("paper", "uniform_by_number", "uniform_by_mass", "curve"),
+    ),
+    "sample.sieve_sizes": Field(
+        "length_list", [],
+        "sieve sizes of a 'curve' grading, smallest first (they set d_min and d_max)",
+    ),
+    "sample.percent_passing": Field(
+        "percent_list", [],
+        "percent passing by mass at each sieve size of a 'curve' grading (0 first, 100 last)",
     ),
     "sample.seed": Field("integer", 1, "random seed of the sample", minimum=0),
     "sample.generation_friction": Field("number", 0.0, "particle friction during radius expansion", minimum=0.0),
@@ -146,6 +156,13 @@ FIELDS: dict[str, Field] = {
     "run.checkpoint_interval": Field("time", 30.0, "wall-clock time between checkpoints", **_POSITIVE),
 }
 
+#: Item kind and range of each list kind.
+_LIST_ITEMS: dict[str, tuple[str, Field]] = {
+    "strain_list": ("strains", Field("strain", 0.0, "", minimum=0.0, maximum=0.5)),
+    "length_list": ("lengths", Field("length", 0.0, "", minimum=0.0, exclusive_minimum=True)),
+    "percent_list": ("percentages", Field("number", 0.0, "", minimum=0.0, maximum=100.0)),
+}
+
 #: Overrides of ``--quick``: a small sample of a few hundred disks, for demos and CI.
 QUICK: dict[str, Any] = {"sample.width": 0.03, "sample.height": 0.06}
 
@@ -202,14 +219,16 @@ def coerce(key: str, value: Any) -> Any:
         ):
             raise ConfigError(f"{key}: expected an integer >= {field.minimum:g}, got {value!r}")
         return int(_check_range(key, field, float(int(value))))
-    if field.kind == "strain_list":
+    if field.kind in _LIST_ITEMS:
+        what, item = _LIST_ITEMS[field.kind]
         items = value
         if isinstance(value, str):
             items = [v for v in value.strip("[]").split(",") if v.strip()]
         if not isinstance(items, list | tuple):
-            raise ConfigError(f"{key}: expected a list of strains, got {value!r}")
-        strain = Field("strain", 0.0, "", minimum=0.0, maximum=0.5)
-        return sorted(_check_range(key, strain, _parse_quantity(key, strain, v)) for v in items)
+            raise ConfigError(f"{key}: expected a list of {what}, got {value!r}")
+        numbers = [_check_range(key, item, _parse_quantity(key, item, v)) for v in items]
+        # snapshot strains are a set of times; sieve data keep their given order
+        return sorted(numbers) if field.kind == "strain_list" else numbers
     return _check_range(key, field, _parse_quantity(key, field, value))
 
 
@@ -289,7 +308,32 @@ def resolve(
     return BiaxialConfig(resolved)
 
 
+def _grading_curve(v: dict[str, Any]) -> None:
+    """Checks a 'curve' grading's sieve data and takes d_min and d_max from it."""
+    sizes, passing = v["sample.sieve_sizes"], v["sample.percent_passing"]
+    if v["sample.grading"] != "curve":
+        if sizes or passing:
+            raise ConfigError(
+                "sample.sieve_sizes/sample.percent_passing: only used with sample.grading = 'curve', "
+                f"got sample.grading = {v['sample.grading']!r}"
+            )
+        return
+    from grainlab.samples import GradingCurve  # the samples package checks the curve itself
+
+    if len(sizes) < 2 or len(passing) != len(sizes):
+        raise ConfigError(
+            "sample.sieve_sizes/sample.percent_passing: a 'curve' grading needs at least 2 sieve sizes "
+            f"and one percentage per size, got {len(sizes)} sizes and {len(passing)} percentages"
+        )
+    try:
+        GradingCurve(sizes, passing)
+    except ValueError as error:
+        raise ConfigError("sample." + str(error).replace("sieve_sizes_m", "sieve_sizes", 1)) from None
+    v["sample.d_min"], v["sample.d_max"] = sizes[0], sizes[-1]
+
+
 def _check_consistency(v: dict[str, Any]) -> None:
+    _grading_curve(v)
     if v["sample.d_min"] > v["sample.d_max"]:
         raise ConfigError(
             f"sample.d_min: {v['sample.d_min']:g} m exceeds sample.d_max {v['sample.d_max']:g} m"
