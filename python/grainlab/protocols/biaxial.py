@@ -33,6 +33,7 @@ import io
 import math
 import os
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -106,6 +107,36 @@ TIMESERIES_UNITS = {
     "boundary_work_j": "J",
     "wall_work_j": "J",
 }
+
+
+class DensityScalingWarning(UserWarning):
+    """The strain rate makes the density-scaled sample too dynamic (paper Eq. 16)."""
+
+
+#: DESIGN §3: above this density scaling factor (paper Eq. 16) a run is warned about.
+DENSITY_SCALING_LIMIT = 1.0e-3
+
+
+def check_density_scaling(config: BiaxialConfig) -> float | None:
+    """The Eq. 16 factor of an explicit ``shear.strain_rate`` (smallest grain,
+    ``sample.d_min / 2``, at ``sigma_3``), with a :class:`DensityScalingWarning`
+    when it exceeds :data:`DENSITY_SCALING_LIMIT`; ``None`` for the ``auto``
+    rate, which keeps the factor at or below ``shear.inertial_number``."""
+    rate = config["shear.strain_rate"]
+    if rate == "auto":
+        return None
+    factor = grainlab.density_scaling_factor(
+        rate, config["material.density"], 0.5 * config["sample.d_min"], config["consolidation.pressure"]
+    )
+    if factor > DENSITY_SCALING_LIMIT:
+        warnings.warn(
+            f"shear.strain_rate = {rate:g} 1/s gives a density scaling factor (paper Eq. 16) of "
+            f"{factor:.1e}, above {DENSITY_SCALING_LIMIT:g}: inertia may change the result; "
+            "lower the strain rate or the density, or use the auto rate",
+            DensityScalingWarning,
+            stacklevel=3,
+        )
+    return factor
 
 
 class BiaxialError(RuntimeError):
@@ -664,6 +695,7 @@ def run_biaxial(
     out = Path(out_dir)
     checkpoint_path = out / "checkpoint.h5"
     started = time.perf_counter()
+    check_density_scaling(config)
     threads = _threads(config)
     if resume:
         if not checkpoint_path.exists():

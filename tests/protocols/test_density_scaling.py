@@ -1,0 +1,34 @@
+"""DESIGN §3: a strain rate whose density scaling factor (paper Eq. 16) exceeds
+1e-3 is warned about before any work."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import pytest
+
+from grainlab.protocols.biaxial import DensityScalingWarning, check_density_scaling, run_biaxial
+from grainlab.protocols.config import resolve
+
+
+def eq16(rate: float, density: float, radius: float, pressure: float) -> float:
+    # paper Eq. 16: f = rate * r_min * sqrt(rho / p), the inertial number of the smallest grain
+    return rate * radius * math.sqrt(density / pressure)
+
+
+def test_factor_is_eq16_of_the_smallest_grain_and_quiet_below_the_limit():
+    config = resolve(overrides=["shear.strain_rate=0.01"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        factor = check_density_scaling(config)
+    assert factor == pytest.approx(eq16(0.01, 2.0e8, 0.25e-3, 1.0e5), rel=1e-12)
+    assert check_density_scaling(resolve()) is None  # the auto rate is bounded by construction
+
+
+def test_fast_rate_is_warned_about_before_any_work(tmp_path):
+    config = resolve(overrides=["shear.strain_rate=0.2"])
+    assert eq16(0.2, 2.0e8, 0.25e-3, 1.0e5) > 1e-3
+    (tmp_path / "run.h5").write_bytes(b"")  # a folder that holds a run: refused right after the check
+    with pytest.warns(DensityScalingWarning, match=r"Eq\. 16\) of 2\.2e-03"), pytest.raises(ValueError):
+        run_biaxial(config, tmp_path, progress=False)
