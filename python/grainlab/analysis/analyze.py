@@ -41,7 +41,9 @@ class AnalysisResult:
 
         a = self.anisotropy
         fa = self.force_anisotropy
-        b = self.band
+        candidate = self.band
+        b = self.found_band
+        b2 = b.second if b is not None and b.second is not None and b.second.found else None
         out: dict[str, Any] = {
             "n_particles": self.coordination.n_particles,
             "n_contacts": self.coordination.n_contacts_total,
@@ -67,13 +69,26 @@ class AnalysisResult:
             "mean_lambda": num(self.stability.mean),
             "mean_lambda_all": num(self.stability.mean_all),
             "lambda_includes_boundary_contacts": self.stability.include_boundary,
+            "band_found": b is not None,
+            "band_reason": (
+                candidate.reason
+                if candidate is not None
+                else "no shear band searched (no reference or too few strains)"
+            ),
             "band_angle_deg": num(b.angle_degrees) if b else None,
+            "band_inclination_deg": num(b.inclination_degrees) if b else None,
             "band_thickness_m": num(b.thickness) if b else None,
             "band_thickness_diameters": num(b.thickness_diameters) if b else None,
             "band_n_particles": int(b.members.sum()) if b else None,
             "band_contrast": num(b.contrast) if b else None,
+            "band_prominence": num(b.prominence) if b else None,
             "mean_lambda_in_band": num(b.mean_lambda_inside) if b else None,
             "mean_lambda_outside_band": num(b.mean_lambda_outside) if b else None,
+            "band2_found": b2 is not None,
+            "band2_angle_deg": num(b2.angle_degrees) if b2 else None,
+            "band2_inclination_deg": num(b2.inclination_degrees) if b2 else None,
+            "band2_thickness_diameters": num(b2.thickness_diameters) if b2 else None,
+            "band2_contrast": num(b2.contrast) if b2 else None,
             "has_reference": self.strain is not None,
             "time": self.snapshot.time,
             "axial_strain": self.snapshot.axial_strain,
@@ -83,6 +98,15 @@ class AnalysisResult:
             "notes": list(self.notes),
         }
         return out
+
+    @property
+    def found_band(self) -> ShearBand | None:
+        """The detected band when it passed ShearBand's acceptance test, else None.
+
+        :attr:`band` keeps the candidate either way (its ``reason`` says why it
+        was not accepted).
+        """
+        return self.band if self.band is not None and self.band.found else None
 
     def particle_table(self) -> dict[str, NDArray[Any]]:
         """Per-particle columns for ``particles.csv`` (beyond id,x,y,radius)."""
@@ -94,7 +118,9 @@ class AnalysisResult:
             "stability_index": self.stability.stability_index,
             "displacement": s.displacement_magnitude if s else nan,
             "local_shear_strain": s.shear_strain if s else nan,
-            "in_shear_band": self.band.members.astype(np.int64) if self.band else nan,
+            "in_shear_band": (self.band.members & self.band.found).astype(np.int64)
+            if self.band
+            else nan,
         }
         if s:
             cols["displacement_x"] = s.displacement[:, 0]
@@ -124,7 +150,7 @@ class AnalysisResult:
         if self.force_anisotropy is not None:
             written += plot.save_figure(self.force_anisotropy.plot(), out / "normal_forces")
         written += plot.save_figure(
-            self.stability.plot(band=self.band), out / "map_stability_index"
+            self.stability.plot(band=self.found_band), out / "map_stability_index"
         )
         ax = plot.particle_map(
             snap.positions,
@@ -133,13 +159,16 @@ class AnalysisResult:
             discrete=True,
             cmap="viridis",
             label="number of contacts",
-            band=self.band,
+            band=self.found_band,
         )
         written += plot.save_figure(ax, out / "map_contacts")
         if self.strain is not None:
-            written += plot.save_figure(self.strain.plot(band=self.band), out / "map_displacement")
             written += plot.save_figure(
-                self.strain.plot(quantity="shear_strain", band=self.band), out / "map_shear_strain"
+                self.strain.plot(band=self.found_band), out / "map_displacement"
+            )
+            written += plot.save_figure(
+                self.strain.plot(quantity="shear_strain", band=self.found_band),
+                out / "map_shear_strain",
             )
         return written
 

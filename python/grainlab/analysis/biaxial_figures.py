@@ -22,7 +22,10 @@ Shear band
     neighbourhoods give spurious strains; they still belong to the band when
     they lie inside it. The candidate band is accepted when it
 
-    1. is at least one mean grain diameter thick,
+    1. passes ShearBand's own tests (:attr:`ShearBand.found
+       <grainlab.analysis.ShearBand.found>`): at least one mean grain
+       diameter thick, and its excess strain over the background at least
+       twice the largest excess elsewhere on the profile across it,
     2. crosses the sample: the centre line's chord through the grains is at
        least 3/4 of the sample's smaller side and the band's grains cover at
        least 3/4 of that chord (a slab that cuts off a corner is not a band),
@@ -31,7 +34,14 @@ Shear band
        the same strain values over the same grains (p <= 0.05, fixed seed).
 
     Otherwise the band is "not found": the maps are drawn without an outline,
-    the panel title says so and :attr:`BandNumbers.reason` says why.
+    the panel title says so and :attr:`BandNumbers.reason` says why. A found
+    band's panel titles give its inclination to the horizontal and thickness.
+
+    The **second band** (ShearBand's second pass, without the first band's
+    grains and at least 20 degrees away from its direction: the conjugate
+    band of a biaxial test) is reported in the ``second_*`` fields of
+    :class:`BandNumbers` and outlined dotted when it passes tests 1 and 2
+    (and the first band was found).
 
 Stability index
     lambda with the library's default: contacts with membrane disks and
@@ -160,6 +170,17 @@ class BandNumbers:
     mean_lambda_outside: float
     #: Permutation p-value of the band's eta² (1/20 is the smallest possible).
     p_value: float
+    #: Band excess strain / largest excess elsewhere on its profile (ShearBand.prominence).
+    prominence: float = math.nan
+    #: The second (conjugate) band: accepted or not, and its numbers (NaN when
+    #: there is no candidate); same conventions as the first band's fields.
+    second_found: bool = False
+    second_reason: str = ""
+    second_angle_deg: float = math.nan
+    second_inclination_deg: float = math.nan
+    second_thickness_diameters: float = math.nan
+    second_contrast: float = math.nan
+    second_prominence: float = math.nan
 
 
 @dataclass
@@ -272,9 +293,18 @@ class FabricNumbers:
                 out.append(
                     f"{label} ({b.snapshot}): angle {b.angle_deg:.1f} deg (inclination "
                     f"{b.inclination_deg:.1f} deg), thickness {b.thickness_diameters:.1f} mean "
-                    f"diameters, {b.n_grains} grains, mean lambda inside {b.mean_lambda_inside:.3f}"
-                    f" / outside {b.mean_lambda_outside:.3f}"
+                    f"diameters, contrast {b.contrast:.2f}, {b.n_grains} grains, mean lambda "
+                    f"inside {b.mean_lambda_inside:.3f} / outside {b.mean_lambda_outside:.3f}"
                 )
+                if b.second_found:
+                    out.append(
+                        f"second (conjugate) band: angle {b.second_angle_deg:.1f} deg "
+                        f"(inclination {b.second_inclination_deg:.1f} deg), thickness "
+                        f"{b.second_thickness_diameters:.1f} mean diameters, contrast "
+                        f"{b.second_contrast:.2f}"
+                    )
+                elif b.second_reason:
+                    out.append(f"no second band: {b.second_reason}")
             else:
                 out.append(f"{label} ({b.snapshot}): not found: {b.reason}")
         out += [f"note: {n}" for n in self.notes]
@@ -319,6 +349,7 @@ class _Band:
     numbers: BandNumbers
     band: ShearBand | None  # the accepted band (None when not found)
     displacement: NDArray[np.float64]  # (N,) of the snapshot, NaN for membrane disks
+    second: ShearBand | None = None  # the accepted second band (None when not found)
 
 
 @dataclass
@@ -459,47 +490,31 @@ def _find_band(reference: _State, current: _State) -> _Band:
             f"only {int(valid.sum())} grains away from the boundary have a local strain "
             "(at least 10 are needed)"
         )
-    band = ShearBand().compute(pos, gamma, rad, mask=interior)
-    normal = band.normal
-    tangent = np.array([np.cos(band.angle), np.sin(band.angle)])
-    s = (pos - band.center) @ normal
-    members = np.abs(s) <= 0.5 * band.thickness
-    # crossing: chord of the centre line through the grains and the members' cover of it
-    near = np.abs(s) <= max(0.5 * band.thickness, d_mean)
-    chord = float(np.ptp(pos[near] @ tangent)) if near.sum() > 1 else 0.0
-    span = float(np.ptp(pos[members] @ tangent)) if members.sum() > 1 else 0.0
+    band = ShearBand(min_thickness=_MIN_THICKNESS_D).compute(pos, gamma, rad, mask=interior)
     side = float(np.ptp(pos, axis=0).min())
     # significance against random rearrangements of the same strain values
     width = band.bin_width * float(np.mean(2.0 * rad[interior]))
-    eta = _eta2(pos[valid], gamma[valid], normal, width)
+    eta = _eta2(pos[valid], gamma[valid], band.normal, width)
     rng = np.random.default_rng(20240611)
     shuffled = gamma.copy()
     null = np.empty(_N_PERMUTATIONS)
     for k in range(_N_PERMUTATIONS):
         shuffled[valid] = rng.permutation(gamma[valid])
-        trial = ShearBand().compute(pos, shuffled, rad, mask=interior)
+        trial = ShearBand(second=False).compute(pos, shuffled, rad, mask=interior)
         null[k] = _eta2(pos[valid], shuffled[valid], trial.normal, width)
     p_value = float((1 + np.sum(null >= eta)) / (_N_PERMUTATIONS + 1))
 
-    problems = []
-    if band.thickness_diameters < _MIN_THICKNESS_D:
-        problems.append(f"thinner than {_MIN_THICKNESS_D:g} mean diameter")
-    if chord < _CROSSING * side or span < _CROSSING * chord:
-        problems.append(
-            f"does not cross the sample (its grains span {span / d_mean:.1f} mean diameters "
-            f"of a {chord / d_mean:.1f}-diameter chord; the sample's smaller side is "
-            f"{side / d_mean:.1f})"
-        )
+    problems = _band_problems(band, pos, d_mean, side)
     if p_value > 0.05:
         problems.append(
             f"not significant (p = {p_value:.2f} against {_N_PERMUTATIONS} random "
             "rearrangements of the strain values)"
         )
+    members = _slab_members(band, pos)
     use = counts >= 2
-    inclination = min(band.angle_degrees, 180.0 - band.angle_degrees)
     numbers: dict[str, Any] = {
         "angle_deg": band.angle_degrees,
-        "inclination_deg": inclination,
+        "inclination_deg": band.inclination_degrees,
         "thickness_m": band.thickness,
         "thickness_diameters": band.thickness_diameters,
         "contrast": band.contrast,
@@ -507,18 +522,67 @@ def _find_band(reference: _State, current: _State) -> _Band:
         "mean_lambda_inside": _finite_mean(lam, use & members),
         "mean_lambda_outside": _finite_mean(lam, use & ~members),
         "p_value": p_value,
+        "prominence": band.prominence,
     }
     if problems:
         return missing(
             f"best candidate at {band.angle_degrees:.1f} deg, {band.thickness_diameters:.1f} "
             "mean diameters thick: " + "; ".join(problems),
             p_value=p_value,
+            prominence=band.prominence,
         )
+    second = band.second
+    accepted_second = None
+    if second is not None:
+        second_problems = _band_problems(second, pos, d_mean, side)
+        numbers.update(
+            second_found=not second_problems,
+            second_reason=(
+                f"best candidate at {second.angle_degrees:.1f} deg, "
+                f"{second.thickness_diameters:.1f} mean diameters thick: "
+                + "; ".join(second_problems)
+                if second_problems
+                else ""
+            ),
+            second_angle_deg=second.angle_degrees,
+            second_inclination_deg=second.inclination_degrees,
+            second_thickness_diameters=second.thickness_diameters,
+            second_contrast=second.contrast,
+            second_prominence=second.prominence,
+        )
+        accepted_second = None if second_problems else second
     return _Band(
         BandNumbers(current.name, reference.name, current.strain, True, "", **numbers),
         band,
         displacement,
+        accepted_second,
     )
+
+
+def _slab_members(band: ShearBand, pos: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Grains whose centre lies inside the band's slab (boundary grains included)."""
+    return np.asarray(np.abs((pos - band.center) @ band.normal) <= 0.5 * band.thickness)
+
+
+def _band_problems(
+    band: ShearBand, pos: NDArray[np.float64], d_mean: float, side: float
+) -> list[str]:
+    """Why a candidate band fails acceptance tests 1 and 2 (module docstring); [] if it passes."""
+    problems = [band.reason] if not band.found else []
+    tangent = np.array([np.cos(band.angle), np.sin(band.angle)])
+    s = (pos - band.center) @ band.normal
+    members = np.abs(s) <= 0.5 * band.thickness
+    # crossing: chord of the centre line through the grains and the members' cover of it
+    near = np.abs(s) <= max(0.5 * band.thickness, d_mean)
+    chord = float(np.ptp(pos[near] @ tangent)) if near.sum() > 1 else 0.0
+    span = float(np.ptp(pos[members] @ tangent)) if members.sum() > 1 else 0.0
+    if chord < _CROSSING * side or span < _CROSSING * chord:
+        problems.append(
+            f"does not cross the sample (its grains span {span / d_mean:.1f} mean diameters "
+            f"of a {chord / d_mean:.1f}-diameter chord; the sample's smaller side is "
+            f"{side / d_mean:.1f})"
+        )
+    return problems
 
 
 def _finite_mean(values: NDArray[np.float64], mask: NDArray[np.bool_]) -> float:
@@ -750,15 +814,28 @@ def _annotate_band(ax: Any, band: _Band | None) -> None:
     if band.band is None:
         ax.set_title(ax.get_title() + "\nno shear band found")
         return
-    for k, seg in enumerate(band.band.outline()):
-        ax.plot(
-            _MM * seg[:, 0],
-            _MM * seg[:, 1],
-            color="crimson",
-            linestyle="--",
-            linewidth=1.0,
-            label="shear band" if k == 0 else None,
+    b = band.numbers
+    text = f"band {b.inclination_deg:.0f}° to horizontal, {b.thickness_diameters:.1f} d"
+    if band.second is not None:
+        text += (
+            f"\nsecond band {b.second_inclination_deg:.0f}°, {b.second_thickness_diameters:.1f} d"
         )
+    ax.set_title(ax.get_title() + "\n" + text)
+    for found, style, label in (
+        (band.band, "--", "shear band"),
+        (band.second, ":", "second band"),
+    ):
+        if found is None:
+            continue
+        for k, seg in enumerate(found.outline()):
+            ax.plot(
+                _MM * seg[:, 0],
+                _MM * seg[:, 1],
+                color="crimson",
+                linestyle=style,
+                linewidth=1.0,
+                label=label if k == 0 else None,
+            )
 
 
 def _map_size(snap: Snapshot, n: int, colorbars: int) -> tuple[float, float]:

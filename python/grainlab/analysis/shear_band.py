@@ -6,8 +6,15 @@ The band is modelled as a straight slab: a centre line at angle
 1. **Orientation.** For a trial angle :math:`\beta` the particles are
    projected on the slab normal :math:`n = (-\sin\beta, \cos\beta)`,
    :math:`s = (x - \bar x) \cdot n`, and binned in ``s`` (bins of
-   ``bin_width``, default half a mean diameter). The score is the adjusted
-   correlation ratio of the strain with the bin,
+   ``bin_width``, default half a mean diameter). Only the bins where the
+   slab *crosses the sample* take part: those with at least ``min_fill``
+   (default 1/2) times as many particles within 2 mean diameters as the
+   fullest position of that angle. The ends of the range, where a slab
+   only clips a corner of the sample, hold few particles; in a biaxial
+   test the platen corners concentrate strain there, and a slab through a
+   corner would otherwise win both the angle score and the peak search
+   (the reason why earlier versions found no band on real runs). The score
+   is the adjusted correlation ratio of the strain with the bin,
 
    .. math::
 
@@ -15,88 +22,212 @@ The band is modelled as a straight slab: a centre line at angle
                     {\sum_p (\gamma_p - \bar\gamma)^2},\qquad
       \eta^2_{adj} = 1 - (1 - \eta^2)\frac{M - 1}{M - B},
 
-   (M particles, B occupied bins), the share of the strain variance that the
-   profile across the slab explains. It is largest when the bins run
-   parallel to the band. A 1° scan over [0°, 180°) is refined with 0.05°
-   steps around the best angle and a parabola through the top three scores.
+   (M particles, B occupied bins, over the bins used), the share of the
+   strain variance that the profile across the slab explains
+   (:attr:`ShearBand.score`). It is largest when the bins run parallel to
+   the band. A 1° scan over [0°, 180°) is refined with 0.05° steps around
+   the best angle and a parabola through the top three scores (the middle
+   of a plateau of equal scores).
 2. **Profile and thickness.** At the best angle the bin means
-   :math:`\bar\gamma_b` form the profile across the band. With the background
-   :math:`\gamma_0` the median strain and the peak :math:`\gamma_{max}` the
-   largest bin mean (3-bin running mean), the band is the run of bins around
-   the peak where the profile is above half height
+   :math:`\bar\gamma_b` form the profile across the band (:attr:`profile`).
+   It is smoothed to the mean strain of the particles within about one mean
+   diameter of each bin. With the background :math:`\gamma_0` the median
+   strain and the peak :math:`\gamma_{max}` the largest smoothed value among
+   the bins that cross the sample, the band is the run of those bins around
+   the peak where the smoothed profile is above half height
    :math:`\gamma_0 + (\gamma_{max} - \gamma_0)/2`; its edges are
    interpolated linearly between the mean positions of the particles in
-   neighbouring bins. ``thickness`` is their
-   distance (m); ``thickness_diameters`` divides by the mean diameter.
+   neighbouring bins. ``thickness`` is their distance (m), the full width at
+   half height of the band's strain profile; ``thickness_diameters`` divides
+   by the mean diameter. The kinematic shear zone (where the displacement
+   parallel to the band changes) is wider: the strain tails off on both
+   sides of the half-height edges.
 3. **Members.** Sample particles whose centre lies inside the slab.
+4. **Acceptance** (:attr:`found`, :attr:`reason`). The band's excess strain
+   :math:`\gamma_{max} - \gamma_0` is compared with the largest excess of the
+   smoothed profile elsewhere (beyond one band thickness, at least 2 mean
+   diameters, from each edge, bins crossing the sample only):
+   ``prominence`` is their ratio. A band is accepted when it is at least
+   ``min_thickness`` (1) mean diameter thick and its prominence is at least
+   ``min_prominence`` (2). On noise (strains shuffled over the grains of a
+   real run, or random non-affine displacements of a packing) the
+   prominence stayed below 1.8 in 240 trials; real bands at 10 % axial strain
+   score 3 to 5. A candidate that fails keeps all its numbers, so that a
+   report can show it as a candidate; :attr:`reason` says what failed.
+5. **Second band** (:attr:`second`). The same search over the particles
+   outside the first band and its flanks (2 mean diameters beyond each
+   edge), at directions at least 20° away from the first band's: in a
+   biaxial test, the conjugate band. It is a ShearBand of its own, with its
+   own :attr:`found`; its members may include first-band particles where the
+   bands cross.
 
-Only the dominant band is found (a conjugate second band counts as
-background). ``contrast = (gamma_max - gamma_0) / gamma_max`` in [0, 1]
-tells how clear the band is (0: no band stands out).
+``contrast = (gamma_max - gamma_0) / gamma_max`` in [0, 1] tells how much of
+the strain in the band is excess over the background (0: nothing stands
+out). ``shear_strain`` is a dimensionless strain: an excess below 1e-9 counts
+as none (round-off of an affine deformation).
+
+Reading the angle
+    :attr:`angle_degrees` is the direction of the band's centre line, CCW
+    from +x, in [0°, 180°): a band rising to the right has an angle below
+    90°, a band falling to the right an angle above 90°. The inclination to
+    a direction at angle :math:`\alpha` (e.g. the minor principal stress
+    :math:`\sigma_3`) is the acute angle between the two lines,
+    :math:`\theta = |((\beta - \alpha + 90°) \bmod 180°) - 90°|`, in
+    [0°, 90°]. In a biaxial test loaded along y, :math:`\sigma_3` is
+    horizontal (:math:`\alpha = 0`): :math:`\theta = \min(\beta, 180° -
+    \beta)`, which :attr:`inclination_degrees` gives. That :math:`\theta` is
+    the angle the classical predictions give: Mohr–Coulomb
+    :math:`45° + \varphi/2`, Roscoe :math:`45° + \psi/2`, Arthur
+    :math:`45° + (\varphi + \psi)/4` (friction angle :math:`\varphi`,
+    dilatancy angle :math:`\psi`).
 
 Which field to pass: :attr:`LocalStrain.excess_shear_strain` (the shear
 invariant of each particle's strain minus the background strain) separates a
 band from a homogeneous deformation of the whole sample better than the total
 :attr:`LocalStrain.shear_strain`, whose invariant mixes the two non-linearly;
-:func:`grainlab.analysis.analyze_snapshot` uses it.
+:func:`grainlab.analysis.analyze_snapshot` and the biaxial figures use it.
+
+For a report, :meth:`ShearBand.summary` gives the scalars as a JSON-ready
+dict (``found``, ``reason``, ``angle_deg``, ``inclination_deg``,
+``thickness_diameters``, ``contrast``, ``prominence``, ..., ``second``).
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.ndimage import uniform_filter1d
 
 from grainlab.analysis._util import Computable, finite_mean
 from grainlab.snapshot import Snapshot
 
 __all__ = ["ShearBand"]
 
+#: The second band's direction differs from the first's by at least this much (rad).
+_SECOND_SEPARATION = np.radians(20.0)
+#: Least width (mean diameters) of each flank of a band: left out of the prominence's
+#: "elsewhere" and of the search for the second band.
+_FLANK_D = 2.0
+#: Excess strain (and fraction of the largest strain) below which there is no band at all.
+_MIN_EXCESS = 1.0e-9
+#: Width (mean diameters) of the running mean over the profile bins.
+_SMOOTH_D = 2.0
+#: Width of the window (mean diameters) over which bin counts are summed to judge
+#: how much of the sample a slab crosses.
+_FILL_WINDOW_D = 2.0
+
+
+def _slab_bins(
+    s: NDArray[np.float64], width: float, window: int, min_fill: float
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_]]:
+    """Bin index of each point, bin counts and the bins that cross the sample.
+
+    ``s`` is (K, M) (or (M,)): the projections on K trial normals. A bin
+    crosses the sample when the particles within ``window`` bins of it are at
+    least ``min_fill`` times as many as around the fullest bin of the same
+    angle; the others are the slab ends that only clip a corner.
+    """
+    s = np.atleast_2d(s)
+    b = ((s - s.min(axis=1, keepdims=True)) / width).astype(np.int64)
+    nb = int(b.max()) + 1
+    k = s.shape[0]
+    key = (np.arange(k)[:, None] * nb + b).ravel()
+    counts = np.bincount(key, minlength=k * nb).reshape(k, nb)
+    around = uniform_filter1d(counts.astype(np.float64), size=window, axis=1, mode="constant")
+    crossing = (counts > 0) & (around >= min_fill * around.max(axis=1, keepdims=True))
+    return b, counts, crossing
+
 
 def _scores(
-    p: NDArray[np.float64], g: NDArray[np.float64], angles: NDArray[np.float64], width: float
+    p: NDArray[np.float64],
+    g: NDArray[np.float64],
+    angles: NDArray[np.float64],
+    width: float,
+    window: int = 1,
+    min_fill: float = 0.0,
 ) -> NDArray[np.float64]:
-    """Adjusted eta^2 of g against bins of the projection on each angle's normal."""
-    m = p.shape[0]
+    """Adjusted eta^2 of g against bins across the slab, for each trial angle.
+
+    Only the particles in bins that cross the sample (:func:`_slab_bins`) count.
+    """
     normal = np.stack([-np.sin(angles), np.cos(angles)], axis=1)  # (K, 2)
-    s = normal @ p.T  # (K, M)
-    s -= s.min(axis=1, keepdims=True)
-    b = (s / width).astype(np.int64)
-    nb = int(b.max()) + 1
-    key = (np.arange(angles.size)[:, None] * nb + b).ravel()
-    counts = np.bincount(key, minlength=angles.size * nb).reshape(angles.size, nb)
-    sums = np.bincount(key, weights=np.broadcast_to(g, s.shape).ravel(), minlength=angles.size * nb)
-    sums = sums.reshape(angles.size, nb)
-    mean = g.mean()
-    total = float(((g - mean) ** 2).sum())
-    if total <= 0.0:
-        return np.zeros(angles.size)
+    b, _, crossing = _slab_bins(normal @ p.T, width, window, min_fill)
+    k, nb = crossing.shape
+    use = np.take_along_axis(crossing, b, axis=1).astype(np.float64)  # (K, M)
+    key = (np.arange(k)[:, None] * nb + b).ravel()
+    counts = np.bincount(key, weights=use.ravel(), minlength=k * nb).reshape(k, nb)
+    sums = np.bincount(key, weights=(use * g).ravel(), minlength=k * nb).reshape(k, nb)
+    m = use.sum(axis=1)
+    mean = (use @ g) / np.maximum(m, 1.0)
+    total = use @ (g * g) - m * mean**2
     occupied = counts > 0
-    between = (sums**2 / np.where(occupied, counts, 1)).sum(axis=1) - m * mean**2
-    eta2 = between / total
+    between = (sums**2 / np.where(occupied, counts, 1.0)).sum(axis=1) - m * mean**2
+    ok = total > 1e-12 * np.maximum(use @ (g * g), 1e-300)
+    eta2 = between / np.where(ok, total, 1.0)
     n_bins = occupied.sum(axis=1)
-    return 1.0 - (1.0 - eta2) * (m - 1) / np.maximum(m - n_bins, 1)
+    adj = 1.0 - (1.0 - eta2) * (m - 1) / np.maximum(m - n_bins, 1)
+    return np.where(ok, adj, 0.0)
+
+
+def _best(scores: NDArray[np.float64]) -> int:
+    """Index of the largest score; the middle of the run when neighbours tie for it."""
+    top = float(np.max(scores))
+    k = int(np.argmax(scores))
+    tie = scores >= top - 1e-12 * max(abs(top), 1.0)
+    lo = hi = k
+    while lo > 0 and tie[lo - 1]:
+        lo -= 1
+    while hi + 1 < scores.size and tie[hi + 1]:
+        hi += 1
+    return (lo + hi) // 2
 
 
 class ShearBand(Computable):
-    r"""Locate the dominant shear band in a per-particle shear strain field.
+    r"""Locate the dominant shear band (and a second one) in a per-particle strain field.
 
-    See the module docstring for the method.
+    See the module docstring for the method and for how to read the angle.
 
     Parameters
     ----------
-    bin_width : float, optional
-        Bin width across the band, in mean diameters (default 0.5).
+    bin_width : float, default 0.5
+        Bin width across the band, in mean diameters.
     max_points : int, default 20000
         Particles used for the coarse angle scan (a fixed-seed random subset
         when there are more); the refinement uses up to 5 times as many.
+    min_fill : float, default 0.5
+        A slab position counts only where the slab crosses the sample: the
+        particles within 2 mean diameters of it are at least ``min_fill``
+        times as many as at the fullest position of that angle. Slab ends
+        that only clip a corner of the sample (where the platen corners
+        concentrate strain) are left out of the angle score and of the peak
+        search. 0 uses every bin.
+    min_thickness : float, default 1.0
+        Thinnest band accepted (:attr:`found`), in mean diameters.
+    min_prominence : float, default 2.0
+        Accepted bands stand out from the profile: the band's excess strain
+        over the background is at least ``min_prominence`` times the largest
+        excess elsewhere on the profile (:attr:`prominence`).
+    second : bool, default True
+        Also look for a second band (:attr:`second`) among the particles
+        outside the first band and its flanks, at least 20° away from its
+        direction: the conjugate band of a biaxial test.
 
     Attributes (after :meth:`compute`)
     ----------------------------------
+    found : bool
+        Whether the band passes the acceptance tests (thickness, prominence).
+    reason : str
+        Why it did not ("" when found). The other results describe the
+        candidate either way.
     angle : float
         Band direction, rad in [0, pi), CCW from +x.
     angle_degrees : float
+    inclination, inclination_degrees : float
+        Acute angle between the band and the x axis, [0, pi/2] (the
+        inclination to the horizontal sigma_3 direction of a biaxial test).
     thickness : float, m
     thickness_diameters : float
         Thickness in mean particle diameters.
@@ -107,9 +238,18 @@ class ShearBand(Computable):
     mean_lambda_inside, mean_lambda_outside : float
         Mean stability index inside / outside the band (particles with at
         least 2 contacts when ``n_contacts`` is given); NaN without lambda.
-    contrast, peak_strain, background_strain : float
+    contrast, prominence, score, peak_strain, background_strain : float
+    mean_diameter : float, m
     profile : tuple of (B,) arrays
         Bin centres ``s`` (m, from the centre line) and mean strain.
+    profile_crossing : (B,) bool
+        The profile bins where the slab crosses the sample (the ones used).
+    second : ShearBand or None
+        The strongest band among the particles outside the first one (its
+        own :attr:`found`, :attr:`angle`, ...); None with ``second=False`` or
+        when fewer than 10 particles are left.
+
+    :meth:`summary` gives the scalars (and the second band's) as a JSON-ready dict.
 
     Example
     -------
@@ -118,19 +258,41 @@ class ShearBand(Computable):
     >>> pos = np.c_[x.ravel(), y.ravel()]
     >>> gamma = np.where(np.abs(pos[:, 1] - 20.0) <= 3.0, 0.1, 0.0)  # 7 rows: y = 17..23
     >>> band = ShearBand().compute(pos, gamma, np.full(1600, 0.5))
-    >>> bool(min(band.angle_degrees, 180.0 - band.angle_degrees) < 1.0)
-    True
+    >>> band.found, bool(band.inclination_degrees < 1.0)
+    (True, True)
     >>> round(band.thickness_diameters, 2), int(band.members.sum())
     (7.0, 280)
+    >>> band.second is not None and band.second.found  # nothing else stands out
+    False
     """
 
-    def __init__(self, bin_width: float = 0.5, max_points: int = 20000) -> None:
+    def __init__(
+        self,
+        bin_width: float = 0.5,
+        max_points: int = 20000,
+        *,
+        min_fill: float = 0.5,
+        min_thickness: float = 1.0,
+        min_prominence: float = 2.0,
+        second: bool = True,
+    ) -> None:
         if not np.isfinite(bin_width) or bin_width <= 0:
             raise ValueError(f"bin_width: must be > 0 (mean diameters), got {bin_width!r}")
         if int(max_points) != max_points or max_points < 10:
             raise ValueError(f"max_points: must be an integer >= 10, got {max_points!r}")
+        if not 0.0 <= min_fill <= 1.0:
+            raise ValueError(f"min_fill: must be in [0, 1], got {min_fill!r}")
+        if not np.isfinite(min_thickness) or min_thickness < 0:
+            raise ValueError(f"min_thickness: must be >= 0 (mean diameters), got {min_thickness!r}")
+        if not np.isfinite(min_prominence) or min_prominence < 1.0:
+            raise ValueError(f"min_prominence: must be >= 1, got {min_prominence!r}")
         self.bin_width = float(bin_width)
         self.max_points = int(max_points)
+        self.min_fill = float(min_fill)
+        self.min_thickness = float(min_thickness)
+        self.min_prominence = float(min_prominence)
+        self.find_second = bool(second)
+        self._avoid: float | None = None  # set on the instance searching for a second band
 
     def compute(
         self,
@@ -175,64 +337,110 @@ class ShearBand(Computable):
             )
         d_mean = float(np.mean(2.0 * rad[considered]))
         width = self.bin_width * d_mean
+        window = max(1, int(round(_FILL_WINDOW_D / self.bin_width)))
         origin = pos[valid].mean(axis=0)
         p = pos[valid] - origin
         g = gamma[valid]
 
+        # 1. orientation: coarse 1 degree scan, then 0.05 degree refinement
         rng = np.random.default_rng(0)
         coarse = np.radians(np.arange(0.0, 180.0, 1.0))
         pc, gc = self._subset(p, g, self.max_points, rng)
-        sc = _scores(pc, gc, coarse, width)
-        best = coarse[int(np.argmax(sc))]
+        sc = _scores(pc, gc, coarse, width, window, self.min_fill)
+        sc[self._avoided(coarse)] = -np.inf
+        best = coarse[_best(sc)]
         fine = best + np.radians(np.arange(-1.5, 1.5 + 1e-9, 0.05))
         pf, gf = self._subset(p, g, 5 * self.max_points, rng)
-        sf = _scores(pf, gf, fine, width)
-        k = int(np.argmax(sf))
+        sf = _scores(pf, gf, fine, width, window, self.min_fill)
+        sf[self._avoided(fine)] = -np.inf
+        k = _best(sf)
         angle = fine[k]
-        if 0 < k < fine.size - 1:
+        if (
+            0 < k < fine.size - 1
+            and np.isfinite(sf[k - 1 : k + 2]).all()
+            and sf[k - 1] < sf[k] > sf[k + 1]
+        ):
             y0, y1, y2 = sf[k - 1], sf[k], sf[k + 1]
             curv = y0 - 2 * y1 + y2
             if curv < 0:
                 angle += 0.5 * (y0 - y2) / curv * (fine[1] - fine[0])
         angle = float(np.mod(angle, np.pi))
+        score = float(_scores(p, g, np.array([angle]), width, window, self.min_fill)[0])
 
+        # 2. profile across the band at that angle
         normal = np.array([-np.sin(angle), np.cos(angle)])
         s = p @ normal
-        lo = s.min()
-        b = ((s - lo) / width).astype(np.int64)
-        counts = np.bincount(b)
-        sums = np.bincount(b, weights=g)
+        b2, counts2, crossing2 = _slab_bins(s, width, window, self.min_fill)
+        b, counts, crossing = b2[0], counts2[0], crossing2[0]
+        sums = np.bincount(b, weights=g, minlength=counts.size)
         occupied = counts > 0
         # profile coordinate: mean position of the particles in each bin
-        centers = np.bincount(b, weights=s)[occupied] / counts[occupied]
+        centers = np.bincount(b, weights=s, minlength=counts.size)[occupied] / counts[occupied]
         prof = sums[occupied] / counts[occupied]
-        smooth = np.convolve(np.pad(prof, 1, mode="edge"), np.ones(3) / 3.0, mode="valid")
+        keep = crossing[occupied]
+        # smoothed profile: mean strain of the particles within about _SMOOTH_D / 2 mean
+        # diameters of each bin (at least one bin on each side)
+        half_window = max(1, int(np.floor(0.5 * _SMOOTH_D / self.bin_width + 0.5)))
+        kernel = np.ones(2 * half_window + 1)
+        near_sums = np.convolve(sums, kernel, mode="same")
+        near_counts = np.convolve(counts.astype(np.float64), kernel, mode="same")
+        smooth = (near_sums / np.maximum(near_counts, 1.0))[occupied]
         background = float(np.median(g))
-        ipeak = int(np.argmax(smooth))
+        ipeak = int(np.argmax(np.where(keep, smooth, -np.inf)))
         peak = float(smooth[ipeak])
         half = background + 0.5 * (peak - background)
-        above = prof >= half
-        above[ipeak] = True
+        inside = keep & (smooth >= half)
+        inside[ipeak] = True
         left = ipeak
-        while left > 0 and above[left - 1]:
+        while left > 0 and inside[left - 1]:
             left -= 1
         right = ipeak
-        while right < prof.size - 1 and above[right + 1]:
+        while right < prof.size - 1 and inside[right + 1]:
             right += 1
 
-        def crossing(inside: int, outside: int) -> float:
-            if outside < 0 or outside >= prof.size:
-                return float(centers[inside])
-            gi, go = prof[inside], prof[outside]
+        def edge(i_in: int, i_out: int) -> float:
+            """Half-height crossing between a band bin and its outer neighbour."""
+            if i_out < 0 or i_out >= prof.size or smooth[i_out] >= half:
+                return float(centers[i_in])  # the band reaches the end of the profile used
+            gi, go = smooth[i_in], smooth[i_out]
             t = (gi - half) / (gi - go) if gi != go else 0.5
-            return float(centers[inside] + t * (centers[outside] - centers[inside]))
+            return float(centers[i_in] + t * (centers[i_out] - centers[i_in]))
 
-        s_lo = crossing(left, left - 1)
-        s_hi = crossing(right, right + 1)
+        s_lo = edge(left, left - 1)
+        s_hi = edge(right, right + 1)
         thickness = max(s_hi - s_lo, 0.0)
         s_mid = 0.5 * (s_lo + s_hi)
         center = origin + s_mid * normal
 
+        # 3. acceptance: how far the band stands out of the rest of the profile
+        excess = peak - background
+        if excess <= max(_MIN_EXCESS, _MIN_EXCESS * float(np.max(np.abs(g)))):
+            excess = 0.0  # round-off: a uniform (affine) deformation has no band
+        # the band's flanks: one band thickness (at least 2 mean diameters) on each side
+        flank = 0.5 * thickness + max(thickness, _FLANK_D * d_mean)
+        away = keep & (np.abs(centers - s_mid) > flank)
+        elsewhere = float(smooth[away].max()) - background if away.any() else 0.0
+        if excess <= 0.0:
+            prominence = 0.0
+        elif elsewhere <= 0.0:
+            prominence = math.inf
+        else:
+            prominence = excess / elsewhere
+        problems = []
+        if excess <= 0.0:
+            problems.append("no part of the profile stands above the background strain")
+        else:
+            if thickness / d_mean < self.min_thickness:
+                problems.append(
+                    f"thinner ({thickness / d_mean:.2f} mean diameters) than "
+                    f"min_thickness = {self.min_thickness:g}"
+                )
+            if prominence < self.min_prominence:
+                problems.append(
+                    f"does not stand out: prominence {prominence:.2f} < min_prominence = "
+                    f"{self.min_prominence:g} (another part of the profile is "
+                    f"{100 * elsewhere / excess:.0f} % as high above the background)"
+                )
         s_all = (pos - center) @ normal
         members = considered & (np.abs(s_all) <= 0.5 * thickness)
         lam_in = lam_out = float("nan")
@@ -243,7 +451,33 @@ class ShearBand(Computable):
                 use &= np.asarray(n_contacts) >= 2
             lam_in = finite_mean(lam, use & members)
             lam_out = finite_mean(lam, use & ~members)
+
+        # 4. second band: the same search without the first band and its flanks, at
+        #    angles at least _SECOND_SEPARATION from the first
+        second = None
+        if self.find_second:
+            rest = valid & (np.abs(s_all) > 0.5 * thickness + _FLANK_D * d_mean)
+            if rest.sum() >= 10:
+                second = ShearBand(
+                    self.bin_width,
+                    self.max_points,
+                    min_fill=self.min_fill,
+                    min_thickness=self.min_thickness,
+                    min_prominence=self.min_prominence,
+                    second=False,
+                )
+                second._avoid = angle
+                second.compute(
+                    pos,
+                    np.where(rest, gamma, np.nan),
+                    rad,
+                    stability_index=stability_index,
+                    n_contacts=n_contacts,
+                    mask=considered,
+                )
         self._store(
+            found=not problems,
+            reason="; ".join(problems),
             angle=angle,
             thickness=float(thickness),
             thickness_diameters=float(thickness / d_mean),
@@ -252,16 +486,27 @@ class ShearBand(Computable):
             members=members,
             mean_lambda_inside=lam_in,
             mean_lambda_outside=lam_out,
-            contrast=float((peak - background) / peak) if peak > 0 else 0.0,
+            contrast=float(excess / peak) if peak > 0 and excess > 0 else 0.0,
+            prominence=float(prominence),
+            score=score,
             peak_strain=peak,
             background_strain=background,
             profile=(centers - s_mid, prof),
+            profile_crossing=keep,
+            second=second,
             mean_diameter=d_mean,
             positions=pos,
             radii=rad,
             shear_strain=gamma,
         )
         return self
+
+    def _avoided(self, angles: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Trial angles too close to the angle to avoid (the first band's, for the second)."""
+        if self._avoid is None:
+            return np.zeros(angles.shape, bool)
+        diff = np.mod(angles - self._avoid + 0.5 * np.pi, np.pi) - 0.5 * np.pi
+        return np.abs(diff) < _SECOND_SEPARATION
 
     @staticmethod
     def _subset(p: NDArray[np.float64], g: NDArray[np.float64], k: int, rng: np.random.Generator):
@@ -271,14 +516,35 @@ class ShearBand(Computable):
         return p[pick], g[pick]
 
     @property
+    def found(self) -> bool:
+        """Whether the band passed the acceptance tests (thickness, prominence)."""
+        return bool(self._result("found"))
+
+    @property
+    def reason(self) -> str:
+        """Why the band was not accepted ("" when :attr:`found`)."""
+        return self._result("reason")
+
+    @property
     def angle(self) -> float:
         """Band direction, rad in [0, pi), CCW from +x."""
         return self._result("angle")
 
     @property
     def angle_degrees(self) -> float:
-        """Band direction in degrees, [0, 180)."""
+        """Band direction in degrees, [0, 180), CCW from +x."""
         return float(np.degrees(self.angle))
+
+    @property
+    def inclination(self) -> float:
+        """Acute angle between the band and the x axis, rad in [0, pi/2]."""
+        return float(min(self.angle, np.pi - self.angle))
+
+    @property
+    def inclination_degrees(self) -> float:
+        """Acute angle between the band and the x axis (the horizontal sigma_3
+        direction of a biaxial test loaded along y), degrees in [0, 90]."""
+        return float(np.degrees(self.inclination))
 
     @property
     def thickness(self) -> float:
@@ -289,6 +555,11 @@ class ShearBand(Computable):
     def thickness_diameters(self) -> float:
         """Band thickness in mean particle diameters."""
         return self._result("thickness_diameters")
+
+    @property
+    def mean_diameter(self) -> float:
+        """Mean diameter of the particles considered, m."""
+        return self._result("mean_diameter")
 
     @property
     def center(self) -> NDArray[np.float64]:
@@ -321,6 +592,18 @@ class ShearBand(Computable):
         return self._result("contrast")
 
     @property
+    def prominence(self) -> float:
+        """Excess strain of the band over the background divided by the largest
+        excess elsewhere on the profile (inf when nothing else is above it)."""
+        return self._result("prominence")
+
+    @property
+    def score(self) -> float:
+        """Adjusted eta² of the strain with the bins across the band (share of
+        the strain variance that the profile explains), at the band's angle."""
+        return self._result("score")
+
+    @property
     def peak_strain(self) -> float:
         """Largest (3-bin smoothed) mean strain across the band."""
         return self._result("peak_strain")
@@ -334,6 +617,40 @@ class ShearBand(Computable):
     def profile(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Distance from the centre line (m) and mean strain of each bin."""
         return self._result("profile")
+
+    @property
+    def profile_crossing(self) -> NDArray[np.bool_]:
+        """(B,) bins of :attr:`profile` that cross the sample (used for the peak)."""
+        return self._result("profile_crossing")
+
+    @property
+    def second(self) -> ShearBand | None:
+        """The band found once this band's particles are removed, or None."""
+        return self._result("second")
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready scalars (NaN and inf as None, angles in degrees), with
+        ``second`` the same dict of the second band (or None)."""
+
+        def num(x: float) -> float | None:
+            return float(x) if math.isfinite(x) else None
+
+        second = self.second
+        return {
+            "found": self.found,
+            "reason": self.reason,
+            "angle_deg": num(self.angle_degrees),
+            "inclination_deg": num(self.inclination_degrees),
+            "thickness_m": num(self.thickness),
+            "thickness_diameters": num(self.thickness_diameters),
+            "contrast": num(self.contrast),
+            "prominence": num(self.prominence),
+            "score": num(self.score),
+            "n_particles": int(self.members.sum()),
+            "mean_lambda_inside": num(self.mean_lambda_inside),
+            "mean_lambda_outside": num(self.mean_lambda_outside),
+            "second": second.summary() if second is not None else None,
+        }
 
     def outline(self, extent: ArrayLike | None = None) -> list[NDArray[np.float64]]:
         """The two band edges as (2, 2) segments clipped to ``extent`` ``[[x0, x1], [y0, y1]]``.
@@ -371,7 +688,11 @@ class ShearBand(Computable):
         return ax
 
     def __repr__(self) -> str:
-        return f"ShearBand(bin_width={self.bin_width}, max_points={self.max_points})"
+        return (
+            f"ShearBand(bin_width={self.bin_width}, max_points={self.max_points}, "
+            f"min_fill={self.min_fill}, min_thickness={self.min_thickness}, "
+            f"min_prominence={self.min_prominence}, second={self.find_second})"
+        )
 
 
 def _clip_line(p0: NDArray[np.float64], t: NDArray[np.float64], ext: NDArray[np.float64]):
