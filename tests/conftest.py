@@ -43,3 +43,15 @@ def dense_periodic():
         return sim
 
     return make
+
+
+@pytest.fixture(scope="session")
+def quick_biaxial_run(tmp_path_factory) -> Path:
+    """One ``grainlab biaxial --quick`` run (results folder, with its report.html) shared by the
+    whole session: the protocol tests and the report tests read it; a test that writes into a
+    results folder copies it first."""
+    from grainlab.cli import main
+
+    out = tmp_path_factory.mktemp("biaxial") / "quick"
+    assert main(["biaxial", "--quick", "--out", str(out), "--no-progress"]) == 0
+    return out

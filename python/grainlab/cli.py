@@ -23,6 +23,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "grainlab.commands.study",
     "grainlab.commands.sweep",
     "grainlab.commands.export",
+    "grainlab.commands.report",
 )
 
 

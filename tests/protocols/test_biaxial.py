@@ -16,10 +16,8 @@ from grainlab.protocols.config import resolve
 
 
 @pytest.fixture(scope="module")
-def quick_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("biaxial") / "quick"
-    assert main(["biaxial", "--quick", "--out", str(out), "--no-progress"]) == 0
-    return out
+def quick_run(quick_biaxial_run):
+    return quick_biaxial_run  # one quick run per session (tests/conftest.py)
 
 
 @pytest.mark.slow

@@ -32,6 +32,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--quick", action="store_true", help="a small sample of a few hundred disks")
     parser.add_argument("--resume", action="store_true", help="continue the killed run in --out")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    parser.add_argument("--no-report", action="store_true", help="do not write report.html at the end")
     parser.set_defaults(func=run)
 
 
@@ -42,4 +43,8 @@ def run(args: argparse.Namespace) -> int:
     config = resolve(args.config, overrides, quick=args.quick)
     result = run_biaxial(config, args.out, resume=args.resume, progress=not args.no_progress)
     print(result.one_line())
-    return 0
+    if args.no_report:
+        return 0
+    from grainlab.commands.report import write_after_run
+
+    return write_after_run(result.out_dir, "biaxial")

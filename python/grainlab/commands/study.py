@@ -22,6 +22,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--scheduler", default=None, help="Dask scheduler address, e.g. tcp://host:8786")
     parser.add_argument("--seed", type=int, default=0, help="campaign seed (default 0)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--no-report", action="store_true", help="do not write report.html at the end")
     parser.set_defaults(func=run)
 
 
@@ -40,4 +41,9 @@ def run(args: argparse.Namespace) -> int:
         f"statuses {summary['statuses']}; Fig. 17 R^2 {r2:.3f}; "
         f"{summary['campaign_wall_time_s']:.1f} s -> {args.out}"
     )
-    return 1 if campaign.failed else 0
+    report_failed = 0
+    if not args.no_report:
+        from grainlab.commands.report import write_after_run
+
+        report_failed = write_after_run(args.out, "study")
+    return 1 if campaign.failed or report_failed else 0

@@ -7,6 +7,7 @@ import math
 import os
 import time
 from collections.abc import Mapping, Sequence
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,7 @@ import numpy as np
 import grainlab
 from grainlab.io.results import write_json_atomic
 from grainlab.study.campaign import CampaignResult, Run, make_run, run_campaign
+from grainlab.study.packing import PackingParams
 
 #: Table 2: target nominal porosities of the irregular packings.
 IRREGULAR_POROSITIES: tuple[float, ...] = (0.08, 0.09, 0.10, 0.11, 0.12, 0.13, 0.14, 0.15, 0.16, 0.161, 0.165)
@@ -182,6 +184,8 @@ def run_study(
         "scheduler": scheduler if isinstance(scheduler, str) else (None if scheduler is None else "client"),
         "seed": seed,
         "overrides": dict(overrides or {}),
+        # what every packing shared (PackingParams defaults with the overrides), for the report
+        "packing_params": {**asdict(PackingParams()), **dict(overrides or {})},
         "fig17_fit": fig["fig17_fit"],
         "trends": trends(campaign.rows),
         "figures": fig["files"],
