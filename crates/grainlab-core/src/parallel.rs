@@ -183,8 +183,14 @@ where
 /// from the front, the others take them from the back, and a compare-exchange
 /// makes sure every item is taken exactly once.
 struct HomeShares {
-    ranges: Vec<AtomicU64>,
+    ranges: Vec<CacheLine<AtomicU64>>,
 }
+
+/// Keeps a value on a cache line (pair of lines, for the adjacent-line
+/// prefetcher) of its own, so that workers claiming from their own shares do
+/// not take the line from each other.
+#[repr(align(128))]
+struct CacheLine<T>(T);
 
 impl HomeShares {
     fn new(items: usize, workers: usize) -> Self {
@@ -192,7 +198,7 @@ impl HomeShares {
         let ranges = (0..workers)
             .map(|w| {
                 let (lo, hi) = (w * items / workers, (w + 1) * items / workers);
-                AtomicU64::new(((lo as u64) << 32) | hi as u64)
+                CacheLine(AtomicU64::new(((lo as u64) << 32) | hi as u64))
             })
             .collect();
         HomeShares { ranges }
@@ -210,7 +216,7 @@ impl HomeShares {
     }
 
     fn take(&self, share: usize, from_front: bool) -> Option<usize> {
-        let word = &self.ranges[share];
+        let word = &self.ranges[share].0;
         let mut current = word.load(Ordering::Acquire);
         loop {
             let (front, back) = (current >> 32, current & 0xffff_ffff);

@@ -1372,20 +1372,25 @@ impl PairKernel<'_> {
         sink: &mut S,
     ) -> ContactTally {
         let mut tally = ContactTally::default();
+        debug_assert!(first + shear.len() <= self.pair_i.len());
         for (k, (spring, slide)) in shear.iter_mut().zip(sliding.iter_mut()).enumerate() {
             let pair = first + k;
-            let i = self.pair_i[pair] as usize;
-            let j = self.pair_j[pair] as usize;
-            let xi = self.position[i];
-            let mut xj = self.position[j];
-            let s = self.shift[pair];
+            // SAFETY: the neighbour list holds pairs `first..first + shear.len()` of
+            // particles that exist (`NeighborList::build`), so every index below is
+            // in bounds; the checks would cost a tenth of the loop
+            let i = *self.pair_i.get_unchecked(pair) as usize;
+            let j = *self.pair_j.get_unchecked(pair) as usize;
+            debug_assert!(i < self.position.len() && j < self.position.len());
+            let xi = *self.position.get_unchecked(i);
+            let mut xj = *self.position.get_unchecked(j);
+            let s = *self.shift.get_unchecked(pair);
             if s != [0, 0] {
                 if let Some(c) = self.cell {
                     xj = add(xj, c.image_offset(s));
                 }
             }
             let d = sub(xj, xi);
-            let (ri, rj) = (self.radius[i], self.radius[j]);
+            let (ri, rj) = (*self.radius.get_unchecked(i), *self.radius.get_unchecked(j));
             let reach = ri + rj;
             let dist_sq = dot(d, d);
             if dist_sq >= reach * reach {
@@ -1400,13 +1405,18 @@ impl PairKernel<'_> {
             let n = scale(d, 1.0 / dist);
             let overlap = reach - dist;
             let t = perp(n);
-            let mut dv = sub(self.velocity[j], self.velocity[i]);
+            let mut dv = sub(
+                *self.velocity.get_unchecked(j),
+                *self.velocity.get_unchecked(i),
+            );
             if let Some(l) = &self.velocity_gradient {
                 dv = add(dv, mat_vec(l, d));
             }
             let vn = dot(dv, n);
-            let vt = dot(dv, t) - (self.angular_velocity[i] * ri + self.angular_velocity[j] * rj);
-            let model = self.materials.by_index(self.model[pair]);
+            let vt = dot(dv, t)
+                - (*self.angular_velocity.get_unchecked(i) * ri
+                    + *self.angular_velocity.get_unchecked(j) * rj);
+            let model = self.materials.by_index(*self.model.get_unchecked(pair));
             let reduced_mass =
                 if model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0 {
                     let (mi, mj) = (self.mass[i], self.mass[j]);
