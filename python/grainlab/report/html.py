@@ -228,6 +228,7 @@ tr.differs td { background: #fff8e1; }
 tr.total td { font-weight: 600; border-top: 2px solid #9aa5b1; }
 table.wide td { font-size: .85em; }
 td.note { min-width: 22em; color: #4a5560; }
+td.muted { color: #4a5560; }
 pre { background: #f1f3f5; border: 1px solid #dde2e7; border-radius: 4px; padding: .7em 1em;
       overflow-x: auto; font-size: .85em; }
 code { font-family: "DejaVu Sans Mono", Menlo, Consolas, monospace; }

@@ -221,7 +221,7 @@ def render_biaxial(r: BiaxialReport) -> str:
                 ["key", "value", "SI unit", "default", "paper", "meaning"],
                 rows,
                 row_classes=["differs" if c.differs else "" for c in r.config_rows],
-                cell_classes={1: "nowrap", 3: "nowrap", 5: "note"},
+                cell_classes={1: "nowrap", 3: "nowrap", 5: "muted"},
             ),
         )
     )
