@@ -13,7 +13,7 @@ from grainlab.protocols.config import resolve
 
 
 def eq16(rate: float, density: float, radius: float, pressure: float) -> float:
-    # paper Eq. 16: f = rate * r_min * sqrt(rho / p), the inertial number of the smallest grain
+    # paper Eq. 16: I = rate * sqrt(rho r_min^2 / p_y), p_y the limiting contact pressure
     return rate * radius * math.sqrt(density / pressure)
 
 
@@ -22,13 +22,19 @@ def test_factor_is_eq16_of_the_smallest_grain_and_quiet_below_the_limit():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         factor = check_density_scaling(config)
-    assert factor == pytest.approx(eq16(0.01, 2.0e8, 0.25e-3, 1.0e5), rel=1e-12)
+    assert factor == pytest.approx(eq16(0.01, 2.0e8, 0.25e-3, 150.0e6), rel=1e-12)  # Table 1 p_y
     assert check_density_scaling(resolve()) is None  # the auto rate is bounded by construction
 
 
 def test_fast_rate_is_warned_about_before_any_work(tmp_path):
-    config = resolve(overrides=["shear.strain_rate=0.2"])
-    assert eq16(0.2, 2.0e8, 0.25e-3, 1.0e5) > 1e-3
+    config = resolve(overrides=["shear.strain_rate=5.0"])
+    assert eq16(5.0, 2.0e8, 0.25e-3, 150.0e6) > 1e-3
     (tmp_path / "run.h5").write_bytes(b"")  # a folder that holds a run: refused right after the check
-    with pytest.warns(DensityScalingWarning, match=r"Eq\. 16\) of 2\.2e-03"), pytest.raises(ValueError):
+    with pytest.warns(DensityScalingWarning, match=r"Eq\. 16\) of 1\.4e-03"), pytest.raises(ValueError):
         run_biaxial(config, tmp_path, progress=False)
+
+
+def test_limiting_contact_pressure_is_a_key_with_the_paper_value():
+    assert resolve()["material.limiting_contact_pressure"] == 150.0e6
+    config = resolve(overrides=["shear.strain_rate=0.01", "material.limiting_contact_pressure=1 MPa"])
+    assert check_density_scaling(config) == pytest.approx(eq16(0.01, 2.0e8, 0.25e-3, 1.0e6), rel=1e-12)

@@ -119,14 +119,15 @@ DENSITY_SCALING_LIMIT = 1.0e-3
 
 def check_density_scaling(config: BiaxialConfig) -> float | None:
     """The Eq. 16 factor of an explicit ``shear.strain_rate`` (smallest grain,
-    ``sample.d_min / 2``, at ``sigma_3``), with a :class:`DensityScalingWarning`
+    ``sample.d_min / 2``, and the limiting contact pressure ``p_y``,
+    ``material.limiting_contact_pressure``), with a :class:`DensityScalingWarning`
     when it exceeds :data:`DENSITY_SCALING_LIMIT`; ``None`` for the ``auto``
     rate, which keeps the factor at or below ``shear.inertial_number``."""
     rate = config["shear.strain_rate"]
     if rate == "auto":
         return None
     factor = grainlab.density_scaling_factor(
-        rate, config["material.density"], 0.5 * config["sample.d_min"], config["consolidation.pressure"]
+        rate, config["material.density"], 0.5 * config["sample.d_min"], config["material.limiting_contact_pressure"]
     )
     if factor > DENSITY_SCALING_LIMIT:
         warnings.warn(
@@ -209,13 +210,14 @@ def default_strain_rate(config: BiaxialConfig, max_diameter: float, min_radius: 
     is about 3.3e-3 1/s; a study on the quick sample (docs/biaxial.md) found
     the peak stress ratio rate-independent within its scatter at and below it,
     and 40 % too high at the rate that the mean-diameter inertial number alone allows.
-    Eq. 16: ``rate * r_min * sqrt(rho / sigma_3)``.
+    Eq. 16: ``rate * r_min * sqrt(rho / p_y)`` with the limiting contact
+    pressure ``p_y`` (Table 1: 150 MPa), far from binding with Table 1.
     """
     rho, p = config["material.density"], config["consolidation.pressure"]
     alpha = config["material.local_damping"]
     bound = config["shear.inertial_number"]
     inertial = max_diameter * math.sqrt(rho / ((1.0 - alpha) * p))
-    eq16 = min_radius * math.sqrt(rho / p)
+    eq16 = min_radius * math.sqrt(rho / config["material.limiting_contact_pressure"])
     return bound / max(inertial, eq16)
 
 
@@ -544,7 +546,7 @@ def _start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
         "inertial_number": inertial_number(config, rate, max_d),
         "inertial_number_mean_diameter": rate * float(2 * radii.mean()) * root,
         "density_scaling_factor": grainlab.density_scaling_factor(
-            rate, config["material.density"], float(radii.min()), config["consolidation.pressure"]
+            rate, config["material.density"], float(radii.min()), config["material.limiting_contact_pressure"]
         ),
         "porosity_initial": 1.0 - float(np.pi * np.sum(radii**2)) / area0,
     }

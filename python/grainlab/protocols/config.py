@@ -101,6 +101,9 @@ FIELDS: dict[str, Field] = {
     "material.friction": Field("number", 0.9, "particle friction (Table 1: 0.9)", minimum=0.0),
     "material.platen_friction": Field("number", 0.0, "particle-platen friction (Table 1: 0)", minimum=0.0),
     "material.density": Field("density", 2.0e8, "scaled particle density (Table 1: 2e8 kg/m^3)", **_POSITIVE),
+    "material.limiting_contact_pressure": Field(
+        "stress", 150.0e6, "p_y of the density scaling factor, paper Eq. 16 (Table 1: 150 MPa)", **_POSITIVE
+    ),
     "material.local_damping": Field(
         "number", 0.8, "local damping alpha (Table 1: 0.8)", minimum=0.0, maximum=1.0, exclusive_maximum=True
     ),
@@ -133,7 +136,7 @@ FIELDS: dict[str, Field] = {
     "boundary.membrane_friction": Field("number", 0.0, "friction between grains and membrane disks", minimum=0.0),
     "shear.strain_rate": Field(
         "strain_rate", "auto",
-        "axial strain rate; auto = the fastest with inertial number and Eq. 16 factor <= 1e-3",
+        "axial strain rate; auto = the fastest with the grains' inertial number <= shear.inertial_number",
         **_POSITIVE, allow_auto=True,
     ),
     "shear.final_strain": Field("strain", 0.10, "final axial strain", minimum=0.0, maximum=0.5, exclusive_minimum=True),
@@ -146,7 +149,7 @@ FIELDS: dict[str, Field] = {
         "axial strains of the full snapshots (the paper's 0, 0.5, 0.7, 0.9, 1.5 and 10 %)",
     ),
     "shear.inertial_number": Field(
-        "number", 1.0e-3, "bound on the inertial number and Eq. 16 factor for the auto strain rate", **_POSITIVE
+        "number", 1.0e-3, "bound on the inertial number (and Eq. 16 factor) for the auto strain rate", **_POSITIVE
     ),
     "run.threads": Field("integer", "auto", "engine threads (auto: all cores)", minimum=1, allow_auto=True),
     "run.time_step_safety": Field(
