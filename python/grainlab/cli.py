@@ -45,11 +45,24 @@ def main(argv: Sequence[str] | None = None) -> int:
     if getattr(args, "func", None) is None:
         parser.print_help()
         return 2
+    from grainlab import SimulationUnstableError
+    from grainlab.protocols.biaxial import BiaxialError
+
     try:
         return int(args.func(args))
-    except ValueError as error:
+    except ValueError as error:  # bad input, refused before any work
         print(f"grainlab {args.command}: error: {error}", file=sys.stderr)
         return 2
+    except (SimulationUnstableError, BiaxialError) as error:  # the physics failed mid-run
+        print(f"grainlab {args.command}: run stopped: {error}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(
+            f"grainlab {args.command}: interrupted; what was written so far is kept "
+            "(a biaxial run continues with --resume)",
+            file=sys.stderr,
+        )
+        return 130
 
 
 if __name__ == "__main__":

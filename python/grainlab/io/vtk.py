@@ -274,7 +274,8 @@ def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArra
     for particles absent from the reference, 0 in the first snapshot),
     ``rotation`` (only when the snapshot has rotations), ``n_contacts`` (walls
     included), ``stability_index``, ``local_shear_strain`` (NaN in the first
-    snapshot), ``in_shear_band`` (0 / 1), then every numeric per-particle field
+    snapshot), ``in_shear_band`` (0 outside, 1 in the dominant band, 2 in
+    the conjugate band; bands that the detector does not accept mark nothing), then every numeric per-particle field
     of the snapshot (``velocity``, ...) under its own name, 2-vectors padded to
     (N, 3); a field whose name is already taken above is left out.
     """
@@ -299,9 +300,14 @@ def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArra
         gamma = np.asarray(strain.shear_strain, np.float64)
         try:
             found = ShearBand().compute(snap, strain.excess_shear_strain)
-            band = np.asarray(found.members, bool).astype(np.int32)
         except ValueError:  # too few particles with a finite strain: no band
-            pass
+            found = None
+        # members of the accepted bands only: 1 the dominant band, 2 its conjugate
+        if found is not None and found.found:
+            band[np.asarray(found.members, bool)] = 1
+            second = found.second
+            if second is not None and second.found:
+                band[np.asarray(second.members, bool) & (band == 0)] = 2
     out["displacement"] = disp
     if snap.rotations is not None:
         out["rotation"] = np.asarray(snap.rotations, np.float64)

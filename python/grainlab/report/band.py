@@ -1,32 +1,23 @@
-"""The shear band of a biaxial run at one snapshot, as the report measures it.
+"""The shear band of a biaxial run, as the report shows it.
 
-The grains' local strain since the first snapshot
-(:class:`grainlab.analysis.LocalStrain`, grains only, matched by id; its
-``excess_shear_strain``, the strain less the sample's median strain) goes to
-:class:`grainlab.analysis.ShearBand`, whose public results are used as they
-are: ``found`` / ``reason`` (its acceptance test), ``angle_degrees``,
-``thickness``, ``thickness_diameters``, ``contrast``, the members and the mean
-lambda inside and outside. The inclination to the sigma_3 (horizontal)
-direction is ``min(angle, 180 deg - angle)``.
-
-Where the installed ShearBand has no acceptance test (no ``found``), a band
-counts as found when its strain profile stands above the background
-(``contrast > 0``) and it is at least one mean diameter thick, and the result
-says so.
+The report shows the bands that the run's figures show: those of
+:func:`grainlab.analysis.biaxial_figures.fabric_numbers` (``band``, at the
+snapshot nearest the peak, and ``band_final``, at the end of shearing; the
+detector :class:`grainlab.analysis.ShearBand` on the grains' excess local
+strain since the first snapshot, grains away from the boundary, with its own
+acceptance test). :func:`band_from_numbers` turns one of them (the JSON form
+of ``summary.json``) into a :class:`BandResult`. The inclination to the
+sigma_3 (horizontal) direction is ``min(angle, 180 deg - angle)``.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
-import numpy as np
-
-from grainlab.analysis import LocalStrain, ShearBand, StabilityIndex
-from grainlab.io.hdf5 import Results
-from grainlab.snapshot import Snapshot
-
-__all__ = ["BandResult", "measure_band", "peak_snapshot"]
+__all__ = ["BandResult", "band_from_numbers"]
 
 
 @dataclass(frozen=True)
@@ -61,78 +52,34 @@ class BandResult:
         return math.degrees(self.angle)
 
 
-def _grains(snap: Snapshot) -> Snapshot:
-    g = snap.is_sample
-    return Snapshot(snap.positions[g], snap.radii[g], snap.ids[g], kind=snap.kind[g], box=snap.box,
-                    periodic=snap.periodic)
+def _number(value: Any) -> float:
+    return float(value) if isinstance(value, int | float) and math.isfinite(value) else math.nan
 
 
-def _strain(info_strain: float | None) -> float:
-    return float(info_strain) if info_strain is not None and math.isfinite(info_strain) else math.nan
-
-
-def peak_snapshot(results: Results, peak_strain: float) -> str | None:
-    """The snapshot other than the first whose axial strain is closest to ``peak_strain``."""
-    infos = list(results.snapshots)[1:]
-    known = [s for s in infos if math.isfinite(_strain(s.axial_strain))]
-    if not known:
-        return infos[-1].name if infos else None
-    return min(known, key=lambda s: abs(_strain(s.axial_strain) - peak_strain)).name
-
-
-def measure_band(results: Results, snapshot: str, reference: str | None = None) -> BandResult:
-    """The band at ``snapshot`` against ``reference`` (default: the first snapshot)."""
-    reference = reference if reference is not None else results.snapshot_names[0]
-    info = {s.name: s for s in results.snapshots}[snapshot]
-    current, first = results.snapshot(snapshot), results.snapshot(reference)
-    g = current.is_sample
-    nan = math.nan
-
-    def missing(reason: str, acceptance: str = "") -> BandResult:
-        return BandResult(snapshot, reference, _strain(info.axial_strain), False, reason, nan, nan, nan, nan,
-                          nan, 0, nan, nan, acceptance)
-
-    gamma = LocalStrain().compute(_grains(first), _grains(current)).excess_shear_strain
-    if int(np.isfinite(gamma).sum()) < 10:
-        return missing(f"only {int(np.isfinite(gamma).sum())} grains have a local strain (10 are needed)")
-    lam = StabilityIndex().compute(current)
-    try:
-        band = ShearBand().compute(
-            current.positions[g],
-            gamma,
-            current.radii[g],
-            stability_index=lam.stability_index[g],
-            n_contacts=lam.n_contacts[g],
-        )
-    except ValueError as error:
-        return missing(f"ShearBand: {error}")
-    if hasattr(type(band), "found"):
-        found, reason = bool(band.found), str(getattr(band, "reason", ""))
-        acceptance = "ShearBand's own acceptance test"
-    else:
-        problems = []
-        if not band.contrast > 0:
-            problems.append("no part of the strain profile stands above the background")
-        if not band.thickness_diameters >= 1.0:
-            problems.append(f"thinner ({band.thickness_diameters:.2f}) than one mean diameter")
-        found, reason = not problems, "; ".join(problems)
-        acceptance = "contrast > 0 and at least one mean diameter thick (this ShearBand has no test of its own)"
-    angle = float(band.angle_degrees)
-    if not found and not reason:
-        reason = "not accepted by ShearBand"
+def band_from_numbers(numbers: Mapping[str, Any] | None) -> BandResult | None:
+    """A :class:`BandResult` from the JSON form of a
+    :class:`~grainlab.analysis.biaxial_figures.BandNumbers` (None stays None)."""
+    if not numbers:
+        return None
+    found = bool(numbers.get("found"))
+    angle = _number(numbers.get("angle_deg"))
+    inclination = _number(numbers.get("inclination_deg"))
+    if math.isfinite(angle) and not math.isfinite(inclination):
+        inclination = min(angle, 180.0 - angle)
+    reason = str(numbers.get("reason") or "")
     return BandResult(
-        snapshot=snapshot,
-        reference=reference,
-        axial_strain=_strain(info.axial_strain),
+        snapshot=str(numbers.get("snapshot", "")),
+        reference=str(numbers.get("reference", "")),
+        axial_strain=_number(numbers.get("axial_strain")),
         found=found,
-        reason="" if found else reason,
+        reason="" if found else (reason or "not accepted by ShearBand"),
         angle=math.radians(angle),
-        inclination=math.radians(min(angle, 180.0 - angle)),
-        thickness_m=float(band.thickness),
-        thickness_diameters=float(band.thickness_diameters),
-        contrast=float(band.contrast),
-        n_grains=int(np.count_nonzero(band.members)),
-        mean_lambda_inside=float(band.mean_lambda_inside),
-        mean_lambda_outside=float(band.mean_lambda_outside),
-        acceptance=acceptance,
+        inclination=math.radians(inclination),
+        thickness_m=_number(numbers.get("thickness_m")),
+        thickness_diameters=_number(numbers.get("thickness_diameters")),
+        contrast=_number(numbers.get("contrast")),
+        n_grains=int(numbers.get("n_grains") or 0),
+        mean_lambda_inside=_number(numbers.get("mean_lambda_inside")),
+        mean_lambda_outside=_number(numbers.get("mean_lambda_outside")),
+        acceptance="ShearBand's own acceptance test (thickness, prominence), grains away from the boundary",
     )

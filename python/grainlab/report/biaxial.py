@@ -30,7 +30,7 @@ from grainlab.report.angles import (
     fit_dilation,
     mobilised_friction_angle,
 )
-from grainlab.report.band import BandResult, measure_band, peak_snapshot
+from grainlab.report.band import BandResult, band_from_numbers
 from grainlab.report.figures import grading_figure, macro_figure
 from grainlab.report.html import EmbeddedFigure, fmt
 from grainlab.report.paper import BIAXIAL_CLAIMS, TABLE1
@@ -389,7 +389,11 @@ def _paper_rows(r: BiaxialReport) -> list[tuple[str, str, str, str]]:
         if math.isfinite(rate)
         else "n/a"
     )
-    run["density_scaling"] = f"{fmt(_num(s.get('density_scaling_factor')), 3)} (Eq. 16 with p = σ₃)"
+    p_y = _num((r.results.config.get("material") or {}).get("limiting_contact_pressure"))
+    run["density_scaling"] = f"{fmt(_num(s.get('density_scaling_factor')), 3)} " + (
+        f"(Eq. 16 with p_y = {fmt(p_y / 1e6, 3)} MPa)" if math.isfinite(p_y)
+        else "(Eq. 16 with p = σ₃: a run from before material.limiting_contact_pressure)"
+    )
     run["a_initial"] = fmt(_num(_val(states, "initial", "a")), 3)
     run["a_n_initial"] = fmt(_num(_val(states, "initial", "a_n")), 3)
     eps = ts["axial_strain"]
@@ -532,14 +536,9 @@ def gather_biaxial(
     if k == len(eps) - 1:
         notes.append("the stress ratio is largest at the last record: the peak may lie beyond the test")
     angles = ClassicalAngles.from_angles(phi, dilation.angle)
-    # the band, measured here with ShearBand at the snapshot nearest the peak and at the end
-    names = results.snapshot_names
-    at_peak = peak_snapshot(results, float(eps[k]))
-    band_peak = measure_band(results, at_peak) if at_peak is not None else None
-    band_end = (
-        band_peak if len(names) > 1 and names[-1] == at_peak
-        else (measure_band(results, names[-1]) if len(names) > 1 else None)
-    )
+    # the bands the figures show: nearest the peak and at the end of shearing
+    band_peak = band_from_numbers(fabric.get("band")) if fabric else None
+    band_end = (band_from_numbers(fabric.get("band_final")) if fabric else None) or band_peak
 
     # the sample
     first = results.snapshot(0)

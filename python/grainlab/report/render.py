@@ -252,7 +252,7 @@ def render_biaxial(r: BiaxialReport) -> str:
         ("strain rate", fmt(_num(s.get("strain_rate")), 4, unit="1/s")),
         ("inertial number (heaviest grain, damped) / mean diameter",
          f"{fmt(_num(s.get('inertial_number')), 3)} / {fmt(_num(s.get('inertial_number_mean_diameter')), 3)}"),
-        ("density scaling factor I (Eq. 16, p = σ₃)", fmt(_num(s.get("density_scaling_factor")), 3)),
+        ("density scaling factor I (Eq. 16 with p_y)", fmt(_num(s.get("density_scaling_factor")), 3)),
         ("time step", fmt(_num(s.get("time_step_s")), 4, unit="s")),
         ("records", fmt(len(ts["axial_strain"]))),
         ("snapshots", ", ".join(res.snapshot_names)),
