@@ -86,29 +86,6 @@ def _band_table(r: BiaxialReport) -> Markup:
     )
 
 
-def _figures_band(r: BiaxialReport) -> str:
-    """What the fabric figures' band (the outline on Figs. 11-13) is, from the fabric numbers."""
-    fab = r.fabric or {}
-    parts = []
-    for label, key in (("at the peak", "band"), ("at the end", "band_final")):
-        b = fab.get(key)
-        if not isinstance(b, dict):
-            continue
-        if b.get("found"):
-            parts.append(
-                f"{label} ({b.get('snapshot')}): found, inclination {fmt(_num(b.get('inclination_deg')), 3)} deg, "
-                f"{fmt(_num(b.get('thickness_diameters')), 3)} mean diameters"
-            )
-        else:
-            parts.append(f"{label} ({b.get('snapshot')}): not found ({b.get('reason', '')})")
-    if not parts:
-        return "The fabric figures carry no band numbers."
-    return (
-        "The outlines on Figs. 11-13 come from the band test of grainlab.analysis.biaxial_figures "
-        f"({r.fabric_source}): " + "; ".join(parts) + "."
-    )
-
-
 def _classical_table(r: BiaxialReport) -> Markup:
     a = r.angles
     b = r.band_end
@@ -321,15 +298,20 @@ def render_biaxial(r: BiaxialReport) -> str:
     acceptance = r.band_end.acceptance if r.band_end is not None else ""
     band_parts: list[Any] = [
         paragraph(
-            "The band is located by grainlab.analysis.ShearBand in the grains' excess local shear strain "
-            "since the first snapshot (grainlab.analysis.LocalStrain), at the snapshot nearest the peak and at "
+            "The band is located by grainlab.analysis.ShearBand in the excess local shear strain of the grains "
+            "away from the boundary since the first snapshot (grainlab.analysis.LocalStrain), at the snapshot "
+            "nearest the peak and at "
             f"the end of shearing; found means accepted by {acceptance or 'the detector'}. Its inclination is "
             "the acute angle to the horizontal, the σ₃ direction; a band not accepted is shown as a "
             "candidate and not compared.",
             "note",
         ),
         _band_table(r),
-        paragraph(_figures_band(r), "note"),
+        paragraph(
+            f"These are the bands outlined on Figs. 11-13 (numbers from {r.fabric_source}); "
+            "'grainlab report --redraw' recomputes them with the installed grainlab.",
+            "note",
+        ),
         formulas,
         _classical_table(r),
     ]
