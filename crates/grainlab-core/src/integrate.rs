@@ -160,8 +160,13 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
     let map_shift = sub(origin, mat_vec(&map, origin));
     let n = chunk.position.len();
     let lo = chunk.lo;
-    let force = chunk.force;
-    let torque = chunk.torque;
+    let force = &chunk.force[..n];
+    let torque = &chunk.torque[..n];
+    let velocity = &mut chunk.velocity[..n];
+    let angular_velocity = &mut chunk.angular_velocity[..n];
+    let rotation = &mut chunk.rotation[..n];
+    let position = &mut chunk.position[..n];
+    let mass = &inputs.mass[lo..lo + n];
     let inv_mass = &inputs.inv_mass[lo..lo + n];
     let inv_inertia = &inputs.inv_inertia[lo..lo + n];
     let fixity = &inputs.fixity[lo..lo + n];
@@ -173,8 +178,8 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
     for k in 0..n {
         let fix = fixity[k];
         let f = force[k];
-        let v_old = chunk.velocity[k];
-        let w_old = chunk.angular_velocity[k];
+        let v_old = velocity[k];
+        let w_old = angular_velocity[k];
         let (mut v, mut w) = (v_old, w_old);
         let mut fd = [0.0; 3];
         if fix == 0 {
@@ -202,7 +207,7 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
         }
         if step.has_external {
             let p = lo + k;
-            let m = inputs.mass[p];
+            let m = mass[k];
             let fe = inputs.external_force[p];
             let fx = if fix & FIX_X == 0 {
                 fe[0] + m * step.gravity[0]
@@ -224,14 +229,13 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
         if MEASURE {
             // 1/2 m v(n-1/2).v(n+1/2): with the elastic energy of linear springs this
             // sum is exactly conserved by leapfrog (away from contact onsets)
-            let p = lo + k;
             let (vk, wk) = if step.half_kick {
                 (v_old, w_old)
             } else {
                 (v, w)
             };
-            tally.kinetic += 0.5 * inputs.mass[p] * (v_old[0] * vk[0] + v_old[1] * vk[1])
-                + 0.5 * inputs.inertia[p] * w_old * wk;
+            tally.kinetic += 0.5 * mass[k] * (v_old[0] * vk[0] + v_old[1] * vk[1])
+                + 0.5 * inputs.inertia[lo + k] * w_old * wk;
             if fix == 0 {
                 tally.unbalanced_force_sum += (f[0] * f[0] + f[1] * f[1]).sqrt();
                 tally.free_count += 1;
@@ -243,7 +247,7 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
             let fy = if fix & FIX_Y == 0 { fb[1] } else { 0.0 };
             tally.boundary_work += (fx * v_full[0] + fy * v_full[1]) * step.kick;
         }
-        let mut x = chunk.position[k];
+        let mut x = position[k];
         x[0] += dt * v[0];
         x[1] += dt * v[1];
         let r = reference[k];
@@ -256,10 +260,10 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
         let d2 = d[0] * d[0] + d[1] * d[1];
         max_displacement_sq = max_displacement_sq.max(d2);
         finite &= x[0].is_finite() & x[1].is_finite() & w.is_finite();
-        chunk.position[k] = x;
-        chunk.velocity[k] = v;
-        chunk.angular_velocity[k] = w;
-        chunk.rotation[k] += dt * w;
+        position[k] = x;
+        velocity[k] = v;
+        angular_velocity[k] = w;
+        rotation[k] += dt * w;
     }
     tally.damping_dissipated = -damping_work * step.kick;
     tally.max_displacement_sq = max_displacement_sq;
