@@ -63,10 +63,10 @@ def test_biaxial_response_is_that_of_a_dense_soil(run):
     out, result, text = run
     ts = read_results(out / "run.h5").timeseries
     ratio, eps = ts["stress_ratio"], ts["axial_strain"]
-    # near-isotropic at the start of shearing: the walls consolidate to sigma_0 on both axes,
-    # then the platens hold still while the membrane takes over and friction switches on,
-    # which moves sigma_1 by up to ~11 % on a sample this small (0.5 % on the default one)
-    assert ratio[0] == pytest.approx(1.0, abs=0.15)
+    # isotropic at the start of shearing: the membrane carries sigma_3 = sigma_0 and the
+    # platens hold sigma_1 within consolidation.tolerance (1 %) of it (without their servo
+    # in the boundary phase this small sample started at 1.11)
+    assert ratio[0] == pytest.approx(1.0, abs=0.011)
     # a peak well above 1 inside the run, then softening
     peak = int(np.argmax(ratio))
     assert result["peak_stress_ratio"] == pytest.approx(ratio[peak])

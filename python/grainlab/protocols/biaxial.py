@@ -9,7 +9,8 @@ Phases, each run by the engine in blocks of steps:
    unbalanced force ratio is below its threshold.
 3. **boundary**: the side walls are switched off and replaced by the bonded
    membrane chains under the confining pressure (follower load); the sample
-   re-equilibrates with the platens held.
+   re-equilibrates with the platens holding ``sigma_0`` (servo-controlled once
+   their stress leaves the tolerance), so shearing starts isotropic.
 4. **shear**: the platens approach each other at a constant axial strain rate
    to the final strain while the confining pressure stays constant; a record
    every ``shear.record_interval`` of axial strain, full snapshots at the
@@ -228,6 +229,16 @@ def inertial_number(config: BiaxialConfig, rate: float, diameter: float) -> floa
 
 
 # ---- measurements -----------------------------------------------------------
+
+
+def _platen_stress(sim: Simulation, membrane: Membrane) -> tuple[float, float]:
+    """Mean axial stress of the two platens on the sample (Pa) and the sample's
+    mean width (area over height, m)."""
+    bottom, top = sim.wall(membrane.bottom_wall), sim.wall(membrane.top_wall)
+    height = float(top.points[0, 1] - bottom.points[0, 1])
+    width = sample_area(sim, membrane) / height
+    axial_force = 0.5 * (float(top.force[1]) - float(bottom.force[1]))
+    return axial_force / width, width
 
 
 def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, float]:
@@ -482,11 +493,34 @@ def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progres
         run.consolidation["membrane_disks"] = len(membrane.left) + len(membrane.right)
         run.membrane = membrane.to_dict()
         sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+        # The platens hold sigma_0 while the membrane takes over and friction
+        # switches on, so that shearing starts from an isotropic state: they
+        # stand still while their stress stays within the tolerance of sigma_0,
+        # and are servo-controlled to it (the engine's servo, as in the
+        # consolidation) from the first chunk that ends outside it until the
+        # sample is in equilibrium. The membrane's end disks keep their place: the
+        # platens move by micrometres.
+        target = config["consolidation.pressure"]
+        tolerance = config["consolidation.tolerance"]
+        max_speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)
+        servo = False
         while True:
             sim.run(CHUNK_STEPS)
             steps += CHUNK_STEPS
-            if sim.unbalanced_force_ratio < limit or steps >= config["consolidation.max_steps"]:
+            sigma_1, width = _platen_stress(sim, membrane)
+            settled = abs(sigma_1 / target - 1.0) < tolerance
+            if not settled or servo:
+                servo = True
+                for platen in (bottom, top):
+                    platen.servo(target, width, relaxation=0.5, max_speed_m_per_s=max_speed)
+            if settled and sim.unbalanced_force_ratio < limit:
                 break
+            if steps >= config["consolidation.max_steps"]:
+                break
+        if servo:
+            bottom.velocity = (0.0, 0.0)
+            top.velocity = (0.0, 0.0)
+        run.consolidation["platen_stress_pa"] = sigma_1
     else:
         radii = sim.radii[: run.n_grains]
         grains = install_grain_boundary(
