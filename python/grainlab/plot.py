@@ -287,15 +287,29 @@ def anisotropy_series(
     return ax
 
 
-def mean_lambda_series(axial_strain: ArrayLike, mean_lambda: ArrayLike, *, ax: Any = None) -> Any:
-    """Mean geometrical stability index against axial strain (Fig. 14)."""
+def mean_lambda_series(
+    axial_strain: ArrayLike,
+    mean_lambda: ArrayLike,
+    *,
+    mean_lambda_all: ArrayLike | None = None,
+    ax: Any = None,
+) -> Any:
+    """Mean geometrical stability index against axial strain (Fig. 14):
+    ``mean_lambda`` over grains with >= 2 contacts and, when given,
+    ``mean_lambda_all`` over every grain (0- and 1-contact grains at 1), dashed."""
     eps = 100.0 * np.asarray(axial_strain, dtype=np.float64)
     lam = np.asarray(mean_lambda, dtype=np.float64)
     if eps.shape != lam.shape:
         raise ValueError(f"mean_lambda: expected shape {eps.shape}, got {lam.shape}")
     ax = new_axes(ax)
     with paper_style():
-        ax.plot(eps, lam, marker="o", markersize=2.5, color="C2")
+        ax.plot(eps, lam, marker="o", markersize=2.5, color="C2", label=r"grains with $\geq 2$ contacts")
+        if mean_lambda_all is not None:
+            lam_all = np.asarray(mean_lambda_all, dtype=np.float64)
+            if lam_all.shape != eps.shape:
+                raise ValueError(f"mean_lambda_all: expected shape {eps.shape}, got {lam_all.shape}")
+            ax.plot(eps, lam_all, ls="--", color="C4", label=r"all grains (0-1 contact: $\lambda = 1$)")
+            ax.legend(frameon=False, fontsize="small")
         _strain_axis(ax)
         ax.set_ylabel(r"mean stability index $\bar\lambda$")
     return ax

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import grainlab.protocols.biaxial as biaxial
+from grainlab.analysis import StabilityIndex
 from grainlab.cli import main
 from grainlab.io.hdf5 import read_results
 from grainlab.protocols.config import resolve
@@ -66,6 +67,14 @@ def test_results_folder_holds_everything(quick_run):
                    "force_anisotropy", "mean_stability_index"):
         assert column in rows[0]
     assert 0 < float(rows[0]["mean_stability_index"]) < 1
+    # every grain's mean counts the 0- and 1-contact grains at lambda = 1, the largest
+    # value: it can only lie above the mean over grains with >= 2 contacts
+    lam = np.array([float(r["mean_stability_index"]) for r in rows])
+    lam_all = np.array([float(r["mean_stability_index_all"]) for r in rows])
+    assert np.all(lam_all >= lam) and np.all(lam_all < 1)
+    # the last snapshot, recomputed: the record's all-grain mean is the library's mean_all
+    last = read_results(quick_run / "run.h5").snapshot("strain_0.1000")
+    assert lam_all[-1] == pytest.approx(StabilityIndex().compute(last).mean_all, rel=1e-12)
     assert summary["fabric"]["states"]["initial"]["a"] < summary["fabric"]["a_at_peak"]
     results = read_results(quick_run / "run.h5")
     assert results.status == "complete"

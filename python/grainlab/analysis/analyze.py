@@ -177,15 +177,19 @@ def fabric_summary(snapshot: Snapshot) -> dict[str, float]:
     """The scalar fabric of a snapshot with the library's defaults (boundary
     contacts excluded from Z and the anisotropies, included in lambda):
     ``coordination_number``, ``mechanical_coordination_number``,
-    ``mean_stability_index``, ``anisotropy`` and ``anisotropy_direction_rad``
+    ``mean_stability_index`` (grains with >= 2 contacts),
+    ``mean_stability_index_all`` (every grain, 0- and 1-contact grains at
+    lambda = 1, paper Sec. 5), ``anisotropy`` and ``anisotropy_direction_rad``
     (Eq. 7-8), ``anisotropy_fourier`` (unbinned) and ``force_anisotropy``
     (NaN when no contact carries a force)."""
     z = CoordinationNumber().compute(snapshot)
     normals = ContactAnisotropy().compute(snapshot)
+    stability = StabilityIndex().compute(snapshot)
     out = {
         "coordination_number": z.coordination_number,
         "mechanical_coordination_number": z.mechanical_coordination_number,
-        "mean_stability_index": StabilityIndex().compute(snapshot).mean,
+        "mean_stability_index": stability.mean,
+        "mean_stability_index_all": stability.mean_all,
         "anisotropy": normals.anisotropy,
         "anisotropy_direction_rad": normals.direction,
         "anisotropy_fourier": normals.anisotropy_fourier,

@@ -925,7 +925,9 @@ def _series_figure(analysis: _Analysis, which: str) -> Figure:
                 eps, ts["anisotropy"], normal_force=ts["force_anisotropy"], ax=ax
             )
         else:
-            plot.mean_lambda_series(eps, ts["mean_stability_index"], ax=ax)
+            plot.mean_lambda_series(
+                eps, ts["mean_stability_index"], mean_lambda_all=ts.get("mean_stability_index_all"), ax=ax
+            )
         if len(eps) > 60:  # markers only clutter a long record
             for line in ax.get_lines():
                 line.set_marker("")

@@ -84,6 +84,7 @@ TIMESERIES_UNITS = {
     "anisotropy_fourier": "1",
     "force_anisotropy": "1",
     "mean_stability_index": "1",
+    "mean_stability_index_all": "1",
     "mechanical_coordination_number": "1",
     "step": "1",
     "time_s": "s",

@@ -426,8 +426,14 @@ def _paper_rows(r: BiaxialReport) -> list[tuple[str, str, str, str]]:
         run["lambda_outside"] = f"n/a (no band at the peak); all grains {fmt(lam_peak, 3)}"
     run["lambda_trend"] = (
         f"{fmt(_num(_val(states, 'initial', 'mean_lambda')), 3)} initial, {fmt(lam_peak, 3)} at the peak "
-        f"snapshot, {fmt(_num(_val(states, 'final', 'mean_lambda')), 3)} final"
+        f"snapshot, {fmt(_num(_val(states, 'final', 'mean_lambda')), 3)} final (grains with 2 or more contacts)"
     )
+    if "mean_stability_index_all" in ts:
+        lam_all = np.asarray(ts["mean_stability_index_all"], dtype=np.float64)
+        run["lambda_trend"] += (
+            f"; counting the 0- and 1-contact grains at λ = 1 (Sec. 5's convention): {fmt(lam_all[0], 3)} "
+            f"initial, {fmt(lam_all[r.peak_row], 3)} at the peak, {fmt(lam_all[-1], 3)} final"
+        )
     return [(c.quantity, c.text, run.get(c.key, "n/a"), c.where) for c in BIAXIAL_CLAIMS]
 
 
