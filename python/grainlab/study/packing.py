@@ -41,6 +41,7 @@ MEASURES: tuple[str, ...] = (
     "coordination_number",
     "mechanical_coordination_number",
     "mean_stability_index",
+    "mean_stability_index_all",
     "anisotropy",
     "anisotropy_fourier",
     "force_anisotropy",
@@ -144,7 +145,7 @@ def measure(snapshot: Snapshot) -> dict[str, float]:
     contacts excluded from Z and the anisotropies, included in lambda)."""
     summary = fabric_summary(snapshot)
     keys = ("coordination_number", "mechanical_coordination_number", "mean_stability_index",
-            "anisotropy", "anisotropy_fourier", "force_anisotropy")
+            "mean_stability_index_all", "anisotropy", "anisotropy_fourier", "force_anisotropy")
     return {k: summary[k] for k in keys}
 
 

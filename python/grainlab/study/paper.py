@@ -32,6 +32,7 @@ STUDY_COLUMNS: tuple[str, ...] = (
     "coordination_number",
     "mechanical_coordination_number",
     "mean_stability_index",
+    "mean_stability_index_all",
     "anisotropy",
     "force_anisotropy",
     "wall_time_s",
