@@ -437,17 +437,25 @@ def render_study(r: StudyReport) -> str:
             table(["parameter", "value", "SI unit"], params, numeric=(1,)),
         )
     )
-    rows = [[_cell(c, row.get(c, "")) for c in r.columns] for row in r.rows]
-    note_col = {k: "note" for k, c in enumerate(r.columns) if c in ("note", "error")}
-    numeric = [k for k, c in enumerate(r.columns) if c not in ("kind", "status", "note", "name", "error")]
-    sections.append(
-        section(
-            "table",
-            "study.csv",
-            paragraph("One row per packing, as written (numbers to 4 significant digits).", "note"),
-            table(r.columns, rows, numeric=numeric, css_class="wide", cell_classes=note_col),
-        )
-    )
+    # the free-text columns go below the table, one line per packing that has any,
+    # so that the table keeps one line per row
+    texts = [c for c in r.columns if c in ("note", "error")]
+    columns = [c for c in r.columns if c not in texts]
+    rows = [[_cell(c, row.get(c, "")) for c in columns] for row in r.rows]
+    numeric = [k for k, c in enumerate(columns) if c not in ("kind", "status", "name")]
+    remarks = [
+        (str(row.get("name", "")), c, str(row.get(c, "")))
+        for row in r.rows
+        for c in texts
+        if str(row.get(c, "")).strip()
+    ]
+    table_parts: list[Any] = [
+        paragraph("One row per packing, as written (numbers to 4 significant digits).", "note"),
+        table(columns, rows, numeric=numeric, css_class="wide"),
+    ]
+    if remarks:
+        table_parts.append(table(["packing", "column", "text"], remarks, cell_classes={2: "note"}))
+    sections.append(section("table", "study.csv", *table_parts))
     fig_parts: list[Any] = [figures(r.figures.values())]
     trends = s.get("trends") or {}
     if fit or trends:
