@@ -104,6 +104,16 @@ impl MaterialTable {
         &self.models[Self::index(a, b) as usize]
     }
 
+    /// Number of stored models (valid indices are below it).
+    pub fn len(&self) -> usize {
+        self.models.len()
+    }
+
+    /// True when no model is stored (never, for a table made by [`MaterialTable::new`]).
+    pub fn is_empty(&self) -> bool {
+        self.models.is_empty()
+    }
+
     /// The model stored at `index`.
     #[inline(always)]
     pub fn by_index(&self, index: u16) -> &ContactModel {

@@ -164,6 +164,89 @@ impl NeighborList {
         self.valid = false;
     }
 
+    /// Checks the lists against the system they index (a loaded state is
+    /// trusted by the force kernels, which read without bounds checks).
+    pub fn check_consistent(
+        &self,
+        n_particles: usize,
+        n_walls: usize,
+        n_models: usize,
+    ) -> Result<()> {
+        let bad = |what: &str| {
+            Err(EngineError::invalid(
+                "state",
+                format!("inconsistent neighbour lists: {what}"),
+            ))
+        };
+        if self.reference.len() != n_particles && self.valid {
+            return bad("reference positions");
+        }
+        let p = &self.pairs;
+        let m = p.i.len();
+        if [
+            p.j.len(),
+            p.shift.len(),
+            p.model.len(),
+            p.shear.len(),
+            p.sliding.len(),
+        ]
+        .iter()
+        .any(|&l| l != m)
+        {
+            return bad("pair arrays of different lengths");
+        }
+        if p.i.iter().chain(&p.j).any(|&q| q as usize >= n_particles) {
+            return bad("a pair names a particle that does not exist");
+        }
+        if p.model.iter().any(|&k| k as usize >= n_models) {
+            return bad("a pair names a contact model that does not exist");
+        }
+        let n_blocks = self.block_ranges.len();
+        if self.valid {
+            if p.block_start.len() != n_blocks + 1
+                || p.block_start.windows(2).any(|w| w[0] > w[1])
+                || p.block_start.last().is_some_and(|&last| last > m)
+            {
+                return bad("block starts");
+            }
+            let mut next = 0usize;
+            for &(lo, hi) in &self.block_ranges {
+                if lo != next || hi < lo {
+                    return bad("block ranges");
+                }
+                next = hi;
+            }
+            if next != n_particles {
+                return bad("block ranges do not cover the particles");
+            }
+            let cross = m - p.block_start[n_blocks];
+            if self.cross_touch_start.len() != n_blocks + 1
+                || self.cross_touch_start.windows(2).any(|w| w[0] > w[1])
+                || self.cross_touch_start.last() != Some(&self.cross_touch.len())
+                || self.cross_touch.iter().any(|&e| (e >> 1) as usize >= cross)
+            {
+                return bad("cross-block pairs");
+            }
+        }
+        let w = &self.wall_pairs;
+        let k = w.wall.len();
+        if [
+            w.particle.len(),
+            w.model.len(),
+            w.shear.len(),
+            w.sliding.len(),
+        ]
+        .iter()
+        .any(|&l| l != k)
+            || w.particle.iter().any(|&q| q as usize >= n_particles)
+            || w.wall.iter().any(|&q| q as usize >= n_walls)
+            || w.model.iter().any(|&q| q as usize >= n_models)
+        {
+            return bad("wall pairs");
+        }
+        Ok(())
+    }
+
     /// Whether the list is currently valid.
     pub fn is_valid(&self) -> bool {
         self.valid

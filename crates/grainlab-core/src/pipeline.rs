@@ -608,6 +608,7 @@ impl Simulation {
     /// The step loop, on the simulation's pool when it has one and the system is
     /// large enough: one broadcast per call, worker 0 steps, the others serve phases.
     fn run_steps(&mut self, n: u64, measure_last: bool) -> Result<()> {
+        self.check_consistent()?;
         // external loads cannot change during a run call: scan them once, not every step
         let p = &self.particles;
         self.external_loads = p.external_force.iter().any(|f| *f != [0.0, 0.0])
@@ -1152,8 +1153,72 @@ impl Simulation {
         let mut sim: Simulation = bincode::deserialize(bytes).map_err(|e| {
             EngineError::invalid("state", format!("not a grainlab engine state: {e}"))
         })?;
+        sim.check_consistent()?;
         sim.make_pool()?;
         Ok(sim)
+    }
+
+    /// Checks that the state indexes only what it holds: the force kernels read
+    /// particle arrays without bounds checks, so a stale or edited state (a
+    /// loaded file, or public fields changed by hand) must be refused before any
+    /// step rather than read out of bounds. Linear in particles and pairs: run
+    /// at every load and at the start of every `run` call.
+    fn check_consistent(&self) -> Result<()> {
+        let bad = |what: &str| {
+            Err(EngineError::invalid(
+                "state",
+                format!("inconsistent state: {what}"),
+            ))
+        };
+        let p = &self.particles;
+        let n = p.len();
+        let vec2s = [&p.velocity, &p.external_force, &p.force];
+        let scalars = [
+            &p.rotation,
+            &p.angular_velocity,
+            &p.radius,
+            &p.mass,
+            &p.inertia,
+            &p.inv_mass,
+            &p.inv_inertia,
+            &p.external_torque,
+            &p.torque,
+        ];
+        if vec2s.iter().any(|a| a.len() != n)
+            || scalars.iter().any(|a| a.len() != n)
+            || p.group.len() != n
+            || p.fixity.len() != n
+            || (p.density.len() != n && p.density.len() != 1)
+        {
+            return bad("particle arrays of different lengths");
+        }
+        if self.order.len() != n
+            || self.rank.len() != n
+            || self
+                .order
+                .iter()
+                .chain(&self.rank)
+                .any(|&q| q as usize >= n)
+        {
+            return bad("particle order");
+        }
+        if self
+            .bonds
+            .list
+            .iter()
+            .any(|b| b.i as usize >= n || b.j as usize >= n)
+            || self.chains.iter().any(|c| {
+                c.particles.iter().any(|&q| q as usize >= n)
+                    || [c.start_wall, c.end_wall]
+                        .iter()
+                        .flatten()
+                        .any(|&w| w as usize >= self.walls.len())
+            })
+        {
+            return bad("a bond or pressure chain names a particle that does not exist");
+        }
+        self.neighbors
+            .check_consistent(n, self.walls.len(), self.materials.len())
     }
 }
 

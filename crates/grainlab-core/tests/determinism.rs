@@ -77,3 +77,56 @@ fn a_garbage_state_is_refused_with_a_clear_error() {
         "{err}"
     );
 }
+
+#[test]
+fn a_state_indexing_what_it_does_not_hold_is_refused() {
+    // The force kernels read particle arrays without bounds checks, trusting the
+    // neighbour lists; a stale or edited state must be refused when loaded.
+    let mut sim = bench_packing(0.5, 0.2, 1);
+    sim.run(5).unwrap();
+    let good = sim.to_bytes().unwrap();
+    assert!(Simulation::from_bytes(&good).is_ok());
+    let n = sim.particles.len() as u32;
+    let cases: Vec<(&str, Box<dyn Fn(&mut Simulation)>)> = vec![
+        (
+            "a pair names a particle",
+            Box::new(move |s| s.neighbors.pairs.j[0] = n + 7),
+        ),
+        (
+            "pair arrays",
+            Box::new(|s| {
+                s.neighbors.pairs.shear.pop();
+            }),
+        ),
+        (
+            "contact model",
+            Box::new(|s| s.neighbors.pairs.model[0] = u16::MAX),
+        ),
+        (
+            "block ranges",
+            Box::new(|s| s.neighbors.block_ranges[0].1 += 1),
+        ),
+        (
+            "particle arrays",
+            Box::new(|s| {
+                s.particles.velocity.pop();
+            }),
+        ),
+    ];
+    for (what, edit) in cases {
+        let mut broken = Simulation::from_bytes(&good).unwrap();
+        edit(&mut broken);
+        let err = Simulation::from_bytes(&broken.to_bytes().unwrap())
+            .err()
+            .unwrap_or_else(|| panic!("{what}: must be refused"));
+        assert!(err.to_string().contains("inconsistent"), "{what}: {err}");
+        // the same edit made in memory is refused by the next run, before any step
+        let mut edited = Simulation::from_bytes(&good).unwrap();
+        edit(&mut edited);
+        let err = edited
+            .run(1)
+            .err()
+            .unwrap_or_else(|| panic!("{what}: run must refuse"));
+        assert!(err.to_string().contains("inconsistent"), "{what}: {err}");
+    }
+}
