@@ -58,8 +58,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     except KeyboardInterrupt:
         print(
-            f"grainlab {args.command}: interrupted; what was written so far is kept "
-            "(a biaxial run continues with --resume)",
+            f"grainlab {args.command}: interrupted; what was written so far is kept (a biaxial "
+            "run continues from its last checkpoint with --resume, or starts over if it had none)",
             file=sys.stderr,
         )
         return 130

@@ -165,3 +165,27 @@ def test_outer_grain_boundary_variant(tmp_path):
     # the boundary grains are the outermost ones on each side
     x = snap.positions[:, 0] - snap.radii
     assert x[boundary].min() == pytest.approx(x.min())
+
+
+def test_a_run_stopped_before_its_first_checkpoint_starts_over(tmp_path, monkeypatch):
+    # Ctrl-C during sample generation leaves run.h5.partial and no checkpoint: nothing to
+    # resume, so a new run in the same folder starts over instead of refusing the folder
+    (tmp_path / "run.h5.partial").write_bytes(b"")
+
+    def generate(*args, **kwargs):
+        raise RuntimeError("generation reached")
+
+    monkeypatch.setattr(biaxial, "_generate", generate)
+    with pytest.raises(RuntimeError, match="generation reached"):
+        biaxial.run_biaxial(resolve(quick=True), tmp_path, progress=False)
+    with pytest.raises(ValueError, match="starts over without --resume"):
+        biaxial.run_biaxial(resolve(quick=True), tmp_path / "other", resume=True, progress=False)
+
+
+def test_a_checkpoint_from_before_new_keys_resumes_with_their_defaults():
+    config = resolve(quick=True)
+    old = config.to_dict()
+    del old["material"]["limiting_contact_pressure"]  # keys added since
+    del old["sample"]["sieve_sizes"], old["sample"]["percent_passing"]
+    assert biaxial._saved_config(old) == config.to_dict()
+    assert biaxial._saved_config({"sample": {"porosity": 2.0}}) is None  # not a valid configuration

@@ -101,6 +101,8 @@ def test_sieve_table_grading_sets_the_size_range():
          "sample.percent_passing: 120 is out of range"),
         (['sample.grading="curve"', 'sample.sieve_sizes=["1 mm", "2 kg"]', "sample.percent_passing=[0, 100]"],
          "unknown unit 'kg'"),
+        (["shear.snapshot_strains=[]"], "shear.snapshot_strains: must include 0"),
+        (["shear.snapshot_strains=[0.01, 0.05]"], "shear.snapshot_strains: must include 0"),
     ],
 )
 def test_bad_sieve_tables_are_refused_before_any_work(overrides, message):

@@ -10,7 +10,8 @@ Phases, each run by the engine in blocks of steps:
 3. **boundary**: the side walls are switched off and replaced by the bonded
    membrane chains under the confining pressure (follower load); the sample
    re-equilibrates with the platens holding ``sigma_0`` (servo-controlled once
-   their stress leaves the tolerance), so shearing starts isotropic.
+   their stress leaves the tolerance), so shearing starts isotropic. (Variant B,
+   the outermost grains as boundary, keeps its platens still.)
 4. **shear**: the platens approach each other at a constant axial strain rate
    to the final strain while the confining pressure stays constant; a record
    every ``shear.record_interval`` of axial strain, full snapshots at the
@@ -521,6 +522,13 @@ def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progres
         if servo:
             bottom.velocity = (0.0, 0.0)
             top.velocity = (0.0, 0.0)
+        if not settled:
+            warnings.warn(
+                f"boundary phase: consolidation.max_steps reached with the platens at {sigma_1 / 1e3:.1f} kPa "
+                f"(sigma_0 {target / 1e3:.1f} kPa +- {tolerance:.0%}): shearing starts from there",
+                RuntimeWarning,
+                stacklevel=2,
+            )
         run.consolidation["platen_stress_pa"] = sigma_1
     else:
         radii = sim.radii[: run.n_grains]
@@ -721,6 +729,15 @@ def _figures(timeseries: dict[str, np.ndarray], out: Path) -> list[Path]:
 # ---- the driver ---------------------------------------------------------------
 
 
+def _saved_config(saved: Any) -> dict[str, Any] | None:
+    """A checkpoint's configuration resolved as this grainlab would (keys added
+    since it was written take their defaults), or None when it cannot be."""
+    try:
+        return BiaxialConfig.from_dict(saved).to_dict()
+    except (ValueError, TypeError, AttributeError):
+        return None
+
+
 def run_biaxial(
     config: BiaxialConfig,
     out_dir: str | os.PathLike[str],
@@ -736,17 +753,23 @@ def run_biaxial(
     threads = _threads(config)
     if resume:
         if not checkpoint_path.exists():
-            raise ValueError(f"--resume: {checkpoint_path} not found; nothing to resume")
+            raise ValueError(
+                f"--resume: {checkpoint_path} not found; nothing to resume (a run stopped before its "
+                "first checkpoint starts over without --resume)"
+            )
         checkpoint = read_checkpoint(checkpoint_path)
         saved = dict(checkpoint.protocol_state)
-        if saved.get("config") != config.to_dict():
+        if _saved_config(saved.get("config")) != config.to_dict():
             raise ValueError(f"--resume: the configuration differs from the one {out} was started with")
         sim = Simulation.from_bytes(checkpoint.engine_state)
         run = _Run(**{k: v for k, v in saved.items() if k != "config" and k != "elapsed_s"})
         writer = ResultsWriter.resume(out, timeseries_rows=run.rows, snapshots=run.snapshots or [])
         elapsed_before = float(saved.get("elapsed_s", 0.0))
     else:
-        if (out / "run.h5").exists() or checkpoint_path.exists() or (out / "run.h5.partial").exists():
+        partial = out / "run.h5.partial"
+        if partial.exists() and not checkpoint_path.exists() and not (out / "run.h5").exists():
+            partial.unlink()  # a run stopped before its first checkpoint: nothing to keep or resume
+        if (out / "run.h5").exists() or checkpoint_path.exists() or partial.exists():
             raise ValueError(f"--out: {out} already holds a run; use --resume to continue it or choose another folder")
         out.mkdir(parents=True, exist_ok=True)
         writer = ResultsWriter(out, kind="biaxial")
@@ -778,7 +801,7 @@ def run_biaxial(
     total = elapsed_before + time.perf_counter() - started
     timeseries = writer.read_timeseries()
     summary = _summary(run, config, timeseries, total)
-    summary["threads"] = threads  # "auto" resolved: the same count reruns bitwise (DESIGN §6)
+    summary["threads"] = sim.threads  # the count the run used (a resumed run keeps its own): reruns bitwise
     writer.write_summary(summary)
     writer.write_phases(run.wall_time)
     writer.finalize()

@@ -346,6 +346,11 @@ def _check_consistency(v: dict[str, Any]) -> None:
             f"sample.width/height: the sample must be at least 10 largest diameters wide "
             f"({10 * v['sample.d_max']:g} m), got {v['sample.width']:g} x {v['sample.height']:g} m"
         )
+    if 0.0 not in v["shear.snapshot_strains"]:
+        raise ConfigError(
+            "shear.snapshot_strains: must include 0, the state at the start of shearing that "
+            f"displacements, local strains and the shear band are measured from; got {v['shear.snapshot_strains']}"
+        )
     positive = [s for s in v["shear.snapshot_strains"] if s > 0]
     if positive and positive[0] > v["shear.final_strain"] + 1e-12:
         raise ConfigError(
