@@ -85,6 +85,7 @@ __all__ = [
     "StateNumbers",
     "fabric_figures",
     "fabric_numbers",
+    "band_labels",
 ]
 
 #: Figure names (file stems), in the paper's order.
@@ -729,6 +730,23 @@ def _analyse(run_dir: str | Path, peak_snapshot: str | int | None) -> _Analysis:
         notes=notes,
     )
     return _Analysis(numbers, results, states, bands)
+
+
+def band_labels(reference: Snapshot, current: Snapshot) -> NDArray[np.int32]:
+    """(N,) per particle of ``current``: 1 inside the accepted shear band, 2
+    inside its accepted conjugate band, 0 elsewhere (membrane disks, and every
+    particle when no band passes the tests): the bands the figures outline,
+    found in the grains' local strain since ``reference``."""
+    found = _find_band(_state("initial", "", 0.0, reference), _state("current", "", math.nan, current))
+    labels = np.zeros(current.n_particles, np.int32)
+    grains = np.flatnonzero(current.is_sample)
+    pos = current.positions[grains]
+    if found.band is not None:
+        labels[grains[_slab_members(found.band, pos)]] = 1
+        if found.second is not None:
+            second = grains[_slab_members(found.second, pos)]
+            labels[second[labels[second] == 0]] = 2
+    return labels
 
 
 def fabric_numbers(run_dir: str | Path, *, peak_snapshot: str | int | None = None) -> FabricNumbers:

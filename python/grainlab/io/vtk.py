@@ -275,11 +275,13 @@ def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArra
     ``rotation`` (only when the snapshot has rotations), ``n_contacts`` (walls
     included), ``stability_index``, ``local_shear_strain`` (NaN in the first
     snapshot), ``in_shear_band`` (0 outside, 1 in the dominant band, 2 in
-    the conjugate band; bands that the detector does not accept mark nothing), then every numeric per-particle field
+    the conjugate band: the bands the biaxial figures outline,
+    :func:`grainlab.analysis.biaxial_figures.band_labels`), then every numeric per-particle field
     of the snapshot (``velocity``, ...) under its own name, 2-vectors padded to
     (N, 3); a field whose name is already taken above is left out.
     """
-    from grainlab.analysis import LocalStrain, ShearBand, StabilityIndex, match_ids
+    from grainlab.analysis import LocalStrain, StabilityIndex, match_ids
+    from grainlab.analysis.biaxial_figures import band_labels
 
     n = snap.n_particles
     out: dict[str, NDArray[Any]] = {
@@ -298,16 +300,12 @@ def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArra
         disp[ok, :2] = snap.minimum_image(snap.positions[ok] - reference.positions[to_ref[ok]])
         strain = LocalStrain().compute(reference, snap)
         gamma = np.asarray(strain.shear_strain, np.float64)
+        # the bands the biaxial figures outline (grains away from the boundary,
+        # with the figures' acceptance tests): 1 dominant, 2 conjugate
         try:
-            found = ShearBand().compute(snap, strain.excess_shear_strain)
-        except ValueError:  # too few particles with a finite strain: no band
-            found = None
-        # members of the accepted bands only: 1 the dominant band, 2 its conjugate
-        if found is not None and found.found:
-            band[np.asarray(found.members, bool)] = 1
-            second = found.second
-            if second is not None and second.found:
-                band[np.asarray(second.members, bool) & (band == 0)] = 2
+            band = band_labels(reference, snap)
+        except ValueError:  # too few grains with a local strain: no band
+            pass
     out["displacement"] = disp
     if snap.rotations is not None:
         out["rotation"] = np.asarray(snap.rotations, np.float64)
