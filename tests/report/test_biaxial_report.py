@@ -168,9 +168,11 @@ def test_quick_run_figures_deleted_are_drawn_again(quick_biaxial_run, tmp_path):
     for name in ("fig08_stress_ratio", "fig12_stability_index"):
         for suffix in (".png", ".svg"):
             (folder / f"{name}{suffix}").unlink()
+    (folder / "fig09_anisotropy.png").write_bytes(b"")  # an empty (interrupted) figure counts as missing
     (folder / "report.html").unlink()
     assert write_report(folder) == folder / "report.html"
     assert (folder / "fig08_stress_ratio.png").exists() and (folder / "fig12_stability_index.png").exists()
+    assert (folder / "fig09_anisotropy.png").read_bytes()[:4] == b"\x89PNG"
     assert check_self_contained(folder / "report.html") == ["png"] * N_FIGURES
 
 

@@ -32,7 +32,7 @@ from grainlab.report.angles import (
 )
 from grainlab.report.band import BandResult, band_from_numbers
 from grainlab.report.figures import grading_figure, macro_figure
-from grainlab.report.html import EmbeddedFigure, fmt
+from grainlab.report.html import EmbeddedFigure, fmt, is_usable_png
 from grainlab.report.paper import BIAXIAL_CLAIMS, TABLE1
 from grainlab.samples import PAPER_GRADING, UniformByMass, UniformByNumber
 from grainlab.samples.grading import Grading, GradingCurve
@@ -345,7 +345,7 @@ def _peak_row(ts: dict[str, np.ndarray]) -> int:
 
 def _file_figure(path: Path, key: str, title: str, caption: str) -> EmbeddedFigure | None:
     png = path.with_suffix(".png")
-    if not png.exists():
+    if not is_usable_png(png):
         return None
     return EmbeddedFigure(key, title, caption, png.read_bytes(), f"{png.name} in the results folder")
 
@@ -364,7 +364,7 @@ def _num(x: Any) -> float:
 
 def _band_text(band: BandResult | None) -> str:
     if band is None:
-        return "not looked for (a single snapshot)"
+        return "not available (a single snapshot, or no fabric numbers)"
     if band.found:
         return (
             f"found at {band.snapshot}: inclination {fmt(band.inclination_degrees, 3)} deg to σ₃, "
@@ -506,7 +506,7 @@ def gather_biaxial(
     threads = summary.get("threads") if isinstance(summary.get("threads"), int) else None
 
     # figures of the folder: draw the missing ones with the functions that drew them
-    missing_curves = [n for n in CURVE_FIGURES if not (folder / f"{n}.png").exists()]
+    missing_curves = [n for n in CURVE_FIGURES if not is_usable_png(folder / f"{n}.png")]
     if redraw or missing_curves:
         if "coordination_number" in ts:
             biaxial_curves(ts, folder)
@@ -514,7 +514,7 @@ def gather_biaxial(
         else:
             notes.append("no coordination_number column: Figs. 8, 10 and 18 could not be drawn")
     expected = [n for n in FIGURES if not (n == "fig11_displacement" and len(results.snapshot_names) < 2)]
-    missing_fabric = [n for n in expected if not (folder / f"{n}.png").exists()]
+    missing_fabric = [n for n in expected if not is_usable_png(folder / f"{n}.png")]
     fabric: dict[str, Any] | None = saved.get("fabric") if isinstance(saved.get("fabric"), dict) else None
     fabric_source = "summary.json (computed with the run, as the figures show them)"
     try:

@@ -14,6 +14,7 @@ import html
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 __all__ = [
@@ -97,6 +98,16 @@ _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 #: Figures are shown at this many times their printed size (matplotlib's inches at 96 px per inch).
 DISPLAY_ZOOM = 1.3
+
+
+def is_usable_png(path: Path) -> bool:
+    """Whether ``path`` is a PNG file the report can embed (exists, signature and
+    header present): an empty or truncated figure counts as missing and is redrawn."""
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return False
+    return len(data) > 33 and data[:8] == _PNG_SIGNATURE and data[12:16] == b"IHDR"
 
 
 def png_info(png: bytes) -> tuple[int, int, float | None]:

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+import shlex
 from typing import Any
 
 import grainlab
@@ -61,7 +62,7 @@ def _band_table(r: BiaxialReport) -> Markup:
     rows = []
     for label, b in (("nearest the peak", r.band_peak), ("end of shearing", r.band_end)):
         if b is None:
-            rows.append((label, "-", "not looked for (a single snapshot)", "", "", "", "", "", "", ""))
+            rows.append((label, "-", "not available (a single snapshot, or no fabric numbers)", "", "", "", "", "", "", ""))
             continue
         rows.append(
             (
@@ -180,7 +181,7 @@ def render_biaxial(r: BiaxialReport) -> str:
         paragraph("Or with the whole resolved configuration in a file:"),
         code_block(r.rerun.command_with_file),
         _details("config.toml (the resolved configuration)", code_block(r.rerun.toml)),
-        paragraph(f"Rebuild this report: grainlab report {r.folder.resolve()}", "note"),
+        paragraph(f"Rebuild this report: grainlab report {shlex.quote(str(r.folder.resolve()))}", "note"),
     ]
     sections.append(section("rerun", "How to rerun", *rerun_parts))
 
@@ -417,7 +418,7 @@ def render_study(r: StudyReport) -> str:
     sections = [section("glance", "At a glance", glance)]
     parts: list[Any] = [code_block(r.rerun_command)]
     parts += [paragraph(n, "note") for n in r.rerun_notes]
-    parts.append(paragraph(f"Rebuild this report: grainlab report {r.folder.resolve()}", "note"))
+    parts.append(paragraph(f"Rebuild this report: grainlab report {shlex.quote(str(r.folder.resolve()))}", "note"))
     sections.append(section("rerun", "How to rerun", *parts))
 
     params = [(k, fmt(v, 6) if isinstance(v, float) else str(v), param_unit(k)) for k, v in r.params.items()]

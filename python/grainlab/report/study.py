@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from grainlab.report.html import EmbeddedFigure, fmt
+from grainlab.report.html import EmbeddedFigure, fmt, is_usable_png
 from grainlab.report.paper import STUDY_CLAIMS
 from grainlab.study.packing import PackingParams
 from grainlab.study.paper import (
@@ -223,7 +223,7 @@ def gather_study(folder: str | Path, *, redraw: bool = False) -> StudyReport:
 
     irregular, hexagonal = _targets(rows, "irregular"), _targets(rows, "hexagonal")
     regenerated: list[str] = []
-    missing = [n for n in STUDY_FIGURES if not (folder / f"{n}.png").exists()]
+    missing = [n for n in STUDY_FIGURES if not is_usable_png(folder / f"{n}.png")]
     if redraw or missing:
         study_figures(rows, folder)
         regenerated = list(STUDY_FIGURES)
@@ -231,7 +231,7 @@ def gather_study(folder: str | Path, *, redraw: bool = False) -> StudyReport:
     figures = {}
     for key, (title, caption) in STUDY_FIGURES.items():
         png = folder / f"{key}.png"
-        if png.exists():
+        if is_usable_png(png):
             figures[key] = EmbeddedFigure(key, title, caption, png.read_bytes(), f"{png.name} in the study folder")
     statuses: dict[str, int] = {}
     for r in rows:
