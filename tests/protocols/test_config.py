@@ -72,16 +72,18 @@ def test_round_trip_through_nested_dict():
 
 
 def test_sieve_table_grading_sets_the_size_range():
-    config = resolve(
-        overrides=[
-            'sample.grading="curve"',
-            'sample.sieve_sizes=["0.8 mm", "1.2 mm", "2 mm"]',
-            "sample.percent_passing=[0, 40, 100]",
-        ]
-    )
+    config_overrides = [
+        'sample.grading="curve"',
+        'sample.sieve_sizes=["0.8 mm", "1.2 mm", "2 mm"]',
+        "sample.percent_passing=[0, 40, 100]",
+    ]
+    config = resolve(overrides=config_overrides)
     assert config["sample.sieve_sizes"] == pytest.approx([0.8e-3, 1.2e-3, 2.0e-3])
     assert config["sample.percent_passing"] == [0.0, 40.0, 100.0]
     assert (config["sample.d_min"], config["sample.d_max"]) == pytest.approx((0.8e-3, 2.0e-3))
+    # a d_min that agrees with the curve may be given too
+    same = resolve(overrides=[*config_overrides, 'sample.d_min="0.8 mm"'])
+    assert same.values == config.values
     # the resolved configuration round-trips through its nested form (run.h5, TOML)
     assert BiaxialConfig.from_dict(config.to_dict()).values == config.values
 
@@ -102,6 +104,8 @@ def test_sieve_table_grading_sets_the_size_range():
         (['sample.grading="curve"', 'sample.sieve_sizes=["1 mm", "2 kg"]', "sample.percent_passing=[0, 100]"],
          "unknown unit 'kg'"),
         (["shear.snapshot_strains=[]"], "shear.snapshot_strains: must include 0"),
+        (['sample.grading="curve"', "sample.sieve_sizes=[1e-3, 2e-3]", "sample.percent_passing=[0, 100]",
+          "sample.d_min=0.5e-3"], "sample.d_min: 0.0005 m disagrees with the 'curve' grading"),
         (["shear.snapshot_strains=[0.01, 0.05]"], "shear.snapshot_strains: must include 0"),
     ],
 )

@@ -307,12 +307,13 @@ def resolve(
         for key, value in layer.items():
             values[key] = value
     resolved = {key: coerce(key, value) for key, value in values.items()}
-    _check_consistency(resolved)
+    _check_consistency(resolved, given={key for layer in layers for key in layer})
     return BiaxialConfig(resolved)
 
 
-def _grading_curve(v: dict[str, Any]) -> None:
-    """Checks a 'curve' grading's sieve data and takes d_min and d_max from it."""
+def _grading_curve(v: dict[str, Any], given: set[str]) -> None:
+    """Checks a 'curve' grading's sieve data and takes d_min and d_max from it
+    (a d_min or d_max given as well must agree with the curve's ends)."""
     sizes, passing = v["sample.sieve_sizes"], v["sample.percent_passing"]
     if v["sample.grading"] != "curve":
         if sizes or passing:
@@ -332,11 +333,17 @@ def _grading_curve(v: dict[str, Any]) -> None:
         GradingCurve(sizes, passing)
     except ValueError as error:
         raise ConfigError("sample." + str(error).replace("sieve_sizes_m", "sieve_sizes", 1)) from None
+    for key, end in (("sample.d_min", sizes[0]), ("sample.d_max", sizes[-1])):
+        if key in given and not math.isclose(v[key], end, rel_tol=1e-9):
+            raise ConfigError(
+                f"{key}: {v[key]:g} m disagrees with the 'curve' grading, whose sieve sizes run from "
+                f"{sizes[0]:g} to {sizes[-1]:g} m; leave {key} out (the curve sets it)"
+            )
     v["sample.d_min"], v["sample.d_max"] = sizes[0], sizes[-1]
 
 
-def _check_consistency(v: dict[str, Any]) -> None:
-    _grading_curve(v)
+def _check_consistency(v: dict[str, Any], given: set[str] = frozenset()) -> None:
+    _grading_curve(v, given)
     if v["sample.d_min"] > v["sample.d_max"]:
         raise ConfigError(
             f"sample.d_min: {v['sample.d_min']:g} m exceeds sample.d_max {v['sample.d_max']:g} m"
