@@ -68,9 +68,9 @@ def test_the_band_is_measured_at_the_end_and_compared(synthetic, synthetic_run):
     assert synthetic.band_peak is not None and synthetic.band_peak.snapshot == "strain_0.0100"
     text = _text(synthetic_run / "report.html")
     if end.found:
-        assert end.inclination_degrees == pytest.approx(BAND_DEG, abs=5.0)
+        assert end.inclination_deg == pytest.approx(BAND_DEG, abs=5.0)
         assert end.thickness_diameters > 1.0
-        assert fmt(end.inclination_degrees, 3) in text
+        assert fmt(end.inclination_deg, 3) in text
         assert "closest to the" in text
     else:  # the detector may refuse it; the report then says why and compares nothing
         assert end.reason and end.reason in text

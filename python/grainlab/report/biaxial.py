@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 import grainlab
+from grainlab.analysis.biaxial_figures import BandNumbers
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.protocols.config import FIELDS, QUICK
 from grainlab.report.angles import (
@@ -30,7 +31,7 @@ from grainlab.report.angles import (
     fit_dilation,
     mobilised_friction_angle,
 )
-from grainlab.report.band import BandResult, band_from_numbers
+from grainlab.report.band import band_from_numbers
 from grainlab.report.figures import grading_figure, macro_figure
 from grainlab.report.html import EmbeddedFigure, fmt, is_usable_png
 from grainlab.report.paper import BIAXIAL_CLAIMS, TABLE1
@@ -138,8 +139,8 @@ class BiaxialReport:
     #: The band measured by the report at the snapshot nearest the peak and at the
     #: end of shearing (None with a single snapshot); the end one is compared with
     #: the classical angles.
-    band_peak: BandResult | None
-    band_end: BandResult | None
+    band_peak: BandNumbers | None
+    band_end: BandNumbers | None
     #: Figures of the folder in report order, and the report's own.
     figures: dict[str, EmbeddedFigure]
     grading_png: bytes
@@ -362,12 +363,12 @@ def _num(x: Any) -> float:
     return float(x) if isinstance(x, int | float) and not isinstance(x, bool) else math.nan
 
 
-def _band_text(band: BandResult | None) -> str:
+def _band_text(band: BandNumbers | None) -> str:
     if band is None:
         return "not available (a single snapshot, or no fabric numbers)"
     if band.found:
         return (
-            f"found at {band.snapshot}: inclination {fmt(band.inclination_degrees, 3)} deg to σ₃, "
+            f"found at {band.snapshot}: inclination {fmt(band.inclination_deg, 3)} deg to σ₃, "
             f"{fmt(band.thickness_diameters, 3)} mean diameters thick"
         )
     return f"not found at {band.snapshot}: {band.reason}"
@@ -414,7 +415,7 @@ def _paper_rows(r: BiaxialReport) -> list[tuple[str, str, str, str]]:
     run["band_at_peak"] = _band_text(r.band_peak)
     end = r.band_end
     run["band_inclination"] = (
-        f"{fmt(end.inclination_degrees, 3)} deg at {end.snapshot}" if end and end.found else "n/a (no band found)"
+        f"{fmt(end.inclination_deg, 3)} deg at {end.snapshot}" if end and end.found else "n/a (no band found)"
     )
     lam_peak = _num(_val(states, "peak", "mean_lambda"))
     peak = r.band_peak

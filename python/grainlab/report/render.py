@@ -8,6 +8,7 @@ import shlex
 from typing import Any
 
 import grainlab
+from grainlab.report.band import ACCEPTANCE
 from grainlab.report.biaxial import BiaxialReport
 from grainlab.report.html import (
     EmbeddedFigure,
@@ -69,8 +70,8 @@ def _band_table(r: BiaxialReport) -> Markup:
                 label,
                 f"{b.snapshot} vs {b.reference}",
                 "found" if b.found else "not found (candidate)",
-                fmt(b.angle_degrees, 4),
-                fmt(b.inclination_degrees, 3),
+                fmt(b.angle_deg, 4),
+                fmt(b.inclination_deg, 3),
                 fmt(b.thickness_diameters, 3),
                 fmt(1e3 * b.thickness_m, 3),
                 fmt(b.contrast, 3),
@@ -90,7 +91,7 @@ def _band_table(r: BiaxialReport) -> Markup:
 def _classical_table(r: BiaxialReport) -> Markup:
     a = r.angles
     b = r.band_end
-    incl = b.inclination if b is not None and b.found else math.nan
+    incl = math.radians(b.inclination_deg) if b is not None and b.found else math.nan
 
     def diff(theta: float) -> str:
         if not (math.isfinite(theta) and math.isfinite(incl)):
@@ -153,7 +154,7 @@ def render_biaxial(r: BiaxialReport) -> str:
     )
     band = r.band_end
     band_glance = (
-        f"{fmt(band.inclination_degrees, 3)} deg, {fmt(band.thickness_diameters, 3)} diameters"
+        f"{fmt(band.inclination_deg, 3)} deg, {fmt(band.thickness_diameters, 3)} diameters"
         if band is not None and band.found
         else "not found"
     )
@@ -296,13 +297,12 @@ def render_biaxial(r: BiaxialReport) -> str:
         '<p class="formula">Inclination to the σ<sub>3</sub> (horizontal) direction: Mohr–Coulomb '
         "45° + φ/2, Roscoe 45° + ψ/2, Arthur 45° + (φ + ψ)/4.</p>"
     )
-    acceptance = r.band_end.acceptance if r.band_end is not None else ""
     band_parts: list[Any] = [
         paragraph(
             "The band is located by grainlab.analysis.ShearBand in the excess local shear strain of the grains "
             "away from the boundary since the first snapshot (grainlab.analysis.LocalStrain), at the snapshot "
             "nearest the peak and at "
-            f"the end of shearing; found means accepted by {acceptance or 'the detector'}. Its inclination is "
+            f"the end of shearing; found means accepted by {ACCEPTANCE}. Its inclination is "
             "the acute angle to the horizontal, the σ₃ direction; a band not accepted is shown as a "
             "candidate and not compared.",
             "note",
@@ -325,7 +325,7 @@ def render_biaxial(r: BiaxialReport) -> str:
             )
         )
     else:
-        closest = r.angles.closest(band.inclination)
+        closest = r.angles.closest(math.radians(band.inclination_deg))
         if closest:
             band_parts.append(paragraph(f"The band's inclination is closest to the {closest} angle."))
     sections.append(section("band", "Shear band and classical angles", *band_parts))
