@@ -110,17 +110,14 @@ def _scalar_or_array(x: NDArray[np.float64], like: ArrayLike) -> NDArray[np.floa
     return float(x) if np.ndim(like) == 0 else x
 
 
-class UniformByNumber(Grading):
-    """Diameters uniform by number on ``[d_min, d_max]``: ``f_N(d) = 1 / (d_max - d_min)``.
+class _UniformRange(Grading):
+    """A grading on ``[d_min, d_max]`` given by its two ends (``_kind`` names it)."""
 
-    This is what PFC's ``ball generate``/``distribute`` draw by default.
-    ``E_N[d^2] = (d_min^2 + d_min d_max + d_max^2) / 3``; mass passing (2D,
-    ``m ∝ d^2``): ``P(d) = 100 (d^3 - d_min^3) / (d_max^3 - d_min^3)``.
-    """
+    _kind = ""
 
     def __init__(self, d_min: float, d_max: float, name: str | None = None) -> None:
         self._a, self._b = _check_range(d_min, d_max)
-        self.name = name or f"uniform by number {self._a * 1e3:g}-{self._b * 1e3:g} mm"
+        self.name = name or f"uniform by {self._kind} {self._a * 1e3:g}-{self._b * 1e3:g} mm"
 
     @property
     def d_min(self) -> float:
@@ -129,6 +126,17 @@ class UniformByNumber(Grading):
     @property
     def d_max(self) -> float:
         return self._b
+
+
+class UniformByNumber(_UniformRange):
+    """Diameters uniform by number on ``[d_min, d_max]``: ``f_N(d) = 1 / (d_max - d_min)``.
+
+    This is what PFC's ``ball generate``/``distribute`` draw by default.
+    ``E_N[d^2] = (d_min^2 + d_min d_max + d_max^2) / 3``; mass passing (2D,
+    ``m ∝ d^2``): ``P(d) = 100 (d^3 - d_min^3) / (d_max^3 - d_min^3)``.
+    """
+
+    _kind = "number"
 
     def number_cdf(self, d: ArrayLike) -> NDArray[np.float64]:
         d = np.asarray(d, dtype=np.float64)
@@ -151,7 +159,7 @@ class UniformByNumber(Grading):
         return _scalar_or_array(np.asarray(p, dtype=np.float64), d)
 
 
-class UniformByMass(Grading):
+class UniformByMass(_UniformRange):
     """Mass uniform in diameter on ``[d_min, d_max]``: the grading curve is a
     straight line in ``d``, ``P(d) = 100 (d - d_min) / (d_max - d_min)``.
 
@@ -163,17 +171,7 @@ class UniformByMass(Grading):
     ``E_N[d^2] = (d_max - d_min) / (1/d_min - 1/d_max) = d_min d_max``.
     """
 
-    def __init__(self, d_min: float, d_max: float, name: str | None = None) -> None:
-        self._a, self._b = _check_range(d_min, d_max)
-        self.name = name or f"uniform by mass {self._a * 1e3:g}-{self._b * 1e3:g} mm"
-
-    @property
-    def d_min(self) -> float:
-        return self._a
-
-    @property
-    def d_max(self) -> float:
-        return self._b
+    _kind = "mass"
 
     def number_cdf(self, d: ArrayLike) -> NDArray[np.float64]:
         d = np.asarray(d, dtype=np.float64)
