@@ -71,6 +71,7 @@ import h5py
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from grainlab._mapping import flatten_keys
 from grainlab.io._table import FileFormatError
 from grainlab.io.results import (
     CHECKPOINT_FILE,
@@ -250,15 +251,6 @@ def _read_text(dataset: h5py.Dataset) -> str:
     return value if isinstance(value, str) else str(value)
 
 
-def _flatten(mapping: Mapping[str, Any], prefix: str = "") -> Iterable[tuple[str, Any]]:
-    for key, value in mapping.items():
-        name = f"{prefix}{key}"
-        if isinstance(value, Mapping):
-            yield from _flatten(value, name + ".")
-        else:
-            yield name, value
-
-
 def _readable_attr(value: Any) -> Any:
     """An HDF5 attribute value for a JSON leaf, or None when it has no simple form."""
     if isinstance(value, bool):
@@ -293,7 +285,7 @@ def _write_json_group(group: h5py.Group, value: Mapping[str, Any], where: str) -
     for key in list(group.attrs):
         del group.attrs[key]
     _write_text(group, "json", text)
-    for key, leaf in _flatten(plain):
+    for key, leaf in flatten_keys(plain).items():
         attr = _readable_attr(leaf)
         if key and attr is not None:
             group.attrs[key] = attr

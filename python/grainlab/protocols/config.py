@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from grainlab._mapping import flatten_keys
+
 
 class ConfigError(ValueError):
     """A configuration key or value is not allowed."""
@@ -235,15 +237,6 @@ def coerce(key: str, value: Any) -> Any:
     return _check_range(key, field, _parse_quantity(key, field, value))
 
 
-def _flatten(table: Mapping[str, Any], prefix: str = "") -> Iterable[tuple[str, Any]]:
-    for name, value in table.items():
-        key = f"{prefix}{name}"
-        if isinstance(value, Mapping):
-            yield from _flatten(value, key + ".")
-        else:
-            yield key, value
-
-
 def _parse_override(text: str) -> tuple[str, Any]:
     if "=" not in text:
         raise ConfigError(f"--set {text!r}: expected key=value, e.g. shear.final_strain=5%")
@@ -274,7 +267,7 @@ class BiaxialConfig:
 
     @classmethod
     def from_dict(cls, nested: Mapping[str, Any]) -> BiaxialConfig:
-        return resolve(overrides=dict(_flatten(nested)))
+        return resolve(overrides=flatten_keys(nested))
 
 
 def resolve(
@@ -297,7 +290,7 @@ def resolve(
             raise ConfigError(f"{path}: configuration file not found") from None
         except tomllib.TOMLDecodeError as error:
             raise ConfigError(f"{path}: not valid TOML ({error})") from None
-        layers.append(dict(_flatten(table)))
+        layers.append(flatten_keys(table))
     if overrides is not None:
         if isinstance(overrides, Mapping):
             layers.append(dict(overrides))

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 import grainlab
+from grainlab._mapping import flatten_keys
 from grainlab.analysis.biaxial_figures import BandNumbers
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.protocols.config import FIELDS, QUICK
@@ -159,17 +160,6 @@ class BiaxialReport:
 
 
 # ----------------------------------------------------------------------------- configuration
-def _flatten(nested: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    flat: dict[str, Any] = {}
-    for name, value in nested.items():
-        key = f"{prefix}{name}"
-        if isinstance(value, dict):
-            flat.update(_flatten(value, key + "."))
-        else:
-            flat[key] = value
-    return flat
-
-
 def _readable(key: str, value: Any, summary: dict[str, Any], threads: int | None) -> str:
     field_ = FIELDS.get(key)
     kind = field_.kind if field_ else ""
@@ -208,7 +198,7 @@ def _paper_text(key: str) -> str:
 def config_rows(config: dict[str, Any], summary: dict[str, Any], threads: int | None) -> list[ConfigRow]:
     """The resolved configuration, one row per key, in the file's order."""
     rows = []
-    for key, value in _flatten(config).items():
+    for key, value in flatten_keys(config).items():
         field_ = FIELDS.get(key)
         default = field_.default if field_ else None
         rows.append(
@@ -254,7 +244,7 @@ def rerun_command(config: dict[str, Any], out: str, threads: int | None = None) 
     size; ``threads`` pins ``run.threads`` when the run used ``auto`` (the
     same configuration, seed and thread count give bitwise the same results).
     """
-    flat = _flatten(config)
+    flat = flatten_keys(config)
     args = ["grainlab", "biaxial", "--out", out]
     quick = all(flat.get(k) == v for k, v in QUICK.items())
     if quick:

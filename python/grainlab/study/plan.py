@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from grainlab._mapping import flatten_keys
 from grainlab.study.campaign import Run, make_run
 
 PLAN_KEYS = ("base", "mode", "seed", "config", "quick", "fixed", "vary", "name")
@@ -73,16 +74,6 @@ class Plan:
                     params["quick"] = True
             runs.append(make_run(f"run_{index:04d}", self.base, params, self.seed, labels=varied))
         return runs
-
-
-def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for key, value in table.items():
-        if isinstance(value, Mapping) and not _is_range(value):
-            out.update(_flatten(value, f"{prefix}{key}."))
-        else:
-            out[f"{prefix}{key}"] = value
-    return out
 
 
 def _is_range(value: Mapping[str, Any]) -> bool:
@@ -184,8 +175,8 @@ def parse_plan(text: str, *, base_dir: str | os.PathLike[str] | None = None, sou
     for section in ("fixed", "vary"):
         if section in table and not isinstance(table[section], Mapping):
             raise PlanError(f"{section}: expected a table")
-    fixed = _flatten(table.get("fixed", {}))
-    vary = {key: _expand(key, value) for key, value in _flatten(table.get("vary", {})).items()}
+    fixed = flatten_keys(table.get("fixed", {}), leaf=_is_range)
+    vary = {key: _expand(key, value) for key, value in flatten_keys(table.get("vary", {}), leaf=_is_range).items()}
     both = set(fixed) & set(vary)
     if both:
         raise PlanError(f"{sorted(both)[0]}: both in [fixed] and [vary]")
