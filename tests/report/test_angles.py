@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import doctest
 import math
 
 import numpy as np
 import pytest
 
-import grainlab.report.angles as angles_module
 from grainlab.report.angles import (
     ClassicalAngles,
     arthur_angle,
@@ -98,7 +96,3 @@ def test_dilation_fit_without_records_after_the_peak():
     with pytest.raises(ValueError, match="window"):
         fit_dilation(eps, ev, peak_row=0, window=0.0)
 
-
-def test_doctests():
-    result = doctest.testmod(angles_module)
-    assert result.attempted > 0 and result.failed == 0

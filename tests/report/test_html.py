@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import base64
-import doctest
 import re
 
 from matplotlib.figure import Figure
 
-import grainlab.report.html as html_module
 from grainlab.report.figures import png_bytes
 from grainlab.report.html import (
     DISPLAY_ZOOM,
@@ -20,11 +18,6 @@ from grainlab.report.html import (
     section,
     table,
 )
-
-
-def test_doctests():
-    result = doctest.testmod(html_module)
-    assert result.attempted > 0 and result.failed == 0
 
 
 def test_text_from_the_data_is_escaped_and_markup_is_not():
