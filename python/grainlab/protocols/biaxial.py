@@ -233,26 +233,32 @@ def inertial_number(config: BiaxialConfig, rate: float, diameter: float) -> floa
 # ---- measurements -----------------------------------------------------------
 
 
-def _platen_stress(sim: Simulation, membrane: Membrane) -> tuple[float, float]:
-    """Mean axial stress of the two platens on the sample (Pa) and the sample's
-    mean width (area over height, m)."""
-    bottom, top = sim.wall(membrane.bottom_wall), sim.wall(membrane.top_wall)
+@dataclass(frozen=True)
+class _Platens:
+    """The platens' state: sample height and area, and the mean axial stress
+    of the two platens over the sample's mean width (area over height)."""
+
+    height_m: float
+    area_m2: float
+    width_m: float
+    axial_stress_pa: float
+
+
+def _platens(sim: Simulation, boundary: Membrane | GrainBoundary) -> _Platens:
+    bottom, top = sim.wall(boundary.bottom_wall), sim.wall(boundary.top_wall)
     height = float(top.points[0, 1] - bottom.points[0, 1])
-    width = sample_area(sim, membrane) / height
+    area = _area(sim, boundary)
+    width = area / height
     axial_force = 0.5 * (float(top.force[1]) - float(bottom.force[1]))
-    return axial_force / width, width
+    return _Platens(height, area, width, axial_force / width)
 
 
 def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, float]:
     """One record of the shearing phase."""
     boundary = _boundary(run)
     shear = run.shear
-    bottom, top = sim.wall(boundary.bottom_wall), sim.wall(boundary.top_wall)
-    height = float(top.points[0, 1] - bottom.points[0, 1])
-    area = _area(sim, boundary)
-    width = area / height
-    axial_force = 0.5 * (float(top.force[1]) - float(bottom.force[1]))
-    sigma_1 = axial_force / width
+    platens = _platens(sim, boundary)
+    height, area, sigma_1 = platens.height_m, platens.area_m2, platens.axial_stress_pa
     sigma_3 = config["consolidation.pressure"]
 
     c = sim.contacts()
@@ -509,12 +515,13 @@ def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progres
         while True:
             sim.run(CHUNK_STEPS)
             steps += CHUNK_STEPS
-            sigma_1, width = _platen_stress(sim, membrane)
+            platens = _platens(sim, membrane)
+            sigma_1 = platens.axial_stress_pa
             settled = abs(sigma_1 / target - 1.0) < tolerance
             if not settled or servo:
                 servo = True
                 for platen in (bottom, top):
-                    platen.servo(target, width, relaxation=0.5, max_speed_m_per_s=max_speed)
+                    platen.servo(target, platens.width_m, relaxation=0.5, max_speed_m_per_s=max_speed)
             if settled and sim.unbalanced_force_ratio < limit:
                 break
             if steps >= config["consolidation.max_steps"]:
