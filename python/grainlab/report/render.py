@@ -58,6 +58,10 @@ def _num(x: Any) -> float:
     return float(x) if isinstance(x, int | float) and not isinstance(x, bool) else math.nan
 
 
+def _footer() -> str:
+    return f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, no network)."
+
+
 # ----------------------------------------------------------------------------- biaxial
 def _band_table(r: BiaxialReport) -> Markup:
     rows = []
@@ -372,8 +376,7 @@ def render_biaxial(r: BiaxialReport) -> str:
         f"grainlab biaxial report: {r.folder.resolve().name}",
         header,
         sections,
-        f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, "
-        "no network).",
+        _footer(),
     )
 
 
@@ -496,6 +499,5 @@ def render_study(r: StudyReport) -> str:
         f"grainlab study report: {r.folder.resolve().name}",
         header,
         sections,
-        f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, "
-        "no network).",
+        _footer(),
     )
