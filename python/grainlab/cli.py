@@ -45,16 +45,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     if getattr(args, "func", None) is None:
         parser.print_help()
         return 2
-    from grainlab import SimulationUnstableError
-    from grainlab.protocols.biaxial import BiaxialError
-
     try:
         return int(args.func(args))
     except ValueError as error:  # bad input, refused before any work
         print(f"grainlab {args.command}: error: {error}", file=sys.stderr)
         return 2
-    except (SimulationUnstableError, BiaxialError) as error:  # the physics failed mid-run
-        print(f"grainlab {args.command}: run stopped: {error}", file=sys.stderr)
+    except Exception as error:
+        # imported only on failure: every command would otherwise pay for the protocol's imports
+        from grainlab import SimulationUnstableError
+        from grainlab.protocols.biaxial import BiaxialError
+
+        if not isinstance(error, SimulationUnstableError | BiaxialError):
+            raise  # a bug: its traceback is the useful report
+        print(f"grainlab {args.command}: run stopped: {error}", file=sys.stderr)  # the physics failed mid-run
         return 1
     except KeyboardInterrupt:
         print(
