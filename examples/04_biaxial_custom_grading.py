@@ -56,6 +56,7 @@ SMALL = {
     "sample.width": "20 mm",  # at least 10 largest diameters (the configuration checks it)
     "sample.height": "40 mm",
     "shear.final_strain": "5 %",
+    "shear.strain_rate": "20 %/min",  # ten times the paper's 2 %/min: a quick look
     "shear.snapshot_strains": [0.0, 0.01, 0.05],
 }
 

@@ -22,6 +22,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "grainlab.commands.demo",
     "grainlab.commands.study",
     "grainlab.commands.sweep",
+    "grainlab.commands.reproduce",
     "grainlab.commands.export",
     "grainlab.commands.report",
 )

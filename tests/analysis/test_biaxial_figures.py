@@ -305,6 +305,8 @@ def test_quick_biaxial_run(tmp_path):
             "--set",
             "shear.final_strain=0.02",
             "--set",
+            "shear.strain_rate=20%/min",
+            "--set",
             "shear.snapshot_strains=[0,0.005,0.015]",
         ]
     )

@@ -86,7 +86,7 @@ def test_results_folder_holds_everything(quick_run):
 
 @pytest.mark.slow
 def test_resumed_run_ends_with_the_same_results(tmp_path, monkeypatch):
-    overrides = ["shear.final_strain=0.02", "run.checkpoint_interval=1e-9", "run.threads=2"]
+    overrides = ["shear.final_strain=0.02", "shear.strain_rate=20%/min", "run.checkpoint_interval=1e-9", "run.threads=2"]
     config = resolve(overrides=overrides, quick=True)
     straight = biaxial.run_biaxial(config, tmp_path / "straight", progress=False)
 
@@ -150,7 +150,8 @@ def test_default_strain_rate_keeps_inertial_number_at_the_bound():
 @pytest.mark.slow
 def test_outer_grain_boundary_variant(tmp_path):
     out = tmp_path / "b"
-    config = resolve(overrides=["boundary.kind=outer_particles", "shear.final_strain=0.04"], quick=True)
+    config = resolve(overrides=["boundary.kind=outer_particles", "shear.final_strain=0.04", "shear.strain_rate=20%/min"],
+                     quick=True)
     result = biaxial.run_biaxial(config, out, progress=False)
     results = read_results(out / "run.h5")
     ts = results.timeseries

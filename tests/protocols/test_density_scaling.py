@@ -23,7 +23,9 @@ def test_factor_is_eq16_of_the_smallest_grain_and_quiet_below_the_limit():
         warnings.simplefilter("error")
         factor = check_density_scaling(config)
     assert factor == pytest.approx(eq16(0.01, 2.0e8, 0.25e-3, 150.0e6), rel=1e-12)  # Table 1 p_y
-    assert check_density_scaling(resolve()) is None  # the auto rate is bounded by construction
+    assert check_density_scaling(resolve(overrides=["shear.strain_rate=auto"])) is None  # bounded by construction
+    # the default is the paper's 2 %/min, far below the limit
+    assert check_density_scaling(resolve()) == pytest.approx(eq16(0.02 / 60, 2.0e8, 0.25e-3, 150.0e6), rel=1e-12)
 
 
 def test_fast_rate_is_warned_about_before_any_work(tmp_path):

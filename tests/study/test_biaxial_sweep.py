@@ -13,7 +13,7 @@ from grainlab.cli import main
 def test_biaxial_sweep_runs_each_test_into_its_own_folder(tmp_path):
     plan = tmp_path / "plan.toml"
     plan.write_text(
-        'base = "biaxial"\nquick = true\n[fixed]\n"shear.final_strain" = 0.006\n'
+        'base = "biaxial"\nquick = true\n[fixed]\n"shear.final_strain" = 0.006\n"shear.strain_rate" = "20 %/min"\n'
         '"shear.snapshot_strains" = [0.0, 0.005]\n[vary]\n"sample.seed" = [1, 2]\n'
     )
     out = tmp_path / "out"

@@ -137,8 +137,9 @@ FIELDS: dict[str, Field] = {
     ),
     "boundary.membrane_friction": Field("number", 0.0, "friction between grains and membrane disks", minimum=0.0),
     "shear.strain_rate": Field(
-        "strain_rate", "auto",
-        "axial strain rate; auto = the fastest with the grains' inertial number <= shear.inertial_number",
+        "strain_rate", 0.02 / 60.0,
+        "axial strain rate (Table 1: 2 %/min); auto = the fastest with the heaviest grain's inertial "
+        "number <= shear.inertial_number (20 %/min with Table 1)",
         **_POSITIVE, allow_auto=True,
     ),
     "shear.final_strain": Field("strain", 0.10, "final axial strain", minimum=0.0, maximum=0.5, exclusive_minimum=True),
