@@ -60,4 +60,9 @@ def run(args: argparse.Namespace) -> int:
         )
         for name in failed:
             print(f"  failed: {name} (see {args.out}/runs/{name}/error.txt)", file=sys.stderr)
+    from grainlab.reproduction.outputs import write_outputs
+
+    written = write_outputs(plan, args.out, workers=args.workers, progress=not args.no_progress)
+    for line in written.lines():
+        print(line)
     return 1 if failed else 0

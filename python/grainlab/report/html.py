@@ -257,6 +257,9 @@ figcaption .source { color: #7b8794; }
 .warn { background: #fff4e5; border-left: 4px solid #f0a020; padding: .5em .8em; }
 .formula { font-family: "DejaVu Serif", Georgia, serif; background: #f8f9fb; padding: .4em .8em;
            border-left: 3px solid #b8c4ce; }
+tr.verdict-reproduced td.verdict { background: #e3f4e6; }
+tr.verdict-not-reproduced td.verdict { background: #fbe4e2; }
+tr.verdict-inconclusive td.verdict { background: #f3f0e0; }
 footer { color: #7b8794; font-size: .85em; text-align: center; padding: 1em; }
 """
 

@@ -1,0 +1,248 @@
+"""Figures of a reproduction: every seed, their mean and the 95 % interval over
+seeds against axial strain (PNG at a modest resolution, for ``reproduction.html``).
+
+For each biaxial variant: ``macro_<variant>`` (stress ratio, volumetric
+strain), ``fabric_<variant>`` (a, Z, mean lambda, the paper's values marked)
+and ``band_<variant>`` (the band-resolved fabric: lambda inside and outside
+the band under both conventions, Z, the share of 2-contact grains, rotation,
+and the ROC AUC of lambda as a classifier of band membership). For each study
+variant ``study_<variant>`` (Figs. 15-17 with every seed); ``rates`` for a
+rate family.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from grainlab import plot
+from grainlab.reproduction.runs import ReproductionPlan, variant_folder
+from grainlab.reproduction.verdicts import t_interval
+
+__all__ = ["DPI", "draw_figures"]
+
+#: Resolution of the PNGs (the page's size matters more than print quality).
+DPI = 80
+
+Measures = Mapping[str, Any]
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with plot.paper_style():
+        fig.savefig(path, format="png", dpi=DPI)
+    return path
+
+
+def _ensemble(runs: Sequence[Measures], key: Callable[[Mapping[str, Any]], float]
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[tuple[np.ndarray, np.ndarray]]]:
+    """Per snapshot strain (rounded to 1e-4): mean, CI low, CI high over the seeds, and each seed's curve."""
+    by_strain: dict[float, list[float]] = {}
+    curves = []
+    for m in runs:
+        xs, ys = [], []
+        for row in m["snapshots"]:
+            value = key(row)
+            x = round(float(row["axial_strain"]), 4)
+            xs.append(x)
+            ys.append(value)
+            if math.isfinite(value):
+                by_strain.setdefault(x, []).append(value)
+        curves.append((np.array(xs), np.array(ys, dtype=np.float64)))
+    strains = np.array(sorted(by_strain))
+    mean, low, high = [], [], []
+    for x in strains:
+        v = np.array(by_strain[x])
+        mean.append(float(v.mean()))
+        ci = t_interval(v) if v.size >= 2 else (math.nan, math.nan)
+        low.append(ci[0])
+        high.append(ci[1])
+    return strains, np.array(mean), np.array(low), np.array(high), curves
+
+
+def _value(name: str) -> Callable[[Mapping[str, Any]], float]:
+    def get(row: Mapping[str, Any]) -> float:
+        if (name.startswith(("inside_", "outside_", "auc_lambda")) and name != "auc_lambda_peak_band"
+                and not row.get("band_found")):
+            return math.nan
+        value = row.get(name)
+        return math.nan if value is None else float(value)
+
+    return get
+
+
+def _band_plot(ax: Any, runs: Sequence[Measures], name: str, label: str, color: str, seeds: bool = False) -> None:
+    x, mean, low, high, curves = _ensemble(runs, _value(name))
+    if seeds:
+        for cx, cy in curves:
+            ax.plot(100 * cx, cy, color=color, linewidth=0.5, alpha=0.35)
+    if x.size:
+        ax.plot(100 * x, mean, color=color, marker="o", markersize=2.5, linewidth=1.3, label=label)
+        ok = np.isfinite(low)
+        ax.fill_between(100 * x[ok], low[ok], high[ok], color=color, alpha=0.2, linewidth=0)
+
+
+def _strain_axis(ax: Any) -> None:
+    ax.set_xlabel(r"axial strain $\varepsilon_{11}$ (%)")
+
+
+def _macro_figure(runs: Sequence[Measures], title: str) -> Figure:
+    with plot.paper_style():
+        fig = Figure(figsize=(8.0, 3.2), layout="constrained")
+        axes = fig.subplots(1, 2)
+        for key, ax, ylabel in (("stress_ratio", axes[0], r"$\sigma_1/\sigma_3$"),
+                                ("volumetric_strain", axes[1], "volumetric strain (%), compression +")):
+            scale = 100.0 if key == "volumetric_strain" else 1.0
+            grids = [np.asarray(m["macro"]["records"]["axial_strain"]) for m in runs]
+            grid = grids[int(np.argmin([g[-1] for g in grids]))]
+            stack = []
+            for m in runs:
+                rec = m["macro"]["records"]
+                eps, y = np.asarray(rec["axial_strain"]), np.asarray(rec[key], dtype=np.float64)
+                ax.plot(100 * eps, scale * y, color="0.6", linewidth=0.6)
+                stack.append(np.interp(grid, eps, y))
+            values = np.array(stack)
+            ax.plot(100 * grid, scale * values.mean(axis=0), color="C0", linewidth=1.4, label="mean over seeds")
+            if len(runs) >= 2:
+                ci = np.array([t_interval(values[:, k]) for k in range(grid.size)])
+                ax.fill_between(100 * grid, scale * ci[:, 0], scale * ci[:, 1], color="C0", alpha=0.2, linewidth=0,
+                                label="95 % interval")
+            _strain_axis(ax)
+            ax.set_ylabel(ylabel)
+        axes[0].axvline(1.5, color="crimson", linestyle=":", linewidth=0.9, label="paper's peak (1.5 %)")
+        axes[0].legend(frameon=False, fontsize=7)
+        fig.suptitle(title, fontsize=9)
+    return fig
+
+
+def _fabric_figure(runs: Sequence[Measures], title: str) -> Figure:
+    with plot.paper_style():
+        fig = Figure(figsize=(10.0, 3.2), layout="constrained")
+        axes = fig.subplots(1, 3)
+        _band_plot(axes[0], runs, "a", "a (contact normals)", "C0", seeds=True)
+        _band_plot(axes[0], runs, "a_n", "a_n (normal forces)", "C1")
+        axes[0].plot([0.0, 0.5], [0.0034, 0.18], "x", color="crimson", label="paper")
+        axes[0].set_ylabel("anisotropy")
+        _band_plot(axes[1], runs, "coordination_number", "Z (grain-grain)", "C2", seeds=True)
+        axes[1].plot([0.0, 1.5], [3.9, 3.0], "x", color="crimson", label="paper")
+        axes[1].set_ylabel("coordination number")
+        _band_plot(axes[2], runs, "mean_lambda", r"mean $\lambda$ (grains with $\geq$ 2 contacts)", "C3", seeds=True)
+        _band_plot(axes[2], runs, "mean_lambda_all", r"mean $\lambda$ (every grain)", "C4", seeds=True)
+        axes[2].axhspan(0.31, 0.34, color="crimson", alpha=0.08, label="paper: 0.31-0.34")
+        axes[2].set_ylabel(r"mean $\lambda$")
+        for ax in axes:
+            _strain_axis(ax)
+            ax.legend(frameon=False, fontsize=7)
+        fig.suptitle(title + " (from the snapshots; line: mean over seeds, band: 95 % interval)", fontsize=9)
+    return fig
+
+
+def _band_figure(runs: Sequence[Measures], title: str) -> Figure:
+    with plot.paper_style():
+        fig = Figure(figsize=(10.0, 6.0), layout="constrained")
+        axes = fig.subplots(2, 3).ravel()
+        panels = (
+            (axes[0], "mean_lambda", r"mean $\lambda$, grains with $\geq$ 2 contacts"),
+            (axes[1], "mean_lambda_all", r"mean $\lambda$, every grain"),
+            (axes[2], "coordination_number", "grain-grain contacts per grain"),
+            (axes[3], "fraction_2_of_load_bearing", "share with 2 contacts (of those with $\\geq$ 2)"),
+            (axes[4], "mean_abs_rotation_rad", "mean |rotation| since 0 % (rad)"),
+        )
+        for ax, name, ylabel in panels:
+            _band_plot(ax, runs, f"inside_{name}", "inside the band", "crimson")
+            _band_plot(ax, runs, f"outside_{name}", "outside", "C0")
+            ax.set_ylabel(ylabel)
+        axes[0].axhline(0.34, color="crimson", linestyle=":", linewidth=0.8)
+        axes[0].axhline(0.31, color="C0", linestyle=":", linewidth=0.8)
+        axes[1].axhline(0.34, color="crimson", linestyle=":", linewidth=0.8)
+        axes[1].axhline(0.31, color="C0", linestyle=":", linewidth=0.8)
+        _band_plot(axes[5], runs, "auc_lambda", r"per-grain $\lambda$, band at this strain", "C3")
+        _band_plot(axes[5], runs, "auc_lambda_field", r"$\lambda$ field (2 d), band at this strain", "C4")
+        _band_plot(axes[5], runs, "auc_lambda_peak_band", r"per-grain $\lambda$, the peak's band", "C5")
+        axes[5].axhline(0.5, color="0.4", linewidth=0.8, linestyle="--")
+        axes[5].set_ylabel("ROC AUC for band membership")
+        for ax in axes:
+            _strain_axis(ax)
+            ax.legend(frameon=False, fontsize=7)
+        fig.suptitle(title + ": inside and outside the band the detector finds at each snapshot (dotted: the "
+                     "paper's 0.34 / 0.31)", fontsize=9)
+    return fig
+
+
+def _study_figure(studies: Sequence[Measures], title: str) -> Figure:
+    with plot.paper_style():
+        fig = Figure(figsize=(10.0, 3.2), layout="constrained")
+        axes = fig.subplots(1, 3)
+        for k, s in enumerate(studies):
+            for kind, marker in (("irregular", "o"), ("hexagonal", "s")):
+                rows = [r for r in s.get("rows", []) if r.get("kind") == kind]
+                lam = np.array([np.nan if r["mean_stability_index"] is None else r["mean_stability_index"]
+                                for r in rows], dtype=np.float64)
+                for ax, key in zip(axes, ("coordination_number", "porosity", "anisotropy"), strict=True):
+                    x = np.array([np.nan if r[key] is None else r[key] for r in rows], dtype=np.float64)
+                    ax.plot(x, lam, marker, color=f"C{k % 10}", markersize=3.5,
+                            fillstyle="full" if kind == "irregular" else "none",
+                            label=f"seed {k + 1} {kind}" if ax is axes[0] else None)
+        for ax, label in zip(axes, ("Z (Fig. 15)", "porosity (Fig. 16)", "anisotropy a (Fig. 17)"), strict=True):
+            ax.set_xlabel(label)
+            ax.set_ylabel(r"mean $\lambda$")
+        axes[0].legend(frameon=False, fontsize=6, ncol=2)
+        fig.suptitle(title + " (dots: irregular, squares: hexagonal; one colour per seed)", fontsize=9)
+    return fig
+
+
+def _rate_figure(family: Sequence[tuple[float, Sequence[Measures]]]) -> Figure:
+    with plot.paper_style():
+        fig = Figure(figsize=(5.0, 3.2), layout="constrained")
+        ax = fig.add_subplot()
+        for key, color, label in (("peak_stress_ratio", "C3", "peak"), ("residual_stress_ratio", "C0", "end window")):
+            rates, means, lows, highs = [], [], [], []
+            for rate, runs in family:
+                v = np.array([m["macro"][key] for m in runs if m is not None], dtype=np.float64)
+                v = v[np.isfinite(v)]
+                if v.size == 0:
+                    continue
+                rates.append(rate * 6000.0)
+                means.append(v.mean())
+                ci = t_interval(v) if v.size >= 2 else (v.mean(), v.mean())
+                lows.append(v.mean() - ci[0])
+                highs.append(ci[1] - v.mean())
+            ax.errorbar(rates, means, yerr=[lows, highs], color=color, marker="o", capsize=3, label=label)
+        ax.set_xscale("log")
+        ax.set_xlabel("axial strain rate (%/min)")
+        ax.set_ylabel(r"$\sigma_1/\sigma_3$ (mean, 95 % interval)")
+        ax.legend(frameon=False)
+    return fig
+
+
+def draw_figures(plan: ReproductionPlan, results: Mapping[tuple[str, str, str], Measures | None],
+                 folder: str | Path) -> dict[str, Path]:
+    """Draws every figure of the reproduction into ``folder``; returns name -> PNG path."""
+    from grainlab.reproduction.outputs import rate_family
+
+    out = Path(folder)
+    drawn: dict[str, Path] = {}
+    for v in plan.variants:
+        kind = "study" if v.kind == "study" else "biaxial"
+        runs = [results.get((v.name, str(s), kind)) for s in plan.seeds]
+        runs = [m for m in runs if m is not None]
+        if not runs:
+            continue
+        stem = variant_folder(v.name)
+        if kind == "study":
+            drawn[f"study_{stem}"] = _save(_study_figure(runs, f"{v.name}: packing study"), out / f"study_{stem}.png")
+            continue
+        title = f"{v.name}, {len(runs)} seeds"
+        drawn[f"macro_{stem}"] = _save(_macro_figure(runs, title), out / f"macro_{stem}.png")
+        drawn[f"fabric_{stem}"] = _save(_fabric_figure(runs, title), out / f"fabric_{stem}.png")
+        drawn[f"band_{stem}"] = _save(_band_figure(runs, title), out / f"band_{stem}.png")
+    family = rate_family(plan)
+    if len(family) >= 2:
+        runs_by_rate = [(rate, [results.get((v.name, str(s), "biaxial")) for s in plan.seeds]) for rate, v in family]
+        drawn["rates"] = _save(_rate_figure(runs_by_rate), out / "rates.png")
+    return drawn

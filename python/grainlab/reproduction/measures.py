@@ -1,0 +1,276 @@
+"""What a reproduction measures on one stored run, with the current analysis.
+
+:func:`measure_biaxial` reads a finished biaxial run (``run.h5``): the macro
+curves from its time series (stress ratio, volumetric strain) and, at every
+snapshot, the fabric recomputed from the stored contacts with the analysis
+classes (a, a_n, Z, mean lambda under both conventions) and the band-resolved
+fabric (:class:`~grainlab.analysis.band_fabric.BandFabric`) inside and outside
+the shear band that the figures' detector finds in the grains' local strain
+since the start of shearing (:func:`grainlab.analysis.biaxial_figures.band_labels`:
+the accepted band and its accepted conjugate band). Nothing frozen at run time
+is used beyond the raw records and snapshots, so a newer analysis gives newer
+numbers from the same runs.
+
+:func:`measure_study` reads one seed's packing study (its ``result.json`` rows).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: Analysis options a variant may set, with their defaults.
+ANALYSIS_DEFAULTS: dict[str, Any] = {"boundary_contacts": "body"}
+
+#: Share of the test's final strain that the end window ("a constant at the end") covers.
+END_WINDOW = 0.3
+#: The linear range of the stress ratio (paper Sec. 6: linear until 0.5 %).
+LINEAR_TO = 0.005
+
+
+def _stability(options: Mapping[str, Any]):
+    from grainlab.analysis.stability import StabilityIndex
+
+    counting = {"body": "body", "raw": "each"}[options.get("boundary_contacts", "body")]
+    return StabilityIndex(boundary=counting)
+
+
+def _finite(x: Any) -> float:
+    try:
+        value = float(x)
+    except (TypeError, ValueError):
+        return math.nan
+    return value if math.isfinite(value) else math.nan
+
+
+def relative_slope(x: NDArray[np.float64], y: NDArray[np.float64]) -> float:
+    """Least-squares slope of ``y`` on ``x`` times 0.01 over the mean of ``y``: the
+    relative change per 1 % axial strain (NaN with fewer than 2 finite points)."""
+    ok = np.isfinite(x) & np.isfinite(y)
+    if ok.sum() < 2 or np.ptp(x[ok]) == 0:
+        return math.nan
+    slope = np.polyfit(x[ok], y[ok], 1)[0]
+    mean = float(np.mean(y[ok]))
+    return float(slope * 0.01 / mean) if mean != 0 else math.nan
+
+
+def _r2(x: NDArray[np.float64], y: NDArray[np.float64]) -> float:
+    ok = np.isfinite(x) & np.isfinite(y)
+    if ok.sum() < 3 or np.ptp(x[ok]) == 0 or np.ptp(y[ok]) == 0:
+        return math.nan
+    r = np.corrcoef(x[ok], y[ok])[0, 1]
+    return float(r * r)
+
+
+def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
+    """The macro numbers of a biaxial time series (compression positive)."""
+    eps = np.asarray(ts["axial_strain"], dtype=np.float64)
+    q = np.asarray(ts["stress_ratio"], dtype=np.float64)
+    ev = np.asarray(ts["volumetric_strain"], dtype=np.float64)
+    ok = np.isfinite(eps) & np.isfinite(q)
+    rows = np.flatnonzero(ok)
+    k = int(rows[np.argmax(q[rows])])
+    final = float(eps[rows[-1]])
+    window = ok & (eps >= max(float(eps[k]), (1.0 - END_WINDOW) * final))
+    linear = ok & (eps <= LINEAR_TO + 1e-9)
+    contraction_row = int(np.nanargmax(ev))
+    return {
+        "final_strain": final,
+        "peak_row": k,
+        "peak_axial_strain": float(eps[k]),
+        "peak_stress_ratio": float(q[k]),
+        "peak_in_interior": bool(rows[0] < k < rows[-1]),
+        "linear_r2": _r2(eps[linear], q[linear]),
+        "residual_stress_ratio": float(np.mean(q[window])) if window.any() else math.nan,
+        "residual_relative_slope": relative_slope(eps[window], q[window]),
+        "end_window_from": float(eps[window][0]) if window.any() else math.nan,
+        "max_contraction": float(ev[contraction_row]),
+        "axial_strain_at_max_contraction": float(eps[contraction_row]),
+        "final_volumetric_strain": float(ev[rows[-1]]),
+        "records": {"axial_strain": eps[rows].tolist(), "stress_ratio": q[rows].tolist(),
+                    "volumetric_strain": ev[rows].tolist()},
+    }
+
+
+def _snapshot_strain(info: Any) -> float:
+    """The axial strain a biaxial snapshot was written at (NaN when not recorded)."""
+    return _finite(info.axial_strain)
+
+
+def _fabric_of(snap: Any, options: Mapping[str, Any]) -> dict[str, Any]:
+    from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
+
+    stability = _stability(options).compute(snap)
+    normals = ContactAnisotropy().compute(snap)
+    forces = ContactAnisotropy(weight="normal_force").compute(snap) if snap.normal_force is not None else None
+    z = CoordinationNumber().compute(snap)
+    return {
+        "stability": stability,
+        "grain_contacts": z.n_contacts,
+        "numbers": {
+            "a": _finite(normals.anisotropy),
+            "a_binned": _finite(getattr(normals, "anisotropy_binned", math.nan)),
+            "a_n": _finite(forces.anisotropy) if forces is not None else math.nan,
+            "coordination_number": _finite(z.coordination_number),
+            "mean_lambda": _finite(stability.mean),
+            "mean_lambda_all": _finite(stability.mean_all),
+        },
+    }
+
+
+def measure_biaxial(run_dir: str | Path, options: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """Every number the claims use, of one finished biaxial run (module docstring).
+
+    ``options``: analysis options (:data:`ANALYSIS_DEFAULTS`). Returns a
+    JSON-ready dict: ``macro``, ``snapshots`` (one dict per snapshot, in strain
+    order), ``peak_snapshot`` (index of the snapshot nearest the stress-ratio
+    peak, other than the first), ``notes``.
+    """
+    from grainlab.analysis.band_fabric import BandFabric, roc_auc
+    from grainlab.analysis.biaxial_figures import band_labels
+    from grainlab.analysis.strain import match_ids
+    from grainlab.io.hdf5 import read_results
+
+    opts = {**ANALYSIS_DEFAULTS, **dict(options or {})}
+    results = read_results(run_dir)
+    ts = results.timeseries
+    macro = macro_measures(ts)
+    infos = list(results.snapshots)
+    strains = [_snapshot_strain(info) for info in infos]
+    order = sorted(range(len(infos)), key=lambda k: strains[k])
+    notes: list[str] = []
+    eps_ts = np.asarray(ts["axial_strain"], dtype=np.float64)
+    q_ts = np.asarray(ts["stress_ratio"], dtype=np.float64)
+
+    reference = results.snapshot(infos[order[0]].name)
+    ref_fabric = _fabric_of(reference, opts)
+    snaps: list[dict[str, Any]] = []
+    states: list[tuple[Any, dict[str, Any], NDArray[np.int32] | None]] = []
+    for pos_k, k in enumerate(order):
+        snap = reference if pos_k == 0 else results.snapshot(infos[k].name)
+        fabric = ref_fabric if pos_k == 0 else _fabric_of(snap, opts)
+        labels = None if pos_k == 0 else band_labels(reference, snap)
+        states.append((snap, fabric, labels))
+    peak_pos = 1 + int(np.argmin([abs(strains[k] - macro["peak_axial_strain"]) for k in order[1:]])) \
+        if len(order) > 1 else 0
+    peak_snap, _, peak_labels = states[peak_pos]
+    peak_ids = set()
+    if peak_labels is not None:
+        peak_ids = set(np.asarray(peak_snap.ids)[peak_labels > 0].tolist())
+
+    for pos_k, (k, (snap, fabric, labels)) in enumerate(zip(order, states, strict=True)):
+        grains = np.asarray(snap.is_sample)
+        stability = fabric["stability"]
+        lam = np.asarray(stability.stability_index)[grains]
+        counts = np.asarray(stability.n_contacts)[grains]
+        grain_contacts = np.asarray(fabric["grain_contacts"])[grains]
+        ids = np.asarray(snap.ids)[grains]
+        rotation = None
+        if snap.rotations is not None and reference.rotations is not None:
+            to_ref = match_ids(reference, snap)[grains]
+            rot = np.full(int(grains.sum()), np.nan)
+            have = to_ref >= 0
+            rot[have] = np.asarray(snap.rotations)[grains][have] - np.asarray(reference.rotations)[to_ref[have]]
+            rotation = rot
+        row: dict[str, Any] = {
+            "name": infos[k].name,
+            "axial_strain": strains[k],
+            "stress_ratio": float(np.interp(strains[k], eps_ts[np.isfinite(q_ts)], q_ts[np.isfinite(q_ts)])),
+            **fabric["numbers"],
+        }
+        in_peak_band = np.isin(ids, list(peak_ids)) if peak_ids else np.zeros(ids.size, bool)
+        row["auc_lambda_peak_band"] = roc_auc(lam, in_peak_band) if peak_ids else math.nan
+        found = labels is not None and bool(np.any(labels > 0))
+        row["band_found"] = found
+        if found:
+            members = np.asarray(labels)[grains] > 0
+            bf = BandFabric().compute(
+                snap.positions[grains], 2.0 * snap.radii[grains], lam, counts, members,
+                grain_contacts=grain_contacts, rotation=rotation,
+            )
+            row.update(bf.summary())
+        snaps.append(row)
+    if not macro["peak_in_interior"]:
+        notes.append("the stress ratio is largest at the first or last record: no interior peak")
+    return {
+        "run": str(Path(results.path)),
+        "analysis": opts,
+        "macro": macro,
+        "snapshots": snaps,
+        "peak_snapshot": peak_pos,
+        "wall_time_s": _finite(results.summary.get("wall_time_s")) if results.summary else math.nan,
+        "strain_rate": _finite(results.summary.get("strain_rate")) if results.summary else math.nan,
+        "notes": notes,
+    }
+
+
+def measure_study(rows: list[Mapping[str, Any]]) -> dict[str, Any]:
+    """The packing-study numbers of one seed from its rows (``study.csv`` columns;
+    failed rows left out). Fits are least squares (:func:`scipy.stats.linregress`)."""
+    from scipy.stats import linregress
+
+    def series(kind: str | None, x: str, y: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        use = [r for r in rows if r.get("status") != "failed" and (kind is None or r.get("kind") == kind)]
+        xs = np.array([_finite(r.get(x)) for r in use])
+        ys = np.array([_finite(r.get(y)) for r in use])
+        ok = np.isfinite(xs) & np.isfinite(ys)
+        return xs[ok], ys[ok]
+
+    def fit(kind: str | None, x: str, y: str = "mean_stability_index") -> dict[str, float]:
+        xs, ys = series(kind, x, y)
+        if xs.size < 3 or np.ptp(xs) == 0:
+            return {"slope": math.nan, "intercept": math.nan, "r2": math.nan, "n": int(xs.size)}
+        if np.ptp(ys) == 0:
+            return {"slope": 0.0, "intercept": float(ys[0]), "r2": math.nan, "n": int(xs.size)}
+        res = linregress(xs, ys)
+        return {"slope": float(res.slope), "intercept": float(res.intercept), "r2": float(res.rvalue**2),
+                "n": int(xs.size)}
+
+    keep = ("kind", "porosity_target", "porosity", "coordination_number", "anisotropy", "mean_stability_index",
+            "mean_stability_index_all", "status")
+    out: dict[str, Any] = {"n_rows": len(rows), "failed": sum(r.get("status") == "failed" for r in rows),
+                           "rows": [{k: r.get(k) for k in keep} for r in rows if r.get("status") != "failed"]}
+    for kind, label in ((None, "pooled"), ("irregular", "irregular"), ("hexagonal", "hexagonal")):
+        out[f"lambda_vs_z_{label}"] = fit(kind, "coordination_number")
+        out[f"lambda_vs_porosity_{label}"] = fit(kind, "porosity")
+        out[f"lambda_vs_a_{label}"] = fit(kind, "anisotropy")
+    # hexagonal against the irregular fit at the same Z, where the Z ranges overlap
+    irr_z, _ = series("irregular", "coordination_number", "mean_stability_index")
+    hex_z, hex_l = series("hexagonal", "coordination_number", "mean_stability_index")
+    f = out["lambda_vs_z_irregular"]
+    inside = (hex_z >= irr_z.min()) & (hex_z <= irr_z.max()) if irr_z.size else np.zeros(hex_z.size, bool)
+    out["hexagonal_in_irregular_z_range"] = int(inside.sum())
+    out["hexagonal_minus_irregular_at_z"] = (
+        float(np.mean(hex_l[inside] - (f["intercept"] + f["slope"] * hex_z[inside])))
+        if inside.any() and math.isfinite(f["slope"]) else math.nan
+    )
+    by_target: dict[str, dict[float, float]] = {"irregular": {}, "hexagonal": {}}
+    for r in rows:
+        if r.get("status") != "failed" and r.get("kind") in by_target:
+            by_target[r["kind"]][round(_finite(r.get("porosity_target")), 6)] = _finite(r.get("mean_stability_index"))
+    shared = sorted(set(by_target["irregular"]) & set(by_target["hexagonal"]))
+    diffs = [by_target["hexagonal"][t] - by_target["irregular"][t] for t in shared]
+    diffs = [d for d in diffs if math.isfinite(d)]
+    out["hexagonal_minus_irregular_at_porosity"] = float(np.mean(diffs)) if diffs else math.nan
+    _, irr_l = series("irregular", "coordination_number", "mean_stability_index")
+    out["hexagonal_minus_irregular_mean"] = (
+        float(np.mean(hex_l) - np.mean(irr_l)) if hex_l.size and irr_l.size else math.nan
+    )
+    return out
+
+
+def read_study_rows(folder: str | Path) -> list[dict[str, Any]]:
+    """The rows of the packings finished in ``folder`` (``*/result.json``)."""
+    rows = []
+    for path in sorted(Path(folder).glob("*/result.json")):
+        try:
+            rows.append(json.loads(path.read_text())["row"])
+        except (OSError, json.JSONDecodeError, KeyError):
+            continue
+    return rows

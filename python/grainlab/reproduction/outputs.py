@@ -1,0 +1,349 @@
+"""From the runs of a reproduction to ``claims.json``, ``claims.csv``, ``measures.json``,
+the figures and ``reproduction.html``.
+
+Everything is recomputed from the stored runs each time (:mod:`.measures`), in
+parallel over the runs; nothing of an earlier call is reused, so a newer
+analysis gives newer claims from the same runs (``grainlab reproduce --out DIR
+--claims-only``).
+
+``claims.json``::
+
+    {"claims": [...], "seeds": [...], "variant": "paper", "grainlab_version": "...",
+     "variants": [{"variant", "kind", "description", "seeds", "claims": [...], "runs", "wall_time_s",
+                   "notes"}, ...],
+     "rate_convergence": [...], "verdict_counts": {...}}
+
+The top-level ``claims`` are the paper's: the biaxial claims of the main
+biaxial variant (``paper`` when run) followed by the packing-study claims of
+the main study variant (``study``); ``variant`` names them (``paper+study``).
+``variants`` holds one block per variant, with all its claims, each row
+naming its variant; ``rate_convergence`` the rate family's comparison
+(:func:`rate_convergence`).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import grainlab
+from grainlab.io.results import write_json_atomic, write_text_atomic
+from grainlab.reproduction.claims import BIAXIAL_CLAIMS, RATE_CLAIMS, STUDY_CLAIMS, evaluate
+from grainlab.reproduction.measures import measure_biaxial, measure_study, read_study_rows
+from grainlab.reproduction.runs import ReproductionPlan, Variant
+from grainlab.reproduction.verdicts import VERDICTS
+
+__all__ = ["CLAIMS_CSV", "CLAIMS_JSON", "MEASURES_JSON", "Outputs", "rate_convergence", "rate_family", "write_outputs"]
+
+CLAIMS_JSON = "claims.json"
+CLAIMS_CSV = "claims.csv"
+MEASURES_JSON = "measures.json"
+HTML_FILE = "reproduction.html"
+
+#: Rate convergence: relative tolerance (or the seed scatter, whichever is larger).
+RATE_TOLERANCE = 0.03
+
+#: claims.csv columns.
+CSV_COLUMNS = ("variant", "id", "verdict", "mean", "ci95_low", "ci95_high", "n", "paper_value", "statement",
+               "source", "measure", "test", "reason", "p_value", "per_seed")
+
+
+def _measure_task(kind: str, path: str, options: dict[str, Any]) -> tuple[dict[str, Any] | None, str]:
+    try:
+        if kind == "biaxial":
+            return measure_biaxial(path, options), ""
+        return measure_study(read_study_rows(path)), ""
+    except Exception as error:  # noqa: BLE001 - one unreadable run must not stop the claims
+        return None, f"{path}: {type(error).__name__}: {error}"
+
+
+def _tasks(plan: ReproductionPlan, out: Path) -> dict[tuple[str, str, str], tuple[str, str, dict[str, Any]]]:
+    """(variant, seed, kind) -> (kind, path, options) of every run that has finished."""
+    tasks = {}
+    for v in plan.variants:
+        source = plan.variant(v.runs_variant)
+        for seed in plan.seeds:
+            if v.kind == "study":
+                folder = plan.study_folder(out, source, seed)
+                if any(folder.glob("*/result.json")):
+                    tasks[(v.name, str(seed), "study")] = ("study", str(folder), {})
+            else:
+                folder = plan.biaxial_folder(out, source, seed)
+                if (folder / "run.h5").exists():
+                    tasks[(v.name, str(seed), "biaxial")] = ("biaxial", str(folder), dict(v.analysis))
+    return tasks
+
+
+def _compute(tasks: dict, workers: int | None, progress: bool) -> tuple[dict, list[str]]:
+    from tqdm.auto import tqdm
+
+    results: dict = {}
+    notes: list[str] = []
+    unique: dict[tuple[str, str, str], list] = {}
+    for key, (kind, path, options) in tasks.items():
+        unique.setdefault((kind, path, json.dumps(options, sort_keys=True)), []).append(key)
+    n_workers = max(1, min(int(workers or (os.cpu_count() or 1)), len(unique) or 1))
+    bar = tqdm(total=len(unique), desc="claims", unit="run", disable=not progress, dynamic_ncols=True)
+    try:
+        if n_workers == 1:
+            for (kind, path, options), keys in unique.items():
+                value, note = _measure_task(kind, path, json.loads(options))
+                for key in keys:
+                    results[key] = value
+                if note:
+                    notes.append(note)
+                bar.update(1)
+        else:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor, as_completed
+
+            context = multiprocessing.get_context("spawn")
+            with ProcessPoolExecutor(max_workers=n_workers, mp_context=context) as pool:
+                futures = {pool.submit(_measure_task, kind, path, json.loads(options)): keys
+                           for (kind, path, options), keys in unique.items()}
+                for future in as_completed(futures):
+                    value, note = future.result()
+                    for key in futures[future]:
+                        results[key] = value
+                    if note:
+                        notes.append(note)
+                    bar.update(1)
+    finally:
+        bar.close()
+    return results, notes
+
+
+def _block(variant: Variant, plan: ReproductionPlan, measures: list[dict[str, Any] | None], out: Path
+           ) -> dict[str, Any]:
+    claims = BIAXIAL_CLAIMS if variant.kind in ("biaxial", "analysis") else STUDY_CLAIMS
+    rows = evaluate(claims, measures, plan.seeds, variant.name)
+    source = plan.variant(variant.runs_variant)
+    walls = [m.get("wall_time_s") if m else None for m in measures] if variant.kind != "study" else []
+    if variant.kind == "study":
+        runs = [str(plan.study_folder(out, source, s).relative_to(out)) for s in plan.seeds]
+        walls = [_study_wall_time(plan.study_folder(out, source, s)) for s in plan.seeds]
+    else:
+        runs = [str(plan.biaxial_folder(out, source, s).relative_to(out)) for s in plan.seeds]
+    finite = [w for w in walls if w is not None and math.isfinite(w)]
+    missing = [s for s, m in zip(plan.seeds, measures, strict=True) if m is None]
+    notes = [f"seed {s}: no finished run to measure" for s in missing]
+    return {
+        "variant": variant.name,
+        "kind": variant.kind,
+        "description": variant.description,
+        "runs_of": variant.runs_variant,
+        "analysis": dict(variant.analysis),
+        "seeds": list(plan.seeds),
+        "runs": runs,
+        "wall_time_s": {"per_seed": walls, "mean": float(np.mean(finite)) if finite else None,
+                        "total": float(np.sum(finite)) if finite else None},
+        "claims": rows,
+        "verdict_counts": _counts(rows),
+        "notes": notes,
+    }
+
+
+def _study_wall_time(folder: Path) -> float | None:
+    rows = read_study_rows(folder)
+    return float(sum(float(r.get("wall_time_s") or 0.0) for r in rows)) if rows else None
+
+
+def _counts(rows: Sequence[dict[str, Any]]) -> dict[str, int]:
+    return {v: sum(r["verdict"] == v for r in rows) for v in VERDICTS}
+
+
+# ----------------------------------------------------------------------------- rates
+def rate_family(plan: ReproductionPlan) -> list[tuple[float, Variant]]:
+    """Biaxial variants that differ from the main one only in the strain rate, by rate."""
+    base = _main(plan, "biaxial")
+    if base is None:
+        return []
+
+    def without_rate(v: Variant) -> tuple[str, float]:
+        config = plan.biaxial_config(plan.variant(v.runs_variant), plan.seeds[0]).to_dict()
+        rate = config["shear"].pop("strain_rate")
+        return json.dumps(config, sort_keys=True), float(rate)
+
+    key, _ = without_rate(base)
+    family: dict[float, Variant] = {}
+    for v in plan.variants:
+        if v.kind != "biaxial":
+            continue
+        k, rate = without_rate(v)
+        if k == key:
+            family.setdefault(rate, v)
+    return sorted(family.items())
+
+
+def _band_difference(m: dict[str, Any] | None) -> float:
+    if m is None:
+        return math.nan
+    row = m["snapshots"][m["peak_snapshot"]]
+    if not row.get("band_found"):
+        return math.nan
+    return float(row.get("inside_mean_lambda") or math.nan) - float(row.get("outside_mean_lambda") or math.nan)
+
+
+_RATE_QUANTITIES = {
+    "peak_stress_ratio": lambda m: m["macro"]["peak_stress_ratio"] if m else math.nan,
+    "residual_stress_ratio": lambda m: m["macro"]["residual_stress_ratio"] if m else math.nan,
+    "final_volumetric_strain": lambda m: m["macro"]["final_volumetric_strain"] if m else math.nan,
+    "band_minus_rest_lambda": _band_difference,
+}
+
+
+def rate_convergence(family: Sequence[tuple[float, list[dict[str, Any] | None]]]) -> list[dict[str, Any]]:
+    """For each rate r with a run at r/2: is each quantity's seed mean at r within
+    max(3 % of its value at r/2, the seed standard deviation at r/2) of the mean at r/2?
+
+    ``family``: (rate, per-seed measures) pairs. One entry per such rate, with
+    ``converged`` true when every quantity is within.
+    """
+    out = []
+    rates = [r for r, _ in family]
+    for rate, measures in family:
+        half = [k for k, r in enumerate(rates) if math.isclose(r, rate / 2, rel_tol=1e-6)]
+        if not half:
+            continue
+        slow = family[half[0]][1]
+        quantities = {}
+        for name, get in _RATE_QUANTITIES.items():
+            a = np.array([float(get(m)) for m in measures], dtype=np.float64)
+            b = np.array([float(get(m)) for m in slow], dtype=np.float64)
+            a, b = a[np.isfinite(a)], b[np.isfinite(b)]
+            if a.size == 0 or b.size == 0:
+                quantities[name] = {"at_rate": None, "at_half_rate": None, "tolerance": None, "within": None}
+                continue
+            scatter = float(np.std(b, ddof=1)) if b.size > 1 else 0.0
+            tolerance = max(RATE_TOLERANCE * abs(float(b.mean())), scatter)
+            quantities[name] = {
+                "at_rate": float(a.mean()), "at_half_rate": float(b.mean()),
+                "difference": float(a.mean() - b.mean()), "tolerance": tolerance,
+                "within": bool(abs(a.mean() - b.mean()) <= tolerance),
+            }
+        known = [q["within"] for q in quantities.values() if q["within"] is not None]
+        out.append({"rate_per_s": rate, "half_rate_per_s": rates[half[0]],
+                    "rate": f"{rate * 6000:g}%/min", "half_rate": f"{rates[half[0]] * 6000:g}%/min",
+                    "quantities": quantities,
+                    "converged": bool(known) and all(known) and len(known) == len(quantities)})
+    return out
+
+
+# ----------------------------------------------------------------------------- writing
+def _main(plan: ReproductionPlan, kind: str) -> Variant | None:
+    preferred = "paper" if kind == "biaxial" else "study"
+    kinds = ("biaxial",) if kind == "biaxial" else ("study",)
+    for v in plan.variants:
+        if v.name == preferred:
+            return v
+    return next((v for v in plan.variants if v.kind in kinds), None)
+
+
+def _csv_text(blocks: Sequence[dict[str, Any]]) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(CSV_COLUMNS)
+    for block in blocks:
+        for row in block["claims"]:
+            values = {**row, "ci95_low": row["ci95"][0], "ci95_high": row["ci95"][1],
+                      "per_seed": " ".join("nan" if v is None else repr(v) for v in row["per_seed"])}
+            writer.writerow(["" if values.get(c) is None else values.get(c) for c in CSV_COLUMNS])
+    return buffer.getvalue()
+
+
+@dataclass
+class Outputs:
+    """What :func:`write_outputs` wrote, and the document it wrote as ``claims.json``."""
+
+    out_dir: Path
+    document: dict[str, Any]
+    files: list[Path] = field(default_factory=list)
+    wall_time_s: float = 0.0
+
+    def lines(self) -> list[str]:
+        """The verdict table and the files, for the terminal."""
+        doc = self.document
+        lines = [f"claims ({doc['variant']}): " + ", ".join(f"{n} {v}" for v, n in doc["verdict_counts"].items())]
+        width = max((len(r["id"]) for r in doc["claims"]), default=10)
+        for r in doc["claims"]:
+            ci = r["ci95"]
+            ci_text = "n/a" if ci[0] is None else f"[{ci[0]:.4g}, {ci[1]:.4g}]"
+            mean = "n/a" if r["mean"] is None else f"{r['mean']:.4g}"
+            lines.append(f"  {r['id']:<{width}}  {r['verdict']:<15} mean {mean:>9}  CI {ci_text}  n={r['n']}")
+        for block in doc["variants"]:
+            if block["variant"] in doc["variant"].split("+"):
+                continue
+            lines.append(f"variant {block['variant']}: " + ", ".join(
+                f"{n} {v}" for v, n in block["verdict_counts"].items()))
+        for entry in doc["rate_convergence"]:
+            lines.append(f"rate {entry['rate']} vs {entry['half_rate']}: "
+                         + ("converged" if entry["converged"] else "not converged"))
+        lines.append(f"grainlab reproduce: {len(self.files)} files in {self.wall_time_s:.1f} s -> "
+                     + ", ".join(str(p) for p in self.files if p.suffix in (".json", ".csv", ".html")))
+        return lines
+
+
+def write_outputs(plan: ReproductionPlan, out_dir: str | os.PathLike[str], *, workers: int | None = None,
+                  progress: bool = True, figures: bool = True) -> Outputs:
+    """Measures every finished run of ``plan`` in ``out_dir`` and writes ``claims.json``,
+    ``claims.csv``, ``measures.json``, the figures and ``reproduction.html``."""
+    started = time.perf_counter()
+    out = Path(out_dir)
+    tasks = _tasks(plan, out)
+    results, notes = _compute(tasks, workers, progress)
+
+    def per_seed(v: Variant) -> list[dict[str, Any] | None]:
+        kind = "study" if v.kind == "study" else "biaxial"
+        return [results.get((v.name, str(s), kind)) for s in plan.seeds]
+
+    blocks = [_block(v, plan, per_seed(v), out) for v in plan.variants]
+    family = rate_family(plan)
+    convergence = rate_convergence([(rate, per_seed(v)) for rate, v in family])
+    if len(family) >= 2:
+        (slow_rate, slow), (fast_rate, fast) = family[0], family[-1]
+        pairs = [None if a is None or b is None else {"fast": a, "slow": b}
+                 for a, b in zip(per_seed(fast), per_seed(slow), strict=True)]
+        name = f"rates {fast.name} vs {slow.name}"
+        rows = evaluate(RATE_CLAIMS, pairs, plan.seeds, name)
+        blocks.append({"variant": name, "kind": "rate", "description": (
+            f"paired per seed: the fastest rate of the family ({fast_rate * 6000:g} %/min) against the slowest "
+            f"({slow_rate * 6000:g} %/min)"), "seeds": list(plan.seeds), "claims": rows,
+            "verdict_counts": _counts(rows), "notes": []})
+
+    main_biaxial, main_study = _main(plan, "biaxial"), _main(plan, "study")
+    top = [b for b in blocks if b["variant"] in {v.name for v in (main_biaxial, main_study) if v}]
+    top_claims = [row for b in top for row in b["claims"]]
+    document = {
+        "claims": top_claims,
+        "seeds": list(plan.seeds),
+        "variant": "+".join(b["variant"] for b in top),
+        "grainlab_version": grainlab.__version__,
+        "quick": plan.quick,
+        "verdict_counts": _counts(top_claims),
+        "variants": blocks,
+        "rate_convergence": convergence,
+        "notes": notes,
+    }
+    files = [write_json_atomic(out / CLAIMS_JSON, document)]
+    document = json.loads(files[0].read_text())  # NaN as null, as the file has it
+    files.append(write_text_atomic(out / CLAIMS_CSV, _csv_text(document["variants"])))
+    measures_doc = {f"{v}/seed-{s}": m for (v, s, _), m in results.items() if m is not None}
+    files.append(write_json_atomic(out / MEASURES_JSON, measures_doc, indent=None))
+    if figures:
+        from grainlab.reproduction.figures import draw_figures
+        from grainlab.reproduction.html import write_html
+
+        drawn = draw_figures(plan, results, out / "figures")
+        files += [p for p in drawn.values()]
+        files.append(write_html(out / HTML_FILE, plan, document, drawn))
+    return Outputs(out, document, files, time.perf_counter() - started)

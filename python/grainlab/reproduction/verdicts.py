@@ -1,0 +1,206 @@
+"""Verdict rules: how the per-seed values of a claim become ``reproduced``,
+``not reproduced`` or ``inconclusive`` (fixed before any run; docs/reproduction.md).
+
+Every rule takes the finite per-seed values (NaN values, e.g. a seed whose band
+was not found, are left out, and ``n`` says how many remain) and returns a
+:class:`Judgement`. With fewer than 2 values the verdict is ``inconclusive``.
+
+- :class:`ValueRule` (a value the paper gives): the 95 % t-interval of the
+  mean over seeds is compared with a tolerance band ``[low, high]`` around the
+  paper's value: **reproduced** when the interval lies inside the band,
+  **not reproduced** when it lies entirely outside, **inconclusive** when it
+  straddles an edge.
+- :class:`SideRule` (a direction or a threshold: a difference of the paper's
+  sign, a value above a bound): the 95 % t-interval of the mean (of the
+  per-seed paired differences for a comparison) is compared with the
+  reference: **reproduced** when entirely on the paper's side, **not
+  reproduced** when entirely on the other side, **inconclusive** when it
+  contains the reference.
+- :class:`ProportionRule` (an event the paper reports, e.g. a band found at
+  0.5 %): per seed 1 or 0; the exact one-sided binomial test at 5 % that the
+  share of seeds exceeds one half: **reproduced** when significant, **not
+  reproduced** when the share is significantly below one half, otherwise
+  **inconclusive** (5 of 5 seeds are needed with 5 seeds; 3 of 3 cannot
+  decide). ``ci95`` is the two-sided exact (Clopper-Pearson) interval.
+
+Example
+-------
+>>> SideRule(+1).judge([0.02, 0.03, 0.025, 0.04, 0.03]).verdict
+'reproduced'
+>>> SideRule(+1).judge([-0.02, 0.03, -0.025, 0.04, 0.001]).verdict
+'inconclusive'
+>>> ValueRule(0.325, 0.355).judge([0.20, 0.21, 0.19]).verdict
+'not reproduced'
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import stats
+
+__all__ = [
+    "INCONCLUSIVE",
+    "NOT_REPRODUCED",
+    "REPRODUCED",
+    "VERDICTS",
+    "Judgement",
+    "ProportionRule",
+    "SideRule",
+    "ValueRule",
+    "t_interval",
+]
+
+REPRODUCED = "reproduced"
+NOT_REPRODUCED = "not reproduced"
+INCONCLUSIVE = "inconclusive"
+VERDICTS = (REPRODUCED, NOT_REPRODUCED, INCONCLUSIVE)
+
+#: Confidence level of every interval, and the level of the tests.
+CONFIDENCE = 0.95
+
+
+@dataclass(frozen=True)
+class Judgement:
+    """The statistics of one claim over the seeds, and its verdict."""
+
+    mean: float
+    ci95: tuple[float, float]
+    n: int
+    p_value: float
+    verdict: str
+    reason: str
+
+
+def _finite(values: Sequence[float | None]) -> np.ndarray:
+    v = np.array([np.nan if x is None else float(x) for x in values], dtype=np.float64)
+    return v[np.isfinite(v)]
+
+
+def t_interval(values: np.ndarray, confidence: float = CONFIDENCE) -> tuple[float, float]:
+    """Two-sided t-interval of the mean of ``values`` (n >= 2); a point when all are equal."""
+    n = values.size
+    mean = float(values.mean())
+    sem = float(stats.sem(values)) if n > 1 else math.nan
+    if not math.isfinite(sem):
+        return (math.nan, math.nan)
+    if sem == 0.0:
+        return (mean, mean)
+    low, high = stats.t.interval(confidence, n - 1, loc=mean, scale=sem)
+    return (float(low), float(high))
+
+
+def _too_few(v: np.ndarray) -> Judgement:
+    mean = float(v.mean()) if v.size else math.nan
+    return Judgement(mean, (math.nan, math.nan), int(v.size), math.nan, INCONCLUSIVE,
+                     f"{v.size} seed(s) with a value; at least 2 are needed")
+
+
+@dataclass(frozen=True)
+class ValueRule:
+    """The paper gives a value: the 95 % CI of the mean must lie in ``[low, high]``."""
+
+    low: float
+    high: float
+
+    def __post_init__(self) -> None:
+        if not self.low <= self.high:
+            raise ValueError(f"ValueRule: low {self.low} above high {self.high}")
+
+    @property
+    def test(self) -> str:
+        return (f"95 % t-interval of the mean over seeds against the tolerance band "
+                f"[{self.low:.4g}, {self.high:.4g}]: inside reproduced, outside not reproduced, "
+                "across an edge inconclusive")
+
+    def judge(self, values: Sequence[float | None]) -> Judgement:
+        v = _finite(values)
+        if v.size < 2:
+            return _too_few(v)
+        low, high = t_interval(v)
+        mid = 0.5 * (self.low + self.high)
+        p = float(stats.ttest_1samp(v, mid).pvalue) if np.ptp(v) > 0 else math.nan
+        if self.low <= low and high <= self.high:
+            verdict, reason = REPRODUCED, "the interval lies inside the tolerance band"
+        elif high < self.low or low > self.high:
+            verdict, reason = NOT_REPRODUCED, "the interval lies outside the tolerance band"
+        else:
+            verdict, reason = INCONCLUSIVE, "the interval crosses an edge of the tolerance band"
+        return Judgement(float(v.mean()), (low, high), int(v.size), p, verdict, reason)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"rule": "value", "low": self.low, "high": self.high}
+
+
+@dataclass(frozen=True)
+class SideRule:
+    """The paper gives a direction: the 95 % CI of the mean must lie on ``sign``'s
+    side of ``reference`` (+1 above, -1 below)."""
+
+    sign: int
+    reference: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.sign not in (1, -1):
+            raise ValueError(f"SideRule: sign must be +1 or -1, got {self.sign}")
+
+    @property
+    def test(self) -> str:
+        side = "above" if self.sign > 0 else "below"
+        return (f"95 % t-interval of the mean over seeds entirely {side} {self.reference:g}: reproduced; "
+                "entirely on the other side: not reproduced; containing it: inconclusive")
+
+    def judge(self, values: Sequence[float | None]) -> Judgement:
+        v = _finite(values)
+        if v.size < 2:
+            return _too_few(v)
+        low, high = t_interval(v)
+        p = float(stats.ttest_1samp(v, self.reference).pvalue) if np.ptp(v) > 0 else math.nan
+        above, below = low > self.reference, high < self.reference
+        if (above and self.sign > 0) or (below and self.sign < 0):
+            verdict, reason = REPRODUCED, "the interval lies on the paper's side"
+        elif above or below:
+            verdict, reason = NOT_REPRODUCED, "the interval lies on the other side"
+        else:
+            verdict, reason = INCONCLUSIVE, f"the interval contains {self.reference:g}"
+        return Judgement(float(v.mean()), (low, high), int(v.size), p, verdict, reason)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"rule": "side", "sign": self.sign, "reference": self.reference}
+
+
+@dataclass(frozen=True)
+class ProportionRule:
+    """The paper reports an event: the share of seeds where it happens must
+    exceed one half (exact one-sided binomial tests at 5 %)."""
+
+    @property
+    def test(self) -> str:
+        return ("exact one-sided binomial test at 5 % of the share of seeds where it happens against 1/2: "
+                "above reproduced, below not reproduced, neither inconclusive")
+
+    def judge(self, values: Sequence[float | None]) -> Judgement:
+        v = _finite(values)
+        if v.size < 2:
+            return _too_few(v)
+        if not np.all((v == 0) | (v == 1)):
+            raise ValueError(f"ProportionRule: per-seed values must be 0 or 1, got {v.tolist()}")
+        k, n = int(v.sum()), int(v.size)
+        greater = stats.binomtest(k, n, 0.5, alternative="greater")
+        less = stats.binomtest(k, n, 0.5, alternative="less")
+        ci = stats.binomtest(k, n, 0.5).proportion_ci(CONFIDENCE, method="exact")
+        if greater.pvalue < 1 - CONFIDENCE:
+            verdict, reason, p = REPRODUCED, f"{k} of {n} seeds (p = {greater.pvalue:.3g})", greater.pvalue
+        elif less.pvalue < 1 - CONFIDENCE:
+            verdict, reason, p = NOT_REPRODUCED, f"{k} of {n} seeds (p = {less.pvalue:.3g})", less.pvalue
+        else:
+            p = min(greater.pvalue, less.pvalue)
+            verdict, reason = INCONCLUSIVE, f"{k} of {n} seeds: neither share is significant at 5 %"
+        return Judgement(k / n, (float(ci.low), float(ci.high)), n, float(p), verdict, reason)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"rule": "proportion", "reference": 0.5}
