@@ -3,7 +3,7 @@
 A snapshot is one state of a 2D assembly of disks: the particles as one array
 per property (structure of arrays) and the contacts as parallel arrays.
 
-Conventions (DESIGN.md §2):
+Conventions (docs/conventions.md):
 
 * SI units: positions and radii in m, rotations in rad, forces in N (per unit
   out-of-plane thickness t = 1 m), time in s.
@@ -23,9 +23,16 @@ Conventions (DESIGN.md §2):
 * Particle ``kind`` codes (:class:`ParticleKind`): ``SOIL`` grains,
   ``MEMBRANE`` disks of a flexible boundary chain (not part of the sample), and
   ``BOUNDARY`` soil grains that currently act as the flexible boundary
-  (DESIGN.md §3, variant B). Analysis treats ``SOIL`` and ``BOUNDARY`` as the
+  (docs/boundary.md, variant B). Analysis treats ``SOIL`` and ``BOUNDARY`` as the
   sample and excludes ``MEMBRANE`` particles; a *boundary contact* is a contact
   with a wall or with a membrane particle.
+* A *boundary body* is one piece of the boundary: a wall, or one chain of
+  membrane particles. The per-particle field ``particle_fields["body"]``
+  (:data:`BODY_FIELD`) labels the chain each ``MEMBRANE`` particle belongs to
+  (an integer >= 0; -1 for particles of no chain); without it the chains are
+  found from the geometry (:meth:`Snapshot.boundary_bodies`). Stability index
+  and contact counts count each boundary body once per particle by default
+  (docs/fabric.md, "Boundary contacts").
 
 Example
 -------
@@ -55,6 +62,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
 __all__ = [
+    "BODY_FIELD",
     "ParticleKind",
     "Snapshot",
     "detect_contacts",
@@ -62,6 +70,13 @@ __all__ = [
 ]
 
 TWO_PI = 2.0 * np.pi
+
+#: Name of the per-particle field that labels each membrane particle's chain.
+BODY_FIELD = "body"
+
+#: Ways of counting a particle's contacts with boundary bodies (see
+#: :meth:`Snapshot.contact_counts`): ``"body"`` once per body, ``"each"`` every contact.
+BOUNDARY_COUNTING = ("body", "each")
 
 
 class ParticleKind(enum.IntEnum):
@@ -318,6 +333,16 @@ class Snapshot:
             },
         )
 
+        if BODY_FIELD in self.particle_fields:
+            labels = _as_int(f"particle_fields[{BODY_FIELD!r}]", self.particle_fields[BODY_FIELD], (n,))
+            if labels.size and labels.min() < -1:
+                k = int(np.argmin(labels))
+                raise ValueError(
+                    f"particle_fields[{BODY_FIELD!r}]: body labels must be >= 0 (or -1 for none), "
+                    f"got {int(labels[k])} at index {k}"
+                )
+            put("particle_fields", {**self.particle_fields, BODY_FIELD: _readonly(labels)})
+
         periodic = tuple(bool(p) for p in self.periodic)
         if len(periodic) != 2:
             raise ValueError(f"periodic: expected two flags (x, y), got {self.periodic!r}")
@@ -476,6 +501,13 @@ class Snapshot:
             **kwargs,
         )
 
+    def with_boundary_bodies(self, body: ArrayLike) -> Snapshot:
+        """The same snapshot with ``particle_fields["body"]`` set to ``body`` (N,) int:
+        the chain (>= 0) each membrane particle belongs to, -1 for other particles."""
+        return dataclasses.replace(
+            self, particle_fields={**self.particle_fields, BODY_FIELD: body}
+        )
+
     def with_contacts(
         self, contact_i: ArrayLike, contact_j: ArrayLike, **contact_arrays: Any
     ) -> Snapshot:
@@ -548,6 +580,68 @@ class Snapshot:
         partner = np.where(wall, 0, cj)
         return wall | (membrane[partner] & ~wall) | membrane[self.contact_i]
 
+    def boundary_bodies(self) -> NDArray[np.int64]:
+        """(N,) the boundary body (membrane chain) of each ``MEMBRANE`` particle; -1 for the others.
+
+        Read from ``particle_fields["body"]`` when the snapshot has it (a
+        membrane particle labelled -1 there is a body of its own and gets a
+        new label). Otherwise the chains are found from the geometry: membrane
+        particles that touch or overlap, centre distance below
+        ``(r_i + r_j)(1 + 1e-6)`` (minimum image), belong to one body, as the
+        overlapping disks of a membrane chain do; grainlab's own snapshots
+        carry the label. Labels are 0, 1, ... (the stored ones are kept).
+        """
+        if "bodies" in self._cache:
+            return self._cache["bodies"]
+        membrane = np.flatnonzero(np.asarray(self.kind) == ParticleKind.MEMBRANE)
+        body = np.full(self.n_particles, -1, dtype=np.int64)
+        if BODY_FIELD in self.particle_fields:
+            stored = np.asarray(self.particle_fields[BODY_FIELD])[membrane]
+            unlabelled = stored < 0
+            stored[unlabelled] = stored.max(initial=-1) + 1 + np.arange(int(unlabelled.sum()))
+            body[membrane] = stored
+        elif membrane.size:
+            from scipy.sparse import coo_matrix
+            from scipy.sparse.csgraph import connected_components
+
+            r = self.radii[membrane]
+            i, j = detect_contacts(
+                self.positions[membrane],
+                r,
+                tolerance=2e-6 * float(r.max()),
+                box=self.box,
+                periodic=self.periodic,
+            )
+            d = self.minimum_image(self.positions[membrane[j]] - self.positions[membrane[i]])
+            near = np.hypot(d[:, 0], d[:, 1]) < (r[i] + r[j]) * (1.0 + 1e-6)
+            m = membrane.size
+            graph = coo_matrix((np.ones(int(near.sum())), (i[near], j[near])), shape=(m, m))
+            body[membrane] = connected_components(graph, directed=False)[1]
+        body = _readonly(body)
+        self._cache["bodies"] = body
+        return body
+
+    def boundary_body_keys(self) -> NDArray[np.int64]:
+        """(Nc, 2) the boundary body on the far side of each contact end.
+
+        Column 0 is the end on particle ``contact_i``, column 1 the end on
+        ``contact_j``. The value is a key naming the body (``2 w`` for wall
+        ``w``, ``2 b + 1`` for membrane chain ``b`` of :meth:`boundary_bodies`),
+        or -1 when the far side is not a boundary body (a sample particle, a
+        particle of the end's own chain) or the end does not exist (column 1 of
+        a wall contact).
+        """
+        ci = np.asarray(self.contact_i)
+        cj = np.asarray(self.contact_j)
+        body = self.boundary_bodies()
+        wall = cj < 0
+        body_i = body[ci]
+        body_j = np.where(wall, -1, body[np.where(wall, 0, cj)])
+        on_i = np.where(wall, -2 - 2 * cj, np.where(body_j >= 0, 2 * body_j + 1, -1))
+        on_i[~wall & (body_j == body_i)] = -1
+        on_j = np.where(~wall & (body_i >= 0) & (body_i != body_j), 2 * body_i + 1, -1)
+        return np.column_stack([on_i, on_j]).astype(np.int64)
+
     def index_of(self, ids: ArrayLike) -> NDArray[np.int64]:
         """Indices of the particles with the given ids; -1 where an id is absent."""
         want = np.asarray(ids, dtype=np.int64)
@@ -618,24 +712,58 @@ class Snapshot:
             self._cache["angles"] = _readonly(a)
         return self._cache["angles"]
 
-    def contact_counts(self, *, include_boundary: bool = True) -> NDArray[np.int64]:
+    def contact_counts(
+        self, *, include_boundary: bool = True, boundary: str = "body"
+    ) -> NDArray[np.int64]:
         """(N,) number of contacts of each particle (each contact counts for both ends).
 
-        With ``include_boundary=False`` contacts with walls and membrane
-        particles are not counted.
+        ``boundary="body"`` (default) counts a particle's contacts with one
+        boundary body (a wall, one membrane chain: :meth:`boundary_bodies`) as
+        one contact; ``"each"`` counts every contact, each membrane disk
+        touched as one. With ``include_boundary=False`` contacts with walls and
+        membrane particles are not counted.
         """
-        ci = self.contact_i
-        cj = self.contact_j
+        if boundary not in BOUNDARY_COUNTING:
+            raise ValueError(f"boundary: must be 'body' or 'each', got {boundary!r}")
+        ci = np.asarray(self.contact_i)
+        cj = np.asarray(self.contact_j)
         keep = np.ones(ci.shape, bool) if include_boundary else ~self.is_boundary_contact
         pp = keep & (cj >= 0)
-        n = self.n_particles
-        return np.bincount(ci[keep], minlength=n) + np.bincount(cj[pp], minlength=n)
+        owner = np.concatenate([ci[keep], cj[pp]])
+        if boundary == "body" and include_boundary:
+            keys = self.boundary_body_keys()
+            key = np.concatenate([keys[keep, 0], keys[pp, 1]])
+            owner = owner[boundary_end_groups(owner, key) == np.arange(owner.size)]
+        return np.bincount(owner, minlength=self.n_particles)
 
     def __repr__(self) -> str:
         return (
             f"Snapshot(n_particles={self.n_particles}, n_contacts={self.n_contacts}, "
             f"time={self.time}, axial_strain={self.axial_strain})"
         )
+
+
+def boundary_end_groups(owner: ArrayLike, key: ArrayLike) -> NDArray[np.int64]:
+    """Group contact ends by particle and boundary body.
+
+    ``owner`` (K,) is the particle of each end, ``key`` (K,) the boundary body
+    on its far side (:meth:`Snapshot.boundary_body_keys`, -1 for none). Ends
+    of one particle with the same key >= 0 form one group; every other end is
+    a group of its own. Returns (K,) the index of the first end of each end's
+    group, so ``groups == arange(K)`` marks one end per group.
+
+    >>> boundary_end_groups([0, 0, 1, 0], [3, -1, 3, 3]).tolist()
+    [0, 1, 2, 0]
+    """
+    o = np.asarray(owner, dtype=np.int64).reshape(-1)
+    k = np.asarray(key, dtype=np.int64).reshape(-1)
+    groups = np.arange(o.size, dtype=np.int64)
+    ends = np.flatnonzero(k >= 0)
+    if ends.size:
+        pairs = np.column_stack([o[ends], k[ends]])
+        _, first, inverse = np.unique(pairs, axis=0, return_index=True, return_inverse=True)
+        groups[ends] = ends[first[inverse.reshape(-1)]]
+    return groups
 
 
 def detect_contacts(

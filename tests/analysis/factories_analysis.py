@@ -69,3 +69,41 @@ def jittered_packing(nx: int, ny: int, seed: int, d: float = D) -> Snapshot:
     pos = np.c_[x.ravel(), y.ravel()] + rng.normal(0.0, 0.04 * d, (nx * ny, 2))
     rad = rng.uniform(0.48, 0.54, nx * ny) * d
     return Snapshot.from_geometry(pos, rad)
+
+
+def grain_on_membrane(
+    n_disks: int = 7,
+    forces=None,
+    *,
+    grain_radius: float = 1.5e-3,
+    disk_radius: float = 0.25e-3,
+    labelled: bool = True,
+) -> Snapshot:
+    """A grain (index 0) pressed into a membrane chain that wraps its left side.
+
+    ``n_disks`` membrane disks (indices 2 ..) touch the grain at angles 180 deg
+    + k * delta, k centred on 0, neighbours overlapping by half their diameter
+    (as the biaxial membrane's disks do); a second grain (index 1) touches it
+    at 0 deg. ``forces`` (n_disks,) are the normal forces of the membrane
+    contacts (the grain-grain contact carries 1 N). With ``labelled`` the
+    chain carries the body label 0.
+    """
+    dist = grain_radius + disk_radius
+    delta = disk_radius / dist  # arc spacing of one disk radius: half-diameter overlap
+    k = np.arange(n_disks) - 0.5 * (n_disks - 1)
+    a = np.pi + k * delta
+    disks = dist * np.c_[np.cos(a), np.sin(a)]
+    pos = np.vstack([[0.0, 0.0], [2 * grain_radius, 0.0], disks])
+    rad = np.r_[grain_radius, grain_radius, np.full(n_disks, disk_radius)]
+    kind = np.r_[0, 0, np.full(n_disks, 1)]
+    f = np.ones(n_disks) if forces is None else np.asarray(forces, dtype=float)
+    fields = {"body": np.r_[-1, -1, np.zeros(n_disks, np.int64)]} if labelled else {}
+    return Snapshot(
+        pos,
+        rad,
+        kind=kind,
+        contact_i=np.r_[0, np.zeros(n_disks, np.int64)],
+        contact_j=np.r_[1, 2 + np.arange(n_disks)],
+        normal_force=np.r_[1.0, f],
+        particle_fields=fields,
+    )

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from factories_analysis import hex_lattice, square_lattice
+from factories_analysis import grain_on_membrane, hex_lattice, square_lattice
 
 from grainlab.analysis import (
     ContactAnisotropy,
@@ -110,6 +110,24 @@ def test_boundary_contacts_excluded_from_z_by_default():
     assert z.coordination_number == pytest.approx(1.0)
     zb = CoordinationNumber(include_boundary=True).compute(snap)
     assert zb.coordination_number == pytest.approx((2 + 2) / 2)
+
+
+def test_boundary_bodies_count_once_when_boundary_contacts_are_included():
+    # grain 0 touches seven disks of one membrane chain and grain 1
+    snap = grain_on_membrane()
+    assert CoordinationNumber().compute(snap).coordination_number == 1.0  # boundary excluded
+    body = CoordinationNumber(include_boundary=True).compute(snap)
+    each = CoordinationNumber(include_boundary=True, boundary="each").compute(snap)
+    np.testing.assert_array_equal(body.n_contacts[:2], [2, 1])
+    np.testing.assert_array_equal(each.n_contacts[:2], [8, 1])
+    assert body.coordination_number == pytest.approx(1.5)
+    assert each.coordination_number == pytest.approx(4.5)
+    # grain 1 is a rattler; without it grain 0 keeps one contact (the chain) or seven
+    np.testing.assert_array_equal(body.rattlers[:2], [True, True])
+    np.testing.assert_array_equal(each.rattlers[:2], [False, True])
+    assert each.mechanical_coordination_number == pytest.approx(7.0)
+    with pytest.raises(ValueError, match="boundary"):
+        CoordinationNumber(boundary="disk")
 
 
 @pytest.mark.parametrize(("a", "theta_deg"), [(0.0, 0.0), (0.2, 30.0), (0.5, 120.0)])

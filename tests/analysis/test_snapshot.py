@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from grainlab.snapshot import ParticleKind, Snapshot, detect_contacts, wall_code
+from grainlab.snapshot import (
+    ParticleKind,
+    Snapshot,
+    boundary_end_groups,
+    detect_contacts,
+    wall_code,
+)
 
 
 def three_disks(**kw):
@@ -74,6 +80,8 @@ def three_disks(**kw):
         (dict(positions=[[0, 0]], radii=[1.0], periodic=(True, False)), "box"),
         (dict(positions=[[0, 0]], radii=[1.0], box=[[1, 0], [0, 1]]), "box"),
         (dict(positions=[[0, 0]], radii=[1.0], particle_fields={"v": [1, 2]}), "particle_fields"),
+        (dict(positions=[[0, 0]], radii=[1.0], particle_fields={"body": [-2]}), "particle_fields"),
+        (dict(positions=[[0, 0]], radii=[1.0], particle_fields={"body": [0.5]}), "particle_fields"),
     ],
 )
 def test_validation_names_the_field(kwargs, field):
@@ -144,6 +152,43 @@ def test_wall_codes_and_boundary_masks():
     np.testing.assert_array_equal(snap.contact_counts(include_boundary=False), [1, 1, 0])
     with pytest.raises(ValueError, match="wall_id"):
         wall_code(-1)
+
+
+def chains(gap: float = 0.5):
+    """Two membrane chains (disks 1-3 and 4-5, neighbours overlapping) and grain 0
+    touching disk 2 and disk 4; ``gap`` is the chains' spacing in diameters."""
+    d = 1e-3
+    y = np.arange(3) * gap * d
+    pos = np.vstack([[[1.0 * d, 0.5 * d]], np.c_[np.zeros(3), y], np.c_[np.full(2, 2 * d), y[:2]]])
+    kind = [0] + [ParticleKind.MEMBRANE] * 5
+    return Snapshot(pos, [0.6 * d] + [0.5 * d] * 5, kind=kind, contact_i=[0, 4, 0], contact_j=[2, 0, -3],
+                    contact_normal=[[-1, 0], [-1, 0], [0, -1]])
+
+
+def test_boundary_bodies_from_labels_or_geometry():
+    snap = chains()
+    np.testing.assert_array_equal(snap.boundary_bodies(), [-1, 0, 0, 0, 1, 1])
+    # spaced beyond touching, every disk is a body of its own
+    np.testing.assert_array_equal(chains(gap=1.01).boundary_bodies(), [-1, 0, 1, 2, 3, 4])
+    # stored labels win; an unlabelled membrane disk becomes a body of its own
+    labelled = snap.with_boundary_bodies([-1, 7, 7, -1, 3, 3])
+    np.testing.assert_array_equal(labelled.boundary_bodies(), [-1, 7, 7, 8, 3, 3])
+    # keys: wall w -> 2w, chain b -> 2b + 1; -1 where the far side is no boundary body
+    np.testing.assert_array_equal(snap.boundary_body_keys(), [[1, -1], [-1, 3], [4, -1]])
+    np.testing.assert_array_equal(snap.contact_counts(), [3, 0, 1, 0, 1, 0])
+    same_chain = snap.with_boundary_bodies([-1, 0, 0, 0, 0, 0])
+    np.testing.assert_array_equal(same_chain.contact_counts(), [2, 0, 1, 0, 1, 0])
+    np.testing.assert_array_equal(same_chain.contact_counts(boundary="each"), [3, 0, 1, 0, 1, 0])
+    assert "body" in same_chain.particle_fields
+    with pytest.raises(ValueError, match="boundary"):
+        snap.contact_counts(boundary="chains")
+
+
+def test_boundary_end_groups():
+    np.testing.assert_array_equal(
+        boundary_end_groups([0, 0, 1, 0, 1, 2], [3, -1, 3, 3, -1, 5]), [0, 1, 2, 0, 4, 5]
+    )
+    assert boundary_end_groups([], []).size == 0
 
 
 def test_index_of_and_select_contacts():

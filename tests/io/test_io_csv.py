@@ -60,6 +60,22 @@ def test_round_trip_keeps_values_exactly(tmp_path):
     assert back.n_contacts > 10
 
 
+def test_body_labels_round_trip_and_are_checked(tmp_path):
+    # two membrane chains (labels 0 and 1) that touch: only the labels keep them apart
+    pos = np.c_[np.arange(6) * 0.8e-3, np.zeros(6)]
+    snap = Snapshot(pos, np.full(6, 0.5e-3), kind=[1] * 6, particle_fields={"body": [0, 0, 0, 1, 1, 1]})
+    write_particles_csv(tmp_path / "p.csv", snap)
+    back = read_particles_csv(tmp_path / "p.csv", detect=False)
+    np.testing.assert_array_equal(back.boundary_bodies(), [0, 0, 0, 1, 1, 1])
+    assert back.particle_fields["body"].dtype == np.int64
+    unlabelled = read_particles_csv(write(tmp_path, "u.csv", "id,x,y,radius,kind\n" + "".join(
+        f"{k},{float(x)!r},0,0.0005,1\n" for k, x in enumerate(pos[:, 0]))), detect=False)
+    np.testing.assert_array_equal(unlabelled.boundary_bodies(), np.zeros(6))  # one touching chain
+    bad = write(tmp_path, "b.csv", "id,x,y,radius,kind,body\n1,0,0,1,1,0\n2,3,0,1,1,-2\n")
+    with pytest.raises(FileFormatError, match=r"b.csv:3: column 'body': -2 is not a body label"):
+        read_particles_csv(bad)
+
+
 def test_header_order_case_comments_and_detected_contacts(tmp_path):
     p = write(
         tmp_path,

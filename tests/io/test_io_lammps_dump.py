@@ -219,6 +219,22 @@ def test_atom_dump_errors_name_file_and_line(tmp_path, mutate, line, message):
     assert message in str(info.value)
 
 
+def test_body_column_labels_boundary_atoms(tmp_path):
+    # atoms 1 and 2 (type 2) are boundary atoms in two bodies, given by the 'mol' column
+    text = ATOMS.split("ITEM: TIMESTEP\n100")[0].replace("ITEM: ATOMS id type", "ITEM: ATOMS id mol type")
+    rows = {"3 1": "3 0 1", "1 1": "1 5 2", "2 1": "2 6 2", "4 1": "4 0 1"}
+    for old, new in rows.items():
+        text = text.replace(f"\n{old} ", f"\n{new} ")
+    p = write(tmp_path, "mol.dump", text)
+    snap = read_lammps_dump(p, boundary_types=(2,), body_column="mol")
+    np.testing.assert_array_equal(snap.particle_fields["body"], [0, 5, 6, 0])
+    np.testing.assert_array_equal(snap.boundary_bodies(), [-1, 5, 6, -1])
+    # without the column, atoms 1 and 2 (0.6 mm apart across the periodic x) touch: one body
+    np.testing.assert_array_equal(read_lammps_dump(p, boundary_types=(2,)).boundary_bodies(), [-1, 0, 0, -1])
+    with pytest.raises(FileFormatError, match="no column 'chain' for body_column"):
+        read_lammps_dump(p, body_column="chain")
+
+
 def test_truncated_file_and_missing_timestep(tmp_path):
     p = write(tmp_path, "t.dump", ATOMS[: ATOMS.rindex("2 1 0.0096")])
     with pytest.raises(FileFormatError, match="file ends inside a frame"):

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.snapshot import Snapshot
+from grainlab.snapshot import BOUNDARY_COUNTING, Snapshot, boundary_end_groups
 
 TWO_PI = 2.0 * np.pi
 
@@ -33,7 +33,7 @@ class Computable:
 
 
 def contact_ends(
-    snapshot: Snapshot, *, include_boundary: bool
+    snapshot: Snapshot, *, include_boundary: bool, boundary: str = "each"
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
     """Owner particle and contact angle of every contact *end* on a sample particle.
 
@@ -42,9 +42,18 @@ def contact_ends(
     particles are dropped; with ``include_boundary=False`` so are the contacts
     with walls or membrane particles.
 
+    ``boundary="body"`` merges the ends of one particle on one boundary body
+    (a wall, one membrane chain: :meth:`Snapshot.boundary_bodies`) into one
+    end at the normal-force-weighted mean direction of those contacts
+    (unweighted when they carry no force, or the snapshot has no forces; the
+    first contact's direction if the mean vanishes). ``"each"`` keeps every
+    contact.
+
     Returns ``owner (K,)``, ``angle (K,)`` in [0, 2 pi) and the (Nc,) mask of
     the contacts used.
     """
+    if boundary not in BOUNDARY_COUNTING:
+        raise ValueError(f"boundary: must be 'body' or 'each', got {boundary!r}")
     ci = np.asarray(snapshot.contact_i)
     cj = np.asarray(snapshot.contact_j)
     angle = np.asarray(snapshot.contact_angles())
@@ -57,7 +66,51 @@ def contact_ends(
     angle_j[angle_j >= TWO_PI] -= TWO_PI
     owner = np.concatenate([ci[on_i], cj[on_j]])
     ends = np.concatenate([angle[on_i], angle_j])
+    if boundary == "body" and include_boundary and owner.size:
+        keys = snapshot.boundary_body_keys()
+        key = np.concatenate([keys[on_i, 0], keys[on_j, 1]])
+        groups = boundary_end_groups(owner, key)
+        if np.any(groups != np.arange(owner.size)):
+            force = snapshot.normal_force
+            weight = (
+                np.ones(owner.size)
+                if force is None
+                else np.maximum(np.concatenate([force[on_i], force[on_j]]), 0.0)
+            )
+            ends = _merged_angles(ends, groups, weight)
+            first = groups == np.arange(owner.size)
+            owner, ends = owner[first], ends[first]
     return owner, ends, keep
+
+
+def repeated_boundary_contacts(snapshot: Snapshot, used: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """(Nc,) mask of the ``used`` contacts that are a sample particle's second or
+    later contact with the same boundary body (a wall, one membrane chain)."""
+    ci = np.asarray(snapshot.contact_i)
+    cj = np.asarray(snapshot.contact_j)
+    keys = snapshot.boundary_body_keys()
+    on_i = snapshot.is_sample[ci]
+    owner = np.where(on_i, ci, np.where(cj >= 0, cj, 0))
+    key = np.where(used, np.where(on_i, keys[:, 0], keys[:, 1]), -1)
+    return boundary_end_groups(owner, key) != np.arange(ci.size)
+
+
+def _merged_angles(
+    angles: NDArray[np.float64], groups: NDArray[np.int64], weight: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Each end's angle replaced by its group's weighted mean direction, in [0, 2 pi)."""
+    n = angles.size
+    c, s = np.cos(angles), np.sin(angles)
+    total = np.bincount(groups, weights=weight, minlength=n)
+    w = np.where(total[groups] > 0.0, weight, 1.0)  # a group without force: unweighted
+    mx = np.bincount(groups, weights=w * c, minlength=n)[groups]
+    my = np.bincount(groups, weights=w * s, minlength=n)[groups]
+    length = np.hypot(mx, my)
+    ok = length > 1e-12 * np.bincount(groups, weights=w, minlength=n)[groups]
+    merged = np.where(ok, np.arctan2(my, mx), angles[groups])
+    merged = np.mod(merged, TWO_PI)
+    merged[merged >= TWO_PI] = 0.0
+    return merged
 
 
 def finite_mean(values: NDArray[np.float64], mask: NDArray[np.bool_] | None = None) -> float:

@@ -75,8 +75,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from grainlab.analysis._util import TWO_PI, Computable, contact_ends
-from grainlab.snapshot import Snapshot
+from grainlab.analysis._util import TWO_PI, Computable, contact_ends, repeated_boundary_contacts
+from grainlab.snapshot import BOUNDARY_COUNTING, Snapshot
 
 __all__ = [
     "ContactAnisotropy",
@@ -211,6 +211,11 @@ class CoordinationNumber(Computable):
         iteratively, before computing Z_m.
     include_boundary : bool, default False
         Count contacts with walls and membrane particles.
+    boundary : {"body", "each"}, default "body"
+        With ``include_boundary``: ``"body"`` counts a grain's contacts with
+        one boundary body (a wall, one membrane chain) as one contact, as
+        :class:`~grainlab.analysis.StabilityIndex` does; ``"each"`` counts
+        every contact (every membrane disk touched).
 
     Attributes (after :meth:`compute`)
     ----------------------------------
@@ -234,15 +239,24 @@ class CoordinationNumber(Computable):
     4.0
     """
 
-    def __init__(self, min_contacts: int = 2, include_boundary: bool = False) -> None:
+    def __init__(
+        self, min_contacts: int = 2, include_boundary: bool = False, boundary: str = "body"
+    ) -> None:
         if int(min_contacts) != min_contacts or min_contacts < 0:
             raise ValueError(f"min_contacts: must be an integer >= 0, got {min_contacts!r}")
+        if boundary not in BOUNDARY_COUNTING:
+            raise ValueError(f"boundary: must be 'body' or 'each', got {boundary!r}")
         self.min_contacts = int(min_contacts)
         self.include_boundary = bool(include_boundary)
+        self.boundary = boundary
 
     def compute(self, snapshot: Snapshot) -> CoordinationNumber:
         """Compute the coordination numbers of ``snapshot``; returns ``self``."""
-        owner, _, used = contact_ends(snapshot, include_boundary=self.include_boundary)
+        owner, _, used = contact_ends(
+            snapshot, include_boundary=self.include_boundary, boundary=self.boundary
+        )
+        if self.include_boundary and self.boundary == "body":
+            used = used & ~repeated_boundary_contacts(snapshot, used)
         n = snapshot.n_particles
         sample = snapshot.is_sample
         counts = np.bincount(owner, minlength=n)
@@ -321,7 +335,7 @@ class CoordinationNumber(Computable):
     def __repr__(self) -> str:
         return (
             f"CoordinationNumber(min_contacts={self.min_contacts}, "
-            f"include_boundary={self.include_boundary})"
+            f"include_boundary={self.include_boundary}, boundary={self.boundary!r})"
         )
 
 

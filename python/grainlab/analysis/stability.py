@@ -1,4 +1,4 @@
-r"""The geometrical stability index lambda (paper Sec. 5, DESIGN.md §4).
+r"""The geometrical stability index lambda (paper Sec. 5; docs/fabric.md).
 
 For a particle with ``n`` contacts at angles sorted counter-clockwise,
 :math:`\phi_0 \le \phi_1 \le \dots \le \phi_{n-1}` in :math:`[0, 2\pi)`:
@@ -24,6 +24,17 @@ For a particle with ``n`` contacts at angles sorted counter-clockwise,
 Equal spacing gives 0; contacts at 0° and 90° give 1/4; at 0°, 60°, 120° give
 1/3, the largest value three equal disks around a fourth can reach.
 
+Range: lambda is not bounded by 1. For ``n >= 2`` contacts it lies in
+:math:`[0, \lfloor n^2/4 \rfloor / n]` (1/2, 2/3, 1, 6/5, 3/2, 12/7, 2, 20/9,
+5/2 for n = 2 ... 10), reached when all contacts sit at one angle, where
+every reference gives :math:`dS_n = \sum_m \min(m, n - m)\,2\pi/n`. So
+lambda > 1 needs five or more contacts crowded on one side of the particle.
+Neighbours of the particle's own size sit at least 60° apart; sampling such
+arrangements gives at most 1/3 (n = 2, 3, 4; 1/5 for n = 5, 0 for the only
+n = 6 arrangement). Many small disks touching one
+side of a grain, as membrane disks do, could exceed 1: :class:`StabilityIndex`
+therefore counts each boundary body once by default (``boundary="body"``).
+
 Implementation: writing :math:`e_j = \phi_j - 2\pi j/n`, the deviation of
 contact ``j`` from reference ``k`` is :math:`|\operatorname{wrap}(e_j - e_k)|`
 for every ``j`` (also past the wrap-around), and :math:`|e_j - e_k| < 2\pi`,
@@ -40,7 +51,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab.analysis._util import TWO_PI, Computable, contact_ends, finite_mean
-from grainlab.snapshot import Snapshot
+from grainlab.snapshot import BOUNDARY_COUNTING, Snapshot
 
 __all__ = ["StabilityIndex", "stability_index", "stability_index_of_angles"]
 
@@ -76,7 +87,8 @@ def stability_index(
     Returns
     -------
     lam : (n_particles,) float
-        lambda in [0, 1]; 1 for particles with 0 or 1 contact.
+        lambda >= 0 (at most floor(n^2/4)/n for n contacts; see the module
+        docstring); 1 for particles with 0 or 1 contact.
     counts : (n_particles,) int
         Number of contacts of each particle.
     """
@@ -126,7 +138,7 @@ class StabilityIndex(Computable):
 
     See the module docstring for the formula. Contact angles come from the
     snapshot's contact normals (direction from the particle's centre towards
-    the other particle or the wall, DESIGN.md §2).
+    the other particle or the wall, docs/conventions.md).
 
     Parameters
     ----------
@@ -136,13 +148,25 @@ class StabilityIndex(Computable):
         active contacts of a particle: a platen or membrane supports a grain
         as a neighbour does. With False, only contacts between sample
         particles count.
+    boundary : {"body", "each"}, default "body"
+        How boundary contacts count. ``"body"``: each boundary body (a wall,
+        one membrane chain, :meth:`Snapshot.boundary_bodies`) is one contact
+        of the grain, at the normal-force-weighted mean direction of the
+        grain's contacts with it (unweighted without forces): a chain of small
+        membrane disks supports a grain as one membrane does, and its
+        discretisation does not change lambda. ``"each"``: every contact
+        counts, each membrane disk touched as a neighbour (then lambda can
+        exceed 1 along the membrane).
 
     Attributes (after :meth:`compute`)
     ----------------------------------
     stability_index : (N,) float
-        lambda in [0, 1]; NaN for membrane particles (not part of the sample).
+        lambda >= 0 (0/1-contact particles 1; above 1 only with five or more
+        crowded contacts); NaN for membrane particles (not part of the sample).
     n_contacts : (N,) int
-        Number of contacts used for each particle (0 for membrane particles).
+        Number of contacts used for each particle, counted as lambda counts
+        them (each boundary body once with ``boundary="body"``; 0 for
+        membrane particles).
     mean : float
         Mean lambda over sample particles with at least 2 contacts (the paper
         filters out particles with 0 or 1 contact, whose lambda is 1 by
@@ -162,12 +186,17 @@ class StabilityIndex(Computable):
     0.333333333333
     """
 
-    def __init__(self, include_boundary: bool = True) -> None:
+    def __init__(self, include_boundary: bool = True, boundary: str = "body") -> None:
+        if boundary not in BOUNDARY_COUNTING:
+            raise ValueError(f"boundary: must be 'body' or 'each', got {boundary!r}")
         self.include_boundary = bool(include_boundary)
+        self.boundary = boundary
 
     def compute(self, snapshot: Snapshot) -> StabilityIndex:
         """Compute lambda for every particle of ``snapshot``; returns ``self``."""
-        owner, ends, _ = contact_ends(snapshot, include_boundary=self.include_boundary)
+        owner, ends, _ = contact_ends(
+            snapshot, include_boundary=self.include_boundary, boundary=self.boundary
+        )
         lam, counts = stability_index(owner, ends, snapshot.n_particles)
         sample = snapshot.is_sample
         lam[~sample] = np.nan
@@ -187,7 +216,8 @@ class StabilityIndex(Computable):
 
     @property
     def n_contacts(self) -> NDArray[np.int64]:
-        """(N,) number of contacts per particle used for lambda."""
+        """(N,) number of contacts per particle used for lambda (boundary bodies
+        counted as ``boundary`` says)."""
         return self._result("n_contacts")
 
     @property
@@ -217,4 +247,6 @@ class StabilityIndex(Computable):
         )
 
     def __repr__(self) -> str:
-        return f"StabilityIndex(include_boundary={self.include_boundary})"
+        return (
+            f"StabilityIndex(include_boundary={self.include_boundary}, boundary={self.boundary!r})"
+        )

@@ -2,9 +2,11 @@
 
 Particles CSV
     A header line, then one row per particle, comma separated. Required
-    columns ``id,x,y,radius`` (SI units: m); optional ``rotation`` (rad) and
-    ``kind`` (:class:`~grainlab.snapshot.ParticleKind` code); any other
-    numeric column is kept in :attr:`Snapshot.particle_fields`. Column order
+    columns ``id,x,y,radius`` (SI units: m); optional ``rotation`` (rad),
+    ``kind`` (:class:`~grainlab.snapshot.ParticleKind` code) and ``body``
+    (integer: the membrane chain of each membrane particle, -1 for none;
+    :meth:`Snapshot.boundary_bodies`); any other numeric column is kept in
+    :attr:`Snapshot.particle_fields`. Column order
     is free, names are case-insensitive; blank lines and lines starting with
     ``#`` are skipped.
 
@@ -35,7 +37,7 @@ from grainlab.io._table import (
     parse_float_table,
     read_lines,
 )
-from grainlab.snapshot import ParticleKind, Snapshot
+from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
 
 __all__ = ["read_contacts_csv", "read_particles_csv", "write_contacts_csv", "write_particles_csv"]
 
@@ -116,6 +118,15 @@ def read_particles_csv(
                 path, int(numbers[k]), f"column 'kind': unknown code {int(kind[k])}"
             )
     extra = {n: v for n, v in col.items() if n not in PARTICLE_COLUMNS + ("rotation", "kind")}
+    if BODY_FIELD in col:
+        body = integral_column(path, col[BODY_FIELD], numbers, BODY_FIELD)
+        bad = body < -1
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(
+                path, int(numbers[k]), f"column {BODY_FIELD!r}: {int(body[k])} is not a body label (>= -1)"
+            )
+        extra[BODY_FIELD] = body
     positions = np.c_[col["x"], col["y"]]
     metadata: dict[str, Any] = {"source": str(path), "format": "particles-csv"}
     kwargs: dict[str, Any] = dict(
@@ -187,7 +198,7 @@ def write_particles_csv(
     *,
     float_format: str = "%.17g",
 ) -> Path:
-    """Write ``id,x,y,radius`` (+ rotation, kind when set, + ``columns``) as CSV.
+    """Write ``id,x,y,radius`` (+ rotation, kind, body when set, + ``columns``) as CSV.
 
     Extra ``columns`` are (N,) arrays; NaN is written as an empty field.
     Integer and bool columns are written as integers. Returns the path.
@@ -202,6 +213,8 @@ def write_particles_csv(
         cols["rotation"] = np.asarray(snapshot.rotations)
     if np.any(np.asarray(snapshot.kind) != ParticleKind.SOIL):
         cols["kind"] = np.asarray(snapshot.kind)
+    if BODY_FIELD in snapshot.particle_fields:
+        cols[BODY_FIELD] = np.asarray(snapshot.particle_fields[BODY_FIELD])
     for name, values in (columns or {}).items():
         v = np.asarray(values)
         if v.shape != (snapshot.n_particles,):

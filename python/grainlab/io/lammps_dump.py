@@ -65,7 +65,7 @@ from grainlab.io._table import (
     parse_float_table,
     read_lines,
 )
-from grainlab.snapshot import ParticleKind, Snapshot
+from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
 
 __all__ = [
     "DumpFrame",
@@ -227,6 +227,7 @@ def read_lammps_dump(
     tolerance: float = 0.0,
     detect: bool = True,
     boundary_types: Sequence[int] = (),
+    body_column: str | None = None,
 ) -> Snapshot:
     """Read one frame of a LAMMPS atoms dump (and its contacts) into a :class:`Snapshot`.
 
@@ -236,6 +237,10 @@ def read_lammps_dump(
     (``tolerance`` in m). Atoms whose ``type`` is in ``boundary_types``
     (e.g. frozen wall disks) get ``kind = MEMBRANE``: they bound the sample
     but are not part of it, and contacts with them are boundary contacts.
+    ``body_column`` names an integer column (e.g. ``mol``, the molecule id of
+    a bonded chain) that says which boundary body each boundary atom belongs
+    to (:data:`~grainlab.snapshot.BODY_FIELD`); without it, boundary atoms
+    that touch one another form one body (:meth:`Snapshot.boundary_bodies`).
     """
     frame = read_dump_frames(path, timestep)
     if frame.kind != "ATOMS":
@@ -308,6 +313,18 @@ def read_lammps_dump(
     for name, values in col.items():
         if name not in used:
             fields[name] = values
+    if body_column is not None:
+        if body_column not in col:
+            raise FileFormatError(
+                path, where, f"no column {body_column!r} for body_column (columns: {' '.join(frame.columns)})"
+            )
+        body = integral_column(path, col[body_column], numbers, body_column)
+        if np.any(body < -1):
+            k = int(np.argmax(body < -1))
+            raise FileFormatError(
+                path, int(numbers[k]), f"column {body_column!r}: {int(body[k])} is not a body label (>= -1)"
+            )
+        fields[BODY_FIELD] = body
     kind = None
     if len(boundary_types):
         if "type" not in col:

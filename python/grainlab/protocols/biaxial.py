@@ -350,11 +350,17 @@ def _area(sim: Simulation, boundary: Membrane | GrainBoundary) -> float:
 
 
 def _snapshot(sim: Simulation, run: _Run, strain: float):
+    """The state as a snapshot: grains, membrane disks labelled by chain (left 0, right 1)."""
     kind = np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8)
     kind[run.n_grains :] = int(ParticleKind.MEMBRANE)
+    body = np.full(sim.n_particles, -1, dtype=np.int64)
     if run.membrane is not None and run.membrane.get("kind") == GrainBoundary.kind:
         kind[run.membrane["left"] + run.membrane["right"]] = int(ParticleKind.BOUNDARY)
-    return sim.snapshot(kind=kind, axial_strain=strain, step=sim.step_count)
+    elif run.membrane is not None:
+        body[run.membrane["left"]] = 0
+        body[run.membrane["right"]] = 1
+    snap = sim.snapshot(kind=kind, axial_strain=strain, step=sim.step_count)
+    return snap.with_boundary_bodies(body)
 
 
 # ---- phases -----------------------------------------------------------------
