@@ -7,7 +7,14 @@ from __future__ import annotations
 import argparse
 import sys
 
-from grainlab.reproduction.runs import DEFAULT_SEEDS, DEFAULT_VARIANTS, describe, plan_from_args, run_reproduction
+from grainlab.reproduction.runs import (
+    DEFAULT_SEEDS,
+    DEFAULT_VARIANTS,
+    QUICK_SEEDS,
+    describe,
+    plan_from_args,
+    run_reproduction,
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -22,15 +29,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         ),
     )
     parser.add_argument("--out", required=True, help="the reproduction folder")
-    parser.add_argument("--seeds", type=int, default=DEFAULT_SEEDS,
-                        help=f"seeds 1..N of the ensemble (default {DEFAULT_SEEDS}, at least 2)")
+    parser.add_argument("--seeds", type=int, default=None,
+                        help=f"seeds 1..N of the ensemble (default {DEFAULT_SEEDS}, {QUICK_SEEDS} with --quick; "
+                        "at least 2)")
     parser.add_argument(
         "--variants", nargs="+", default=None, metavar="VARIANT",
         help="paper, boundary_b, lambda_raw, rate=<rate> (e.g. rate=1%%/min), set:<key>=<value>, study, "
         f"study:<field>=<value> (default: {' '.join(DEFAULT_VARIANTS)}; with a folder that already holds "
         "a reproduction, its variants are kept)",
     )
-    parser.add_argument("--quick", action="store_true",
+    parser.add_argument("--quick", action="store_true", default=None,
                         help="small samples, 5 %%/min to 5 %% strain, the packing study in a small box")
     parser.add_argument("--workers", type=int, default=None, help="local worker processes (default: cores)")
     parser.add_argument("--scheduler", default=None, help="Dask scheduler address, e.g. tcp://host:8786")

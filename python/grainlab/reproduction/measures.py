@@ -164,7 +164,7 @@ def measure_biaxial(run_dir: str | Path, options: Mapping[str, Any] | None = Non
     if peak_labels is not None:
         peak_ids = set(np.asarray(peak_snap.ids)[peak_labels > 0].tolist())
 
-    for pos_k, (k, (snap, fabric, labels)) in enumerate(zip(order, states, strict=True)):
+    for k, (snap, fabric, labels) in zip(order, states, strict=True):
         grains = np.asarray(snap.is_sample)
         stability = fabric["stability"]
         lam = np.asarray(stability.stability_index)[grains]

@@ -38,7 +38,7 @@ import json
 import math
 import os
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -51,6 +51,7 @@ __all__ = [
     "DEFAULT_VARIANTS",
     "PLAN_FILE",
     "QUICK_BIAXIAL",
+    "QUICK_SEEDS",
     "QUICK_STUDY",
     "RUNS_TABLE",
     "ReproductionPlan",
@@ -59,8 +60,9 @@ __all__ = [
     "snapshot_strains",
 ]
 
-#: Seeds of the default ensemble (``--seeds 5`` means seeds 1 ... 5).
+#: Seeds of the default ensemble (``--seeds 5`` means seeds 1 ... 5), and of ``--quick``'s.
 DEFAULT_SEEDS = 5
+QUICK_SEEDS = 3
 #: Variants run when none are named.
 DEFAULT_VARIANTS: tuple[str, ...] = ("paper", "lambda_raw", "study")
 #: The reproduction's own record of what it was asked to run.
@@ -157,7 +159,7 @@ def parse_variant(text: str) -> Variant:
     """The :class:`Variant` named by ``text`` (module docstring); ``ValueError`` naming it."""
     name = text.strip()
     if name == "paper":
-        return Variant("paper", "biaxial", description="the paper's test: Table 1, membrane boundary, 2 %/min")
+        return Variant("paper", "biaxial", description="the paper's test: Table 1, membrane boundary")
     if name == "boundary_b":
         return Variant(
             "boundary_b", "biaxial", {"boundary.kind": "outer_particles"},
@@ -317,28 +319,6 @@ class ReproductionPlan:
     def to_dict(self) -> dict[str, Any]:
         return {"seeds": list(self.seeds), "variants": [v.name for v in self.variants], "quick": self.quick}
 
-    def merged_with(self, out_dir: str | os.PathLike[str]) -> ReproductionPlan:
-        """This plan joined with the one recorded in ``out_dir`` (its variants and seeds
-        stay part of the reproduction); ``ValueError`` when the modes differ."""
-        path = Path(out_dir) / PLAN_FILE
-        if not path.exists():
-            return self
-        try:
-            saved = json.loads(path.read_text())
-        except (OSError, json.JSONDecodeError) as error:
-            raise ValueError(f"--out: {path} is not readable ({error}); remove it to start the record again") from None
-        if bool(saved.get("quick")) != self.quick:
-            was = "with" if saved.get("quick") else "without"
-            raise ValueError(
-                f"--quick: {out_dir} was started {was} --quick; use the same mode or another --out folder"
-            )
-        names = list(saved.get("variants", []))
-        for v in self.variants:
-            if v.name not in names:
-                names.append(v.name)
-        seeds = sorted(set(saved.get("seeds", [])) | set(self.seeds))
-        return ReproductionPlan.build(seeds, names, self.quick)
-
     def save(self, out_dir: str | os.PathLike[str]) -> Path:
         Path(out_dir).mkdir(parents=True, exist_ok=True)
         return write_json_atomic(Path(out_dir) / PLAN_FILE, self.to_dict())
@@ -382,17 +362,34 @@ def describe(plan: ReproductionPlan) -> list[str]:
         if v.kind == "analysis" or v.source:
             runs = f"reads {v.source}'s runs"
         elif v.kind == "biaxial":
-            runs = f"{len(plan.seeds)} biaxial runs"
+            config = plan.biaxial_config(v, plan.seeds[0])
+            runs = (f"{len(plan.seeds)} biaxial runs at {config['shear.strain_rate'] * 6000:g} %/min to "
+                    f"{100 * config['shear.final_strain']:g} %")
         else:
             runs = f"{len(plan.seeds)} x 19 packings"
         lines.append(f"{v.name}: {v.description}; {runs}")
     return lines
 
 
-def plan_from_args(seeds: int, variants: Sequence[str] | None, quick: bool,
+def plan_from_args(seeds: int | None, variants: Sequence[str] | None, quick: bool | None,
                    out_dir: str | os.PathLike[str] | None = None) -> ReproductionPlan:
-    """The plan of a ``grainlab reproduce`` call: given variants (default
-    :data:`DEFAULT_VARIANTS`), joined with what ``out_dir`` already records."""
-    plan = ReproductionPlan.build(seeds, variants or DEFAULT_VARIANTS, quick)
-    return plan.merged_with(out_dir) if out_dir is not None else plan
-
+    """The plan of a ``grainlab reproduce`` call. A folder that already holds a
+    reproduction keeps its variants, seeds and mode; those given are added (a mode
+    given must be the folder's). Otherwise: the given variants (default
+    :data:`DEFAULT_VARIANTS`), ``seeds`` (default :data:`DEFAULT_SEEDS`,
+    :data:`QUICK_SEEDS` with ``quick``)."""
+    if out_dir is not None and (Path(out_dir) / PLAN_FILE).exists():
+        saved = load_plan(out_dir)
+        if quick is not None and bool(quick) != saved.quick:
+            was = "with" if saved.quick else "without"
+            raise ValueError(f"--quick: {out_dir} was started {was} --quick; use the same mode or another --out")
+        names = [v.name for v in saved.variants]
+        names += [v.name for v in (parse_variant(t) for t in variants or ()) if v.name not in names]
+        all_seeds = sorted(set(saved.seeds) | set(range(1, (seeds or 0) + 1)))
+        if seeds is not None and seeds < 2:
+            raise ValueError(f"--seeds: expected an integer >= 2, got {seeds!r}")
+        return ReproductionPlan.build(all_seeds, names, saved.quick)
+    quick = bool(quick)
+    if seeds is None:
+        seeds = QUICK_SEEDS if quick else DEFAULT_SEEDS
+    return ReproductionPlan.build(seeds, variants or DEFAULT_VARIANTS, quick)
