@@ -11,6 +11,7 @@ from grainlab.reproduction.runs import (
     DEFAULT_SEEDS,
     DEFAULT_VARIANTS,
     QUICK_SEEDS,
+    QUICK_VARIANTS,
     describe,
     plan_from_args,
     run_reproduction,
@@ -35,8 +36,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--variants", nargs="+", default=None, metavar="VARIANT",
         help="paper, boundary_b, lambda_raw, rate=<rate> (e.g. rate=1%%/min), set:<key>=<value>, study, "
-        f"study:<field>=<value> (default: {' '.join(DEFAULT_VARIANTS)}; with a folder that already holds "
-        "a reproduction, its variants are kept)",
+        f"study:<field>=<value> (default: {' '.join(DEFAULT_VARIANTS)}; with --quick {' '.join(QUICK_VARIANTS)}; "
+        "a folder that already holds a reproduction keeps its variants)",
     )
     parser.add_argument("--quick", action="store_true", default=None,
                         help="small samples, 5 %%/min to 5 %% strain, the packing study in a small box")

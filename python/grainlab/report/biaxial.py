@@ -148,6 +148,8 @@ class BiaxialReport:
     macro_png: bytes
     #: (quantity, paper, run, where) rows.
     paper_rows: list[tuple[str, str, str, str]]
+    #: The reproduction's claims on this one run (:func:`grainlab.reproduction.claims.single_run_rows`).
+    claim_rows: list[dict[str, Any]]
     #: (phase, description, seconds) and the recorded total.
     wall_times: list[tuple[str, str, float]]
     wall_total: float
@@ -585,10 +587,24 @@ def gather_biaxial(
         grading_png=grading_figure(diameters, grading, "requested"),
         macro_png=macro_figure(eps, q, ev, k, dilation, phi),
         paper_rows=[],
+        claim_rows=[],
         wall_times=wall,
         wall_total=total,
         regenerated=regenerated,
         notes=notes + [f"fabric figures: {n}" for n in (fabric or {}).get("notes", [])],
     )
     report.paper_rows = _paper_rows(report)
+    report.claim_rows = _claim_rows(folder, report.notes)
     return report
+
+
+def _claim_rows(path: Path, notes: list[str]) -> list[dict[str, Any]]:
+    """The reproduction's claims measured on this run (empty, with a note, when it cannot be measured)."""
+    from grainlab.reproduction.claims import single_run_rows
+    from grainlab.reproduction.measures import measure_biaxial
+
+    try:
+        return single_run_rows(measure_biaxial(path))
+    except (ValueError, KeyError, IndexError, OSError) as error:
+        notes.append(f"the paper's claims could not be measured on this run ({type(error).__name__}: {error})")
+        return []

@@ -63,6 +63,31 @@ def _footer() -> str:
 
 
 # ----------------------------------------------------------------------------- biaxial
+def _claims_part(r: BiaxialReport) -> list[Markup]:
+    """The reproduction's claims on this one run, and where the ensemble's verdicts come from."""
+    if not r.claim_rows:
+        return []
+    rows = [
+        (Markup(f"<code>{escape(c['id'])}</code>"), c["statement"], c["source"],
+         "" if c["paper_value"] is None else fmt(float(c["paper_value"]), 3), c["measure"],
+         fmt(float(c["value"]), 4), c["this_run"])
+        for c in r.claim_rows
+    ]
+    same = sum(c["this_run"] == "as the paper" for c in r.claim_rows)
+    return [
+        Markup("<h3>Every claim of the paper on this run</h3>"),
+        paragraph(
+            f"The claims that grainlab reproduce checks, measured on this one run from its snapshots: {same} of "
+            f"{len(rows)} lie where the claim's rule wants them (inside the tolerance band, on the paper's side). "
+            "One run is one sample, not a verdict: grainlab reproduce --out DIR runs the test over an ensemble "
+            "of seeds and gives each claim a verdict with its 95 % interval (docs/reproduction.md).",
+            "note",
+        ),
+        table(["claim", "the paper", "where", "paper's value", "measured", "this run", "one run"], rows,
+              numeric=(5,), css_class="wide"),
+    ]
+
+
 def _band_table(r: BiaxialReport) -> Markup:
     rows = []
     for label, b in (("nearest the peak", r.band_peak), ("end of shearing", r.band_end)):
@@ -343,6 +368,7 @@ def render_biaxial(r: BiaxialReport) -> str:
                 "note",
             ),
             table(["quantity", "paper", "this run", "where in the paper"], r.paper_rows, cell_classes={2: "note"}),
+            *_claims_part(r),
         )
     )
 

@@ -36,7 +36,7 @@ import numpy as np
 from grainlab.reproduction.measures import END_WINDOW, relative_slope
 from grainlab.reproduction.verdicts import ProportionRule, SideRule, ValueRule
 
-__all__ = ["BIAXIAL_CLAIMS", "RATE_CLAIMS", "STUDY_CLAIMS", "Claim", "evaluate"]
+__all__ = ["BIAXIAL_CLAIMS", "RATE_CLAIMS", "STUDY_CLAIMS", "Claim", "evaluate", "single_run_rows"]
 
 Measures = Mapping[str, Any]
 Rule = ValueRule | SideRule | ProportionRule
@@ -93,6 +93,35 @@ def evaluate(claims: Sequence[Claim], measures: Sequence[Measures | None], seeds
             except (KeyError, IndexError, TypeError, ValueError, ZeroDivisionError):
                 values.append(math.nan)
         rows.append(claim.row(values, seeds, variant))
+    return rows
+
+
+def _one_run(rule: Rule, value: float) -> str:
+    """Whether one run's value lies where the rule wants the ensemble's interval."""
+    if not math.isfinite(value):
+        return "no value"
+    if isinstance(rule, ValueRule):
+        inside = rule.low <= value <= rule.high
+    elif isinstance(rule, SideRule):
+        inside = rule.sign * (value - rule.reference) > 0
+    else:
+        inside = value == 1.0
+    return "as the paper" if inside else "not as the paper"
+
+
+def single_run_rows(measures: Measures, claims: Sequence[Claim] = ()) -> list[dict[str, Any]]:
+    """Each claim on one run: its value and whether it lies where the claim's rule
+    wants the ensemble's interval (a tolerance band, a side of a reference, an
+    event that happens). One run is not a verdict: ``grainlab reproduce`` is."""
+    rows = []
+    for claim in claims or BIAXIAL_CLAIMS:
+        try:
+            value = float(claim.extract(measures))
+        except (KeyError, IndexError, TypeError, ValueError, ZeroDivisionError):
+            value = math.nan
+        rows.append({"id": claim.id, "statement": claim.statement, "source": claim.source,
+                     "paper_value": claim.paper_value, "measure": claim.measure, "value": value,
+                     "rule": claim.rule.to_dict(), "this_run": _one_run(claim.rule, value)})
     return rows
 
 

@@ -89,6 +89,18 @@ def _band_plot(ax: Any, runs: Sequence[Measures], name: str, label: str, color: 
 
 def _strain_axis(ax: Any) -> None:
     ax.set_xlabel(r"axial strain $\varepsilon_{11}$ (%)")
+    _limits_from_lines(ax)
+
+
+def _limits_from_lines(ax: Any) -> None:
+    """y limits from the plotted curves (means, seeds, marks), so that an interval
+    from two or three seeds, which can be far wider, does not flatten them."""
+    values = [np.asarray(line.get_ydata(), dtype=np.float64) for line in ax.get_lines()]
+    finite = np.concatenate([v[np.isfinite(v)] for v in values]) if values else np.zeros(0)
+    if finite.size:
+        low, high = float(finite.min()), float(finite.max())
+        pad = 0.15 * (high - low) if high > low else 0.05 * max(abs(high), 1e-3)
+        ax.set_ylim(low - pad, high + pad)
 
 
 def _macro_figure(runs: Sequence[Measures], title: str) -> Figure:

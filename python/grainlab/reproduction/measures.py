@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -132,82 +132,81 @@ def measure_biaxial(run_dir: str | Path, options: Mapping[str, Any] | None = Non
     order), ``peak_snapshot`` (index of the snapshot nearest the stress-ratio
     peak, other than the first), ``notes``.
     """
-    from grainlab.analysis.band_fabric import BandFabric, roc_auc
+    return measure_biaxial_each(run_dir, [options or {}])[0]
+
+
+def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """:func:`measure_biaxial` under each of several analysis options, reading the
+    run and finding its bands (which do not depend on the options) once."""
     from grainlab.analysis.biaxial_figures import band_labels
-    from grainlab.analysis.strain import match_ids
     from grainlab.io.hdf5 import read_results
 
-    opts = {**ANALYSIS_DEFAULTS, **dict(options or {})}
     results = read_results(run_dir)
     ts = results.timeseries
     macro = macro_measures(ts)
     infos = list(results.snapshots)
     strains = [_snapshot_strain(info) for info in infos]
     order = sorted(range(len(infos)), key=lambda k: strains[k])
-    notes: list[str] = []
+    snaps = [results.snapshot(infos[k].name) for k in order]
+    labels = [None] + [band_labels(snaps[0], snap) for snap in snaps[1:]]
+    peak_pos = (1 + int(np.argmin([abs(strains[k] - macro["peak_axial_strain"]) for k in order[1:]]))
+                if len(order) > 1 else 0)
+    peak_ids: NDArray[np.int64] = np.zeros(0, np.int64)
+    if labels[peak_pos] is not None:
+        peak_ids = np.asarray(snaps[peak_pos].ids)[np.asarray(labels[peak_pos]) > 0]
     eps_ts = np.asarray(ts["axial_strain"], dtype=np.float64)
     q_ts = np.asarray(ts["stress_ratio"], dtype=np.float64)
-
-    reference = results.snapshot(infos[order[0]].name)
-    ref_fabric = _fabric_of(reference, opts)
-    snaps: list[dict[str, Any]] = []
-    states: list[tuple[Any, dict[str, Any], NDArray[np.int32] | None]] = []
-    for pos_k, k in enumerate(order):
-        snap = reference if pos_k == 0 else results.snapshot(infos[k].name)
-        fabric = ref_fabric if pos_k == 0 else _fabric_of(snap, opts)
-        labels = None if pos_k == 0 else band_labels(reference, snap)
-        states.append((snap, fabric, labels))
-    peak_pos = 1 + int(np.argmin([abs(strains[k] - macro["peak_axial_strain"]) for k in order[1:]])) \
-        if len(order) > 1 else 0
-    peak_snap, _, peak_labels = states[peak_pos]
-    peak_ids = set()
-    if peak_labels is not None:
-        peak_ids = set(np.asarray(peak_snap.ids)[peak_labels > 0].tolist())
-
-    for k, (snap, fabric, labels) in zip(order, states, strict=True):
-        grains = np.asarray(snap.is_sample)
-        stability = fabric["stability"]
-        lam = np.asarray(stability.stability_index)[grains]
-        counts = np.asarray(stability.n_contacts)[grains]
-        grain_contacts = np.asarray(fabric["grain_contacts"])[grains]
-        ids = np.asarray(snap.ids)[grains]
-        rotation = None
-        if snap.rotations is not None and reference.rotations is not None:
-            to_ref = match_ids(reference, snap)[grains]
-            rot = np.full(int(grains.sum()), np.nan)
-            have = to_ref >= 0
-            rot[have] = np.asarray(snap.rotations)[grains][have] - np.asarray(reference.rotations)[to_ref[have]]
-            rotation = rot
-        row: dict[str, Any] = {
-            "name": infos[k].name,
-            "axial_strain": strains[k],
-            "stress_ratio": float(np.interp(strains[k], eps_ts[np.isfinite(q_ts)], q_ts[np.isfinite(q_ts)])),
-            **fabric["numbers"],
-        }
-        in_peak_band = np.isin(ids, list(peak_ids)) if peak_ids else np.zeros(ids.size, bool)
-        row["auc_lambda_peak_band"] = roc_auc(lam, in_peak_band) if peak_ids else math.nan
-        found = labels is not None and bool(np.any(labels > 0))
-        row["band_found"] = found
-        if found:
-            members = np.asarray(labels)[grains] > 0
-            bf = BandFabric().compute(
-                snap.positions[grains], 2.0 * snap.radii[grains], lam, counts, members,
-                grain_contacts=grain_contacts, rotation=rotation,
-            )
-            row.update(bf.summary())
-        snaps.append(row)
-    if not macro["peak_in_interior"]:
-        notes.append("the stress ratio is largest at the first or last record: no interior peak")
-    return {
+    finite = np.isfinite(q_ts) & np.isfinite(eps_ts)
+    common = {
         "run": str(Path(results.path)),
-        "analysis": opts,
         "macro": macro,
-        "snapshots": snaps,
         "peak_snapshot": peak_pos,
         "wall_time_s": _finite(results.summary.get("wall_time_s")) if results.summary else math.nan,
         "strain_rate": _finite(results.summary.get("strain_rate")) if results.summary else math.nan,
-        "notes": notes,
+        "notes": [] if macro["peak_in_interior"] else
+        ["the stress ratio is largest at the first or last record: no interior peak"],
     }
+    out = []
+    for given in options:
+        opts = {**ANALYSIS_DEFAULTS, **dict(given)}
+        rows = []
+        for k, snap, band in zip(order, snaps, labels, strict=True):
+            row = {"name": infos[k].name, "axial_strain": strains[k],
+                   "stress_ratio": float(np.interp(strains[k], eps_ts[finite], q_ts[finite]))}
+            row.update(_snapshot_row(snaps[0], snap, band, peak_ids, opts))
+            rows.append(row)
+        out.append({**common, "analysis": opts, "snapshots": rows})
+    return out
+
+
+def _snapshot_row(reference: Any, snap: Any, labels: NDArray[np.int32] | None, peak_ids: NDArray[np.int64],
+                  options: Mapping[str, Any]) -> dict[str, Any]:
+    """Fabric of one snapshot, and inside / outside its band (when one was found)."""
+    from grainlab.analysis.band_fabric import BandFabric, roc_auc
+    from grainlab.analysis.strain import match_ids
+
+    fabric = _fabric_of(snap, options)
+    grains = np.asarray(snap.is_sample)
+    stability = fabric["stability"]
+    lam = np.asarray(stability.stability_index)[grains]
+    counts = np.asarray(stability.n_contacts)[grains]
+    ids = np.asarray(snap.ids)[grains]
+    rotation = None
+    if snap.rotations is not None and reference.rotations is not None:
+        to_ref = match_ids(reference, snap)[grains]
+        rotation = np.full(int(grains.sum()), np.nan)
+        have = to_ref >= 0
+        rotation[have] = np.asarray(snap.rotations)[grains][have] - np.asarray(reference.rotations)[to_ref[have]]
+    row: dict[str, Any] = dict(fabric["numbers"])
+    row["auc_lambda_peak_band"] = roc_auc(lam, np.isin(ids, peak_ids)) if peak_ids.size else math.nan
+    row["band_found"] = labels is not None and bool(np.any(labels > 0))
+    if row["band_found"]:
+        bf = BandFabric().compute(
+            snap.positions[grains], 2.0 * snap.radii[grains], lam, counts, np.asarray(labels)[grains] > 0,
+            grain_contacts=np.asarray(fabric["grain_contacts"])[grains], rotation=rotation,
+        )
+        row.update(bf.summary())
+    return row
 
 
 def measure_study(rows: list[Mapping[str, Any]]) -> dict[str, Any]:

@@ -39,7 +39,7 @@ import numpy as np
 import grainlab
 from grainlab.io.results import write_json_atomic, write_text_atomic
 from grainlab.reproduction.claims import BIAXIAL_CLAIMS, RATE_CLAIMS, STUDY_CLAIMS, evaluate
-from grainlab.reproduction.measures import measure_biaxial, measure_study, read_study_rows
+from grainlab.reproduction.measures import measure_biaxial_each, measure_study, read_study_rows
 from grainlab.reproduction.runs import ReproductionPlan, Variant
 from grainlab.reproduction.verdicts import VERDICTS
 
@@ -58,13 +58,14 @@ CSV_COLUMNS = ("variant", "id", "verdict", "mean", "ci95_low", "ci95_high", "n",
                "source", "measure", "test", "reason", "p_value", "per_seed")
 
 
-def _measure_task(kind: str, path: str, options: dict[str, Any]) -> tuple[dict[str, Any] | None, str]:
+def _measure_task(kind: str, path: str, options: list[dict[str, Any]]) -> tuple[list[dict[str, Any] | None], str]:
+    """The measures of one run under each of ``options`` (a study: one), and a note when it fails."""
     try:
         if kind == "biaxial":
-            return measure_biaxial(path, options), ""
-        return measure_study(read_study_rows(path)), ""
+            return list(measure_biaxial_each(path, options)), ""
+        return [measure_study(read_study_rows(path))], ""
     except Exception as error:  # noqa: BLE001 - one unreadable run must not stop the claims
-        return None, f"{path}: {type(error).__name__}: {error}"
+        return [None] * len(options), f"{path}: {type(error).__name__}: {error}"
 
 
 def _tasks(plan: ReproductionPlan, out: Path) -> dict[tuple[str, str, str], tuple[str, str, dict[str, Any]]]:
@@ -85,39 +86,40 @@ def _tasks(plan: ReproductionPlan, out: Path) -> dict[tuple[str, str, str], tupl
 
 
 def _compute(tasks: dict, workers: int | None, progress: bool) -> tuple[dict, list[str]]:
+    """Measures every run once (a biaxial run under every analysis option its variants ask
+    for), in ``workers`` local processes; returns the measures by task key and notes."""
     from tqdm.auto import tqdm
 
     results: dict = {}
     notes: list[str] = []
-    unique: dict[tuple[str, str, str], list] = {}
+    jobs: dict[tuple[str, str], dict[str, list]] = {}  # (kind, path) -> options text -> task keys
     for key, (kind, path, options) in tasks.items():
-        unique.setdefault((kind, path, json.dumps(options, sort_keys=True)), []).append(key)
-    n_workers = max(1, min(int(workers or (os.cpu_count() or 1)), len(unique) or 1))
-    bar = tqdm(total=len(unique), desc="claims", unit="run", disable=not progress, dynamic_ncols=True)
+        jobs.setdefault((kind, path), {}).setdefault(json.dumps(options, sort_keys=True), []).append(key)
+
+    def collect(job: tuple[str, str], values: list, note: str) -> None:
+        for keys, value in zip(jobs[job].values(), values, strict=True):
+            for key in keys:
+                results[key] = value
+        if note:
+            notes.append(note)
+        bar.update(1)
+
+    n_workers = max(1, min(int(workers or (os.cpu_count() or 1)), len(jobs) or 1))
+    bar = tqdm(total=len(jobs), desc="claims", unit="run", disable=not progress, dynamic_ncols=True)
     try:
         if n_workers == 1:
-            for (kind, path, options), keys in unique.items():
-                value, note = _measure_task(kind, path, json.loads(options))
-                for key in keys:
-                    results[key] = value
-                if note:
-                    notes.append(note)
-                bar.update(1)
+            for job, by_options in jobs.items():
+                collect(job, *_measure_task(*job, [json.loads(t) for t in by_options]))
         else:
             import multiprocessing
             from concurrent.futures import ProcessPoolExecutor, as_completed
 
             context = multiprocessing.get_context("spawn")
             with ProcessPoolExecutor(max_workers=n_workers, mp_context=context) as pool:
-                futures = {pool.submit(_measure_task, kind, path, json.loads(options)): keys
-                           for (kind, path, options), keys in unique.items()}
+                futures = {pool.submit(_measure_task, *job, [json.loads(t) for t in by_options]): job
+                           for job, by_options in jobs.items()}
                 for future in as_completed(futures):
-                    value, note = future.result()
-                    for key in futures[future]:
-                        results[key] = value
-                    if note:
-                        notes.append(note)
-                    bar.update(1)
+                    collect(futures[future], *future.result())
     finally:
         bar.close()
     return results, notes

@@ -63,8 +63,9 @@ __all__ = [
 #: Seeds of the default ensemble (``--seeds 5`` means seeds 1 ... 5), and of ``--quick``'s.
 DEFAULT_SEEDS = 5
 QUICK_SEEDS = 3
-#: Variants run when none are named.
+#: Variants run when none are named (``--quick``: without the analysis-only ``lambda_raw``).
 DEFAULT_VARIANTS: tuple[str, ...] = ("paper", "lambda_raw", "study")
+QUICK_VARIANTS: tuple[str, ...] = ("paper", "study")
 #: The reproduction's own record of what it was asked to run.
 PLAN_FILE = "reproduction.json"
 #: One row per run.
@@ -376,7 +377,7 @@ def plan_from_args(seeds: int | None, variants: Sequence[str] | None, quick: boo
     """The plan of a ``grainlab reproduce`` call. A folder that already holds a
     reproduction keeps its variants, seeds and mode; those given are added (a mode
     given must be the folder's). Otherwise: the given variants (default
-    :data:`DEFAULT_VARIANTS`), ``seeds`` (default :data:`DEFAULT_SEEDS`,
+    :data:`DEFAULT_VARIANTS`, :data:`QUICK_VARIANTS` with ``quick``), ``seeds`` (default :data:`DEFAULT_SEEDS`,
     :data:`QUICK_SEEDS` with ``quick``)."""
     if out_dir is not None and (Path(out_dir) / PLAN_FILE).exists():
         saved = load_plan(out_dir)
@@ -392,4 +393,4 @@ def plan_from_args(seeds: int | None, variants: Sequence[str] | None, quick: boo
     quick = bool(quick)
     if seeds is None:
         seeds = QUICK_SEEDS if quick else DEFAULT_SEEDS
-    return ReproductionPlan.build(seeds, variants or DEFAULT_VARIANTS, quick)
+    return ReproductionPlan.build(seeds, variants or (QUICK_VARIANTS if quick else DEFAULT_VARIANTS), quick)
