@@ -64,8 +64,8 @@ def main() -> dict:
     forces = ContactAnisotropy(bins=18, weight="normal_force").compute(reference)
     lam = StabilityIndex().compute(reference)
     print(f"reference: {reference.n_particles} particles, {reference.n_contacts} contacts")
-    print(f"  a   = {fabric.anisotropy:.4f} (Eq. 7), {fabric.anisotropy_fourier:.4f} (unbinned)")
-    print(f"  a_n = {forces.anisotropy:.4f} (Eq. 7), {forces.anisotropy_fourier:.4f} (unbinned)")
+    print(f"  a   = {fabric.anisotropy:.4f} (exact), {fabric.anisotropy_binned:.4f} (Eq. 7, 18 bins)")
+    print(f"  a_n = {forces.anisotropy:.4f} (exact), {forces.anisotropy_binned:.4f} (Eq. 7, 18 bins)")
     print(f"  mean lambda = {lam.mean:.3f}")
 
     # everything at once, from files, as `grainlab analyze` does

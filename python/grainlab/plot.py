@@ -4,7 +4,7 @@ All functions draw on a given matplotlib ``Axes`` (``ax=None`` creates a new
 figure with the paper style, without pyplot, so nothing global changes and
 any backend works) and return the axes; :func:`save_figure` writes PNG and
 SVG. Angles in the figures are in degrees; strains in percent, compression
-positive (DESIGN.md §2).
+positive (docs/conventions.md).
 
 Paper figures: :func:`polar_distribution` (Figs. 6–7), :func:`particle_map`
 coloured by displacement (Fig. 11), lambda (Fig. 12) or contact count

@@ -24,26 +24,33 @@ def hex_lattice(nx: int = 8, ny: int = 8, d: float = D, rotation_deg: float = 0.
     snap = Snapshot.from_geometry(
         pos, np.full(len(pos), d / 2), box=box, periodic=(True, True), tolerance=1e-6 * d
     )
-    if rotation_deg:
-        c, s = np.cos(np.radians(rotation_deg)), np.sin(np.radians(rotation_deg))
-        rot = np.array([[c, -s], [s, c]])
-        normals = snap.contact_normals() @ rot.T
-        snap = Snapshot(
-            snap.positions @ rot.T,
-            snap.radii,
-            contact_i=snap.contact_i,
-            contact_j=snap.contact_j,
-            contact_normal=normals,
-        )
-    return snap
+    return rotated(snap, rotation_deg)
 
 
-def square_lattice(nx: int = 8, ny: int = 8, d: float = D) -> Snapshot:
+def square_lattice(nx: int = 8, ny: int = 8, d: float = D, rotation_deg: float = 0.0) -> Snapshot:
+    """Periodic square lattice of touching disks, optionally rotated (as hex_lattice)."""
     j, i = np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij")
     pos = np.c_[i.ravel() * d, j.ravel() * d]
     box = np.array([[0.0, nx * d], [0.0, ny * d]])
-    return Snapshot.from_geometry(
+    snap = Snapshot.from_geometry(
         pos, np.full(len(pos), d / 2), box=box, periodic=(True, True), tolerance=1e-6 * d
+    )
+    return rotated(snap, rotation_deg)
+
+
+def rotated(snap: Snapshot, rotation_deg: float) -> Snapshot:
+    """The snapshot turned by ``rotation_deg`` about the origin, with its contacts
+    (explicit normals, no box: a rotated periodic cell is not a box)."""
+    if not rotation_deg:
+        return snap
+    c, s = np.cos(np.radians(rotation_deg)), np.sin(np.radians(rotation_deg))
+    rot = np.array([[c, -s], [s, c]])
+    return Snapshot(
+        snap.positions @ rot.T,
+        snap.radii,
+        contact_i=snap.contact_i,
+        contact_j=snap.contact_j,
+        contact_normal=snap.contact_normals() @ rot.T,
     )
 
 

@@ -7,6 +7,7 @@ import pytest
 from factories_analysis import grain_on_membrane, hex_lattice, square_lattice
 
 from grainlab.analysis import (
+    EDGE_TOLERANCE_RAD,
     ContactAnisotropy,
     CoordinationNumber,
     angular_histogram,
@@ -52,16 +53,53 @@ def test_hex_lattice_z6_and_isotropic():
     np.testing.assert_allclose(z.count_distribution, [0, 0, 0, 0, 0, 0, 1.0])
     an = ContactAnisotropy().compute(snap)
     assert an.anisotropy == pytest.approx(0.0, abs=1e-12)
-    assert an.anisotropy_fourier == pytest.approx(0.0, abs=1e-12)
+    assert an.anisotropy_binned == pytest.approx(0.0, abs=1e-12)
+    assert an.anisotropy_fourier == an.anisotropy
     np.testing.assert_allclose(an.fabric_tensor, 0.5 * np.eye(2), atol=1e-12)
     # each contact counted in both directions: 6 directions x 64 particles / 2 x 2
     assert an.histogram.sum() == 2 * snap.n_contacts == 6 * 64
 
 
-def test_unrotated_hex_lattice_fourier_isotropic_and_z6():
-    snap = hex_lattice()
-    assert CoordinationNumber().compute(snap).coordination_number == 6.0
-    assert ContactAnisotropy().compute(snap).anisotropy_fourier == pytest.approx(0.0, abs=1e-12)
+#: Rotations (deg) of the lattices: a fine scan, the multiples of 10 deg that put
+#: contacts exactly on the 20 deg bin edges (or centres), and odd ones.
+ROTATIONS = sorted({*np.arange(0.0, 90.0, 0.5).tolist(), 1e-12, 1e-7, 13.37, 59.999, 100.0, 170.0, 345.0})
+
+
+def test_hexagon_is_isotropic_at_every_rotation_binned_or_not():
+    # six directions 60 deg apart: no second harmonic, so Eq. 6 fits a = 0. Bins of
+    # 20 deg put all six at the same place in their bins (60 deg = 3 bins), so Eq. 7
+    # gives 0 too, once contacts on a bin edge count half to each side
+    worst_exact = worst_binned = 0.0
+    for deg in ROTATIONS:
+        an = ContactAnisotropy().compute(hex_lattice(rotation_deg=deg))
+        worst_exact = max(worst_exact, an.anisotropy)
+        worst_binned = max(worst_binned, an.anisotropy_binned)
+        np.testing.assert_allclose(an.fabric_tensor, 0.5 * np.eye(2), atol=1e-12)
+    assert worst_exact < 1e-12
+    assert worst_binned < 1e-12
+    # binned by floor alone, contacts on the edges fall into one bin or the other by round-off
+    on_edges = ContactAnisotropy(edge_tolerance=0.0).compute(hex_lattice(rotation_deg=20.0))
+    assert on_edges.anisotropy_binned > 0.05
+
+
+def test_square_lattice_exact_zero_and_binned_closed_forms():
+    # four directions 90 deg apart have no second harmonic either: Eq. 6 fits a = 0 (the
+    # lattice's anisotropy is in the fourth harmonic, which Eq. 6 does not have)
+    dt = np.radians(20.0)
+    generic = np.sin(dt) / dt * 2 * np.sin(dt / 2)  # 0.340: x, y half a bin apart (90 = 4.5 bins)
+    on_edge = np.sin(dt) / dt * (1 - np.cos(dt))  # 0.059: one of x, y on an edge, split
+    for deg in ROTATIONS:
+        snap = square_lattice(rotation_deg=deg)
+        an = ContactAnisotropy().compute(snap)
+        assert an.anisotropy < 1e-12
+        np.testing.assert_allclose(an.fabric_tensor, 0.5 * np.eye(2), atol=1e-12)
+        theta = snap.contact_angles()
+        assert abs(np.exp(4j * theta).mean()) == pytest.approx(1.0, abs=1e-12)
+        edge = abs(np.radians((deg + 5) % 10 - 5)) <= EDGE_TOLERANCE_RAD  # 1e-12 deg is, 1e-7 is not
+        expected = on_edge if edge else generic
+        assert an.anisotropy_binned == pytest.approx(expected, abs=1e-12), deg
+        # with 10 deg bins (90 = 9 bins) Eq. 7 sees no anisotropy at any rotation
+        assert ContactAnisotropy(bins=36).compute(snap).anisotropy_binned < 1e-12
 
 
 def test_square_lattice_z4():
@@ -137,15 +175,19 @@ def test_recovers_eq6_parameters(rng, a, theta_deg):
     an = ContactAnisotropy(bins=18).compute(snapshot_with_normals(angles, rng))
     sigma = np.sqrt(2.0 / n)  # standard error of a from n contacts
     assert an.anisotropy_fourier == pytest.approx(a, abs=4 * sigma)
+    assert an.anisotropy == an.anisotropy_fourier
     # Eq. 7 as printed carries the binning factor (sin dt / dt)^2 = 0.960 at 18 bins
     dt = np.radians(20.0)
-    assert an.anisotropy == pytest.approx(a * (np.sin(dt) / dt) ** 2, abs=4 * sigma)
+    assert an.anisotropy_binned == pytest.approx(a * (np.sin(dt) / dt) ** 2, abs=4 * sigma)
+    # the same contacts give the same binned value with and without the edge rule
+    plain = ContactAnisotropy(bins=18, edge_tolerance=0.0).compute(snapshot_with_normals(angles, rng))
+    assert plain.anisotropy_binned == pytest.approx(an.anisotropy_binned, abs=1e-6)
     # the fabric tensor gives the same a as the Fourier estimate
     w = np.linalg.eigvalsh(an.fabric_tensor)
     assert 2 * (w[1] - w[0]) == pytest.approx(an.anisotropy_fourier, rel=1e-9)
     if a > 0:
         tol = np.degrees(4 * sigma / (2 * a))
-        for theta in (an.direction, an.direction_fourier):
+        for theta in (an.direction, an.direction_binned):
             diff = (np.degrees(theta) - theta_deg + 90) % 180 - 90
             assert abs(diff) < tol
 
@@ -190,3 +232,16 @@ def test_functions_validate_and_handle_empty():
     assert np.isnan(fabric_tensor(np.zeros((0, 2)))).all()
     phi = fabric_tensor([[1, 0], [0, 1], [1, 0]], weights=[1, 2, 1])
     np.testing.assert_allclose(phi, [[0.5, 0], [0, 0.5]])
+
+
+def test_fabric_summary_headline_is_exact_and_binned_beside_it():
+    from grainlab.analysis import fabric_summary
+
+    hexagon = fabric_summary(hex_lattice(rotation_deg=20.0))  # contacts on bin edges
+    assert hexagon["anisotropy"] < 1e-12 and hexagon["anisotropy_binned"] < 1e-12
+    square = fabric_summary(square_lattice(rotation_deg=5.0))
+    assert square["anisotropy"] < 1e-12
+    assert square["anisotropy_fourier"] == square["anisotropy"]
+    assert square["anisotropy_binned"] == pytest.approx(0.3403, abs=1e-4)
+    # contacts found from the geometry carry no force: no force anisotropy either way
+    assert np.isnan(square["force_anisotropy"]) and np.isnan(square["force_anisotropy_binned"])

@@ -8,6 +8,7 @@ raise until computed, ``plot(ax=None)``) backed by plain NumPy functions.
 
 from grainlab.analysis.analyze import AnalysisResult, analyze_snapshot, fabric_summary
 from grainlab.analysis.fabric import (
+    EDGE_TOLERANCE_RAD,
     ContactAnisotropy,
     CoordinationNumber,
     angular_histogram,
@@ -21,6 +22,7 @@ from grainlab.analysis.stability import StabilityIndex, stability_index, stabili
 from grainlab.analysis.strain import LocalStrain, match_ids, neighbour_pairs
 
 __all__ = [
+    "EDGE_TOLERANCE_RAD",
     "AnalysisResult",
     "ContactAnisotropy",
     "CoordinationNumber",

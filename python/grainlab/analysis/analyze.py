@@ -57,6 +57,8 @@ class AnalysisResult:
             "bins": a.bins,
             "a": num(a.anisotropy),
             "theta_a_deg": num(np.degrees(a.direction)),
+            "a_binned": num(a.anisotropy_binned),
+            "theta_a_binned_deg": num(np.degrees(a.direction_binned)),
             "a_fourier": num(a.anisotropy_fourier),
             "theta_a_fourier_deg": num(np.degrees(a.direction_fourier)),
             "fabric_tensor": a.fabric_tensor.tolist()
@@ -64,11 +66,14 @@ class AnalysisResult:
             else None,
             "a_n": num(fa.anisotropy) if fa else None,
             "theta_n_deg": num(np.degrees(fa.direction)) if fa else None,
+            "a_n_binned": num(fa.anisotropy_binned) if fa else None,
+            "theta_n_binned_deg": num(np.degrees(fa.direction_binned)) if fa else None,
             "a_n_fourier": num(fa.anisotropy_fourier) if fa else None,
             "theta_n_fourier_deg": num(np.degrees(fa.direction_fourier)) if fa else None,
             "mean_lambda": num(self.stability.mean),
             "mean_lambda_all": num(self.stability.mean_all),
             "lambda_includes_boundary_contacts": self.stability.include_boundary,
+            "lambda_boundary_counting": self.stability.boundary,
             "band_found": b is not None,
             "band_reason": (
                 candidate.reason
@@ -180,8 +185,10 @@ def fabric_summary(snapshot: Snapshot) -> dict[str, float]:
     ``mean_stability_index`` (grains with >= 2 contacts),
     ``mean_stability_index_all`` (every grain, 0- and 1-contact grains at
     lambda = 1, paper Sec. 5), ``anisotropy`` and ``anisotropy_direction_rad``
-    (Eq. 7-8), ``anisotropy_fourier`` (unbinned) and ``force_anisotropy``
-    (NaN when no contact carries a force)."""
+    (the exact, unbinned estimate; ``anisotropy_fourier`` is the same value
+    under its earlier name), ``anisotropy_binned`` (Eq. 7 on 18 bins),
+    ``force_anisotropy`` and ``force_anisotropy_binned`` (NaN when no contact
+    carries a force)."""
     z = CoordinationNumber().compute(snapshot)
     normals = ContactAnisotropy().compute(snapshot)
     stability = StabilityIndex().compute(snapshot)
@@ -192,11 +199,15 @@ def fabric_summary(snapshot: Snapshot) -> dict[str, float]:
         "mean_stability_index_all": stability.mean_all,
         "anisotropy": normals.anisotropy,
         "anisotropy_direction_rad": normals.direction,
+        "anisotropy_binned": normals.anisotropy_binned,
         "anisotropy_fourier": normals.anisotropy_fourier,
         "force_anisotropy": math.nan,
+        "force_anisotropy_binned": math.nan,
     }
     if snapshot.normal_force is not None and float(np.sum(snapshot.normal_force)) > 0.0:
-        out["force_anisotropy"] = ContactAnisotropy(weight="normal_force").compute(snapshot).anisotropy
+        forces = ContactAnisotropy(weight="normal_force").compute(snapshot)
+        out["force_anisotropy"] = forces.anisotropy
+        out["force_anisotropy_binned"] = forces.anisotropy_binned
     return {k: float(v) for k, v in out.items()}
 
 

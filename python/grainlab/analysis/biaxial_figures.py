@@ -132,7 +132,7 @@ class StateNumbers:
     snapshot: str
     #: Axial strain of the snapshot (fraction; NaN when not recorded).
     axial_strain: float
-    #: Contact-normal anisotropy a and direction theta_a (Eq. 7–8, degrees).
+    #: Contact-normal anisotropy a and direction theta_a (exact, unbinned; degrees).
     a: float
     theta_a_deg: float
     #: Normal-force anisotropy a_n and its direction (NaN without forces).

@@ -1,6 +1,6 @@
 r"""Fabric measures: coordination numbers, contact-normal distribution, anisotropy.
 
-Conventions (DESIGN.md §2, §4):
+Conventions (docs/conventions.md, docs/fabric.md):
 
 * Angles in rad inside the code, CCW from +x; a contact's normal *line* is
   counted in both directions (:math:`\theta` and :math:`\theta + \pi`), so the
@@ -12,7 +12,8 @@ Conventions (DESIGN.md §2, §4):
 Coordination number
     :math:`Z = 2 N_c / N_p` with :math:`N_p` the sample particles and
     :math:`N_c` the contacts between them (with boundary contacts included,
-    :math:`Z` is the mean number of contacts per sample particle).
+    :math:`Z` is the mean number of contacts per sample particle, each
+    boundary body counted once per particle unless ``boundary="each"``).
 
 Mechanical coordination number (rattler rule)
     A *rattler* is a particle with fewer than ``min_contacts`` contacts
@@ -23,11 +24,32 @@ Mechanical coordination number (rattler rule)
     the contacts among them. ``min_contacts=3`` gives the frictionless
     isostatic rule (d + 1 in 2D).
 
-Contact-normal histogram and Eq. 7–8 (as printed)
+Anisotropy: the exact estimate (the headline value)
+    Fitting Eq. 6, :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos
+    2(\theta-\theta_a)]`, to the contact normals by their second Fourier
+    moment,
+
+    .. math::
+
+       a = 2\,\Bigl|\tfrac{1}{W}\sum_c w_c\, e^{2 i \theta_c}\Bigr|,\qquad
+       \theta_a = \tfrac12 \arg \sum_c w_c\, e^{2 i \theta_c},
+
+    unbinned and unbiased for Eq. 6. In terms of the 2D fabric tensor
+    :math:`\phi = \frac{1}{W}\sum_c w_c\, n_c \otimes n_c` (trace 1, 2D
+    prefactors: :math:`\phi = \tfrac12 I + \tfrac{a}{4} \begin{pmatrix}
+    \cos 2\theta_a & \sin 2\theta_a \\ \sin 2\theta_a & -\cos 2\theta_a
+    \end{pmatrix}`), :math:`a = 2(\phi_1 - \phi_2)` and :math:`\theta_a` is
+    the direction of the major eigenvector. A hexagonal or a square lattice
+    gives exactly 0 (six or four directions have no second harmonic).
+
+Contact-normal histogram and Eq. 7–8 as printed (the binned value)
     ``ng`` bins of width :math:`\Delta\theta = 2\pi/n_g` over
     :math:`[0, 2\pi)`, bin ``g = 1..ng`` covering
     :math:`[(g-1)\Delta\theta, g\Delta\theta)`; :math:`N_g` counts the contact
-    ends in bin g (each contact twice) and :math:`N = \sum_g N_g`.
+    ends in bin g (each contact twice) and :math:`N = \sum_g N_g`. An angle
+    within ``edge_tolerance`` (default :data:`EDGE_TOLERANCE_RAD`) of a bin
+    edge counts half to each of the two bins, so that contacts lying on edges
+    (lattices) do not fall into one bin or the other by round-off.
 
     .. math::
 
@@ -39,26 +61,14 @@ Contact-normal histogram and Eq. 7–8 (as printed)
 
     The paper writes :math:`\tan^{-1}(S/C)`; we use ``atan2`` so that
     :math:`\theta_a \in [0, \pi)` is the direction of the major axis.
-    Note: binning a distribution :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos
-    2(\theta-\theta_a)]` (Eq. 6) multiplies its second harmonic by
-    :math:`\sin\Delta\theta/\Delta\theta`, so the prefactor that recovers
-    :math:`a` exactly is :math:`2\Delta\theta / (N\sin\Delta\theta)`. The
-    printed prefactor therefore returns :math:`a (\sin\Delta\theta /
-    \Delta\theta)^2` in expectation, 0.960 a at 18 bins. We keep the printed
-    form for comparison with the paper and report the unbinned estimate too.
-
-Unbinned estimate (second-order Fourier / fabric tensor)
-    .. math::
-
-       a = 2\,\Bigl|\tfrac{1}{W}\sum_c w_c\, e^{2 i \theta_c}\Bigr|,\qquad
-       \theta_a = \tfrac12 \arg \sum_c w_c\, e^{2 i \theta_c},
-
-    which is unbiased for Eq. 6. In terms of the 2D fabric tensor
-    :math:`\phi = \frac{1}{W}\sum_c w_c\, n_c \otimes n_c` (trace 1, 2D
-    prefactors: :math:`\phi = \tfrac12 I + \tfrac{a}{4} \begin{pmatrix}
-    \cos 2\theta_a & \sin 2\theta_a \\ \sin 2\theta_a & -\cos 2\theta_a
-    \end{pmatrix}`), :math:`a = 2(\phi_1 - \phi_2)` and :math:`\theta_a` is
-    the direction of the major eigenvector.
+    Binning a distribution of Eq. 6 multiplies its second harmonic by
+    :math:`\sin\Delta\theta/\Delta\theta`, so the printed prefactor returns
+    :math:`a (\sin\Delta\theta / \Delta\theta)^2` in expectation, 0.960 a at
+    18 bins. Binning also moves each contact to its bin centre: directions
+    whose spacing is a whole number of bins (a hexagonal lattice at 18 bins)
+    keep a = 0, others do not (a square lattice gives
+    :math:`\frac{\sin\Delta\theta}{\Delta\theta}\, 2\sin\frac{\Delta\theta}{2}
+    = 0.340` at 18 bins, 90° being 4.5 bins).
 
 Normal-force anisotropy a_n
     The same formulas with each contact weighted by its normal force
@@ -79,6 +89,7 @@ from grainlab.analysis._util import TWO_PI, Computable, contact_ends, repeated_b
 from grainlab.snapshot import BOUNDARY_COUNTING, Snapshot
 
 __all__ = [
+    "EDGE_TOLERANCE_RAD",
     "ContactAnisotropy",
     "CoordinationNumber",
     "anisotropy_eq7",
@@ -121,26 +132,53 @@ def rattlers(
         alive &= ~removed[ci] & ~(pp & removed[cj_safe])
 
 
+#: Angles (rad) closer than this to a bin edge count half to each neighbouring bin:
+#: far above the round-off of an angle computed from positions (about 1e-15 rad),
+#: far below any physical spread of contact directions.
+EDGE_TOLERANCE_RAD = 1e-9
+
+
 def angular_histogram(
-    angles: ArrayLike, bins: int = 18, weights: ArrayLike | None = None
+    angles: ArrayLike,
+    bins: int = 18,
+    weights: ArrayLike | None = None,
+    *,
+    edge_tolerance: float = EDGE_TOLERANCE_RAD,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Histogram of contact normals over [0, 2 pi), each counted in both directions.
 
     Returns ``(values (bins,), edges (bins + 1,))``; ``values`` are counts, or
-    sums of ``weights``. Bin g covers ``[edges[g], edges[g+1])``.
+    sums of ``weights``. Bin g covers ``[edges[g], edges[g+1])``; an angle
+    closer than ``edge_tolerance`` (rad, >= 0) to an edge counts half to each
+    of the two bins beside it (0: every angle in the bin that holds it).
+
+    >>> angular_histogram([0.0, np.pi / 4], bins=4)[0].tolist()
+    [1.5, 0.5, 1.5, 0.5]
     """
     if int(bins) != bins or bins < 2:
         raise ValueError(f"bins: must be an integer >= 2, got {bins!r}")
+    tol = float(edge_tolerance)
+    width = TWO_PI / int(bins)
+    if not 0.0 <= tol < 0.5 * width:
+        raise ValueError(
+            f"edge_tolerance: must be >= 0 and below half a bin ({0.5 * width:g} rad), got {edge_tolerance!r}"
+        )
     bins = int(bins)
     a = np.mod(np.asarray(angles, dtype=np.float64).reshape(-1), TWO_PI)
-    width = TWO_PI / bins
-    g1 = np.minimum((a / width).astype(np.int64), bins - 1)
-    g2 = np.minimum((np.mod(a + np.pi, TWO_PI) / width).astype(np.int64), bins - 1)
-    w = None if weights is None else np.asarray(weights, dtype=np.float64).reshape(-1)
-    if w is not None and w.shape != a.shape:
+    w = np.ones(a.shape) if weights is None else np.asarray(weights, dtype=np.float64).reshape(-1)
+    if w.shape != a.shape:
         raise ValueError(f"weights: expected shape {a.shape}, got {w.shape}")
-    values = np.bincount(g1, weights=w, minlength=bins) + np.bincount(g2, weights=w, minlength=bins)
-    return values.astype(np.float64), np.linspace(0.0, TWO_PI, bins + 1)
+    values = np.zeros(bins)
+    for end in (a, np.mod(a + np.pi, TWO_PI)):
+        u = end / width
+        edge = np.rint(u)
+        on_edge = np.abs(u - edge) * width < tol
+        inside = np.floor(u)
+        lower = np.where(on_edge, edge - 1, inside).astype(np.int64) % bins
+        upper = np.where(on_edge, edge, inside).astype(np.int64) % bins
+        values += np.bincount(lower, weights=0.5 * w, minlength=bins)
+        values += np.bincount(upper, weights=0.5 * w, minlength=bins)
+    return values, np.linspace(0.0, TWO_PI, bins + 1)
 
 
 def anisotropy_eq7(values: ArrayLike) -> tuple[float, float]:
@@ -343,28 +381,37 @@ class ContactAnisotropy(Computable):
     r"""Contact-normal (or normal-force) distribution and its anisotropy (Eq. 6–8).
 
     Fitted distribution (Eq. 6): :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos
-    2(\theta - \theta_a)]`. See the module docstring for Eq. 7–8 as printed,
-    the unbinned estimate and the fabric tensor.
+    2(\theta - \theta_a)]`. The headline :attr:`anisotropy` and
+    :attr:`direction` are the exact (unbinned) estimate from the second
+    Fourier moment; :attr:`anisotropy_binned` and :attr:`direction_binned`
+    are the paper's Eq. 7–8 on the histogram (see the module docstring).
 
     Parameters
     ----------
     bins : int, default 18
-        Number of angular bins ``ng`` over 360° (18 bins of 20° in the paper).
+        Number of angular bins ``ng`` over 360° (18 bins of 20° in the paper),
+        for the histogram and the binned value.
     weight : {"count", "normal_force"}, default "count"
         ``"count"`` gives a and theta_a; ``"normal_force"`` weights each
         contact by its normal force, giving a_n (the snapshot needs forces).
     include_boundary : bool, default False
-        Include contacts with walls and membrane particles.
+        Include contacts with walls and membrane particles (every contact:
+        the distribution is one of contact normals).
+    edge_tolerance : float, rad, default :data:`EDGE_TOLERANCE_RAD`
+        Angles this close to a bin edge count half to each neighbouring bin.
 
     Attributes (after :meth:`compute`)
     ----------------------------------
-    histogram : (bins,) float
-        Counts N_g (or summed normal force, N) per bin, each contact twice.
-    bin_edges : (bins + 1,) float, rad
     anisotropy, direction : float
-        a (or a_n) and theta_a (rad, [0, pi)) by Eq. 7–8 as printed.
+        a (or a_n) and theta_a (rad, [0, pi)): the exact estimate, unbinned.
+    anisotropy_binned, direction_binned : float
+        The same by Eq. 7–8 as printed, from :attr:`histogram`.
     anisotropy_fourier, direction_fourier : float
-        The unbinned estimate.
+        Equal to :attr:`anisotropy` and :attr:`direction` (their earlier name).
+    histogram : (bins,) float
+        Counts N_g (or summed normal force, N) per bin, each contact twice
+        (halves for contacts on a bin edge).
+    bin_edges : (bins + 1,) float, rad
     fabric_tensor : (2, 2) float
         ``sum w n (x) n / sum w``.
     total : float
@@ -377,12 +424,17 @@ class ContactAnisotropy(Computable):
     >>> x, y = np.meshgrid(np.arange(6.0), np.arange(6.0))
     >>> snap = Snapshot.from_geometry(np.c_[x.ravel(), y.ravel()], np.full(36, 0.5),
     ...                               box=[[0, 6], [0, 6]], periodic=(True, True), tolerance=1e-9)
-    >>> round(ContactAnisotropy().compute(snap).anisotropy_fourier, 12)
-    0.0
+    >>> fabric = ContactAnisotropy().compute(snap)  # a square lattice
+    >>> round(fabric.anisotropy, 12), round(fabric.anisotropy_binned, 4)
+    (0.0, 0.0591)
     """
 
     def __init__(
-        self, bins: int = 18, weight: str = "count", include_boundary: bool = False
+        self,
+        bins: int = 18,
+        weight: str = "count",
+        include_boundary: bool = False,
+        edge_tolerance: float = EDGE_TOLERANCE_RAD,
     ) -> None:
         if int(bins) != bins or bins < 2:
             raise ValueError(f"bins: must be an integer >= 2, got {bins!r}")
@@ -391,6 +443,8 @@ class ContactAnisotropy(Computable):
         self.bins = int(bins)
         self.weight = weight
         self.include_boundary = bool(include_boundary)
+        self.edge_tolerance = float(edge_tolerance)
+        angular_histogram(np.zeros(0), self.bins, edge_tolerance=self.edge_tolerance)  # checks it
 
     def compute(self, snapshot: Snapshot) -> ContactAnisotropy:
         """Compute the distribution for ``snapshot``; returns ``self``."""
@@ -408,17 +462,19 @@ class ContactAnisotropy(Computable):
                     "normal_force: the snapshot has no contact forces (needed for a_n)"
                 )
             weights = np.asarray(snapshot.normal_force)[used]
-        values, edges = angular_histogram(angles, self.bins, weights)
+        values, edges = angular_histogram(
+            angles, self.bins, weights, edge_tolerance=self.edge_tolerance
+        )
         a7, t7 = anisotropy_eq7(values)
         af, tf = anisotropy_fourier(angles, weights)
         normals = np.asarray(snapshot.contact_normals())[used]
         self._store(
             histogram=values,
             bin_edges=edges,
-            anisotropy=a7,
-            direction=t7,
-            anisotropy_fourier=af,
-            direction_fourier=tf,
+            anisotropy=af,
+            direction=tf,
+            anisotropy_binned=a7,
+            direction_binned=t7,
             fabric_tensor=fabric_tensor(normals, weights),
             total=float(used.sum() if weights is None else weights.sum()),
         )
@@ -442,23 +498,33 @@ class ContactAnisotropy(Computable):
 
     @property
     def anisotropy(self) -> float:
-        """a (or a_n) by Eq. 7 as printed."""
+        """a (or a_n), exact: twice the modulus of the mean of exp(2 i theta)."""
         return self._result("anisotropy")
 
     @property
     def direction(self) -> float:
-        """theta_a by Eq. 8 (atan2 form), rad in [0, pi)."""
+        """theta_a, exact: half the argument of the mean of exp(2 i theta), rad in [0, pi)."""
         return self._result("direction")
 
     @property
+    def anisotropy_binned(self) -> float:
+        """a (or a_n) by Eq. 7 as printed, from the histogram."""
+        return self._result("anisotropy_binned")
+
+    @property
+    def direction_binned(self) -> float:
+        """theta_a by Eq. 8 (atan2 form) from the histogram, rad in [0, pi)."""
+        return self._result("direction_binned")
+
+    @property
     def anisotropy_fourier(self) -> float:
-        """Unbinned a (or a_n)."""
-        return self._result("anisotropy_fourier")
+        """The exact a, :attr:`anisotropy` under its earlier name."""
+        return self._result("anisotropy")
 
     @property
     def direction_fourier(self) -> float:
-        """Unbinned theta_a, rad in [0, pi)."""
-        return self._result("direction_fourier")
+        """The exact theta_a, :attr:`direction` under its earlier name."""
+        return self._result("direction")
 
     @property
     def fabric_tensor(self) -> NDArray[np.float64]:
@@ -486,5 +552,5 @@ class ContactAnisotropy(Computable):
     def __repr__(self) -> str:
         return (
             f"ContactAnisotropy(bins={self.bins}, weight={self.weight!r}, "
-            f"include_boundary={self.include_boundary})"
+            f"include_boundary={self.include_boundary}, edge_tolerance={self.edge_tolerance!r})"
         )

@@ -82,8 +82,10 @@ PAPER_VALUES = {
 TIMESERIES_UNITS = {
     "anisotropy": "1",
     "anisotropy_direction_rad": "rad",
+    "anisotropy_binned": "1",
     "anisotropy_fourier": "1",
     "force_anisotropy": "1",
+    "force_anisotropy_binned": "1",
     "mean_stability_index": "1",
     "mean_stability_index_all": "1",
     "mechanical_coordination_number": "1",
@@ -332,8 +334,9 @@ def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, flo
 
 def _fabric(sim: Simulation, run: _Run) -> dict[str, float]:
     """Fabric measures of the grains (membrane disks excluded as particles):
-    anisotropy of contact normals and normal forces (Eq. 7-8 and the unbinned
-    estimate), the mean stability index (Sec. 5) and the mechanical coordination number."""
+    anisotropy of contact normals and normal forces (the exact estimate, and
+    Eq. 7-8 on the histogram as ``*_binned``), the mean stability index (Sec. 5)
+    and the mechanical coordination number."""
     summary = fabric_summary(_snapshot(sim, run, 0.0))
     summary.pop("coordination_number")  # the record's own, grain-grain contacts
     return summary

@@ -34,6 +34,7 @@ STUDY_COLUMNS: tuple[str, ...] = (
     "mean_stability_index",
     "mean_stability_index_all",
     "anisotropy",
+    "anisotropy_binned",
     "force_anisotropy",
     "wall_time_s",
     "status",
