@@ -273,3 +273,77 @@ def test_killed_text_writer_leaves_the_old_file(tmp_path):
     leftovers = [p.name for p in tmp_path.iterdir() if p.name != "big.txt"]
     assert all(name.startswith(".big.txt.") and name.endswith(".tmp") for name in leftovers)
     assert os.path.getsize(path) == 4
+
+
+def test_a_buffered_writer_reaches_the_disk_only_whole(tmp_path):
+    out = ResultsWriter(tmp_path / "run.h5", kind="biaxial", buffered=True)
+    on_disk = out.partial_path.read_bytes()  # published at once: a complete, empty run
+    assert read_results(tmp_path, allow_incomplete=True).timeseries == {}
+    out.append_rows({"axial_strain": [0.0, 1e-3], "q": [0.0, 5.0]})
+    out.write_snapshot("strain_0.0010", TWO_DISKS)
+    assert out.partial_path.read_bytes() == on_disk  # nothing reached the disk yet
+    image = out.publish()
+    assert out.partial_path.read_bytes() == image
+    live = read_results(tmp_path, allow_incomplete=True)
+    assert live.timeseries["q"].tolist() == [0.0, 5.0] and live.snapshot_names == ["strain_0.0010"]
+    out.append_timeseries({"axial_strain": 2e-3, "q": 6.0})
+    # the partial file damaged or deleted after the image was taken: restore continues from the image
+    out.close()
+    out.partial_path.write_bytes(image[: len(image) // 3])
+    again = ResultsWriter.restore(tmp_path / "run.h5", image, buffered=True)
+    assert again.n_rows == 2 and again.snapshot_names == ["strain_0.0010"]
+    out.partial_path.unlink()
+    again.append_timeseries({"axial_strain": 2e-3, "q": 7.0})
+    again.finalize()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.h5"]
+    res = read_results(tmp_path)
+    assert res.status == "complete" and res.timeseries["q"].tolist() == [0.0, 5.0, 7.0]
+
+
+def test_an_unbuffered_writer_publishes_and_restores_too(tmp_path):
+    out = ResultsWriter(tmp_path / "run.h5", kind="biaxial")
+    out.append_timeseries({"axial_strain": 0.0, "q": 1.0})
+    image = out.publish()  # closed, read and reopened: writing goes on
+    out.append_timeseries({"axial_strain": 1e-3, "q": 2.0})
+    out.close()
+    restored = ResultsWriter.restore(tmp_path, image)
+    assert restored.n_rows == 1
+    restored.finalize()
+    assert read_results(tmp_path).timeseries["q"].tolist() == [1.0]
+
+
+def test_a_buffered_writer_that_fails_publishes_its_status(tmp_path):
+    with pytest.raises(RuntimeError), ResultsWriter(tmp_path, buffered=True) as out:
+        out.append_timeseries({"axial_strain": 0.0})
+        raise RuntimeError("the engine blew up")
+    res = read_results(tmp_path, allow_incomplete=True)
+    assert res.status == "failed" and res.attrs["error"] == "RuntimeError: the engine blew up"
+    assert res.timeseries["axial_strain"].tolist() == [0.0]
+
+
+def test_a_full_disk_keeps_the_published_file_and_the_old_checkpoint(tmp_path, monkeypatch):
+    import errno
+
+    import grainlab.io.hdf5 as hdf5
+
+    out = ResultsWriter(tmp_path, buffered=True)
+    out.append_timeseries({"axial_strain": 0.0})
+    image = out.publish()
+    hdf5.write_checkpoint(tmp_path / "checkpoint.h5", b"state 1", {"phase": "shear", "rows": 1})
+    out.append_timeseries({"axial_strain": 1e-3})
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(hdf5, "write_bytes_atomic", full)
+    with pytest.raises(OSError, match="No space left"):
+        out.publish()
+    with pytest.raises(OSError, match="No space left"):
+        hdf5.write_checkpoint(tmp_path / "checkpoint.h5", b"state 2", {"phase": "shear", "rows": 2})
+    with pytest.raises(OSError, match="No space left"):
+        out.close()
+    assert out.closed
+    monkeypatch.undo()
+    assert out.partial_path.read_bytes() == image
+    assert hdf5.read_checkpoint(tmp_path).protocol_state == {"phase": "shear", "rows": 1}
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]

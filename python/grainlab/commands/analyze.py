@@ -11,7 +11,10 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-__all__ = ["parse_columns", "parse_types", "register", "run"]
+__all__ = ["MAX_BINS", "parse_columns", "parse_types", "register", "run"]
+
+#: Most angular bins ``--bins`` takes (0.1 degree each): more only slows the rose diagrams.
+MAX_BINS = 3600
 
 
 def parse_columns(text: str | None) -> dict[str, str] | None:
@@ -74,7 +77,7 @@ def register(subparsers: Any) -> None:
         help="frame of the reference dump (default: the first)",
     )
     p.add_argument(
-        "--bins", type=int, default=18, help="angular bins over 360 degrees (default 18)"
+        "--bins", type=int, default=18, help=f"angular bins over 360 degrees, 2 to {MAX_BINS} (default 18)"
     )
     p.add_argument(
         "--tolerance",
@@ -114,11 +117,12 @@ def run(args: argparse.Namespace) -> int:
     """Entry point of ``grainlab analyze``; returns the exit code."""
     from grainlab.analysis import analyze_snapshot
     from grainlab.io import detect_format, list_timesteps, read_snapshot
+    from grainlab.io.results import ensure_output_folder
 
-    if args.bins < 2:
-        raise ValueError(f"--bins: must be >= 2, got {args.bins}")
-    if args.tolerance < 0:
-        raise ValueError(f"--tolerance: must be >= 0 m, got {args.tolerance}")
+    if not 2 <= args.bins <= MAX_BINS:
+        raise ValueError(f"--bins: must be an integer from 2 to {MAX_BINS}, got {args.bins}")
+    if not 0 <= args.tolerance < float("inf"):
+        raise ValueError(f"--tolerance: must be a finite value >= 0 m, got {args.tolerance}")
     columns = parse_columns(args.contact_columns)
     boundary_types = parse_types(args.boundary_types)
     snapshot = read_snapshot(
@@ -142,6 +146,7 @@ def run(args: argparse.Namespace) -> int:
             columns=columns if args.reference_contacts else None,
             boundary_types=boundary_types,
         )
+    ensure_output_folder(args.out)
     result = analyze_snapshot(
         snapshot,
         reference,

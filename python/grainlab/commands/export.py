@@ -45,8 +45,14 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     if not args.vtk:
         raise ValueError("nothing to export: give a format, e.g. --vtk")
+    from pathlib import Path
+
+    from grainlab.io.results import ensure_output_folder
     from grainlab.io.vtk import export_vtk
 
+    run = Path(args.dir)
+    if run.exists():  # else export_vtk says what is missing
+        ensure_output_folder(args.out if args.out is not None else (run if run.is_dir() else run.parent) / "vtk")
     done = export_vtk(args.dir, args.out, binary=not args.ascii)
     print(
         f"grainlab export: {len(done.files)} snapshot(s) -> {done.pvd} "

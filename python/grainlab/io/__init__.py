@@ -57,7 +57,7 @@ def detect_format(path: str | Path) -> str:
         raise FileFormatError(p, None, "is a directory, not a file") from None
     if head.startswith(_HDF5_MAGIC):
         return "grainlab-hdf5"
-    text = head.decode("utf-8", errors="replace")
+    text = head.decode("utf-8", errors="replace").removeprefix("\ufeff")  # a spreadsheet's byte-order mark
     lines = [
         ln.strip() for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")
     ]

@@ -20,11 +20,30 @@ class FileFormatError(ValueError):
         super().__init__(f"{where}: {problem}")
 
 
+#: Largest coordinate or radius magnitude read, m: far beyond any granular sample in SI
+#: units, and small enough that squared distances stay finite in float64.
+MAX_LENGTH_M = 1.0e12
+
+
+def plain(value: float) -> str:
+    """A number as a message shows it: ``1e-300``, ``nan``, ``3`` (never ``np.float64(...)``).
+
+    >>> import numpy as np
+    >>> plain(np.float64("nan")), plain(np.float64(1e-300)), plain(np.int64(3)), plain(0.5)
+    ('nan', '1e-300', '3', '0.5')
+    """
+    number = float(value)
+    return str(int(number)) if number.is_integer() and abs(number) < 2.0**53 else repr(number)
+
+
 def read_lines(path: str | Path) -> list[str]:
-    """All lines of a text file (no line endings); a clear error if unreadable."""
+    """All lines of a text file (no line endings); a clear error if unreadable.
+
+    A UTF-8 byte-order mark at the start (spreadsheet programs write one) is dropped.
+    """
     p = Path(path)
     try:
-        return p.read_text(encoding="utf-8", errors="strict").splitlines()
+        return p.read_text(encoding="utf-8-sig", errors="strict").splitlines()
     except FileNotFoundError:
         raise FileFormatError(p, None, "file not found") from None
     except IsADirectoryError:
@@ -70,7 +89,7 @@ def parse_float_table(
         raise FileFormatError(
             path,
             int(line_numbers[r]),
-            f"column {column_names[c]!r}: value {data[r, c]!r} is not finite",
+            f"column {column_names[c]!r}: value {plain(data[r, c])} is not finite",
         )
     return data
 
@@ -107,7 +126,7 @@ def integral_column(
     if bad.any():
         k = int(np.argmax(bad))
         raise FileFormatError(
-            path, int(line_numbers[k]), f"column {name!r}: {values[k]!r} is not an integer id"
+            path, int(line_numbers[k]), f"column {name!r}: {plain(values[k])} is not an integer id"
         )
     return values.astype(np.int64)
 
@@ -126,4 +145,40 @@ def check_unique_ids(
             int(line_numbers[second]),
             f"duplicate particle id {int(ids[second])} "
             f"(first seen on line {int(line_numbers[first])})",
+        )
+
+
+def check_geometry(
+    path: str | Path,
+    positions: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    line_numbers: NDArray[np.int64],
+    position_columns: tuple[str, str] = ("x", "y"),
+) -> None:
+    """Raise naming the line of a coordinate or radius beyond :data:`MAX_LENGTH_M`
+    or of a particle whose centre another particle has already (the contact
+    normal between them would be undefined)."""
+    for values, name in ((positions[:, 0], position_columns[0]), (positions[:, 1], position_columns[1]),
+                         (radii, "radius")):
+        bad = np.abs(values) > MAX_LENGTH_M
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(
+                path,
+                int(line_numbers[k]),
+                f"column {name!r}: {plain(values[k])} m is beyond the {MAX_LENGTH_M:g} m grainlab reads "
+                "(lengths are in metres)",
+            )
+    if len(radii) < 2:
+        return
+    order = np.lexsort((positions[:, 1], positions[:, 0]))
+    same = np.all(positions[order[1:]] == positions[order[:-1]], axis=1)
+    if same.any():
+        k = int(np.argmax(same))
+        first, second = sorted((int(order[k]), int(order[k + 1])))
+        raise FileFormatError(
+            path,
+            int(line_numbers[second]),
+            f"this particle's centre ({plain(positions[second, 0])}, {plain(positions[second, 1])}) is the "
+            f"centre of the particle on line {int(line_numbers[first])} too: coincident disks have no contact normal",
         )

@@ -32,9 +32,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from grainlab.io._table import (
     FileFormatError,
+    check_geometry,
     check_unique_ids,
     integral_column,
     parse_float_table,
+    plain,
     read_lines,
 )
 from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
@@ -107,7 +109,8 @@ def read_particles_csv(
     bad = radius <= 0
     if bad.any():
         k = int(np.argmax(bad))
-        raise FileFormatError(path, int(numbers[k]), f"column 'radius': {radius[k]!r} is not > 0")
+        raise FileFormatError(path, int(numbers[k]), f"column 'radius': {plain(radius[k])} is not > 0")
+    check_geometry(path, np.c_[col["x"], col["y"]], radius, numbers)
     kind = None
     if "kind" in col:
         kind = integral_column(path, col["kind"], numbers, "kind")

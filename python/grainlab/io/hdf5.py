@@ -58,6 +58,7 @@ from __future__ import annotations
 import contextlib
 import datetime
 import hashlib
+import io
 import json
 import math
 import os
@@ -76,9 +77,9 @@ from grainlab.io._table import FileFormatError
 from grainlab.io.results import (
     CHECKPOINT_FILE,
     RESULTS_FILE,
-    atomic_path,
     fsync_directory,
     fsync_file,
+    write_bytes_atomic,
 )
 from grainlab.snapshot import Snapshot
 
@@ -507,6 +508,14 @@ class ResultsWriter:
     the partial file ``"failed"`` (with the error message) and does not
     rename it (``KeyboardInterrupt`` leaves it ``"running"``, resumable).
 
+    With ``buffered=True`` the file is built in memory and reaches the disk
+    only whole, through :meth:`publish`, :meth:`close` and :meth:`finalize`,
+    each an atomic write of the complete file (:func:`write_bytes_atomic`):
+    the HDF5 library never writes the disk itself, so a kill or a full disk
+    can never leave a damaged ``PATH.partial`` (a full disk is a plain
+    ``OSError`` from that write, and the file on disk stays the last one
+    published). The biaxial test writes this way and publishes at every checkpoint.
+
     Parameters
     ----------
     path
@@ -518,6 +527,8 @@ class ResultsWriter:
         existing one raises :class:`FileExistsError`.
     compression
         HDF5 filter for snapshot arrays (``"gzip"``, ``"lzf"``) or None (default).
+    buffered
+        Build the file in memory and write it to disk only whole (above).
 
     Notes
     -----
@@ -534,6 +545,7 @@ class ResultsWriter:
         kind: str = "run",
         overwrite: bool = False,
         compression: str | None = None,
+        buffered: bool = False,
     ) -> None:
         final = _resolve_results_path(path)
         partial = _partial_of(final)
@@ -547,7 +559,8 @@ class ResultsWriter:
                         "ResultsWriter.resume() to continue a partial run"
                     )
                 p.unlink()
-        f = h5py.File(partial, "w", libver=_LIBVER, track_order=True)
+        buffer = io.BytesIO() if buffered else None
+        f = h5py.File(buffer if buffered else partial, "w", libver=_LIBVER, track_order=True)
         try:
             f.attrs["format"] = FORMAT
             f.attrs["format_version"] = np.int64(FORMAT_VERSION)
@@ -564,13 +577,24 @@ class ResultsWriter:
         except BaseException:
             f.close()
             raise
-        self._init(f, final, compression)
+        self._init(f, final, compression, buffer)
+        if buffered:
+            self._publish_or_close()
 
-    def _init(self, f: h5py.File, final: Path, compression: str | None) -> None:
+    def _init(self, f: h5py.File, final: Path, compression: str | None, buffer: io.BytesIO | None = None) -> None:
         self._file: h5py.File | None = f
         self._final = final
         self._partial = _partial_of(final)
         self._compression = compression
+        self._buffer = buffer
+
+    def _publish_or_close(self) -> None:
+        try:
+            self.publish()
+        except BaseException:
+            self._f.close()
+            self._file = None
+            raise
 
     @classmethod
     def resume(
@@ -580,6 +604,8 @@ class ResultsWriter:
         timeseries_rows: int | None = None,
         snapshots: Iterable[str] | None = None,
         compression: str | None = None,
+        buffered: bool = False,
+        image: bytes | None = None,
     ) -> ResultsWriter:
         """Reopen the partial file of a killed run to continue writing it.
 
@@ -587,16 +613,23 @@ class ResultsWriter:
         count saved with the checkpoint the run resumes from); ``snapshots``,
         when given, keeps only the snapshots with these names (those written
         after the checkpoint are dropped, to be written again). The status
-        goes back to ``"running"``.
+        goes back to ``"running"``. ``buffered``: continue in memory (see the
+        class); ``image``: the file's bytes to continue from instead of
+        ``PATH.partial`` (see :meth:`restore`).
         """
         final = _resolve_results_path(path)
         partial = _partial_of(final)
-        if not partial.exists():
+        if image is None and not partial.exists():
             if final.exists():
                 raise FileExistsError(f"{final}: the run is already finalized; nothing to resume")
             raise FileNotFoundError(f"{partial}: no partial results file to resume")
+        buffer = None
         try:
-            f = h5py.File(partial, "r+")
+            if buffered or image is not None:
+                buffer = io.BytesIO(partial.read_bytes() if image is None else bytes(image))
+                f = h5py.File(buffer, "r+")
+            else:
+                f = h5py.File(partial, "r+")
         except OSError as error:
             raise ResultsFileError(
                 partial,
@@ -612,7 +645,7 @@ class ResultsWriter:
                     "can be continued by this grainlab",
                 )
             writer = cls.__new__(cls)
-            writer._init(f, final, compression)
+            writer._init(f, final, compression, buffer if buffered else None)
         except BaseException:
             f.close()
             raise
@@ -628,6 +661,14 @@ class ResultsWriter:
             if "index" not in group[name].attrs:
                 del group[name]
         writer.set_status("running")
+        if buffered:
+            writer._publish_or_close()
+        elif image is not None:  # continued on disk: the image becomes the partial file
+            f.flush()
+            data = buffer.getvalue()
+            f.close()
+            write_bytes_atomic(partial, data)
+            writer._init(h5py.File(partial, "r+"), final, compression)
         return writer
 
     # ------------------------------------------------------------ properties
@@ -676,7 +717,8 @@ class ResultsWriter:
 
     # ---------------------------------------------------------------- writes
     def flush(self) -> None:
-        """Hand everything written so far to the operating system."""
+        """Hand everything written so far to the operating system (a buffered
+        writer: to its memory; :meth:`publish` writes it to disk)."""
         self._f.flush()
 
     def write_config(self, config: Mapping[str, Any]) -> None:
@@ -859,13 +901,61 @@ class ResultsWriter:
         self.flush()
 
     def close(self) -> None:
-        """Flush and close without finalizing: ``run.h5.partial`` stays, resumable."""
-        if self._file is not None:
-            try:
-                self._file.flush()
-            finally:
-                self._file.close()
-                self._file = None
+        """Flush and close without finalizing: ``run.h5.partial`` stays, resumable
+        (a buffered writer publishes it first).
+
+        The writer counts as closed even when the flush or the publication
+        fails (a full disk): the error is raised once and a second ``close``
+        does nothing.
+        """
+        f = self._file
+        if f is None:
+            return
+        try:
+            if self._buffer is not None:
+                self.publish()
+            else:
+                f.flush()
+        finally:
+            self._file = None
+            f.close()
+
+    def publish(self) -> bytes:
+        """Make ``run.h5.partial`` on disk the complete file as it stands, and
+        return its bytes (for a checkpoint to carry; :meth:`restore` continues
+        from them). A buffered writer writes its memory atomically; an
+        unbuffered one closes the file, reads it and reopens it. Writing goes on.
+        """
+        f = self._f
+        f.flush()
+        if self._buffer is not None:
+            data = self._buffer.getvalue()
+            write_bytes_atomic(self._partial, data)
+            return data
+        self._file = None
+        f.close()
+        try:
+            data = self._partial.read_bytes()
+        finally:
+            self._file = h5py.File(self._partial, "r+")
+        return data
+
+    @classmethod
+    def restore(
+        cls,
+        path: str | os.PathLike[str],
+        image: bytes,
+        *,
+        compression: str | None = None,
+        buffered: bool = False,
+    ) -> ResultsWriter:
+        """Continue the results file from ``image`` (from :meth:`publish`), which
+        becomes ``run.h5.partial`` (written atomically): the file exactly as it
+        was when the image was taken, whatever happened to ``run.h5.partial``
+        since (a kill during a write, a full disk, the file deleted). An
+        existing ``run.h5`` is left alone.
+        """
+        return cls.resume(path, compression=compression, buffered=buffered, image=image)
 
     def finalize(self, status: Literal["complete", "failed"] = "complete") -> Path:
         """Mark the run ``status``, close, fsync and rename ``run.h5.partial`` to ``run.h5``.
@@ -877,6 +967,15 @@ class ResultsWriter:
         f = self._f
         f.attrs["status"] = status
         f.attrs["finished"] = _now()
+        if self._buffer is not None:  # the final file written whole, then the partial one removed
+            f.flush()
+            data = self._buffer.getvalue()
+            self._file = None
+            f.close()
+            write_bytes_atomic(self._final, data)
+            self._partial.unlink(missing_ok=True)
+            fsync_directory(self._final.parent)
+            return self._final
         self.close()
         fsync_file(self._partial)
         os.replace(self._partial, self._final)
@@ -1281,7 +1380,10 @@ def write_checkpoint(
         if a.dtype.kind not in "biuf":
             raise ValueError(f"arrays[{name!r}]: cannot store dtype {a.dtype} (numbers only)")
         prepared[name] = a
-    with atomic_path(p) as tmp, h5py.File(tmp, "w", libver=_LIBVER, track_order=True) as f:
+    # built in memory and written whole: the HDF5 library never writes the disk,
+    # so a full disk is a plain OSError and leaves the previous checkpoint intact
+    buffer = io.BytesIO()
+    with h5py.File(buffer, "w", libver=_LIBVER, track_order=True) as f:
         f.attrs["format"] = CHECKPOINT_FORMAT
         f.attrs["format_version"] = np.int64(CHECKPOINT_FORMAT_VERSION)
         f.attrs["grainlab_version"] = _grainlab_version()
@@ -1293,6 +1395,7 @@ def write_checkpoint(
         g = f.create_group("arrays", track_order=True)
         for name, a in prepared.items():
             g.create_dataset(name, data=a).attrs["sha256"] = _sha256(a)
+    write_bytes_atomic(p, buffer.getvalue())
     return p
 
 

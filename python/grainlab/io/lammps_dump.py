@@ -59,10 +59,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.io._table import (
+    MAX_LENGTH_M,
     FileFormatError,
+    check_geometry,
     check_unique_ids,
     integral_column,
     parse_float_table,
+    plain,
     read_lines,
 )
 from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
@@ -91,8 +94,17 @@ class DumpFrame:
     header_line: int
 
 
+#: A LAMMPS boundary flag of one direction: ``pp`` periodic, else two of f, s, m.
+_BOUNDARY_FLAG = re.compile(r"^(pp|[fsm]{2})$")
+
+
 def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
-    """Walk the frames using the counts in their headers (no scan of data rows)."""
+    """Walk the frames using the counts in their headers (no scan of data rows).
+
+    A last frame cut short by the end of the file is kept with ``truncated``
+    = (line, problem), so that the frames before it stay readable; a
+    timestep given twice is refused.
+    """
     frames = []
     k = 0
     n_lines = len(lines)
@@ -104,7 +116,10 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
             raise FileFormatError(
                 path, k + 1, f"expected 'ITEM: TIMESTEP', found {lines[k][:60]!r}"
             )
-        frame: dict[str, Any] = {"box": None, "boundary": [], "time": None, "count": None}
+        frame: dict[str, Any] = {"box": None, "boundary": [], "time": None, "count": None, "line": k + 1}
+        if k + 1 >= n_lines:
+            frames.append({**frame, "truncated": (n_lines, "file ends after 'ITEM: TIMESTEP'")})
+            break
         try:
             frame["timestep"] = int(lines[k + 1].split()[0])
         except (IndexError, ValueError):
@@ -112,12 +127,15 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
         k += 2
         while True:
             if k >= n_lines:
-                raise FileFormatError(
-                    path, k, "file ends inside a frame header (no ITEM: ATOMS / ENTRIES)"
-                )
+                frame["truncated"] = (k, "file ends inside a frame header (no ITEM: ATOMS / ENTRIES)")
+                break
             item = lines[k]
             if not item.startswith("ITEM:"):
                 raise FileFormatError(path, k + 1, f"expected an 'ITEM:' line, found {item[:60]!r}")
+            if item.startswith("ITEM: NUMBER OF") or item.startswith("ITEM: TIME"):
+                if k + 1 >= n_lines:
+                    frame["truncated"] = (n_lines, "file ends inside a frame header")
+                    break
             if item.startswith("ITEM: NUMBER OF"):
                 try:
                     frame["count"] = int(lines[k + 1].split()[0])
@@ -130,6 +148,17 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
                 flags = item.split()[3:]
                 if "xy" in flags:
                     raise FileFormatError(path, k + 1, "triclinic boxes are not supported")
+                if len(flags) != 3 or not all(_BOUNDARY_FLAG.match(f) for f in flags):
+                    raise FileFormatError(
+                        path,
+                        k + 1,
+                        "expected three boundary flags after 'ITEM: BOX BOUNDS' (x y z, each pp for "
+                        f"periodic or two of f, s, m, e.g. 'pp ff pp'), found {' '.join(flags) or 'none'!r}: "
+                        "cannot tell which directions are periodic",
+                    )
+                if k + 3 >= n_lines:
+                    frame["truncated"] = (n_lines, "file ends inside the box bounds")
+                    break
                 try:
                     frame["box"] = np.array(
                         [[float(v) for v in lines[k + 1 + a].split()[:2]] for a in range(3)]
@@ -138,6 +167,15 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
                     raise FileFormatError(
                         path, k + 2, "expected three lines of box bounds 'lo hi'"
                     ) from None
+                for axis, name in ((0, "x"), (1, "y")):
+                    lo, hi = frame["box"][axis]
+                    if not -MAX_LENGTH_M <= lo < hi <= MAX_LENGTH_M:
+                        raise FileFormatError(
+                            path,
+                            k + 2 + axis,
+                            f"box bounds: {name}lo {plain(lo)} and {name}hi {plain(hi)} are not a finite "
+                            f"range with {name}lo < {name}hi",
+                        )
                 frame["boundary"] = flags
                 k += 4
             elif item.startswith("ITEM: TIME"):
@@ -161,8 +199,7 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
                 frame["first"] = k + 1
                 k += 1 + frame["count"]
                 if k > n_lines:
-                    raise FileFormatError(
-                        path,
+                    frame["truncated"] = (
                         n_lines,
                         f"file ends inside a frame: expected {frame['count']} rows "
                         f"after line {frame['header_line']}",
@@ -171,31 +208,49 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
             else:
                 raise FileFormatError(path, k + 1, f"unknown dump item {item[:60]!r}")
         frames.append(frame)
+        if "truncated" in frame:
+            break
     if not frames:
         raise FileFormatError(path, None, "empty file: no 'ITEM: TIMESTEP' frame")
+    if "truncated" in frames[0]:
+        raise FileFormatError(path, *frames[0]["truncated"])
+    first_line: dict[int, int] = {}
+    for frame in frames[:-1] if "truncated" in frames[-1] else frames:
+        if frame["timestep"] in first_line:
+            raise FileFormatError(
+                path,
+                frame["line"],
+                f"timestep {frame['timestep']} again (its first frame starts on line "
+                f"{first_line[frame['timestep']]}): which frame is meant is ambiguous",
+            )
+        first_line[frame["timestep"]] = frame["line"]
     return frames
 
 
 def list_timesteps(path: str | Path) -> list[int]:
-    """The timesteps of the frames in a dump file, in file order."""
-    return [f["timestep"] for f in _frame_index(path, read_lines(path))]
+    """The timesteps of the frames in a dump file, in file order (a last frame cut
+    short by the end of the file is left out)."""
+    return [f["timestep"] for f in _frame_index(path, read_lines(path)) if "truncated" not in f]
 
 
 def read_dump_frames(path: str | Path, timestep: int | None = None) -> DumpFrame:
     """Parse one frame of a dump (the last one when ``timestep`` is None)."""
     lines = read_lines(path)
     frames = _frame_index(path, lines)
+    steps = [fr["timestep"] for fr in frames if "truncated" not in fr]
+    shown = ", ".join(map(str, steps[:20])) + (" ..." if len(steps) > 20 else "")
     if timestep is None:
         f = frames[-1]
     else:
-        match = [fr for fr in frames if fr["timestep"] == int(timestep)]
+        match = [fr for fr in frames if fr.get("timestep") == int(timestep)]
         if not match:
-            steps = [fr["timestep"] for fr in frames]
-            shown = ", ".join(map(str, steps[:20])) + (" ..." if len(steps) > 20 else "")
             raise FileFormatError(
                 path, None, f"no frame with timestep {timestep} (timesteps: {shown})"
             )
         f = match[-1]
+    if "truncated" in f:  # the last frame: the ones before it are intact
+        line, problem = f["truncated"]
+        raise FileFormatError(path, line, f"{problem}; the intact frames are at timesteps {shown}")
     first, count = f["first"], f["count"]
     rows = lines[first : first + count]
     numbers = np.arange(first + 1, first + count + 1, dtype=np.int64)
@@ -303,8 +358,9 @@ def read_lammps_dump(
     if bad.any():
         k = int(np.argmax(bad))
         raise FileFormatError(
-            path, int(numbers[k]), f"column {rname!r}: {col[rname][k]!r} is not > 0"
+            path, int(numbers[k]), f"column {rname!r}: {plain(col[rname][k])} is not > 0"
         )
+    check_geometry(path, np.c_[x, y], radius, numbers, (xn, yn))
     fields: dict[str, NDArray[Any]] = {}
     for pair, name in ((("vx", "vy"), "velocity"), (("fx", "fy"), "force")):
         if pair[0] in col and pair[1] in col:

@@ -27,11 +27,12 @@ Example
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import math
 import os
-import tempfile
-from collections.abc import Callable, Iterator
+import secrets
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -39,8 +40,11 @@ __all__ = [
     "CHECKPOINT_FILE",
     "RESULTS_FILE",
     "atomic_path",
+    "ensure_output_folder",
     "fsync_directory",
     "fsync_file",
+    "is_disk_full",
+    "refuse_overwrite",
     "write_bytes_atomic",
     "write_json_atomic",
     "write_text_atomic",
@@ -96,9 +100,7 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """
     final = Path(path)
     folder = final.parent
-    fd, name = tempfile.mkstemp(prefix=f".{final.name}.", suffix=".tmp", dir=folder)
-    os.close(fd)
-    tmp = Path(name)
+    tmp = _create_temporary(folder, final.name)
     try:
         yield tmp
         fsync_file(tmp)
@@ -108,6 +110,21 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
             tmp.unlink()
         raise
     fsync_directory(folder)
+
+
+def _create_temporary(folder: Path, name: str) -> Path:
+    """An empty new file ``.NAME.XXXXXXXX.tmp`` in ``folder``, created exclusively
+    with mode ``0666`` so that the umask applies as to any ordinary file
+    (``tempfile.mkstemp`` would create it ``0600`` whatever the umask)."""
+    for _ in range(100):
+        tmp = folder / f".{name}.{secrets.token_hex(4)}.tmp"
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        except FileExistsError:
+            continue
+        os.close(fd)
+        return tmp
+    raise FileExistsError(f"{folder}: no free temporary name for {name}")  # pragma: no cover
 
 
 def _write_atomic(path: str | os.PathLike[str], write: Callable[[Path], Any]) -> Path:
@@ -154,3 +171,96 @@ def write_json_atomic(path: str | os.PathLike[str], value: Any, *, indent: int |
     """
     text = json.dumps(_json_safe(value), indent=indent, ensure_ascii=False, allow_nan=False)
     return write_text_atomic(path, text + "\n")
+
+
+# ---- output folders ------------------------------------------------------------
+
+
+def ensure_output_folder(path: str | os.PathLike[str], *, option: str = "--out", create: bool = True) -> Path:
+    """The folder ``path``, made if needed (``create``), checked to be a folder
+    this process can write into; returns it.
+
+    Raises ``ValueError`` naming ``option`` and the path, before any work,
+    when ``path`` is a file, lies under a file, cannot be created or written
+    (permissions, a read-only or pseudo file system such as ``/proc``), or,
+    with ``create=False``, does not exist.
+
+    >>> import tempfile, pathlib
+    >>> base = pathlib.Path(tempfile.mkdtemp())
+    >>> ensure_output_folder(base / "runs" / "a").is_dir()
+    True
+    >>> (base / "notes.txt").write_text("x")
+    1
+    >>> ensure_output_folder(base / "notes.txt")
+    Traceback (most recent call last):
+    ...
+    ValueError: --out: .../notes.txt is a file, not a folder
+    """
+    folder = Path(path)
+    for parent in (folder, *folder.parents):
+        if parent.exists() or parent.is_symlink():
+            if not parent.is_dir():
+                where = f"{folder}" if parent == folder else f"{folder}: {parent}"
+                raise ValueError(f"{option}: {where} is a file, not a folder")
+            break
+    if not folder.is_dir():
+        if not create:
+            raise ValueError(f"{option}: {folder} does not exist")
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            raise ValueError(f"{option}: cannot create the folder {folder} ({_reason(error)})") from None
+    try:
+        probe = _create_temporary(folder, "write-test")
+    except OSError as error:
+        raise ValueError(f"{option}: cannot write in {folder} ({_reason(error)})") from None
+    with contextlib.suppress(OSError):
+        probe.unlink()
+    return folder
+
+
+def refuse_overwrite(folder: str | os.PathLike[str], names: Iterable[str], *, why: str) -> None:
+    """Raise ``ValueError`` naming the first of ``names`` (file names or glob
+    patterns) that exists in ``folder``; ``why`` says whose folder it is, e.g.
+    ``"grainlab demo writes its own"``.
+
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> refuse_overwrite(folder, ["summary.json"], why="grainlab demo writes its own")
+    >>> _ = (folder / "summary.json").write_text("{}")
+    >>> refuse_overwrite(folder, ["summary.json"], why="grainlab demo writes its own")
+    Traceback (most recent call last):
+    ...
+    ValueError: --out: .../summary.json exists and was not written by this run (grainlab demo writes its own); ...
+    """
+    root = Path(folder)
+    for name in names:
+        found = sorted(root.glob(name)) if any(c in name for c in "*?[") else [root / name]
+        for path in found:
+            if path.exists():
+                raise ValueError(
+                    f"--out: {path} exists and was not written by this run ({why}); grainlab does not "
+                    "overwrite it: choose another folder or move the file away"
+                )
+
+
+def is_disk_full(error: BaseException) -> bool:
+    """True when ``error`` (or an error it was raised from) is a full disk or
+    an exhausted quota: ``ENOSPC``/``EDQUOT``, also as reported inside an
+    HDF5 library message (``errno = 28``)."""
+    codes = {errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC)}
+    seen: set[int] = set()
+    current: BaseException | None = error
+    while current is not None and id(current) not in seen:
+        seen.add(id(current))
+        if isinstance(current, OSError) and current.errno in codes:
+            return True
+        text = str(current)
+        if "No space left on device" in text or "Disk quota exceeded" in text:
+            return True
+        current = current.__cause__ or current.__context__
+    return False
+
+
+def _reason(error: OSError) -> str:
+    return error.strerror or str(error)
