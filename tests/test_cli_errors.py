@@ -46,3 +46,51 @@ def test_a_bug_still_shows_its_traceback(monkeypatch):
     monkeypatch.setattr(cli, "build_parser", _parser_raising(ZeroDivisionError("a bug")))
     with pytest.raises(ZeroDivisionError):
         cli.main(["boom"])
+
+
+def _one_line(capsys, *needles: str) -> None:
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in err, err
+
+
+def test_a_folder_given_as_the_configuration_file_is_one_line(tmp_path, capsys):
+    assert cli.main(["biaxial", "--config", str(tmp_path), "--out", str(tmp_path / "run")]) == 2
+    _one_line(capsys, f"{tmp_path}: is a folder, not a configuration file")
+    assert not (tmp_path / "run").exists()
+
+
+def test_every_value_of_a_configuration_file_is_checked_even_one_an_override_replaces(tmp_path, capsys):
+    (tmp_path / "run.toml").write_text("[run]\nthreads = 0\n")
+    args = ["biaxial", "--config", str(tmp_path / "run.toml"), "--set", "run.threads=2", "--out", str(tmp_path / "r")]
+    assert cli.main(args) == 2
+    _one_line(capsys, f"{tmp_path / 'run.toml'}: run.threads: 0 is out of range")
+
+
+def test_resume_of_a_folder_without_a_run_is_one_line(tmp_path, capsys):
+    assert cli.main(["biaxial", "--quick", "--out", str(tmp_path), "--resume"]) == 2
+    _one_line(capsys, "--resume:", "holds no run", "nothing to resume")
+    assert cli.main(["biaxial", "--quick", "--out", str(tmp_path / "missing"), "--resume"]) == 2
+    _one_line(capsys, "does not exist: nothing to resume")
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")
+@pytest.mark.filterwarnings("ignore::ResourceWarning")
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_an_unreachable_scheduler_is_one_line_after_a_short_wait(tmp_path, capsys, monkeypatch):
+    import time
+
+    pytest.importorskip("dask.distributed")
+    from grainlab.study import campaign
+
+    monkeypatch.setattr(campaign, "SCHEDULER_TIMEOUT_S", 1.0)
+    plan = tmp_path / "plan.toml"
+    plan.write_text('base = "packing"\nmode = "zip"\n[fixed]\nwidth = 0.02\nheight = 0.04\n'
+                    '[vary]\nporosity = [0.12]\n')
+    started = time.monotonic()
+    # port 9 (discard) on this machine: nothing listens there
+    code = cli.main(["sweep", str(plan), "--out", str(tmp_path / "sweep"), "--scheduler", "tcp://127.0.0.1:9",
+                     "--no-progress"])
+    assert code == 2 and time.monotonic() - started < 20
+    _one_line(capsys, "--scheduler: cannot reach a Dask scheduler at tcp://127.0.0.1:9 within 1 s")

@@ -9,7 +9,7 @@ sample in well under a minute.
 from __future__ import annotations
 
 import csv
-import json
+import io
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -17,6 +17,12 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from grainlab.io.results import (
+    ensure_output_folder,
+    refuse_overwrite,
+    write_json_atomic,
+    write_text_atomic,
+)
 from grainlab.simulation import (
     TABLE1_DENSITY_KG_PER_M3,
     TABLE1_FRICTION,
@@ -26,6 +32,9 @@ from grainlab.simulation import (
     ContactModel,
     Simulation,
 )
+
+#: What the demo writes into its folder; a folder already holding one is refused.
+DEMO_FILES = ("timeseries.csv", "summary.json", "state.bin")
 
 
 @dataclass(frozen=True)
@@ -76,11 +85,15 @@ def compress(
     cells) in a box of four servo walls to ``pressure_pa`` until both wall
     stresses are within ``tolerance`` of the target and the mean unbalanced
     force ratio is below ``unbalanced_force_limit``. Writes ``timeseries.csv``,
-    ``summary.json`` and ``state.bin`` to ``out_dir`` if given."""
+    ``summary.json`` and ``state.bin`` to ``out_dir`` if given; a folder that
+    already holds one of them (another run's) is refused before any work."""
     if not pressure_pa > 0:
         raise ValueError(f"pressure_pa: must be > 0, got {pressure_pa}")
     if n_side < 3:
         raise ValueError(f"n_side: must be >= 3, got {n_side}")
+    if out_dir is not None:
+        ensure_output_folder(out_dir)
+        refuse_overwrite(out_dir, DEMO_FILES, why="grainlab demo writes its own")
     spacing = 3.2e-3
     positions, radii = random_disks(n_side, spacing, 0.5e-3, 3.0e-3, seed)
     box = n_side * spacing
@@ -151,11 +164,11 @@ def compress(
     )
     if out_dir is not None:
         out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
-        with open(out / "timeseries.csv", "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
-            writer.writeheader()
-            writer.writerows(rows)
-        (out / "summary.json").write_text(json.dumps(asdict(result), indent=2) + "\n")
+        table = io.StringIO()
+        writer = csv.DictWriter(table, fieldnames=list(rows[0]), lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(rows)
+        write_text_atomic(out / "timeseries.csv", table.getvalue())
+        write_json_atomic(out / "summary.json", asdict(result))
         sim.save(out / "state.bin")
     return result

@@ -179,7 +179,7 @@ def test_a_run_stopped_before_its_first_checkpoint_starts_over(tmp_path, monkeyp
     monkeypatch.setattr(biaxial, "_generate", generate)
     with pytest.raises(RuntimeError, match="generation reached"):
         biaxial.run_biaxial(resolve(quick=True), tmp_path, progress=False)
-    with pytest.raises(ValueError, match="starts over without --resume"):
+    with pytest.raises(ValueError, match="nothing to resume"):
         biaxial.run_biaxial(resolve(quick=True), tmp_path / "other", resume=True, progress=False)
 
 

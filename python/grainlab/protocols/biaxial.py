@@ -30,8 +30,10 @@ membrane polygon, both from the start of shearing.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
+import json
 import math
 import os
 import time
@@ -45,10 +47,25 @@ import numpy as np
 from tqdm import tqdm
 
 import grainlab
+from grainlab._mapping import flatten_keys
 from grainlab.analysis import fabric_summary
 from grainlab.analysis.stress import love_weber_stress
-from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, snapshot_name, write_checkpoint
-from grainlab.io.results import write_json_atomic, write_text_atomic
+from grainlab.io.hdf5 import (
+    PARTIAL_SUFFIX,
+    ResultsWriter,
+    read_checkpoint,
+    snapshot_name,
+    write_checkpoint,
+)
+from grainlab.io.results import (
+    CHECKPOINT_FILE,
+    RESULTS_FILE,
+    ensure_output_folder,
+    is_disk_full,
+    refuse_overwrite,
+    write_json_atomic,
+    write_text_atomic,
+)
 from grainlab.protocols.boundary import (
     GrainBoundary,
     Membrane,
@@ -143,6 +160,86 @@ def check_density_scaling(config: BiaxialConfig) -> float | None:
             stacklevel=3,
         )
     return factor
+
+
+#: A record interval must span at least this many time steps, so that every
+#: record and snapshot lies within 1/20 of a record interval of its strain.
+MIN_STEPS_PER_RECORD = 10
+#: The farthest a platen may travel in one time step, as a fraction of the
+#: smallest particle's radius (typical contact overlaps are below 1 % of it).
+MAX_PLATEN_TRAVEL_PER_STEP = 0.01
+
+
+def strain_rate_problem(
+    rate: float, time_step_s: float, height_m: float, min_radius_m: float, record_interval: float
+) -> str | None:
+    """Why shearing at ``rate`` (1/s) with time step ``time_step_s`` cannot give
+    meaningful records, or None when it can: a record interval spanning fewer
+    than :data:`MIN_STEPS_PER_RECORD` steps, or a platen (each moves at
+    ``rate * height / 2``) travelling more than :data:`MAX_PLATEN_TRAVEL_PER_STEP`
+    of the smallest radius in one step. The message ends with the fastest rate
+    that this time step allows.
+
+    >>> strain_rate_problem(0.02 / 60, 1e-4, 0.15, 0.25e-3, 0.0005) is None
+    True
+    >>> print(strain_rate_problem(10.0, 1e-4, 0.15, 0.25e-3, 0.0005))
+    one time step (0.0001 s) shears the sample by 0.001, so a record interval (0.0005) spans 0.5 steps, fewer than 10; this time step allows at most 0.333 1/s
+    """
+    strain_per_step = rate * time_step_s
+    steps_per_record = record_interval / strain_per_step
+    travel = 0.5 * rate * height_m * time_step_s
+    fastest = min(
+        record_interval / (MIN_STEPS_PER_RECORD * time_step_s),
+        MAX_PLATEN_TRAVEL_PER_STEP * min_radius_m / (0.5 * height_m * time_step_s),
+    )
+    if steps_per_record < MIN_STEPS_PER_RECORD:
+        why = (
+            f"one time step ({time_step_s:.3g} s) shears the sample by {strain_per_step:.3g}, so a record "
+            f"interval ({record_interval:g}) spans {steps_per_record:.3g} steps, fewer than {MIN_STEPS_PER_RECORD}"
+        )
+    elif travel > MAX_PLATEN_TRAVEL_PER_STEP * min_radius_m:
+        why = (
+            f"each platen moves {travel:.3g} m in one time step ({time_step_s:.3g} s), "
+            f"{travel / min_radius_m:.1%} of the smallest radius ({MAX_PLATEN_TRAVEL_PER_STEP:.0%} allowed)"
+        )
+    else:
+        return None
+    return f"{why}; this time step allows at most {fastest:.3g} 1/s"
+
+
+def check_strain_rate(config: BiaxialConfig) -> None:
+    """Refuse, before any work, an explicit ``shear.strain_rate`` too fast for
+    any time step the run can have (:func:`strain_rate_problem`), and snapshot
+    strains that share a name. The time step is known only after the
+    consolidation (:meth:`Simulation.critical_time_step`, from the contacts);
+    this check takes a tenth of the one-contact critical step of the smallest
+    particle (grain or membrane disk), below any the run reaches, and the run
+    checks its own time step again before shearing."""
+    names: dict[str, float] = {}
+    for strain in config["shear.snapshot_strains"]:
+        name = snapshot_name(strain)
+        if name in names:
+            raise ValueError(
+                f"shear.snapshot_strains: {names[name]:g} and {strain:g} share the snapshot name {name!r}; "
+                "keep snapshot strains at least 0.0001 apart"
+            )
+        names[name] = strain
+    rate = config["shear.strain_rate"]
+    if rate == "auto":
+        return  # bounded by the inertial number, far below these limits
+    diameter = config["sample.d_min"]
+    if config["boundary.kind"] == "membrane":
+        diameter = min(diameter, config["boundary.membrane_diameter"])
+    radius = 0.5 * diameter
+    mass = config["material.density"] * math.pi * radius**2
+    stiffness = max(config["material.normal_stiffness"], 2.0 * config["material.shear_stiffness"])
+    time_step = 0.1 * config["run.time_step_safety"] * math.sqrt(mass / stiffness)
+    problem = strain_rate_problem(rate, time_step, config["sample.height"], radius, config["shear.record_interval"])
+    if problem is not None:
+        raise ValueError(
+            f"shear.strain_rate: {rate:g} 1/s is too fast even for a time step shorter than any this sample "
+            f"reaches: {problem} (the run checks its own, longer time step again before shearing)"
+        )
 
 
 class BiaxialError(RuntimeError):
@@ -744,6 +841,15 @@ def _figures(timeseries: dict[str, np.ndarray], out: Path) -> list[Path]:
 
 # ---- the driver ---------------------------------------------------------------
 
+#: Files that only a biaxial run writes: a new run refuses a folder holding any of
+#: them (``--resume`` continues that run, or finishes its outputs).
+RUN_FILES = (RESULTS_FILE, RESULTS_FILE + PARTIAL_SUFFIX, CHECKPOINT_FILE)
+#: The run's other outputs (``report.html`` is ``grainlab biaxial``'s): a new run
+#: refuses a folder that already holds one, which another run or the user wrote.
+OUTPUT_FILES = ("timeseries.csv", "summary.json", "report.html", "fig[0-9][0-9]_*.png", "fig[0-9][0-9]_*.svg")
+#: Name of the checkpoint array that holds the partial results file (:meth:`ResultsWriter.publish`).
+_RESULTS_IMAGE = "results_partial"
+
 
 def _saved_config(saved: Any) -> dict[str, Any] | None:
     """A checkpoint's configuration resolved as this grainlab would (keys added
@@ -754,6 +860,135 @@ def _saved_config(saved: Any) -> dict[str, Any] | None:
         return None
 
 
+def _config_difference(saved: Any, config: BiaxialConfig) -> str | None:
+    """The keys on which a run's saved configuration and ``config`` differ, with
+    both values; None when they agree."""
+    resolved = _saved_config(saved)
+    if resolved is None:
+        return "the run's saved configuration cannot be read by this grainlab"
+    current = config.to_dict()
+    if resolved == current:
+        return None
+    old, new = flatten_keys(resolved), flatten_keys(current)
+    keys = [k for k in dict.fromkeys([*old, *new]) if old.get(k) != new.get(k)]
+    return "; ".join(f"{k} = {old.get(k)!r} in the run, {new.get(k)!r} now" for k in keys)
+
+
+def _refuse_differing(out: Path, saved: Any, config: BiaxialConfig) -> None:
+    difference = _config_difference(saved, config)
+    if difference is not None:
+        raise ValueError(
+            f"--resume: the configuration differs from the one {out} was started with: {difference} "
+            "(resume with the run's own configuration, or start a new run in another folder)"
+        )
+
+
+def _write_outputs(out: Path) -> dict[str, Any]:
+    """``timeseries.csv``, the figures and ``summary.json``, all from the finished
+    ``run.h5``: a run stopped while they were written finishes them with ``--resume``."""
+    from grainlab.analysis.biaxial_figures import fabric_figures
+    from grainlab.io.hdf5 import read_results
+
+    results = read_results(out / RESULTS_FILE)
+    summary = dict(results.summary)
+    write_text_atomic(out / "timeseries.csv", _csv(results.timeseries))
+    _figures(results.timeseries, out)
+    # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
+    summary["fabric"] = fabric_figures(out).numbers.summary()
+    write_json_atomic(out / "summary.json", summary)
+    return summary
+
+
+def _disk_full(out: Path, error: BaseException) -> BiaxialError:
+    checkpoint = out / CHECKPOINT_FILE
+    kept = (
+        f"the last checkpoint, {checkpoint}, is intact: free some space and continue with --resume"
+        if checkpoint.exists()
+        else "no checkpoint was written yet: free some space and run again (with --resume it starts over)"
+    )
+    return BiaxialError(f"{out}: the disk is full (no space left on device while writing the results); {kept}")
+
+
+def _stop_writer(writer: ResultsWriter | None, error: BaseException) -> None:
+    """Leave the partial results file closed, marked ``failed`` with the error
+    unless the run was interrupted (then it stays ``running``). Neither may hide
+    ``error``: on a full disk they may fail too, and the checkpoint keeps the file."""
+    if writer is None or writer.closed:
+        return
+    if isinstance(error, Exception):
+        text = "no space left on device" if is_disk_full(error) else f"{type(error).__name__}: {error}"
+        with contextlib.suppress(Exception):
+            writer.set_status("failed", error=text)
+    with contextlib.suppress(Exception):
+        writer.close()
+
+
+def _finished_run(out: Path, config: BiaxialConfig) -> BiaxialResult | None:
+    """``--resume`` without a checkpoint: the result of the run that finished in
+    ``out`` (its outputs finished first if a stop left them unfinished), or None
+    for a run stopped before its first checkpoint, which starts over."""
+    from grainlab.io.hdf5 import read_results
+
+    if (out / RESULTS_FILE).exists():
+        results = read_results(out / RESULTS_FILE)
+        _refuse_differing(out, results.config, config)
+        summary_path = out / "summary.json"
+        if summary_path.exists():
+            return BiaxialResult(out, json.loads(summary_path.read_text(encoding="utf-8")))
+        try:
+            return BiaxialResult(out, _write_outputs(out))
+        except OSError as error:
+            if is_disk_full(error):
+                raise _disk_full(out, error) from error
+            raise
+    if (out / (RESULTS_FILE + PARTIAL_SUFFIX)).exists():
+        return None
+    raise ValueError(
+        f"--resume: {out} holds no run: no {CHECKPOINT_FILE}, {RESULTS_FILE} or {RESULTS_FILE + PARTIAL_SUFFIX}; "
+        "nothing to resume"
+    )
+
+
+def _reopen_results(out: Path, run: _Run, checkpoint: Any) -> ResultsWriter | None:
+    """The results writer of a resumed run, as it was at the checkpoint; None
+    when the run's ``run.h5`` is already final (only the outputs remain)."""
+    final, partial = out / RESULTS_FILE, out / (RESULTS_FILE + PARTIAL_SUFFIX)
+    if final.exists():
+        if run.phase == "done":
+            partial.unlink(missing_ok=True)  # a stop right after run.h5 was written
+            return None
+        raise ValueError(
+            f"--resume: {final} exists, but {out / CHECKPOINT_FILE} is of a run still in its {run.phase!r} "
+            "phase; the folder holds two different runs: move one away"
+        )
+    image = checkpoint.arrays.get(_RESULTS_IMAGE)
+    if image is not None:  # the partial file as it was at the checkpoint, whatever became of it since
+        return ResultsWriter.restore(out, np.asarray(image, dtype=np.uint8).tobytes(), buffered=True)
+    if not partial.exists():
+        raise ValueError(
+            f"--resume: {partial} is missing and {out / CHECKPOINT_FILE} (written by an earlier grainlab) "
+            "cannot rebuild it; start the run again in a new folder"
+        )
+    return ResultsWriter.resume(out, timeseries_rows=run.rows, snapshots=run.snapshots or [], buffered=True)
+
+
+def _check_shear_plan(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
+    """The shearing phase's records and snapshots fall on distinct time steps,
+    checked with the run's own time step before the first record."""
+    shear = run.shear
+    problem = strain_rate_problem(
+        shear["strain_rate"], sim.time_step, shear["height0"], float(sim.radii.min()), config["shear.record_interval"]
+    )
+    if problem is not None:
+        raise BiaxialError(f"shear.strain_rate: {problem}")
+    wanted = [s for s in config["shear.snapshot_strains"] if s <= config["shear.final_strain"] + 1e-12]
+    if len(shear["snapshot_steps"]) < len(wanted):
+        raise BiaxialError(
+            f"shear.snapshot_strains: two of {wanted} fall on the same time step "
+            f"({sim.time_step:.3g} s at {shear['strain_rate']:.3g} 1/s); keep them further apart"
+        )
+
+
 def run_biaxial(
     config: BiaxialConfig,
     out_dir: str | os.PathLike[str],
@@ -761,72 +996,89 @@ def run_biaxial(
     resume: bool = False,
     progress: bool = True,
 ) -> BiaxialResult:
-    """Runs (or, with ``resume``, continues) the biaxial test into ``out_dir``."""
+    """Runs (or, with ``resume``, continues) the biaxial test into ``out_dir``.
+
+    ``resume`` continues a run from wherever it stopped: from its last
+    checkpoint (the partial results file is restored from it, so a kill or a
+    full disk while it was written does not matter), or, for a run whose
+    ``run.h5`` is final, by writing the outputs a stop left unwritten; a run
+    that finished returns its result, and one stopped before its first
+    checkpoint starts over. A new run refuses a folder that holds another
+    run's files (:data:`RUN_FILES`, :data:`OUTPUT_FILES`). A full disk stops
+    the run with a :class:`BiaxialError` that keeps the last checkpoint.
+    """
     out = Path(out_dir)
-    checkpoint_path = out / "checkpoint.h5"
+    checkpoint_path = out / CHECKPOINT_FILE
     started = time.perf_counter()
+    check_strain_rate(config)  # a rate refused needs no warning about its inertia
     check_density_scaling(config)
     threads = _threads(config)
-    if resume:
-        if not checkpoint_path.exists():
-            raise ValueError(
-                f"--resume: {checkpoint_path} not found; nothing to resume (a run stopped before its "
-                "first checkpoint starts over without --resume)"
-            )
-        checkpoint = read_checkpoint(checkpoint_path)
-        saved = dict(checkpoint.protocol_state)
-        if _saved_config(saved.get("config")) != config.to_dict():
-            raise ValueError(f"--resume: the configuration differs from the one {out} was started with")
-        sim = Simulation.from_bytes(checkpoint.engine_state)
-        run = _Run(**{k: v for k, v in saved.items() if k != "config" and k != "elapsed_s"})
-        writer = ResultsWriter.resume(out, timeseries_rows=run.rows, snapshots=run.snapshots or [])
-        elapsed_before = float(saved.get("elapsed_s", 0.0))
-    else:
-        partial = out / "run.h5.partial"
-        if partial.exists() and not checkpoint_path.exists() and not (out / "run.h5").exists():
-            partial.unlink()  # a run stopped before its first checkpoint: nothing to keep or resume
-        if (out / "run.h5").exists() or checkpoint_path.exists() or partial.exists():
-            raise ValueError(f"--out: {out} already holds a run; use --resume to continue it or choose another folder")
-        out.mkdir(parents=True, exist_ok=True)
-        writer = ResultsWriter(out, kind="biaxial")
-        writer.write_config(config.to_dict())
-        sim, run = _generate(config, threads, progress)
-        elapsed_before = 0.0
+    if resume and not out.exists():
+        raise ValueError(f"--resume: {out} does not exist: nothing to resume")
+    ensure_output_folder(out, create=not resume)
+    if resume and not checkpoint_path.exists():
+        finished = _finished_run(out, config)
+        if finished is not None:
+            return finished
+        resume = False  # stopped before its first checkpoint: starts over
+    writer: ResultsWriter | None = None
+    try:
+        if resume:
+            checkpoint = read_checkpoint(checkpoint_path)
+            saved = dict(checkpoint.protocol_state)
+            _refuse_differing(out, saved.get("config"), config)
+            sim = Simulation.from_bytes(checkpoint.engine_state)
+            run = _Run(**{k: v for k, v in saved.items() if k != "config" and k != "elapsed_s"})
+            elapsed_before = float(saved.get("elapsed_s", 0.0))
+            writer = _reopen_results(out, run, checkpoint)
+        else:
+            partial = out / (RESULTS_FILE + PARTIAL_SUFFIX)
+            if partial.exists() and not checkpoint_path.exists() and not (out / RESULTS_FILE).exists():
+                partial.unlink()  # a run stopped before its first checkpoint: nothing to keep or resume
+            if any((out / name).exists() for name in RUN_FILES):
+                raise ValueError(
+                    f"--out: {out} already holds a run; use --resume to continue it or choose another folder"
+                )
+            refuse_overwrite(out, OUTPUT_FILES, why="a biaxial run writes its own")
+            writer = ResultsWriter(out, kind="biaxial", buffered=True)  # HDF5 never writes the disk itself
+            writer.write_config(config.to_dict())
+            sim, run = _generate(config, threads, progress)
+            elapsed_before = 0.0
 
-    def save() -> None:
-        state = run.to_dict()
-        state["config"] = config.to_dict()
-        state["elapsed_s"] = elapsed_before + time.perf_counter() - started
-        writer.flush()
-        state["rows"] = writer.n_rows
-        state["snapshots"] = list(writer.snapshot_names)
-        write_checkpoint(checkpoint_path, sim.to_bytes(), state)
+        def save() -> None:
+            state = run.to_dict()
+            state["config"] = config.to_dict()
+            state["elapsed_s"] = elapsed_before + time.perf_counter() - started
+            state["rows"] = writer.n_rows
+            state["snapshots"] = list(writer.snapshot_names)
+            image = np.frombuffer(writer.publish(), dtype=np.uint8)
+            write_checkpoint(checkpoint_path, sim.to_bytes(), state, arrays={_RESULTS_IMAGE: image})
 
-    if not resume:
-        save()
-    if run.phase == "consolidate":
-        _consolidate(sim, run, config, progress)
-        save()
-    if run.phase == "boundary":
-        _install_boundary(sim, run, config, progress)
-        _start_shear(sim, run, config)
-        save()
-    if run.phase == "shear":
-        _shear(sim, run, config, writer, save, progress)
-        save()
-    total = elapsed_before + time.perf_counter() - started
-    timeseries = writer.read_timeseries()
-    summary = _summary(run, config, timeseries, total)
-    summary["threads"] = sim.threads  # the count the run used (a resumed run keeps its own): reruns bitwise
-    writer.write_summary(summary)
-    writer.write_phases(run.wall_time)
-    writer.finalize()
-    write_text_atomic(out / "timeseries.csv", _csv(timeseries))
-    _figures(timeseries, out)
-    # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
-    from grainlab.analysis.biaxial_figures import fabric_figures
-
-    summary["fabric"] = fabric_figures(out).numbers.summary()
-    write_json_atomic(out / "summary.json", summary)
+        if writer is not None:
+            if not resume:
+                save()
+            if run.phase == "consolidate":
+                _consolidate(sim, run, config, progress)
+                save()
+            if run.phase == "boundary":
+                _install_boundary(sim, run, config, progress)
+                _start_shear(sim, run, config)
+                _check_shear_plan(sim, run, config)
+                save()
+            if run.phase == "shear":
+                _shear(sim, run, config, writer, save, progress)
+                save()
+            total = elapsed_before + time.perf_counter() - started
+            summary = _summary(run, config, writer.read_timeseries(), total)
+            summary["threads"] = sim.threads  # the count the run used (a resumed run keeps its own): reruns bitwise
+            writer.write_summary(summary)
+            writer.write_phases(run.wall_time)
+            writer.finalize()
+        summary = _write_outputs(out)
+    except BaseException as error:
+        _stop_writer(writer, error)
+        if is_disk_full(error):
+            raise _disk_full(out, error) from error
+        raise
     checkpoint_path.unlink(missing_ok=True)
     return BiaxialResult(out, summary)

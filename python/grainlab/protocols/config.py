@@ -286,12 +286,22 @@ def resolve(
     if config_file is not None:
         path = Path(config_file)
         try:
-            table = tomllib.loads(path.read_text())
+            table = tomllib.loads(path.read_text(encoding="utf-8"))
         except FileNotFoundError:
             raise ConfigError(f"{path}: configuration file not found") from None
+        except IsADirectoryError:
+            raise ConfigError(f"{path}: is a folder, not a configuration file") from None
+        except (OSError, UnicodeDecodeError) as error:
+            raise ConfigError(f"{path}: cannot be read as a TOML configuration file ({error})") from None
         except tomllib.TOMLDecodeError as error:
             raise ConfigError(f"{path}: not valid TOML ({error})") from None
-        layers.append(flatten_keys(table))
+        file_layer = flatten_keys(table)
+        for key, value in file_layer.items():  # checked even where an override replaces it
+            try:
+                coerce(key, value)
+            except ConfigError as error:
+                raise ConfigError(f"{path}: {error}") from None
+        layers.append(file_layer)
     if overrides is not None:
         if isinstance(overrides, Mapping):
             layers.append(dict(overrides))

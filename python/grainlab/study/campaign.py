@@ -177,6 +177,10 @@ def load_finished(run: Run, out_dir: str | os.PathLike[str]) -> dict[str, Any] |
 # ---- execution -----------------------------------------------------------------
 
 
+#: How long a campaign waits to connect to a ``--scheduler`` address before giving up.
+SCHEDULER_TIMEOUT_S = 10.0
+
+
 def default_workers() -> int:
     return os.cpu_count() or 1
 
@@ -294,7 +298,16 @@ def _run_dask(todo: Sequence[Run], out: Path, scheduler: str | Any, threads: int
             "--scheduler: Dask is not installed; pip install 'grainlab[cluster]'"
         ) from error
     own = not isinstance(scheduler, Client)
-    client = Client(scheduler) if own else scheduler
+    if own:
+        try:
+            client = Client(scheduler, timeout=SCHEDULER_TIMEOUT_S)
+        except (OSError, TimeoutError) as error:
+            raise ValueError(
+                f"--scheduler: cannot reach a Dask scheduler at {scheduler} within {SCHEDULER_TIMEOUT_S:g} s "
+                f"({error}); check the address and that the scheduler is running"
+            ) from None
+    else:
+        client = scheduler
     try:
         futures = [
             client.submit(execute_run, run, str(out), threads, key=f"grainlab-{out.name}-{run.name}-{run.seed}",
