@@ -37,7 +37,7 @@ def test_reaches_the_target_porosity_and_reports_where_it_is(small_sample):
     assert s.porosity_overlap_corrected == pytest.approx(overlap_corrected_porosity(s.positions, s.radii, SMALL))
     assert s.porosity_overlap_corrected > s.porosity  # overlaps are counted once
     assert s.equilibrium_reached and s.unbalanced_force_ratio < 1e-4
-    # dense and stressed: locked-in stress of order MPa (the feasibility study)
+    # dense and stressed: locked-in stress of order MPa (docs/samples.md, the Table 1 sample)
     assert 2e5 < s.mean_wall_stress_pa < 5e6
     assert s.mean_wall_stress_pa == pytest.approx(s.wall_stresses_pa.mean())
     assert 3.0 < s.coordination_number < 5.0
@@ -174,7 +174,7 @@ def test_paper_scale_sample():
     assert s.n_particles == 3518
     assert s.porosity == pytest.approx(0.12, abs=1e-12)
     assert s.equilibrium_reached
-    # the feasibility study: 1-3.5 MPa locked in, mean overlaps 2-10% of the smallest radius
+    # docs/samples.md: 1-3.5 MPa locked in, mean overlaps 2-10% of the smallest radius
     assert 1.0e6 < s.mean_wall_stress_pa < 3.5e6
     assert 0.02 < s.mean_overlap_ratio < 0.12
     assert 0.12 < s.porosity_overlap_corrected < 0.13

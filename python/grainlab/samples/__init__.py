@@ -8,6 +8,12 @@ Usable on its own (docs/samples.md)::
 """
 
 from grainlab.samples.expansion import WALL_NAMES, ExpansionError, Sample, expand_to_porosity
+from grainlab.samples.friction_search import (
+    FrictionSearch,
+    FrictionSearchError,
+    FrictionTrial,
+    expand_with_friction_search,
+)
 from grainlab.samples.grading import (
     PAPER_GRADING,
     Grading,
@@ -38,6 +44,9 @@ __all__ = [
     "SQUARE_CONTACT_POROSITY",
     "WALL_NAMES",
     "ExpansionError",
+    "FrictionSearch",
+    "FrictionSearchError",
+    "FrictionTrial",
     "Grading",
     "GradingCurve",
     "Lattice",
@@ -48,6 +57,7 @@ __all__ = [
     "box_area",
     "disk_area_in_box",
     "expand_to_porosity",
+    "expand_with_friction_search",
     "hexagonal_lattice",
     "lens_area",
     "nominal_porosity",

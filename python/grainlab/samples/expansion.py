@@ -53,6 +53,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from grainlab.analysis.fabric import CoordinationNumber
 from grainlab.samples.grading import PAPER_GRADING, Grading
 from grainlab.samples.placement import random_placement
 from grainlab.samples.porosity import (
@@ -71,6 +72,8 @@ WALL_NAMES = ("bottom", "right", "top", "left")
 _KN = 8.45e7
 _DENSITY = 2.0e8
 _DAMPING = 0.8
+#: Default stress bound of the expansion (mean wall stress in equilibrium), Pa.
+MAX_STRESS_PA = 5.0e6
 
 
 class ExpansionError(ValueError):
@@ -78,7 +81,8 @@ class ExpansionError(ValueError):
 
     Attributes give where the expansion stopped: ``porosity`` (nominal),
     ``porosity_overlap_corrected``, ``stress_pa`` (mean wall stress it needed,
-    in equilibrium when ``equilibrium`` is true) and ``target``.
+    in equilibrium when ``equilibrium`` is true), ``target`` and ``steps``
+    (DEM steps run until then).
     """
 
     def __init__(
@@ -90,6 +94,7 @@ class ExpansionError(ValueError):
         stress_pa: float,
         target: float,
         equilibrium: bool,
+        steps: int = 0,
     ) -> None:
         super().__init__(message)
         self.porosity = porosity
@@ -97,6 +102,7 @@ class ExpansionError(ValueError):
         self.stress_pa = stress_pa
         self.target = target
         self.equilibrium = equilibrium
+        self.steps = steps
 
 
 @dataclass(frozen=True, eq=False)
@@ -130,6 +136,10 @@ class Sample:
     """Mean of :attr:`wall_stresses_pa`, Pa: the stress locked in by the expansion."""
     coordination_number: float
     """``2 Nc / N`` (particle-particle contacts, rattlers included)."""
+    mechanical_coordination_number: float
+    """``Z_m``: ``2 Nc / N`` over the particles left once rattlers (fewer than 2
+    particle-particle contacts) are removed iteratively
+    (:class:`grainlab.analysis.CoordinationNumber`); NaN when none is left."""
     mean_overlap_ratio: float
     """Mean contact overlap over the smallest radius."""
     max_overlap_ratio: float
@@ -185,6 +195,7 @@ class Sample:
             "wall_stresses_pa": self.wall_stresses_pa.tolist(),
             "mean_wall_stress_pa": self.mean_wall_stress_pa,
             "coordination_number": self.coordination_number,
+            "mechanical_coordination_number": self.mechanical_coordination_number,
             "mean_overlap_ratio": self.mean_overlap_ratio,
             "max_overlap_ratio": self.max_overlap_ratio,
             "unbalanced_force_ratio": self.unbalanced_force_ratio,
@@ -273,7 +284,7 @@ def expand_to_porosity(
     equilibrium_ratio: float = 1.0e-4,
     stress_free_overlap: float = 1.0e-5,
     max_equilibrium_steps: int = 300_000,
-    max_stress_pa: float = 5.0e6,
+    max_stress_pa: float = MAX_STRESS_PA,
     time_step_safety: float = 0.8,
     density_scaling: bool = True,
     threads: int = 1,
@@ -293,7 +304,7 @@ def expand_to_porosity(
     diameters : (N,) m, drawn beforehand (then ``grading`` only names them and
         ``n_particles`` must be None)
     friction, wall_friction : particle-particle and particle-wall friction
-        while generating (the issue's default: 0 for both)
+        while generating (default 0 for both)
     normal_stiffness, shear_stiffness : contact kn, ks (N/m; Table 1: 8.45e7)
     density : kg/m^3 (Table 1: 2e8); local_damping : alpha (Table 1: 0.8)
     initial_scale : placed radius over final radius (the paper halves: 0.5)
@@ -469,6 +480,7 @@ def expand_to_porosity(
             stress_pa=stress,
             target=porosity,
             equilibrium=equilibrium,
+            steps=steps,
         )
 
     try:
@@ -520,6 +532,7 @@ def expand_to_porosity(
         mean_overlap = max_overlap = 0.0
     n_nom, n_cor = walls.porosities()
     coordination = sim.coordination_number
+    mechanical = CoordinationNumber().compute(sim.snapshot()).mechanical_coordination_number
 
     # hand over a clean state: Table 1 density back, at rest, a time step for the real masses
     if density_scaling:
@@ -543,6 +556,7 @@ def expand_to_porosity(
         wall_stresses_pa=wall_stresses,
         mean_wall_stress_pa=stress,
         coordination_number=coordination,
+        mechanical_coordination_number=mechanical,
         mean_overlap_ratio=mean_overlap,
         max_overlap_ratio=max_overlap,
         unbalanced_force_ratio=ratio,

@@ -12,7 +12,7 @@ In 2D a disk of unit thickness has mass ``m = rho pi d^2 / 4``: mass goes as
 ``d^2`` (not ``d^3`` as for spheres), so a number density ``f_N(d)`` and a mass
 density ``f_M(d)`` are related by ``f_M(d) = d^2 f_N(d) / E_N[d^2]``.
 
-Diameters are in metres (SI, DESIGN.md §2).
+Diameters are in metres (SI, docs/conventions.md).
 
 Example
 -------

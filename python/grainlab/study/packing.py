@@ -5,10 +5,16 @@ Two kinds (Tables 2 and 3):
 - ``irregular``: radius expansion (:func:`grainlab.samples.expand_to_porosity`)
   to a target *nominal* porosity inside the rigid box, Table 1/2 contact
   properties, diameters 0.5-3 mm (radii 0.25-1.5 mm); the packing is the
-  equilibrium state at the target. Generation is frictionless (the library's
-  and the biaxial protocol's default); switching Table 2's mu = 0.9 on at rest
-  changes nothing (shear springs start at zero and the packing is already in
-  equilibrium), so it is not cycled again.
+  equilibrium state at the target. The generation friction is by default
+  ``"search"``: the least friction, found by bisection in ``[0, friction]``
+  (:func:`grainlab.samples.expand_with_friction_search`), whose packing at the
+  target bears a mean wall stress of at least ``search_stress_min`` (aiming
+  at ``search_stress_min`` ... ``search_stress_max``) with ``Z_m >= 3``; the
+  targets the frictionless expansion already jams at keep friction 0. A number
+  fixes it instead (0: the frictionless expansion; 0.9: Table 2's mu
+  throughout). The packing is measured as generated: switching Table 2's
+  mu = 0.9 on at rest changes nothing (shear springs start at zero and the
+  packing is already in equilibrium), so it is not cycled again.
 - ``hexagonal``: equal disks (Table 3's 0.875 mm read as a radius: 1.75 mm
   diameter) on a hexagonal lattice in a periodic cell of the box's size:
   random vacancies above the contact porosity 0.0931, uniform compression
@@ -43,11 +49,18 @@ MEASURES: tuple[str, ...] = (
     "mean_stability_index",
     "mean_stability_index_all",
     "anisotropy",
+    "anisotropy_binned",
     "anisotropy_fourier",
     "force_anisotropy",
+    "force_anisotropy_binned",
     "n_particles",
     "mean_wall_stress_pa",
+    "generation_friction",
+    "generation_expansions",
 )
+
+#: ``PackingParams.generation_friction`` value that asks for the friction search.
+GENERATION_FRICTION_SEARCH = "search"
 
 #: Statuses a packing row can have.
 STATUSES = ("ok", "unjammed", "densest_reached", "failed")
@@ -68,10 +81,12 @@ class PackingParams:
     d_max: float = 3.0e-3
     diameter: float = 1.75e-3
     """Diameter of the hexagonal packings' disks (Table 3's 0.875 mm read as a radius)."""
-    generation_friction: float = 0.0
-    """Particle friction during the radius expansion."""
+    generation_friction: float | str = GENERATION_FRICTION_SEARCH
+    """Particle friction during the radius expansion: a number (fixed), or ``"search"``
+    (chosen per packing in ``[0, friction]``; see the module docstring)."""
     friction: float = 0.9
-    """Table 2's mu (recorded; see the module docstring)."""
+    """Table 2's mu: the upper end of the generation friction search (the packing is
+    measured as generated; see the module docstring)."""
     platen_friction: float = 0.0
     normal_stiffness: float = 8.45e7
     shear_stiffness: float = 8.45e7
@@ -79,6 +94,12 @@ class PackingParams:
     local_damping: float = 0.8
     max_stress: float = 5.0e6
     """Stress bound of the radius expansion, Pa (the samples library default)."""
+    search_stress_min: float = 1.0e5
+    """Friction search: least mean wall stress of a stress-bearing packing, Pa (the
+    paper's consolidation stress, 100 kPa)."""
+    search_stress_max: float = 3.0e5
+    """Friction search: upper end of the stress band aimed at, Pa (about what the
+    frictionless expansion locks in at 0.15, the loosest target it jams at)."""
     lattice_boundary: str = "periodic"
     """Hexagonal packings: ``"periodic"`` or ``"walls"``."""
     threads: int = 1
@@ -95,14 +116,36 @@ class PackingParams:
             if not (0.0 < value < 1.0):
                 raise ValueError(f"{name}: expected a number in (0, 1), got {value!r}")
         for name in ("width", "height", "d_min", "d_max", "diameter", "normal_stiffness", "shear_stiffness",
-                     "density", "max_stress"):
+                     "density", "max_stress", "search_stress_min", "search_stress_max"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name}: expected a number > 0, got {value!r}")
-        for name in ("generation_friction", "friction", "platen_friction"):
+        for name in ("friction", "platen_friction"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"{name}: expected a number >= 0, got {value!r}")
+        if not self.searches_friction:
+            value = self.generation_friction
+            if isinstance(value, str | bool) or not (math.isfinite(value) and value >= 0):
+                raise ValueError(
+                    f"generation_friction: expected a number >= 0 or {GENERATION_FRICTION_SEARCH!r}, got {value!r}"
+                )
+        elif self.kind == "irregular":  # a lattice is built, not generated: no search to check
+            if self.friction <= 0:
+                raise ValueError(
+                    "friction: the generation friction search runs over [0, friction] and needs friction > 0, "
+                    f"got {self.friction!r}; give a fixed generation_friction instead"
+                )
+            if self.search_stress_min >= self.search_stress_max:
+                raise ValueError(
+                    f"search_stress_min: {self.search_stress_min:g} Pa must be below search_stress_max "
+                    f"{self.search_stress_max:g} Pa"
+                )
+            if self.search_stress_max > self.max_stress:
+                raise ValueError(
+                    f"search_stress_max: {self.search_stress_max:g} Pa exceeds the expansion's stress bound "
+                    f"max_stress {self.max_stress:g} Pa, so the band could not be reached"
+                )
         if not (0.0 <= self.local_damping < 1.0):
             raise ValueError(f"local_damping: expected a number in [0, 1), got {self.local_damping!r}")
         if self.d_min > self.d_max:
@@ -113,6 +156,11 @@ class PackingParams:
             raise ValueError(f"seed: expected an integer >= 0, got {self.seed!r}")
         return self
 
+    @property
+    def searches_friction(self) -> bool:
+        """Whether the generation friction is searched (``generation_friction = "search"``)."""
+        return self.generation_friction == GENERATION_FRICTION_SEARCH
+
     @classmethod
     def from_mapping(cls, values: Mapping[str, Any]) -> PackingParams:
         """From a plain mapping; an unknown key raises ``ValueError`` naming it."""
@@ -122,7 +170,12 @@ class PackingParams:
             if key not in known:
                 raise ValueError(f"unknown packing parameter {key!r}; known: {', '.join(known)}")
             default = getattr(cls, key)
-            if isinstance(default, str):
+            if key == "generation_friction":
+                if isinstance(value, bool) or not isinstance(value, int | float | str):
+                    raise ValueError(
+                        f"{key}: expected a number >= 0 or {GENERATION_FRICTION_SEARCH!r}, got {value!r}")
+                value = value if isinstance(value, str) else float(value)
+            elif isinstance(default, str):
                 if not isinstance(value, str):
                     raise ValueError(f"{key}: expected a string, got {value!r}")
             elif isinstance(default, int) and not isinstance(default, bool):
@@ -141,22 +194,23 @@ class PackingParams:
 
 
 def measure(snapshot: Snapshot) -> dict[str, float]:
-    """Z, Z_m, mean lambda, anisotropies of a snapshot (library defaults: boundary
-    contacts excluded from Z and the anisotropies, included in lambda)."""
+    """Z, Z_m, mean lambda (both readings), anisotropies (the exact estimate and Eq. 7 on
+    the histogram) of a snapshot (library defaults: boundary contacts excluded from Z and
+    the anisotropies, included in lambda)."""
     summary = fabric_summary(snapshot)
     keys = ("coordination_number", "mechanical_coordination_number", "mean_stability_index",
-            "mean_stability_index_all", "anisotropy", "anisotropy_fourier", "force_anisotropy")
+            "mean_stability_index_all", "anisotropy", "anisotropy_binned", "anisotropy_fourier",
+            "force_anisotropy", "force_anisotropy_binned")
     return {k: summary[k] for k in keys}
 
 
 def _irregular(p: PackingParams) -> dict[str, Any]:
-    from grainlab.samples import ExpansionError, UniformByNumber, expand_to_porosity
+    from grainlab.samples import ExpansionError, UniformByNumber, expand_to_porosity, expand_with_friction_search
 
     box = (0.0, 0.0, p.width, p.height)
     grading = UniformByNumber(p.d_min, p.d_max)
     common = dict(
         seed=p.seed,
-        friction=p.generation_friction,
         wall_friction=p.platen_friction,
         normal_stiffness=p.normal_stiffness,
         shear_stiffness=p.shear_stiffness,
@@ -167,18 +221,27 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
         progress=False,
         keep_simulation=True,
     )
-    status, note = "ok", ""
+    # the least friction the search may use: a target too dense for it is too dense for any
+    friction = 0.0 if p.searches_friction else float(p.generation_friction)
+    status, note, search = "ok", "", None
     try:
-        sample = expand_to_porosity(box, p.porosity, grading, **common)
+        if p.searches_friction:
+            search = expand_with_friction_search(
+                box, p.porosity, grading, friction_range=(0.0, p.friction),
+                stress_band_pa=(p.search_stress_min, p.search_stress_max), **common,
+            )
+            sample = search.sample
+        else:
+            sample = expand_to_porosity(box, p.porosity, grading, friction=friction, **common)
     except ExpansionError as error:
         # the densest packing the bound allows: aim just above where this expansion stopped
         fallback = math.ceil(error.porosity * 1000.0) / 1000.0 + 0.001
-        sample = expand_to_porosity(box, fallback, grading, **common)
+        sample = expand_to_porosity(box, fallback, grading, friction=friction, **common)
         status = "densest_reached"
         note = (
             f"target {p.porosity:.4f} not reached within the stress bound {p.max_stress / 1e6:.3g} MPa "
-            f"({error}); measured instead the packing expanded to {fallback:.4f}, just above the densest "
-            f"one reached ({error.porosity:.4f})"
+            f"({error}); measured instead the packing expanded to {fallback:.4f} with generation friction "
+            f"{friction:g}, just above the densest one reached ({error.porosity:.4f})"
         )
     sim = sample.simulation
     snap = sim.snapshot()
@@ -186,23 +249,27 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
     if not sample.jammed:
         status = "unjammed" if status == "ok" else status
         note = (note + "; " if note else "") + (
-            f"stress-free at nominal porosity {sample.porosity:.4f}: the frictionless radius expansion "
-            f"jams denser than this in this box, so the disks do not fill it under load "
-            f"(mean wall stress {sample.mean_wall_stress_pa:.3g} Pa); contacts are the near-touching ones "
+            f"stress-free at nominal porosity {sample.porosity:.4f}: the radius expansion with generation "
+            f"friction {sample.friction:g} jams denser than this in this box, so the disks do not fill it under "
+            f"load (mean wall stress {sample.mean_wall_stress_pa:.3g} Pa); contacts are the near-touching ones "
             "left at rest"
         )
     elif status == "ok":
+        how = f"generation friction {sample.friction:g} (fixed)" if search is None else search.summary()
         note = (
             f"equilibrium after radius expansion, locked-in mean wall stress "
-            f"{sample.mean_wall_stress_pa / 1e3:.0f} kPa, {sample.steps} DEM steps"
+            f"{sample.mean_wall_stress_pa / 1e3:.0f} kPa, {sample.steps} DEM steps; {how}"
         )
     result.update(
         porosity=sample.porosity,
         porosity_overlap_corrected=sample.porosity_overlap_corrected,
         n_particles=float(len(sample.radii)),
         mean_wall_stress_pa=sample.mean_wall_stress_pa,
+        generation_friction=sample.friction,
+        generation_expansions=(len(search.trials) if search is not None else 1) + (status == "densest_reached"),
     )
-    return {**result, "status": status, "note": note}
+    return {**result, "status": status, "note": note,
+            "friction_search": search.trials_json() if search is not None else ""}
 
 
 def _hexagonal(p: PackingParams) -> dict[str, Any]:
@@ -251,18 +318,22 @@ def _hexagonal(p: PackingParams) -> dict[str, Any]:
         porosity_overlap_corrected=lattice.porosity_overlap_corrected,
         n_particles=float(lattice.n_particles),
         mean_wall_stress_pa=float("nan"),
+        generation_friction=float("nan"),  # built, not generated: no friction involved
+        generation_expansions=0,
     )
     note = lattice.note
     if not overlap.any():
         note += "; the lattice at contact carries no load, so the force anisotropy is undefined (NaN)"
-    return {**result, "status": "ok", "note": note}
+    return {**result, "status": "ok", "note": note, "friction_search": ""}
 
 
 def run_packing(params: PackingParams | Mapping[str, Any]) -> dict[str, Any]:
-    """Makes and measures one packing; returns :data:`MEASURES` + ``status``, ``note``, ``wall_time_s``."""
+    """Makes and measures one packing; returns :data:`MEASURES` + ``status``, ``note``,
+    ``friction_search`` (the search's trials as JSON, or ``""``), ``seed``, ``wall_time_s``."""
     p = params if isinstance(params, PackingParams) else PackingParams.from_mapping(params)
     p.validate()
     started = time.perf_counter()
     result = _irregular(p) if p.kind == "irregular" else _hexagonal(p)
+    result["seed"] = p.seed
     result["wall_time_s"] = time.perf_counter() - started
     return result

@@ -15,8 +15,8 @@ import numpy as np
 
 import grainlab
 from grainlab.io.results import write_json_atomic
-from grainlab.study.campaign import CampaignResult, Run, make_run, run_campaign
-from grainlab.study.packing import PackingParams
+from grainlab.study.campaign import CampaignResult, Run, derive_seed, run_campaign
+from grainlab.study.packing import GENERATION_FRICTION_SEARCH, PackingParams
 
 #: Table 2: target nominal porosities of the irregular packings.
 IRREGULAR_POROSITIES: tuple[float, ...] = (0.08, 0.09, 0.10, 0.11, 0.12, 0.13, 0.14, 0.15, 0.16, 0.161, 0.165)
@@ -36,6 +36,7 @@ STUDY_COLUMNS: tuple[str, ...] = (
     "anisotropy",
     "anisotropy_binned",
     "force_anisotropy",
+    "force_anisotropy_binned",
     "wall_time_s",
     "status",
     "note",
@@ -43,22 +44,43 @@ STUDY_COLUMNS: tuple[str, ...] = (
     "anisotropy_fourier",
     "n_particles",
     "mean_wall_stress_pa",
+    "generation_friction",
+    "generation_expansions",
     "name",
     "error",
+    "friction_search",
 )
+
+#: The two readings of the mean stability index (docs/fabric.md): over grains with >= 2
+#: contacts, and over every grain (0- and 1-contact grains at lambda = 1).
+LAMBDA_COLUMNS: dict[str, str] = {"mean_stability_index": "", "mean_stability_index_all": "_all"}
 
 
 def study_runs(seed: int = 0, overrides: Mapping[str, Any] | None = None,
                irregular: Sequence[float] = IRREGULAR_POROSITIES,
                hexagonal: Sequence[float] = HEXAGONAL_POROSITIES) -> list[Run]:
     """The 19 runs (11 irregular, 8 hexagonal) with Tables 2-3 defaults; ``overrides``
-    (packing parameters, e.g. a smaller box for tests) apply to all."""
+    (packing parameters, e.g. a smaller box for tests) apply to all.
+
+    The irregular runs carry their ``generation_friction`` in their parameters
+    (``"search"`` unless overridden; a number fixes it); the hexagonal lattices are
+    built, not generated, and do not. Each run's seed is derived from the campaign
+    seed and its other parameters, not the generation friction, so the variants
+    (``generation_friction`` = ``"search"``, 0, 0.9, ...) of one campaign seed start
+    from the same diameters and placement. Every run's parameters are checked here,
+    before any work (``ValueError`` naming the field)."""
+    shared = dict(overrides or {})
+    generation_friction = shared.pop("generation_friction", GENERATION_FRICTION_SEARCH)
     runs = []
     for kind, targets in (("irregular", irregular), ("hexagonal", hexagonal)):
         for target in targets:
-            params = {**dict(overrides or {}), "kind": kind, "porosity": float(target)}
-            runs.append(make_run(f"{kind}_{target:.3f}", "packing", params, seed,
-                                 labels={"kind": kind, "porosity_target": float(target)}))
+            params = {**shared, "kind": kind, "porosity": float(target)}
+            run_seed = derive_seed(seed, "packing", params)
+            if kind == "irregular":
+                params["generation_friction"] = generation_friction
+            PackingParams.from_mapping(params)
+            runs.append(Run(f"{kind}_{target:.3f}", "packing", params, run_seed,
+                            {"kind": kind, "porosity_target": float(target)}))
     return runs
 
 
@@ -83,11 +105,22 @@ def linear_fit(x: np.ndarray, y: np.ndarray) -> dict[str, float]:
 
 _STYLE = {"irregular": dict(marker="o", color="tab:blue", label="irregular"),
           "hexagonal": dict(marker="s", color="tab:red", label="hexagonal", mfc="none")}
+#: The every-grain reading beside the >= 2 contacts one: the same colour, a lighter marker.
+_STYLE_ALL = {"irregular": dict(marker="^", color="tab:blue", alpha=0.45, label="irregular, every grain"),
+              "hexagonal": dict(marker="D", color="tab:red", alpha=0.45, mfc="none", label="hexagonal, every grain")}
+
+
+def _pooled(rows: Sequence[Mapping[str, Any]], x: str, y: str) -> tuple[np.ndarray, np.ndarray]:
+    xs = [_series(rows, kind, x, y) for kind in ("irregular", "hexagonal")]
+    return np.concatenate([a for a, _ in xs]), np.concatenate([b for _, b in xs])
 
 
 def study_figures(rows: Sequence[Mapping[str, Any]], out_dir: str | os.PathLike[str]) -> dict[str, Any]:
     """Figs. 15 (lambda vs Z), 16 (lambda vs porosity), 17 (lambda vs anisotropy with a
-    linear fit over all packings), PNG + SVG; returns the files and the fit."""
+    linear fit over all packings), PNG + SVG, each with both readings of lambda (over
+    grains with >= 2 contacts, filled markers; over every grain, lighter markers);
+    returns the files and the Fig. 17 fits (``fig17_fit``: lambda over >= 2 contacts,
+    ``fig17_fit_all``: over every grain)."""
     from grainlab.plot import new_axes, save_figure
 
     out = Path(out_dir)
@@ -95,60 +128,65 @@ def study_figures(rows: Sequence[Mapping[str, Any]], out_dir: str | os.PathLike[
     specs = (
         ("fig15_lambda_vs_coordination", "coordination_number", "mean coordination number Z"),
         ("fig16_lambda_vs_porosity", "porosity", "nominal porosity n"),
-        ("fig17_lambda_vs_anisotropy", "anisotropy", "fabric anisotropy a (Eq. 7)"),
+        ("fig17_lambda_vs_anisotropy", "anisotropy", "fabric anisotropy a"),
     )
-    fit: dict[str, float] = {}
+    fits: dict[str, dict[str, float]] = {"fig17_fit": {}, "fig17_fit_all": {}}
     for name, x_key, x_label in specs:
         ax = new_axes(figsize=(3.6, 3.0))
-        xs, ys = [], []
-        for kind in ("irregular", "hexagonal"):
-            x, y = _series(rows, kind, x_key, "mean_stability_index")
-            if len(x):
-                order = np.argsort(x)
-                ax.plot(x[order], y[order], linestyle="none", **_STYLE[kind])
-            xs.append(x)
-            ys.append(y)
-        if name.startswith("fig17"):
-            x_all, y_all = np.concatenate(xs), np.concatenate(ys)
-            fit = linear_fit(x_all, y_all)
-            if math.isfinite(fit["slope"]):
-                grid = np.linspace(x_all.min(), x_all.max(), 2)
-                ax.plot(grid, fit["slope"] * grid + fit["intercept"], color="k", linewidth=0.8,
-                        label=f"fit: λ = {fit['slope']:.3f} a + {fit['intercept']:.3f}, R² = {fit['r2']:.3f}")
+        for lam_key, suffix in LAMBDA_COLUMNS.items():
+            style = _STYLE if not suffix else _STYLE_ALL
+            for kind in ("irregular", "hexagonal"):
+                x, y = _series(rows, kind, x_key, lam_key)
+                if len(x):
+                    order = np.argsort(x)
+                    ax.plot(x[order], y[order], linestyle="none", **style[kind])
+            if name.startswith("fig17"):
+                x_all, y_all = _pooled(rows, x_key, lam_key)
+                fit = linear_fit(x_all, y_all)
+                fits[f"fig17_fit{suffix}"] = fit
+                if math.isfinite(fit["slope"]):
+                    grid = np.linspace(x_all.min(), x_all.max(), 2)
+                    ax.plot(grid, fit["slope"] * grid + fit["intercept"], color="k", linewidth=0.8,
+                            linestyle="-" if not suffix else "--",
+                            label=f"fit{' (every grain)' if suffix else ''}: λ = {fit['slope']:.3f} a + "
+                                  f"{fit['intercept']:.3f}, R² = {fit['r2']:.3f}")
         ax.set_xlabel(x_label)
         ax.set_ylabel("mean stability index λ")
-        ax.legend(fontsize=7)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=6)
         files[name] = [str(p) for p in save_figure(ax, out / name)]
-    return {"files": files, "fig17_fit": fit}
+    return {"files": files, **fits}
 
 
 def trends(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
-    """The numbers behind the paper's claims: correlation of lambda with Z per series,
-    and hexagonal vs irregular lambda at overlapping Z."""
+    """The numbers behind the paper's claims, for both readings of lambda (keys with
+    ``lambda_all``: over every grain; ``lambda``: over grains with >= 2 contacts):
+    linear fits of lambda against Z, porosity and the anisotropy (exact, and Eq. 7 binned) per series
+    and pooled, and hexagonal minus irregular lambda at the same Z (the irregular
+    series interpolated at the hexagonal packings' Z, where their ranges overlap)."""
     out: dict[str, Any] = {}
-    for kind in ("irregular", "hexagonal"):
-        z, lam = _series(rows, kind, "coordination_number", "mean_stability_index")
-        fit = linear_fit(z, lam)
-        out[f"{kind}_lambda_vs_z_slope"] = fit["slope"]
-        out[f"{kind}_lambda_vs_z_r2"] = fit["r2"]
-    for x_key in ("anisotropy", "anisotropy_fourier"):
-        for kind in ("irregular", "hexagonal"):
-            x, lam = _series(rows, kind, x_key, "mean_stability_index")
-            out[f"{kind}_lambda_vs_{x_key}_r2"] = linear_fit(x, lam)["r2"]
-        xs = [_series(rows, kind, x_key, "mean_stability_index") for kind in ("irregular", "hexagonal")]
-        fit = linear_fit(np.concatenate([x for x, _ in xs]), np.concatenate([y for _, y in xs]))
-        out[f"all_lambda_vs_{x_key}_slope"] = fit["slope"]
-        out[f"all_lambda_vs_{x_key}_r2"] = fit["r2"]
-    zi, li = _series(rows, "irregular", "coordination_number", "mean_stability_index")
-    zh, lh = _series(rows, "hexagonal", "coordination_number", "mean_stability_index")
-    if len(zi) >= 2 and len(zh):
-        order = np.argsort(zi)
-        inside = (zh >= zi.min()) & (zh <= zi.max())
-        interp = np.interp(zh, zi[order], li[order])
-        out["hexagonal_in_irregular_z_range"] = int(inside.sum())
-        out["hexagonal_minus_irregular_lambda_at_same_z"] = (
-            [float(v) for v in (lh - interp)[inside]] if inside.any() else []
-        )
+    anisotropies = [k for k in ("anisotropy", "anisotropy_binned") if any(k in r for r in rows)]
+    for lam_key, suffix in LAMBDA_COLUMNS.items():
+        lam = f"lambda{suffix}"
+        for x_key, x_name in (("coordination_number", "z"), ("porosity", "porosity"),
+                              *((a, a) for a in anisotropies)):
+            for kind in ("irregular", "hexagonal"):
+                fit = linear_fit(*_series(rows, kind, x_key, lam_key))
+                out[f"{kind}_{lam}_vs_{x_name}_slope"] = fit["slope"]
+                out[f"{kind}_{lam}_vs_{x_name}_r2"] = fit["r2"]
+            fit = linear_fit(*_pooled(rows, x_key, lam_key))
+            out[f"all_{lam}_vs_{x_name}_slope"] = fit["slope"]
+            out[f"all_{lam}_vs_{x_name}_r2"] = fit["r2"]
+        zi, li = _series(rows, "irregular", "coordination_number", lam_key)
+        zh, lh = _series(rows, "hexagonal", "coordination_number", lam_key)
+        if len(zi) >= 2 and len(zh):
+            order = np.argsort(zi)
+            inside = (zh >= zi.min()) & (zh <= zi.max())
+            interp = np.interp(zh, zi[order], li[order])
+            out["hexagonal_in_irregular_z_range"] = int(inside.sum())
+            out[f"hexagonal_minus_irregular_{lam}_at_same_z"] = (
+                [float(v) for v in (lh - interp)[inside]] if inside.any() else []
+            )
     return out
 
 
@@ -170,7 +208,8 @@ def run_study(
     runs = study_runs(seed, overrides, irregular, hexagonal)
     campaign = run_campaign(runs, out, workers=workers, scheduler=scheduler, progress=progress,
                             table_name="study.csv", columns=STUDY_COLUMNS)
-    fig = study_figures(campaign.rows, out) if figures else {"files": {}, "fig17_fit": {}}
+    no_figures: dict[str, Any] = {"files": {}, "fig17_fit": {}, "fig17_fit_all": {}}
+    fig = study_figures(campaign.rows, out) if figures else no_figures
     statuses: dict[str, int] = {}
     for row in campaign.rows:
         statuses[row.get("status", "?")] = statuses.get(row.get("status", "?"), 0) + 1
@@ -189,6 +228,9 @@ def run_study(
         # what every packing shared (PackingParams defaults with the overrides), for the report
         "packing_params": {**asdict(PackingParams()), **dict(overrides or {})},
         "fig17_fit": fig["fig17_fit"],
+        "fig17_fit_all": fig["fig17_fit_all"],
+        "generation_friction": {r["name"]: r.get("generation_friction") for r in campaign.rows
+                                if r.get("kind") == "irregular" and "name" in r},
         "trends": trends(campaign.rows),
         "figures": fig["files"],
         "grainlab_version": grainlab.__version__,

@@ -1,0 +1,375 @@
+"""Radius expansion with the generation friction chosen by a bracketed search.
+
+A frictionless radius expansion jams at one nominal porosity, ``n_J(0)``
+(between 0.155 and 0.16 in the paper's 75 x 150 mm box, docs/samples.md): a
+looser target comes out stress-free. Friction during the expansion lets arches
+carry load before the disks fill the space, so the packing jams looser: the
+jamming porosity ``n_J(mu)`` rises with the generation friction ``mu``. For a
+target ``n`` this makes the packing's state at ``n`` a monotone function of
+``mu``: stress-free below the friction at which ``n_J(mu) = n``, stress-bearing
+above it, with a mean wall stress that rises with ``mu``, until the expansion
+stops at the stress bound or the engine's overlap limit.
+:func:`expand_with_friction_search` bisects on that relation for a friction
+whose packing at ``n`` bears a mean wall stress inside a band.
+
+Each trial is a whole :func:`~grainlab.samples.expand_to_porosity` with the
+same seed (same diameters, same initial placement), so only the friction
+differs. A trial's outcome, in the order the outcomes come with rising friction:
+
+``stress_free`` / ``unsettled`` / ``below_band`` < ``in_band`` < ``above_band`` < ``stopped``
+
+- ``stress_free``: the contacts carry no load (``Sample.jammed`` false);
+- ``unsettled``: the unbalanced force ratio did not fall below the equilibrium
+  threshold within ``max_equilibrium_steps`` (near the jamming point the
+  relaxation is slow; more friction settles it);
+- ``below_band``: in equilibrium, but the mean wall stress is below the band
+  or the mechanical coordination number ``Z_m`` below
+  ``min_mechanical_coordination`` (3 = d + 1, the fewest contacts per disk
+  with which a frictional disk network in 2D can be rigid);
+- ``in_band``: stress-bearing (equilibrium, ``jammed``, ``Z_m`` at least the
+  minimum) with the mean wall stress in the band: accepted;
+- ``above_band``: stress-bearing above the band;
+- ``stopped``: :class:`~grainlab.samples.ExpansionError` (the stress bound,
+  or an overlap beyond the engine's limit).
+
+The search (cost: one expansion when the least friction already bears the
+band's lower end, otherwise two plus at most
+``ceil(log2((mu_max - mu_min) / friction_tolerance))``):
+
+1. the least friction ``mu_min``: if the packing is stress-bearing (in or above
+   the band) it is taken (friction only adds stress); an ``ExpansionError`` is
+   raised as it is (the target is too dense for the stress bound even then);
+2. the largest friction ``mu_max``: if the packing is still on the loose side
+   the target cannot be made stress-bearing (:class:`FrictionSearchError`);
+   ``in_band`` is taken;
+3. bisection: the midpoint replaces the lower end when it is on the loose side,
+   the upper end otherwise, until a trial is ``in_band`` or the bracket is
+   narrower than ``friction_tolerance``; then the least friction found above
+   the band is taken (``FrictionSearch.in_band`` false), or, if none was,
+   :class:`FrictionSearchError`.
+
+Example
+-------
+>>> from grainlab.samples import expand_with_friction_search, UniformByNumber
+>>> found = expand_with_friction_search((0.0, 0.0, 0.012, 0.012), 0.2, UniformByNumber(0.5e-3, 1.0e-3),
+...                                     seed=1, stress_band_pa=(1e4, 1e6), progress=False)
+>>> found.sample.jammed and found.sample.mean_wall_stress_pa >= 1e4
+True
+>>> found.friction == found.sample.friction
+True
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from numpy.typing import ArrayLike
+
+from grainlab.samples.expansion import MAX_STRESS_PA, ExpansionError, Sample, expand_to_porosity
+from grainlab.samples.grading import PAPER_GRADING, Grading
+
+__all__ = ["TRIAL_OUTCOMES", "FrictionSearch", "FrictionSearchError", "FrictionTrial", "expand_with_friction_search"]
+
+#: Trial outcomes and their rank: 0 the loose side (more friction), 1 accepted, >= 2 the dense side.
+TRIAL_OUTCOMES: dict[str, int] = {
+    "stress_free": 0,
+    "unsettled": 0,
+    "below_band": 0,
+    "in_band": 1,
+    "above_band": 2,
+    "stopped": 3,
+}
+
+#: The fewest contacts per disk (d + 1 in d = 2) with which a frictional disk network can be rigid.
+MIN_MECHANICAL_COORDINATION = 3.0
+
+
+@dataclass(frozen=True)
+class FrictionTrial:
+    """One radius expansion of the search, at one generation friction."""
+
+    friction: float
+    outcome: str
+    """One of :data:`TRIAL_OUTCOMES`."""
+    mean_wall_stress_pa: float
+    """Mean wall stress at the end (where the expansion stopped for ``stopped``), Pa."""
+    mechanical_coordination_number: float
+    """``Z_m`` of the packing (NaN for ``stopped``)."""
+    coordination_number: float
+    """``Z`` of the packing (NaN for ``stopped``)."""
+    steps: int
+    wall_time_s: float
+    message: str = ""
+    """The :class:`ExpansionError` message for ``stopped``."""
+
+    @property
+    def rank(self) -> int:
+        """0 loose side, 1 accepted, >= 2 dense side (:data:`TRIAL_OUTCOMES`)."""
+        return TRIAL_OUTCOMES[self.outcome]
+
+    @property
+    def stress_bearing(self) -> bool:
+        return self.outcome in ("in_band", "above_band")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "friction": self.friction,
+            "outcome": self.outcome,
+            "mean_wall_stress_pa": self.mean_wall_stress_pa,
+            "mechanical_coordination_number": self.mechanical_coordination_number,
+            "coordination_number": self.coordination_number,
+            "steps": self.steps,
+            "wall_time_s": self.wall_time_s,
+            "message": self.message,
+        }
+
+    def describe(self) -> str:
+        """``"0.05: in_band, 218 kPa, Z_m 3.93"``."""
+        text = f"{self.friction:.4g}: {self.outcome}, {self.mean_wall_stress_pa / 1e3:.3g} kPa"
+        return text if math.isnan(self.mechanical_coordination_number) else (
+            f"{text}, Z_m {self.mechanical_coordination_number:.2f}")
+
+
+class FrictionSearchError(ValueError):
+    """No generation friction in the range makes the target stress-bearing.
+
+    ``trials`` are the expansions run (:class:`FrictionTrial`), ``target`` the
+    nominal porosity asked for.
+    """
+
+    def __init__(self, message: str, *, target: float, trials: Sequence[FrictionTrial]) -> None:
+        super().__init__(message)
+        self.target = target
+        self.trials = tuple(trials)
+
+
+@dataclass(frozen=True, eq=False)
+class FrictionSearch:
+    """The packing a friction search chose, and every trial it ran (in the order run)."""
+
+    sample: Sample
+    """The accepted packing; its :attr:`~Sample.friction` is the generation friction chosen."""
+    trials: tuple[FrictionTrial, ...]
+    friction_range: tuple[float, float]
+    stress_band_pa: tuple[float, float]
+    friction_tolerance: float
+    min_mechanical_coordination: float
+
+    @property
+    def friction(self) -> float:
+        """The generation friction chosen."""
+        return self.sample.friction
+
+    @property
+    def accepted(self) -> FrictionTrial:
+        """The trial of the accepted packing."""
+        return next(t for t in reversed(self.trials) if t.friction == self.sample.friction)
+
+    @property
+    def in_band(self) -> bool:
+        """Whether the accepted packing's stress is inside the band (false: the least friction
+        already bears more, or the stress jumps across the band within ``friction_tolerance``)."""
+        return self.accepted.outcome == "in_band"
+
+    @property
+    def monotone(self) -> bool:
+        """Whether the trials, sorted by friction, have non-decreasing rank and, among the
+        stress-bearing ones, non-decreasing stress (the relation the bisection relies on)."""
+        ordered = sorted(self.trials, key=lambda t: t.friction)
+        ranks = [t.rank for t in ordered]
+        stresses = [t.mean_wall_stress_pa for t in ordered if t.stress_bearing]
+        return all(a <= b for a, b in zip(ranks, ranks[1:], strict=False)) and all(
+            a <= b for a, b in zip(stresses, stresses[1:], strict=False))
+
+    @property
+    def wall_time_s(self) -> float:
+        return float(sum(t.wall_time_s for t in self.trials))
+
+    @property
+    def steps(self) -> int:
+        return int(sum(t.steps for t in self.trials))
+
+    def summary(self) -> str:
+        """One line: the friction chosen, its stress, and the trials."""
+        where = "in" if self.in_band else "outside"
+        return (
+            f"generation friction {self.friction:.4g} (mean wall stress "
+            f"{self.sample.mean_wall_stress_pa / 1e3:.3g} kPa, {where} the band "
+            f"{self.stress_band_pa[0] / 1e3:.3g}-{self.stress_band_pa[1] / 1e3:.3g} kPa) after "
+            f"{len(self.trials)} expansion(s), {self.wall_time_s:.1f} s; trials "
+            + "; ".join(t.describe() for t in self.trials)
+        )
+
+    def trials_json(self) -> str:
+        """The trials as compact JSON (a list of :meth:`FrictionTrial.to_dict`)."""
+        return json.dumps([t.to_dict() for t in self.trials], separators=(",", ":"))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "friction": self.friction,
+            "in_band": self.in_band,
+            "monotone": self.monotone,
+            "friction_range": list(self.friction_range),
+            "stress_band_pa": list(self.stress_band_pa),
+            "friction_tolerance": self.friction_tolerance,
+            "min_mechanical_coordination": self.min_mechanical_coordination,
+            "trials": [t.to_dict() for t in self.trials],
+            "sample": self.sample.to_dict(),
+        }
+
+
+def _pair(name: str, value: Any, minimum: float, strict_minimum: bool) -> tuple[float, float]:
+    try:
+        low, high = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected two numbers (low, high), got {value!r}") from None
+    bad_low = low <= minimum if strict_minimum else low < minimum
+    if not (math.isfinite(low) and math.isfinite(high)) or bad_low or not low < high:
+        bound = f"> {minimum:g}" if strict_minimum else f">= {minimum:g}"
+        raise ValueError(f"{name}: expected finite numbers {bound} with low < high, got ({low!r}, {high!r})")
+    return low, high
+
+
+def expand_with_friction_search(
+    box: ArrayLike = (0.0, 0.0, 0.075, 0.15),
+    porosity: float = 0.12,
+    grading: Grading = PAPER_GRADING,
+    *,
+    friction_range: Sequence[float] = (0.0, 0.9),
+    stress_band_pa: Sequence[float] = (1.0e5, 3.0e5),
+    friction_tolerance: float = 5.0e-3,
+    min_mechanical_coordination: float = MIN_MECHANICAL_COORDINATION,
+    progress: bool = True,
+    keep_simulation: bool = False,
+    **expansion: Any,
+) -> FrictionSearch:
+    """Radius expansion to a target nominal porosity with the generation friction chosen so
+    that the packing there is stress-bearing (module docstring: criterion, algorithm, cost).
+
+    Parameters
+    ----------
+    box, porosity, grading : as :func:`~grainlab.samples.expand_to_porosity`
+    friction_range : ``(mu_min, mu_max)``, the bracket (default 0 to Table 1's 0.9)
+    stress_band_pa : ``(low, high)`` mean wall stress aimed at, Pa (default 100-300 kPa:
+        the paper's consolidation stress, 100 kPa, up to about what the frictionless
+        expansion locks in at 0.15 in the paper's box); ``high`` must not exceed
+        ``max_stress_pa``
+    friction_tolerance : stop bisecting when the bracket is narrower than this
+    min_mechanical_coordination : least ``Z_m`` of a stress-bearing packing (default 3)
+    progress, keep_simulation : as :func:`~grainlab.samples.expand_to_porosity`
+        (only the accepted packing keeps its simulation)
+    **expansion : any other keyword of :func:`~grainlab.samples.expand_to_porosity`
+        (``seed``, ``max_stress_pa``, ``threads``, ...), except ``friction``
+
+    Raises
+    ------
+    ValueError
+        bad input, naming the field, before any work.
+    ExpansionError
+        the target needs more than ``max_stress_pa`` even at ``mu_min``.
+    FrictionSearchError
+        (a ValueError) the packing is still on the loose side at ``mu_max``, or no
+        friction in the range gives a stress-bearing packing within the stress bound.
+    """
+    if "friction" in expansion:
+        raise ValueError("friction: chosen by the search; give friction_range = (low, high) instead")
+    porosity = float(porosity)
+    if not (0.0 < porosity < 1.0):
+        raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+    mu_min, mu_max = _pair("friction_range", friction_range, 0.0, strict_minimum=False)
+    stress_low, stress_high = _pair("stress_band_pa", stress_band_pa, 0.0, strict_minimum=True)
+    max_stress_pa = float(expansion.get("max_stress_pa", MAX_STRESS_PA))
+    if stress_high > max_stress_pa:
+        raise ValueError(
+            f"stress_band_pa: the band's upper end {stress_high:.4g} Pa exceeds max_stress_pa = "
+            f"{max_stress_pa:.4g} Pa, beyond which the expansion stops; lower the band or raise max_stress_pa"
+        )
+    friction_tolerance = float(friction_tolerance)
+    if not (math.isfinite(friction_tolerance) and friction_tolerance > 0.0):
+        raise ValueError(f"friction_tolerance: must be a finite number > 0, got {friction_tolerance!r}")
+    min_mechanical_coordination = float(min_mechanical_coordination)
+    if not (math.isfinite(min_mechanical_coordination) and min_mechanical_coordination >= 0.0):
+        raise ValueError(
+            f"min_mechanical_coordination: must be a finite number >= 0, got {min_mechanical_coordination!r}")
+
+    trials: list[FrictionTrial] = []
+
+    def trial(friction: float) -> tuple[FrictionTrial, Sample | None]:
+        started = time.perf_counter()
+        try:
+            with warnings.catch_warnings():
+                # an unsettled trial is an outcome of the search, not a warning to the caller
+                warnings.filterwarnings("ignore", message="expand_to_porosity: unbalanced force ratio",
+                                        category=RuntimeWarning)
+                sample = expand_to_porosity(box, porosity, grading, friction=friction, progress=progress,
+                                            keep_simulation=keep_simulation, **expansion)
+        except ExpansionError as error:
+            if not trials:
+                raise  # too dense for the stress bound even with the least friction
+            done = FrictionTrial(friction, "stopped", error.stress_pa, math.nan, math.nan, error.steps,
+                                 time.perf_counter() - started, str(error))
+            trials.append(done)
+            return done, None
+        stress, z_m = sample.mean_wall_stress_pa, sample.mechanical_coordination_number
+        if not sample.equilibrium_reached:
+            outcome = "unsettled"
+        elif not sample.jammed:
+            outcome = "stress_free"
+        elif stress < stress_low or not z_m >= min_mechanical_coordination:
+            outcome = "below_band"
+        else:
+            outcome = "in_band" if stress <= stress_high else "above_band"
+        done = FrictionTrial(friction, outcome, stress, z_m, sample.coordination_number, sample.steps,
+                             sample.wall_time_s)
+        trials.append(done)
+        return done, sample
+
+    def result(sample: Sample) -> FrictionSearch:
+        return FrictionSearch(sample, tuple(trials), (mu_min, mu_max), (stress_low, stress_high),
+                              friction_tolerance, min_mechanical_coordination)
+
+    first, sample = trial(mu_min)
+    if first.stress_bearing:
+        return result(sample)  # type: ignore[arg-type]
+    last, sample = trial(mu_max)
+    if last.rank == 0:
+        raise FrictionSearchError(
+            f"porosity: nominal porosity {porosity:.4f} is looser than radius expansion jams even with the "
+            f"largest generation friction allowed: with friction {mu_max:g} the packing ends {last.outcome} "
+            f"(mean wall stress {last.mean_wall_stress_pa:.3g} Pa, Z_m {last.mechanical_coordination_number:.2f}; "
+            f"a stress-bearing packing needs at least {stress_low:.3g} Pa and Z_m >= "
+            f"{min_mechanical_coordination:g}). Aim for a denser target or raise friction_range's upper end.",
+            target=porosity, trials=trials,
+        )
+    if last.outcome == "in_band":
+        return result(sample)  # type: ignore[arg-type]
+    best = sample if last.stress_bearing else None
+    low, high = mu_min, mu_max
+    while high - low > friction_tolerance:
+        middle = 0.5 * (low + high)
+        done, sample = trial(middle)
+        if done.outcome == "in_band":
+            return result(sample)  # type: ignore[arg-type]
+        if done.rank == 0:
+            low = middle
+        else:
+            high = middle
+            if done.stress_bearing:
+                best = sample
+    if best is None:
+        loose = max((t for t in trials if t.rank == 0), key=lambda t: t.friction)
+        dense = min((t for t in trials if t.rank > 0), key=lambda t: t.friction)
+        raise FrictionSearchError(
+            f"porosity: no generation friction in [{mu_min:g}, {mu_max:g}] makes nominal porosity "
+            f"{porosity:.4f} stress-bearing within max_stress_pa = {max_stress_pa / 1e6:.3g} MPa: at friction "
+            f"{loose.friction:.4g} the packing ends {loose.outcome}, at {dense.friction:.4g} the expansion "
+            f"stopped ({dense.message}). Widen stress_band_pa or raise max_stress_pa.",
+            target=porosity, trials=trials,
+        )
+    return result(best)
