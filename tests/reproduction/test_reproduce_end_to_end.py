@@ -16,7 +16,8 @@ from grainlab.cli import main
 def test_quick_reproduction_writes_claims_in_range(tmp_path, capsys):
     out = tmp_path / "repro"
     argv = ["reproduce", "--quick", "--out", str(out), "--seeds", "3", "--workers", "2", "--no-progress",
-            "--variants", "set:shear.final_strain=0.02", "lambda_raw", "study:width=0.02,height=0.04"]
+            "--variants", "set:shear.final_strain=0.02", "lambda_raw:set:shear.final_strain=0.02",
+            "study:width=0.02,height=0.04"]
     assert main(argv) == 0
     printed = capsys.readouterr().out
     assert "already finished" in printed and "claims (" in printed
@@ -42,7 +43,7 @@ def test_quick_reproduction_writes_claims_in_range(tmp_path, capsys):
     # the study: hexagonal lattices are more stable than the random packings, every seed
     assert all(v < 0 for v in rows["hexagonal_more_stable"]["per_seed"])
     # the analysis-only variant read the same runs: the macro claims are the same numbers
-    raw = {r["id"]: r for r in next(b for b in doc["variants"] if b["variant"] == "lambda_raw")["claims"]}
+    raw = {r["id"]: r for r in next(b for b in doc["variants"] if b["kind"] == "analysis")["claims"]}
     assert raw["peak_near_1.5"]["per_seed"] == rows["peak_near_1.5"]["per_seed"]
     assert raw["z_initial"]["per_seed"] == rows["z_initial"]["per_seed"]
     with open(out / "claims.csv") as f:

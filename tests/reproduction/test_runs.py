@@ -39,6 +39,7 @@ def test_variants_by_name():
     assert study.kind == "study" and study.overrides == {"generation_friction": 0.9}
     raw = parse_variant("lambda_raw")
     assert raw.kind == "analysis" and raw.source == "paper" and raw.analysis == {"boundary_contacts": "raw"}
+    assert parse_variant("lambda_raw:boundary_b").source == "boundary_b"
 
 
 @pytest.mark.parametrize(
@@ -50,6 +51,7 @@ def test_variants_by_name():
         ("study:friction_of_the_moon=1", "unknown packing parameter"),
         ("set:sample.porosity=1.5", "sample.porosity"),
         ("set:porosity", "key=value"),
+        ("lambda_raw:study", "reads a biaxial variant"),
     ],
 )
 def test_bad_variants_name_the_problem(name, message):

@@ -160,6 +160,12 @@ def _band(row: Mapping[str, Any], key: str) -> float:
     return _num(row.get(key)) if row.get("band_found") else math.nan
 
 
+def _band_share(row: Mapping[str, Any]) -> float:
+    """Share of the grains inside the band (NaN when no band was found)."""
+    inside, outside = _band(row, "inside_n_grains"), _band(row, "outside_n_grains")
+    return inside / (inside + outside)
+
+
 def _series(m: Measures, key: str) -> tuple[np.ndarray, np.ndarray]:
     rows = _snaps(m)
     return (np.array([_num(r["axial_strain"]) for r in rows]), np.array([_num(r.get(key)) for r in rows]))
@@ -246,6 +252,10 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
     Claim("band_at_peak", "the shear band is fully developed at the peak", "Sec. 6, Fig. 11d", None,
           "1 when the detector accepts a band at the snapshot nearest the peak, else 0", ProportionRule(),
           lambda m: _found(_peak(m))),
+    Claim("band_narrows_to_peak", "the zone narrows as the stress ratio increases, to the shear plane at the "
+          "peak", "Sec. 6, Figs. 11a-d", None,
+          "share of the grains inside the band at the peak minus at 0.5 %, paired per seed (seeds with a band "
+          "at both)", SideRule(-1), lambda m: _band_share(_peak(m)) - _band_share(_at(m, 0.005))),
     Claim("band_lambda_above_rest", "mean lambda in the shear zone at the peak (0.34) above the rest (0.31)",
           "Sec. 6, Fig. 13", 0.03, f"band minus rest at the peak snapshot, paired per seed; {_LAMBDA_BAND}",
           SideRule(+1), lambda m: _band(_peak(m), "inside_mean_lambda") - _band(_peak(m), "outside_mean_lambda")),

@@ -24,9 +24,10 @@ Variants (:func:`parse_variant`):
     the paper variant's reads the paper variant's runs.
 ``set:<key>=<value>[,<key>=<value>...]``
     ``paper`` with any biaxial configuration keys changed.
-``lambda_raw``
-    Analysis only: the paper variant's runs, lambda counting every membrane disk
-    a grain touches as a contact (instead of each boundary body once).
+``lambda_raw``, ``lambda_raw:<variant>``
+    Analysis only: the paper variant's (or the given biaxial variant's) runs,
+    lambda counting every membrane disk a grain touches as a contact (instead
+    of each boundary body once).
 ``study``, ``study:<field>=<value>[,...]``
     The Sec. 7 packing study (19 packings per seed), with packing parameters
     changed, e.g. ``study:generation_friction=0.9``.
@@ -166,10 +167,14 @@ def parse_variant(text: str) -> Variant:
             "boundary_b", "biaxial", {"boundary.kind": "outer_particles"},
             description="the outermost grains as the lateral boundary (boundary.kind = outer_particles)",
         )
-    if name == "lambda_raw":
+    if name == "lambda_raw" or name.startswith("lambda_raw:"):
+        source = parse_variant(name[len("lambda_raw:"):]) if name != "lambda_raw" else parse_variant("paper")
+        if source.kind != "biaxial":
+            raise ValueError(f"--variants: {name!r}: lambda_raw reads a biaxial variant's runs, not {source.name!r}")
         return Variant(
-            "lambda_raw", "analysis", analysis={"boundary_contacts": "raw"}, source="paper",
-            description="the paper variant's runs; lambda with every membrane disk a grain touches counted",
+            name if name == "lambda_raw" else f"lambda_raw:{source.name}", "analysis",
+            analysis={"boundary_contacts": "raw"}, source=source.name,
+            description=f"{source.name}'s runs; lambda with every membrane disk a grain touches counted",
         )
     if name.startswith("rate="):
         rate = _biaxial_value(name, "shear.strain_rate", name[len("rate="):])
