@@ -101,6 +101,7 @@ def test_a_folder_keeps_its_variants_seeds_and_mode(tmp_path):
         (["--workers", "0"], "--workers"),
         (["--workers", "2", "--scheduler", "tcp://localhost:1"], "--workers/--scheduler"),
         (["--variants", "paper", "paper"], "given twice"),
+        (["--claims-only"], "holds no reproduction"),
     ],
 )
 def test_bad_input_fails_before_any_work(tmp_path, capsys, argv, message):
@@ -108,6 +109,12 @@ def test_bad_input_fails_before_any_work(tmp_path, capsys, argv, message):
     assert main(["reproduce", "--out", str(out), "--no-progress", *argv]) == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_an_out_that_is_a_file_is_refused(tmp_path, capsys):
+    (tmp_path / "file").write_text("")
+    assert main(["reproduce", "--out", str(tmp_path / "file"), "--no-progress"]) == 2
+    assert "is a file" in capsys.readouterr().err
 
 
 @pytest.mark.slow

@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from grainlab.reproduction.runs import (
     DEFAULT_SEEDS,
     DEFAULT_VARIANTS,
+    PLAN_FILE,
     QUICK_SEEDS,
     QUICK_VARIANTS,
     describe,
@@ -54,6 +56,11 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers: expected an integer >= 1, got {args.workers}")
     if args.workers is not None and args.scheduler is not None:
         raise ValueError("--workers/--scheduler: give one of them (Dask sets its own workers)")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out: {out} is a file, not a folder")
+    if args.claims_only and not (out / PLAN_FILE).exists():
+        raise ValueError(f"--claims-only: {out} holds no reproduction ({PLAN_FILE} not found); run it first")
     plan = plan_from_args(args.seeds, args.variants, args.quick, args.out)
     print(f"grainlab reproduce: seeds {', '.join(map(str, plan.seeds))}" + (" (quick)" if plan.quick else ""))
     for line in describe(plan):
