@@ -779,11 +779,14 @@ def detect_contacts(
     Parameters
     ----------
     positions : (N, 2) float, m
+        Disk centres; (N, 3) for spheres (the readers' projection of 3D
+        data), the third direction never periodic.
     radii : (N,) float, m
     tolerance : float, m, >= 0
         Touching tolerance added to the radius sum.
     box, periodic
-        As in :class:`Snapshot`; periodic directions use the minimum image.
+        As in :class:`Snapshot` (x and y); periodic directions use the
+        minimum image.
 
     Returns
     -------
@@ -810,6 +813,8 @@ def detect_contacts(
                 pos[:, axis] = np.mod(pos[:, axis] - b[axis, 0], lengths[axis])
                 pos[pos[:, axis] >= lengths[axis], axis] = 0.0
                 boxsize[axis] = lengths[axis]
+    if boxsize is not None and pos.shape[1] > 2:
+        boxsize = np.r_[boxsize, np.zeros(pos.shape[1] - 2)]
     cutoff = 2.0 * float(rad.max()) + tolerance
     tree = cKDTree(pos, boxsize=boxsize)
     pairs = tree.query_pairs(cutoff, output_type="ndarray").astype(np.int64)
@@ -821,7 +826,7 @@ def detect_contacts(
         for axis in (0, 1):
             if boxsize[axis] > 0:
                 d[:, axis] -= boxsize[axis] * np.round(d[:, axis] / boxsize[axis])
-    dist = np.hypot(d[:, 0], d[:, 1])
+    dist = np.hypot(d[:, 0], d[:, 1]) if d.shape[1] == 2 else np.linalg.norm(d, axis=1)
     touching = dist < rad[i] + rad[j] + tolerance
     i, j = i[touching], j[touching]
     lo, hi = np.minimum(i, j), np.maximum(i, j)

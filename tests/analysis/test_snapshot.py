@@ -112,6 +112,21 @@ def test_detect_contacts_matches_brute_force(rng):
     assert i.size > 100
 
 
+def test_detect_contacts_of_spheres_periodic_in_x(rng):
+    # spheres (N, 3), x periodic, y and z not: as the readers' projection of 3D data uses it
+    n = 300
+    box = np.array([[0.0, 20e-3], [0.0, 20e-3]])
+    pos = rng.uniform(0, 20e-3, (n, 3))
+    rad = rng.uniform(0.5e-3, 1.5e-3, n)
+    i, j = detect_contacts(pos, rad, box=box, periodic=(True, False))
+    d = pos[:, None, :] - pos[None, :, :]
+    d[..., 0] -= 20e-3 * np.round(d[..., 0] / 20e-3)
+    bi, bj = np.nonzero(np.triu(np.linalg.norm(d, axis=2) < rad[:, None] + rad[None, :], 1))
+    np.testing.assert_array_equal(np.c_[i, j], np.c_[bi, bj])
+    flat_i, _ = detect_contacts(pos[:, :2], rad, box=box, periodic=(True, False))
+    assert 50 < i.size < flat_i.size / 2  # the projected disks touch far more often
+
+
 def test_touching_tolerance():
     pos = [[0.0, 0.0], [1.0e-3 + 1e-9, 0.0]]
     assert detect_contacts(pos, [0.5e-3, 0.5e-3])[0].size == 0

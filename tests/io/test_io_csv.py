@@ -165,3 +165,27 @@ def test_writer_writes_nan_as_empty_and_checks_lengths(tmp_path):
     assert lines[2] == "1,1,0,0.5,,0"
     with pytest.raises(ValueError, match="columns"):
         write_particles_csv(tmp_path / "w.csv", snap, {"v": [1.0]})
+
+
+def test_z_column_3d_refused_unless_projected_or_sliced(tmp_path):
+    r = 0.5e-3
+    rows = [(1, 0.0, 0.0, 0.0), (2, 0.85e-3, 0.0, 0.3e-3), (3, 0.0, 0.2e-3, 2.0e-3)]
+    text = "id,x,y,z,radius\n" + "".join(f"{i},{x!r},{y!r},{z!r},{r!r}\n" for i, x, y, z in rows)
+    p = write(tmp_path, "s.csv", text)
+    with pytest.raises(FileFormatError) as info:
+        read_particles_csv(p)
+    assert str(info.value).startswith(f"{p}: 3D data: column 'z' spreads over 0.002 m (4 times")
+    # projection: spheres 1-2 overlap in 3D; 1-3 overlap only as disks
+    proj = read_particles_csv(p, z_policy="project")
+    np.testing.assert_array_equal(np.c_[proj.contact_i, proj.contact_j], [[0, 1]])
+    np.testing.assert_allclose(proj.contact_normals(), [[1.0, 0.0]])
+    # the slice z = 0 cuts spheres 1 and 2 (the second at 0.3 mm: radius 0.4 mm)
+    cut = read_particles_csv(p, z_policy="slice", z0=0.0)
+    np.testing.assert_array_equal(cut.ids, [1, 2])
+    np.testing.assert_allclose(cut.radii, [r, 0.4e-3])
+    assert cut.n_contacts == 1  # 0.85 mm apart, radii 0.5 + 0.4 mm
+    # a flat z column is 2D data and stays a field
+    flat = write(tmp_path, "f.csv", text.replace("0.0003,", "0.0,").replace("0.002,", "0.0,"))
+    assert read_particles_csv(flat).n_particles == 3
+    with pytest.raises(ValueError, match="^z_policy: "):
+        read_particles_csv(p, z_policy="drop")

@@ -13,6 +13,7 @@ from grainlab.io import (
     read_lammps_dump,
     read_snapshot,
 )
+from grainlab.snapshot import Snapshot
 
 ATOMS = """\
 ITEM: TIMESTEP
@@ -279,3 +280,128 @@ def test_read_snapshot_dispatch(tmp_path):
         read_snapshot(csv, timestep=3)
     with pytest.raises(ValueError, match="format"):
         read_snapshot(csv, format="vtk")
+
+
+def dump_3d(tmp_path, xyz, radius, name="spheres.dump", columns="x y z", box_z=(-0.01, 0.02)):
+    """An atoms dump of spheres (ids 1..N) in a fixed 0.02 m box."""
+    rows = "".join(
+        f"{k + 1} 1 {p[0]!r} {p[1]!r} {p[2]!r} {r!r}\n"
+        for k, (p, r) in enumerate(zip(xyz.tolist(), np.broadcast_to(radius, len(xyz)).tolist(), strict=True))
+    )
+    text = (
+        f"ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n{len(xyz)}\nITEM: BOX BOUNDS ff ff ff\n"
+        f"0.0 0.02\n0.0 0.02\n{box_z[0]!r} {box_z[1]!r}\nITEM: ATOMS id type {columns} radius\n{rows}"
+    )
+    return write(tmp_path, name, text)
+
+
+def random_spheres(rng, n=200, r=0.5e-3, side=0.02):
+    """n non-overlapping spheres of radius r in a cube of the given side (rejection)."""
+    out = []
+    while len(out) < n:
+        p = rng.uniform(r, side - r, 3)
+        if all(np.sum((p - q) ** 2) >= (2 * r) ** 2 for q in out):
+            out.append(p)
+    return np.array(out)
+
+
+def test_3d_dump_is_refused_with_one_line_naming_file_and_spread(tmp_path):
+    rng = np.random.default_rng(3)
+    xyz = random_spheres(rng, r=1e-3)  # 10 % of the cube's volume
+    p = dump_3d(tmp_path, xyz, 1e-3)
+    with pytest.raises(FileFormatError) as info:
+        read_lammps_dump(p)
+    message = str(info.value)
+    spread = xyz[:, 2].max() - xyz[:, 2].min()
+    assert message.startswith(f"{p}:9: 3D data: column 'z' spreads over {spread:.6g} m")
+    assert "\n" not in message and "z_policy='project'" in message
+    # read as 2D the projected disks would overlap everywhere: what the refusal prevents
+    flat = Snapshot.from_geometry(xyz[:, :2], np.full(len(xyz), 1e-3))
+    assert 2 * flat.n_contacts / len(xyz) > 5.0
+    # projected on request: the contacts are the spheres' (none touch), not the disks'
+    projected = read_lammps_dump(p, z_policy="project")
+    assert projected.n_contacts == 0
+    np.testing.assert_array_equal(projected.particle_fields["z"], xyz[:, 2])
+    assert projected.metadata["z_policy"] == "project"
+
+
+def test_planar_tolerance_is_relative_to_the_radii(tmp_path):
+    xyz = np.array([[0.005, 0.005, 0.0], [0.006, 0.005, 0.0], [0.010, 0.010, 0.0]])
+    for r, scale in ((0.5e-3, 1.0), (5e-6, 0.01)):  # the same sample at 1/100 scale
+        xyz_s = xyz * scale
+        ok = xyz_s.copy()
+        ok[2, 2] = 0.9e-3 * r  # below 1e-3 of the smallest radius: a plane
+        snap = read_lammps_dump(dump_3d(tmp_path, ok, r, f"ok{scale}.dump"))
+        assert snap.n_particles == 3 and "z" not in snap.particle_fields
+        np.testing.assert_array_equal(snap.positions, ok[:, :2])
+        bad = xyz_s.copy()
+        bad[2, 2] = 1.1e-3 * r
+        with pytest.raises(FileFormatError, match="3D data"):
+            read_lammps_dump(dump_3d(tmp_path, bad, r, f"bad{scale}.dump"))
+    # a constant z, however large, is a plane
+    lifted = xyz + [0.0, 0.0, 0.007]
+    assert read_lammps_dump(dump_3d(tmp_path, lifted, 0.5e-3, "lifted.dump")).n_particles == 3
+
+
+def test_projection_keeps_sphere_contacts_with_their_in_plane_direction(tmp_path):
+    r = 0.5e-3
+    a = np.array([0.008, 0.008, 0.0])
+    b = a + 1.999 * r * np.array([np.cos(np.radians(30)), 0.0, np.sin(np.radians(30))])  # overlaps a
+    c = a + np.array([0.0, 0.6 * r, 3 * r])  # above a: disks overlap, spheres do not
+    p = dump_3d(tmp_path, np.array([a, b, c]), r)
+    snap = read_lammps_dump(p, z_policy="project", tolerance=1e-9)
+    np.testing.assert_array_equal(np.c_[snap.contact_i, snap.contact_j], [[0, 1]])
+    np.testing.assert_allclose(snap.contact_normals(), [[1.0, 0.0]], atol=1e-12)
+    np.testing.assert_array_equal(snap.radii, [r, r, r])
+    # a listed pair counts only if the spheres touch in 3D (no 'dist' column: recomputed with z)
+    local = (
+        "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ENTRIES\n2\nITEM: BOX BOUNDS ff ff ff\n0 0.02\n0 0.02\n0 0.02\n"
+        "ITEM: ENTRIES c_ids[1] c_ids[2] c_f[1]\n1 2 0.0\n1 3 0.0\n"
+    )
+    listed = read_lammps_dump(p, z_policy="project", contacts=write(tmp_path, "c.dump", local),
+                              columns={"i": "c_ids[1]", "j": "c_ids[2]"})  # fmt: skip
+    np.testing.assert_array_equal(np.c_[listed.contact_i, listed.contact_j], [[0, 1]])
+    # one sphere right above another: no direction in the plane
+    stacked = dump_3d(tmp_path, np.array([a, a + [1e-15, 0.0, 2 * r]]), r, "stacked.dump")
+    with pytest.raises(FileFormatError, match="ids 1 and 2 touch one above the other"):
+        read_lammps_dump(stacked, z_policy="project", tolerance=1e-9)
+
+
+def test_slice_gives_the_cross_sections(tmp_path):
+    r = 0.5e-3
+    z0 = 0.001
+    xyz = np.array(
+        [[0.005, 0.005, z0 + 0.6 * r], [0.005 + 1.6 * r, 0.005, z0], [0.010, 0.010, z0 + 1.2 * r]]
+    )
+    p = dump_3d(tmp_path, xyz, r)
+    snap = read_lammps_dump(p, z_policy="slice", z0=z0)
+    np.testing.assert_array_equal(snap.ids, [1, 2])  # the third sphere misses the plane
+    np.testing.assert_allclose(snap.radii, [0.8 * r, r], rtol=1e-12)
+    # cross-sections 1.6 r apart with radii 0.8 r + r overlap: one contact, along +x
+    np.testing.assert_array_equal(np.c_[snap.contact_i, snap.contact_j], [[0, 1]])
+    np.testing.assert_allclose(snap.particle_fields["z"], xyz[:2, 2])
+    assert snap.metadata["z0_m"] == z0
+    with pytest.raises(FileFormatError, match="no sphere crosses the plane"):
+        read_lammps_dump(p, z_policy="slice", z0=0.5)
+    # a sphere right above the first, away from the plane: the slice does not see it,
+    # the projection puts two disks on one centre (refused, naming its line)
+    column = dump_3d(tmp_path, np.vstack([xyz, xyz[0] + [0.0, 0.0, 5 * r]]), r, "column.dump")
+    np.testing.assert_array_equal(read_lammps_dump(column, z_policy="slice", z0=z0).ids, [1, 2])
+    with pytest.raises(FileFormatError, match=r"column.dump:13: .*coincident disks"):
+        read_lammps_dump(column, z_policy="project")
+
+
+def test_scaled_z_and_z_policy_errors(tmp_path):
+    xyz = np.array([[0.25, 0.25, 0.1], [0.5, 0.5, 0.9]])  # scaled; box z from -0.01 to 0.02
+    p = dump_3d(tmp_path, xyz, 0.5e-3, columns="xs ys zs")
+    with pytest.raises(FileFormatError, match=r"column 'zs' spreads over 0.024 m"):
+        read_lammps_dump(p)
+    np.testing.assert_allclose(read_lammps_dump(p, z_policy="project").particle_fields["z"], [-0.007, 0.017])
+    flat = write(tmp_path, "flat.dump", ATOMS.split("ITEM: TIMESTEP\n100")[0].replace(" z ", " q "))
+    with pytest.raises(FileFormatError, match="z_policy='project': the file has no z column"):
+        read_lammps_dump(flat, z_policy="project")
+    for kwargs, name in ((dict(z_policy="flatten"), "z_policy"), (dict(z_policy="slice"), "z0"),
+                         (dict(z_policy="project", z0=0.0), "z0"),
+                         (dict(z_policy="slice", z0=0.0, contacts=p), "contacts")):  # fmt: skip
+        with pytest.raises(ValueError, match=rf"^{name}: "):
+            read_lammps_dump(p, **kwargs)

@@ -8,7 +8,9 @@ Particles CSV
     :meth:`Snapshot.boundary_bodies`); any other numeric column is kept in
     :attr:`Snapshot.particle_fields`. Column order
     is free, names are case-insensitive; blank lines and lines starting with
-    ``#`` are skipped.
+    ``#`` are skipped. A ``z`` column makes the file 3D when it is not
+    constant (within 1e-3 of the smallest radius): such a file is refused
+    unless ``z_policy`` asks for a projection or a slice.
 
 Contacts CSV
     Header and rows ``i,j[,normal_force,shear_force]`` where ``i`` and ``j``
@@ -39,6 +41,7 @@ from grainlab.io._table import (
     plain,
     read_lines,
 )
+from grainlab.io._planar import check_z_policy, planar, sphere_contacts
 from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
 
 __all__ = ["read_contacts_csv", "read_particles_csv", "write_contacts_csv", "write_particles_csv"]
@@ -93,12 +96,22 @@ def read_particles_csv(
     contacts: str | Path | None = None,
     tolerance: float = 0.0,
     detect: bool = True,
+    z_policy: str = "refuse",
+    z0: float | None = None,
 ) -> Snapshot:
     """Read a particles CSV (and optionally a contacts CSV) into a :class:`Snapshot`.
 
     Without ``contacts`` and with ``detect=True`` contacts are detected from
-    the geometry (centre distance < r_i + r_j + ``tolerance``).
+    the geometry (centre distance < r_i + r_j + ``tolerance``). A ``z``
+    column spreading over more than 1e-3 of the smallest radius is 3D data:
+    refused unless ``z_policy`` is ``"project"`` or ``"slice"`` (with ``z0``),
+    as for :func:`~grainlab.io.read_lammps_dump`.
     """
+    check_z_policy(z_policy, z0)
+    if z_policy == "slice" and contacts is not None:
+        raise ValueError(
+            "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
+        )
     names, data, numbers = _read_csv(path, PARTICLE_COLUMNS)
     if data.shape[0] == 0:
         raise FileFormatError(path, None, "no particle rows after the header")
@@ -110,7 +123,6 @@ def read_particles_csv(
     if bad.any():
         k = int(np.argmax(bad))
         raise FileFormatError(path, int(numbers[k]), f"column 'radius': {plain(radius[k])} is not > 0")
-    check_geometry(path, np.c_[col["x"], col["y"]], radius, numbers)
     kind = None
     if "kind" in col:
         kind = integral_column(path, col["kind"], numbers, "kind")
@@ -132,12 +144,28 @@ def read_particles_csv(
         extra[BODY_FIELD] = body
     positions = np.c_[col["x"], col["y"]]
     metadata: dict[str, Any] = {"source": str(path), "format": "particles-csv"}
+    rotations = col.get("rotation")
+    plan = planar(path, None, col.get("z"), radius, z_policy=z_policy, z0=z0)
+    check_geometry(path, positions[plan.keep], plan.radii, numbers[plan.keep])
+    if plan.z is not None:  # 3D data read as asked: keep the chosen rows
+        keep = plan.keep
+        positions, radius, ids = positions[keep], plan.radii, ids[keep]
+        kind = None if kind is None else kind[keep]
+        rotations = None if rotations is None else rotations[keep]
+        extra = {n: v[keep] for n, v in extra.items()}
+        metadata.update(plan.metadata)
     kwargs: dict[str, Any] = dict(
-        ids=ids, rotations=col.get("rotation"), kind=kind, particle_fields=extra, metadata=metadata
+        ids=ids, rotations=rotations, kind=kind, particle_fields=extra, metadata=metadata
     )
     if contacts is not None:
         snap = Snapshot(positions, radius, **kwargs)
         return attach_contacts_csv(snap, contacts)
+    if detect and plan.spheres:
+        i, j, normals = sphere_contacts(
+            path, positions, plan.z, radius, ids, tolerance=tolerance, box=None, periodic=(False, False)
+        )
+        metadata["contacts"] = f"detected between the spheres in 3D (tolerance {tolerance:g} m)"
+        return Snapshot(positions, radius, contact_i=i, contact_j=j, contact_normal=normals, **kwargs)
     if detect:
         return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **kwargs)
     return Snapshot(positions, radius, **kwargs)

@@ -8,8 +8,11 @@ Atoms dump (``dump ID group custom N file id x y radius ...``)
     (else ``xu yu``, else scaled ``xs ys`` / ``xsu ysu``); ``radius`` (else
     ``diameter``). ``type``, ``vx vy``, ``fx fy``, ``omegaz`` and any other
     column are kept in :attr:`Snapshot.particle_fields` under their dump names
-    (velocities as ``velocity`` (N, 2), forces as ``force`` (N, 2)). ``z`` is
-    ignored (2D). The file's units are taken as given: use ``units si``.
+    (velocities as ``velocity`` (N, 2), forces as ``force`` (N, 2)). A
+    ``z`` column that is constant (within 1e-3 of the smallest radius) is
+    dropped; 3D data is refused unless ``z_policy`` asks for a projection or a
+    slice (:func:`read_lammps_dump`). The file's units are taken as given: use
+    ``units si``.
 
 Contacts dump (``dump ID group local N file ...``)
     Frames with ``ITEM: NUMBER OF ENTRIES`` and ``ITEM: ENTRIES <columns>``,
@@ -68,6 +71,7 @@ from grainlab.io._table import (
     plain,
     read_lines,
 )
+from grainlab.io._planar import check_z_policy, planar, sphere_contacts
 from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
 
 __all__ = [
@@ -283,6 +287,8 @@ def read_lammps_dump(
     detect: bool = True,
     boundary_types: Sequence[int] = (),
     body_column: str | None = None,
+    z_policy: str = "refuse",
+    z0: float | None = None,
 ) -> Snapshot:
     """Read one frame of a LAMMPS atoms dump (and its contacts) into a :class:`Snapshot`.
 
@@ -296,7 +302,22 @@ def read_lammps_dump(
     a bonded chain) that says which boundary body each boundary atom belongs
     to (:data:`~grainlab.snapshot.BODY_FIELD`); without it, boundary atoms
     that touch one another form one body (:meth:`Snapshot.boundary_bodies`).
+
+    3D data (the ``z`` column, or ``zu`` / ``zs`` / ``zsu`` beside the chosen
+    x and y, spreading over more than ``PLANAR_TOLERANCE`` = 1e-3 of the
+    smallest radius) is refused with a :class:`FileFormatError` naming the
+    file and the spread, unless ``z_policy`` says what to do: ``"project"``
+    (disks of the spheres' radii at (x, y); contacts from ``contacts`` or
+    detected between the spheres in 3D, with the in-plane direction of each
+    centre line) or ``"slice"`` with ``z0`` (the spheres crossing the plane
+    z = z0, as disks of their cross-section radius; contacts detected between
+    those disks; no ``contacts`` file). ``z`` is kept in ``particle_fields``.
     """
+    check_z_policy(z_policy, z0)
+    if z_policy == "slice" and contacts is not None:
+        raise ValueError(
+            "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
+        )
     frame = read_dump_frames(path, timestep)
     if frame.kind != "ATOMS":
         raise FileFormatError(
@@ -360,7 +381,12 @@ def read_lammps_dump(
         raise FileFormatError(
             path, int(numbers[k]), f"column {rname!r}: {plain(col[rname][k])} is not > 0"
         )
-    check_geometry(path, np.c_[x, y], radius, numbers, (xn, yn))
+    zn = {"x": "z", "xu": "zu", "xs": "zs", "xsu": "zsu"}[xn]
+    z = col[zn] if zn in col else None
+    if z is not None and zn in ("zs", "zsu"):
+        z = frame.box[2, 0] + z * (frame.box[2, 1] - frame.box[2, 0])
+    plan = planar(path, where, z, radius, z_policy=z_policy, z0=z0, column=zn)
+    check_geometry(path, np.c_[x, y][plan.keep], plan.radii, numbers[plan.keep], (xn, yn))
     fields: dict[str, NDArray[Any]] = {}
     for pair, name in ((("vx", "vy"), "velocity"), (("fx", "fy"), "force")):
         if pair[0] in col and pair[1] in col:
@@ -409,9 +435,24 @@ def read_lammps_dump(
         metadata=metadata,
     )
     positions = np.c_[x, y]
+    if plan.z is not None:  # 3D data read as asked: keep the chosen rows, z as a field
+        keep = plan.keep
+        positions, radius = positions[keep], plan.radii
+        fields = {name: values[keep] for name, values in fields.items()} | {"z": plan.z}
+        metadata.update(plan.metadata)
+        snap_kwargs.update(
+            ids=ids[keep], kind=None if kind is None else kind[keep], particle_fields=fields
+        )
     if contacts is not None:
         snap = Snapshot(positions, radius, **snap_kwargs)
         return attach_lammps_contacts(snap, contacts, timestep=frame.timestep, columns=columns)
+    if detect and plan.spheres:
+        i, j, normals = sphere_contacts(
+            path, positions, plan.z, radius, snap_kwargs["ids"], tolerance=tolerance,
+            box=box2, periodic=snap_kwargs["periodic"],
+        )  # fmt: skip
+        metadata["contacts"] = f"detected between the spheres in 3D (tolerance {tolerance:g} m)"
+        return Snapshot(positions, radius, contact_i=i, contact_j=j, contact_normal=normals, **snap_kwargs)
     if detect:
         return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **snap_kwargs)
     return Snapshot(positions, radius, **snap_kwargs)
@@ -533,7 +574,9 @@ def attach_lammps_contacts(
 
     d = snapshot.minimum_image(snapshot.positions[j] - snapshot.positions[i])
     dist_geom = np.hypot(d[:, 0], d[:, 1])
-    dist = data[:, roles["dist"]] if "dist" in roles else dist_geom
+    z = snapshot.particle_fields.get("z") if snapshot.metadata.get("z_policy") == "project" else None
+    dist_3d = dist_geom if z is None else np.hypot(dist_geom, z[j] - z[i])  # projected spheres
+    dist = data[:, roles["dist"]] if "dist" in roles else dist_3d
     touching = dist < snapshot.radii[i] + snapshot.radii[j]
     if np.any(dist_geom == 0.0):
         k = int(np.argmax(dist_geom == 0.0))

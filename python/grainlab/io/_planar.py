@@ -1,0 +1,134 @@
+"""3D input to a 2D snapshot: refuse it, or project or slice it when asked (readers only).
+
+A dump or table whose z coordinates spread by more than
+:data:`PLANAR_TOLERANCE` times the smallest radius holds spheres, not disks
+in a plane; read as 2D, its projected disks overlap everywhere (200 random
+spheres give Z = 6). The readers refuse it unless ``z_policy`` asks for
+
+* ``"project"``: every sphere becomes the disk of its radius at ``(x, y)``;
+  contacts are those of the spheres (from the contacts file, or detected in
+  3D), each with the in-plane direction of its centre line;
+* ``"slice"``: the spheres cut by the plane ``z = z0`` (``|z - z0| < r``)
+  become their cross-sections, disks of radius ``sqrt(r^2 - (z - z0)^2)``,
+  whose contacts are detected in the plane.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.io._table import FileFormatError
+from grainlab.snapshot import detect_contacts
+
+#: Largest spread of z (max - min), as a fraction of the smallest radius, read as 2D.
+PLANAR_TOLERANCE = 1e-3
+
+#: What a reader does with 3D data.
+Z_POLICIES = ("refuse", "project", "slice")
+
+
+def check_z_policy(z_policy: str, z0: float | None) -> None:
+    """ValueError naming ``z_policy`` / ``z0`` for a bad choice, before any reading."""
+    if z_policy not in Z_POLICIES:
+        raise ValueError(f"z_policy: must be one of {', '.join(Z_POLICIES)}, got {z_policy!r}")
+    if z_policy == "slice":
+        if z0 is None or not np.isfinite(z0):
+            raise ValueError("z0: z_policy='slice' needs the height z0 (m) of the slicing plane")
+    elif z0 is not None:
+        raise ValueError(f"z0: only applies to z_policy='slice', not {z_policy!r}")
+
+
+@dataclass
+class Planar:
+    """What a reader keeps of its rows: ``keep`` (N,) mask, the disks' ``radii``
+    (of the kept rows), ``z`` (kept rows, None for 2D data) and metadata."""
+
+    keep: NDArray[np.bool_]
+    radii: NDArray[np.float64]
+    z: NDArray[np.float64] | None
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def spheres(self) -> bool:
+        """True when contacts must be those of the 3D spheres (projection)."""
+        return self.metadata.get("z_policy") == "project"
+
+
+def planar(
+    path: str | Path,
+    line: int | None,
+    z: NDArray[np.float64] | None,
+    radii: NDArray[np.float64],
+    *,
+    z_policy: str = "refuse",
+    z0: float | None = None,
+    column: str = "z",
+) -> Planar:
+    """Apply ``z_policy`` to rows with z coordinates ``z`` (None: no z column)."""
+    n = radii.shape[0]
+    if z is None:
+        if z_policy != "refuse":
+            raise FileFormatError(path, line, f"z_policy={z_policy!r}: the file has no z column")
+        return Planar(np.ones(n, bool), radii, None)
+    spread = float(z.max() - z.min())
+    smallest = float(radii.min())
+    if z_policy == "refuse":
+        if spread > PLANAR_TOLERANCE * smallest:
+            raise FileFormatError(
+                path,
+                line,
+                f"3D data: column {column!r} spreads over {spread:.6g} m ({spread / smallest:.3g} times the "
+                f"smallest radius, more than {PLANAR_TOLERANCE:g} for a 2D snapshot); read it with "
+                "z_policy='project' (disks of the spheres' radii, sphere contacts) or z_policy='slice' "
+                "with z0 (the cross-sections with the plane z = z0)",
+            )
+        return Planar(np.ones(n, bool), radii, None)
+    meta: dict[str, Any] = {"z_policy": z_policy, "z_spread_m": spread}
+    if z_policy == "project":
+        return Planar(np.ones(n, bool), radii, z, meta)
+    h = z - float(z0)
+    keep = np.abs(h) < radii
+    if not keep.any():
+        raise FileFormatError(
+            path, line, f"z_policy='slice': no sphere crosses the plane z = {z0:g} m (z from {z.min():g} to {z.max():g} m)"
+        )
+    meta["z0_m"] = float(z0)
+    return Planar(keep, np.sqrt(radii[keep] ** 2 - h[keep] ** 2), z[keep], meta)
+
+
+def sphere_contacts(
+    path: str | Path,
+    positions: NDArray[np.float64],
+    z: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    ids: NDArray[np.int64],
+    *,
+    tolerance: float,
+    box: NDArray[np.float64] | None,
+    periodic: tuple[bool, bool],
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
+    """Contacts of the spheres (3D centre distance < r_i + r_j + tolerance) and
+    the in-plane unit normal of each; an error when a centre line is vertical."""
+    i, j = detect_contacts(np.c_[positions, z], radii, tolerance=tolerance, box=box, periodic=periodic)
+    d = positions[j] - positions[i]
+    if box is not None:
+        lengths = box[:, 1] - box[:, 0]
+        for axis in (0, 1):
+            if periodic[axis]:
+                d[:, axis] -= lengths[axis] * np.round(d[:, axis] / lengths[axis])
+    length = np.hypot(d[:, 0], d[:, 1])
+    flat = length <= 1e-9 * (radii[i] + radii[j])
+    if flat.any():
+        k = int(np.argmax(flat))
+        raise FileFormatError(
+            path,
+            None,
+            f"z_policy='project': the spheres with ids {int(ids[i[k]])} and {int(ids[j[k]])} touch one "
+            "above the other: their contact has no direction in the plane",
+        )
+    return i, j, d / length[:, None]
