@@ -2,7 +2,7 @@
 
 All per-step work happens in the Rust engine (:mod:`grainlab._core`); this
 module validates input, converts arrays and gives the state friendly names.
-Conventions (DESIGN.md §2): SI units, 2D disks of unit thickness
+Conventions (docs/conventions.md): SI units, 2D disks of unit thickness
 (``m = rho pi r^2``, ``I = m r^2 / 2``), angles in radians counter-clockwise,
 stresses compression positive.
 
@@ -73,7 +73,12 @@ class Contacts:
 
     ``normal`` is the unit vector from ``i`` to ``j``; ``normal_force`` (N, >= 0
     unless bonded) and ``shear_force`` (N, along ``(-n_y, n_x)``) act on ``j``,
-    their opposites on ``i``. Forces are the elastic parts (no dashpot forces).
+    their opposites on ``i``. Every row is one consistent state: the forces at
+    the current positions exactly as the next step's force evaluation computes
+    them, ``normal_force = kn * overlap`` and the shear spring with the increment
+    of the displacement since the last evaluation, capped at ``mu * normal_force``;
+    ``sliding`` is true exactly where ``|shear_force| = mu * normal_force``.
+    Forces are the elastic parts (no dashpot forces); see docs/contact-law.md.
     """
 
     i: NDArray[np.uint32]
@@ -92,8 +97,8 @@ class Contacts:
 
 @dataclass(frozen=True)
 class WallContacts:
-    """Particle-wall contacts; ``normal`` points from the wall to the particle and
-    the forces act on the particle."""
+    """Particle-wall contacts, in the same consistent state as :class:`Contacts`;
+    ``normal`` points from the wall to the particle and the forces act on the particle."""
 
     wall: NDArray[np.uint32]
     particle: NDArray[np.uint32]
@@ -448,7 +453,9 @@ class Simulation:
     @property
     def positions(self) -> NDArray[np.float64]:
         """(N, 2) centres (m). Inside a periodic cell they are wrapped when the
-        neighbour lists are rebuilt, so they may stray slightly outside between builds."""
+        neighbour lists are rebuilt, so they may stray slightly outside between builds.
+        Positions you set are a jump: the shear springs first take the last step's
+        displacement and nothing from the jump (docs/contact-law.md)."""
         return _readonly(self._engine.positions)
 
     @positions.setter
@@ -458,7 +465,9 @@ class Simulation:
     @property
     def velocities(self) -> NDArray[np.float64]:
         """(N, 2) velocities (m/s): half-step values v(n - 1/2) once stepped. Values
-        you set are taken as full-step values, and the next step kicks by dt/2."""
+        you set are taken as full-step values: the next step kicks by dt/2 and adds
+        no shear increment, and the shear springs first take the displacement the
+        last step made at the old velocities (docs/contact-law.md)."""
         return _readonly(self._engine.velocities)
 
     @velocities.setter
@@ -649,7 +658,7 @@ class Simulation:
         end_wall: Wall | int | None = None,
     ) -> int:
         """A confining pressure on a chain of boundary particles that follows the
-        boundary as it deforms (DESIGN §3): particle ``k`` of the chain gets
+        boundary as it deforms (docs/boundary.md): particle ``k`` of the chain gets
         ``p / 2 * rotCW(x[k+1] - x[k-1])`` every step, pointing to the sample,
         which lies on the chain's right (walk the chain clockwise around the
         sample). The end particles carry the segment to their projection on
@@ -709,12 +718,13 @@ class Simulation:
     # ---- contacts and diagnostics ----
 
     def contacts(self) -> Contacts:
-        """Current particle-particle contacts (overlap > 0) and bonds."""
+        """Current particle-particle contacts (overlap > 0) and bonds, with the forces
+        the next step will apply (the state is not changed)."""
         d = self._engine.contacts()
         return Contacts(**{k: _readonly(v) for k, v in d.items()})
 
     def wall_contacts(self) -> WallContacts:
-        """Current particle-wall contacts."""
+        """Current particle-wall contacts, with the forces the next step will apply."""
         d = self._engine.wall_contacts()
         return WallContacts(**{k: _readonly(v) for k, v in d.items()})
 

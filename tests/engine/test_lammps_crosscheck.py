@@ -5,7 +5,7 @@ The reference in ``tests/data/lammps_frictionless/`` (see its README) is a
 1,000 steps by LAMMPS (``gran/hooke``, ``nve/sphere disc``). LAMMPS integrates
 with velocity Verlet; grainlab's leapfrog starts from full-step velocities with
 a half kick, so positions agree to round-off, and full-step velocities are
-``(v(n-1/2) + v(n+1/2)) / 2`` (DESIGN §7).
+``(v(n-1/2) + v(n+1/2)) / 2`` (docs/contact-law.md).
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 //! Follower loads on chains of boundary particles: a confining pressure that
-//! follows a deforming boundary (DESIGN §3, the paper's flexible membrane).
+//! follows a deforming boundary (docs/boundary.md, the paper's flexible membrane).
 //!
 //! A chain is an ordered list of particles `x_0 .. x_{m-1}` walked with the
 //! sample on its right (clockwise around the sample). Particle `k` gets

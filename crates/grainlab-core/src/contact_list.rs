@@ -1,8 +1,8 @@
 //! The current contacts as parallel arrays, for output and analysis.
-use crate::contact::{contact_point, disk_disk};
+use crate::contact::contact_point;
 use crate::error::Result;
-use crate::pipeline::{minimum_image, Simulation};
-use crate::vec2::{add, norm, scale, sub, Vec2};
+use crate::pipeline::Simulation;
+use crate::vec2::{scale, Vec2};
 
 /// One row of the contact table while it is assembled.
 type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool);
@@ -10,9 +10,14 @@ type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool);
 /// Particle-particle contacts and bonds, sorted by `(i, j)` with `i < j`,
 /// in external (user) particle indices.
 ///
-/// `normal` points from `i` to `j`; `normal_force` (N, >= 0 unless bonded) and
-/// `shear_force` (N, along `perp(normal)`) are the forces on `j`, elastic parts
-/// only (viscous dashpot forces are not included).
+/// Every row is one consistent state, the forces at the current positions
+/// exactly as the next force evaluation will compute them: the normal force
+/// from the current overlap, the shear spring with the increment of the
+/// displacement made since the last evaluation (none when velocities were just
+/// set), capped at `mu * normal_force`. `normal` points from `i` to `j`;
+/// `normal_force` (N, `kn * overlap`, >= 0 unless bonded) and `shear_force`
+/// (N, along `perp(normal)`) are the forces on `j`, elastic parts only (the
+/// optional viscous dashpots are not included).
 #[derive(Debug, Clone, Default)]
 pub struct ContactList {
     /// First particle.
@@ -29,14 +34,15 @@ pub struct ContactList {
     pub normal_force: Vec<f64>,
     /// Shear force (N).
     pub shear_force: Vec<f64>,
-    /// Whether the contact slid in the last step.
+    /// Whether the shear force is at the Coulomb cap, `|Fs| = mu Fn` (never for bonds).
     pub sliding: Vec<bool>,
     /// Whether the pair is a bond.
     pub bonded: Vec<bool>,
 }
 
 /// Particle-wall contacts, sorted by `(wall, particle)` (external particle
-/// indices); `normal` points from the wall to the particle.
+/// indices), in the same consistent state as [`ContactList`]; `normal` points
+/// from the wall to the particle and the forces act on the particle.
 #[derive(Debug, Clone, Default)]
 pub struct WallContactList {
     /// Wall id.
@@ -53,50 +59,50 @@ pub struct WallContactList {
     pub normal_force: Vec<f64>,
     /// Shear force on the particle (N).
     pub shear_force: Vec<f64>,
-    /// Whether the contact slid in the last step.
+    /// Whether the shear force is at the Coulomb cap.
     pub sliding: Vec<bool>,
 }
 
 impl Simulation {
-    /// Current particle-particle contacts (overlap > 0) and all bonds.
+    /// Current particle-particle contacts (overlap > 0) and all bonds, as the
+    /// next force evaluation will compute them (the state is not changed).
     pub fn contacts(&mut self) -> Result<ContactList> {
         self.ensure_neighbors()?;
         let p = &self.particles;
         let pairs = &self.neighbors.pairs;
         let mut rows: Vec<ContactRow> = Vec::new();
-        for k in 0..pairs.len() {
-            let (i, j) = (pairs.i[k] as usize, pairs.j[k] as usize);
-            let offset = match &self.cell {
-                Some(c) => c.image_offset(pairs.shift[k]),
-                None => [0.0; 2],
-            };
-            let d = sub(add(p.position[j], offset), p.position[i]);
-            let g = disk_disk(d, p.radius[i], p.radius[j]);
-            if g.overlap > 0.0 {
-                let kn = self.materials.by_index(pairs.model[k]).normal_stiffness;
-                let point = contact_point(p.position[i], g.normal, p.radius[i], g.overlap);
+        for (k, record) in self.preview_pairs().into_iter().enumerate() {
+            if let Some(c) = record {
+                let i = pairs.i[k] as usize;
+                let point = contact_point(p.position[i], c.normal, p.radius[i], c.overlap);
                 rows.push((
                     pairs.i[k],
                     pairs.j[k],
                     point,
-                    g.normal,
-                    g.overlap,
-                    kn * g.overlap,
-                    pairs.shear[k],
-                    pairs.sliding[k],
+                    c.normal,
+                    c.overlap,
+                    c.elastic_normal,
+                    c.shear_spring,
+                    c.sliding,
                     false,
                 ));
             }
         }
-        for b in &self.bonds.list {
+        for (b, f) in self.bonds.list.iter().zip(self.preview_bonds()) {
             let (i, j) = (b.i as usize, b.j as usize);
-            let d = minimum_image(self.cell.as_ref(), sub(p.position[j], p.position[i]));
-            let dist = norm(d);
-            let normal = scale(d, 1.0 / dist);
-            let overlap = p.radius[i] + p.radius[j] - dist;
-            let point = contact_point(p.position[i], normal, p.radius[i], overlap);
-            let fn_ = b.normal_stiffness * (b.rest_length - dist);
-            rows.push((b.i, b.j, point, normal, overlap, fn_, b.shear, false, true));
+            let overlap = p.radius[i] + p.radius[j] - f.distance;
+            let point = contact_point(p.position[i], f.normal, p.radius[i], overlap);
+            rows.push((
+                b.i,
+                b.j,
+                point,
+                f.normal,
+                overlap,
+                f.normal_force,
+                f.shear_force,
+                false,
+                true,
+            ));
         }
         // external indices, i < j: swapping a pair flips its normal, and nothing
         // else (the shear force on the new j along the new tangent is unchanged,
@@ -129,33 +135,28 @@ impl Simulation {
         Ok(out)
     }
 
-    /// Current particle-wall contacts.
+    /// Current particle-wall contacts, as the next force evaluation will compute them.
     pub fn wall_contacts(&mut self) -> Result<WallContactList> {
         self.ensure_neighbors()?;
         let p = &self.particles;
         let mut out = WallContactList::default();
         let wp = &self.neighbors.wall_pairs;
-        let candidates =
-            (0..wp.wall.len()).map(|k| (wp.wall[k], wp.particle[k], wp.shear[k], wp.sliding[k]));
-        for (w, q, shear, sliding) in candidates {
-            let wall = &self.walls[w as usize];
-            let x = p.position[q as usize];
-            let r = p.radius[q as usize];
-            let g = wall.disk_contact(x, r);
-            if g.overlap > 0.0 {
-                let kn = self
-                    .materials
-                    .get(wall.group, p.group[q as usize])
-                    .normal_stiffness;
-                out.wall.push(w);
-                out.particle.push(self.external_index(q as usize) as u32);
-                out.point
-                    .push(contact_point(x, scale(g.normal, -1.0), r, g.overlap));
+        for (k, record) in self.preview_wall_pairs().into_iter().enumerate() {
+            if let Some((g, c, spring)) = record {
+                let q = wp.particle[k] as usize;
+                out.wall.push(wp.wall[k]);
+                out.particle.push(self.external_index(q) as u32);
+                out.point.push(contact_point(
+                    p.position[q],
+                    scale(g.normal, -1.0),
+                    p.radius[q],
+                    g.overlap,
+                ));
                 out.normal.push(g.normal);
                 out.overlap.push(g.overlap);
-                out.normal_force.push(kn * g.overlap);
-                out.shear_force.push(shear);
-                out.sliding.push(sliding);
+                out.normal_force.push(c.elastic_normal);
+                out.shear_force.push(spring);
+                out.sliding.push(c.sliding);
             }
         }
         let mut idx: Vec<usize> = (0..out.wall.len()).collect();

@@ -6,7 +6,7 @@
 //! `x(n+1) = x(n) + dt v(n+1/2)`. A prescribed degree of freedom keeps its
 //! velocity. On the first step after velocities were set (full-step values
 //! `v(n)`), the kick is `dt/2`, so that `v(1/2) = v(0) + dt/2 a(0)`; this makes
-//! leapfrog positions equal velocity-Verlet ones (DESIGN §7).
+//! leapfrog positions equal velocity-Verlet ones (docs/contact-law.md).
 use crate::state::{FIX_ROTATION, FIX_X, FIX_Y};
 use crate::vec2::{mat_vec, sub, Mat2, Vec2};
 

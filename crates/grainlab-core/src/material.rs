@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{require_non_negative, require_positive, EngineError, Result};
 use crate::state::MAX_GROUPS;
 
-/// Parameters of the linear contact law with Coulomb friction (DESIGN §3).
+/// Parameters of the linear contact law with Coulomb friction (docs/contact-law.md).
 ///
 /// `normal_stiffness` and `shear_stiffness` are *contact* stiffnesses (N/m);
 /// the damping ratios are fractions of critical damping of the viscous

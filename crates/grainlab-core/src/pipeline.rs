@@ -4,7 +4,9 @@
 //!    missed (wraps particles into the periodic cell, carries contact history over).
 //! 2. **Reset**: resultant = external force + gravity, per block of particles.
 //! 3. **Particle contacts**: linear law with shear history and Coulomb cap,
-//!    blocks in parallel, then the cross-block pairs.
+//!    blocks in parallel, then the cross-block pairs. The shear increment is the
+//!    displacement since the last force evaluation: none on a step that starts
+//!    from full-step velocities (see [`Simulation::catch_up_shear_springs`]).
 //! 4. **Bonds**: linear normal and shear springs that carry tension.
 //! 5. **Wall contacts**: the same law against walls; walls sum their force.
 //! 6. **Servo**: servo-controlled walls set their velocity from this step's force.
@@ -20,13 +22,13 @@ use serde::{Deserialize, Serialize};
 use crate::bond::{Bond, Bonds};
 use crate::boundary::PressureChain;
 use crate::cell::PeriodicCell;
-use crate::contact::disk_disk;
+use crate::contact::{disk_disk, ContactGeometry};
 use crate::diagnostics::{EnergyLedger, Measurements};
 use crate::error::{require_non_negative, require_positive, EngineError, Result};
 use crate::integrate::{
     integrate_chunk, IntegrationInputs, IntegrationStep, IntegrationTally, MotionChunk,
 };
-use crate::law::{elastic_energy, linear_coulomb};
+use crate::law::{elastic_energy, linear_coulomb, ContactForce};
 use crate::material::{ContactModel, MaterialTable};
 use crate::neighbor::NeighborList;
 use crate::parallel::{block_count, even_bounds, map_blocks, split_ranges, DisjointWriter, Team};
@@ -39,6 +41,10 @@ use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 /// thread: the same partition and order, so the same bits, without the
 /// hand-over cost that would dominate a tiny system.
 const PARALLEL_MIN_PARTICLES: usize = 3000;
+
+/// The first bytes of [`Simulation::to_bytes`]: the layout of the state that
+/// follows (bincode of [`Simulation`]); a new field makes a new tag.
+const STATE_TAG: &[u8; 8] = b"GLSTATE2";
 
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -123,7 +129,12 @@ pub struct Simulation {
     /// Internal slot of each external index (the inverse of `order`).
     rank: Vec<u32>,
     ledger: EnergyLedger,
+    /// Velocities are full-step values (set from outside): the next step kicks by `dt/2`.
     half_kick_pending: bool,
+    /// The shear springs hold every tangential displacement made so far: nothing
+    /// moved since the last force evaluation (or [`Simulation::catch_up_shear_springs`]),
+    /// so the next one adds no increment.
+    springs_current: bool,
     threads: usize,
     #[serde(skip)]
     pool: Option<ThreadPool>,
@@ -174,6 +185,7 @@ impl Simulation {
             rank: identity,
             ledger: EnergyLedger::default(),
             half_kick_pending: true,
+            springs_current: true,
             threads,
             pool: None,
             cross_forces: Vec::new(),
@@ -216,6 +228,8 @@ impl Simulation {
     /// Sets the step tunables.
     pub fn set_params(&mut self, params: StepParameters) -> Result<()> {
         params.validate()?;
+        // the last step's displacement was made with the old time step
+        self.catch_up_shear_springs();
         self.params = params;
         Ok(())
     }
@@ -230,6 +244,8 @@ impl Simulation {
 
     /// Sets the contact model between groups `a` and `b`.
     pub fn set_contact_model(&mut self, a: usize, b: usize, model: ContactModel) -> Result<()> {
+        model.validate("contact_model")?;
+        self.catch_up_shear_springs();
         self.materials.set(a, b, model)?;
         self.neighbors.invalidate();
         Ok(())
@@ -240,6 +256,8 @@ impl Simulation {
         if let Some(c) = &cell {
             c.validate()?;
         }
+        // the last step's displacement was made in the old cell's flow
+        self.catch_up_shear_springs();
         self.cell = cell;
         self.neighbors.invalidate();
         Ok(())
@@ -252,7 +270,9 @@ impl Simulation {
         self.walls.len() - 1
     }
 
-    /// The wall with id `id`, or an error naming the valid range.
+    /// The wall with id `id`, or an error naming the valid range. A change of its
+    /// velocity or position by hand must follow [`Simulation::catch_up_shear_springs`]
+    /// ([`Simulation::set_wall_velocity`] and [`Simulation::translate_wall`] do it).
     pub fn wall_mut(&mut self, id: usize) -> Result<&mut Wall> {
         let n = self.walls.len();
         self.walls.get_mut(id).ok_or_else(|| {
@@ -269,6 +289,30 @@ impl Simulation {
             s.validate()?;
         }
         self.wall_mut(id)?.control = control;
+        Ok(())
+    }
+
+    /// Puts wall `id` under velocity control at `velocity` (m/s, finite). The
+    /// springs first take the displacement the wall made at its old velocity.
+    pub fn set_wall_velocity(&mut self, id: usize, velocity: Vec2) -> Result<()> {
+        crate::error::require_finite("velocity", velocity[0])?;
+        crate::error::require_finite("velocity", velocity[1])?;
+        self.wall_mut(id)?;
+        self.catch_up_shear_springs();
+        let wall = self.wall_mut(id)?;
+        wall.control = WallControl::Velocity;
+        wall.velocity = velocity;
+        Ok(())
+    }
+
+    /// Moves wall `id` at once by `d` (m), between steps: a jump, not a shear
+    /// displacement of its contacts (their springs are caught up first).
+    pub fn translate_wall(&mut self, id: usize, d: Vec2) -> Result<()> {
+        crate::error::require_finite("displacement", d[0])?;
+        crate::error::require_finite("displacement", d[1])?;
+        self.wall_mut(id)?;
+        self.catch_up_shear_springs();
+        self.wall_mut(id)?.translate(d);
         Ok(())
     }
 
@@ -310,6 +354,8 @@ impl Simulation {
             }
             None => norm(self.branch(i, j)),
         };
+        // a new bond starts from zero shear: no displacement before it existed counts
+        self.catch_up_shear_springs();
         self.bonds.push(Bond {
             i: i as u32,
             j: j as u32,
@@ -337,6 +383,7 @@ impl Simulation {
         density: Vec<f64>,
     ) -> Result<()> {
         let added = Particles::new(position, radius, density)?;
+        self.catch_up_shear_springs();
         let first = self.particles.len() as u32;
         let count = added.len() as u32;
         self.particles.extend(added);
@@ -452,6 +499,8 @@ impl Simulation {
 
     /// Switches a wall on or off; an inactive wall has no contacts and stays put.
     pub fn set_wall_active(&mut self, id: usize, active: bool) -> Result<()> {
+        self.wall_mut(id)?;
+        self.catch_up_shear_springs();
         let wall = self.wall_mut(id)?;
         wall.active = active;
         if !active {
@@ -470,9 +519,161 @@ impl Simulation {
         self.neighbors.invalidate();
     }
 
-    /// Velocities were set: they are full-step values, and the next step starts with a half kick.
-    pub fn velocities_changed(&mut self) {
+    /// Changes the velocities and angular velocities (internal order, see
+    /// [`Simulation::to_internal`]) through `change`. The values it leaves are
+    /// full-step values: the next step starts with a half kick and adds no shear
+    /// increment, and the displacement of the last step, made at the old
+    /// half-step velocities, is first added to the springs, so it is counted once.
+    pub fn change_velocities(&mut self, change: impl FnOnce(&mut [Vec2], &mut [f64])) {
+        self.catch_up_shear_springs();
+        let p = &mut self.particles;
+        change(&mut p.velocity, &mut p.angular_velocity);
         self.half_kick_pending = true;
+    }
+
+    /// Changes the positions (internal order) through `change`: a jump, not a
+    /// displacement, so the springs are caught up first and the jump adds nothing
+    /// to them; the neighbour lists are rebuilt at the next step or query.
+    pub fn change_positions(&mut self, change: impl FnOnce(&mut [Vec2])) {
+        self.catch_up_shear_springs();
+        change(&mut self.particles.position);
+        self.neighbors.invalidate();
+    }
+
+    /// Whether the next force evaluation adds a shear increment: false after a
+    /// state was built or its velocities set, or after
+    /// [`Simulation::catch_up_shear_springs`]; true after a step.
+    pub fn shear_increment_pending(&self) -> bool {
+        !self.springs_current
+    }
+
+    /// The time over which the current velocities displaced the contacts since
+    /// their springs were last updated: the time step after a step, else 0.
+    fn increment_time(&self) -> f64 {
+        if self.springs_current {
+            0.0
+        } else {
+            self.params.time_step
+        }
+    }
+
+    /// Adds to every shear spring (contacts, wall contacts, bonds) the increment
+    /// of the displacement made by the last step, `-ks v_t dt` at the current
+    /// positions and half-step velocities, capped as the next force evaluation
+    /// would; that evaluation then adds none. A no-op when the springs are
+    /// current. Every method that changes what the increment would be (velocities,
+    /// positions, the time step, contact models, the cell, walls, bonds,
+    /// particles) calls it first; call it yourself before changing the public
+    /// fields by hand. Slip in it is booked as friction dissipation.
+    pub fn catch_up_shear_springs(&mut self) {
+        if self.springs_current {
+            return;
+        }
+        let dt = self.params.time_step;
+        let pairs = &mut self.neighbors.pairs;
+        let p = &self.particles;
+        let kernel = pair_kernel!(self, p, pairs, dt);
+        // SAFETY: one caller, and the sink writes nothing
+        let tally = unsafe {
+            kernel.run::<false, _>(0, &mut pairs.shear, &mut pairs.sliding, &mut NullSink)
+        };
+        let mut friction = tally.friction;
+        let l = self.deforming_gradient();
+        for bond in self.bonds.list.iter_mut() {
+            let copy = *bond;
+            bond_force(
+                &copy,
+                &self.particles,
+                self.cell.as_ref(),
+                l,
+                dt,
+                &mut bond.shear,
+            );
+        }
+        let wp = &mut self.neighbors.wall_pairs;
+        for k in 0..wp.wall.len() {
+            let wall = &self.walls[wp.wall[k] as usize];
+            let model = self.materials.by_index(wp.model[k]);
+            let q = wp.particle[k] as usize;
+            match wall_contact(wall, model, &self.particles, q, dt, dt, &mut wp.shear[k]) {
+                Some((_, c)) => {
+                    wp.sliding[k] = c.sliding;
+                    friction += c.friction_dissipation;
+                }
+                None => wp.sliding[k] = false,
+            }
+        }
+        self.ledger.friction_dissipated += friction;
+        self.springs_current = true;
+    }
+
+    /// Every listed pair as the next force evaluation will see it, without
+    /// changing the state (the springs are updated in copies).
+    pub(crate) fn preview_pairs(&self) -> Vec<Option<PairRecord>> {
+        let increment_time = self.increment_time();
+        let pairs = &self.neighbors.pairs;
+        let (mut shear, mut sliding) = (pairs.shear.clone(), pairs.sliding.clone());
+        let p = &self.particles;
+        let kernel = pair_kernel!(self, p, pairs, increment_time);
+        let mut sink = RecordSink {
+            records: vec![None; pairs.len()],
+        };
+        // SAFETY: one caller, and the sink writes only its own records
+        unsafe { kernel.run::<false, _>(0, &mut shear, &mut sliding, &mut sink) };
+        sink.records
+    }
+
+    /// Every wall pair as the next force evaluation will see it: the geometry,
+    /// the law's forces and the updated spring (in a copy), or `None`.
+    pub(crate) fn preview_wall_pairs(&self) -> Vec<Option<(ContactGeometry, ContactForce, f64)>> {
+        let (dt, increment_time) = (self.params.time_step, self.increment_time());
+        let wp = &self.neighbors.wall_pairs;
+        (0..wp.wall.len())
+            .map(|k| {
+                let mut spring = wp.shear[k];
+                let wall = &self.walls[wp.wall[k] as usize];
+                let model = self.materials.by_index(wp.model[k]);
+                let q = wp.particle[k] as usize;
+                wall_contact(
+                    wall,
+                    model,
+                    &self.particles,
+                    q,
+                    dt,
+                    increment_time,
+                    &mut spring,
+                )
+                .map(|(g, c)| (g, c, spring))
+            })
+            .collect()
+    }
+
+    /// Every bond as the next force evaluation will see it (springs in copies).
+    pub(crate) fn preview_bonds(&self) -> Vec<BondForce> {
+        let (increment_time, l) = (self.increment_time(), self.deforming_gradient());
+        self.bonds
+            .list
+            .iter()
+            .map(|b| {
+                let mut shear = b.shear;
+                bond_force(
+                    b,
+                    &self.particles,
+                    self.cell.as_ref(),
+                    l,
+                    increment_time,
+                    &mut shear,
+                )
+            })
+            .collect()
+    }
+
+    /// The velocity gradient of a deforming periodic cell, if any.
+    fn deforming_gradient(&self) -> Option<Mat2> {
+        self.cell
+            .as_ref()
+            .filter(|c| c.is_deforming())
+            .map(|c| c.velocity_gradient)
     }
 
     /// The energy ledger (kinetic and elastic as of the last measured step).
@@ -725,6 +926,7 @@ impl Simulation {
             };
         }
         self.half_kick_pending = false;
+        self.springs_current = false;
         self.step_count += 1;
         self.time += dt;
         // keep the lists valid between steps, so that queries see every contact;
@@ -742,6 +944,7 @@ impl Simulation {
 
     /// Steps 2-3: reset resultants, then particle-particle contact forces.
     fn particle_contacts<const MEASURE: bool>(&mut self, team: Option<&Team>) -> ContactTally {
+        let increment_time = self.increment_time();
         let n_blocks = self.neighbors.block_ranges.len();
         let pairs = &mut self.neighbors.pairs;
         let starts = &pairs.block_start;
@@ -771,26 +974,7 @@ impl Simulation {
         let p = &mut self.particles;
         let force = DisjointWriter::new(&mut p.force);
         let torque = DisjointWriter::new(&mut p.torque);
-        let kernel = PairKernel {
-            position: &p.position,
-            velocity: &p.velocity,
-            angular_velocity: &p.angular_velocity,
-            radius: &p.radius,
-            mass: &p.mass,
-            pair_i: &pairs.i,
-            pair_j: &pairs.j,
-            shift: &pairs.shift,
-            model: &pairs.model,
-            materials: &self.materials,
-            cell: self.cell.as_ref(),
-            velocity_gradient: self
-                .cell
-                .as_ref()
-                .filter(|c| c.is_deforming())
-                .map(|c| c.velocity_gradient),
-            dt: self.params.time_step,
-            max_overlap_ratio: self.params.max_overlap_ratio,
-        };
+        let kernel = pair_kernel!(self, p, pairs, increment_time);
         let reset = ResetKernel {
             boundary_load: (!self.chains.is_empty()).then_some(self.boundary_load.as_slice()),
             external_force: &p.external_force,
@@ -856,36 +1040,32 @@ impl Simulation {
     /// Step 4: bonds (sequential; chains of membrane disks are short).
     fn bond_forces<const MEASURE: bool>(&mut self) -> ContactTally {
         let mut tally = ContactTally::default();
-        let dt = self.params.time_step;
-        let l = self
-            .cell
-            .as_ref()
-            .filter(|c| c.is_deforming())
-            .map(|c| c.velocity_gradient);
-        let p = &mut self.particles;
-        for bond in &mut self.bonds.list {
-            let (i, j) = (bond.i as usize, bond.j as usize);
-            let d = minimum_image(self.cell.as_ref(), sub(p.position[j], p.position[i]));
-            let dist = norm(d);
-            let n = scale(d, 1.0 / dist);
-            let t = perp(n);
-            let mut dv = sub(p.velocity[j], p.velocity[i]);
-            if let Some(l) = &l {
-                dv = add(dv, mat_vec(l, d));
-            }
-            let (ri, rj) = (p.radius[i], p.radius[j]);
-            let vt = dot(dv, t) - (p.angular_velocity[i] * ri + p.angular_velocity[j] * rj);
-            let fn_ = bond.normal_stiffness * (bond.rest_length - dist);
-            bond.shear -= bond.shear_stiffness * vt * dt;
-            let fs = bond.shear;
-            let f = add(scale(n, fn_), scale(t, fs));
+        let increment_time = self.increment_time();
+        let l = self.deforming_gradient();
+        for bond in self.bonds.list.iter_mut() {
+            let copy = *bond;
+            let b = bond_force(
+                &copy,
+                &self.particles,
+                self.cell.as_ref(),
+                l,
+                increment_time,
+                &mut bond.shear,
+            );
+            let (i, j) = (copy.i as usize, copy.j as usize);
+            let p = &mut self.particles;
+            let f = add(
+                scale(b.normal, b.normal_force),
+                scale(perp(b.normal), b.shear_force),
+            );
             p.force[j] = add(p.force[j], f);
             p.force[i] = sub(p.force[i], f);
-            p.torque[i] -= ri * fs;
-            p.torque[j] -= rj * fs;
+            p.torque[i] -= p.radius[i] * b.shear_force;
+            p.torque[j] -= p.radius[j] * b.shear_force;
             if MEASURE {
+                let (fn_, fs) = (b.normal_force, b.shear_force);
                 tally.elastic +=
-                    0.5 * fn_ * fn_ / bond.normal_stiffness + 0.5 * fs * fs / bond.shear_stiffness;
+                    0.5 * fn_ * fn_ / copy.normal_stiffness + 0.5 * fs * fs / copy.shear_stiffness;
                 tally.force_sum += (fn_ * fn_ + fs * fs).sqrt();
                 tally.contacts += 1;
             }
@@ -903,27 +1083,29 @@ impl Simulation {
             wall.stiffness_sum = 0.0;
         }
         let dt = self.params.time_step;
-        let p = &mut self.particles;
+        let increment_time = self.increment_time();
         let wp = &mut self.neighbors.wall_pairs;
         for k in 0..wp.wall.len() {
             let wall = &mut self.walls[wp.wall[k] as usize];
             let q = wp.particle[k] as usize;
-            let r = p.radius[q];
-            let g = wall.disk_contact(p.position[q], r);
-            if g.overlap <= 0.0 {
-                wp.shear[k] = 0.0;
+            let model = self.materials.by_index(wp.model[k]);
+            let Some((g, c)) = wall_contact(
+                wall,
+                model,
+                &self.particles,
+                q,
+                dt,
+                increment_time,
+                &mut wp.shear[k],
+            ) else {
                 wp.sliding[k] = false;
                 continue;
-            }
-            let model = self.materials.by_index(wp.model[k]);
-            let n = g.normal;
-            let t = perp(n);
-            let dv = sub(p.velocity[q], wall.velocity);
-            let vn = dot(dv, n);
-            let vt = dot(dv, t) - p.angular_velocity[q] * r;
-            let c = linear_coulomb(model, g.overlap, vn, vt, dt, p.mass[q], &mut wp.shear[k]);
+            };
             wp.sliding[k] = c.sliding;
-            let f = add(scale(n, c.normal), scale(t, c.shear));
+            let p = &mut self.particles;
+            let r = p.radius[q];
+            let n = g.normal;
+            let f = add(scale(n, c.normal), scale(perp(n), c.shear));
             p.force[q] = add(p.force[q], f);
             p.torque[q] -= r * c.shear;
             wall.force = sub(wall.force, f);
@@ -936,8 +1118,7 @@ impl Simulation {
                 tally.overlap_violation = true;
             }
             if MEASURE {
-                tally.elastic +=
-                    elastic_energy(model, model.normal_stiffness * g.overlap, wp.shear[k]);
+                tally.elastic += elastic_energy(model, c.elastic_normal, wp.shear[k]);
                 tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
                 tally.contacts += 1;
             }
@@ -1142,15 +1323,26 @@ impl Simulation {
         }
     }
 
-    /// Serialises the complete state (contact history and neighbour lists included).
+    /// Serialises the complete state (contact history, pending shear increment
+    /// and neighbour lists included), after a tag naming its layout.
     pub fn to_bytes(&self) -> Result<Vec<u8>> {
-        bincode::serialize(self).map_err(|e| EngineError::invalid("state", e.to_string()))
+        let mut bytes = STATE_TAG.to_vec();
+        bincode::serialize_into(&mut bytes, self)
+            .map_err(|e| EngineError::invalid("state", e.to_string()))?;
+        Ok(bytes)
     }
 
     /// Restores a state written by [`Simulation::to_bytes`]; it continues bitwise
-    /// identically with the same thread count.
+    /// identically.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
-        let mut sim: Simulation = bincode::deserialize(bytes).map_err(|e| {
+        let Some(body) = bytes.strip_prefix(STATE_TAG.as_slice()) else {
+            return Err(EngineError::invalid(
+                "state",
+                "not a grainlab engine state of this engine's layout (a state written \
+                 by an older grainlab engine cannot be resumed by this one: start the run again)",
+            ));
+        };
+        let mut sim: Simulation = bincode::deserialize(body).map_err(|e| {
             EngineError::invalid("state", format!("not a grainlab engine state: {e}"))
         })?;
         sim.check_consistent()?;
@@ -1254,6 +1446,88 @@ pub fn minimum_image(cell: Option<&PeriodicCell>, d: Vec2) -> Vec2 {
     }
 }
 
+/// A bond's geometry and forces at the current state.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BondForce {
+    /// Unit normal from `i` to `j`.
+    pub normal: Vec2,
+    /// Centre distance (m).
+    pub distance: f64,
+    /// Normal force on `j` (N), positive in compression.
+    pub normal_force: f64,
+    /// Shear force on `j` along `perp(normal)` (N): the updated spring.
+    pub shear_force: f64,
+}
+
+/// Evaluates `bond` at the current state, adding `-ks v_t increment_time` to `shear`
+/// (its spring: the bond's own, or a copy for a query).
+#[inline]
+pub(crate) fn bond_force(
+    bond: &Bond,
+    p: &Particles,
+    cell: Option<&PeriodicCell>,
+    velocity_gradient: Option<Mat2>,
+    increment_time: f64,
+    shear: &mut f64,
+) -> BondForce {
+    let (i, j) = (bond.i as usize, bond.j as usize);
+    let d = minimum_image(cell, sub(p.position[j], p.position[i]));
+    let dist = norm(d);
+    let n = scale(d, 1.0 / dist);
+    let t = perp(n);
+    let mut dv = sub(p.velocity[j], p.velocity[i]);
+    if let Some(l) = &velocity_gradient {
+        dv = add(dv, mat_vec(l, d));
+    }
+    let (ri, rj) = (p.radius[i], p.radius[j]);
+    let vt = dot(dv, t) - (p.angular_velocity[i] * ri + p.angular_velocity[j] * rj);
+    *shear -= bond.shear_stiffness * vt * increment_time;
+    BondForce {
+        normal: n,
+        distance: dist,
+        normal_force: bond.normal_stiffness * (bond.rest_length - dist),
+        shear_force: *shear,
+    }
+}
+
+/// Particle `q` against `wall` at the current state: the geometry and the
+/// contact law's forces on the particle, updating `spring` (the pair's shear
+/// spring, or a copy for a query) over `increment_time`; `None`, with the
+/// spring zeroed, when they do not touch.
+#[inline]
+pub(crate) fn wall_contact(
+    wall: &Wall,
+    model: &ContactModel,
+    p: &Particles,
+    q: usize,
+    dt: f64,
+    increment_time: f64,
+    spring: &mut f64,
+) -> Option<(ContactGeometry, ContactForce)> {
+    let r = p.radius[q];
+    let g = wall.disk_contact(p.position[q], r);
+    if g.overlap <= 0.0 {
+        *spring = 0.0;
+        return None;
+    }
+    let n = g.normal;
+    let t = perp(n);
+    let dv = sub(p.velocity[q], wall.velocity);
+    let vn = dot(dv, n);
+    let vt = dot(dv, t) - p.angular_velocity[q] * r;
+    let c = linear_coulomb(
+        model,
+        g.overlap,
+        vn,
+        vt,
+        dt,
+        increment_time,
+        p.mass[q],
+        spring,
+    );
+    Some((g, c))
+}
+
 /// Where a pair's force goes: straight onto the particles, or into a buffer slot.
 trait ForceSink {
     /// Adds force `f` on `j` (its opposite on `i`) and the torques, for local pair `k`.
@@ -1263,6 +1537,56 @@ trait ForceSink {
     unsafe fn add(&mut self, k: usize, i: usize, j: usize, f: Vec2, torque_i: f64, torque_j: f64);
     /// Local pair `k` is not in contact.
     fn skip(&mut self, k: usize);
+    /// Local pair `k` is in contact with `overlap`, unit normal `n`, forces `c` and
+    /// (updated) shear spring `spring`; only the contact list keeps it.
+    #[inline(always)]
+    fn record(&mut self, _k: usize, _overlap: f64, _n: Vec2, _c: &ContactForce, _spring: f64) {}
+}
+
+/// Throws the forces away (the springs' catch-up).
+struct NullSink;
+
+impl ForceSink for NullSink {
+    #[inline(always)]
+    unsafe fn add(&mut self, _: usize, _: usize, _: usize, _: Vec2, _: f64, _: f64) {}
+    #[inline(always)]
+    fn skip(&mut self, _k: usize) {}
+}
+
+/// A particle pair's contact as the force evaluation saw it, for the contact list.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PairRecord {
+    /// Overlap (m).
+    pub overlap: f64,
+    /// Unit normal from `i` to `j`.
+    pub normal: Vec2,
+    /// Elastic normal force `kn * overlap` (N).
+    pub elastic_normal: f64,
+    /// Shear spring after the update (N).
+    pub shear_spring: f64,
+    /// Whether the spring is at the Coulomb cap.
+    pub sliding: bool,
+}
+
+/// Keeps every contact's record, in pair order (`None`: not in contact).
+struct RecordSink {
+    records: Vec<Option<PairRecord>>,
+}
+
+impl ForceSink for RecordSink {
+    #[inline(always)]
+    unsafe fn add(&mut self, _: usize, _: usize, _: usize, _: Vec2, _: f64, _: f64) {}
+    #[inline(always)]
+    fn skip(&mut self, _k: usize) {}
+    fn record(&mut self, k: usize, overlap: f64, n: Vec2, c: &ContactForce, spring: f64) {
+        self.records[k] = Some(PairRecord {
+            overlap,
+            normal: n,
+            elastic_normal: c.elastic_normal,
+            shear_spring: spring,
+            sliding: c.sliding,
+        });
+    }
 }
 
 struct DirectSink<'a> {
@@ -1406,7 +1730,36 @@ impl ResetKernel<'_> {
     }
 }
 
-struct PairKernel<'a> {
+/// A [`PairKernel`] over the particles `$p` and pair list `$pairs` of simulation
+/// `$sim` (a macro, so that the shear springs can be borrowed mutably apart).
+macro_rules! pair_kernel {
+    ($sim:expr, $p:expr, $pairs:expr, $increment_time:expr) => {
+        PairKernel {
+            position: &$p.position,
+            velocity: &$p.velocity,
+            angular_velocity: &$p.angular_velocity,
+            radius: &$p.radius,
+            mass: &$p.mass,
+            pair_i: &$pairs.i,
+            pair_j: &$pairs.j,
+            shift: &$pairs.shift,
+            model: &$pairs.model,
+            materials: &$sim.materials,
+            cell: $sim.cell.as_ref(),
+            velocity_gradient: $sim
+                .cell
+                .as_ref()
+                .filter(|c| c.is_deforming())
+                .map(|c| c.velocity_gradient),
+            dt: $sim.params.time_step,
+            increment_time: $increment_time,
+            max_overlap_ratio: $sim.params.max_overlap_ratio,
+        }
+    };
+}
+pub(crate) use pair_kernel;
+
+pub(crate) struct PairKernel<'a> {
     position: &'a [Vec2],
     velocity: &'a [Vec2],
     angular_velocity: &'a [f64],
@@ -1420,6 +1773,7 @@ struct PairKernel<'a> {
     cell: Option<&'a PeriodicCell>,
     velocity_gradient: Option<Mat2>,
     dt: f64,
+    increment_time: f64,
     max_overlap_ratio: f64,
 }
 
@@ -1489,8 +1843,18 @@ impl PairKernel<'_> {
                 } else {
                     0.0
                 };
-            let c = linear_coulomb(model, overlap, vn, vt, self.dt, reduced_mass, spring);
+            let c = linear_coulomb(
+                model,
+                overlap,
+                vn,
+                vt,
+                self.dt,
+                self.increment_time,
+                reduced_mass,
+                spring,
+            );
             *slide = c.sliding;
+            sink.record(k, overlap, n, &c, *spring);
             let f = [
                 c.normal * n[0] + c.shear * t[0],
                 c.normal * n[1] + c.shear * t[1],

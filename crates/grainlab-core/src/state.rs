@@ -1,6 +1,6 @@
 //! Particle state as a structure of arrays: one contiguous array per property.
 //!
-//! Disks have unit out-of-plane thickness (DESIGN §2): `m = rho * pi * r^2`,
+//! Disks have unit out-of-plane thickness (docs/conventions.md): `m = rho * pi * r^2`,
 //! `I = m r^2 / 2`. Velocities are the leapfrog half-step values `v(n - 1/2)`
 //! once the simulation has stepped; velocities set by the user are taken as
 //! full-step values at the current time, and the next step starts with a half kick.

@@ -9,25 +9,30 @@ fn agitate(sim: &mut grainlab_core::Simulation, spin: bool) {
     sim.run(1).unwrap();
     let elastic = sim.energy().elastic;
     let mut rng = Rng::new(5);
-    let p = &mut sim.particles;
-    let mut kinetic = 0.0;
-    for k in 0..p.len() {
-        p.velocity[k] = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
-        p.angular_velocity[k] = if spin {
-            rng.uniform(-1.0, 1.0) / p.radius[k]
-        } else {
-            0.0
-        };
-        let v = p.velocity[k];
-        kinetic += 0.5 * p.mass[k] * (v[0] * v[0] + v[1] * v[1])
-            + 0.5 * p.inertia[k] * p.angular_velocity[k].powi(2);
-    }
-    let s = (elastic / kinetic).sqrt();
-    for k in 0..p.len() {
-        p.velocity[k] = [p.velocity[k][0] * s, p.velocity[k][1] * s];
-        p.angular_velocity[k] *= s;
-    }
-    sim.velocities_changed();
+    let (mass, inertia, radius) = (
+        sim.particles.mass.clone(),
+        sim.particles.inertia.clone(),
+        sim.particles.radius.clone(),
+    );
+    sim.change_velocities(|velocity, omega| {
+        let mut kinetic = 0.0;
+        for k in 0..velocity.len() {
+            velocity[k] = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
+            omega[k] = if spin {
+                rng.uniform(-1.0, 1.0) / radius[k]
+            } else {
+                0.0
+            };
+            let v = velocity[k];
+            kinetic +=
+                0.5 * mass[k] * (v[0] * v[0] + v[1] * v[1]) + 0.5 * inertia[k] * omega[k].powi(2);
+        }
+        let s = (elastic / kinetic).sqrt();
+        for k in 0..velocity.len() {
+            velocity[k] = [velocity[k][0] * s, velocity[k][1] * s];
+            omega[k] *= s;
+        }
+    });
 }
 
 #[test]
@@ -111,16 +116,12 @@ fn momentum_is_conserved_without_walls() {
     // Newton's third law in every contact: total linear momentum is constant.
     let mut sim = dense_periodic(16, 1.0e-3, 0.9, 21, 2);
     let mut rng = Rng::new(1);
-    for (v, w) in sim
-        .particles
-        .velocity
-        .iter_mut()
-        .zip(sim.particles.angular_velocity.iter_mut())
-    {
-        *v = [rng.uniform(-0.01, 0.01), rng.uniform(-0.01, 0.01)];
-        *w = rng.uniform(-5.0, 5.0);
-    }
-    sim.velocities_changed();
+    sim.change_velocities(|velocity, omega| {
+        for (v, w) in velocity.iter_mut().zip(omega.iter_mut()) {
+            *v = [rng.uniform(-0.01, 0.01), rng.uniform(-0.01, 0.01)];
+            *w = rng.uniform(-5.0, 5.0);
+        }
+    });
     let momentum = |sim: &grainlab_core::Simulation| {
         let p = &sim.particles;
         (0..p.len()).fold([0.0, 0.0], |acc, k| {

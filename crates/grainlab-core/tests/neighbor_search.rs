@@ -92,11 +92,12 @@ fn random_sim(seed: u64, periodic: bool, deform: bool, threads: usize) -> Simula
         }
         sim.set_cell(Some(cell)).unwrap();
     }
-    for v in sim.particles.velocity.iter_mut() {
-        // up to 5 m/s: 50 um per step, a large fraction of the small radii and of the skin
-        *v = [rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0)];
-    }
-    sim.velocities_changed();
+    sim.change_velocities(|velocity, _| {
+        for v in velocity.iter_mut() {
+            // up to 5 m/s: 50 um per step, a large fraction of the small radii and of the skin
+            *v = [rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0)];
+        }
+    });
     sim
 }
 

@@ -26,9 +26,10 @@ fn collide(alpha: f64) -> (f64, f64) {
         max_overlap_ratio: 0.9,
     })
     .unwrap();
-    sim.particles.velocity[0] = [v0, 0.0];
-    sim.particles.velocity[1] = [-v0, 0.0];
-    sim.velocities_changed();
+    sim.change_velocities(|v, _| {
+        v[0] = [v0, 0.0];
+        v[1] = [-v0, 0.0];
+    });
     let (mut start, mut end) = (None, None);
     for _ in 0..20_000 {
         sim.run(1).unwrap();

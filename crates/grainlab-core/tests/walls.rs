@@ -36,8 +36,7 @@ fn normal_impact_on_a_wall() {
     let t_c = std::f64::consts::PI * (mass() / KN).sqrt();
     let dt = t_c / 2000.0;
     let mut sim = floor_sim(ContactModel::linear(KN, KN, 0.3), dt, 0.0, R + 1e-7);
-    sim.particles.velocity[0] = [0.0, -0.1];
-    sim.velocities_changed();
+    sim.change_velocities(|v, _| v[0] = [0.0, -0.1]);
     let (mut start, mut end) = (None, None);
     for _ in 0..10_000 {
         sim.run(1).unwrap();
@@ -67,8 +66,7 @@ fn oblique_impact_in_gross_sliding() {
     let t_c = std::f64::consts::PI * (mass() / KN).sqrt();
     let dt = t_c / 4000.0;
     let mut sim = floor_sim(ContactModel::linear(KN, KN, mu), dt, 0.0, R + 1e-7);
-    sim.particles.velocity[0] = [vt, -vn];
-    sim.velocities_changed();
+    sim.change_velocities(|v, _| v[0] = [vt, -vn]);
     let mut touched = false;
     for _ in 0..20_000 {
         sim.run(1).unwrap();
@@ -107,8 +105,7 @@ fn sliding_disk_ends_in_pure_rolling_at_two_thirds_speed() {
     let dt = t_c / 50.0;
     let overlap = mass() * g / KN;
     let mut sim = floor_sim(model, dt, g, R - overlap);
-    sim.particles.velocity[0] = [v0, 0.0];
-    sim.velocities_changed();
+    sim.change_velocities(|v, _| v[0] = [v0, 0.0]);
     // sliding lasts v0 / (3 mu g) ~ 14 ms; run 40 ms
     let steps = (0.04 / dt) as u64;
     sim.run(steps).unwrap();

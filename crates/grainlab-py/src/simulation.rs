@@ -280,8 +280,9 @@ impl Engine {
         let v = points("positions", &positions)?;
         same_length("positions", v.len(), self.sim.particles.len())?;
         check_finite_points("positions", &v)?;
-        self.sim.particles.position = self.sim.to_internal(&v);
-        self.sim.invalidate_neighbors();
+        let internal = self.sim.to_internal(&v);
+        self.sim
+            .change_positions(|position| position.copy_from_slice(&internal));
         Ok(())
     }
 
@@ -289,8 +290,9 @@ impl Engine {
         let v = points("velocities", &velocities)?;
         same_length("velocities", v.len(), self.sim.particles.len())?;
         check_finite_points("velocities", &v)?;
-        self.sim.particles.velocity = self.sim.to_internal(&v);
-        self.sim.velocities_changed();
+        let internal = self.sim.to_internal(&v);
+        self.sim
+            .change_velocities(|velocity, _| velocity.copy_from_slice(&internal));
         Ok(())
     }
 
@@ -314,8 +316,9 @@ impl Engine {
         let v = values(&omega);
         same_length("angular_velocities", v.len(), self.sim.particles.len())?;
         check_finite("angular_velocities", &v)?;
-        self.sim.particles.angular_velocity = self.sim.to_internal(&v);
-        self.sim.velocities_changed();
+        let internal = self.sim.to_internal(&v);
+        self.sim
+            .change_velocities(|_, omega| omega.copy_from_slice(&internal));
         Ok(())
     }
 
@@ -333,6 +336,8 @@ impl Engine {
         for (k, &r) in v.iter().enumerate() {
             grainlab_core::error::require_positive(&format!("radii[{k}]"), r).map_err(to_py_err)?;
         }
+        // new radii change the overlaps: the last step's displacement is counted first
+        self.sim.catch_up_shear_springs();
         self.sim.particles.radius = self.sim.to_internal(&v);
         self.sim.particles.update_mass_properties();
         self.sim.invalidate_neighbors();
@@ -363,6 +368,7 @@ impl Engine {
                 "groups[{k}]: group {g} out of range 0..16"
             )));
         }
+        self.sim.catch_up_shear_springs();
         self.sim.particles.group = self.sim.to_internal(&v);
         self.sim.invalidate_neighbors();
         Ok(())
@@ -479,13 +485,7 @@ impl Engine {
 
     fn set_wall_velocity(&mut self, wall_id: usize, velocity: Vec<f64>) -> PyResult<()> {
         let v = point("velocity", velocity)?;
-        for c in v {
-            grainlab_core::error::require_finite("velocity", c).map_err(to_py_err)?;
-        }
-        let wall = self.sim.wall_mut(wall_id).map_err(to_py_err)?;
-        wall.control = WallControl::Velocity;
-        wall.velocity = v;
-        Ok(())
+        self.sim.set_wall_velocity(wall_id, v).map_err(to_py_err)
     }
 
     fn set_wall_servo(
@@ -509,8 +509,7 @@ impl Engine {
 
     fn move_wall(&mut self, wall_id: usize, displacement: Vec<f64>) -> PyResult<()> {
         let d = point("displacement", displacement)?;
-        self.sim.wall_mut(wall_id).map_err(to_py_err)?.translate(d);
-        Ok(())
+        self.sim.translate_wall(wall_id, d).map_err(to_py_err)
     }
 
     fn wall_state<'py>(&mut self, py: Python<'py>, wall_id: usize) -> PyResult<Bound<'py, PyDict>> {

@@ -25,15 +25,16 @@ impl Rng {
 pub const KN: f64 = 8.45e7;
 pub const DENSITY: f64 = 2.0e8;
 
-/// A dense, overlapping packing in a periodic square cell: a jittered square grid
-/// of spacing `s` with radii uniform in `[0.45 s, 0.56 s]`.
-pub fn dense_periodic(
+/// A jittered square grid of `n_side` x `n_side` disks of spacing `s`, radii
+/// uniform in `[0.45 s, 0.56 s]` (neighbours overlap), Table 1's stiffness,
+/// dt = 0.1 sqrt(m_min / kn), no cell or walls; returns the generator for more.
+fn jittered_grid(
     n_side: usize,
     s: f64,
     friction: f64,
     seed: u64,
     threads: usize,
-) -> Simulation {
+) -> (Simulation, Rng) {
     let mut rng = Rng::new(seed);
     let mut pos = Vec::new();
     let mut rad = Vec::new();
@@ -49,13 +50,25 @@ pub fn dense_periodic(
     let particles = Particles::new(pos, rad, vec![DENSITY]).unwrap();
     let m_min = DENSITY * std::f64::consts::PI * (0.45 * s).powi(2);
     let dt = 0.1 * (m_min / KN).sqrt();
-    let mut sim = Simulation::new(
+    let sim = Simulation::new(
         particles,
         ContactModel::linear(KN, KN, friction),
         dt,
         threads,
     )
     .unwrap();
+    (sim, rng)
+}
+
+/// A dense, overlapping packing in a periodic square cell: [`jittered_grid`].
+pub fn dense_periodic(
+    n_side: usize,
+    s: f64,
+    friction: f64,
+    seed: u64,
+    threads: usize,
+) -> Simulation {
+    let (mut sim, _) = jittered_grid(n_side, s, friction, seed, threads);
     let l = n_side as f64 * s;
     sim.set_cell(Some(
         PeriodicCell::rectangle([0.0, 0.0], l, l, [true, true]).unwrap(),
@@ -110,5 +123,48 @@ pub fn bench_packing(friction: f64, dt_factor: f64, threads: usize) -> Simulatio
         PeriodicCell::rectangle([0.0, 0.0], l, l, [true, true]).unwrap(),
     ))
     .unwrap();
+    sim
+}
+
+/// A dense, overlapping packing in a box: a jittered square grid of spacing `s`
+/// (radii uniform in `[0.45 s, 0.56 s]`) between four segment walls at its edges
+/// (ids 0 bottom, 1 right, 2 top, 3 left, all touched by the outer disks), the
+/// first column (`0..n_side`, bottom to top) bonded into a chain like a membrane,
+/// random velocities and spins (full-step values), local damping 0.3.
+pub fn boxed_packing(n_side: usize, friction: f64, seed: u64, threads: usize) -> Simulation {
+    use grainlab_core::{StepParameters, Wall, WallShape};
+    let s = 1.0e-3;
+    let (mut sim, mut rng) = jittered_grid(n_side, s, friction, seed, threads);
+    let n = sim.particles.len();
+    let dt = sim.params.time_step;
+    sim.set_params(StepParameters {
+        time_step: dt,
+        local_damping: 0.3,
+        gravity: [0.0; 2],
+        max_overlap_ratio: 0.5,
+    })
+    .unwrap();
+    let l = n_side as f64 * s;
+    let corners = [[0.0, 0.0], [l, 0.0], [l, l], [0.0, l]];
+    for k in 0..4 {
+        let wall = Wall::new(
+            WallShape::Segment {
+                a: corners[k],
+                b: corners[(k + 1) % 4],
+            },
+            1,
+        )
+        .unwrap();
+        sim.add_wall(wall);
+    }
+    for b in 0..n_side - 1 {
+        sim.add_bond(b, b + 1, 0.1 * KN, 0.1 * KN, None).unwrap();
+    }
+    sim.change_velocities(|v, w| {
+        for k in 0..n {
+            v[k] = [rng.uniform(-0.02, 0.02), rng.uniform(-0.02, 0.02)];
+            w[k] = rng.uniform(-20.0, 20.0);
+        }
+    });
     sim
 }
