@@ -284,8 +284,8 @@ class Simulation:
         :meth:`set_contact_model` says otherwise
     time_step : s; ``None`` picks ``time_step_safety`` times the critical step
         (:meth:`critical_time_step`)
-    threads : worker threads (default: all cores); results are bitwise
-        reproducible for a given count
+    threads : worker threads (default: all cores); results are bitwise the
+        same for every count (the work partition depends on the system only)
     local_damping : alpha of paper Eq. 5, in [0, 1)
     gravity : (gx, gy), m/s^2
     """
@@ -393,6 +393,7 @@ class Simulation:
 
     @property
     def threads(self) -> int:
+        """Worker threads; setting it, even mid-run, does not change any result."""
         return int(self._engine.threads)
 
     @threads.setter
@@ -806,7 +807,7 @@ class Simulation:
 
     @classmethod
     def from_bytes(cls, data: bytes) -> Simulation:
-        """Restores :meth:`to_bytes`; the run continues bitwise identically (same thread count)."""
+        """Restores :meth:`to_bytes`; the run continues bitwise identically (on any thread count)."""
         return cls._from_engine(_core.Engine.from_bytes(data))
 
     def save(self, path: str | os.PathLike[str]) -> None:

@@ -10,7 +10,9 @@
 //! rebuilt as soon as either bound could be violated, at the start of a step.
 //!
 //! Pairs are grouped for parallel force evaluation: the particles are split
-//! into `n_blocks` stripes of bin columns with balanced counts; pairs with both
+//! into stripes of bin columns with balanced counts, as many as
+//! [`stripe_count`] gives for the system (never a function of the thread
+//! count); pairs with both
 //! particles in block `b` are stored contiguously (`block_start[b]..block_start[b+1]`)
 //! and may be evaluated concurrently with other blocks; pairs across blocks
 //! come last. Shear history is carried over from the previous list by pair key.
@@ -22,6 +24,7 @@ use crate::bond::Bonds;
 use crate::cell::PeriodicCell;
 use crate::error::{EngineError, Result};
 use crate::material::MaterialTable;
+use crate::parallel::stripe_count;
 use crate::state::Particles;
 use crate::vec2::{add, distance_from_identity, dot, sub, Mat2, Vec2, IDENTITY};
 use crate::wall::Wall;
@@ -314,10 +317,8 @@ impl NeighborList {
         walls: &[Wall],
         bonds: &mut Bonds,
         materials: &MaterialTable,
-        n_blocks: usize,
     ) -> Result<Vec<u32>> {
         let n = particles.len();
-        let n_blocks = n_blocks.max(1);
         let r_max = particles.max_radius();
         let cutoff = 2.0 * r_max + self.skin;
 
@@ -331,6 +332,7 @@ impl NeighborList {
 
         // 2. bins in fractional coordinates
         let grid = BinGrid::new(&particles.position, cell, cutoff)?;
+        let n_blocks = stripe_count(n, grid.n[0]);
         let bins = grid.assign(&particles.position, cell);
         let (bin_start, perm) = counting_sort(&bins, grid.count());
 

@@ -266,17 +266,33 @@ impl<T, R> ClaimSlot<T, R> {
     }
 }
 
-/// Work blocks per worker thread: a few, so that workers balance their load
-/// by claiming blocks, while cross-block pairs stay few.
-pub const BLOCKS_PER_THREAD: usize = 4;
+/// Below this many particles a system is one stripe, run on the calling
+/// thread: the hand-over of a phase would cost more than it saves.
+pub const PARALLEL_MIN_PARTICLES: usize = 3000;
 
-/// Number of work blocks for `threads` threads (one block without parallelism).
-pub fn block_count(threads: usize) -> usize {
-    if threads <= 1 {
-        1
-    } else {
-        threads * BLOCKS_PER_THREAD
+/// Particles per work stripe: enough stripes for a few per worker (which then
+/// balance their load by claiming stripes), few enough that the pairs across
+/// stripes, buffered and applied afterwards, stay a small part of all pairs.
+pub const PARTICLES_PER_STRIPE: usize = 500;
+
+/// Bin columns per stripe at least: a narrower stripe has most pairs across.
+pub const MIN_COLUMNS_PER_STRIPE: usize = 3;
+
+/// Most stripes of a system (four per worker on four cores).
+pub const MAX_STRIPES: usize = 16;
+
+/// Number of work stripes for `particles` disks in `columns` bin columns.
+///
+/// It depends on the system only, never on the thread count: every thread count
+/// runs the same partition, the same pairs in the same order and the same
+/// reductions in stripe order, so results are bitwise independent of it.
+pub fn stripe_count(particles: usize, columns: usize) -> usize {
+    if particles < PARALLEL_MIN_PARTICLES {
+        return 1;
     }
+    (particles / PARTICLES_PER_STRIPE)
+        .min(columns / MIN_COLUMNS_PER_STRIPE)
+        .clamp(1, MAX_STRIPES)
 }
 /// A raw pointer that may be shared between threads that write *disjoint*
 /// elements: each particle belongs to exactly one block, and a block's task

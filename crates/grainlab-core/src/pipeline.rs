@@ -31,16 +31,13 @@ use crate::integrate::{
 use crate::law::{elastic_energy, linear_coulomb, ContactForce};
 use crate::material::{ContactModel, MaterialTable};
 use crate::neighbor::NeighborList;
-use crate::parallel::{block_count, even_bounds, map_blocks, split_ranges, DisjointWriter, Team};
+use crate::parallel::{
+    even_bounds, map_blocks, split_ranges, DisjointWriter, Team, PARALLEL_MIN_PARTICLES,
+};
 use crate::state::Particles;
 use crate::vec2::{add, dot, mat_vec, norm, perp, scale, sub, Mat2, Vec2};
 use crate::wall::{Wall, WallControl};
 use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
-
-/// Below this many particles the blocks run one after another on the calling
-/// thread: the same partition and order, so the same bits, without the
-/// hand-over cost that would dominate a tiny system.
-const PARALLEL_MIN_PARTICLES: usize = 3000;
 
 /// The first bytes of [`Simulation::to_bytes`]: the layout of the state that
 /// follows (bincode of [`Simulation`]); a new field makes a new tag.
@@ -210,18 +207,18 @@ impl Simulation {
         Ok(())
     }
 
-    /// Worker threads used by the step (results are bitwise reproducible for a given count).
+    /// Worker threads used by the step. Results are bitwise the same for every
+    /// count: the work partition depends on the system only (`parallel::stripe_count`).
     pub fn threads(&self) -> usize {
         self.threads
     }
 
-    /// Changes the thread count (and so the block partition: results change bitwise).
+    /// Changes the thread count, at any time: the results do not change.
     pub fn set_threads(&mut self, threads: usize) -> Result<()> {
         if threads == 0 {
             return Err(EngineError::invalid("threads", "must be >= 1"));
         }
         self.threads = threads;
-        self.neighbors.invalidate();
         self.make_pool()
     }
 
@@ -763,7 +760,6 @@ impl Simulation {
             &self.walls,
             &mut self.bonds,
             &self.materials,
-            block_count(self.threads),
         )?;
         for chain in self.chains.iter_mut() {
             chain.remap(&new_of_old);
@@ -1161,12 +1157,9 @@ impl Simulation {
             boundary_load: (!self.chains.is_empty()).then_some(self.boundary_load.as_slice()),
             reference: self.neighbors.reference().reference,
         };
-        // each worker integrates the block whose contacts it just computed
-        let bounds = if self.neighbors.block_ranges.len() == block_count(self.threads) {
-            self.neighbors.block_ranges.clone()
-        } else {
-            even_bounds(p.position.len(), block_count(self.threads))
-        };
+        // the stripes of the contact phase: a worker integrates (first) the
+        // stripes whose contacts it just computed
+        let bounds = self.neighbors.block_ranges.clone();
         let cross = CrossForces {
             pair_i: &self.neighbors.pairs.i,
             pair_j: &self.neighbors.pairs.j,
@@ -1181,12 +1174,6 @@ impl Simulation {
             touch: &self.neighbors.cross_touch,
             touch_start: &self.neighbors.cross_touch_start,
         };
-        let per_block = bounds == self.neighbors.block_ranges;
-        if !per_block {
-            for b in 0..self.neighbors.block_ranges.len() {
-                cross.apply(b, 0, &mut p.force, &mut p.torque);
-            }
-        }
         type Work<'w> = (
             usize,
             usize,
@@ -1231,11 +1218,9 @@ impl Simulation {
             team,
             chunks,
             |(b, lo, position, velocity, rotation, angular_velocity, force, torque)| {
-                if per_block {
-                    // the cross-block pairs touching this block, in pair order, as a
-                    // sequential pass over all of them would have added them
-                    cross.apply(b, lo, force, torque);
-                }
+                // the cross-block pairs touching this block, in pair order, as a
+                // sequential pass over all of them would have added them
+                cross.apply(b, lo, force, torque);
                 let chunk = MotionChunk {
                     lo,
                     position,
