@@ -177,6 +177,8 @@ def test_a_run_stopped_while_its_report_is_written_gets_it_with_resume(tmp_path,
     monkeypatch.setattr(report, "write_report", fake_report)
     assert main([*args, "--resume"]) == 0
     assert written == [out] and (out / "report.html").exists()
+    assert main([*args, "--resume"]) == 0  # finished, report and all: nothing more to write
+    assert written == [out]
 
 
 #: The command line with stand-in figures that take a while to draw (the real ones take

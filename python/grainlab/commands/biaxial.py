@@ -43,8 +43,8 @@ def run(args: argparse.Namespace) -> int:
     config = resolve(args.config, overrides, quick=args.quick)
     result = run_biaxial(config, args.out, resume=args.resume, progress=not args.no_progress)
     print(result.one_line())
-    if args.no_report:
-        return 0
+    if args.no_report or (args.resume and (result.out_dir / "report.html").exists()):
+        return 0  # a report is written last (atomically): one there is this finished run's
     from grainlab.commands.report import write_after_run
 
     return write_after_run(result.out_dir, "biaxial")

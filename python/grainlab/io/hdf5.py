@@ -184,7 +184,7 @@ def snapshot_name(axial_strain: float, *, digits: int = 4, prefix: str = "strain
     """
     value = float(axial_strain)
     if not math.isfinite(value):
-        raise ValueError(f"axial_strain: must be finite, got {axial_strain!r}")
+        raise ValueError(f"axial_strain: must be finite, got {value!r}")
     if not 0 <= int(digits) <= 12:
         raise ValueError(f"digits: must be in 0..12, got {digits!r}")
     text = f"{value:.{int(digits)}f}"

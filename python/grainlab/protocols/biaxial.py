@@ -980,7 +980,7 @@ def _check_shear_plan(sim: Simulation, run: _Run, config: BiaxialConfig) -> None
         shear["strain_rate"], sim.time_step, shear["height0"], float(sim.radii.min()), config["shear.record_interval"]
     )
     if problem is not None:
-        raise BiaxialError(f"shear.strain_rate: {problem}")
+        raise BiaxialError(f"shear.strain_rate: {problem}; start again with a slower rate in another folder")
     wanted = [s for s in config["shear.snapshot_strains"] if s <= config["shear.final_strain"] + 1e-12]
     if len(shear["snapshot_steps"]) < len(wanted):
         raise BiaxialError(
