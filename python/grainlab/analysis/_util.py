@@ -89,16 +89,19 @@ def repeated_boundary_contacts(snapshot: Snapshot, used: NDArray[np.bool_]) -> N
     ci = np.asarray(snapshot.contact_i)
     cj = np.asarray(snapshot.contact_j)
     keys = snapshot.boundary_body_keys()
-    on_i = snapshot.is_sample[ci]
+    sample = snapshot.is_sample
+    on_i = sample[ci]
     owner = np.where(on_i, ci, np.where(cj >= 0, cj, 0))
-    key = np.where(used, np.where(on_i, keys[:, 0], keys[:, 1]), -1)
+    on_sample = on_i | ((cj >= 0) & sample[owner])
+    key = np.where(used & on_sample, np.where(on_i, keys[:, 0], keys[:, 1]), -1)
     return boundary_end_groups(owner, key) != np.arange(ci.size)
 
 
 def _merged_angles(
     angles: NDArray[np.float64], groups: NDArray[np.int64], weight: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    """Each end's angle replaced by its group's weighted mean direction, in [0, 2 pi)."""
+    """Each end's angle replaced by its group's weighted mean direction, in [0, 2 pi)
+    (ends alone in their group keep their angle exactly)."""
     n = angles.size
     c, s = np.cos(angles), np.sin(angles)
     total = np.bincount(groups, weights=weight, minlength=n)
@@ -107,10 +110,10 @@ def _merged_angles(
     my = np.bincount(groups, weights=w * s, minlength=n)[groups]
     length = np.hypot(mx, my)
     ok = length > 1e-12 * np.bincount(groups, weights=w, minlength=n)[groups]
-    merged = np.where(ok, np.arctan2(my, mx), angles[groups])
-    merged = np.mod(merged, TWO_PI)
+    merged = np.mod(np.where(ok, np.arctan2(my, mx), angles[groups]), TWO_PI)
     merged[merged >= TWO_PI] = 0.0
-    return merged
+    alone = np.bincount(groups, minlength=n)[groups] == 1
+    return np.where(alone, angles, merged)
 
 
 def finite_mean(values: NDArray[np.float64], mask: NDArray[np.bool_] | None = None) -> float:
