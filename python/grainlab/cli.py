@@ -37,7 +37,26 @@ def build_parser() -> argparse.ArgumentParser:
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
         importlib.import_module(name).register(subparsers)
+    for command in subparsers.choices.values():
+        add_output_options(command)
     return parser
+
+
+def add_output_options(parser: argparse.ArgumentParser) -> None:
+    """``--quiet``, ``--verbose`` and ``--no-progress``, the same on every subcommand.
+
+    A command reads ``args.progress`` (show progress) and ``args.quiet`` (print
+    nothing but errors and its final summary line), both set by :func:`main`.
+    Progress goes to stderr: a bar on a terminal, a few plain lines otherwise
+    (:mod:`grainlab._progress`).
+    """
+    group = parser.add_argument_group("output")
+    loudness = group.add_mutually_exclusive_group()
+    loudness.add_argument("-q", "--quiet", action="store_true",
+                          help="print nothing but errors and the final summary line")
+    loudness.add_argument("-v", "--verbose", action="store_true",
+                          help="progress lines with more milestones and the current values (when not on a terminal)")
+    group.add_argument("--no-progress", action="store_true", help="no progress display")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -46,6 +65,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     if getattr(args, "func", None) is None:
         parser.print_help()
         return 2
+    from grainlab._progress import set_verbose
+
+    args.quiet = getattr(args, "quiet", False)  # a parser built without add_output_options has none
+    args.progress = not (getattr(args, "no_progress", False) or args.quiet)
+    set_verbose(getattr(args, "verbose", False))
     try:
         return int(args.func(args))
     except ValueError as error:  # bad input, refused before any work

@@ -15,8 +15,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
+from grainlab._progress import progress_bar
 from grainlab.io.results import (
     ensure_output_folder,
     refuse_overwrite,
@@ -79,7 +79,7 @@ def compress(
     tolerance: float = 0.01,
     unbalanced_force_limit: float = 1.0e-3,
     threads: int | None = None,
-    progress: bool = True,
+    progress: bool = False,
 ) -> CompressionResult:
     """Compresses ``n_side**2`` disks (diameters 0.5-3 mm scaled to their grid
     cells) in a box of four servo walls to ``pressure_pa`` until both wall
@@ -116,7 +116,7 @@ def compress(
     start = time.perf_counter()
     steps = 0
     converged = False
-    bar = tqdm(total=max_steps, desc="compressing", unit="step", disable=not progress, leave=False)
+    bar = progress_bar(max_steps, "compressing", enabled=progress, unit="step")
     while steps < max_steps:
         sim.run(chunk)
         steps += chunk
@@ -140,7 +140,7 @@ def compress(
                 "kinetic_energy_j": sim.energy["kinetic"],
             }
         )
-        bar.set_postfix(sxx=f"{sx / 1e3:.1f}kPa", syy=f"{sy / 1e3:.1f}kPa", ubf=f"{sim.unbalanced_force_ratio:.1e}")
+        bar.set_postfix_str(f"sxx {sx / 1e3:.1f} kPa, syy {sy / 1e3:.1f} kPa, unbalanced {sim.unbalanced_force_ratio:.1e}")
         if (
             abs(sx / pressure_pa - 1) < tolerance
             and abs(sy / pressure_pa - 1) < tolerance

@@ -31,7 +31,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--strain-rate", help='axial strain rate, e.g. "2%%/min" (the paper\'s) or 0.01 (1/s)')
     parser.add_argument("--quick", action="store_true", help="a small sample of a few hundred disks")
     parser.add_argument("--resume", action="store_true", help="continue the killed run in --out")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.add_argument("--no-report", action="store_true", help="do not write report.html at the end")
     parser.set_defaults(func=run)
 
@@ -41,10 +40,10 @@ def run(args: argparse.Namespace) -> int:
     if args.strain_rate is not None:
         overrides.append(f"shear.strain_rate={args.strain_rate}")
     config = resolve(args.config, overrides, quick=args.quick)
-    result = run_biaxial(config, args.out, resume=args.resume, progress=not args.no_progress)
+    result = run_biaxial(config, args.out, resume=args.resume, progress=args.progress)
     print(result.one_line())
     if args.no_report or (args.resume and (result.out_dir / "report.html").exists()):
         return 0  # a report is written last (atomically): one there is this finished run's
     from grainlab.commands.report import write_after_run
 
-    return write_after_run(result.out_dir, "biaxial")
+    return write_after_run(result.out_dir, "biaxial", quiet=args.quiet)

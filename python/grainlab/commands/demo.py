@@ -18,7 +18,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--pressure-kpa", type=float, default=100.0, help="target stress in kPa (default 100)")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--threads", type=int, default=None, help="engine threads (default: all cores)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.set_defaults(func=run)
 
 
@@ -29,7 +28,7 @@ def run(args: argparse.Namespace) -> int:
         pressure_pa=args.pressure_kpa * 1e3,
         seed=args.seed,
         threads=args.threads,
-        progress=not args.no_progress,
+        progress=args.progress,
     )
     state = "converged" if result.converged else "NOT converged"
     print(

@@ -43,9 +43,9 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def write_after_run(out_dir: str | Path, command: str) -> int:
-    """The report at the end of ``grainlab biaxial`` / ``grainlab study``: prints its path,
-    or, if it fails, says why on stderr and how to retry (the run's results stay valid)."""
+def write_after_run(out_dir: str | Path, command: str, quiet: bool = False) -> int:
+    """The report at the end of ``grainlab biaxial`` / ``grainlab study``: prints its path
+    (unless ``quiet``), or, if it fails, says why on stderr and how to retry (the run's results stay valid)."""
     try:
         path = write_report(out_dir)
     except Exception as error:  # the run is done and valid; a report failure must not hide that
@@ -55,5 +55,6 @@ def write_after_run(out_dir: str | Path, command: str) -> int:
             file=sys.stderr,
         )
         return 1
-    print(f"grainlab {command}: report {path}")
+    if not quiet:
+        print(f"grainlab {command}: report {path}")
     return 0

@@ -47,7 +47,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--scheduler", default=None, help="Dask scheduler address, e.g. tcp://host:8786")
     parser.add_argument("--claims-only", action="store_true",
                         help="run nothing: recompute the claims from the runs already in OUT")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.set_defaults(func=run)
 
 
@@ -62,13 +61,14 @@ def run(args: argparse.Namespace) -> int:
     if args.claims_only and not (out / PLAN_FILE).exists():
         raise ValueError(f"--claims-only: {out} holds no reproduction ({PLAN_FILE} not found); run it first")
     plan = plan_from_args(args.seeds, args.variants, args.quick, args.out)
-    print(f"grainlab reproduce: seeds {', '.join(map(str, plan.seeds))}" + (" (quick)" if plan.quick else ""))
-    for line in describe(plan):
-        print(f"  {line}")
+    if not args.quiet:
+        print(f"grainlab reproduce: seeds {', '.join(map(str, plan.seeds))}" + (" (quick)" if plan.quick else ""))
+        for line in describe(plan):
+            print(f"  {line}")
     failed: list[str] = []
     if not args.claims_only:
         result = run_reproduction(plan, args.out, workers=args.workers, scheduler=args.scheduler,
-                                  progress=not args.no_progress)
+                                  progress=args.progress)
         failed = result.failed
         print(
             f"grainlab reproduce: {len(result.rows)} runs ({len(result.executed)} run, {len(result.skipped)} "
@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"  failed: {name} (see {args.out}/runs/{name}/error.txt)", file=sys.stderr)
     from grainlab.reproduction.outputs import write_outputs
 
-    written = write_outputs(plan, args.out, workers=args.workers, progress=not args.no_progress)
+    written = write_outputs(plan, args.out, workers=args.workers, progress=args.progress)
     for line in written.lines():
         print(line)
     return 1 if failed else 0

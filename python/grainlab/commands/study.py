@@ -30,7 +30,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
               "the least friction in [0, 0.9] at which the target porosity bears 100-300 kPa) or a fixed "
               "number, e.g. 0 (frictionless) or 0.9 (Table 2's mu)"),
     )
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--no-report", action="store_true", help="do not write report.html at the end")
     parser.set_defaults(func=run)
 
@@ -53,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
     if args.seed < 0:
         raise ValueError(f"--seed: expected an integer >= 0, got {args.seed}")
     campaign, summary = run_study(args.out, seed=args.seed, workers=args.workers, scheduler=args.scheduler,
-                                  progress=not args.no_progress,
+                                  progress=args.progress,
                                   overrides={"generation_friction": _generation_friction(args.generation_friction)})
     fit = summary["fig17_fit"]
     r2 = fit.get("r2", float("nan"))
@@ -67,5 +66,5 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_report:
         from grainlab.commands.report import write_after_run
 
-        report_failed = write_after_run(args.out, "study")
+        report_failed = write_after_run(args.out, "study", quiet=args.quiet)
     return 1 if campaign.failed or report_failed else 0

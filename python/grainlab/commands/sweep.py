@@ -20,7 +20,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", default="sweep", help="results folder (default: sweep)")
     parser.add_argument("--workers", type=int, default=None, help="local worker processes (default: cores)")
     parser.add_argument("--scheduler", default=None, help="Dask scheduler address, e.g. tcp://host:8786")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.set_defaults(func=run)
 
 
@@ -29,7 +28,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers: expected an integer >= 1, got {args.workers}")
     load_plan(args.plan)  # validate before anything runs
     result = run_sweep(args.plan, args.out, workers=args.workers, scheduler=args.scheduler,
-                       progress=not args.no_progress)
+                       progress=args.progress)
     print(
         f"grainlab sweep: {len(result.rows)} runs ({len(result.executed)} run, {len(result.skipped)} already "
         f"finished, {len(result.failed)} failed); {result.wall_time_s:.1f} s -> {result.table}"

@@ -44,10 +44,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from tqdm import tqdm
 
 import grainlab
 from grainlab._mapping import flatten_keys
+from grainlab._progress import progress_bar
 from grainlab.analysis import fabric_summary
 from grainlab.analysis.stress import love_weber_stress
 from grainlab.io.hdf5 import (
@@ -527,7 +527,7 @@ def _consolidate(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bo
     max_steps = config["consolidation.max_steps"]
     speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
     steps = 0
-    bar = tqdm(total=max_steps, desc="consolidating", unit="step", disable=not progress, leave=False)
+    bar = progress_bar(max_steps, "consolidating", enabled=progress, unit="step")
     while True:
         sxx, syy, width, height = _box_stresses(sim, run)
         for name, length in (("bottom", width), ("top", width), ("left", height), ("right", height)):
@@ -537,7 +537,7 @@ def _consolidate(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bo
         bar.update(CHUNK_STEPS)
         sxx, syy, width, height = _box_stresses(sim, run)
         ratio = sim.unbalanced_force_ratio
-        bar.set_postfix(sxx=f"{sxx / 1e3:.1f}kPa", syy=f"{syy / 1e3:.1f}kPa", ubf=f"{ratio:.1e}")
+        bar.set_postfix_str(f"sxx {sxx / 1e3:.1f} kPa, syy {syy / 1e3:.1f} kPa, unbalanced {ratio:.1e}")
         if abs(sxx / target - 1) < tolerance and abs(syy / target - 1) < tolerance and ratio < limit:
             break
         if steps >= max_steps:
@@ -726,15 +726,14 @@ def _shear(
         writer.append_timeseries(record, units=TIMESERIES_UNITS)
         writer.write_snapshot(snapshot_name(0.0), _snapshot(sim, run, 0.0), step=sim.step_count)
     last_checkpoint = time.perf_counter()
-    bar = tqdm(
-        total=round(100 * final, 3),
-        desc="shearing",
+    done_strain = 0.0
+    bar = progress_bar(
+        round(100 * final, 3),
+        "shearing",
+        enabled=progress,
         unit="% strain",
-        disable=not progress,
-        leave=False,
         bar_format="{l_bar}{bar}| {n:.2f}/{total:.1f} % [{elapsed}<{remaining}{postfix}]",
     )
-    done_strain = 0.0
     while shear["next"] < len(steps):
         target = shear["start_step"] + steps[shear["next"]]
         sim.run(target - sim.step_count)
@@ -994,7 +993,7 @@ def run_biaxial(
     out_dir: str | os.PathLike[str],
     *,
     resume: bool = False,
-    progress: bool = True,
+    progress: bool = False,
 ) -> BiaxialResult:
     """Runs (or, with ``resume``, continues) the biaxial test into ``out_dir``.
 
@@ -1006,6 +1005,8 @@ def run_biaxial(
     checkpoint starts over. A new run refuses a folder that holds another
     run's files (:data:`RUN_FILES`, :data:`OUTPUT_FILES`). A full disk stops
     the run with a :class:`BiaxialError` that keeps the last checkpoint.
+    ``progress`` shows each phase's progress on stderr (off by default; see
+    :func:`grainlab._progress.progress_bar`).
     """
     out = Path(out_dir)
     checkpoint_path = out / CHECKPOINT_FILE

@@ -88,7 +88,7 @@ def _tasks(plan: ReproductionPlan, out: Path) -> dict[tuple[str, str, str], tupl
 def _compute(tasks: dict, workers: int | None, progress: bool) -> tuple[dict, list[str]]:
     """Measures every run once (a biaxial run under every analysis option its variants ask
     for), in ``workers`` local processes; returns the measures by task key and notes."""
-    from tqdm.auto import tqdm
+    from grainlab._progress import progress_bar
 
     results: dict = {}
     notes: list[str] = []
@@ -105,7 +105,7 @@ def _compute(tasks: dict, workers: int | None, progress: bool) -> tuple[dict, li
         bar.update(1)
 
     n_workers = max(1, min(int(workers or (os.cpu_count() or 1)), len(jobs) or 1))
-    bar = tqdm(total=len(jobs), desc="claims", unit="run", disable=not progress, dynamic_ncols=True)
+    bar = progress_bar(len(jobs), "claims", enabled=progress, unit="run")
     try:
         if n_workers == 1:
             for job, by_options in jobs.items():
@@ -296,7 +296,7 @@ class Outputs:
 
 
 def write_outputs(plan: ReproductionPlan, out_dir: str | os.PathLike[str], *, workers: int | None = None,
-                  progress: bool = True, figures: bool = True) -> Outputs:
+                  progress: bool = False, figures: bool = True) -> Outputs:
     """Measures every finished run of ``plan`` in ``out_dir`` and writes ``claims.json``,
     ``claims.csv``, ``measures.json``, the figures and ``reproduction.html``."""
     started = time.perf_counter()

@@ -345,7 +345,7 @@ def run_reproduction(
     *,
     workers: int | None = None,
     scheduler: Any = None,
-    progress: bool = True,
+    progress: bool = False,
 ):
     """Runs (or resumes) every run of ``plan`` into ``out_dir``; one row per run in
     ``runs.csv``. Returns the :class:`~grainlab.study.campaign.CampaignResult`."""

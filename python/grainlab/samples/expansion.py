@@ -288,7 +288,7 @@ def expand_to_porosity(
     time_step_safety: float = 0.8,
     density_scaling: bool = True,
     threads: int = 1,
-    progress: bool = True,
+    progress: bool = False,
     keep_simulation: bool = False,
 ) -> Sample:
     """Generates a sample by radius expansion inside rigid walls to a target nominal porosity.
@@ -320,7 +320,7 @@ def expand_to_porosity(
     time_step_safety : time step = this x the critical step, re-evaluated every increment
     density_scaling : give every disk the largest disk's mass while generating
     threads : engine worker threads (part of what makes a sample reproducible)
-    progress : show a progress bar (tqdm, on stderr)
+    progress : show the progress on stderr (off by default)
     keep_simulation : return the live simulation in :attr:`Sample.simulation`
         (walls 0..3 are bottom, right, top, left; particle-particle friction is
         still the generation friction: set the test's own contact models)
@@ -415,17 +415,12 @@ def expand_to_porosity(
         sim.densities = density * (final_radii.max() / final_radii) ** 2
 
     steps = 0
-    from tqdm.auto import tqdm
+    from grainlab._progress import progress_bar
 
     ticks = 1000
     total_growth = -math.log(scale)
-    bar = tqdm(
-        total=ticks,
-        desc="radius expansion",
-        disable=not progress,
-        leave=False,
-        bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}{postfix}",
-    )
+    bar = progress_bar(ticks, "radius expansion", enabled=progress,
+                       bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}{postfix}")
 
     r_min = float(final_radii.min())
 
@@ -493,7 +488,7 @@ def expand_to_porosity(
             sim.run(steps_per_increment)
             steps += steps_per_increment
             stress = walls.mean_stress()
-            bar.n = int(ticks * (1.0 - math.log(1.0 / scale) / total_growth)) if total_growth > 0 else ticks
+            bar.moveto(int(ticks * (1.0 - math.log(1.0 / scale) / total_growth)) if total_growth > 0 else ticks)
             bar.set_postfix_str(f"stress {stress / 1e3:.0f} kPa, Z {sim.coordination_number:.2f}")
             if stress > max_stress_pa:
                 status, used = relax(max_equilibrium_steps)
@@ -501,7 +496,7 @@ def expand_to_porosity(
                 stress = walls.mean_stress()
                 if stress > max_stress_pa:
                     raise fail(stress, status == "equilibrium")
-        bar.n = ticks
+        bar.moveto(ticks)
         bar.set_description_str("equilibrium")
         status, used = relax(max_equilibrium_steps)
         steps += used

@@ -245,7 +245,7 @@ def expand_with_friction_search(
     stress_band_pa: Sequence[float] = (1.0e5, 3.0e5),
     friction_tolerance: float = 5.0e-3,
     min_mechanical_coordination: float = MIN_MECHANICAL_COORDINATION,
-    progress: bool = True,
+    progress: bool = False,
     keep_simulation: bool = False,
     **expansion: Any,
 ) -> FrictionSearch:

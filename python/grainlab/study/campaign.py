@@ -203,7 +203,7 @@ def run_campaign(
     *,
     workers: int | None = None,
     scheduler: str | Any | None = None,
-    progress: bool = True,
+    progress: bool = False,
     table_name: str = "summary.csv",
     columns: Sequence[str] = (),
     threads: int | None = None,
@@ -238,10 +238,9 @@ def run_campaign(
         threads = max(1, cores // n_workers) if scheduler is None else 1
     failed: list[str] = []
 
-    from tqdm.auto import tqdm
+    from grainlab._progress import progress_bar
 
-    bar = tqdm(total=len(runs), initial=len(skipped), desc="campaign", unit="run", disable=not progress,
-               dynamic_ncols=True)
+    bar = progress_bar(len(runs), "campaign", enabled=progress, unit="run", initial=len(skipped))
     bar.set_postfix_str(f"failed 0, skipped {len(skipped)}")
 
     def record(run: Run, row: dict[str, Any]) -> None:

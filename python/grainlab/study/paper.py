@@ -196,7 +196,7 @@ def run_study(
     seed: int = 0,
     workers: int | None = None,
     scheduler: str | Any | None = None,
-    progress: bool = True,
+    progress: bool = False,
     overrides: Mapping[str, Any] | None = None,
     irregular: Sequence[float] = IRREGULAR_POROSITIES,
     hexagonal: Sequence[float] = HEXAGONAL_POROSITIES,

@@ -202,7 +202,7 @@ def load_plan(path: str | os.PathLike[str]) -> Plan:
 
 
 def run_sweep(plan: Plan | str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
-              workers: int | None = None, scheduler: Any = None, progress: bool = True):
+              workers: int | None = None, scheduler: Any = None, progress: bool = False):
     """Runs (or resumes) a sweep; ``sweep.csv`` in ``out_dir``, each run in ``runs/run_NNNN``."""
     from grainlab.io.results import write_text_atomic
     from grainlab.study.campaign import run_campaign
