@@ -169,3 +169,26 @@ def test_analyze_snapshot_api(tmp_path):
     assert s["mean_lambda"] == pytest.approx(0.0, abs=1e-9)
     assert s["a_n"] is None and any("a_n" in note for note in s["notes"])
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fabric.json", "particles.csv"]
+
+
+def test_run_h5_as_its_own_reference_defaults_to_the_strain_zero_snapshot(tmp_path, run_cli, capsys):
+    # run.h5 as --reference: its first snapshot (strain 0) by default, not the last, which is the
+    # analysed one (every displacement 0, no band) and is warned about when asked for explicitly
+    from grainlab.io.hdf5 import ResultsWriter
+
+    ref, cur, _ = lattice_pair(tmp_path)
+    path = tmp_path / "run.h5"
+    with ResultsWriter(path, kind="biaxial") as writer:
+        writer.write_snapshot("strain_0.0000", Snapshot(ref.positions, ref.radii, ids=cur.ids), step=0)
+        writer.write_snapshot("strain_0.0100", cur, step=1000)
+    out = tmp_path / "out"
+    argv = ["analyze", str(path), "--reference", str(path), "--no-figures", "--out", str(out)]
+    assert run_cli(argv) == 0
+    assert capsys.readouterr().err == ""
+    disp = np.array([float(r["displacement"]) for r in read_rows(out / "particles.csv")])
+    np.testing.assert_allclose(np.sort(disp), np.sort(np.hypot(*(cur.positions - ref.positions).T)), atol=1e-12)
+    assert disp.max() > 0.04e-3  # 0.02 x 2.1 d at the band's edges
+    assert run_cli([*argv[:4], "--reference-timestep", "1000", *argv[4:]]) == 0
+    err = capsys.readouterr().err
+    assert "the reference is the analysed snapshot itself" in err and "--reference-timestep" in err
+    assert max(float(r["displacement"]) for r in read_rows(out / "particles.csv")) == 0.0

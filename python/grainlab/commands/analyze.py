@@ -8,6 +8,7 @@ directly.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -74,7 +75,7 @@ def register(subparsers: Any) -> None:
         "--reference-timestep",
         type=int,
         metavar="N",
-        help="frame of the reference dump (default: the first)",
+        help="frame of the reference dump or run.h5 (default: the first; a run.h5 its strain-0 snapshot)",
     )
     p.add_argument(
         "--bins", type=int, default=18, help=f"angular bins over 360 degrees, 2 to {MAX_BINS} (default 18)"
@@ -113,6 +114,14 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
+def _same_configuration(snapshot: Any, reference: Any) -> bool:
+    """True when the reference holds exactly the analysed snapshot's positions."""
+    import numpy as np
+
+    a, b = np.asarray(snapshot.positions), np.asarray(reference.positions)
+    return a.shape == b.shape and bool(np.array_equal(a, b))
+
+
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``grainlab analyze``; returns the exit code."""
     from grainlab.analysis import analyze_snapshot
@@ -136,8 +145,10 @@ def run(args: argparse.Namespace) -> int:
     reference = None
     if args.reference:
         ref_step = args.reference_timestep
-        if ref_step is None and detect_format(args.reference) == "lammps-dump":
+        ref_format = detect_format(args.reference)
+        if ref_step is None and ref_format == "lammps-dump":
             ref_step = list_timesteps(args.reference)[0]
+        first = {"snapshot": 0} if ref_step is None and ref_format == "grainlab-hdf5" else {}  # strain 0
         reference = read_snapshot(
             args.reference,
             contacts=args.reference_contacts,
@@ -145,7 +156,15 @@ def run(args: argparse.Namespace) -> int:
             tolerance=args.tolerance,
             columns=columns if args.reference_contacts else None,
             boundary_types=boundary_types,
+            **first,
         )
+        if _same_configuration(snapshot, reference):
+            print(
+                "grainlab analyze: warning: the reference is the analysed snapshot itself (the same "
+                "positions): every displacement is 0 and no shear band can be found; choose an earlier "
+                "frame with --reference-timestep",
+                file=sys.stderr,
+            )
     ensure_output_folder(args.out)
     result = analyze_snapshot(
         snapshot,
