@@ -102,6 +102,21 @@ def test_global_options_and_command_list_are_in_cli_md():
             assert f"| `grainlab {command}` |" in text, f"{command} missing from the command table"
 
 
+def test_the_options_of_every_command_are_in_cli_md_and_on_every_command():
+    # --quiet, --verbose, --no-progress: added once (cli.add_output_options), documented once
+    shared = argparse.ArgumentParser()
+    cli.add_output_options(shared)
+    names = _arguments(shared)
+    assert {"--quiet", "--verbose", "--no-progress"} <= set(names)
+    text = (DOCS / "cli.md").read_text(encoding="utf-8")
+    head = text.split("\n## ", 1)[0]
+    for name in names:
+        assert f"`{name}`" in head, f"{name} missing from cli.md's options of every command"
+    full = next(a for a in cli.build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    for command, parser in full.choices.items():
+        assert set(names) <= set(_arguments(parser)), command
+
+
 def test_every_configuration_key_is_in_cli_md():
     text = (DOCS / "cli.md").read_text(encoding="utf-8")
     missing = [key for key in FIELDS if f"`{key}`" not in text]
