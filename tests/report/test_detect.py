@@ -40,9 +40,12 @@ def test_unfinished_run_says_how_to_finish_it(tmp_path, capsys):
     _refused(capsys, tmp_path, "has not finished", "--resume")
 
 
-def test_sweep_folder_points_to_its_runs(tmp_path, capsys):
-    (tmp_path / "sweep.csv").write_text("name,status\nrun_0000,ok\n")
-    _refused(capsys, tmp_path, "sweep folder", "runs/run_0000/biaxial")
+def test_sweep_folder_points_to_a_run_that_exists(tmp_path, capsys):
+    (tmp_path / "sweep.csv").write_text("name,status\nrun_0003,ok\n")
+    _refused(capsys, tmp_path, "sweep folder", "packing runs, which have no report", "sweep.csv", "result.json")
+    (tmp_path / "runs" / "run_0003" / "biaxial").mkdir(parents=True)
+    (tmp_path / "runs" / "run_0003" / "biaxial" / "run.h5").write_bytes(b"")
+    _refused(capsys, tmp_path, "sweep folder", f"grainlab report {tmp_path / 'runs' / 'run_0003' / 'biaxial'}")
 
 
 def test_results_of_another_kind_are_refused(tmp_path, capsys):

@@ -80,9 +80,12 @@ def detect_kind(folder: str | os.PathLike[str]) -> tuple[Path, Kind]:
     if (path / "study.csv").exists():
         return path, "study"
     if (path / "sweep.csv").exists():
+        biaxial = sorted(path.glob("runs/*/biaxial/run.h5"))
+        hint = (f"report a run of the sweep, e.g. grainlab report {biaxial[0].parent}" if biaxial else
+                f"its runs are packing runs, which have no report: their numbers are in {path / 'sweep.csv'} "
+                f"and {path / 'runs' / 'NAME' / 'result.json'}")
         raise ReportError(
-            f"{path}: a sweep folder (sweep.csv); grainlab report covers one biaxial run or the packing "
-            f"study: report a run of the sweep, e.g. grainlab report {path / 'runs' / 'run_0000' / 'biaxial'}"
+            f"{path}: a sweep folder (sweep.csv); grainlab report covers one biaxial run or the packing study: {hint}"
         )
     raise ReportError(
         f"{path}: neither a biaxial results folder (no run.h5) nor a study folder (no study.csv)"
