@@ -188,3 +188,18 @@ def test_slugs_follow_github():
         "contact-normal-distribution-and-anisotropy-eq-68"
     )
     assert _slug("A default run, and the paper") == "a-default-run-and-the-paper"
+
+
+@pytest.mark.slow
+def test_the_table_1_sample_summary_in_samples_md_is_what_expand_to_porosity_prints():
+    # docs/samples.md opens with expand_to_porosity()'s summary of the Table 1 sample; all but the
+    # wall time (the machine's) must be what the current code prints
+    from grainlab.samples import expand_to_porosity
+
+    text = (DOCS / "samples.md").read_text(encoding="utf-8")
+    lines = re.search(r"print\(sample\.summary\(\)\)\n# (.*)\n# (.*)\n", text)
+    assert lines, "samples.md: the summary of expand_to_porosity() not found"
+    quoted = f"{lines.group(1)} {lines.group(2)}"
+    printed = expand_to_porosity().summary()
+    strip_time = re.compile(r", [0-9.]+ s$")
+    assert strip_time.sub("", printed) == strip_time.sub("", quoted)
