@@ -20,7 +20,8 @@ pub struct EnergyLedger {
     pub viscous_dissipated: f64,
     /// Energy dissipated by local damping.
     pub damping_dissipated: f64,
-    /// Work done on the particles by moving walls.
+    /// Work done on the particles by moving walls: for each step's displacement of
+    /// a wall, the trapezoid of its forces before and after it.
     pub wall_work: f64,
     /// Work done by external forces and torques and by gravity.
     pub external_work: f64,

@@ -856,17 +856,25 @@ impl Simulation {
         self.ensure_neighbors()?;
         let dt = self.params.time_step;
         self.boundary_loads();
-        let mut contacts = self.particle_contacts::<MEASURE>(team);
+        let mut stripes = self.particle_contacts::<MEASURE>(team);
         let bond_tally = self.bond_forces::<MEASURE>();
-        contacts.merge(&bond_tally);
         let (wall_tally, wall_work) = self.wall_forces::<MEASURE>();
+        if team.is_none() {
+            self.cross_pairs_in_order::<MEASURE>(&mut stripes);
+        }
+        let mut contacts = ContactTally::default();
+        for t in &stripes {
+            contacts.merge(t);
+        }
+        contacts.merge(&bond_tally);
         for wall in self.walls.iter_mut().filter(|w| w.active) {
             wall.update_servo(dt);
         }
         let motion = self.integrate::<MEASURE>(team);
-        for wall in self.walls.iter_mut().filter(|w| w.active) {
+        for wall in self.walls.iter_mut() {
             let d = scale(wall.velocity, dt);
-            if d != [0.0, 0.0] {
+            wall.last_step_displacement = if wall.active { d } else { [0.0; 2] };
+            if wall.active && d != [0.0, 0.0] {
                 wall.translate(d);
             }
         }
@@ -938,9 +946,13 @@ impl Simulation {
         Ok(())
     }
 
-    /// Steps 2-3: reset resultants, then particle-particle contact forces.
-    fn particle_contacts<const MEASURE: bool>(&mut self, team: Option<&Team>) -> ContactTally {
+    /// Steps 2-3: reset resultants, then particle-particle contact forces; returns
+    /// each stripe's tally. With a team the pairs across stripes are evaluated in
+    /// the same phase into a buffer that each stripe's integration applies (step
+    /// 7); without one they wait for [`Simulation::cross_pairs_in_order`].
+    fn particle_contacts<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Vec<ContactTally> {
         let increment_time = self.increment_time();
+        let buffer_cross = team.is_some();
         let n_blocks = self.neighbors.block_ranges.len();
         let pairs = &mut self.neighbors.pairs;
         let starts = &pairs.block_start;
@@ -1012,25 +1024,59 @@ impl Simulation {
                 }
                 let mut tally =
                     kernel.run::<MEASURE, _>(ranges[b].0, work.shear, work.sliding, &mut direct);
-                let mut buffered = BufferSink {
-                    slots: work.cross_forces,
-                };
-                let cross = kernel.run::<MEASURE, _>(
-                    ranges[n_blocks + b].0,
-                    work.cross_shear,
-                    work.cross_sliding,
-                    &mut buffered,
-                );
-                tally.merge(&cross);
+                if buffer_cross {
+                    let mut buffered = BufferSink {
+                        slots: work.cross_forces,
+                    };
+                    let cross = kernel.run::<MEASURE, _>(
+                        ranges[n_blocks + b].0,
+                        work.cross_shear,
+                        work.cross_sliding,
+                        &mut buffered,
+                    );
+                    tally.merge(&cross);
+                }
                 tally
             }
         });
-        let mut tally = ContactTally::default();
-        for t in &tallies {
-            tally.merge(t);
+        // with a buffer the cross-block forces are applied by each block's
+        // integration (step 7)
+        tallies
+    }
+
+    /// Step 5b, on one thread: the pairs across stripes, after bonds and walls,
+    /// in pair order and in the same chunks as a team would evaluate them, adding
+    /// their forces straight onto the particles. Each particle then receives the
+    /// same additions in the same order as from the buffer (which a stripe's
+    /// integration applies after the bonds and walls, in pair order), and each
+    /// stripe's tally the same merges: the same bits without the buffer.
+    fn cross_pairs_in_order<const MEASURE: bool>(&mut self, tallies: &mut [ContactTally]) {
+        let increment_time = self.increment_time();
+        let n_blocks = self.neighbors.block_ranges.len();
+        let pairs = &mut self.neighbors.pairs;
+        let cross_start = pairs.block_start[n_blocks];
+        let chunks = even_bounds(pairs.len() - cross_start, n_blocks);
+        let p = &mut self.particles;
+        let force = DisjointWriter::new(&mut p.force);
+        let torque = DisjointWriter::new(&mut p.torque);
+        let kernel = pair_kernel!(self, p, pairs, increment_time);
+        let mut direct = DirectSink {
+            force: &force,
+            torque: &torque,
+        };
+        for (tally, &(lo, hi)) in tallies.iter_mut().zip(&chunks) {
+            let (lo, hi) = (cross_start + lo, cross_start + hi);
+            // SAFETY: one thread; the pairs index particles that exist
+            let cross = unsafe {
+                kernel.run::<MEASURE, _>(
+                    lo,
+                    &mut pairs.shear[lo..hi],
+                    &mut pairs.sliding[lo..hi],
+                    &mut direct,
+                )
+            };
+            tally.merge(&cross);
         }
-        // the cross-block forces are applied by each block's integration (step 7)
-        tally
     }
 
     /// Step 4: bonds (sequential; chains of membrane disks are short).
@@ -1069,10 +1115,11 @@ impl Simulation {
         tally
     }
 
-    /// Step 5: particle-wall contacts; returns the tally and the walls' work.
+    /// Step 5: particle-wall contacts; returns the tally and the walls' work over
+    /// their last step's displacement.
     fn wall_forces<const MEASURE: bool>(&mut self) -> (ContactTally, f64) {
         let mut tally = ContactTally::default();
-        let mut work = 0.0;
+        let previous_force: Vec<Vec2> = self.walls.iter().map(|w| w.force).collect();
         for wall in &mut self.walls {
             wall.force = [0.0; 2];
             wall.contact_count = 0;
@@ -1107,7 +1154,6 @@ impl Simulation {
             wall.force = sub(wall.force, f);
             wall.contact_count += 1;
             wall.stiffness_sum += model.normal_stiffness;
-            work += dot(f, wall.velocity) * dt;
             tally.friction += c.friction_dissipation;
             tally.viscous += c.viscous_dissipation;
             if g.overlap > self.params.max_overlap_ratio * r {
@@ -1119,11 +1165,22 @@ impl Simulation {
                 tally.contacts += 1;
             }
         }
+        // the work of a wall on the particles over its last step's displacement d,
+        // with the trapezoid of the forces before and after it: the counterpart of
+        // leapfrog's kinetic energy and the springs' elastic energy (docs/contact-law.md)
+        let work = self
+            .walls
+            .iter()
+            .zip(&previous_force)
+            .map(|(w, f0)| -0.5 * dot(add(*f0, w.force), w.last_step_displacement))
+            .sum();
         (tally, work)
     }
 
     /// Step 7: leapfrog with local damping in parallel chunks.
     fn integrate<const MEASURE: bool>(&mut self, team: Option<&Team>) -> IntegrationTally {
+        // with a team the cross-block forces wait in the buffer (else they are applied)
+        let buffered = team.is_some();
         let dt = self.params.time_step;
         let step_map = self
             .cell
@@ -1218,9 +1275,11 @@ impl Simulation {
             team,
             chunks,
             |(b, lo, position, velocity, rotation, angular_velocity, force, torque)| {
-                // the cross-block pairs touching this block, in pair order, as a
-                // sequential pass over all of them would have added them
-                cross.apply(b, lo, force, torque);
+                if buffered {
+                    // the cross-block pairs touching this block, in pair order, as a
+                    // sequential pass over all of them adds them
+                    cross.apply(b, lo, force, torque);
+                }
                 let chunk = MotionChunk {
                     lo,
                     position,

@@ -94,6 +94,9 @@ pub struct Wall {
     pub stiffness_sum: f64,
     /// Total displacement since the wall was created (m).
     pub displacement: Vec2,
+    /// Displacement made at its velocity in the last step (m; zero before the
+    /// first step and while inactive), for the work ledger's trapezoid.
+    pub last_step_displacement: Vec2,
     /// An inactive wall has no contacts and does not move (e.g. the rigid side
     /// walls once a flexible boundary replaced them).
     pub active: bool,
@@ -139,6 +142,7 @@ impl Wall {
             contact_count: 0,
             stiffness_sum: 0.0,
             displacement: [0.0; 2],
+            last_step_displacement: [0.0; 2],
             active: true,
         })
     }

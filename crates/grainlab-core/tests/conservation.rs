@@ -112,6 +112,41 @@ fn energy_ledger_balances_with_viscous_contact_damping() {
 }
 
 #[test]
+fn energy_ledger_balances_with_moving_and_servo_walls() {
+    // A dense frictional box squeezed by its top wall at constant velocity while
+    // its right wall holds a stress by servo, with local damping and a bonded
+    // chain, at dt = 0.1 sqrt(m_min/kn): the walls' work, booked with the
+    // trapezoid of the forces before and after each step's displacement, balances
+    // kinetic + elastic energy + dissipation to 1e-4 of the work done.
+    use grainlab_core::{ServoControl, WallControl};
+    let mut sim = boxed_packing(16, 0.5, 8, 1);
+    let l = 16.0e-3;
+    sim.run(2000).unwrap(); // settle in the fixed box first
+    sim.set_wall_velocity(2, [0.0, -2.0e-3]).unwrap();
+    let servo = ServoControl {
+        target_stress: 2.0e6,
+        loaded_length: l,
+        relaxation: 0.5,
+        max_speed: 0.01,
+    };
+    sim.set_wall_control(1, WallControl::Servo(servo)).unwrap();
+    sim.run(1).unwrap();
+    let b0 = sim.energy().balance();
+    sim.run(3000).unwrap();
+    let e = sim.energy();
+    assert!(e.wall_work > 0.5 * b0, "{e:?}");
+    assert!(
+        e.friction_dissipated > 0.01 * e.wall_work && e.damping_dissipated > 0.01 * e.wall_work
+    );
+    let drift = (e.balance() - b0) / e.wall_work;
+    eprintln!("balance drift {drift:.3e} of the wall work");
+    assert!(
+        drift.abs() < 1e-4,
+        "balance drift {drift:.3e} of the wall work; {e:?}"
+    );
+}
+
+#[test]
 fn momentum_is_conserved_without_walls() {
     // Newton's third law in every contact: total linear momentum is constant.
     let mut sim = dense_periodic(16, 1.0e-3, 0.9, 21, 2);
