@@ -202,13 +202,17 @@ def parse_variant(text: str) -> Variant:
 
 
 def _rate_text(rate: float) -> str:
-    """``0.02 / 60`` -> ``"2%/min"`` (shortest round-tripping percent per minute)."""
+    """The shortest plain decimal (no exponent) that round-trips, in percent per minute.
+
+    >>> _rate_text(0.02 / 60), _rate_text(0.2 / 60), _rate_text(0.015 / 60)
+    ('2%/min', '20%/min', '1.5%/min')
+    """
     per_min = rate * 6000.0
     for digits in range(1, 12):
         text = f"{per_min:.{digits}g}"
-        if math.isclose(float(text), per_min, rel_tol=1e-9):
+        if "e" not in text and math.isclose(float(text), per_min, rel_tol=1e-9):
             return f"{text}%/min"
-    return f"{per_min!r}%/min"
+    return f"{per_min:f}".rstrip("0").rstrip(".") + "%/min"
 
 
 @dataclass(frozen=True)
