@@ -45,3 +45,50 @@ def test_the_search_settings_do_not_apply_to_a_lattice():
     row = run_packing({"kind": "hexagonal", "porosity": 0.12, "width": 0.02, "height": 0.04})
     assert math.isnan(row["generation_friction"]) and row["generation_expansions"] == 0
     assert row["friction_search"] == "" and row["seed"] == 0
+
+
+@pytest.mark.parametrize("generation_friction", [0.0, "search"])
+def test_an_engine_stop_below_the_stress_bound_is_expanded_again_more_gently(monkeypatch, generation_friction):
+    import grainlab.samples
+    import grainlab.samples.friction_search as friction_search
+    from grainlab.samples import ExpansionError
+    from grainlab.samples.expansion import GROWTH_PER_INCREMENT
+    from grainlab.study.packing import GENTLE_GROWTH_FACTOR
+
+    real = grainlab.samples.expand_to_porosity
+    growths = []
+
+    def stops_once(*args, growth_per_increment=GROWTH_PER_INCREMENT, **kwargs):
+        growths.append(growth_per_increment)
+        if len(growths) == 1:  # the overlap limit, at 2 MPa: below the 5 MPa bound
+            raise ExpansionError("porosity: the engine stopped", porosity=0.14, porosity_overlap_corrected=0.145,
+                                 stress_pa=2.0e6, target=0.14, equilibrium=False, engine_stopped=True)
+        return real(*args, growth_per_increment=growth_per_increment, **kwargs)
+
+    monkeypatch.setattr(grainlab.samples, "expand_to_porosity", stops_once)
+    monkeypatch.setattr(friction_search, "expand_to_porosity", stops_once)
+    row = run_packing({"kind": "irregular", "porosity": 0.14, "width": 0.02, "height": 0.04, "seed": 3,
+                       "generation_friction": generation_friction})
+    assert growths == [GROWTH_PER_INCREMENT, GROWTH_PER_INCREMENT / GENTLE_GROWTH_FACTOR]
+    assert row["status"] == "ok" and row["porosity"] == pytest.approx(0.14, abs=1e-12)
+    assert row["generation_expansions"] == 2
+    assert "the first expansion stopped at the engine's overlap limit at 2 MPa" in row["note"]
+
+
+def test_the_stress_bound_is_not_retried(monkeypatch):
+    import grainlab.samples
+    from grainlab.samples import ExpansionError
+
+    calls = []
+
+    def over_the_bound(*args, **kwargs):
+        calls.append(kwargs)
+        raise ExpansionError("porosity: over the bound", porosity=0.1, porosity_overlap_corrected=0.11,
+                             stress_pa=6.0e6, target=0.08, equilibrium=True)
+
+    monkeypatch.setattr(grainlab.samples, "expand_to_porosity", over_the_bound)
+    with pytest.raises(ExpansionError):
+        run_packing({"kind": "irregular", "porosity": 0.08, "width": 0.02, "height": 0.04,
+                     "generation_friction": 0.0})
+    # one attempt at the target, then the densest-reached fallback at 0.102 (which fails here too)
+    assert len(calls) == 2 and calls[1].get("growth_per_increment") == calls[0].get("growth_per_increment")

@@ -9,8 +9,7 @@ from grainlab.study import STUDY_COLUMNS, derive_seed, read_table, run_study, st
 
 
 def test_small_study_writes_table_figures_summary(tmp_path):
-    # one engine thread per run whatever the worker count: the thread count is part of a realisation
-    small = {"width": 0.02, "height": 0.04, "threads": 1}
+    small = {"width": 0.02, "height": 0.04}
     campaign, summary = run_study(
         tmp_path, workers=2, progress=False, overrides=small,
         irregular=(0.14, 0.2), hexagonal=(0.08, 0.12),

@@ -26,9 +26,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--seed", type=int, default=0, help="campaign seed (default 0)")
     parser.add_argument(
         "--generation-friction", default="search", metavar="MU|search",
-        help=("particle friction of the irregular packings' radius expansion: 'search' (default: per packing "
-              "the least friction in [0, 0.9] at which the target porosity bears 100-300 kPa) or a fixed "
-              "number, e.g. 0 (frictionless) or 0.9 (Table 2's mu)"),
+        help=("particle friction of the irregular packings' radius expansion: 'search' (default: per packing, "
+              "0 where the frictionless packing at the target bears >= 100 kPa, otherwise one found by "
+              "bisection in [0, 0.9] at which it bears 100-300 kPa) or a fixed number, e.g. 0 (frictionless) "
+              "or 0.9 (Table 2's mu)"),
     )
     parser.add_argument("--no-report", action="store_true", help="do not write report.html at the end")
     parser.set_defaults(func=run)

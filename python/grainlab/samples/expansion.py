@@ -74,6 +74,8 @@ _DENSITY = 2.0e8
 _DAMPING = 0.8
 #: Default stress bound of the expansion (mean wall stress in equilibrium), Pa.
 MAX_STRESS_PA = 5.0e6
+#: Default largest growth of ``ln r`` per increment.
+GROWTH_PER_INCREMENT = 1.0e-2
 
 
 class ExpansionError(ValueError):
@@ -81,8 +83,9 @@ class ExpansionError(ValueError):
 
     Attributes give where the expansion stopped: ``porosity`` (nominal),
     ``porosity_overlap_corrected``, ``stress_pa`` (mean wall stress it needed,
-    in equilibrium when ``equilibrium`` is true), ``target`` and ``steps``
-    (DEM steps run until then).
+    in equilibrium when ``equilibrium`` is true), ``target``, ``steps``
+    (DEM steps run until then) and ``engine_stopped`` (true when the engine's
+    overlap limit stopped it, not the stress bound).
     """
 
     def __init__(
@@ -95,6 +98,7 @@ class ExpansionError(ValueError):
         target: float,
         equilibrium: bool,
         steps: int = 0,
+        engine_stopped: bool = False,
     ) -> None:
         super().__init__(message)
         self.porosity = porosity
@@ -103,6 +107,7 @@ class ExpansionError(ValueError):
         self.target = target
         self.equilibrium = equilibrium
         self.steps = steps
+        self.engine_stopped = engine_stopped
 
 
 @dataclass(frozen=True, eq=False)
@@ -278,7 +283,7 @@ def expand_to_porosity(
     density: float = _DENSITY,
     local_damping: float = _DAMPING,
     initial_scale: float = 0.5,
-    growth_per_increment: float = 1.0e-2,
+    growth_per_increment: float = GROWTH_PER_INCREMENT,
     steps_per_increment: int = 50,
     growth_stress_scale_pa: float = 1.0e5,
     equilibrium_ratio: float = 1.0e-4,
@@ -298,8 +303,8 @@ def expand_to_porosity(
     box : ``(xmin, ymin, xmax, ymax)``, m (Table 1: 75 x 150 mm)
     porosity : target *nominal* porosity, in (0, 1) (Table 1: 0.12)
     grading : where diameters come from (default :data:`PAPER_GRADING`)
-    seed : seeds ``numpy.random.default_rng``; with the same ``threads`` the
-        same seed gives the same sample bit for bit
+    seed : seeds ``numpy.random.default_rng``; the same seed gives the same
+        sample bit for bit (whatever ``threads`` is)
     n_particles : default :func:`particle_count` of the box, porosity and grading
     diameters : (N,) m, drawn beforehand (then ``grading`` only names them and
         ``n_particles`` must be None)
@@ -319,7 +324,7 @@ def expand_to_porosity(
     max_stress_pa : stress bound (mean wall stress in equilibrium), Pa
     time_step_safety : time step = this x the critical step, re-evaluated every increment
     density_scaling : give every disk the largest disk's mass while generating
-    threads : engine worker threads (part of what makes a sample reproducible)
+    threads : engine worker threads (the sample does not depend on them)
     progress : show the progress on stderr (off by default)
     keep_simulation : return the live simulation in :attr:`Sample.simulation`
         (walls 0..3 are bottom, right, top, left; particle-particle friction is
@@ -476,6 +481,7 @@ def expand_to_porosity(
             target=porosity,
             equilibrium=equilibrium,
             steps=steps,
+            engine_stopped=engine_error is not None,
         )
 
     try:

@@ -61,6 +61,9 @@ MEASURES: tuple[str, ...] = (
 
 #: ``PackingParams.generation_friction`` value that asks for the friction search.
 GENERATION_FRICTION_SEARCH = "search"
+#: How much more gently than the samples library's default the radius expansion grows on a
+#: second attempt, when the engine's overlap limit (not the stress bound) stopped the first.
+GENTLE_GROWTH_FACTOR = 4.0
 
 #: Statuses a packing row can have.
 STATUSES = ("ok", "unjammed", "densest_reached", "failed")
@@ -206,6 +209,7 @@ def measure(snapshot: Snapshot) -> dict[str, float]:
 
 def _irregular(p: PackingParams) -> dict[str, Any]:
     from grainlab.samples import ExpansionError, UniformByNumber, expand_to_porosity, expand_with_friction_search
+    from grainlab.samples.expansion import GROWTH_PER_INCREMENT
 
     box = (0.0, 0.0, p.width, p.height)
     grading = UniformByNumber(p.d_min, p.d_max)
@@ -223,32 +227,54 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
     )
     # the least friction the search may use: a target too dense for it is too dense for any
     friction = 0.0 if p.searches_friction else float(p.generation_friction)
-    status, note, search = "ok", "", None
-    try:
-        if p.searches_friction:
-            search = expand_with_friction_search(
-                box, p.porosity, grading, friction_range=(0.0, p.friction),
-                stress_band_pa=(p.search_stress_min, p.search_stress_max), **common,
+
+    def generate(porosity: float, growth: float, search: bool) -> tuple[Any, Any]:
+        """(sample, friction search or None) at ``porosity``."""
+        options = {**common, "growth_per_increment": growth}
+        if search:
+            found = expand_with_friction_search(
+                box, porosity, grading, friction_range=(0.0, p.friction),
+                stress_band_pa=(p.search_stress_min, p.search_stress_max), **options,
             )
-            sample = search.sample
-        else:
-            sample = expand_to_porosity(box, p.porosity, grading, friction=friction, **common)
+            return found.sample, found
+        return expand_to_porosity(box, porosity, grading, friction=friction, **options), None
+
+    status, notes, expansions = "ok", [], 0
+    growth = GROWTH_PER_INCREMENT
+    try:
+        try:
+            expansions += 1
+            sample, search = generate(p.porosity, growth, p.searches_friction)
+        except ExpansionError as error:
+            if not (error.engine_stopped and error.stress_pa < p.max_stress):
+                raise
+            # not the stress bound but a transient overlap beyond the engine's limit while the
+            # radii grow: grow more gently and try once more
+            growth = GROWTH_PER_INCREMENT / GENTLE_GROWTH_FACTOR
+            notes.append(f"the first expansion stopped at the engine's overlap limit at "
+                         f"{error.stress_pa / 1e6:.3g} MPa, below the stress bound; expanded again with "
+                         f"growth_per_increment {growth:g}")
+            expansions += 1
+            sample, search = generate(p.porosity, growth, p.searches_friction)
     except ExpansionError as error:
         # the densest packing the bound allows: aim just above where this expansion stopped
         fallback = math.ceil(error.porosity * 1000.0) / 1000.0 + 0.001
-        sample = expand_to_porosity(box, fallback, grading, friction=friction, **common)
+        expansions += 1
+        sample, search = generate(fallback, growth, False)
         status = "densest_reached"
-        note = (
+        notes.append(
             f"target {p.porosity:.4f} not reached within the stress bound {p.max_stress / 1e6:.3g} MPa "
             f"({error}); measured instead the packing expanded to {fallback:.4f} with generation friction "
             f"{friction:g}, just above the densest one reached ({error.porosity:.4f})"
         )
+    if search is not None:
+        expansions += len(search.trials) - 1
     sim = sample.simulation
     snap = sim.snapshot()
     result = measure(snap)
     if not sample.jammed:
         status = "unjammed" if status == "ok" else status
-        note = (note + "; " if note else "") + (
+        notes.append(
             f"stress-free at nominal porosity {sample.porosity:.4f}: the radius expansion with generation "
             f"friction {sample.friction:g} jams denser than this in this box, so the disks do not fill it under "
             f"load (mean wall stress {sample.mean_wall_stress_pa:.3g} Pa); contacts are the near-touching ones "
@@ -256,7 +282,7 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
         )
     elif status == "ok":
         how = f"generation friction {sample.friction:g} (fixed)" if search is None else search.summary()
-        note = (
+        notes.append(
             f"equilibrium after radius expansion, locked-in mean wall stress "
             f"{sample.mean_wall_stress_pa / 1e3:.0f} kPa, {sample.steps} DEM steps; {how}"
         )
@@ -266,9 +292,9 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
         n_particles=float(len(sample.radii)),
         mean_wall_stress_pa=sample.mean_wall_stress_pa,
         generation_friction=sample.friction,
-        generation_expansions=(len(search.trials) if search is not None else 1) + (status == "densest_reached"),
+        generation_expansions=expansions,
     )
-    return {**result, "status": status, "note": note,
+    return {**result, "status": status, "note": "; ".join(notes),
             "friction_search": search.trials_json() if search is not None else ""}
 
 
