@@ -105,10 +105,10 @@ def test_a_new_contact_reports_the_increment_it_will_get():
     sim = sheared_packing()
     c = sim.contacts()
     for _ in range(500):
-        before = set(zip(c.i, c.j))
+        before = set(zip(c.i, c.j, strict=True))
         sim.run(1)
         c = sim.contacts()
-        new = np.array([(i, j) not in before for i, j in zip(c.i, c.j)])
+        new = np.array([(i, j) not in before for i, j in zip(c.i, c.j, strict=True)])
         if new.sum() >= 3:
             break
     assert new.sum() >= 3
@@ -169,7 +169,7 @@ def test_wall_velocity_and_bonds_between_runs_count_the_last_displacement_once()
     sim.wall(2).velocity = (0.0, 0.0)
     sim.velocities = np.zeros((sim.n_particles, 2))
     after = sim.contacts(), sim.wall_contacts()
-    for a, b in zip(after, pending):
+    for a, b in zip(after, pending, strict=True):
         np.testing.assert_array_equal(a.shear_force, b.shear_force)
         np.testing.assert_array_equal(a.sliding, b.sliding)
     assert np.any(after[0].bonded) and len(after[1]) > 20

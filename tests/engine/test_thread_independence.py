@@ -57,7 +57,7 @@ def test_one_to_four_threads_give_the_same_bits():
         )
         assert sim.threads == threads
     assert len(states[0]["normal_force"]) > 5000 and len(states[0]["wall_normal_force"]) > 50
-    for threads, state in zip((2, 3, 4), states[1:]):
+    for threads, state in zip((2, 3, 4), states[1:], strict=True):
         for key, value in state.items():
             np.testing.assert_array_equal(value, states[0][key], err_msg=f"{key}, {threads} threads")
 
