@@ -48,28 +48,27 @@ def test_the_search_settings_do_not_apply_to_a_lattice():
 
 
 @pytest.mark.parametrize("generation_friction", [0.0, "search"])
-def test_an_engine_stop_below_the_stress_bound_is_expanded_again_more_gently(monkeypatch, generation_friction):
+def test_an_engine_stop_below_the_stress_bound_is_expanded_again_with_real_masses(monkeypatch,
+                                                                                  generation_friction):
     import grainlab.samples
     import grainlab.samples.friction_search as friction_search
     from grainlab.samples import ExpansionError
-    from grainlab.samples.expansion import GROWTH_PER_INCREMENT
-    from grainlab.study.packing import GENTLE_GROWTH_FACTOR
 
     real = grainlab.samples.expand_to_porosity
-    growths = []
+    scaling = []
 
-    def stops_once(*args, growth_per_increment=GROWTH_PER_INCREMENT, **kwargs):
-        growths.append(growth_per_increment)
-        if len(growths) == 1:  # the overlap limit, at 2 MPa: below the 5 MPa bound
+    def stops_once(*args, density_scaling=True, **kwargs):
+        scaling.append(density_scaling)
+        if len(scaling) == 1:  # the overlap limit, at 2 MPa: below the 5 MPa bound
             raise ExpansionError("porosity: the engine stopped", porosity=0.14, porosity_overlap_corrected=0.145,
                                  stress_pa=2.0e6, target=0.14, equilibrium=False, engine_stopped=True)
-        return real(*args, growth_per_increment=growth_per_increment, **kwargs)
+        return real(*args, density_scaling=density_scaling, **kwargs)
 
     monkeypatch.setattr(grainlab.samples, "expand_to_porosity", stops_once)
     monkeypatch.setattr(friction_search, "expand_to_porosity", stops_once)
     row = run_packing({"kind": "irregular", "porosity": 0.14, "width": 0.02, "height": 0.04, "seed": 3,
                        "generation_friction": generation_friction})
-    assert growths == [GROWTH_PER_INCREMENT, GROWTH_PER_INCREMENT / GENTLE_GROWTH_FACTOR]
+    assert scaling == [True, False]
     assert row["status"] == "ok" and row["porosity"] == pytest.approx(0.14, abs=1e-12)
     assert row["generation_expansions"] == 2
     assert "the first expansion stopped at the engine's overlap limit at 2 MPa" in row["note"]
@@ -91,4 +90,4 @@ def test_the_stress_bound_is_not_retried(monkeypatch):
         run_packing({"kind": "irregular", "porosity": 0.08, "width": 0.02, "height": 0.04,
                      "generation_friction": 0.0})
     # one attempt at the target, then the densest-reached fallback at 0.102 (which fails here too)
-    assert len(calls) == 2 and calls[1].get("growth_per_increment") == calls[0].get("growth_per_increment")
+    assert len(calls) == 2 and calls[0]["density_scaling"] and calls[1]["density_scaling"]

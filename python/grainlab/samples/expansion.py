@@ -74,8 +74,6 @@ _DENSITY = 2.0e8
 _DAMPING = 0.8
 #: Default stress bound of the expansion (mean wall stress in equilibrium), Pa.
 MAX_STRESS_PA = 5.0e6
-#: Default largest growth of ``ln r`` per increment.
-GROWTH_PER_INCREMENT = 1.0e-2
 
 
 class ExpansionError(ValueError):
@@ -283,7 +281,7 @@ def expand_to_porosity(
     density: float = _DENSITY,
     local_damping: float = _DAMPING,
     initial_scale: float = 0.5,
-    growth_per_increment: float = GROWTH_PER_INCREMENT,
+    growth_per_increment: float = 1.0e-2,
     steps_per_increment: int = 50,
     growth_stress_scale_pa: float = 1.0e5,
     equilibrium_ratio: float = 1.0e-4,

@@ -61,9 +61,6 @@ MEASURES: tuple[str, ...] = (
 
 #: ``PackingParams.generation_friction`` value that asks for the friction search.
 GENERATION_FRICTION_SEARCH = "search"
-#: How much more gently than the samples library's default the radius expansion grows on a
-#: second attempt, when the engine's overlap limit (not the stress bound) stopped the first.
-GENTLE_GROWTH_FACTOR = 4.0
 
 #: Statuses a packing row can have.
 STATUSES = ("ok", "unjammed", "densest_reached", "failed")
@@ -209,7 +206,6 @@ def measure(snapshot: Snapshot) -> dict[str, float]:
 
 def _irregular(p: PackingParams) -> dict[str, Any]:
     from grainlab.samples import ExpansionError, UniformByNumber, expand_to_porosity, expand_with_friction_search
-    from grainlab.samples.expansion import GROWTH_PER_INCREMENT
 
     box = (0.0, 0.0, p.width, p.height)
     grading = UniformByNumber(p.d_min, p.d_max)
@@ -228,9 +224,9 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
     # the least friction the search may use: a target too dense for it is too dense for any
     friction = 0.0 if p.searches_friction else float(p.generation_friction)
 
-    def generate(porosity: float, growth: float, search: bool) -> tuple[Any, Any]:
+    def generate(porosity: float, density_scaling: bool, search: bool) -> tuple[Any, Any]:
         """(sample, friction search or None) at ``porosity``."""
-        options = {**common, "growth_per_increment": growth}
+        options = {**common, "density_scaling": density_scaling}
         if search:
             found = expand_with_friction_search(
                 box, porosity, grading, friction_range=(0.0, p.friction),
@@ -240,27 +236,29 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
         return expand_to_porosity(box, porosity, grading, friction=friction, **options), None
 
     status, notes, expansions = "ok", [], 0
-    growth = GROWTH_PER_INCREMENT
+    density_scaling = True
     try:
         try:
             expansions += 1
-            sample, search = generate(p.porosity, growth, p.searches_friction)
+            sample, search = generate(p.porosity, density_scaling, p.searches_friction)
         except ExpansionError as error:
             if not (error.engine_stopped and error.stress_pa < p.max_stress):
                 raise
-            # not the stress bound but a transient overlap beyond the engine's limit while the
-            # radii grow: grow more gently and try once more
-            growth = GROWTH_PER_INCREMENT / GENTLE_GROWTH_FACTOR
+            # not the stress bound but one pair overlapping beyond the engine's limit while the
+            # packing rearranges under MPa: the overshoot of a contact grows with the disk's mass,
+            # and density scaling gives the smallest disks the largest one's mass; once more with
+            # the real masses
+            density_scaling = False
             notes.append(f"the first expansion stopped at the engine's overlap limit at "
-                         f"{error.stress_pa / 1e6:.3g} MPa, below the stress bound; expanded again with "
-                         f"growth_per_increment {growth:g}")
+                         f"{error.stress_pa / 1e6:.3g} MPa, below the stress bound; expanded again "
+                         "with the real masses (density scaling off)")
             expansions += 1
-            sample, search = generate(p.porosity, growth, p.searches_friction)
+            sample, search = generate(p.porosity, density_scaling, p.searches_friction)
     except ExpansionError as error:
         # the densest packing the bound allows: aim just above where this expansion stopped
         fallback = math.ceil(error.porosity * 1000.0) / 1000.0 + 0.001
         expansions += 1
-        sample, search = generate(fallback, growth, False)
+        sample, search = generate(fallback, density_scaling, False)
         status = "densest_reached"
         notes.append(
             f"target {p.porosity:.4f} not reached within the stress bound {p.max_stress / 1e6:.3g} MPa "
