@@ -225,7 +225,10 @@ def _signal_in_output_phase(tmp_path, stop, real_figures: bool) -> None:
     process = subprocess.Popen([*command, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                env=env)
     deadline = time.monotonic() + 240
-    while not (out / "run.h5").exists() and process.poll() is None and time.monotonic() < deadline:
+    # timeseries.csv is the first output written from the final run.h5: once it is there the
+    # process is inside the output phase (the stand-in figures' sleep), past h5py's clean-up of
+    # the results file, where an interrupt can land in a callback that ignores it
+    while not (out / "timeseries.csv").exists() and process.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)
     assert process.poll() is None, process.communicate()
     process.send_signal(stop)
