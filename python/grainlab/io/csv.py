@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from grainlab.io._planar import check_z_policy, planar, sphere_contacts
 from grainlab.io._table import (
     FileFormatError,
     check_geometry,
@@ -41,7 +42,6 @@ from grainlab.io._table import (
     plain,
     read_lines,
 )
-from grainlab.io._planar import check_z_policy, planar, sphere_contacts
 from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
 
 __all__ = ["read_contacts_csv", "read_particles_csv", "write_contacts_csv", "write_particles_csv"]

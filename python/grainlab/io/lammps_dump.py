@@ -61,6 +61,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from grainlab.io._planar import check_z_policy, planar, sphere_contacts
 from grainlab.io._table import (
     MAX_LENGTH_M,
     FileFormatError,
@@ -71,7 +72,6 @@ from grainlab.io._table import (
     plain,
     read_lines,
 )
-from grainlab.io._planar import check_z_policy, planar, sphere_contacts
 from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
 
 __all__ = [

@@ -205,7 +205,12 @@ def measure(snapshot: Snapshot) -> dict[str, float]:
 
 
 def _irregular(p: PackingParams) -> dict[str, Any]:
-    from grainlab.samples import ExpansionError, UniformByNumber, expand_to_porosity, expand_with_friction_search
+    from grainlab.samples import (
+        ExpansionError,
+        UniformByNumber,
+        expand_to_porosity,
+        expand_with_friction_search,
+    )
 
     box = (0.0, 0.0, p.width, p.height)
     grading = UniformByNumber(p.d_min, p.d_max)
