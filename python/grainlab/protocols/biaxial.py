@@ -71,6 +71,7 @@ from grainlab.protocols.boundary import (
     Membrane,
     install_grain_boundary,
     install_membrane,
+    membrane_breach,
     sample_area,
     set_platen_velocity,
 )
@@ -753,6 +754,13 @@ def _shear(
             }
         if run.membrane.get("kind") == GrainBoundary.kind:
             run.membrane = GrainBoundary.from_dict(run.membrane).identify(sim).to_dict()
+        else:
+            breach = membrane_breach(sim, Membrane.from_dict(run.membrane))
+            if breach is not None:
+                bar.close()
+                raise BiaxialError(
+                    f"shearing stopped at {100 * record['axial_strain']:.2f} % axial strain: {breach}"
+                )
         shear["next"] += 1
         bar.update(100 * record["axial_strain"] - done_strain)
         done_strain = 100 * record["axial_strain"]

@@ -25,6 +25,14 @@ from grainlab.simulation import FIX_Y, ContactModel, Simulation, Wall
 
 #: Material group of membrane disks (grains are group 0, walls group 1).
 MEMBRANE_GROUP = 2
+#: Stiffness of the ties between second neighbours of a chain, as a fraction of the
+#: bond stiffness: they only keep those pairs out of the contact law (a force of
+#: 1e-6 of the membrane's at equal stretch, nothing the run can feel).
+SLACK_TIE = 1.0e-6
+#: Neighbouring membrane disks farther apart than this many disk diameters leave a
+#: hole that grains pass through: the membrane has burst or folded through itself,
+#: and the run stops with an error (at rest they are half a diameter apart).
+MAX_NEIGHBOUR_DISTANCE_DIAMETERS = 2.0
 
 
 @dataclass(frozen=True)
@@ -109,16 +117,22 @@ def install_membrane(
     for chain in (left_ids, right_ids):
         for a, b in zip(chain[:-1], chain[1:], strict=True):
             sim.add_bond(a, b, bond_stiffness, bond_stiffness)
+        # second neighbours touch at rest (2 x spacing = diameter at the default
+        # overlap of one half): a slack tie keeps them out of the contact law, so
+        # that they do not resist the chain's wrinkles
+        for a, b in zip(chain[:-2], chain[2:], strict=True):
+            sim.add_bond(a, b, SLACK_TIE * bond_stiffness, SLACK_TIE * bond_stiffness)
     membrane_grain = ContactModel(
         grain_model.normal_stiffness, grain_model.shear_stiffness, friction
     )
     sim.set_contact_model(0, MEMBRANE_GROUP, membrane_grain)
     sim.set_contact_model(1, MEMBRANE_GROUP, ContactModel(grain_model.normal_stiffness, grain_model.shear_stiffness, 0.0))
-    # the membrane's disks do not touch one another: the chain holds together by its
-    # bonds and may wrinkle as the sample shortens, as a latex membrane does
-    sim.set_contact_model(
-        MEMBRANE_GROUP, MEMBRANE_GROUP, ContactModel(bond_stiffness, bond_stiffness, 0.0, enabled=False)
-    )
+    # The chain holds together by its bonds and wrinkles as the sample shortens, as
+    # a latex membrane does; its disks from third neighbours on touch one another
+    # (frictionless, at the bond stiffness), so that a fold cannot pass through the
+    # chain. A chain that crossed itself would enclose a lobe whose follower load
+    # points outward and inflates it without bound.
+    sim.set_contact_model(MEMBRANE_GROUP, MEMBRANE_GROUP, ContactModel(bond_stiffness, bond_stiffness, 0.0))
     fixity = sim.fixity.copy()
     ends = [left_ids[0], left_ids[-1], right_ids[0], right_ids[-1]]
     fixity[ends] |= FIX_Y
@@ -163,6 +177,23 @@ def shoelace_area(polygon: NDArray[np.float64]) -> float:
     """Area of a simple polygon (either orientation)."""
     x, y = polygon[:, 0], polygon[:, 1]
     return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+
+
+def membrane_breach(sim: Simulation, membrane: Membrane) -> str | None:
+    """``None`` while the membrane is a closed skin; else what broke it: the chain,
+    the disk and the distance to its neighbour, when two neighbours are farther
+    apart than :data:`MAX_NEIGHBOUR_DISTANCE_DIAMETERS` diameters."""
+    x = sim.positions
+    limit = MAX_NEIGHBOUR_DISTANCE_DIAMETERS * 2.0 * membrane.radius
+    for side, chain in (("left", membrane.left), ("right", membrane.right)):
+        gaps = np.linalg.norm(np.diff(x[chain], axis=0), axis=1)
+        k = int(np.argmax(gaps))
+        if gaps[k] > limit:
+            return (
+                f"the {side} membrane chain opened between disks {chain[k]} and {chain[k + 1]} "
+                f"({gaps[k] * 1e3:.2f} mm apart, limit {limit * 1e3:.2f} mm)"
+            )
+    return None
 
 
 def sample_area(sim: Simulation, membrane: Membrane) -> float:

@@ -156,7 +156,7 @@ FIELDS: dict[str, Field] = {
     ),
     "run.threads": Field("integer", "auto", "engine threads (auto: all cores)", minimum=1, allow_auto=True),
     "run.time_step_safety": Field(
-        "number", 0.5, "time step = this x the critical time step", minimum=0.0, maximum=1.0,
+        "number", 0.8, "time step = this x the critical time step (0.8, as PFC)", minimum=0.0, maximum=1.0,
         exclusive_minimum=True,
     ),
     "run.checkpoint_interval": Field("time", 30.0, "wall-clock time between checkpoints", **_POSITIVE),
