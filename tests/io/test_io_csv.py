@@ -161,8 +161,8 @@ def test_writer_writes_nan_as_empty_and_checks_lengths(tmp_path):
         tmp_path / "w.csv", snap, {"v": [1.0, np.nan], "flag": np.array([True, False])}
     )
     lines = p.read_text().splitlines()
-    assert lines[0] == "id,x,y,radius,v,flag"
-    assert lines[2] == "1,1,0,0.5,,0"
+    assert lines[0] == "id,x,y,radius,kind,v,flag"  # kind always: the file reads back without a warning
+    assert lines[2] == "1,1,0,0.5,0,,0"
     with pytest.raises(ValueError, match="columns"):
         write_particles_csv(tmp_path / "w.csv", snap, {"v": [1.0]})
 

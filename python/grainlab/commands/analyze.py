@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +19,7 @@ __all__ = ["MAX_BINS", "parse_columns", "parse_types", "register", "run"]
 MAX_BINS = 3600
 
 
-def parse_columns(text: str | None) -> dict[str, str] | None:
+def parse_columns(text: str | None, option: str = "--contact-columns") -> dict[str, str] | None:
     """``"i=c_ids[1],j=c_ids[2],normal_force=c_pl[2]"`` -> a role -> column dict."""
     if not text:
         return None
@@ -27,7 +28,7 @@ def parse_columns(text: str | None) -> dict[str, str] | None:
         role, sep, name = item.partition("=")
         if not sep or not role.strip() or not name.strip():
             raise ValueError(
-                f"--contact-columns: expected ROLE=COLUMN items separated by commas, got {item!r}"
+                f"{option}: expected ROLE=COLUMN items separated by commas, got {item!r}"
             )
         out[role.strip()] = name.strip()
     return out
@@ -51,16 +52,26 @@ def register(subparsers: Any) -> None:
         "analyze",
         help="fabric, stability index, strain and shear band of a snapshot",
         description=(
-            "Analyse a snapshot (particles CSV id,x,y,radius or LAMMPS dump, detected from "
+            "Analyse a snapshot (particles CSV id,x,y,radius or other names with --columns, PFC "
+            "ball table, LAMMPS dump, YADE text export, legacy VTK file or run.h5, detected from "
             "the content): coordination numbers, contact anisotropy (Eq. 6-8), geometrical "
             "stability index lambda, and, with --reference, displacements, local strain and "
             "the shear band. Writes particles.csv, "
             "fabric.json and PNG + SVG figures into --out."
         ),
     )
-    p.add_argument("input", metavar="INPUT", help="particles CSV or LAMMPS atoms dump")
     p.add_argument(
-        "--contacts", metavar="FILE", help="contacts CSV (i,j by id) or LAMMPS local dump"
+        "input", metavar="INPUT",
+        help="particles CSV, PFC ball table, LAMMPS atoms dump, YADE text export, legacy VTK file or run.h5",
+    )
+    p.add_argument(
+        "--contacts", metavar="FILE",
+        help="contacts CSV (i,j by id; a PFC table's end1,end2) or LAMMPS local dump",
+    )
+    p.add_argument(
+        "--columns",
+        metavar="ROLE=COLUMN,...",
+        help="column names of a particles CSV (INPUT and --reference), e.g. id=ID,x=pos_x,y=pos_y,radius=rad",
     )
     p.add_argument(
         "--reference", metavar="SNAPSHOT_FILE", help="earlier snapshot for displacement and strain"
@@ -90,7 +101,8 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--contact-columns",
         metavar="ROLE=COLUMN,...",
-        help="column roles of a LAMMPS local dump, e.g. i=c_ids[1],j=c_ids[2],normal_force=c_pl[2]",
+        help="column roles of the contacts file: a LAMMPS local dump (i=c_ids[1],j=c_ids[2],"
+        "normal_force=c_pl[2]) or a contacts CSV (i=end1,j=end2)",
     )
     p.add_argument(
         "--boundary-types",
@@ -125,7 +137,13 @@ def _same_configuration(snapshot: Any, reference: Any) -> bool:
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``grainlab analyze``; returns the exit code."""
     from grainlab.analysis import analyze_snapshot
-    from grainlab.io import detect_format, list_timesteps, read_snapshot
+    from grainlab.io import (
+        FileFormatError,
+        MissingKindWarning,
+        detect_format,
+        list_timesteps,
+        read_snapshot,
+    )
     from grainlab.io.results import ensure_output_folder
 
     if not 2 <= args.bins <= MAX_BINS:
@@ -133,31 +151,48 @@ def run(args: argparse.Namespace) -> int:
     if not 0 <= args.tolerance < float("inf"):
         raise ValueError(f"--tolerance: must be a finite value >= 0 m, got {args.tolerance}")
     columns = parse_columns(args.contact_columns)
+    particle_columns = parse_columns(getattr(args, "columns", None), "--columns")
     boundary_types = parse_types(args.boundary_types)
-    snapshot = read_snapshot(
-        args.input,
-        contacts=args.contacts,
-        timestep=args.timestep,
-        tolerance=args.tolerance,
-        columns=columns,
-        boundary_types=boundary_types,
-    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", MissingKindWarning)
+        snapshot = read_snapshot(
+            args.input,
+            contacts=args.contacts,
+            timestep=args.timestep,
+            tolerance=args.tolerance,
+            columns=columns,
+            boundary_types=boundary_types,
+            particle_columns=particle_columns,
+        )
+    for warning in caught:  # one line each, without the warnings module's source line
+        if issubclass(warning.category, MissingKindWarning):
+            print(f"grainlab analyze: warning: {warning.message}", file=sys.stderr)
+        else:
+            warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
     reference = None
     if args.reference:
         ref_step = args.reference_timestep
-        ref_format = detect_format(args.reference)
+        try:
+            ref_format = detect_format(args.reference)
+        except FileFormatError:
+            if not particle_columns:
+                raise
+            ref_format = "particles-csv"  # its names are those --columns maps
         if ref_step is None and ref_format == "lammps-dump":
             ref_step = list_timesteps(args.reference)[0]
         first = {"snapshot": 0} if ref_step is None and ref_format == "grainlab-hdf5" else {}  # strain 0
-        reference = read_snapshot(
-            args.reference,
-            contacts=args.reference_contacts,
-            timestep=ref_step,
-            tolerance=args.tolerance,
-            columns=columns if args.reference_contacts else None,
-            boundary_types=boundary_types,
-            **first,
-        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MissingKindWarning)  # said once, for INPUT
+            reference = read_snapshot(
+                args.reference,
+                contacts=args.reference_contacts,
+                timestep=ref_step,
+                tolerance=args.tolerance,
+                columns=columns if args.reference_contacts else None,
+                boundary_types=boundary_types,
+                particle_columns=particle_columns if ref_format != "grainlab-hdf5" else None,
+                **first,
+            )
         if _same_configuration(snapshot, reference):
             print(
                 "grainlab analyze: warning: the reference is the analysed snapshot itself (the same "

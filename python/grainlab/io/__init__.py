@@ -1,4 +1,4 @@
-"""Reading and writing snapshots: particles CSV, LAMMPS/LIGGGHTS dumps.
+"""Reading and writing snapshots: particles CSV, LAMMPS/LIGGGHTS dumps, PFC, YADE, legacy VTK.
 
 :func:`read_snapshot` recognises the format of a file from its content and
 dispatches to the reader registered for it in :data:`READERS`; grainlab's
@@ -16,6 +16,7 @@ from typing import Any
 
 from grainlab.io._table import FileFormatError
 from grainlab.io.csv import (
+    MissingKindWarning,
     read_contacts_csv,
     read_particles_csv,
     write_contacts_csv,
@@ -23,17 +24,24 @@ from grainlab.io.csv import (
 )
 from grainlab.io.hdf5 import read_hdf5_snapshot
 from grainlab.io.lammps_dump import list_timesteps, read_lammps_dump
+from grainlab.io.pfc import is_pfc_balls, read_pfc_balls
+from grainlab.io.vtk_read import is_legacy_vtk, read_legacy_vtk
+from grainlab.io.yade import read_yade_text
 from grainlab.snapshot import Snapshot
 
 __all__ = [
     "READERS",
     "FileFormatError",
+    "MissingKindWarning",
     "detect_format",
     "list_timesteps",
     "read_contacts_csv",
     "read_lammps_dump",
+    "read_legacy_vtk",
     "read_particles_csv",
+    "read_pfc_balls",
     "read_snapshot",
+    "read_yade_text",
     "write_contacts_csv",
     "write_particles_csv",
 ]
@@ -42,10 +50,15 @@ _HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
 
 
 def detect_format(path: str | Path) -> str:
-    """``"particles-csv"``, ``"lammps-dump"`` or ``"grainlab-hdf5"``, from the file's content.
+    """The format name of a file (a key of :data:`READERS`), from its content.
 
-    HDF5 by its signature; a LAMMPS dump by a first line ``ITEM: TIMESTEP``;
-    a particles CSV by a header with the columns ``id,x,y,radius``.
+    ``"grainlab-hdf5"`` by the HDF5 signature; ``"legacy-vtk"`` by a first
+    line ``# vtk DataFile Version``; ``"yade-text"`` by a first line
+    ``#format NAME``; ``"lammps-dump"`` by a first line ``ITEM: TIMESTEP``;
+    ``"particles-csv"`` by a header with the columns ``id,x,y,radius``;
+    ``"pfc-csv"`` by one with ``id,pos_x,pos_y,radius``. A CSV with other
+    names is read as a particles CSV with a column mapping
+    (``read_snapshot(..., particle_columns=...)``).
     """
     p = Path(path)
     try:
@@ -58,6 +71,11 @@ def detect_format(path: str | Path) -> str:
     if head.startswith(_HDF5_MAGIC):
         return "grainlab-hdf5"
     text = head.decode("utf-8", errors="replace").removeprefix("\ufeff")  # a spreadsheet's byte-order mark
+    first = text.lstrip().split("\n", 1)[0]
+    if is_legacy_vtk(first):
+        return "legacy-vtk"
+    if first.startswith("#format"):
+        return "yade-text"
     lines = [
         ln.strip() for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")
     ]
@@ -68,31 +86,83 @@ def detect_format(path: str | Path) -> str:
     header = {h.strip().lower() for h in lines[0].split(",")}
     if {"id", "x", "y", "radius"} <= header:
         return "particles-csv"
+    if is_pfc_balls(sorted(header)):
+        return "pfc-csv"
     raise FileFormatError(
         p,
         None,
-        "unknown format: expected a particles CSV (header id,x,y,radius) or a LAMMPS dump "
-        f"(first line 'ITEM: TIMESTEP'); the first line is {lines[0][:60]!r}",
+        "unknown format: expected a particles CSV (header id,x,y,radius; other names with a "
+        "column mapping, --columns id=ID,x=pos_x,...), a PFC ball table (id,pos_x,pos_y,radius), "
+        "a LAMMPS dump (first line 'ITEM: TIMESTEP'), a YADE text export (first line '#format "
+        f"x_y_z_r') or a legacy VTK file; the first line is {lines[0][:60]!r}",
     )
 
 
-def _read_csv(
-    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=()
-) -> Snapshot:
+def _no_timestep(fmt: str, timestep: int | None) -> None:
     if timestep is not None:
-        raise ValueError("timestep: only applies to LAMMPS dumps, not to a particles CSV")
-    if columns:
-        raise ValueError("contact columns: only apply to LAMMPS local dumps")
+        raise ValueError(f"timestep: only applies to LAMMPS dumps and run.h5, not to a {fmt}")
+
+
+def _read_csv(
+    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
+    particle_columns=None,
+) -> Snapshot:
+    _no_timestep("particles CSV", timestep)
     if len(boundary_types):
         raise ValueError(
-            "boundary types: only apply to LAMMPS dumps (use a 'kind' column in a CSV)"
+            "boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column in a CSV)"
         )
-    return read_particles_csv(path, contacts=contacts, tolerance=tolerance)
+    if columns and contacts is None:
+        raise ValueError("contact columns: only apply to a contacts file (give one)")
+    return read_particles_csv(
+        path, contacts=contacts, tolerance=tolerance, columns=particle_columns, contact_columns=columns
+    )
+
+
+def _read_pfc(
+    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
+    particle_columns=None,
+) -> Snapshot:
+    _no_timestep("PFC ball table", timestep)
+    if len(boundary_types):
+        raise ValueError("boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column)")
+    return read_pfc_balls(
+        path, contacts=contacts, tolerance=tolerance, columns=particle_columns, contact_columns=columns
+    )
+
+
+def _points_only(fmt: str, contacts, timestep, columns, particle_columns) -> None:
+    _no_timestep(fmt, timestep)
+    for name, value in (("contacts", contacts), ("contact columns", columns),
+                        ("particle columns", particle_columns)):
+        if value:
+            raise ValueError(f"{name}: a {fmt} is read alone (its contacts are detected from the geometry)")
+
+
+def _read_yade(
+    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
+    particle_columns=None,
+) -> Snapshot:
+    _points_only("YADE text export", contacts, timestep, columns, particle_columns)
+    if len(boundary_types):
+        raise ValueError("boundary types: a YADE file has no atom types (read_yade_text(boundary_materials=...))")
+    return read_yade_text(path, tolerance=tolerance)
+
+
+def _read_vtk(
+    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
+    particle_columns=None,
+) -> Snapshot:
+    _points_only("legacy VTK file", contacts, timestep, columns, particle_columns)
+    return read_legacy_vtk(path, tolerance=tolerance, boundary_types=boundary_types)
 
 
 def _read_dump(
-    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=()
+    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
+    particle_columns=None,
 ) -> Snapshot:
+    if particle_columns:
+        raise ValueError("particle columns: only apply to CSV files (a LAMMPS dump names its columns)")
     return read_lammps_dump(
         path,
         timestep=timestep,
@@ -103,11 +173,14 @@ def _read_dump(
     )
 
 
-#: Reader per format name:
-#: ``reader(path, *, contacts, timestep, tolerance, columns, boundary_types) -> Snapshot``.
+#: Reader per format name: ``reader(path, *, contacts, timestep, tolerance, columns,
+#: boundary_types, particle_columns) -> Snapshot``.
 READERS: dict[str, Callable[..., Snapshot]] = {
     "particles-csv": _read_csv,
+    "pfc-csv": _read_pfc,
     "lammps-dump": _read_dump,
+    "yade-text": _read_yade,
+    "legacy-vtk": _read_vtk,
     "grainlab-hdf5": read_hdf5_snapshot,
 }
 
@@ -122,23 +195,33 @@ def read_snapshot(
     boundary_types: Sequence[int] = (),
     format: str | None = None,
     snapshot: str | int | None = None,
+    particle_columns: Mapping[str, str] | None = None,
 ) -> Snapshot:
     """Read a snapshot from any supported file.
 
     Parameters
     ----------
     path
-        Particles CSV, LAMMPS atoms dump or grainlab results file ``run.h5``
-        (format detected, or ``format``).
+        Particles CSV, PFC ball table, LAMMPS atoms dump, YADE text export,
+        legacy VTK particle file (LIGGGHTS / LAMMPS) or grainlab results file
+        ``run.h5`` (format detected, or ``format``, a key of :data:`READERS`).
     contacts
-        Contacts file: a contacts CSV for a particles CSV, a ``dump local``
-        file for a LAMMPS dump. Without it contacts are detected from the
-        geometry (centre distance < r_i + r_j + ``tolerance``, m).
+        Contacts file: a contacts CSV for a particles CSV or PFC table, a
+        ``dump local`` file for a LAMMPS dump. Without it contacts are
+        detected from the geometry (centre distance < r_i + r_j +
+        ``tolerance``, m).
     timestep
         Frame of a multi-frame dump (default the last); for ``run.h5`` the
         snapshot recorded at that engine step.
     columns
-        Column roles of a LAMMPS local dump (see :mod:`grainlab.io.lammps_dump`).
+        Column roles of the contacts file: of a LAMMPS local dump (see
+        :mod:`grainlab.io.lammps_dump`) or a contacts CSV (``{"i": "end1",
+        "j": "end2"}``, :data:`grainlab.io.csv.CONTACT_ROLES`).
+    particle_columns
+        Column roles of a particles CSV or PFC table, ``{role: file
+        column}`` (``{"id": "ID", "x": "pos_x", "y": "pos_y", "radius":
+        "radius"}``, :data:`grainlab.io.csv.PARTICLE_ROLES`); a CSV with
+        other names is read as a particles CSV when this is given.
     boundary_types
         LAMMPS atom types that bound the sample (wall disks): kind MEMBRANE.
     snapshot
@@ -147,12 +230,24 @@ def read_snapshot(
         ``timestep`` selects one by its engine step instead.
     """
     p = Path(path)
-    fmt = format or detect_format(p)
+    if format is None and particle_columns:
+        try:
+            fmt = detect_format(p)
+        except FileFormatError as error:  # a CSV whose names only the mapping explains
+            if "unknown format" not in error.problem:
+                raise
+            fmt = "particles-csv"
+    else:
+        fmt = format or detect_format(p)
     if fmt not in READERS:
         raise ValueError(f"format: unknown {fmt!r} (known: {', '.join(READERS)})")
     if snapshot is not None and fmt != "grainlab-hdf5":
         raise ValueError(f"snapshot: only applies to grainlab HDF5 results files, not a {fmt}")
     extra: dict[str, Any] = {} if snapshot is None else {"snapshot": snapshot}
+    if particle_columns:
+        if fmt == "grainlab-hdf5":
+            raise ValueError("particle columns: only apply to CSV files, not to a grainlab results file")
+        extra["particle_columns"] = particle_columns
     return READERS[fmt](
         p,
         contacts=contacts,

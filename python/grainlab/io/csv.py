@@ -18,6 +18,15 @@ Contacts CSV
     (normal force repulsion positive, shear force signed along rot90 of the
     normal from i to j). Only particle–particle contacts.
 
+Other layouts
+    A ``columns`` mapping ``{role: file column}`` names the file's own
+    columns for grainlab's roles (``{"id": "ID", "x": "pos_x", "y": "pos_y"}``;
+    roles :data:`PARTICLE_ROLES` and :data:`CONTACT_ROLES`, file names
+    case-insensitive); the CLI takes it as ``--columns id=ID,x=pos_x,...``.
+    A particles file without a ``kind`` column is read as grains only and
+    warns (:class:`MissingKindWarning`): membrane or wall disks in it would
+    count as grains in Z, lambda and the fabric.
+
 Errors raise :class:`~grainlab.io.FileFormatError` (a ``ValueError``) with
 the message ``FILE:LINE: problem``.
 """
@@ -25,6 +34,7 @@ the message ``FILE:LINE: problem``.
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -44,14 +54,90 @@ from grainlab.io._table import (
 )
 from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
 
-__all__ = ["read_contacts_csv", "read_particles_csv", "write_contacts_csv", "write_particles_csv"]
+__all__ = [
+    "CONTACT_ROLES",
+    "PARTICLE_ROLES",
+    "MissingKindWarning",
+    "check_column_map",
+    "read_contacts_csv",
+    "read_particles_csv",
+    "write_contacts_csv",
+    "write_particles_csv",
+]
 
 PARTICLE_COLUMNS = ("id", "x", "y", "radius")
 CONTACT_COLUMNS = ("i", "j")
+#: Roles a ``columns`` mapping may give to a particles file's columns.
+PARTICLE_ROLES = ("id", "x", "y", "z", "radius", "rotation", "kind", BODY_FIELD)
+#: Roles a ``columns`` mapping may give to a contacts file's columns.
+CONTACT_ROLES = ("i", "j", "normal_force", "shear_force")
+
+
+class MissingKindWarning(UserWarning):
+    """A particles file without a ``kind`` column: every particle is read as a grain."""
+
+
+def warn_missing_kind(path: str | Path, stacklevel: int = 3) -> None:
+    """Warn that ``path`` has no particle kinds, so boundary disks would count as grains."""
+    warnings.warn(
+        f"{path}: no 'kind' column: every particle is read as a grain (kind 0), so membrane or "
+        "wall disks in the file would count as grains in Z, lambda and the fabric; add a 'kind' "
+        "column (1 for membrane disks, docs/file-formats.md) or map one with columns=",
+        MissingKindWarning,
+        stacklevel=stacklevel,
+    )
+
+
+def check_column_map(
+    columns: Mapping[str, str] | None, roles: tuple[str, ...], what: str = "columns"
+) -> dict[str, str]:
+    """``columns`` as ``{role: file column (lower case)}``; ValueError naming a bad entry.
+
+    >>> check_column_map({"id": "ID", "x": "pos_x"}, PARTICLE_ROLES)
+    {'id': 'id', 'x': 'pos_x'}
+    """
+    out: dict[str, str] = {}
+    for role, name in (columns or {}).items():
+        if role not in roles:
+            raise ValueError(f"{what}: unknown role {role!r} (roles: {', '.join(roles)})")
+        if not isinstance(name, str) or not name.strip():
+            raise ValueError(f"{what}[{role!r}]: expected a column name, got {name!r}")
+        out[role] = name.strip().lower()
+    taken = list(out.values())
+    for name in taken:
+        if taken.count(name) > 1:
+            both = [r for r, n in out.items() if n == name]
+            raise ValueError(f"{what}: column {name!r} given two roles ({', '.join(both)})")
+    return out
+
+
+def _rename(
+    path: str | Path, line: int, names: list[str], column_map: Mapping[str, str]
+) -> list[str]:
+    """The header's names with the mapped file columns renamed to their roles."""
+    role_of = {name: role for role, name in column_map.items()}
+    for role, name in column_map.items():
+        if name not in names:
+            raise FileFormatError(
+                path,
+                line,
+                f"column mapping {role}={name}: no column {name!r} in the header "
+                f"(header has {', '.join(names)})",
+            )
+    renamed = [role_of.get(n, n) for n in names]
+    for role, name in column_map.items():
+        if role != name and role in names:
+            raise FileFormatError(
+                path,
+                line,
+                f"column mapping {role}={name}: the header also has a column {role!r}; "
+                f"map one of them away or drop it",
+            )
+    return renamed
 
 
 def _read_csv(
-    path: str | Path, required: tuple[str, ...]
+    path: str | Path, required: tuple[str, ...], column_map: Mapping[str, str] | None = None
 ) -> tuple[list[str], NDArray[np.float64], NDArray[np.int64]]:
     lines = read_lines(path)
     keep = [
@@ -68,6 +154,8 @@ def _read_csv(
     trailing = len(names) > 1 and names[-1] == ""  # tolerate a trailing comma on every line
     if trailing:
         names = names[:-1]
+    if column_map:
+        names = _rename(path, header_line, names, column_map)
     seen: set[str] = set()
     for name in names:
         if name == "":
@@ -77,11 +165,13 @@ def _read_csv(
         seen.add(name)
     missing = [c for c in required if c not in seen]
     if missing:
+        example = ",".join(f"{c}=NAME" for c in missing)
         raise FileFormatError(
             path,
             header_line,
             f"missing column(s) {', '.join(missing)} "
-            f"(header has {', '.join(names)}; need {','.join(required)})",
+            f"(header has {', '.join(names)}; need {','.join(required)}; a file with other "
+            f"names maps them with columns=, on the command line --columns {example})",
         )
     rows = keep[1:]
     numbers = np.array([k for k, _ in rows], dtype=np.int64)
@@ -98,6 +188,9 @@ def read_particles_csv(
     detect: bool = True,
     z_policy: str = "refuse",
     z0: float | None = None,
+    columns: Mapping[str, str] | None = None,
+    contact_columns: Mapping[str, str] | None = None,
+    format_name: str = "particles-csv",
 ) -> Snapshot:
     """Read a particles CSV (and optionally a contacts CSV) into a :class:`Snapshot`.
 
@@ -106,13 +199,33 @@ def read_particles_csv(
     column spreading over more than 1e-3 of the smallest radius is 3D data:
     refused unless ``z_policy`` is ``"project"`` or ``"slice"`` (with ``z0``),
     as for :func:`~grainlab.io.read_lammps_dump`.
+
+    ``columns`` maps grainlab's roles (:data:`PARTICLE_ROLES`) to the file's
+    column names, ``contact_columns`` those of the contacts file
+    (:data:`CONTACT_ROLES`), e.g. ``columns={"id": "ID", "x": "pos_x",
+    "y": "pos_y"}``, ``contact_columns={"i": "end1", "j": "end2"}``. A file
+    without a ``kind`` column warns (:class:`MissingKindWarning`).
+
+    >>> import pathlib, tempfile, warnings
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "balls.csv"
+    >>> _ = f.write_text("ID,pos_x,pos_y,rad\n7,0,0,0.001\n8,0.002,0,0.001\n")
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore", MissingKindWarning)
+    ...     s = read_particles_csv(f, columns={"id": "ID", "x": "pos_x", "y": "pos_y", "radius": "rad"},
+    ...                            tolerance=1e-9)
+    >>> s.ids.tolist(), s.n_contacts
+    ([7, 8], 1)
     """
     check_z_policy(z_policy, z0)
+    column_map = check_column_map(columns, PARTICLE_ROLES)
+    contact_map = check_column_map(contact_columns, CONTACT_ROLES, "contact_columns")
+    if contact_map and contacts is None:
+        raise ValueError("contact_columns: only apply to a contacts file (give contacts=)")
     if z_policy == "slice" and contacts is not None:
         raise ValueError(
             "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
         )
-    names, data, numbers = _read_csv(path, PARTICLE_COLUMNS)
+    names, data, numbers = _read_csv(path, PARTICLE_COLUMNS, column_map)
     if data.shape[0] == 0:
         raise FileFormatError(path, None, "no particle rows after the header")
     col = {n: data[:, k] for k, n in enumerate(names)}
@@ -124,7 +237,9 @@ def read_particles_csv(
         k = int(np.argmax(bad))
         raise FileFormatError(path, int(numbers[k]), f"column 'radius': {plain(radius[k])} is not > 0")
     kind = None
-    if "kind" in col:
+    if "kind" not in col:
+        warn_missing_kind(path)
+    else:
         kind = integral_column(path, col["kind"], numbers, "kind")
         bad = ~np.isin(kind, [int(k) for k in ParticleKind])
         if bad.any():
@@ -143,7 +258,9 @@ def read_particles_csv(
             )
         extra[BODY_FIELD] = body
     positions = np.c_[col["x"], col["y"]]
-    metadata: dict[str, Any] = {"source": str(path), "format": "particles-csv"}
+    metadata: dict[str, Any] = {"source": str(path), "format": format_name}
+    if column_map:
+        metadata["columns"] = dict(column_map)
     rotations = col.get("rotation")
     plan = planar(path, None, col.get("z"), radius, z_policy=z_policy, z0=z0)
     check_geometry(path, positions[plan.keep], plan.radii, numbers[plan.keep])
@@ -159,7 +276,7 @@ def read_particles_csv(
     )
     if contacts is not None:
         snap = Snapshot(positions, radius, **kwargs)
-        return attach_contacts_csv(snap, contacts)
+        return attach_contacts_csv(snap, contacts, columns=contact_map)
     if detect and plan.spheres:
         i, j, normals = sphere_contacts(
             path, positions, plan.z, radius, ids, tolerance=tolerance, box=None, periodic=(False, False)
@@ -171,12 +288,17 @@ def read_particles_csv(
     return Snapshot(positions, radius, **kwargs)
 
 
-def read_contacts_csv(path: str | Path) -> dict[str, NDArray[Any]]:
+def read_contacts_csv(
+    path: str | Path, *, columns: Mapping[str, str] | None = None
+) -> dict[str, NDArray[Any]]:
     """Read a contacts CSV: a dict with ``i``, ``j`` (ids) and the optional force columns.
 
-    Also returns ``line`` (the file line of each row) for error messages.
+    ``columns`` maps the roles :data:`CONTACT_ROLES` to the file's column
+    names (``{"i": "end1", "j": "end2"}``). Also returns ``line`` (the file
+    line of each row) for error messages.
     """
-    names, data, numbers = _read_csv(path, CONTACT_COLUMNS)
+    column_map = check_column_map(columns, CONTACT_ROLES, "contact_columns")
+    names, data, numbers = _read_csv(path, CONTACT_COLUMNS, column_map)
     col = {n: data[:, k] for k, n in enumerate(names)}
     out: dict[str, NDArray[Any]] = {
         "i": integral_column(path, col["i"], numbers, "i"),
@@ -189,9 +311,11 @@ def read_contacts_csv(path: str | Path) -> dict[str, NDArray[Any]]:
     return out
 
 
-def attach_contacts_csv(snapshot: Snapshot, path: str | Path) -> Snapshot:
+def attach_contacts_csv(
+    snapshot: Snapshot, path: str | Path, *, columns: Mapping[str, str] | None = None
+) -> Snapshot:
     """The snapshot with the contacts read from a contacts CSV (ids -> indices)."""
-    c = read_contacts_csv(path)
+    c = read_contacts_csv(path, columns=columns)
     i = snapshot.index_of(c["i"])
     j = snapshot.index_of(c["j"])
     for name, idx, ids in (("i", i, c["i"]), ("j", j, c["j"])):
@@ -229,7 +353,10 @@ def write_particles_csv(
     *,
     float_format: str = "%.17g",
 ) -> Path:
-    """Write ``id,x,y,radius`` (+ rotation, kind, body when set, + ``columns``) as CSV.
+    """Write ``id,x,y,radius`` (+ rotation when set, kind, body when set, + ``columns``) as CSV.
+
+    ``kind`` is always written, so that reading the file back does not warn
+    (:class:`MissingKindWarning`).
 
     Extra ``columns`` are (N,) arrays; NaN is written as an empty field.
     Integer and bool columns are written as integers. Returns the path.
@@ -242,8 +369,7 @@ def write_particles_csv(
     }
     if snapshot.rotations is not None:
         cols["rotation"] = np.asarray(snapshot.rotations)
-    if np.any(np.asarray(snapshot.kind) != ParticleKind.SOIL):
-        cols["kind"] = np.asarray(snapshot.kind)
+    cols["kind"] = np.asarray(snapshot.kind)
     if BODY_FIELD in snapshot.particle_fields:
         cols[BODY_FIELD] = np.asarray(snapshot.particle_fields[BODY_FIELD])
     for name, values in (columns or {}).items():

@@ -1,0 +1,66 @@
+"""A snapshot from parsed point rows: the part every point-table reader shares (readers only)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.io._planar import planar, sphere_contacts
+from grainlab.io._table import FileFormatError, check_geometry, check_unique_ids, plain
+from grainlab.snapshot import ParticleKind, Snapshot
+
+
+def boundary_kind(codes: NDArray[Any], boundary: Any) -> NDArray[np.int8]:
+    """Kind MEMBRANE where ``codes`` (atom types, material ids) is one of ``boundary``, else SOIL."""
+    bounding = np.isin(codes, np.asarray(list(boundary), dtype=np.float64))
+    return np.where(bounding, ParticleKind.MEMBRANE, ParticleKind.SOIL).astype(np.int8)
+
+
+def snapshot_from_points(
+    path: str | Path,
+    line_numbers: NDArray[np.int64],
+    positions: NDArray[np.float64],
+    z: NDArray[np.float64] | None,
+    radii: NDArray[np.float64],
+    ids: NDArray[np.int64],
+    *,
+    kind: NDArray[np.int8] | None,
+    fields: dict[str, NDArray[Any]],
+    metadata: dict[str, Any],
+    tolerance: float,
+    z_policy: str,
+    z0: float | None,
+) -> Snapshot:
+    """Check the rows, apply ``z_policy`` and detect the contacts from the geometry.
+
+    ``line_numbers`` name the file line of each row in errors (``None``
+    entries are not allowed: pass the first data line for files without rows
+    per particle). ``kind`` None means every particle a grain.
+    """
+    if radii.shape[0] == 0:
+        raise FileFormatError(path, None, "no particles in the file")
+    check_unique_ids(path, ids, line_numbers)
+    bad = ~(radii > 0)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise FileFormatError(path, int(line_numbers[k]), f"radius {plain(radii[k])} is not > 0")
+    if not (0 <= tolerance < np.inf):
+        raise ValueError(f"tolerance: must be a finite value >= 0 m, got {tolerance}")
+    plan = planar(path, None, z, radii, z_policy=z_policy, z0=z0)
+    keep = plan.keep
+    check_geometry(path, positions[keep], plan.radii, line_numbers[keep])
+    positions, ids = positions[keep], ids[keep]
+    kind = None if kind is None else kind[keep]
+    fields = {name: value[keep] for name, value in fields.items()}
+    metadata = {**metadata, **plan.metadata}
+    kwargs: dict[str, Any] = dict(ids=ids, kind=kind, particle_fields=fields, metadata=metadata)
+    if plan.spheres:
+        i, j, normals = sphere_contacts(
+            path, positions, plan.z, plan.radii, ids, tolerance=tolerance, box=None, periodic=(False, False)
+        )
+        metadata["contacts"] = f"detected between the spheres in 3D (tolerance {tolerance:g} m)"
+        return Snapshot(positions, plan.radii, contact_i=i, contact_j=j, contact_normal=normals, **kwargs)
+    return Snapshot.from_geometry(positions, plan.radii, tolerance=tolerance, **kwargs)
