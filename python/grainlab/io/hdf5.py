@@ -81,6 +81,7 @@ from grainlab.io.results import (
     fsync_file,
     write_bytes_atomic,
 )
+from grainlab.io.walls import WallGeometry, read_wall_group, write_wall_group
 from grainlab.snapshot import Snapshot
 
 __all__ = [
@@ -122,6 +123,8 @@ _STATUSES = ("running", "complete", "failed")
 # attribute storage, creation order), readable by HDF5 >= 1.8 (MATLAB R2011+).
 _LIBVER = ("v108", "v108")
 _TIMESERIES_CHUNK = 1024
+#: Time series columns stored as int64 (the rest float64): the engine step count.
+INTEGER_COLUMNS = ("step",)
 _STR = h5py.string_dtype("utf-8")
 
 # Units of the snapshot datasets and of well-known per-particle / per-contact fields.
@@ -770,7 +773,7 @@ class ResultsWriter:
                 name,
                 shape=(0,),
                 maxshape=(None,),
-                dtype=np.float64,
+                dtype=np.int64 if name in INTEGER_COLUMNS else np.float64,
                 chunks=(_TIMESERIES_CHUNK,),
             )
         for name, unit in units.items():
@@ -792,6 +795,8 @@ class ResultsWriter:
 
         The first call defines the columns (with ``units``, default ``""``,
         dimensionless or unknown); later calls must give exactly those columns.
+        The columns of :data:`INTEGER_COLUMNS` (``step``) are stored as int64
+        and must hold whole numbers.
         """
         data: dict[str, NDArray[np.float64]] = {}
         for name, values in columns.items():
@@ -801,6 +806,10 @@ class ResultsWriter:
                 raise ValueError(f"timeseries[{name!r}]: not numbers ({error})") from None
             if a.ndim != 1:
                 raise ValueError(f"timeseries[{name!r}]: expected 1D values, got shape {a.shape}")
+            if name in INTEGER_COLUMNS:
+                if not np.all(np.isfinite(a) & (a == np.round(a))):
+                    raise ValueError(f"timeseries[{name!r}]: the engine step must be a whole number, got {a}")
+                a = a.astype(np.int64)
             data[str(name)] = a
         lengths = {len(a) for a in data.values()}
         if len(lengths) > 1:
@@ -851,12 +860,16 @@ class ResultsWriter:
         *,
         step: int | None = None,
         overwrite: bool = False,
+        walls: WallGeometry | None = None,
     ) -> None:
         """Store ``snapshot`` completely as ``/snapshots/<name>``.
 
         ``name`` is any string without ``/`` (see :func:`snapshot_name`);
         ``step`` is the engine step count (default ``snapshot.metadata["step"]``
         when that is an integer), which ``read_snapshot(..., timestep=N)`` selects by.
+        ``walls``, the run's walls at that instant
+        (:meth:`WallGeometry.from_simulation <grainlab.io.walls.WallGeometry.from_simulation>`),
+        are stored as ``/snapshots/<name>/walls`` and read back by :meth:`Results.walls`.
         """
         _check_name("snapshot name", name)
         if not isinstance(snapshot, Snapshot):
@@ -875,6 +888,8 @@ class ResultsWriter:
         g = group.create_group(name, track_order=True)
         try:
             _write_snapshot_group(g, snapshot, compression=self._compression, step=step)
+            if walls is not None:
+                write_wall_group(g.create_group("walls", track_order=True), walls)
         except BaseException:
             del group[name]
             raise
@@ -1081,7 +1096,7 @@ class Results:
     status: str
     #: The resolved configuration, as written.
     config: dict[str, Any]
-    #: Time series: ``column -> (n_rows,) float64``, columns in order.
+    #: Time series: ``column -> (n_rows,) float64`` (``step``: int64), columns in order.
     timeseries: dict[str, NDArray[np.float64]]
     #: Units of each time series column (``""`` when dimensionless or unknown).
     timeseries_units: dict[str, str]
@@ -1105,6 +1120,13 @@ class Results:
         info = _select(self.path, self.snapshots, name, None)
         with _open_results(self.path, self._allow_incomplete) as (f, reader):
             return reader.read_snapshot(f, info.name, self.path)
+
+    def walls(self, name: str | int | None = None) -> WallGeometry | None:
+        """The walls stored with a snapshot (selected as by :meth:`snapshot`), or None if none were."""
+        info = _select(self.path, self.snapshots, name, None)
+        with _open_results(self.path, self._allow_incomplete) as (f, _reader):
+            group = f["snapshots"][info.name]
+            return read_wall_group(group["walls"]) if "walls" in group else None
 
 
 @dataclass(frozen=True)
@@ -1132,7 +1154,8 @@ def _read_results_v1(f: h5py.File, path: Path, allow_incomplete: bool) -> Result
                     path,
                     f"/timeseries/{name}: {ds.shape[0]} values, fewer than n_rows = {n_rows}",
                 )
-            timeseries[name] = np.asarray(ds[:n_rows], dtype=np.float64)
+            integral = ds.dtype.kind in "iu"  # the engine step (INTEGER_COLUMNS)
+            timeseries[name] = np.asarray(ds[:n_rows], dtype=np.int64 if integral else np.float64)
             units[name] = _attr_str(ds.attrs, "units", "")
     phases: dict[str, float] = {}
     if "phases" in f:

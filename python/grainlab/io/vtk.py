@@ -58,14 +58,19 @@ __all__ = [
     "contact_lines",
     "export_vtk",
     "snapshot_arrays",
+    "CELL_WALL",
     "write_pvd",
     "write_vtp",
+    "write_vtu",
+    "write_walls_vtp",
 ]
 
 #: ``cell_kind`` of the vertex cell of a particle.
 CELL_PARTICLE = 0
 #: ``cell_kind`` of the line cell of a particle–particle contact.
 CELL_CONTACT = 1
+#: ``cell_kind`` of the line cell of a wall (platen) in a walls file.
+CELL_WALL = 2
 
 _VTK_TYPES = {
     np.dtype(np.float32): "Float32",
@@ -167,6 +172,54 @@ def write_vtp(
         On a wrong shape, a line index out of range, an unsupported dtype,
         a line array named ``cell_kind`` or ``-inf`` in an ASCII file.
     """
+    return _write_xml("PolyData", path, points, lines, point_data, line_data, field_data, binary)
+
+
+def write_vtu(
+    path: str | os.PathLike[str],
+    points: ArrayLike,
+    *,
+    lines: ArrayLike | None = None,
+    point_data: Mapping[str, ArrayLike] | None = None,
+    line_data: Mapping[str, ArrayLike] | None = None,
+    field_data: Mapping[str, ArrayLike] | None = None,
+    binary: bool = True,
+) -> Path:
+    """What :func:`write_vtp` writes, as a VTK XML UnstructuredGrid (``.vtu``).
+
+    The same points, cells (a ``VTK_VERTEX`` per point, then a ``VTK_LINE``
+    per line), point, cell and field data, for readers that take unstructured
+    grids but no PolyData (meshio). Parameters and errors as :func:`write_vtp`.
+    """
+    return _write_xml("UnstructuredGrid", path, points, lines, point_data, line_data, field_data, binary)
+
+
+def write_walls_vtp(path: str | os.PathLike[str], segments: ArrayLike, *, binary: bool = True) -> Path:
+    """The walls as line cells (no vertices) of a PolyData: ``segments`` (K, 2, 2) end points, m.
+
+    The cell data are ``cell_kind`` (:data:`CELL_WALL`) and ``wall_index``
+    (0 .. K-1, in the order given); the field data ``n_walls`` is K.
+    """
+    seg = np.asarray(segments, dtype=np.float64).reshape(-1, 2, 2)
+    k = seg.shape[0]
+    field: dict[str, ArrayLike] = {"n_walls": [k]}
+    return _write_xml(
+        "PolyData", path, seg.reshape(-1, 2), np.arange(2 * k).reshape(k, 2),
+        None, {"wall_index": np.arange(k, dtype=np.int32)}, field, binary, verts=False,
+    )
+
+
+def _write_xml(
+    dataset: str,
+    path: str | os.PathLike[str],
+    points: ArrayLike,
+    lines: ArrayLike | None,
+    point_data: Mapping[str, ArrayLike] | None,
+    line_data: Mapping[str, ArrayLike] | None,
+    field_data: Mapping[str, ArrayLike] | None,
+    binary: bool,
+    verts: bool = True,
+) -> Path:
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] not in (2, 3):
         raise ValueError(f"points: expected shape (N, 2) or (N, 3), got {pts.shape}")
@@ -183,44 +236,51 @@ def write_vtp(
         raise ValueError("line_data: 'cell_kind' is reserved for the writer")
 
     root = ET.Element(
-        "VTKFile", type="PolyData", version="1.0", byte_order="LittleEndian", header_type="UInt64"
+        "VTKFile", type=dataset, version="1.0", byte_order="LittleEndian", header_type="UInt64"
     )
-    poly = ET.SubElement(root, "PolyData")
+    poly = ET.SubElement(root, dataset)
+    nv = n if verts else 0  # vertex cells: one per point, or none (walls)
     if field_data:
         fd = ET.SubElement(poly, "FieldData")
         for name, value in field_data.items():
             a = np.asarray(value).ravel()
             a = _prepare(name, a, a.shape[0])
             _data_array(fd, name, a, binary, NumberOfTuples=str(a.shape[0]))
-    piece = ET.SubElement(
-        poly,
-        "Piece",
-        NumberOfPoints=str(n),
-        NumberOfVerts=str(n),
-        NumberOfLines=str(m),
-        NumberOfStrips="0",
-        NumberOfPolys="0",
+    counts = (
+        {"NumberOfCells": str(nv + m)}
+        if dataset == "UnstructuredGrid"
+        else {"NumberOfVerts": str(nv), "NumberOfLines": str(m), "NumberOfStrips": "0", "NumberOfPolys": "0"}
     )
+    piece = ET.SubElement(poly, "Piece", NumberOfPoints=str(n), **counts)
     pd = ET.SubElement(piece, "PointData")
     for name, value in (point_data or {}).items():
         _data_array(pd, name, _prepare(name, value, n), binary)
     cd = ET.SubElement(piece, "CellData")
-    kind = np.r_[np.full(n, CELL_PARTICLE, "<i4"), np.full(m, CELL_CONTACT, "<i4")]
+    kind = np.r_[np.full(nv, CELL_PARTICLE, "<i4"), np.full(m, CELL_CONTACT if verts else CELL_WALL, "<i4")]
     _data_array(cd, "cell_kind", kind, binary)
     for name, value in (line_data or {}).items():
         a, fill = _fill_value(_prepare(name, value, m))
-        full = np.full((n + m, *a.shape[1:]), fill, dtype=a.dtype)
-        full[n:] = a
+        full = np.full((nv + m, *a.shape[1:]), fill, dtype=a.dtype)
+        full[nv:] = a
         _data_array(cd, name, full, binary)
     _data_array(ET.SubElement(piece, "Points"), "Points", _prepare("points", pts, n), binary)
-    for tag, connectivity, size in (
-        ("Verts", np.arange(n, dtype="<i8"), 1),
-        ("Lines", seg.ravel().astype("<i8"), 2),
-    ):
-        el = ET.SubElement(piece, tag)
-        count = connectivity.shape[0] // size
+    if dataset == "UnstructuredGrid":
+        el = ET.SubElement(piece, "Cells")
+        connectivity = np.r_[np.arange(nv, dtype="<i8"), seg.ravel().astype("<i8")]
+        offsets = np.r_[np.arange(1, nv + 1), nv + 2 * np.arange(1, m + 1)].astype("<i8")
         _data_array(el, "connectivity", connectivity, binary)
-        _data_array(el, "offsets", size * np.arange(1, count + 1, dtype="<i8"), binary)
+        _data_array(el, "offsets", offsets, binary)
+        types = np.r_[np.full(nv, 1, "u1"), np.full(m, 3, "u1")]  # VTK_VERTEX, VTK_LINE
+        _data_array(el, "types", types, binary)
+    else:
+        for tag, connectivity, size in (
+            ("Verts", np.arange(nv, dtype="<i8"), 1),
+            ("Lines", seg.ravel().astype("<i8"), 2),
+        ):
+            el = ET.SubElement(piece, tag)
+            count = connectivity.shape[0] // size
+            _data_array(el, "connectivity", connectivity, binary)
+            _data_array(el, "offsets", size * np.arange(1, count + 1, dtype="<i8"), binary)
 
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
