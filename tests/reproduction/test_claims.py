@@ -110,3 +110,52 @@ def test_the_page_is_self_contained_with_every_figure_embedded(tmp_path, monkeyp
     assert (tmp_path / "reproduction.html").stat().st_size < 1_500_000
     for row in written.document["claims"]:
         assert row["id"] in html
+
+
+def test_each_variant_is_compared_with_the_variant_nearest_in_configuration():
+    plan = ReproductionPlan.build(3, ["paper", "boundary_b", "rate=8%/min",
+                                      "set:shear.strain_rate=8%/min,run.time_step_safety=0.5", "lambda_raw"])
+    pairs = {v.name: (ref.name, keys) for v, ref, keys in outputs.comparison_pairs(plan)}
+    assert pairs["boundary_b"] == ("paper", ["boundary.kind"])
+    assert pairs["rate=8%/min"] == ("paper", ["shear.strain_rate"])
+    # one key from the 8 %/min run, two from paper's: compared with the 8 %/min run
+    assert pairs["set:shear.strain_rate=8%/min,run.time_step_safety=0.5"] == (
+        "rate=8%/min", ["run.time_step_safety"])
+    assert "paper" not in pairs and "lambda_raw" not in pairs  # the reference itself; analysis only
+
+
+def test_a_paired_comparison_finds_a_shift_beyond_the_tolerance_and_not_noise():
+    base = [paper_like(s) for s in SEEDS]
+    same = variant_comparison_of(base, base)
+    assert same["all_within"] and same["quantities"]["peak_stress_ratio"]["difference"] == 0.0
+    shifted = []
+    for m in base:
+        m = json.loads(json.dumps(m))
+        m["macro"]["peak_stress_ratio"] *= 1.10  # 10 % higher peak, every seed
+        shifted.append(m)
+    result = variant_comparison_of(shifted, base)
+    peak = result["quantities"]["peak_stress_ratio"]
+    assert not peak["within"] and not result["all_within"]
+    assert peak["difference"] == pytest.approx(0.10 * peak["reference_mean"], rel=1e-9)
+    assert peak["ci95"][0] > 0.0 and peak["n"] == 5
+    assert result["quantities"]["final_volumetric_strain"]["within"]
+
+
+def variant_comparison_of(measures, reference):
+    return outputs.variant_comparison(measures, reference)
+
+
+def test_claims_md_is_the_verdict_tables_of_claims_json(tmp_path, monkeypatch):
+    from grainlab.reproduction.markdown import claims_markdown
+
+    plan = ReproductionPlan.build(5, ["paper", "boundary_b", "rate=1%/min"])
+    _write(plan, tmp_path, monkeypatch, figures=False)
+    doc = json.loads((tmp_path / "claims.json").read_text())
+    text = (tmp_path / "claims.md").read_text()
+    assert text == claims_markdown(doc)
+    lines = text.splitlines()
+    for row in doc["claims"]:  # one table line per claim, with its verdict
+        (line,) = [ln for ln in lines if ln.startswith(f"| `{row['id']}` |") and row["verdict"] in ln]
+        assert f"| {row['n']} |" in line
+    assert "## Rate convergence" in text and "| 2%/min | 1%/min | peak σ1/σ3 |" in text
+    assert "| `boundary_b` | `paper` | peak σ1/σ3 |" in text

@@ -39,14 +39,17 @@ import numpy as np
 import grainlab
 from grainlab.io.results import write_json_atomic, write_text_atomic
 from grainlab.reproduction.claims import BIAXIAL_CLAIMS, RATE_CLAIMS, STUDY_CLAIMS, evaluate
+from grainlab.reproduction.markdown import claims_markdown
 from grainlab.reproduction.measures import measure_biaxial_each, measure_study, read_study_rows
 from grainlab.reproduction.runs import ReproductionPlan, Variant
-from grainlab.reproduction.verdicts import VERDICTS
+from grainlab.reproduction.verdicts import VERDICTS, t_interval
 
-__all__ = ["CLAIMS_CSV", "CLAIMS_JSON", "MEASURES_JSON", "Outputs", "rate_convergence", "rate_family", "write_outputs"]
+__all__ = ["CLAIMS_CSV", "CLAIMS_JSON", "CLAIMS_MD", "MEASURES_JSON", "Outputs", "comparison_pairs", "rate_convergence",
+           "rate_family", "variant_comparison", "write_outputs"]
 
 CLAIMS_JSON = "claims.json"
 CLAIMS_CSV = "claims.csv"
+CLAIMS_MD = "claims.md"
 MEASURES_JSON = "measures.json"
 HTML_FILE = "reproduction.html"
 
@@ -241,6 +244,65 @@ def rate_convergence(family: Sequence[tuple[float, list[dict[str, Any] | None]]]
     return out
 
 
+# ----------------------------------------------------------------------------- variant pairs
+def _config_leaves(plan: ReproductionPlan, v: Variant) -> dict[str, Any]:
+    config = plan.biaxial_config(plan.variant(v.runs_variant), plan.seeds[0]).to_dict()
+    return {f"{section}.{key}": value for section, keys in config.items() if isinstance(keys, dict)
+            for key, value in keys.items()}
+
+
+def comparison_pairs(plan: ReproductionPlan) -> list[tuple[Variant, Variant, list[str]]]:
+    """Each biaxial variant that runs its own configuration, other than the main one,
+    with its reference: the biaxial variant whose configuration differs from it in the
+    fewest keys (the main variant on a tie), and those keys."""
+    main = _main(plan, "biaxial")
+    own = [v for v in plan.variants if v.kind == "biaxial" and not v.source]
+    if main is None or len(own) < 2:
+        return []
+    leaves = {v.name: _config_leaves(plan, v) for v in own}
+    pairs = []
+    for v in own:
+        if v.name == main.name:
+            continue
+
+        def differing(other: Variant, v: Variant = v) -> list[str]:
+            a, b = leaves[v.name], leaves[other.name]
+            return sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
+
+        others = sorted((o for o in own if o.name != v.name),
+                        key=lambda o: (len(differing(o)), o.name != main.name))
+        pairs.append((v, others[0], differing(others[0])))
+    return pairs
+
+
+def variant_comparison(measures: Sequence[dict[str, Any] | None], reference: Sequence[dict[str, Any] | None]
+                       ) -> dict[str, Any]:
+    """Paired per seed, for the quantities of the rate convergence: the mean of
+    ``measures`` minus ``reference``, its 95 % t-interval, and whether the difference
+    is within max(3 % of the reference mean, the reference's seed standard deviation),
+    the rate convergence's tolerance."""
+    quantities: dict[str, Any] = {}
+    for name, get in _RATE_QUANTITIES.items():
+        a = np.array([float(get(m)) for m in measures], dtype=np.float64)
+        b = np.array([float(get(m)) for m in reference], dtype=np.float64)
+        both = np.isfinite(a) & np.isfinite(b)
+        if not both.any():
+            quantities[name] = {"mean": None, "reference_mean": None, "difference": None, "ci95": [None, None],
+                                "n": 0, "tolerance": None, "within": None}
+            continue
+        d = a[both] - b[both]
+        scatter = float(np.std(b[both], ddof=1)) if both.sum() > 1 else 0.0
+        tolerance = max(RATE_TOLERANCE * abs(float(b[both].mean())), scatter)
+        low, high = t_interval(d) if d.size > 1 else (math.nan, math.nan)
+        quantities[name] = {
+            "mean": float(a[both].mean()), "reference_mean": float(b[both].mean()),
+            "difference": float(d.mean()), "ci95": [low, high], "n": int(d.size),
+            "tolerance": tolerance, "within": bool(abs(d.mean()) <= tolerance),
+        }
+    known = [q["within"] for q in quantities.values() if q["within"] is not None]
+    return {"quantities": quantities, "all_within": bool(known) and all(known) and len(known) == len(quantities)}
+
+
 # ----------------------------------------------------------------------------- writing
 def _main(plan: ReproductionPlan, kind: str) -> Variant | None:
     preferred = "paper" if kind == "biaxial" else "study"
@@ -322,6 +384,10 @@ def write_outputs(plan: ReproductionPlan, out_dir: str | os.PathLike[str], *, wo
             f"({slow_rate * 6000:g} %/min)"), "seeds": list(plan.seeds), "claims": rows,
             "verdict_counts": _counts(rows), "notes": []})
 
+    comparisons = [{"variant": v.name, "reference": ref.name, "differs_in": keys,
+                    **variant_comparison(per_seed(v), per_seed(ref))}
+                   for v, ref, keys in comparison_pairs(plan)]
+
     main_biaxial, main_study = _main(plan, "biaxial"), _main(plan, "study")
     top = [b for b in blocks if b["variant"] in {v.name for v in (main_biaxial, main_study) if v}]
     top_claims = [row for b in top for row in b["claims"]]
@@ -334,11 +400,13 @@ def write_outputs(plan: ReproductionPlan, out_dir: str | os.PathLike[str], *, wo
         "verdict_counts": _counts(top_claims),
         "variants": blocks,
         "rate_convergence": convergence,
+        "comparisons": comparisons,
         "notes": notes,
     }
     files = [write_json_atomic(out / CLAIMS_JSON, document)]
     document = json.loads(files[0].read_text())  # NaN as null, as the file has it
     files.append(write_text_atomic(out / CLAIMS_CSV, _csv_text(document["variants"])))
+    files.append(write_text_atomic(out / CLAIMS_MD, claims_markdown(document)))
     measures_doc = {f"{v}/seed-{s}": m for (v, s, _), m in results.items() if m is not None}
     files.append(write_json_atomic(out / MEASURES_JSON, measures_doc, indent=None))
     if figures:

@@ -1,0 +1,127 @@
+"""``claims.md``: the verdicts of a reproduction as Markdown tables, from the
+``claims.json`` document alone (so a stored ``claims.json`` gives the same tables
+again: docs/reproduction.md quotes them and a test keeps them equal).
+
+Sections: the main claims (id, the paper's value, mean, 95 % interval, n,
+verdict), the verdicts of every claim in every variant side by side, the rate
+convergence, the paired comparisons of variants and the wall times.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+__all__ = ["claims_markdown"]
+
+#: Rate-convergence and comparison quantities, as the tables name them.
+QUANTITY_LABELS = {
+    "peak_stress_ratio": "peak σ1/σ3",
+    "residual_stress_ratio": "end-window σ1/σ3",
+    "final_volumetric_strain": "final εv",
+    "band_minus_rest_lambda": "band − rest λ (peak)",
+}
+#: Short verdicts for the side-by-side table.
+SHORT = {"reproduced": "yes", "not reproduced": "**no**", "inconclusive": "?"}
+
+
+def _num(x: Any, digits: int = 3) -> str:
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "n/a"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, int):
+        return str(x)
+    return f"{float(x):.{digits}g}"
+
+
+def _interval(ci: Sequence[Any]) -> str:
+    if not ci or ci[0] is None or ci[1] is None:
+        return "n/a"
+    return f"[{_num(ci[0])}, {_num(ci[1])}]"
+
+
+def _table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> list[str]:
+    lines = ["| " + " | ".join(header) + " |", "| " + " | ".join("---" for _ in header) + " |"]
+    lines += ["| " + " | ".join(str(c).replace("|", "\\|") for c in row) + " |" for row in rows]
+    return lines
+
+
+def _paper_value(row: dict[str, Any]) -> str:
+    value = row.get("paper_value")
+    return "–" if value is None else _num(value)
+
+
+def claims_markdown(document: dict[str, Any]) -> str:
+    """The Markdown text of ``claims.md`` for a ``claims.json`` document."""
+    counts = document.get("verdict_counts", {})
+    out = [
+        f"# Claims: {document['variant']}",
+        "",
+        f"Seeds {', '.join(str(s) for s in document['seeds'])}; grainlab {document['grainlab_version']}"
+        + ("; quick mode" if document.get("quick") else "") + ". "
+        + ", ".join(f"{n} {v}" for v, n in counts.items()) + ".",
+        "",
+        "## The paper's claims",
+        "",
+    ]
+    out += _table(
+        ["id", "paper", "mean", "95 % interval", "n", "verdict"],
+        ([f"`{r['id']}`", _paper_value(r), _num(r["mean"]), _interval(r["ci95"]), str(r["n"]), r["verdict"]]
+         for r in document["claims"]),
+    )
+    blocks = [b for b in document.get("variants", []) if b.get("kind") != "rate"]
+    if len(blocks) > 1:
+        out += ["", "## Every variant", "",
+                "Verdict (yes = reproduced, **no** = not reproduced, ? = inconclusive) and seed mean.", ""]
+        ids: list[str] = []
+        for b in blocks:
+            ids += [r["id"] for r in b["claims"] if r["id"] not in ids]
+        by = {b["variant"]: {r["id"]: r for r in b["claims"]} for b in blocks}
+        rows = []
+        for claim in ids:
+            cells = [f"`{claim}`"]
+            for b in blocks:
+                r = by[b["variant"]].get(claim)
+                cells.append("" if r is None else f"{SHORT.get(r['verdict'], r['verdict'])} {_num(r['mean'])}")
+            rows.append(cells)
+        out += _table(["claim"] + [f"`{b['variant']}`" for b in blocks], rows)
+        out += ["", "Counts: " + "; ".join(
+            f"`{b['variant']}` " + ", ".join(f"{n} {v}" for v, n in b["verdict_counts"].items()) for b in blocks) + "."]
+    for b in document.get("variants", []):
+        if b.get("kind") == "rate":
+            out += ["", f"## {b['variant']}", "", b["description"] + ".", ""]
+            out += _table(["id", "mean", "95 % interval", "n", "verdict"],
+                          ([f"`{r['id']}`", _num(r["mean"]), _interval(r["ci95"]), str(r["n"]), r["verdict"]]
+                           for r in b["claims"]))
+    if document.get("rate_convergence"):
+        out += ["", "## Rate convergence", "",
+                "Seed means at r and r/2; within: |difference| ≤ max(3 % of the value at r/2, its seed "
+                "standard deviation).", ""]
+        rows = []
+        for e in document["rate_convergence"]:
+            for name, q in e["quantities"].items():
+                rows.append([e["rate"], e["half_rate"], QUANTITY_LABELS.get(name, name), _num(q["at_rate"]),
+                             _num(q["at_half_rate"]), _num(q["tolerance"], 2), _num(q["within"]),
+                             "**converged**" if e["converged"] else "not converged"])
+        out += _table(["r", "r/2", "quantity", "at r", "at r/2", "tolerance", "within", "r"], rows)
+    if document.get("comparisons"):
+        out += ["", "## Variants against their reference", "",
+                "Paired per seed: the variant's mean minus its reference's, with the 95 % interval of the "
+                "paired differences; within: as the rate convergence.", ""]
+        rows = []
+        for c in document["comparisons"]:
+            for name, q in c["quantities"].items():
+                rows.append([f"`{c['variant']}`", f"`{c['reference']}`", QUANTITY_LABELS.get(name, name),
+                             _num(q["mean"]), _num(q["reference_mean"]), _num(q["difference"], 2),
+                             _interval(q["ci95"]), str(q["n"]), _num(q["tolerance"], 2), _num(q["within"])])
+        out += _table(["variant", "reference", "quantity", "mean", "reference", "difference", "95 % interval",
+                       "n", "tolerance", "within"], rows)
+    walls = [b for b in document.get("variants", []) if b.get("wall_time_s", {}).get("mean") is not None]
+    if walls:
+        out += ["", "## Wall time", ""]
+        out += _table(["variant", "runs of", "mean per seed (s)", "total (s)"],
+                      ([f"`{b['variant']}`", f"`{b['runs_of']}`", _num(b["wall_time_s"]["mean"], 4),
+                        _num(b["wall_time_s"]["total"], 4)] for b in walls))
+    return "\n".join(out) + "\n"
