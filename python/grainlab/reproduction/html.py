@@ -91,6 +91,19 @@ def _rate_table(entries: Sequence[Mapping[str, Any]]) -> Markup:
                  rows, numeric=(3, 4, 5))
 
 
+def _comparison_table(entries: Sequence[Mapping[str, Any]]) -> Markup:
+    rows = []
+    for c in entries:
+        for name, q in c["quantities"].items():
+            ci = q.get("ci95") or [None, None]
+            rows.append([c["variant"], c["reference"], name, _value(q.get("mean"), 4),
+                         _value(q.get("reference_mean"), 4), _value(q.get("difference"), 3),
+                         f"[{_value(ci[0], 3)}, {_value(ci[1], 3)}]", str(q.get("n", 0)), _value(q.get("tolerance"), 3),
+                         "n/a" if q.get("within") is None else fmt(q["within"])])
+    return table(["variant", "reference", "quantity", "mean", "reference mean", "difference", "95 % interval",
+                  "n", "tolerance", "within"], rows, numeric=(3, 4, 5, 7, 8))
+
+
 def _figure(name: str, path: Path) -> EmbeddedFigure:
     kind = name.split("_", 1)[0]
     return EmbeddedFigure(name, name.replace("_", " "), _FIGURE_CAPTIONS.get(kind, ""), path.read_bytes(),
@@ -131,6 +144,10 @@ def write_html(path: str | Path, plan: ReproductionPlan, document: Mapping[str, 
             "For each rate r with a run at r/2: is each quantity's mean over seeds at r within 3 % (or the seed "
             "standard deviation at r/2, whichever is larger) of its mean at r/2?"),
             _rate_table(document["rate_convergence"])))
+    if document.get("comparisons"):
+        sections.append(section("comparisons", "Variants against their reference", paragraph(
+            "Each variant against the variant whose configuration differs from it in the fewest keys, paired "
+            "per seed; within: the rate convergence's tolerance."), _comparison_table(document["comparisons"])))
     by_variant: dict[str, list[EmbeddedFigure]] = {}
     for name, file in drawn.items():
         stem = name.split("_", 1)[1] if "_" in name else name
