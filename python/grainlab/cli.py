@@ -70,8 +70,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     args.quiet = getattr(args, "quiet", False)  # a parser built without add_output_options has none
     args.progress = not (getattr(args, "no_progress", False) or args.quiet)
     set_verbose(getattr(args, "verbose", False))
+    from grainlab._interrupt import interrupts_recorded
+
     try:
-        return int(args.func(args))
+        with interrupts_recorded():
+            return int(args.func(args))
     except ValueError as error:  # bad input, refused before any work
         print(f"grainlab {args.command}: error: {error}", file=sys.stderr)
         return 2

@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 
 import grainlab
+from grainlab._interrupt import raise_if_interrupted
 from grainlab._mapping import flatten_keys
 from grainlab._progress import progress_bar
 from grainlab.analysis import fabric_summary
@@ -762,6 +763,7 @@ def _shear(
                     f"shearing stopped at {100 * record['axial_strain']:.2f} % axial strain: {breach}"
                 )
         shear["next"] += 1
+        raise_if_interrupted()
         bar.update(100 * record["axial_strain"] - done_strain)
         done_strain = 100 * record["axial_strain"]
         bar.set_postfix_str(f"ratio {record['stress_ratio']:.2f}")
@@ -897,11 +899,14 @@ def _write_outputs(out: Path) -> dict[str, Any]:
     from grainlab.io.hdf5 import read_results
 
     results = read_results(out / RESULTS_FILE)
+    raise_if_interrupted()  # a Ctrl-C that h5py's clean-up swallowed stops the run here
     summary = dict(results.summary)
     write_text_atomic(out / "timeseries.csv", _csv(results.timeseries))
     _figures(results.timeseries, out)
+    raise_if_interrupted()
     # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
     summary["fabric"] = fabric_figures(out).numbers.summary()
+    raise_if_interrupted()
     write_json_atomic(out / "summary.json", summary)
     return summary
 
