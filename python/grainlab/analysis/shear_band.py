@@ -95,6 +95,7 @@ dict (``found``, ``reason``, ``angle_deg``, ``inclination_deg``,
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -183,6 +184,126 @@ def _best(scores: NDArray[np.float64]) -> int:
     while hi + 1 < scores.size and tie[hi + 1]:
         hi += 1
     return (lo + hi) // 2
+
+
+@dataclass(frozen=True)
+class _BandInput:
+    """The checked input of :meth:`ShearBand.compute`: every particle's position,
+    radius and strain, which are considered and valid (finite strain), and the
+    valid ones' positions relative to their centroid."""
+
+    pos: NDArray[np.float64]
+    rad: NDArray[np.float64]
+    gamma: NDArray[np.float64]
+    considered: NDArray[np.bool_]
+    valid: NDArray[np.bool_]
+    d_mean: float
+    origin: NDArray[np.float64]
+    p: NDArray[np.float64]
+    g: NDArray[np.float64]
+
+    @classmethod
+    def of(
+        cls,
+        positions: ArrayLike | Snapshot,
+        shear_strain: ArrayLike,
+        radii: ArrayLike | None,
+        mask: ArrayLike | None,
+    ) -> _BandInput:
+        if isinstance(positions, Snapshot):
+            snap = positions
+            pos = np.asarray(snap.positions)
+            radii = snap.radii if radii is None else radii
+            mask = snap.is_sample if mask is None else mask
+        else:
+            pos = np.asarray(positions, dtype=np.float64)
+        if radii is None:
+            raise ValueError("radii: needed to express the thickness in mean diameters")
+        rad = np.asarray(radii, dtype=np.float64)
+        gamma = np.asarray(shear_strain, dtype=np.float64)
+        n = pos.shape[0]
+        if pos.shape != (n, 2) or rad.shape != (n,) or gamma.shape != (n,):
+            raise ValueError(
+                f"positions, radii, shear_strain: expected shapes (N, 2), (N,), (N,), got "
+                f"{pos.shape}, {rad.shape}, {gamma.shape}"
+            )
+        considered = np.ones(n, bool) if mask is None else np.asarray(mask, bool)
+        valid = considered & np.isfinite(gamma)
+        if valid.sum() < 10:
+            raise ValueError(
+                "shear_strain: need at least 10 particles with a finite strain, "
+                f"got {int(valid.sum())}"
+            )
+        origin = pos[valid].mean(axis=0)
+        return cls(pos, rad, gamma, considered, valid, float(np.mean(2.0 * rad[considered])), origin,
+                   pos[valid] - origin, gamma[valid])
+
+
+@dataclass(frozen=True)
+class _Profile:
+    """The strain profile across the band (one entry per occupied bin) and the
+    band's edges on it."""
+
+    centers: NDArray[np.float64]
+    """Mean coordinate across the band of each bin's particles."""
+    mean_strain: NDArray[np.float64]
+    smooth: NDArray[np.float64]
+    """Mean strain within about ``_SMOOTH_D / 2`` mean diameters of each bin."""
+    crossing: NDArray[np.bool_]
+    """Bins that cross the sample (filled enough along the band)."""
+    background: float
+    peak: float
+    s_lo: float
+    s_hi: float
+
+    @property
+    def thickness(self) -> float:
+        return max(self.s_hi - self.s_lo, 0.0)
+
+    @property
+    def s_mid(self) -> float:
+        return 0.5 * (self.s_lo + self.s_hi)
+
+
+def _band_profile(
+    s: NDArray[np.float64], g: NDArray[np.float64], width: float, window: int, bin_width: float, min_fill: float
+) -> _Profile:
+    """Step 2: the profile across the band at coordinates ``s`` and its
+    half-height edges around the highest smoothed bin that crosses the sample."""
+    b2, counts2, crossing2 = _slab_bins(s, width, window, min_fill)
+    b, counts, crossing = b2[0], counts2[0], crossing2[0]
+    sums = np.bincount(b, weights=g, minlength=counts.size)
+    occupied = counts > 0
+    centers = np.bincount(b, weights=s, minlength=counts.size)[occupied] / counts[occupied]
+    prof = sums[occupied] / counts[occupied]
+    keep = crossing[occupied]
+    half_window = max(1, int(np.floor(0.5 * _SMOOTH_D / bin_width + 0.5)))
+    kernel = np.ones(2 * half_window + 1)
+    near_sums = np.convolve(sums, kernel, mode="same")
+    near_counts = np.convolve(counts.astype(np.float64), kernel, mode="same")
+    smooth = (near_sums / np.maximum(near_counts, 1.0))[occupied]
+    background = float(np.median(g))
+    ipeak = int(np.argmax(np.where(keep, smooth, -np.inf)))
+    peak = float(smooth[ipeak])
+    half = background + 0.5 * (peak - background)
+    inside = keep & (smooth >= half)
+    inside[ipeak] = True
+    left = ipeak
+    while left > 0 and inside[left - 1]:
+        left -= 1
+    right = ipeak
+    while right < prof.size - 1 and inside[right + 1]:
+        right += 1
+
+    def edge(i_in: int, i_out: int) -> float:
+        """Half-height crossing between a band bin and its outer neighbour."""
+        if i_out < 0 or i_out >= prof.size or smooth[i_out] >= half:
+            return float(centers[i_in])  # the band reaches the end of the profile used
+        gi, go = smooth[i_in], smooth[i_out]
+        t = (gi - half) / (gi - go) if gi != go else 0.5
+        return float(centers[i_in] + t * (centers[i_out] - centers[i_in]))
+
+    return _Profile(centers, prof, smooth, keep, background, peak, edge(left, left - 1), edge(right, right + 1))
 
 
 class ShearBand(Computable):
@@ -310,39 +431,66 @@ class ShearBand(Computable):
         ``mask`` default to the snapshot's radii and sample particles);
         ``shear_strain`` (N,), NaN entries are ignored; ``radii`` (N,) m;
         ``mask`` (N,) bool restricts the particles considered.
-        """
-        if isinstance(positions, Snapshot):
-            snap = positions
-            pos = np.asarray(snap.positions)
-            radii = snap.radii if radii is None else radii
-            mask = snap.is_sample if mask is None else mask
-        else:
-            pos = np.asarray(positions, dtype=np.float64)
-        if radii is None:
-            raise ValueError("radii: needed to express the thickness in mean diameters")
-        rad = np.asarray(radii, dtype=np.float64)
-        gamma = np.asarray(shear_strain, dtype=np.float64)
-        n = pos.shape[0]
-        if pos.shape != (n, 2) or rad.shape != (n,) or gamma.shape != (n,):
-            raise ValueError(
-                f"positions, radii, shear_strain: expected shapes (N, 2), (N,), (N,), got "
-                f"{pos.shape}, {rad.shape}, {gamma.shape}"
-            )
-        considered = np.ones(n, bool) if mask is None else np.asarray(mask, bool)
-        valid = considered & np.isfinite(gamma)
-        if valid.sum() < 10:
-            raise ValueError(
-                "shear_strain: need at least 10 particles with a finite strain, "
-                f"got {int(valid.sum())}"
-            )
-        d_mean = float(np.mean(2.0 * rad[considered]))
-        width = self.bin_width * d_mean
-        window = max(1, int(round(_FILL_WINDOW_D / self.bin_width)))
-        origin = pos[valid].mean(axis=0)
-        p = pos[valid] - origin
-        g = gamma[valid]
 
-        # 1. orientation: coarse 1 degree scan, then 0.05 degree refinement
+        The steps: the band's orientation (:meth:`_orientation`), its profile and
+        edges across it (:func:`_band_profile`), the acceptance tests
+        (:meth:`_acceptance`), lambda inside and outside, and a second band
+        (:meth:`_second_band`).
+        """
+        data = _BandInput.of(positions, shear_strain, radii, mask)
+        width = self.bin_width * data.d_mean
+        window = max(1, int(round(_FILL_WINDOW_D / self.bin_width)))
+        angle, score = self._orientation(data.p, data.g, width, window)
+        normal = np.array([-np.sin(angle), np.cos(angle)])
+        profile = _band_profile(data.p @ normal, data.g, width, window, self.bin_width, self.min_fill)
+        center = data.origin + profile.s_mid * normal
+        excess, prominence, problems = self._acceptance(profile, data)
+        s_all = (data.pos - center) @ normal
+        members = data.considered & (np.abs(s_all) <= 0.5 * profile.thickness)
+        lam_in = lam_out = float("nan")
+        if stability_index is not None:
+            lam = np.asarray(stability_index, dtype=np.float64)
+            use = data.considered.copy()
+            if n_contacts is not None:
+                use &= np.asarray(n_contacts) >= 2
+            lam_in = finite_mean(lam, use & members)
+            lam_out = finite_mean(lam, use & ~members)
+        second = None
+        if self.find_second:
+            rest = data.valid & (np.abs(s_all) > 0.5 * profile.thickness + _FLANK_D * data.d_mean)
+            second = self._second_band(data, rest, angle, stability_index, n_contacts)
+        peak = profile.peak
+        self._store(
+            found=not problems,
+            reason="; ".join(problems),
+            angle=angle,
+            thickness=float(profile.thickness),
+            thickness_diameters=float(profile.thickness / data.d_mean),
+            center=center,
+            normal=normal,
+            members=members,
+            mean_lambda_inside=lam_in,
+            mean_lambda_outside=lam_out,
+            contrast=float(excess / peak) if peak > 0 and excess > 0 else 0.0,
+            prominence=float(prominence),
+            score=score,
+            peak_strain=peak,
+            background_strain=profile.background,
+            profile=(profile.centers - profile.s_mid, profile.mean_strain),
+            profile_crossing=profile.crossing,
+            second=second,
+            mean_diameter=data.d_mean,
+            positions=data.pos,
+            radii=data.rad,
+            shear_strain=data.gamma,
+        )
+        return self
+
+    def _orientation(
+        self, p: NDArray[np.float64], g: NDArray[np.float64], width: float, window: int
+    ) -> tuple[float, float]:
+        """Step 1: the band angle (a 1 degree scan, a 0.05 degree refinement, a
+        parabola through the best three) and its score."""
         rng = np.random.default_rng(0)
         coarse = np.radians(np.arange(0.0, 180.0, 1.0))
         pc, gc = self._subset(p, g, self.max_points, rng)
@@ -366,60 +514,19 @@ class ShearBand(Computable):
                 angle += 0.5 * (y0 - y2) / curv * (fine[1] - fine[0])
         angle = float(np.mod(angle, np.pi))
         score = float(_scores(p, g, np.array([angle]), width, window, self.min_fill)[0])
+        return angle, score
 
-        # 2. profile across the band at that angle
-        normal = np.array([-np.sin(angle), np.cos(angle)])
-        s = p @ normal
-        b2, counts2, crossing2 = _slab_bins(s, width, window, self.min_fill)
-        b, counts, crossing = b2[0], counts2[0], crossing2[0]
-        sums = np.bincount(b, weights=g, minlength=counts.size)
-        occupied = counts > 0
-        # profile coordinate: mean position of the particles in each bin
-        centers = np.bincount(b, weights=s, minlength=counts.size)[occupied] / counts[occupied]
-        prof = sums[occupied] / counts[occupied]
-        keep = crossing[occupied]
-        # smoothed profile: mean strain of the particles within about _SMOOTH_D / 2 mean
-        # diameters of each bin (at least one bin on each side)
-        half_window = max(1, int(np.floor(0.5 * _SMOOTH_D / self.bin_width + 0.5)))
-        kernel = np.ones(2 * half_window + 1)
-        near_sums = np.convolve(sums, kernel, mode="same")
-        near_counts = np.convolve(counts.astype(np.float64), kernel, mode="same")
-        smooth = (near_sums / np.maximum(near_counts, 1.0))[occupied]
-        background = float(np.median(g))
-        ipeak = int(np.argmax(np.where(keep, smooth, -np.inf)))
-        peak = float(smooth[ipeak])
-        half = background + 0.5 * (peak - background)
-        inside = keep & (smooth >= half)
-        inside[ipeak] = True
-        left = ipeak
-        while left > 0 and inside[left - 1]:
-            left -= 1
-        right = ipeak
-        while right < prof.size - 1 and inside[right + 1]:
-            right += 1
-
-        def edge(i_in: int, i_out: int) -> float:
-            """Half-height crossing between a band bin and its outer neighbour."""
-            if i_out < 0 or i_out >= prof.size or smooth[i_out] >= half:
-                return float(centers[i_in])  # the band reaches the end of the profile used
-            gi, go = smooth[i_in], smooth[i_out]
-            t = (gi - half) / (gi - go) if gi != go else 0.5
-            return float(centers[i_in] + t * (centers[i_out] - centers[i_in]))
-
-        s_lo = edge(left, left - 1)
-        s_hi = edge(right, right + 1)
-        thickness = max(s_hi - s_lo, 0.0)
-        s_mid = 0.5 * (s_lo + s_hi)
-        center = origin + s_mid * normal
-
-        # 3. acceptance: how far the band stands out of the rest of the profile
-        excess = peak - background
-        if excess <= max(_MIN_EXCESS, _MIN_EXCESS * float(np.max(np.abs(g)))):
+    def _acceptance(self, profile: _Profile, data: _BandInput) -> tuple[float, float, list[str]]:
+        """Step 3: how far the band stands out of the rest of the profile: its
+        excess strain over the background, its prominence and what fails."""
+        excess = profile.peak - profile.background
+        if excess <= max(_MIN_EXCESS, _MIN_EXCESS * float(np.max(np.abs(data.g)))):
             excess = 0.0  # round-off: a uniform (affine) deformation has no band
         # the band's flanks: one band thickness (at least 2 mean diameters) on each side
-        flank = 0.5 * thickness + max(thickness, _FLANK_D * d_mean)
-        away = keep & (np.abs(centers - s_mid) > flank)
-        elsewhere = float(smooth[away].max()) - background if away.any() else 0.0
+        thickness = profile.thickness
+        flank = 0.5 * thickness + max(thickness, _FLANK_D * data.d_mean)
+        away = profile.crossing & (np.abs(profile.centers - profile.s_mid) > flank)
+        elsewhere = float(profile.smooth[away].max()) - profile.background if away.any() else 0.0
         if excess <= 0.0:
             prominence = 0.0
         elif elsewhere <= 0.0:
@@ -430,9 +537,9 @@ class ShearBand(Computable):
         if excess <= 0.0:
             problems.append("no part of the profile stands above the background strain")
         else:
-            if thickness / d_mean < self.min_thickness:
+            if thickness / data.d_mean < self.min_thickness:
                 problems.append(
-                    f"thinner ({thickness / d_mean:.2f} mean diameters) than "
+                    f"thinner ({thickness / data.d_mean:.2f} mean diameters) than "
                     f"min_thickness = {self.min_thickness:g}"
                 )
             if prominence < self.min_prominence:
@@ -441,65 +548,37 @@ class ShearBand(Computable):
                     f"{self.min_prominence:g} (another part of the profile is "
                     f"{100 * elsewhere / excess:.0f} % as high above the background)"
                 )
-        s_all = (pos - center) @ normal
-        members = considered & (np.abs(s_all) <= 0.5 * thickness)
-        lam_in = lam_out = float("nan")
-        if stability_index is not None:
-            lam = np.asarray(stability_index, dtype=np.float64)
-            use = considered.copy()
-            if n_contacts is not None:
-                use &= np.asarray(n_contacts) >= 2
-            lam_in = finite_mean(lam, use & members)
-            lam_out = finite_mean(lam, use & ~members)
+        return excess, prominence, problems
 
-        # 4. second band: the same search without the first band and its flanks, at
-        #    angles at least _SECOND_SEPARATION from the first
-        second = None
-        if self.find_second:
-            rest = valid & (np.abs(s_all) > 0.5 * thickness + _FLANK_D * d_mean)
-            if rest.sum() >= 10:
-                second = ShearBand(
-                    self.bin_width,
-                    self.max_points,
-                    min_fill=self.min_fill,
-                    min_thickness=self.min_thickness,
-                    min_prominence=self.min_prominence,
-                    second=False,
-                )
-                second._avoid = angle
-                second.compute(
-                    pos,
-                    np.where(rest, gamma, np.nan),
-                    rad,
-                    stability_index=stability_index,
-                    n_contacts=n_contacts,
-                    mask=considered,
-                )
-        self._store(
-            found=not problems,
-            reason="; ".join(problems),
-            angle=angle,
-            thickness=float(thickness),
-            thickness_diameters=float(thickness / d_mean),
-            center=center,
-            normal=normal,
-            members=members,
-            mean_lambda_inside=lam_in,
-            mean_lambda_outside=lam_out,
-            contrast=float(excess / peak) if peak > 0 and excess > 0 else 0.0,
-            prominence=float(prominence),
-            score=score,
-            peak_strain=peak,
-            background_strain=background,
-            profile=(centers - s_mid, prof),
-            profile_crossing=keep,
-            second=second,
-            mean_diameter=d_mean,
-            positions=pos,
-            radii=rad,
-            shear_strain=gamma,
+    def _second_band(
+        self,
+        data: _BandInput,
+        rest: NDArray[np.bool_],
+        angle: float,
+        stability_index: ArrayLike | None,
+        n_contacts: ArrayLike | None,
+    ) -> ShearBand | None:
+        """Step 4: the same search without the first band and its flanks (``rest``),
+        at angles at least ``_SECOND_SEPARATION`` from the first."""
+        if rest.sum() < 10:
+            return None
+        second = ShearBand(
+            self.bin_width,
+            self.max_points,
+            min_fill=self.min_fill,
+            min_thickness=self.min_thickness,
+            min_prominence=self.min_prominence,
+            second=False,
         )
-        return self
+        second._avoid = angle
+        return second.compute(
+            data.pos,
+            np.where(rest, data.gamma, np.nan),
+            data.rad,
+            stability_index=stability_index,
+            n_contacts=n_contacts,
+            mask=data.considered,
+        )
 
     def _avoided(self, angles: NDArray[np.float64]) -> NDArray[np.bool_]:
         """Trial angles too close to the angle to avoid (the first band's, for the second)."""
