@@ -339,48 +339,114 @@ def expand_to_porosity(
         ``max_stress_pa`` (or overlaps beyond the engine's limit): the message
         gives the densest nominal porosity reached and the stress it needed.
     """
-    import grainlab
-    from grainlab.simulation import WALL_GROUP
-
     started = time.perf_counter()
-    box = check_box(box)
-    porosity = float(porosity)
-    if not (0.0 < porosity < 1.0):
-        raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
-    if not isinstance(grading, Grading):
-        raise TypeError(f"grading: expected a Grading (UniformByNumber, UniformByMass, GradingCurve), got {grading!r}")
-    friction = _positive("friction", friction, allow_zero=True)
-    wall_friction = _positive("wall_friction", wall_friction, allow_zero=True)
-    normal_stiffness = _positive("normal_stiffness", normal_stiffness)
-    shear_stiffness = _positive("shear_stiffness", shear_stiffness)
-    density = _positive("density", density)
-    local_damping = float(local_damping)
-    if not (0.0 <= local_damping < 1.0):
-        raise ValueError(f"local_damping: must be in [0, 1), got {local_damping}")
-    initial_scale = float(initial_scale)
-    if not (0.0 < initial_scale <= 1.0):
-        raise ValueError(f"initial_scale: must be in (0, 1], got {initial_scale}")
-    growth_per_increment = _positive("growth_per_increment", growth_per_increment)
-    growth_stress_scale_pa = _positive("growth_stress_scale_pa", growth_stress_scale_pa)
-    steps_per_increment = int(steps_per_increment)
-    if steps_per_increment < 1:
-        raise ValueError(f"steps_per_increment: must be >= 1, got {steps_per_increment}")
-    equilibrium_ratio = _positive("equilibrium_ratio", equilibrium_ratio)
-    stress_free_overlap = _positive("stress_free_overlap", stress_free_overlap)
-    max_equilibrium_steps = int(max_equilibrium_steps)
-    if max_equilibrium_steps < 0:
-        raise ValueError(f"max_equilibrium_steps: must be >= 0, got {max_equilibrium_steps}")
-    max_stress_pa = _positive("max_stress_pa", max_stress_pa)
-    time_step_safety = float(time_step_safety)
-    if not (0.0 < time_step_safety <= 1.0):
-        raise ValueError(f"time_step_safety: must be in (0, 1], got {time_step_safety}")
-    threads = int(threads)
-    if threads < 1:
-        raise ValueError(f"threads: must be >= 1, got {threads}")
-
-    x0, y0, x1, y1 = box
-    area = (x1 - x0) * (y1 - y0)
+    settings = _Settings.checked(
+        box=box, porosity=porosity, grading=grading, friction=friction, wall_friction=wall_friction,
+        normal_stiffness=normal_stiffness, shear_stiffness=shear_stiffness, density=density,
+        local_damping=local_damping, initial_scale=initial_scale, growth_per_increment=growth_per_increment,
+        steps_per_increment=steps_per_increment, growth_stress_scale_pa=growth_stress_scale_pa,
+        equilibrium_ratio=equilibrium_ratio, stress_free_overlap=stress_free_overlap,
+        max_equilibrium_steps=max_equilibrium_steps, max_stress_pa=max_stress_pa,
+        time_step_safety=time_step_safety, threads=threads,
+    )
     rng = np.random.default_rng(seed)
+    d = _diameters(settings, grading, diameters, n_particles, rng)
+    expansion = _Expansion.placed(settings, d, rng, density_scaling, progress)
+    expansion.grow()
+    sample = expansion.finish(settings, density_scaling)
+    return Sample(
+        **sample,
+        radius_factor=expansion.radius_factor,
+        seed=seed,
+        grading=grading.name,
+        friction=settings.friction,
+        wall_friction=settings.wall_friction,
+        threads=settings.threads,
+        steps=expansion.steps,
+        wall_time_s=time.perf_counter() - started,
+        simulation=expansion.sim if keep_simulation else None,
+    )
+
+
+@dataclass(frozen=True)
+class _Settings:
+    """The checked parameters of :func:`expand_to_porosity` (its docstring says what each is)."""
+
+    box: tuple[float, float, float, float]
+    porosity: float
+    friction: float
+    wall_friction: float
+    normal_stiffness: float
+    shear_stiffness: float
+    density: float
+    local_damping: float
+    initial_scale: float
+    growth_per_increment: float
+    steps_per_increment: int
+    growth_stress_scale_pa: float
+    equilibrium_ratio: float
+    stress_free_overlap: float
+    max_equilibrium_steps: int
+    max_stress_pa: float
+    time_step_safety: float
+    threads: int
+
+    @property
+    def area(self) -> float:
+        x0, y0, x1, y1 = self.box
+        return (x1 - x0) * (y1 - y0)
+
+    @classmethod
+    def checked(cls, *, box: ArrayLike, porosity: float, grading: Grading, **values: Any) -> _Settings:
+        """The settings, or a ``ValueError`` naming the first bad one, before any work."""
+        box = check_box(box)
+        porosity = float(porosity)
+        if not (0.0 < porosity < 1.0):
+            raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+        if not isinstance(grading, Grading):
+            raise TypeError(
+                f"grading: expected a Grading (UniformByNumber, UniformByMass, GradingCurve), got {grading!r}"
+            )
+        v = dict(values)
+        for name in ("friction", "wall_friction"):
+            v[name] = _positive(name, v[name], allow_zero=True)
+        for name in ("normal_stiffness", "shear_stiffness", "density"):
+            v[name] = _positive(name, v[name])
+        v["local_damping"] = float(v["local_damping"])
+        if not (0.0 <= v["local_damping"] < 1.0):
+            raise ValueError(f"local_damping: must be in [0, 1), got {v['local_damping']}")
+        v["initial_scale"] = float(v["initial_scale"])
+        if not (0.0 < v["initial_scale"] <= 1.0):
+            raise ValueError(f"initial_scale: must be in (0, 1], got {v['initial_scale']}")
+        for name in ("growth_per_increment", "growth_stress_scale_pa"):
+            v[name] = _positive(name, v[name])
+        v["steps_per_increment"] = int(v["steps_per_increment"])
+        if v["steps_per_increment"] < 1:
+            raise ValueError(f"steps_per_increment: must be >= 1, got {v['steps_per_increment']}")
+        for name in ("equilibrium_ratio", "stress_free_overlap"):
+            v[name] = _positive(name, v[name])
+        v["max_equilibrium_steps"] = int(v["max_equilibrium_steps"])
+        if v["max_equilibrium_steps"] < 0:
+            raise ValueError(f"max_equilibrium_steps: must be >= 0, got {v['max_equilibrium_steps']}")
+        v["max_stress_pa"] = _positive("max_stress_pa", v["max_stress_pa"])
+        v["time_step_safety"] = float(v["time_step_safety"])
+        if not (0.0 < v["time_step_safety"] <= 1.0):
+            raise ValueError(f"time_step_safety: must be in (0, 1], got {v['time_step_safety']}")
+        v["threads"] = int(v["threads"])
+        if v["threads"] < 1:
+            raise ValueError(f"threads: must be >= 1, got {v['threads']}")
+        return cls(box=box, porosity=porosity, **v)
+
+
+def _diameters(
+    settings: _Settings,
+    grading: Grading,
+    diameters: ArrayLike | None,
+    n_particles: int | None,
+    rng: np.random.Generator,
+) -> NDArray[np.float64]:
+    """The diameters given, or ``n_particles`` (default: :func:`particle_count`) drawn
+    from the grading."""
     if diameters is not None:
         if n_particles is not None:
             raise ValueError("n_particles: give either n_particles or diameters, not both")
@@ -390,61 +456,83 @@ def expand_to_porosity(
         if not np.all(np.isfinite(d)) or np.any(d <= 0):
             k = int(np.argmax(~np.isfinite(d) | (d <= 0)))
             raise ValueError(f"diameters[{k}]: must be a finite diameter > 0 (m), got {d[k]}")
-    else:
-        n = particle_count(area, porosity, grading) if n_particles is None else int(n_particles)
-        if n < 1:
-            raise ValueError(f"n_particles: must be >= 1, got {n}")
-        d = grading.sample(n, rng)
+        return d
+    n = particle_count(settings.area, settings.porosity, grading) if n_particles is None else int(n_particles)
+    if n < 1:
+        raise ValueError(f"n_particles: must be >= 1, got {n}")
+    return grading.sample(n, rng)
 
-    # one common factor so that the final nominal porosity is exactly the target
-    radius_factor = math.sqrt((1.0 - porosity) * area / (math.pi * float(np.sum((0.5 * d) ** 2))))
-    final_radii = radius_factor * 0.5 * d
-    if 2.0 * final_radii.max() > min(x1 - x0, y1 - y0):
-        raise ValueError(
-            f"box: the largest final disk (diameter {2 * final_radii.max():.4g} m) does not fit in "
-            f"the box ({x1 - x0:.4g} x {y1 - y0:.4g} m)"
-        )
-    positions, _ = random_placement(box, 2.0 * final_radii, rng, scale=initial_scale)
-    scale = initial_scale
-    placed_radii = scale * final_radii
 
-    model = grainlab.ContactModel(normal_stiffness, shear_stiffness, friction)
-    sim = grainlab.Simulation(
-        positions, placed_radii, density=density, contact_model=model, threads=threads, local_damping=local_damping
-    )
-    sim.set_contact_model(0, WALL_GROUP, grainlab.ContactModel(normal_stiffness, shear_stiffness, wall_friction))
-    walls = _Box(sim, box)
-    if density_scaling:
-        sim.densities = density * (final_radii.max() / final_radii) ** 2
+class _Expansion:
+    """The disks placed at ``initial_scale`` in the box, the simulation that grows
+    them, and the growth itself: :meth:`grow`, then :meth:`finish`."""
 
-    steps = 0
-    from grainlab._progress import progress_bar
+    #: Progress bar resolution.
+    TICKS = 1000
 
-    ticks = 1000
-    total_growth = -math.log(scale)
-    bar = progress_bar(ticks, "radius expansion", enabled=progress,
-                       bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}{postfix}")
+    def __init__(self, settings: _Settings, sim: Any, final_radii: NDArray[np.float64], radius_factor: float,
+                 progress: bool) -> None:
+        from grainlab._progress import progress_bar
 
-    r_min = float(final_radii.min())
+        self.settings = settings
+        self.sim = sim
+        self.walls = _Box(sim, settings.box)
+        self.final_radii = final_radii
+        self.radius_factor = radius_factor
+        self.scale = settings.initial_scale
+        self.steps = 0
+        self.status = "unsettled"
+        self.r_min = float(final_radii.min())
+        self.bar = progress_bar(self.TICKS, "radius expansion", enabled=progress,
+                                bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}{postfix}")
 
-    def relax(limit: int) -> tuple[str, int]:
+    @classmethod
+    def placed(cls, settings: _Settings, d: NDArray[np.float64], rng: np.random.Generator, density_scaling: bool,
+               progress: bool) -> _Expansion:
+        """Final radii scaled by one common factor so that the final nominal porosity is
+        exactly the target; the disks placed at random at ``initial_scale`` of them."""
+        import grainlab
+        from grainlab.simulation import WALL_GROUP
+
+        s = settings
+        x0, y0, x1, y1 = s.box
+        radius_factor = math.sqrt((1.0 - s.porosity) * s.area / (math.pi * float(np.sum((0.5 * d) ** 2))))
+        final_radii = radius_factor * 0.5 * d
+        if 2.0 * final_radii.max() > min(x1 - x0, y1 - y0):
+            raise ValueError(
+                f"box: the largest final disk (diameter {2 * final_radii.max():.4g} m) does not fit in "
+                f"the box ({x1 - x0:.4g} x {y1 - y0:.4g} m)"
+            )
+        positions, _ = random_placement(s.box, 2.0 * final_radii, rng, scale=s.initial_scale)
+        model = grainlab.ContactModel(s.normal_stiffness, s.shear_stiffness, s.friction)
+        sim = grainlab.Simulation(positions, s.initial_scale * final_radii, density=s.density, contact_model=model,
+                                  threads=s.threads, local_damping=s.local_damping)
+        sim.set_contact_model(0, WALL_GROUP, grainlab.ContactModel(s.normal_stiffness, s.shear_stiffness,
+                                                                   s.wall_friction))
+        expansion = cls(s, sim, final_radii, radius_factor, progress)
+        if density_scaling:
+            sim.densities = s.density * (final_radii.max() / final_radii) ** 2
+        return expansion
+
+    def relax(self, limit: int) -> tuple[str, int]:
         """Cycles at fixed radii until equilibrium (``"equilibrium"``), until the contacts
         carry no load (``"stress-free"``), or for ``limit`` steps (``"unsettled"``)."""
+        s, sim = self.settings, self.sim
         done = 0
         while done < limit:
-            chunk = min(4 * steps_per_increment, limit - done)
-            sim.time_step = sim.critical_time_step(time_step_safety)
+            chunk = min(4 * s.steps_per_increment, limit - done)
+            sim.time_step = sim.critical_time_step(s.time_step_safety)
             sim.run(chunk)
             done += chunk
             ratio = sim.unbalanced_force_ratio
-            bar.set_postfix_str(f"unbalanced {ratio:.1e}, stress {walls.mean_stress() / 1e3:.0f} kPa")
-            if ratio < equilibrium_ratio:
+            self.bar.set_postfix_str(f"unbalanced {ratio:.1e}, stress {self.walls.mean_stress() / 1e3:.0f} kPa")
+            if ratio < s.equilibrium_ratio:
                 return "equilibrium", done
             energy = sim.energy
             # rms overlap of the linear contacts from their elastic energy sum(kn delta^2 / 2)
-            n_contacts = sim.contact_count + sum(w.contact_count for w in walls.walls)
-            rms_overlap = math.sqrt(2.0 * max(energy["elastic"], 0.0) / (normal_stiffness * max(n_contacts, 1)))
-            if rms_overlap < stress_free_overlap * r_min:
+            n_contacts = sim.contact_count + sum(w.contact_count for w in self.walls.walls)
+            rms_overlap = math.sqrt(2.0 * max(energy["elastic"], 0.0) / (s.normal_stiffness * max(n_contacts, 1)))
+            if rms_overlap < s.stress_free_overlap * self.r_min:
                 return "stress-free", done
             if energy["kinetic"] > energy["elastic"]:
                 # no load-bearing network: free disks feel no local damping and would fly
@@ -453,21 +541,23 @@ def expand_to_porosity(
                 sim.angular_velocities = np.zeros(sim.n_particles)
         return "unsettled", done
 
-    def fail(stress: float, equilibrium: bool, engine_error: Exception | None = None) -> ExpansionError:
-        n_nom, n_cor = walls.porosities()
+    def fail(self, stress: float, equilibrium: bool, engine_error: Exception | None = None) -> ExpansionError:
+        """The error for a target that needs more than ``max_stress_pa`` (or that the engine stopped)."""
+        s = self.settings
+        n_nom, n_cor = self.walls.porosities()
         reached = (
             f"the densest packing reached has nominal porosity {n_nom:.4f} (overlap-corrected {n_cor:.4f})"
         )
         if engine_error is None:
             state = "in equilibrium" if equilibrium else "while growing"
             message = (
-                f"porosity: cannot reach nominal porosity {porosity:.4f} within max_stress_pa = "
-                f"{max_stress_pa / 1e6:.3g} MPa: {reached} and needed a mean wall stress of "
+                f"porosity: cannot reach nominal porosity {s.porosity:.4f} within max_stress_pa = "
+                f"{s.max_stress_pa / 1e6:.3g} MPa: {reached} and needed a mean wall stress of "
                 f"{stress / 1e6:.3g} MPa {state}. Raise max_stress_pa or aim for a higher porosity."
             )
         else:
             message = (
-                f"porosity: cannot reach nominal porosity {porosity:.4f}: {reached}, at a mean wall "
+                f"porosity: cannot reach nominal porosity {s.porosity:.4f}: {reached}, at a mean wall "
                 f"stress of {stress / 1e6:.3g} MPa, when the engine stopped ({engine_error}). "
                 "Aim for a higher porosity or generate with less friction."
             )
@@ -476,98 +566,99 @@ def expand_to_porosity(
             porosity=n_nom,
             porosity_overlap_corrected=n_cor,
             stress_pa=stress,
-            target=porosity,
+            target=s.porosity,
             equilibrium=equilibrium,
-            steps=steps,
+            steps=self.steps,
             engine_stopped=engine_error is not None,
         )
 
-    try:
-        stress = 0.0
-        while scale < 1.0:
-            growth = growth_per_increment / (1.0 + max(stress, 0.0) / growth_stress_scale_pa)
-            scale = min(1.0, scale * math.exp(growth))
-            sim.radii = final_radii if scale == 1.0 else scale * final_radii
-            sim.time_step = sim.critical_time_step(time_step_safety)
-            sim.run(steps_per_increment)
-            steps += steps_per_increment
-            stress = walls.mean_stress()
-            bar.moveto(int(ticks * (1.0 - math.log(1.0 / scale) / total_growth)) if total_growth > 0 else ticks)
-            bar.set_postfix_str(f"stress {stress / 1e3:.0f} kPa, Z {sim.coordination_number:.2f}")
-            if stress > max_stress_pa:
-                status, used = relax(max_equilibrium_steps)
-                steps += used
-                stress = walls.mean_stress()
-                if stress > max_stress_pa:
-                    raise fail(stress, status == "equilibrium")
-        bar.moveto(ticks)
-        bar.set_description_str("equilibrium")
-        status, used = relax(max_equilibrium_steps)
-        steps += used
-    except grainlab.SimulationUnstableError as error:
+    def grow(self) -> None:
+        """Grows the radii by increments that shrink as the wall stress rises, relaxing
+        whenever the stress passes ``max_stress_pa`` (an error if it stays above), then
+        cycles the final packing to equilibrium."""
+        import grainlab
+
+        s, sim, bar = self.settings, self.sim, self.bar
+        total_growth = -math.log(self.scale)
+        try:
+            stress = 0.0
+            while self.scale < 1.0:
+                growth = s.growth_per_increment / (1.0 + max(stress, 0.0) / s.growth_stress_scale_pa)
+                self.scale = min(1.0, self.scale * math.exp(growth))
+                sim.radii = self.final_radii if self.scale == 1.0 else self.scale * self.final_radii
+                sim.time_step = sim.critical_time_step(s.time_step_safety)
+                sim.run(s.steps_per_increment)
+                self.steps += s.steps_per_increment
+                stress = self.walls.mean_stress()
+                bar.moveto(int(self.TICKS * (1.0 - math.log(1.0 / self.scale) / total_growth))
+                           if total_growth > 0 else self.TICKS)
+                bar.set_postfix_str(f"stress {stress / 1e3:.0f} kPa, Z {sim.coordination_number:.2f}")
+                if stress > s.max_stress_pa:
+                    status, used = self.relax(s.max_equilibrium_steps)
+                    self.steps += used
+                    stress = self.walls.mean_stress()
+                    if stress > s.max_stress_pa:
+                        raise self.fail(stress, status == "equilibrium")
+            bar.moveto(self.TICKS)
+            bar.set_description_str("equilibrium")
+            self.status, used = self.relax(s.max_equilibrium_steps)
+            self.steps += used
+        except grainlab.SimulationUnstableError as error:
+            bar.close()
+            raise self.fail(self.walls.mean_stress(), False, error) from error
         bar.close()
-        raise fail(walls.mean_stress(), False, error) from error
-    bar.close()
 
-    wall_stresses = walls.wall_stresses()
-    stress = float(wall_stresses.mean())
-    settled = status != "unsettled"
-    if stress > max_stress_pa:
-        raise fail(stress, status == "equilibrium")
-    ratio = sim.unbalanced_force_ratio
-    if not settled:
-        warnings.warn(
-            f"expand_to_porosity: unbalanced force ratio {ratio:.2e} still above equilibrium_ratio = "
-            f"{equilibrium_ratio:.1e} after max_equilibrium_steps = {max_equilibrium_steps}",
-            RuntimeWarning,
-            stacklevel=2,
-        )
-    contacts = sim.contacts()
-    radii = sim.radii
-    if len(contacts):
-        mean_overlap = float(contacts.overlap.mean() / radii.min())
-        max_overlap = float(np.max(contacts.overlap / np.minimum(radii[contacts.i], radii[contacts.j])))
-    else:
-        mean_overlap = max_overlap = 0.0
-    n_nom, n_cor = walls.porosities()
-    coordination = sim.coordination_number
-    mechanical = CoordinationNumber().compute(sim.snapshot()).mechanical_coordination_number
-
-    # hand over a clean state: Table 1 density back, at rest, a time step for the real masses
-    if density_scaling:
-        sim.densities = np.full(len(radii), density)
-    sim.velocities = np.zeros((len(radii), 2))
-    sim.angular_velocities = np.zeros(len(radii))
-    sim.time_step = sim.critical_time_step(0.5)
-
-    positions_out = np.array(sim.positions)
-    radii_out = np.array(radii)
-    for array in (positions_out, radii_out, wall_stresses):
-        array.flags.writeable = False
-    return Sample(
-        positions=positions_out,
-        radii=radii_out,
-        box=box,
-        wall_points=_wall_points(box),
-        porosity_target=porosity,
-        porosity=n_nom,
-        porosity_overlap_corrected=n_cor,
-        wall_stresses_pa=wall_stresses,
-        mean_wall_stress_pa=stress,
-        coordination_number=coordination,
-        mechanical_coordination_number=mechanical,
-        mean_overlap_ratio=mean_overlap,
-        max_overlap_ratio=max_overlap,
-        unbalanced_force_ratio=ratio,
-        equilibrium_reached=settled,
-        jammed=status == "equilibrium" and len(contacts) > 0 and stress > 0.0,
-        radius_factor=radius_factor,
-        seed=seed,
-        grading=grading.name,
-        friction=friction,
-        wall_friction=wall_friction,
-        threads=threads,
-        steps=steps,
-        wall_time_s=time.perf_counter() - started,
-        simulation=sim if keep_simulation else None,
-    )
+    def finish(self, settings: _Settings, density_scaling: bool) -> dict[str, Any]:
+        """The packing's measures (a ``Sample``'s fields) and a clean hand-over: Table 1
+        density back, at rest, a time step for the real masses."""
+        sim, status = self.sim, self.status
+        wall_stresses = self.walls.wall_stresses()
+        stress = float(wall_stresses.mean())
+        settled = status != "unsettled"
+        if stress > settings.max_stress_pa:
+            raise self.fail(stress, status == "equilibrium")
+        ratio = sim.unbalanced_force_ratio
+        if not settled:
+            warnings.warn(
+                f"expand_to_porosity: unbalanced force ratio {ratio:.2e} still above equilibrium_ratio = "
+                f"{settings.equilibrium_ratio:.1e} after max_equilibrium_steps = {settings.max_equilibrium_steps}",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+        contacts = sim.contacts()
+        radii = sim.radii
+        if len(contacts):
+            mean_overlap = float(contacts.overlap.mean() / radii.min())
+            max_overlap = float(np.max(contacts.overlap / np.minimum(radii[contacts.i], radii[contacts.j])))
+        else:
+            mean_overlap = max_overlap = 0.0
+        n_nom, n_cor = self.walls.porosities()
+        coordination = sim.coordination_number
+        mechanical = CoordinationNumber().compute(sim.snapshot()).mechanical_coordination_number
+        if density_scaling:
+            sim.densities = np.full(len(radii), settings.density)
+        sim.velocities = np.zeros((len(radii), 2))
+        sim.angular_velocities = np.zeros(len(radii))
+        sim.time_step = sim.critical_time_step(0.5)
+        positions_out = np.array(sim.positions)
+        radii_out = np.array(radii)
+        for array in (positions_out, radii_out, wall_stresses):
+            array.flags.writeable = False
+        return {
+            "positions": positions_out,
+            "radii": radii_out,
+            "box": settings.box,
+            "wall_points": _wall_points(settings.box),
+            "porosity_target": settings.porosity,
+            "porosity": n_nom,
+            "porosity_overlap_corrected": n_cor,
+            "wall_stresses_pa": wall_stresses,
+            "mean_wall_stress_pa": stress,
+            "coordination_number": coordination,
+            "mechanical_coordination_number": mechanical,
+            "mean_overlap_ratio": mean_overlap,
+            "max_overlap_ratio": max_overlap,
+            "unbalanced_force_ratio": ratio,
+            "equilibrium_reached": settled,
+            "jammed": status == "equilibrium" and len(contacts) > 0 and stress > 0.0,
+        }
