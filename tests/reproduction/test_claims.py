@@ -161,3 +161,25 @@ def test_claims_md_is_the_verdict_tables_of_claims_json(tmp_path, monkeypatch):
         assert f"| {row['n']} |" in line
     assert "## Rate convergence" in text and "| 2%/min | 1%/min | peak σ1/σ3 |" in text
     assert "| `boundary_b` | `paper` | peak σ1/σ3 |" in text
+
+
+def test_band_grains_before_the_detector_accepts_the_band_are_those_of_the_first_accepted_band():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from grainlab.reproduction.measures import _band_members
+
+    def snap(ids):
+        ids = np.asarray(ids)
+        return SimpleNamespace(ids=ids, is_sample=ids < 100)  # id 100: a membrane disk
+
+    snaps = [snap([0, 1, 2, 3, 100]), snap([3, 2, 1, 0, 100]), snap([1, 0, 3, 2, 100]), snap([0, 1, 2, 3, 100])]
+    none = np.zeros(5, np.int32)
+    labels = [None, none, np.array([1, 0, 2, 0, 0], np.int32), none]  # band: ids 1 and 3
+    members = _band_members(snaps, labels)
+    assert members[3] is None  # nothing accepted at or after the last snapshot
+    for k in (0, 1, 2):
+        inside, source = members[k]
+        assert source == 2
+        assert set(np.asarray(snaps[k].ids)[inside]) == {1, 3}

@@ -156,13 +156,18 @@ def _at(m: Measures, strain: float, tolerance: float = 0.001) -> Mapping[str, An
 
 
 def _band(row: Mapping[str, Any], key: str) -> float:
-    """A band measure of a snapshot; NaN when no band was found there."""
-    return _num(row.get(key)) if row.get("band_found") else math.nan
+    """A band measure of a snapshot: the band's grains (the band accepted at the
+    snapshot, or else the first accepted after it, matched by id) against the
+    rest; NaN when no band is accepted at or after the snapshot."""
+    return _num(row.get(key)) if row.get("band_members_known", row.get("band_found")) else math.nan
 
 
 def _band_share(row: Mapping[str, Any]) -> float:
-    """Share of the grains inside the band (NaN when no band was found)."""
-    inside, outside = _band(row, "inside_n_grains"), _band(row, "outside_n_grains")
+    """Share of the grains inside the band accepted at this snapshot itself (NaN
+    when none is)."""
+    if not row.get("band_found"):
+        return math.nan
+    inside, outside = _num(row.get("inside_n_grains")), _num(row.get("outside_n_grains"))
     return inside / (inside + outside)
 
 

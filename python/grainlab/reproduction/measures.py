@@ -149,11 +149,12 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
     order = sorted(range(len(infos)), key=lambda k: strains[k])
     snaps = [results.snapshot(infos[k].name) for k in order]
     labels = [None] + [band_labels(snaps[0], snap) for snap in snaps[1:]]
+    members = _band_members(snaps, labels)
     peak_pos = (1 + int(np.argmin([abs(strains[k] - macro["peak_axial_strain"]) for k in order[1:]]))
                 if len(order) > 1 else 0)
     peak_ids: NDArray[np.int64] = np.zeros(0, np.int64)
-    if labels[peak_pos] is not None:
-        peak_ids = np.asarray(snaps[peak_pos].ids)[np.asarray(labels[peak_pos]) > 0]
+    if members[peak_pos] is not None:
+        peak_ids = np.asarray(snaps[peak_pos].ids)[members[peak_pos][0]]
     eps_ts = np.asarray(ts["axial_strain"], dtype=np.float64)
     q_ts = np.asarray(ts["stress_ratio"], dtype=np.float64)
     finite = np.isfinite(q_ts) & np.isfinite(eps_ts)
@@ -170,18 +171,41 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
     for given in options:
         opts = {**ANALYSIS_DEFAULTS, **dict(given)}
         rows = []
-        for k, snap, band in zip(order, snaps, labels, strict=True):
+        for k, snap, band, member in zip(order, snaps, labels, members, strict=True):
             row = {"name": infos[k].name, "axial_strain": strains[k],
                    "stress_ratio": float(np.interp(strains[k], eps_ts[finite], q_ts[finite]))}
-            row.update(_snapshot_row(snaps[0], snap, band, peak_ids, opts))
+            row.update(_snapshot_row(snaps[0], snap, band, member, peak_ids, opts))
+            if member is not None:
+                row["band_from_strain"] = strains[order[member[1]]]
             rows.append(row)
         out.append({**common, "analysis": opts, "snapshots": rows})
     return out
 
 
-def _snapshot_row(reference: Any, snap: Any, labels: NDArray[np.int32] | None, peak_ids: NDArray[np.int64],
+def _band_members(snaps: Sequence[Any], labels: Sequence[NDArray[np.int32] | None]
+                  ) -> list[tuple[NDArray[np.bool_], int] | None]:
+    """Per snapshot, the grains of the shear band and the snapshot whose band they
+    are: the band accepted at this snapshot; else the first band accepted after
+    it, its grains matched by id (the grains that form the band, before the
+    detector can tell it from the rest); None when no band is accepted at or
+    after the snapshot."""
+    out: list[tuple[NDArray[np.bool_], int] | None] = [None] * len(snaps)
+    later: tuple[NDArray[np.int64], int] | None = None
+    for k in range(len(snaps) - 1, -1, -1):
+        band = labels[k]
+        if band is not None and np.any(np.asarray(band) > 0):
+            later = (np.asarray(snaps[k].ids)[np.asarray(band) > 0], k)
+        if later is not None:
+            out[k] = (np.isin(np.asarray(snaps[k].ids), later[0]) & np.asarray(snaps[k].is_sample), later[1])
+    return out
+
+
+def _snapshot_row(reference: Any, snap: Any, labels: NDArray[np.int32] | None,
+                  member: tuple[NDArray[np.bool_], int] | None, peak_ids: NDArray[np.int64],
                   options: Mapping[str, Any]) -> dict[str, Any]:
-    """Fabric of one snapshot, and inside / outside its band (when one was found)."""
+    """Fabric of one snapshot, and inside / outside the band's grains (``member``,
+    :func:`_band_members`). ``band_found``: a band is accepted at this snapshot
+    itself; ``band_members_known``: at this snapshot or a later one."""
     from grainlab.analysis.band_fabric import BandFabric, roc_auc
     from grainlab.analysis.strain import match_ids
 
@@ -200,9 +224,10 @@ def _snapshot_row(reference: Any, snap: Any, labels: NDArray[np.int32] | None, p
     row: dict[str, Any] = dict(fabric["numbers"])
     row["auc_lambda_peak_band"] = roc_auc(lam, np.isin(ids, peak_ids)) if peak_ids.size else math.nan
     row["band_found"] = labels is not None and bool(np.any(labels > 0))
-    if row["band_found"]:
+    row["band_members_known"] = member is not None
+    if member is not None:
         bf = BandFabric().compute(
-            snap.positions[grains], 2.0 * snap.radii[grains], lam, counts, np.asarray(labels)[grains] > 0,
+            snap.positions[grains], 2.0 * snap.radii[grains], lam, counts, member[0][grains],
             grain_contacts=np.asarray(fabric["grain_contacts"])[grains], rotation=rotation,
         )
         row.update(bf.summary())
