@@ -9,11 +9,14 @@ convergence, the paired comparisons of variants and the wall times.
 
 from __future__ import annotations
 
+import json
 import math
+import re
 from collections.abc import Iterable, Sequence
+from pathlib import Path
 from typing import Any
 
-__all__ = ["claims_markdown"]
+__all__ = ["claims_markdown", "generated_blocks", "update_generated_blocks"]
 
 #: Rate-convergence and comparison quantities, as the tables name them.
 QUANTITY_LABELS = {
@@ -53,17 +56,19 @@ def _paper_value(row: dict[str, Any]) -> str:
     return "–" if value is None else _num(value)
 
 
-def claims_markdown(document: dict[str, Any]) -> str:
-    """The Markdown text of ``claims.md`` for a ``claims.json`` document."""
+def claims_markdown(document: dict[str, Any], level: int = 1) -> str:
+    """The Markdown text of ``claims.md`` for a ``claims.json`` document; ``level``:
+    the heading level of its title (sections one below)."""
     counts = document.get("verdict_counts", {})
+    h1, h2 = "#" * level, "#" * (level + 1)
     out = [
-        f"# Claims: {document['variant']}",
+        f"{h1} Claims: {document['variant']}",
         "",
         f"Seeds {', '.join(str(s) for s in document['seeds'])}; grainlab {document['grainlab_version']}"
         + ("; quick mode" if document.get("quick") else "") + ". "
         + ", ".join(f"{n} {v}" for v, n in counts.items()) + ".",
         "",
-        "## The paper's claims",
+        f"{h2} The paper's claims",
         "",
     ]
     out += _table(
@@ -73,7 +78,7 @@ def claims_markdown(document: dict[str, Any]) -> str:
     )
     blocks = [b for b in document.get("variants", []) if b.get("kind") != "rate"]
     if len(blocks) > 1:
-        out += ["", "## Every variant", "",
+        out += ["", f"{h2} Every variant", "",
                 "Verdict (yes = reproduced, **no** = not reproduced, ? = inconclusive) and seed mean.", ""]
         ids: list[str] = []
         for b in blocks:
@@ -91,12 +96,12 @@ def claims_markdown(document: dict[str, Any]) -> str:
             f"`{b['variant']}` " + ", ".join(f"{n} {v}" for v, n in b["verdict_counts"].items()) for b in blocks) + "."]
     for b in document.get("variants", []):
         if b.get("kind") == "rate":
-            out += ["", f"## {b['variant']}", "", b["description"] + ".", ""]
+            out += ["", f"{h2} {b['variant']}", "", b["description"] + ".", ""]
             out += _table(["id", "mean", "95 % interval", "n", "verdict"],
                           ([f"`{r['id']}`", _num(r["mean"]), _interval(r["ci95"]), str(r["n"]), r["verdict"]]
                            for r in b["claims"]))
     if document.get("rate_convergence"):
-        out += ["", "## Rate convergence", "",
+        out += ["", f"{h2} Rate convergence", "",
                 "Seed means at r and r/2; within: |difference| ≤ max(3 % of the value at r/2, its seed "
                 "standard deviation).", ""]
         rows = []
@@ -107,7 +112,7 @@ def claims_markdown(document: dict[str, Any]) -> str:
                              "**converged**" if e["converged"] else "not converged"])
         out += _table(["r", "r/2", "quantity", "at r", "at r/2", "tolerance", "within", "r"], rows)
     if document.get("comparisons"):
-        out += ["", "## Variants against their reference", "",
+        out += ["", f"{h2} Variants against their reference", "",
                 "Paired per seed: the variant's mean minus its reference's, with the 95 % interval of the "
                 "paired differences; within: as the rate convergence.", ""]
         rows = []
@@ -120,8 +125,44 @@ def claims_markdown(document: dict[str, Any]) -> str:
                        "n", "tolerance", "within"], rows)
     walls = [b for b in document.get("variants", []) if b.get("wall_time_s", {}).get("mean") is not None]
     if walls:
-        out += ["", "## Wall time", ""]
+        out += ["", f"{h2} Wall time", ""]
         out += _table(["variant", "runs of", "mean per seed (s)", "total (s)"],
                       ([f"`{b['variant']}`", f"`{b['runs_of']}`", _num(b["wall_time_s"]["mean"], 4),
                         _num(b["wall_time_s"]["total"], 4)] for b in walls))
     return "\n".join(out) + "\n"
+
+
+#: A block of a Markdown page generated from a stored ``claims.json`` (path relative
+#: to the repository root): :func:`update_generated_blocks` rewrites its body.
+GENERATED_BLOCK = re.compile(
+    r"(<!-- generated from (?P<path>\S+) by claims_markdown\(level=(?P<level>\d)\) -->\n)(?P<body>.*?)"
+    r"(<!-- end of generated block -->)",
+    re.S,
+)
+
+
+def generated_blocks(text: str) -> list[tuple[str, int, str]]:
+    """(path, level, body) of every generated block of ``text``."""
+    return [(m["path"], int(m["level"]), m["body"]) for m in GENERATED_BLOCK.finditer(text)]
+
+
+def update_generated_blocks(page: str | Path, root: str | Path) -> int:
+    """Rewrites every generated block of the Markdown ``page`` from its stored
+    ``claims.json`` (paths relative to ``root``); returns how many it rewrote."""
+    page = Path(page)
+    text = page.read_text(encoding="utf-8")
+
+    def body(m: re.Match[str]) -> str:
+        document = json.loads((Path(root) / m["path"]).read_text(encoding="utf-8"))
+        return m.group(1) + claims_markdown(document, int(m["level"])) + m.group(5)
+
+    new, count = GENERATED_BLOCK.subn(body, text)
+    page.write_text(new, encoding="utf-8")
+    return count
+
+
+if __name__ == "__main__":  # python -m grainlab.reproduction.markdown docs/reproduction.md
+    import sys
+
+    for name in sys.argv[1:]:
+        print(f"{name}: {update_generated_blocks(name, Path.cwd())} generated blocks rewritten")
