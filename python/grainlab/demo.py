@@ -23,6 +23,7 @@ from grainlab.io.results import (
     write_json_atomic,
     write_text_atomic,
 )
+from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
 from grainlab.simulation import (
     TABLE1_DENSITY_KG_PER_M3,
     TABLE1_FRICTION,
@@ -108,46 +109,33 @@ def compress(
     # Table 1: particle-platen friction 0
     sim.set_contact_model(0, WALL_GROUP, ContactModel(friction=0.0))
     corners = [(0.0, 0.0), (box, 0.0), (box, box), (0.0, box)]
-    walls = [sim.add_segment_wall(corners[k], corners[(k + 1) % 4]) for k in range(4)]
-    for wall in walls:
-        wall.servo(pressure_pa, box, relaxation=0.5, max_speed_m_per_s=0.05)
-    chunk = 2000
+    walls = dict(zip(BOX_WALLS, (sim.add_segment_wall(corners[k], corners[(k + 1) % 4]) for k in range(4)),
+                     strict=True))
     rows = []
     start = time.perf_counter()
-    steps = 0
-    converged = False
     bar = progress_bar(max_steps, "compressing", enabled=progress, unit="step")
-    while steps < max_steps:
-        sim.run(chunk)
-        steps += chunk
-        bar.update(chunk)
-        width = walls[1].points[0, 0] - walls[3].points[0, 0]
-        height = walls[2].points[0, 1] - walls[0].points[0, 1]
-        sx = 0.5 * (walls[1].normal_stress(height) + walls[3].normal_stress(height))
-        sy = 0.5 * (walls[0].normal_stress(width) + walls[2].normal_stress(width))
-        for wall, length in zip(walls, (width, height, width, height), strict=True):
-            wall.servo(pressure_pa, length, relaxation=0.5, max_speed_m_per_s=0.05)
-        porosity = 1.0 - np.pi * np.sum(sim.radii**2) / (width * height)
+
+    def record(state: BoxState, steps: int) -> None:
         rows.append(
             {
                 "step": sim.step_count,
                 "time_s": sim.time,
-                "stress_xx_pa": sx,
-                "stress_yy_pa": sy,
-                "porosity": porosity,
+                "stress_xx_pa": state.stress_xx_pa,
+                "stress_yy_pa": state.stress_yy_pa,
+                "porosity": 1.0 - np.pi * np.sum(sim.radii**2) / (state.width_m * state.height_m),
                 "coordination_number": sim.coordination_number,
                 "unbalanced_force_ratio": sim.unbalanced_force_ratio,
                 "kinetic_energy_j": sim.energy["kinetic"],
             }
         )
-        bar.set_postfix_str(f"sxx {sx / 1e3:.1f} kPa, syy {sy / 1e3:.1f} kPa, unbalanced {sim.unbalanced_force_ratio:.1e}")
-        if (
-            abs(sx / pressure_pa - 1) < tolerance
-            and abs(sy / pressure_pa - 1) < tolerance
-            and sim.unbalanced_force_ratio < unbalanced_force_limit
-        ):
-            converged = True
-            break
+        bar.update(2000)
+        bar.set_postfix_str(f"sxx {state.stress_xx_pa / 1e3:.1f} kPa, syy {state.stress_yy_pa / 1e3:.1f} kPa, "
+                            f"unbalanced {sim.unbalanced_force_ratio:.1e}")
+
+    _, steps, converged = servo_box(
+        sim, walls, pressure_pa, tolerance=tolerance, unbalanced_force_limit=unbalanced_force_limit,
+        max_steps=max_steps, max_speed_m_per_s=0.05, chunk_steps=2000, after_chunk=record,
+    )
     bar.close()
     wall_time = time.perf_counter() - start
     last = rows[-1]

@@ -77,6 +77,7 @@ from grainlab.protocols.boundary import (
     set_platen_velocity,
 )
 from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
 from grainlab.samples import (
     PAPER_GRADING,
     GradingCurve,
@@ -503,17 +504,6 @@ def _generate(config: BiaxialConfig, threads: int, progress: bool) -> tuple[Simu
     return sim, run
 
 
-def _box_stresses(sim: Simulation, run: _Run) -> tuple[float, float, float, float]:
-    """(sigma_xx, sigma_yy, width, height) from the four walls."""
-    w = run.walls
-    bottom, right, top, left = (sim.wall(w[k]) for k in ("bottom", "right", "top", "left"))
-    width = float(right.points[0, 0] - left.points[0, 0])
-    height = float(top.points[0, 1] - bottom.points[0, 1])
-    sxx = 0.5 * (left.normal_stress(height) + right.normal_stress(height))
-    syy = 0.5 * (bottom.normal_stress(width) + top.normal_stress(width))
-    return sxx, syy, width, height
-
-
 def _consolidate(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
     start = time.perf_counter()
     consolidation_model = ContactModel(
@@ -528,27 +518,26 @@ def _consolidate(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bo
     limit = config["consolidation.unbalanced_force_ratio"]
     max_steps = config["consolidation.max_steps"]
     speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
-    steps = 0
     bar = progress_bar(max_steps, "consolidating", enabled=progress, unit="step")
-    while True:
-        sxx, syy, width, height = _box_stresses(sim, run)
-        for name, length in (("bottom", width), ("top", width), ("left", height), ("right", height)):
-            sim.wall(run.walls[name]).servo(target, length, relaxation=0.5, max_speed_m_per_s=speed)
-        sim.run(CHUNK_STEPS)
-        steps += CHUNK_STEPS
+
+    def show(state: BoxState, steps: int) -> None:
         bar.update(CHUNK_STEPS)
-        sxx, syy, width, height = _box_stresses(sim, run)
-        ratio = sim.unbalanced_force_ratio
-        bar.set_postfix_str(f"sxx {sxx / 1e3:.1f} kPa, syy {syy / 1e3:.1f} kPa, unbalanced {ratio:.1e}")
-        if abs(sxx / target - 1) < tolerance and abs(syy / target - 1) < tolerance and ratio < limit:
-            break
-        if steps >= max_steps:
-            bar.close()
-            raise BiaxialError(
-                f"consolidation did not converge in {steps} steps: wall stresses {sxx / 1e3:.1f} / "
-                f"{syy / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa +- {tolerance:.0%}), unbalanced "
-                f"force ratio {ratio:.2e} (limit {limit:.0e}); raise consolidation.max_steps"
-            )
+        bar.set_postfix_str(f"sxx {state.stress_xx_pa / 1e3:.1f} kPa, syy {state.stress_yy_pa / 1e3:.1f} kPa, "
+                            f"unbalanced {sim.unbalanced_force_ratio:.1e}")
+
+    walls = {name: sim.wall(run.walls[name]) for name in BOX_WALLS}
+    state, steps, converged = servo_box(
+        sim, walls, target, tolerance=tolerance, unbalanced_force_limit=limit, max_steps=max_steps,
+        max_speed_m_per_s=speed, chunk_steps=CHUNK_STEPS, after_chunk=show,
+    )
+    if not converged:
+        bar.close()
+        raise BiaxialError(
+            f"consolidation did not converge in {steps} steps: wall stresses {state.stress_xx_pa / 1e3:.1f} / "
+            f"{state.stress_yy_pa / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa +- {tolerance:.0%}), unbalanced "
+            f"force ratio {sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise consolidation.max_steps"
+        )
+    sxx, syy, width, height = state.stress_xx_pa, state.stress_yy_pa, state.width_m, state.height_m
     bar.close()
     grains = np.arange(run.n_grains)
     radii = sim.radii[grains]
