@@ -67,24 +67,40 @@ def _claims_part(r: BiaxialReport) -> list[Markup]:
     """The reproduction's claims on this one run, and where the ensemble's verdicts come from."""
     if not r.claim_rows:
         return []
+    from grainlab.reproduction.stored import paper_scale_verdicts
+
+    ensemble = paper_scale_verdicts()
+
+    def verdict(claim_id: str) -> str:
+        v = ensemble.get(claim_id)
+        if v is None:
+            return ""
+        ci = v["ci95"] or [None, None]
+        interval = "" if ci[0] is None else f" [{fmt(float(ci[0]), 3)}, {fmt(float(ci[1]), 3)}]"
+        mean = "" if v["mean"] is None else f": {fmt(float(v['mean']), 3)}{interval}"
+        return f"{v['verdict']}{mean}"
+
     rows = [
         (Markup(f"<code>{escape(c['id'])}</code>"), c["statement"], c["source"],
          "" if c["paper_value"] is None else fmt(float(c["paper_value"]), 3), c["measure"],
-         fmt(float(c["value"]), 4), c["this_run"])
+         fmt(float(c["value"]), 4), c["this_run"], verdict(c["id"]))
         for c in r.claim_rows
     ]
     same = sum(c["this_run"] == "as the paper" for c in r.claim_rows)
+    seeds = next(iter(ensemble.values()))["seeds"] if ensemble else 0
+    where = (f"The last column is the verdict of grainlab's paper-scale ensemble ({seeds} seeds, the mean and its "
+             "95 % interval), shipped with grainlab." if ensemble else "")
     return [
         Markup("<h3>Every claim of the paper on this run</h3>"),
         paragraph(
             f"The claims that grainlab reproduce checks, measured on this one run from its snapshots: {same} of "
             f"{len(rows)} lie where the claim's rule wants them (inside the tolerance band, on the paper's side). "
             "One run is one sample, not a verdict: grainlab reproduce --out DIR runs the test over an ensemble "
-            "of seeds and gives each claim a verdict with its 95 % interval (docs/reproduction.md).",
+            f"of seeds and gives each claim a verdict with its 95 % interval (docs/reproduction.md). {where}",
             "note",
         ),
-        table(["claim", "the paper", "where", "paper's value", "measured", "this run", "one run"], rows,
-              numeric=(5,), css_class="wide"),
+        table(["claim", "the paper", "where", "paper's value", "measured", "this run", "one run",
+               "paper-scale verdict"], rows, numeric=(5,), css_class="wide"),
     ]
 
 
