@@ -183,3 +183,10 @@ def test_band_grains_before_the_detector_accepts_the_band_are_those_of_the_first
         inside, source = members[k]
         assert source == 2
         assert set(np.asarray(snaps[k].ids)[inside]) == {1, 3}
+
+
+def test_the_fastest_converged_rate_is_the_top_of_an_unbroken_chain():
+    entry = lambda rate, ok: {"rate_per_s": rate, "converged": ok}  # noqa: E731
+    assert outputs.fastest_converged_rate([entry(2, True), entry(4, True), entry(8, False)]) == 4.0
+    assert outputs.fastest_converged_rate([entry(8, True), entry(2, False), entry(4, True)]) is None
+    assert outputs.fastest_converged_rate([]) is None

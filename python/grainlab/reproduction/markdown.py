@@ -111,6 +111,10 @@ def claims_markdown(document: dict[str, Any], level: int = 1) -> str:
                              _num(q["at_half_rate"]), _num(q["tolerance"], 2), _num(q["within"]),
                              "**converged**" if e["converged"] else "not converged"])
         out += _table(["r", "r/2", "quantity", "at r", "at r/2", "tolerance", "within", "r"], rows)
+        fastest = document.get("fastest_converged_rate_per_s")
+        out += ["", "Fastest converged rate (it and every slower rate converged): "
+                + ("none: the slowest comparison already differs" if fastest is None
+                   else f"{fastest * 6000:g} %/min ({fastest:.4g} 1/s)") + "."]
     if document.get("comparisons"):
         out += ["", f"{h2} Variants against their reference", "",
                 "Paired per seed: the variant's mean minus its reference's, with the 95 % interval of the "

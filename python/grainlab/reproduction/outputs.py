@@ -45,7 +45,7 @@ from grainlab.reproduction.runs import ReproductionPlan, Variant
 from grainlab.reproduction.verdicts import VERDICTS, t_interval
 
 __all__ = ["CLAIMS_CSV", "CLAIMS_JSON", "CLAIMS_MD", "MEASURES_JSON", "Outputs", "comparison_pairs", "rate_convergence",
-           "rate_family", "variant_comparison", "write_outputs"]
+           "fastest_converged_rate", "rate_family", "variant_comparison", "write_outputs"]
 
 CLAIMS_JSON = "claims.json"
 CLAIMS_CSV = "claims.csv"
@@ -244,6 +244,19 @@ def rate_convergence(family: Sequence[tuple[float, list[dict[str, Any] | None]]]
     return out
 
 
+def fastest_converged_rate(convergence: Sequence[dict[str, Any]]) -> float | None:
+    """The fastest rate r (1/s) such that r and every slower rate of the family that
+    has a run at half of it are converged (:func:`rate_convergence`): a chain from
+    the slowest comparison up. None when the slowest comparison already fails (or
+    there is none)."""
+    fastest = None
+    for entry in sorted(convergence, key=lambda e: e["rate_per_s"]):
+        if not entry["converged"]:
+            break
+        fastest = float(entry["rate_per_s"])
+    return fastest
+
+
 # ----------------------------------------------------------------------------- variant pairs
 def _config_leaves(plan: ReproductionPlan, v: Variant) -> dict[str, Any]:
     config = plan.biaxial_config(plan.variant(v.runs_variant), plan.seeds[0]).to_dict()
@@ -400,6 +413,7 @@ def write_outputs(plan: ReproductionPlan, out_dir: str | os.PathLike[str], *, wo
         "verdict_counts": _counts(top_claims),
         "variants": blocks,
         "rate_convergence": convergence,
+        "fastest_converged_rate_per_s": fastest_converged_rate(convergence),
         "comparisons": comparisons,
         "notes": notes,
     }
