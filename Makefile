@@ -19,8 +19,9 @@ test-fast:  ## the quick local loop: engine tests and pytest without slow physic
 	cargo test --release -p grainlab-core
 	python -m pytest -m "not slow" -q
 
-bench:  ## the common throughput case, grainlab vs LAMMPS side by side
+bench:  ## side by side: the common throughput case (grainlab vs LAMMPS), the million-disk analysis (NumPy vs compiled)
 	python benchmarks/throughput.py
+	python benchmarks/analysis_large.py
 
 bench-engine:  ## the engine alone (no Python): the throughput case from Rust
 	cargo run --release -p grainlab-core --example throughput -- 1

@@ -61,6 +61,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
+from grainlab import _core, _kernels
+
 __all__ = [
     "BODY_FIELD",
     "ParticleKind",
@@ -386,7 +388,8 @@ class Snapshot:
 
         A pair is in contact when its centre distance is ``< r_i + r_j +
         tolerance`` (``tolerance`` in m, >= 0; use a small positive value for
-        lattices of exactly touching disks). Uses a k-d tree, O(N log N).
+        lattices of exactly touching disks). Uses a cell list, O(N)
+        (:func:`detect_contacts`).
         ``box`` / ``periodic`` in ``kwargs`` are honoured (minimum image).
         """
         pos = _as_float("positions", positions, (None, 2))
@@ -680,6 +683,21 @@ class Snapshot:
             return self._cache["normals"]
         ci = self.contact_i
         cj = self.contact_j
+        if _kernels.compiled() and not (cj.size and cj.min() < 0):
+            lengths = [None, None]
+            if any(self.periodic):
+                span = self.box[:, 1] - self.box[:, 0]
+                lengths = [float(span[a]) if self.periodic[a] else None for a in (0, 1)]
+            normals, angles = _core.contact_normals(
+                np.ascontiguousarray(self.positions),
+                np.ascontiguousarray(ci),
+                np.ascontiguousarray(cj),
+                *lengths,
+                _kernels.threads(),
+            )
+            self._cache["normals"] = _readonly(normals)
+            self._cache.setdefault("angles", _readonly(angles))
+            return self._cache["normals"]
         wall = cj < 0
         other = np.where(wall, ci, cj)
         d = self.positions[other] - self.positions[ci]
@@ -792,11 +810,63 @@ def detect_contacts(
     -------
     i, j : (Nc,) int64
         Particle indices with ``i < j``, sorted by ``i`` then ``j``.
+
+    Raises
+    ------
+    ValueError
+        Before any work, naming the input: a tolerance < 0 or not finite,
+        positions not (N, 2) / (N, 3), radii not (N,), a non-finite
+        coordinate, a radius <= 0, a periodic direction without ``box``.
+
+    Notes
+    -----
+    Runs in the Rust engine crate with a cell list on every core
+    (docs/analysis.md, "Speed"); the result does not depend on the number of
+    threads and equals that of the k-d tree reference
+    (:func:`_detect_contacts_numpy`).
     """
     pos = np.asarray(positions, dtype=np.float64)
     rad = np.asarray(radii, dtype=np.float64)
     if tolerance < 0 or not np.isfinite(tolerance):
         raise ValueError(f"tolerance: must be a finite value >= 0, got {tolerance}")
+    if not _kernels.compiled():
+        return _detect_contacts_numpy(pos, rad, tolerance=tolerance, box=box, periodic=periodic)
+    if pos.shape[0] < 2:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    if pos.ndim != 2 or pos.shape[1] not in (2, 3):
+        raise ValueError(f"positions: expected shape (N, 2) or (N, 3), got {pos.shape}")
+    if rad.shape != (pos.shape[0],):
+        raise ValueError(f"radii: expected shape ({pos.shape[0]},), got {rad.shape}")
+    periodic = tuple(bool(p) for p in periodic)
+    periods: list[tuple[float, float] | None] = [None, None]
+    if any(periodic):
+        if box is None:
+            raise ValueError("box: a periodic direction needs the box bounds")
+        b = _as_float("box", box, (2, 2))
+        lengths = b[:, 1] - b[:, 0]
+        for axis in (0, 1):
+            if periodic[axis]:
+                periods[axis] = (float(b[axis, 0]), float(lengths[axis]))
+    i, j = _core.detect_contacts(
+        np.ascontiguousarray(pos),
+        np.ascontiguousarray(rad),
+        float(tolerance),
+        periods[0],
+        periods[1],
+        _kernels.threads(),
+    )
+    return i, j
+
+
+def _detect_contacts_numpy(
+    pos: NDArray[np.float64],
+    rad: NDArray[np.float64],
+    *,
+    tolerance: float,
+    box: ArrayLike | None,
+    periodic: tuple[bool, bool],
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The k-d tree reference of :func:`detect_contacts` (same arguments and result)."""
     if pos.shape[0] < 2:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
     periodic = tuple(bool(p) for p in periodic)

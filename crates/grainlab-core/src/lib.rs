@@ -4,6 +4,7 @@
 //! see `pipeline.rs` for the step order and `law.rs` for the contact law.
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod bond;
 pub mod boundary;
 pub mod cell;

@@ -5,6 +5,7 @@
 //! `grainlab.Simulation` (python/grainlab/simulation.py), which wraps [`simulation::Engine`].
 use pyo3::prelude::*;
 
+mod analysis;
 mod convert;
 mod simulation;
 
@@ -30,5 +31,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add_class::<simulation::Engine>()?;
     m.add_function(wrap_pyfunction!(density_scaling_factor, m)?)?;
+    analysis::register(m)?;
     Ok(())
 }

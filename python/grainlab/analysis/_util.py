@@ -7,9 +7,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.snapshot import BOUNDARY_COUNTING, Snapshot, boundary_end_groups
-
-TWO_PI = 2.0 * np.pi
+from grainlab import _kernels
+from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot, boundary_end_groups
 
 
 class NotComputedError(AttributeError):
@@ -57,6 +56,12 @@ def contact_ends(
     ci = np.asarray(snapshot.contact_i)
     cj = np.asarray(snapshot.contact_j)
     angle = np.asarray(snapshot.contact_angles())
+    if _kernels.compiled() and not has_boundary(snapshot):
+        # no wall, no membrane: every contact gives two ends and nothing merges
+        angle_j = angle + np.pi
+        angle_j[angle_j >= TWO_PI] -= TWO_PI
+        owner = np.concatenate([ci, cj])
+        return owner, np.concatenate([angle, angle_j]), np.ones(ci.shape, bool)
     keep = np.ones(ci.shape, bool) if include_boundary else ~snapshot.is_boundary_contact
     sample = snapshot.is_sample
     pp = keep & (cj >= 0)
@@ -81,6 +86,13 @@ def contact_ends(
             first = groups == np.arange(owner.size)
             owner, ends = owner[first], ends[first]
     return owner, ends, keep
+
+
+def has_boundary(snapshot: Snapshot) -> bool:
+    """Whether ``snapshot`` has a wall contact or a membrane particle (else every
+    particle is in the sample and no contact is a boundary contact)."""
+    cj = np.asarray(snapshot.contact_j)
+    return bool(cj.size and cj.min() < 0) or bool(np.any(~snapshot.is_sample))
 
 
 def repeated_boundary_contacts(snapshot: Snapshot, used: NDArray[np.bool_]) -> NDArray[np.bool_]:

@@ -85,7 +85,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from grainlab.analysis._util import TWO_PI, Computable, contact_ends, repeated_boundary_contacts
+from grainlab import _core, _kernels
+from grainlab.analysis._util import (
+    TWO_PI,
+    Computable,
+    contact_ends,
+    has_boundary,
+    repeated_boundary_contacts,
+)
 from grainlab.snapshot import BOUNDARY_COUNTING, Snapshot
 
 __all__ = [
@@ -117,6 +124,27 @@ def rattlers(
     """
     ci = np.asarray(contact_i, dtype=np.int64)
     cj = np.asarray(contact_j, dtype=np.int64)
+    if _kernels.compiled():
+        mask = None if candidates is None else np.ascontiguousarray(candidates, dtype=bool)
+        return _core.rattlers(
+            np.ascontiguousarray(ci.reshape(-1)),
+            np.ascontiguousarray(cj.reshape(-1)),
+            int(n_particles),
+            int(min_contacts),
+            mask,
+            _kernels.threads(),
+        )
+    return _rattlers_numpy(ci, cj, n_particles, min_contacts, candidates)
+
+
+def _rattlers_numpy(
+    ci: NDArray[np.int64],
+    cj: NDArray[np.int64],
+    n_particles: int,
+    min_contacts: int,
+    candidates: ArrayLike | None,
+) -> NDArray[np.bool_]:
+    """The NumPy reference of :func:`rattlers`: rounds of removal until none is left."""
     removable = np.ones(n_particles, bool) if candidates is None else np.asarray(candidates, bool)
     removed = np.zeros(n_particles, bool)
     alive = np.ones(ci.shape, bool)
@@ -164,10 +192,24 @@ def angular_histogram(
             f"edge_tolerance: must be >= 0 and below half a bin ({0.5 * width:g} rad), got {edge_tolerance!r}"
         )
     bins = int(bins)
-    a = np.mod(np.asarray(angles, dtype=np.float64).reshape(-1), TWO_PI)
-    w = np.ones(a.shape) if weights is None else np.asarray(weights, dtype=np.float64).reshape(-1)
-    if w.shape != a.shape:
-        raise ValueError(f"weights: expected shape {a.shape}, got {w.shape}")
+    angles_in = np.asarray(angles, dtype=np.float64).reshape(-1)
+    w = (
+        np.ones(angles_in.shape)
+        if weights is None
+        else np.asarray(weights, dtype=np.float64).reshape(-1)
+    )
+    if w.shape != angles_in.shape:
+        raise ValueError(f"weights: expected shape {angles_in.shape}, got {w.shape}")
+    if _kernels.compiled():  # the kernel takes the angles modulo 2 pi itself
+        values = _core.angular_histogram(
+            np.ascontiguousarray(angles_in),
+            None if weights is None else np.ascontiguousarray(w),
+            bins,
+            tol,
+            _kernels.threads(),
+        )
+        return values, np.linspace(0.0, TWO_PI, bins + 1)
+    a = np.mod(angles_in, TWO_PI)
     values = np.zeros(bins)
     for end in (a, np.mod(a + np.pi, TWO_PI)):
         u = end / width
@@ -203,13 +245,25 @@ def anisotropy_eq7(values: ArrayLike) -> tuple[float, float]:
 def anisotropy_fourier(angles: ArrayLike, weights: ArrayLike | None = None) -> tuple[float, float]:
     """Unbinned ``(a, theta_a)`` from the second Fourier moment (theta_a in rad, [0, pi))."""
     a = np.asarray(angles, dtype=np.float64).reshape(-1)
-    w = np.ones_like(a) if weights is None else np.asarray(weights, dtype=np.float64).reshape(-1)
-    total = w.sum()
-    if a.size == 0 or total <= 0:
-        return float("nan"), float("nan")
-    two = 2.0 * a
-    s = float(np.dot(w, np.sin(two)))
-    c = float(np.dot(w, np.cos(two)))
+    if _kernels.compiled():
+        w = None if weights is None else np.asarray(weights, dtype=np.float64).reshape(-1)
+        if w is not None and w.shape != a.shape:
+            raise ValueError(f"weights: expected shape {a.shape}, got {w.shape}")
+        s, c, total = _core.fourier_moment(
+            np.ascontiguousarray(a),
+            None if w is None else np.ascontiguousarray(w),
+            _kernels.threads(),
+        )
+        if a.size == 0 or total <= 0:
+            return float("nan"), float("nan")
+    else:
+        w = np.ones_like(a) if weights is None else np.asarray(weights, dtype=np.float64).reshape(-1)
+        total = w.sum()
+        if a.size == 0 or total <= 0:
+            return float("nan"), float("nan")
+        two = 2.0 * a
+        s = float(np.dot(w, np.sin(two)))
+        c = float(np.dot(w, np.cos(two)))
     return float(2.0 * np.hypot(s, c) / total), float(np.mod(0.5 * np.arctan2(s, c), np.pi))
 
 
@@ -220,6 +274,16 @@ def fabric_tensor(normals: ArrayLike, weights: ArrayLike | None = None) -> NDArr
     optional (e.g. normal forces). NaN matrix when empty.
     """
     n = np.asarray(normals, dtype=np.float64).reshape(-1, 2)
+    if _kernels.compiled():
+        w = None if weights is None else np.asarray(weights, dtype=np.float64).reshape(-1)
+        if w is not None and w.shape != (n.shape[0],):
+            raise ValueError(f"weights: expected shape ({n.shape[0]},), got {w.shape}")
+        phi, _ = _core.fabric_tensor(
+            np.ascontiguousarray(n),
+            None if w is None else np.ascontiguousarray(w),
+            _kernels.threads(),
+        )
+        return phi
     w = (
         np.ones(n.shape[0])
         if weights is None
@@ -290,29 +354,41 @@ class CoordinationNumber(Computable):
 
     def compute(self, snapshot: Snapshot) -> CoordinationNumber:
         """Compute the coordination numbers of ``snapshot``; returns ``self``."""
-        owner, _, used = contact_ends(
-            snapshot, include_boundary=self.include_boundary, boundary=self.boundary
-        )
-        if self.include_boundary and self.boundary == "body":
-            used = used & ~repeated_boundary_contacts(snapshot, used)
         n = snapshot.n_particles
         sample = snapshot.is_sample
-        counts = np.bincount(owner, minlength=n)
+        fast = _kernels.compiled() and not has_boundary(snapshot)
+        if fast:  # no wall, no membrane: each contact counts for both its particles
+            counts = np.bincount(snapshot.contact_i, minlength=n)
+            counts += np.bincount(snapshot.contact_j, minlength=n)
+        else:
+            owner, _, used = contact_ends(
+                snapshot, include_boundary=self.include_boundary, boundary=self.boundary
+            )
+            if self.include_boundary and self.boundary == "body":
+                used = used & ~repeated_boundary_contacts(snapshot, used)
+            counts = np.bincount(owner, minlength=n)
         n_p = int(sample.sum())
         z = float(counts[sample].sum() / n_p) if n_p else float("nan")
-        # Contact list seen from the sample: an end on a membrane particle is dropped
-        # (j = -1 then means "counts for i only", like a wall).
-        a = np.asarray(snapshot.contact_i)[used]
-        b = np.asarray(snapshot.contact_j)[used]
-        b_is_p = b >= 0
-        b_sample = b_is_p & sample[np.where(b_is_p, b, 0)]
-        a_sample = sample[a]
-        a, b = np.where(a_sample, a, b), np.where(a_sample, np.where(b_sample, b, -1), -1)
-        on_sample = a_sample | b_sample
-        a, b = a[on_sample], b[on_sample]
-        rat = rattlers(a, b, n, min_contacts=self.min_contacts, candidates=sample)
-        core = sample & ~rat
-        alive = core[a] & ((b < 0) | core[np.where(b >= 0, b, 0)])
+        if fast:  # every particle in the sample, every contact between two of them
+            a = np.asarray(snapshot.contact_i)
+            b = np.asarray(snapshot.contact_j)
+            rat = rattlers(a, b, n, min_contacts=self.min_contacts)
+            core = ~rat
+            alive = core[a] & core[b]
+        else:
+            # Contact list seen from the sample: an end on a membrane particle is dropped
+            # (j = -1 then means "counts for i only", like a wall).
+            a = np.asarray(snapshot.contact_i)[used]
+            b = np.asarray(snapshot.contact_j)[used]
+            b_is_p = b >= 0
+            b_sample = b_is_p & sample[np.where(b_is_p, b, 0)]
+            a_sample = sample[a]
+            a, b = np.where(a_sample, a, b), np.where(a_sample, np.where(b_sample, b, -1), -1)
+            on_sample = a_sample | b_sample
+            a, b = a[on_sample], b[on_sample]
+            rat = rattlers(a, b, n, min_contacts=self.min_contacts, candidates=sample)
+            core = sample & ~rat
+            alive = core[a] & ((b < 0) | core[np.where(b >= 0, b, 0)])
         n_m = int(core.sum())
         z_m = float((alive.sum() + (alive & (b >= 0)).sum()) / n_m) if n_m else float("nan")
         dist = np.bincount(counts[sample]).astype(np.float64) if n_p else np.zeros(1)
@@ -450,24 +526,40 @@ class ContactAnisotropy(Computable):
         """Compute the distribution for ``snapshot``; returns ``self``."""
         ci = np.asarray(snapshot.contact_i)
         cj = np.asarray(snapshot.contact_j)
-        sample = snapshot.is_sample
-        used = np.ones(ci.shape, bool) if self.include_boundary else ~snapshot.is_boundary_contact
-        # a contact between two membrane particles is not part of the sample's fabric
-        used &= sample[ci] | ((cj >= 0) & sample[np.where(cj >= 0, cj, 0)])
+        if self.weight == "normal_force" and snapshot.normal_force is None:
+            raise ValueError("normal_force: the snapshot has no contact forces (needed for a_n)")
+        if _kernels.compiled() and not has_boundary(snapshot):
+            used = slice(None)  # every contact is between sample particles
+            n_used = ci.size
+        else:
+            sample = snapshot.is_sample
+            used = (
+                np.ones(ci.shape, bool) if self.include_boundary else ~snapshot.is_boundary_contact
+            )
+            # a contact between two membrane particles is not part of the sample's fabric
+            used &= sample[ci] | ((cj >= 0) & sample[np.where(cj >= 0, cj, 0)])
+            n_used = int(used.sum())
         angles = np.asarray(snapshot.contact_angles())[used]
         weights = None
         if self.weight == "normal_force":
-            if snapshot.normal_force is None:
-                raise ValueError(
-                    "normal_force: the snapshot has no contact forces (needed for a_n)"
-                )
             weights = np.asarray(snapshot.normal_force)[used]
         values, edges = angular_histogram(
             angles, self.bins, weights, edge_tolerance=self.edge_tolerance
         )
         a7, t7 = anisotropy_eq7(values)
-        af, tf = anisotropy_fourier(angles, weights)
         normals = np.asarray(snapshot.contact_normals())[used]
+        phi = fabric_tensor(normals, weights)
+        if _kernels.compiled() and snapshot.contact_normal is None:
+            # unit normals from the centres: e^{2 i theta} = (n_x + i n_y)^2, so the
+            # moment comes from the tensor, a = 2 (phi_1 - phi_2), without trigonometry
+            if np.isfinite(phi[0, 0]):
+                s2, c2 = 2.0 * phi[0, 1], phi[0, 0] - phi[1, 1]
+                af = float(2.0 * np.hypot(s2, c2))
+                tf = float(np.mod(0.5 * np.arctan2(s2, c2), np.pi))
+            else:
+                af, tf = float("nan"), float("nan")
+        else:
+            af, tf = anisotropy_fourier(angles, weights)
         self._store(
             histogram=values,
             bin_edges=edges,
@@ -475,8 +567,8 @@ class ContactAnisotropy(Computable):
             direction=tf,
             anisotropy_binned=a7,
             direction_binned=t7,
-            fabric_tensor=fabric_tensor(normals, weights),
-            total=float(used.sum() if weights is None else weights.sum()),
+            fabric_tensor=phi,
+            total=float(n_used if weights is None else weights.sum()),
         )
         return self
 

@@ -38,9 +38,11 @@ therefore counts each boundary body once by default (``boundary="body"``).
 Implementation: writing :math:`e_j = \phi_j - 2\pi j/n`, the deviation of
 contact ``j`` from reference ``k`` is :math:`|\operatorname{wrap}(e_j - e_k)|`
 for every ``j`` (also past the wrap-around), and :math:`|e_j - e_k| < 2\pi`,
-so the minimum angle is :math:`\min(|x|, 2\pi - |x|)`. Particles are grouped
-by their number of contacts and each group is one ``(m, n, n)`` array
-operation: no Python loop over particles or contacts.
+so the minimum angle is :math:`\min(|x|, 2\pi - |x|)`. The kernel runs in the
+Rust engine crate, one particle at a time on every core (docs/analysis.md,
+"Speed"); the NumPy reference (:func:`_stability_index_numpy`) groups the
+particles by their number of contacts, each group one ``(m, n, n)`` array
+operation.
 """
 
 from __future__ import annotations
@@ -50,7 +52,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from grainlab.analysis._util import TWO_PI, Computable, contact_ends, finite_mean
+from grainlab import _core, _kernels
+from grainlab.analysis._util import TWO_PI, Computable, contact_ends, finite_mean, has_boundary
 from grainlab.snapshot import BOUNDARY_COUNTING, Snapshot
 
 __all__ = ["StabilityIndex", "stability_index", "stability_index_of_angles"]
@@ -93,11 +96,23 @@ def stability_index(
         Number of contacts of each particle.
     """
     owner = np.asarray(owner, dtype=np.int64).reshape(-1)
-    ang = np.mod(np.asarray(angles, dtype=np.float64).reshape(-1), TWO_PI)
+    ang = np.asarray(angles, dtype=np.float64).reshape(-1)
     if owner.shape != ang.shape:
         raise ValueError(f"angles: expected shape {owner.shape}, got {ang.shape}")
     if owner.size and (owner.min() < 0 or owner.max() >= n_particles):
         raise ValueError(f"owner: indices must be in [0, {n_particles})")
+    if _kernels.compiled():  # the kernel takes the angles modulo 2 pi itself
+        lam, counts = _core.stability_index(
+            np.ascontiguousarray(owner), np.ascontiguousarray(ang), int(n_particles), _kernels.threads()
+        )
+        return lam, counts
+    return _stability_index_numpy(owner, np.mod(ang, TWO_PI), n_particles)
+
+
+def _stability_index_numpy(
+    owner: NDArray[np.int64], ang: NDArray[np.float64], n_particles: int
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """The NumPy reference of :func:`stability_index` (angles already in [0, 2 pi])."""
     counts = np.bincount(owner, minlength=n_particles)
     lam = np.ones(n_particles, dtype=np.float64)
     if owner.size == 0:
@@ -194,10 +209,20 @@ class StabilityIndex(Computable):
 
     def compute(self, snapshot: Snapshot) -> StabilityIndex:
         """Compute lambda for every particle of ``snapshot``; returns ``self``."""
-        owner, ends, _ = contact_ends(
-            snapshot, include_boundary=self.include_boundary, boundary=self.boundary
-        )
-        lam, counts = stability_index(owner, ends, snapshot.n_particles)
+        if _kernels.compiled() and not has_boundary(snapshot):
+            # no wall, no membrane: the kernel takes both ends of every contact itself
+            lam, counts = _core.stability_index_of_contacts(
+                np.ascontiguousarray(snapshot.contact_i),
+                np.ascontiguousarray(snapshot.contact_j),
+                np.ascontiguousarray(snapshot.contact_angles()),
+                snapshot.n_particles,
+                _kernels.threads(),
+            )
+        else:
+            owner, ends, _ = contact_ends(
+                snapshot, include_boundary=self.include_boundary, boundary=self.boundary
+            )
+            lam, counts = stability_index(owner, ends, snapshot.n_particles)
         sample = snapshot.is_sample
         lam[~sample] = np.nan
         self._store(
