@@ -18,6 +18,7 @@ import numpy as np
 
 from grainlab.analysis import ContactAnisotropy, StabilityIndex, analyze_snapshot
 from grainlab.io import read_snapshot, write_particles_csv
+from grainlab.postprocess import write_analysis
 from grainlab.snapshot import Snapshot
 
 KN = 8.45e7  # N/m, contact normal stiffness (paper Table 1)
@@ -74,7 +75,8 @@ def main() -> dict:
         write_particles_csv(Path(tmp) / "cur.csv", current)
         ref = read_snapshot(Path(tmp) / "ref.csv")
         cur = read_snapshot(Path(tmp) / "cur.csv")
-        result = analyze_snapshot(cur, ref, out_dir=Path(tmp) / "out", figures=False)
+        result = analyze_snapshot(cur, ref)
+        write_analysis(result, Path(tmp) / "out", figures=False)
         summary = result.summary()
     print("current (sheared copy, contacts detected from geometry):")
     for key in ("Z", "mechanical_Z", "a", "theta_a_deg", "a_fourier", "mean_lambda"):

@@ -13,6 +13,7 @@ from factories_analysis import hex_lattice
 from grainlab import cli
 from grainlab.analysis import analyze_snapshot
 from grainlab.io import write_contacts_csv, write_particles_csv
+from grainlab.postprocess import write_analysis
 from grainlab.snapshot import Snapshot
 
 
@@ -160,7 +161,10 @@ def test_cli_bad_input_exits_2_with_file_and_line(tmp_path, run_cli, capsys):
 
 def test_analyze_snapshot_api(tmp_path):
     snap = hex_lattice(rotation_deg=7.0)
-    result = analyze_snapshot(snap, out_dir=tmp_path, figures=False)
+    result = analyze_snapshot(snap)
+    written = write_analysis(result, tmp_path, figures=False)
+    assert [p.name for p in written] == ["particles.csv", "fabric.json"]
+    assert json.loads((tmp_path / "fabric.json").read_text())["Z"] == 6.0
     s = result.summary()
     assert s["Z"] == 6.0 and s["mechanical_Z"] == 6.0
     assert s["a"] == pytest.approx(0.0, abs=1e-12) and s["a_fourier"] == pytest.approx(

@@ -1,4 +1,4 @@
-"""ParaView export (grainlab.io.vtk, ``grainlab export --vtk``), read back by VTK's own reader.
+"""ParaView export (grainlab.io.vtk, grainlab.postprocess.vtk, ``grainlab export --vtk``), read back by VTK's own reader.
 
 Every file is parsed with ``vtkXMLPolyDataReader`` (the reader ParaView uses)
 and compared exactly with the snapshot it came from; the ``.pvd`` is parsed
@@ -20,10 +20,10 @@ from grainlab.io.vtk import (
     CELL_CONTACT,
     CELL_PARTICLE,
     contact_lines,
-    export_vtk,
     write_pvd,
     write_vtp,
 )
+from grainlab.postprocess.vtk import export_vtk
 from grainlab.snapshot import Snapshot
 
 vtk_xml = pytest.importorskip("vtkmodules.vtkIOXML")

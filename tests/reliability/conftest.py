@@ -11,7 +11,7 @@ from reliability_factories import fake_curves, fake_fabric_figures, tiny_config
 @pytest.fixture
 def fast_figures(monkeypatch):
     """The biaxial driver with stand-in figures (the output phase's logic is unchanged)."""
-    import grainlab.analysis.biaxial_figures as figures
+    import grainlab.postprocess.figures as figures
     import grainlab.protocols.biaxial as biaxial
 
     monkeypatch.setattr(biaxial, "_figures", fake_curves)
@@ -21,7 +21,7 @@ def fast_figures(monkeypatch):
 @pytest.fixture(scope="session")
 def tiny_reference(tmp_path_factory) -> Path:
     """One uninterrupted tiny run (stand-in figures) for the stopped runs to match."""
-    import grainlab.analysis.biaxial_figures as figures
+    import grainlab.postprocess.figures as figures
     import grainlab.protocols.biaxial as biaxial
 
     out = tmp_path_factory.mktemp("tiny") / "straight"

@@ -88,7 +88,7 @@ FILLING = """\
 import os, sys
 sys.path.insert(0, {tests!r})
 import reliability_factories as stand_ins
-import grainlab.analysis.biaxial_figures as figures
+import grainlab.postprocess.figures as figures
 import grainlab.protocols.biaxial as biaxial
 from grainlab.cli import main
 

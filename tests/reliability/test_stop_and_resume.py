@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from reliability_factories import TINY_TOML, assert_same_run, tiny_config
 
-import grainlab.analysis.biaxial_figures as figures
+import grainlab.postprocess.figures as figures
 import grainlab.protocols.biaxial as biaxial
 from grainlab.cli import main
 from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, read_results, write_checkpoint
@@ -187,7 +187,7 @@ SLOW_STAND_INS = """\
 import os, sys, time
 sys.path.insert(0, {tests!r})
 import reliability_factories as stand_ins
-import grainlab.analysis.biaxial_figures as figures
+import grainlab.postprocess.figures as figures
 import grainlab.protocols.biaxial as biaxial
 from grainlab.cli import main
 

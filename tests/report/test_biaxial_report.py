@@ -14,9 +14,9 @@ import pytest
 from report_factories import BAND_DEG, DILATION_SLOPE, PEAK_RATIO, PEAK_STRAIN, PHASES, THREADS
 from report_helpers import check_self_contained, parse
 
-from grainlab.analysis.biaxial_figures import FIGURES
 from grainlab.cli import build_parser, main
 from grainlab.io.hdf5 import read_results
+from grainlab.postprocess import FIGURES
 from grainlab.protocols.config import resolve
 from grainlab.report import write_report
 from grainlab.report.biaxial import CURVE_FIGURES, gather_biaxial

@@ -1,11 +1,10 @@
-"""Run every measure on a snapshot and write the results (``grainlab analyze``)."""
+"""Run every measure on a snapshot (``grainlab analyze``; the files are written by
+:func:`grainlab.postprocess.write_analysis`)."""
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -22,7 +21,8 @@ __all__ = ["AnalysisResult", "analyze_snapshot", "fabric_summary"]
 
 @dataclass
 class AnalysisResult:
-    """Everything :func:`analyze_snapshot` computed, with writers for the files."""
+    """Everything :func:`analyze_snapshot` computed (the files of ``grainlab analyze``
+    are written from it by :func:`grainlab.postprocess.write_analysis`)."""
 
     snapshot: Snapshot
     coordination: CoordinationNumber
@@ -137,46 +137,6 @@ class AnalysisResult:
         cols["rattler"] = self.coordination.rattlers.astype(np.int64)
         return cols
 
-    def write(self, out_dir: str | Path, *, figures: bool = True) -> list[Path]:
-        """Write ``particles.csv``, ``fabric.json`` and the figures into ``out_dir``."""
-        from grainlab import plot
-        from grainlab.io.csv import write_particles_csv
-
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
-        written = [write_particles_csv(out / "particles.csv", self.snapshot, self.particle_table())]
-        path = out / "fabric.json"
-        path.write_text(json.dumps(self.summary(), indent=2) + "\n", encoding="utf-8")
-        written.append(path)
-        if not figures:
-            return written
-        snap = self.snapshot
-        written += plot.save_figure(self.anisotropy.plot(), out / "contact_normals")
-        if self.force_anisotropy is not None:
-            written += plot.save_figure(self.force_anisotropy.plot(), out / "normal_forces")
-        written += plot.save_figure(
-            self.stability.plot(band=self.found_band), out / "map_stability_index"
-        )
-        ax = plot.particle_map(
-            snap.positions,
-            snap.radii,
-            np.where(snap.is_sample, self.stability.n_contacts, np.nan),
-            discrete=True,
-            cmap="viridis",
-            label="number of contacts",
-            band=self.found_band,
-        )
-        written += plot.save_figure(ax, out / "map_contacts")
-        if self.strain is not None:
-            written += plot.save_figure(
-                self.strain.plot(band=self.found_band), out / "map_displacement"
-            )
-            written += plot.save_figure(
-                self.strain.plot(quantity="shear_strain", band=self.found_band),
-                out / "map_shear_strain",
-            )
-        return written
-
 
 def fabric_summary(snapshot: Snapshot) -> dict[str, float]:
     """The scalar fabric of a snapshot with the library's defaults (boundary
@@ -221,8 +181,6 @@ def analyze_snapshot(
     fabric_include_boundary: bool = False,
     strain_neighbours: str = "radius",
     strain_cutoff: float | None = None,
-    out_dir: str | Path | None = None,
-    figures: bool = True,
 ) -> AnalysisResult:
     """Compute the fabric measures, lambda, and (with a reference) strain and shear band.
 
@@ -243,10 +201,6 @@ def analyze_snapshot(
         for Z and the anisotropies (default no).
     strain_neighbours, strain_cutoff
         Neighbourhood of the local strain fit (see :class:`LocalStrain`).
-    out_dir
-        If given, write ``particles.csv``, ``fabric.json`` and figures there.
-    figures
-        Draw the PNG + SVG figures when writing.
 
     Returns
     -------
@@ -289,9 +243,6 @@ def analyze_snapshot(
             )
         else:
             notes.append("fewer than 10 particles with a local strain: no shear band detected")
-    result = AnalysisResult(
+    return AnalysisResult(
         snapshot, coordination, anisotropy, force_anisotropy, stability, strain, band, notes
     )
-    if out_dir is not None:
-        result.write(out_dir, figures=figures)
-    return result

@@ -1,8 +1,8 @@
 """``grainlab analyze``: fabric, stability index, strain and shear band of a snapshot.
 
-Everything here is a thin wrapper around :func:`grainlab.io.read_snapshot`
-and :func:`grainlab.analysis.analyze_snapshot`, which scripts can call
-directly.
+Everything here is a thin wrapper around :func:`grainlab.io.read_snapshot`,
+:func:`grainlab.analysis.analyze_snapshot` and
+:func:`grainlab.postprocess.write_analysis`, which scripts can call directly.
 """
 
 from __future__ import annotations
@@ -145,6 +145,7 @@ def run(args: argparse.Namespace) -> int:
         read_snapshot,
     )
     from grainlab.io.results import ensure_output_folder
+    from grainlab.postprocess import write_analysis
 
     if not 2 <= args.bins <= MAX_BINS:
         raise ValueError(f"--bins: must be an integer from 2 to {MAX_BINS}, got {args.bins}")
@@ -207,9 +208,8 @@ def run(args: argparse.Namespace) -> int:
         bins=args.bins,
         min_contacts=args.min_contacts,
         lambda_include_boundary=not args.lambda_exclude_boundary,
-        out_dir=Path(args.out),
-        figures=not args.no_figures,
     )
+    write_analysis(result, Path(args.out), figures=not args.no_figures)
     s = result.summary()
 
     def f(x: float | None, fmt: str = ".3f") -> str:

@@ -1,6 +1,6 @@
 """``grainlab export``: convert a run folder for other tools (``--vtk``: ParaView).
 
-A thin wrapper around :func:`grainlab.io.vtk.export_vtk`, which scripts can call directly.
+A thin wrapper around :func:`grainlab.postprocess.export_vtk`, which scripts can call directly.
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from grainlab.io.results import ensure_output_folder
-    from grainlab.io.vtk import export_vtk
+    from grainlab.postprocess.vtk import export_vtk
 
     run = Path(args.dir)
     if run.exists():  # else export_vtk says what is missing

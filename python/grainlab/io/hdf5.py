@@ -79,6 +79,7 @@ from grainlab.io.results import (
     RESULTS_FILE,
     fsync_directory,
     fsync_file,
+    json_safe,
     write_bytes_atomic,
 )
 from grainlab.io.walls import WallGeometry, read_wall_group, write_wall_group
@@ -206,42 +207,9 @@ def _check_name(what: str, name: str) -> str:
 
 
 # ------------------------------------------------------------------------------- JSON
-def _jsonable(value: Any, where: str) -> Any:
-    """``value`` as plain JSON types; NumPy scalars/arrays converted, tuples as lists."""
-    if value is None or isinstance(value, bool | str):
-        return value
-    if isinstance(value, int):
-        return int(value)
-    if isinstance(value, float):
-        return float(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.floating):
-        return float(value)
-    if isinstance(value, np.ndarray):
-        if value.dtype.kind not in "biuf":
-            raise ValueError(f"{where}: cannot store an array of dtype {value.dtype} as JSON")
-        return _jsonable(value.tolist(), where)
-    if isinstance(value, list | tuple):
-        return [_jsonable(v, f"{where}[{k}]") for k, v in enumerate(value)]
-    if isinstance(value, Mapping):
-        out: dict[str, Any] = {}
-        for k, v in value.items():
-            if not isinstance(k, str):
-                raise TypeError(f"{where}: key {k!r} is not a string (JSON keys are strings)")
-            out[k] = _jsonable(v, f"{where}[{k!r}]")
-        return out
-    raise TypeError(
-        f"{where}: cannot store a value of type {type(value).__name__} (allowed: None, bool, int, float, "
-        "str, lists and dicts of them, NumPy numbers and arrays)"
-    )
-
-
 def _dumps(value: Any, where: str) -> str:
     # NaN / inf are kept as the tokens NaN / Infinity (Python's json), so they round-trip.
-    return json.dumps(_jsonable(value, where), ensure_ascii=False, allow_nan=True)
+    return json.dumps(json_safe(value, nan="keep", where=where), ensure_ascii=False, allow_nan=True)
 
 
 def _write_text(group: h5py.Group, name: str, text: str) -> None:
@@ -284,7 +252,7 @@ def _write_json_group(group: h5py.Group, value: Mapping[str, Any], where: str) -
     """``group/json`` holds ``value`` exactly; group attributes give a readable, flat view."""
     if not isinstance(value, Mapping):
         raise TypeError(f"{where}: expected a dict, got {type(value).__name__}")
-    plain = _jsonable(value, where)
+    plain = json_safe(value, nan="keep", where=where)
     text = json.dumps(plain, ensure_ascii=False, allow_nan=True)
     for key in list(group.attrs):
         del group.attrs[key]

@@ -32,9 +32,11 @@ import json
 import math
 import os
 import secrets
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 __all__ = [
     "CHECKPOINT_FILE",
@@ -44,6 +46,7 @@ __all__ = [
     "fsync_directory",
     "fsync_file",
     "is_disk_full",
+    "json_safe",
     "refuse_overwrite",
     "write_bytes_atomic",
     "write_json_atomic",
@@ -149,17 +152,52 @@ def write_text_atomic(path: str | os.PathLike[str], text: str, *, encoding: str 
     return _write_atomic(path, lambda tmp: tmp.write_bytes(data))
 
 
-def _json_safe(value: Any) -> Any:
-    """Non-finite floats -> None, recursively (strict JSON has no NaN / inf)."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
+def json_safe(value: Any, *, nan: str = "null", where: str = "value") -> Any:
+    """``value`` as plain JSON types, recursively: the one sanitiser of grainlab's JSON.
+
+    NumPy scalars and arrays become numbers and lists, tuples lists, paths
+    strings; dict keys must be strings. Non-finite
+    floats become None with ``nan="null"`` (strict JSON, for files other
+    programs read) or stay as they are with ``nan="keep"`` (Python's ``NaN`` /
+    ``Infinity`` tokens, for grainlab's own HDF5 attributes, which round-trip).
+    Any other type (and a key that is not a string) raises TypeError, an
+    array of strings or objects ValueError, naming ``where``.
+
+    >>> json_safe({"a": float("nan"), "b": (1, 2.5), "c": [float("inf")]})
+    {'a': None, 'b': [1, 2.5], 'c': [None]}
+    >>> json_safe({"a": float("nan")}, nan="keep")
+    {'a': nan}
+    """
+    if nan not in ("null", "keep"):
+        raise ValueError(f"nan: 'null' or 'keep', got {nan!r}")
+    if value is None or isinstance(value, bool | str):
+        return value
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, int | np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        x = float(value)
+        return None if nan == "null" and not math.isfinite(x) else x
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind not in "biuf":
+            raise ValueError(f"{where}: cannot store an array of dtype {value.dtype} as JSON")
+        return json_safe(value.tolist(), nan=nan, where=where)
     if isinstance(value, list | tuple):
-        return [_json_safe(v) for v in value]
-    if hasattr(value, "tolist") and hasattr(value, "dtype"):  # NumPy scalars and arrays
-        return _json_safe(value.tolist())
-    return value
+        return [json_safe(v, nan=nan, where=f"{where}[{k}]") for k, v in enumerate(value)]
+    if isinstance(value, Mapping):
+        out: dict[str, Any] = {}
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise TypeError(f"{where}: key {k!r} is not a string (JSON keys are strings)")
+            out[k] = json_safe(v, nan=nan, where=f"{where}[{k!r}]")
+        return out
+    raise TypeError(
+        f"{where}: cannot store a value of type {type(value).__name__} as JSON (allowed: None, bool, "
+        "int, float, str, paths, lists, tuples and dicts of them, NumPy numbers and arrays)"
+    )
 
 
 def write_json_atomic(path: str | os.PathLike[str], value: Any, *, indent: int | None = 2) -> Path:
@@ -169,7 +207,7 @@ def write_json_atomic(path: str | os.PathLike[str], value: Any, *, indent: int |
     NumPy scalars and arrays are written as numbers and lists. A trailing
     newline ends the file.
     """
-    text = json.dumps(_json_safe(value), indent=indent, ensure_ascii=False, allow_nan=False)
+    text = json.dumps(json_safe(value), indent=indent, ensure_ascii=False, allow_nan=False)
     return write_text_atomic(path, text + "\n")
 
 

@@ -1,10 +1,13 @@
-"""ParaView export: VTK XML PolyData (``.vtp``) files and a ``.pvd`` time series.
+"""ParaView files: VTK XML PolyData (``.vtp``) and a ``.pvd`` time series.
 
-Each snapshot of a run becomes one ``.vtp`` file, written here by a small
-writer (:func:`write_vtp`; no VTK needed to write, VTK's own reader in the tests):
+A small writer (:func:`write_vtp`; no VTK needed to write, VTK's own reader in
+the tests) and the contact lines of a snapshot (:func:`contact_lines`). The
+export of a run (:func:`grainlab.postprocess.vtk.export_vtk`) writes one
+``.vtp`` per snapshot with them:
 
 * every particle is a point (z = 0) with one vertex cell (``Verts``), carrying
-  the point data of :func:`snapshot_arrays` (radius, kind, displacement,
+  the point data the export computes
+  (:func:`grainlab.postprocess.vtk.snapshot_arrays`: radius, kind, displacement,
   rotation, n_contacts, stability_index, local_shear_strain, in_shear_band, the
   snapshot's per-particle fields such as velocity, ...);
 * every particle–particle contact is a line cell (``Lines``) between the two
@@ -44,7 +47,6 @@ import base64
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -54,10 +56,9 @@ from numpy.typing import ArrayLike, NDArray
 __all__ = [
     "CELL_CONTACT",
     "CELL_PARTICLE",
-    "VtkExport",
+    "as_vector3",
     "contact_lines",
-    "export_vtk",
-    "snapshot_arrays",
+    "exportable",
     "CELL_WALL",
     "write_pvd",
     "write_vtp",
@@ -311,73 +312,17 @@ def write_pvd(
     return out
 
 
-def _as_vector3(a: NDArray[Any]) -> NDArray[Any]:
+def as_vector3(a: NDArray[Any]) -> NDArray[Any]:
     """(N, 2) vectors padded with z = 0, so that ParaView's vector filters apply."""
     if a.ndim == 2 and a.shape[1] == 2:
         return np.c_[a, np.zeros(a.shape[0], a.dtype)]
     return a
 
 
-def _exportable(a: NDArray[Any]) -> bool:
+def exportable(a: NDArray[Any]) -> bool:
+    """Whether an array can be a VTK data array: numeric or boolean, real, 1 or 2 dimensions."""
     numeric = a.dtype == np.bool_ or np.issubdtype(a.dtype, np.number)
     return numeric and not np.iscomplexobj(a) and a.ndim in (1, 2)
-
-
-def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArray[Any]]:
-    """Point data of one :class:`~grainlab.snapshot.Snapshot` for the export.
-
-    ``reference`` is the run's first snapshot (``None`` or ``snap`` itself for
-    the first one): displacement, local shear strain and shear band are taken
-    against it. Keys, in order (units in docs/file-formats.md, "ParaView"):
-
-    ``id``, ``kind``, ``radius``, ``displacement`` (N, 3) (matched by id, NaN
-    for particles absent from the reference, 0 in the first snapshot),
-    ``rotation`` (only when the snapshot has rotations), ``n_contacts`` (walls
-    included), ``stability_index``, ``local_shear_strain`` (NaN in the first
-    snapshot), ``in_shear_band`` (0 outside, 1 in the dominant band, 2 in
-    the conjugate band: the bands the biaxial figures outline,
-    :func:`grainlab.analysis.biaxial_figures.band_labels`), then every numeric per-particle field
-    of the snapshot (``velocity``, ...) under its own name, 2-vectors padded to
-    (N, 3); a field whose name is already taken above is left out.
-    """
-    from grainlab.analysis import LocalStrain, StabilityIndex, match_ids
-    from grainlab.analysis.biaxial_figures import band_labels
-
-    n = snap.n_particles
-    out: dict[str, NDArray[Any]] = {
-        "id": np.asarray(snap.ids, np.int64),
-        "kind": np.asarray(snap.kind, np.int32),
-        "radius": np.asarray(snap.radii, np.float64),
-    }
-    first = reference is None or reference is snap
-    disp = np.zeros((n, 3))
-    gamma = np.full(n, np.nan)
-    band = np.zeros(n, np.int32)
-    if not first:
-        to_ref = match_ids(reference, snap)
-        ok = to_ref >= 0
-        disp[:, :2] = np.nan
-        disp[ok, :2] = snap.minimum_image(snap.positions[ok] - reference.positions[to_ref[ok]])
-        strain = LocalStrain().compute(reference, snap)
-        gamma = np.asarray(strain.shear_strain, np.float64)
-        # the bands the biaxial figures outline (grains away from the boundary,
-        # with the figures' acceptance tests): 1 dominant, 2 conjugate
-        try:
-            band = band_labels(reference, snap)
-        except ValueError:  # too few grains with a local strain: no band
-            pass
-    out["displacement"] = disp
-    if snap.rotations is not None:
-        out["rotation"] = np.asarray(snap.rotations, np.float64)
-    out["n_contacts"] = snap.contact_counts().astype(np.int32)
-    out["stability_index"] = np.asarray(StabilityIndex().compute(snap).stability_index, float)
-    out["local_shear_strain"] = gamma
-    out["in_shear_band"] = band
-    for name, value in snap.particle_fields.items():
-        a = np.asarray(value)
-        if name not in out and _exportable(a):
-            out[name] = _as_vector3(a)
-    return out
 
 
 def contact_lines(snap: Any) -> tuple[NDArray[np.int64], dict[str, NDArray[Any]], dict[str, int]]:
@@ -405,75 +350,7 @@ def contact_lines(snap: Any) -> tuple[NDArray[np.int64], dict[str, NDArray[Any]]
             data[name] = np.asarray(value, np.float64)[keep]
     for name, value in snap.contact_fields.items():
         a = np.asarray(value)
-        if name not in data and name != "cell_kind" and _exportable(a):
-            data[name] = _as_vector3(a[keep])
+        if name not in data and name != "cell_kind" and exportable(a):
+            data[name] = as_vector3(a[keep])
     left_out = {"n_wall_contacts": int(wall.sum()), "n_periodic_contacts": int(crosses.sum())}
     return np.c_[ci[keep], cj[keep]], data, left_out
-
-
-def _time_axis(snaps: Sequence[Any]) -> tuple[str, list[float]]:
-    for quantity in ("axial_strain", "time"):
-        values = [getattr(s, quantity) for s in snaps]
-        if all(v is not None for v in values):
-            t = np.asarray(values, np.float64)
-            if np.all(np.diff(t) > 0):
-                return quantity, [float(v) for v in t]
-    return "index", [float(k) for k in range(len(snaps))]
-
-
-@dataclass(frozen=True)
-class VtkExport:
-    """What :func:`export_vtk` wrote."""
-
-    pvd: Path
-    files: tuple[Path, ...]
-    times: tuple[float, ...]
-    time_quantity: str  # "axial_strain", "time" or "index"
-
-
-def export_vtk(
-    run: str | os.PathLike[str],
-    out_dir: str | os.PathLike[str] | None = None,
-    *,
-    binary: bool = True,
-) -> VtkExport:
-    """Write one ``.vtp`` per snapshot of ``run`` (a run folder or its ``run.h5``) and a ``.pvd``.
-
-    Files go to ``out_dir`` (default ``<run folder>/vtk``) as ``snapshot_0000.vtp``, ...
-    (in the run's snapshot order) and ``run.pvd``. Each file's field data holds
-    ``axial_strain`` and ``time`` (when the snapshot has them) and the counts
-    of :func:`contact_lines`. Raises ValueError when the run has no snapshots.
-    """
-    from grainlab.io.hdf5 import read_results
-
-    path = Path(run)
-    h5 = path / "run.h5" if path.is_dir() else path
-    folder = Path(out_dir) if out_dir is not None else h5.parent / "vtk"
-    results = read_results(h5)
-    names = list(results.snapshot_names)
-    if not names:
-        raise ValueError(f"{h5}: the run has no snapshots to export")
-    snaps = [results.snapshot(name) for name in names]
-    quantity, times = _time_axis(snaps)
-    files = []
-    for k, snap in enumerate(snaps):
-        lines, line_data, left_out = contact_lines(snap)
-        field_data: dict[str, ArrayLike] = {
-            name: [getattr(snap, name)]
-            for name in ("axial_strain", "time")
-            if getattr(snap, name) is not None
-        }
-        field_data.update({name: [count] for name, count in left_out.items()})
-        files.append(
-            write_vtp(
-                folder / f"snapshot_{k:04d}.vtp",
-                snap.positions,
-                lines=lines,
-                point_data=snapshot_arrays(snap, snaps[0]),
-                line_data=line_data,
-                field_data=field_data,
-                binary=binary,
-            )
-        )
-    pvd = write_pvd(folder / "run.pvd", [(t, f.name) for t, f in zip(times, files, strict=True)])
-    return VtkExport(pvd, tuple(files), tuple(times), quantity)

@@ -884,8 +884,8 @@ def _refuse_differing(out: Path, saved: Any, config: BiaxialConfig) -> None:
 def _write_outputs(out: Path) -> dict[str, Any]:
     """``timeseries.csv``, the figures and ``summary.json``, all from the finished
     ``run.h5``: a run stopped while they were written finishes them with ``--resume``."""
-    from grainlab.analysis.biaxial_figures import fabric_figures
     from grainlab.io.hdf5 import read_results
+    from grainlab.postprocess.figures import fabric_figures
 
     results = read_results(out / RESULTS_FILE)
     raise_if_interrupted()  # a Ctrl-C that h5py's clean-up swallowed stops the run here

@@ -1,13 +1,13 @@
 """The shear band of a biaxial run, as the report shows it.
 
 The report shows the bands that the run's figures show: those of
-:func:`grainlab.analysis.biaxial_figures.fabric_numbers` (``band``, at the
+:func:`grainlab.postprocess.fabric_numbers` (``band``, at the
 snapshot nearest the peak, and ``band_final``, at the end of shearing; the
 detector :class:`grainlab.analysis.ShearBand` on the grains' excess local
 strain since the first snapshot, grains away from the boundary, with the
 figures' acceptance tests). :func:`band_from_numbers` reads one of them back
 from its JSON form in ``summary.json`` as the
-:class:`~grainlab.analysis.biaxial_figures.BandNumbers` it was written from.
+:class:`~grainlab.postprocess.band.BandNumbers` it was written from.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from collections.abc import Mapping
 from dataclasses import fields
 from typing import Any
 
-from grainlab.analysis.biaxial_figures import BandNumbers
+from grainlab.postprocess.band import BandNumbers
 
 __all__ = ["ACCEPTANCE", "band_from_numbers"]
 

@@ -22,8 +22,8 @@ import numpy as np
 
 import grainlab
 from grainlab._mapping import flatten_keys
-from grainlab.analysis.biaxial_figures import BandNumbers
 from grainlab.io.hdf5 import Results, read_results
+from grainlab.postprocess.band import BandNumbers
 from grainlab.protocols.config import FIELDS, QUICK
 from grainlab.report.angles import (
     DEFAULT_DILATION_WINDOW,
@@ -33,7 +33,7 @@ from grainlab.report.angles import (
     mobilised_friction_angle,
 )
 from grainlab.report.band import band_from_numbers
-from grainlab.report.figures import grading_figure, macro_figure
+from grainlab.report.figures import embedded_png, grading_figure, macro_figure
 from grainlab.report.html import EmbeddedFigure, fmt, is_usable_png
 from grainlab.report.paper import BIAXIAL_CLAIMS, TABLE1
 from grainlab.samples import PAPER_GRADING, UniformByMass, UniformByNumber
@@ -340,7 +340,7 @@ def _file_figure(path: Path, key: str, title: str, caption: str) -> EmbeddedFigu
     png = path.with_suffix(".png")
     if not is_usable_png(png):
         return None
-    return EmbeddedFigure(key, title, caption, png.read_bytes(), f"{png.name} in the results folder")
+    return EmbeddedFigure(key, title, caption, embedded_png(png.read_bytes()), f"{png.name} in the results folder")
 
 
 def _val(d: dict[str, Any] | None, *keys: str) -> Any:
@@ -480,12 +480,12 @@ def gather_biaxial(
 
     Figures missing from the folder are drawn into it (all of them with
     ``redraw``), with :func:`grainlab.plot.biaxial_curves` and
-    :func:`grainlab.analysis.biaxial_figures.fabric_figures`. The fabric and
+    :func:`grainlab.postprocess.fabric_figures`. The fabric and
     shear-band numbers are ``summary.json``'s (those the figures show) unless
     the fabric figures are drawn here, in which case they are the new ones.
     """
-    from grainlab.analysis.biaxial_figures import FIGURES, fabric_figures, fabric_numbers
     from grainlab.plot import biaxial_curves
+    from grainlab.postprocess import FIGURES, fabric_figures, fabric_numbers
 
     folder = Path(folder)
     results = check_biaxial_folder(folder)

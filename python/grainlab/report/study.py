@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from grainlab.report.figures import embedded_png
 from grainlab.report.html import EmbeddedFigure, fmt, is_usable_png
 from grainlab.report.paper import STUDY_CLAIMS
 from grainlab.study.packing import PackingParams
@@ -232,7 +233,7 @@ def gather_study(folder: str | Path, *, redraw: bool = False) -> StudyReport:
     for key, (title, caption) in STUDY_FIGURES.items():
         png = folder / f"{key}.png"
         if is_usable_png(png):
-            figures[key] = EmbeddedFigure(key, title, caption, png.read_bytes(), f"{png.name} in the study folder")
+            figures[key] = EmbeddedFigure(key, title, caption, embedded_png(png.read_bytes()), f"{png.name} in the study folder")
     statuses: dict[str, int] = {}
     for r in rows:
         statuses[r.get("status", "?")] = statuses.get(r.get("status", "?"), 0) + 1

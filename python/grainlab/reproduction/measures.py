@@ -6,7 +6,7 @@ snapshot, the fabric recomputed from the stored contacts with the analysis
 classes (a, a_n, Z, mean lambda under both conventions) and the band-resolved
 fabric (:class:`~grainlab.analysis.band_fabric.BandFabric`) inside and outside
 the shear band that the figures' detector finds in the grains' local strain
-since the start of shearing (:func:`grainlab.analysis.biaxial_figures.band_labels`:
+since the start of shearing (:func:`grainlab.postprocess.band.band_labels`:
 the accepted band and its accepted conjugate band). Nothing frozen at run time
 is used beyond the raw records and snapshots, so a newer analysis gives newer
 numbers from the same runs.
@@ -138,8 +138,8 @@ def measure_biaxial(run_dir: str | Path, options: Mapping[str, Any] | None = Non
 def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """:func:`measure_biaxial` under each of several analysis options, reading the
     run and finding its bands (which do not depend on the options) once."""
-    from grainlab.analysis.biaxial_figures import band_labels
     from grainlab.io.hdf5 import read_results
+    from grainlab.postprocess.band import band_labels
 
     results = read_results(run_dir)
     ts = results.timeseries

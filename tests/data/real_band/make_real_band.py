@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from grainlab.analysis.biaxial_figures import _interior
 from grainlab.io.hdf5 import read_results
+from grainlab.postprocess.band import interior_grains
 
 SNAPSHOTS = {"initial": "strain_0.0000", "peak": "strain_0.0150", "final": "strain_0.1000"}
 
@@ -35,7 +35,7 @@ def main(run_dir: str) -> Path:
             # same rule as the biaxial figures: grains within one mean diameter of the
             # membrane disks or the platen contact points are left out of the search
             d_mean = float(np.mean(2.0 * snap.radii[snap.is_sample]))
-            interior = _interior(snap, d_mean)  # indexed like snap's grains
+            interior = interior_grains(snap, d_mean)  # indexed like snap's grains
             order = np.flatnonzero(snap.is_sample)
             where = np.empty(snap.n_particles, np.int64)
             where[order] = np.arange(order.size)

@@ -9,15 +9,15 @@ import numpy as np
 import pytest
 
 from grainlab import plot
-from grainlab.analysis import biaxial_figures
-from grainlab.analysis.biaxial_figures import (
+from grainlab.io.hdf5 import ResultsWriter, read_results, snapshot_name
+from grainlab.plot.biaxial import COUNT_CAP
+from grainlab.postprocess import (
     FIGURES,
     FabricFigures,
     MissingColumnError,
     fabric_figures,
     fabric_numbers,
 )
-from grainlab.io.hdf5 import ResultsWriter, read_results, snapshot_name
 from grainlab.snapshot import Snapshot
 
 D = 1.0e-3  # lattice spacing of the synthetic grains, m
@@ -143,7 +143,7 @@ def drawn(run_dir, tmp_path_factory):
     out = tmp_path_factory.mktemp("figures")
     spy = _MapSpy()
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(biaxial_figures.plot, "particle_map", spy)
+        mp.setattr(plot, "particle_map", spy)
         figures = fabric_figures(run_dir, out)
     return figures, out, spy
 
@@ -224,7 +224,7 @@ def test_maps_draw_membrane_disks_grey_and_outline_the_band(drawn, run_dir):
     lambda_values = [v for _, v, _ in spy.calls[2:5]]
     assert all(np.nanmax(v) <= 1.0 for v in lambda_values)
     counts = spy.calls[5:]
-    assert all(np.nanmax(v) <= biaxial_figures._COUNT_CAP for _, v, _ in counts)
+    assert all(np.nanmax(v) <= COUNT_CAP for _, v, _ in counts)
     outlined = [
         any(line.get_label() == "shear band" for line in ax.get_lines()) for _, _, ax in spy.calls
     ]
@@ -234,7 +234,7 @@ def test_maps_draw_membrane_disks_grey_and_outline_the_band(drawn, run_dir):
 
 def test_a_band_that_is_not_there_is_not_outlined(run_dir, tmp_path, monkeypatch):
     spy = _MapSpy()
-    monkeypatch.setattr(biaxial_figures.plot, "particle_map", spy)
+    monkeypatch.setattr(plot, "particle_map", spy)
     figures = fabric_figures(run_dir, tmp_path, peak_snapshot="strain_0.0050")
     n = figures.numbers
     assert n.band is not None and not n.band.found

@@ -6,6 +6,11 @@ any backend works) and return the axes; :func:`save_figure` writes PNG and
 SVG. Angles in the figures are in degrees; strains in percent, compression
 positive (docs/conventions.md).
 
+Files stay small without losing what they show: the disks of a particle map
+are one collection, rasterised inside SVG files (axes, text and band
+outlines stay vector); PNGs are written at :data:`FIGURE_DPI` with a
+256-colour palette (:func:`compact_png`), and so are the images inside SVGs.
+
 Paper figures: :func:`polar_distribution` (Figs. 6–7), :func:`particle_map`
 coloured by displacement (Fig. 11), lambda (Fig. 12) or contact count
 (Fig. 13, ``discrete=True``) with :func:`outline_shear_band`,
@@ -14,7 +19,10 @@ coloured by displacement (Fig. 11), lambda (Fig. 12) or contact count
 
 from __future__ import annotations
 
+import base64
 import contextlib
+import io
+import re
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -24,11 +32,15 @@ import numpy as np
 from matplotlib.collections import EllipseCollection
 from matplotlib.colors import BoundaryNorm, Normalize
 from matplotlib.figure import Figure
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
+from PIL import Image
+from scipy.spatial import cKDTree
 
 __all__ = [
+    "FIGURE_DPI",
     "PAPER_STYLE",
     "anisotropy_series",
+    "compact_png",
     "contact_count_distribution",
     "mean_lambda_series",
     "new_axes",
@@ -38,6 +50,9 @@ __all__ = [
     "polar_distribution",
     "save_figure",
 ]
+
+#: Resolution of the figure files (PNG, and the raster particle maps inside SVGs), dots per inch.
+FIGURE_DPI = 200
 
 #: rcParams for paper figures: serif text, small sizes, thin lines, no clutter.
 PAPER_STYLE: dict[str, Any] = {
@@ -53,7 +68,7 @@ PAPER_STYLE: dict[str, Any] = {
     "axes.spines.top": False,
     "axes.spines.right": False,
     "savefig.bbox": "tight",
-    "savefig.dpi": 300,
+    "savefig.dpi": FIGURE_DPI,
     "svg.fonttype": "none",
     "figure.dpi": 100,
 }
@@ -77,10 +92,102 @@ def new_axes(
         return fig.add_subplot(projection="polar" if polar else None)
 
 
+def compact_png(data: bytes, *, dpi: float | None = None, keep: ArrayLike | None = None) -> bytes:
+    """A PNG image re-encoded small: at most ``dpi`` dots per inch (resampled
+    down when its recorded resolution is higher), with a 256-colour palette
+    (no dithering), transparency kept, the resolution recorded.
+
+    ``keep`` ((k, 3) RGB values 0-255, k <= 192) are colours the palette holds
+    exactly, e.g. the steps of a colour bar, so that a colour scale stays
+    smooth; the other entries are fitted to the image (octree), which moves
+    antialiased edges by a few levels at most. An opaque palette image
+    without ``keep`` keeps its own palette (a smaller copy of a figure file).
+    """
+    fixed = np.zeros((0, 3), np.uint8) if keep is None else np.asarray(keep, dtype=np.uint8).reshape(-1, 3)
+    if len(fixed) > 192:
+        raise ValueError(f"keep: at most 192 colours, got {len(fixed)}")
+    with Image.open(io.BytesIO(data)) as source:
+        image = source.convert("RGBA")
+        recorded = source.info.get("dpi")
+        # a palette image resampled keeps its own palette (a colour bar stays as smooth as it was)
+        own = source.getpalette() if source.mode == "P" and "transparency" not in source.info else None
+    src_dpi = float(recorded[0]) if recorded else None
+    out_dpi = src_dpi
+    if dpi is not None and src_dpi is not None and src_dpi > dpi * 1.001:
+        scale = dpi / src_dpi
+        size = (max(1, round(image.width * scale)), max(1, round(image.height * scale)))
+        image = image.resize(size, Image.Resampling.LANCZOS)
+        out_dpi = dpi
+    if image.getextrema()[3][0] < 255:  # transparent pixels: an RGBA palette
+        palette = image.quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
+    else:
+        rgb = image.convert("RGB")
+        if own is not None and keep is None:
+            entries = np.asarray(own, dtype=np.uint8)
+        else:
+            fitted = rgb.quantize(colors=256 - len(fixed), method=Image.Quantize.FASTOCTREE)
+            found = np.asarray(fitted.getpalette() or [], dtype=np.uint8)[: 3 * (256 - len(fixed))]
+            entries = np.concatenate([fixed.reshape(-1), found])
+        palette = _nearest_palette_image(np.asarray(rgb), entries.reshape(-1, 3))
+    buffer = io.BytesIO()
+    options: dict[str, Any] = {"format": "png", "optimize": True}
+    if out_dpi is not None:
+        options["dpi"] = (out_dpi, out_dpi)
+    palette.save(buffer, **options)
+    return buffer.getvalue()
+
+
+def _nearest_palette_image(rgb: NDArray[np.uint8], entries: NDArray[np.uint8]) -> Image.Image:
+    """The "P" image of ``rgb`` (H, W, 3) with each pixel the nearest of ``entries`` (k, 3):
+    a colour of the palette maps to itself exactly (Pillow's own mapping is approximate)."""
+    packed = (rgb[..., 0].astype(np.int64) << 16) | (rgb[..., 1].astype(np.int64) << 8) | rgb[..., 2]
+    colours, inverse = np.unique(packed.reshape(-1), return_inverse=True)
+    unique_rgb = np.c_[colours >> 16, (colours >> 8) & 255, colours & 255].astype(np.float64)
+    _, nearest = cKDTree(entries.astype(np.float64)).query(unique_rgb)
+    image = Image.fromarray(np.asarray(nearest, np.uint8)[inverse].reshape(rgb.shape[:2]), mode="P")
+    image.putpalette(entries.reshape(-1).tolist())
+    return image
+
+
+def scale_colors(fig: Figure, budget: int = 128) -> NDArray[np.uint8]:
+    """(k, 3) RGB steps of the colour maps in ``fig`` (at most ``budget`` in
+    all, shared between the maps; a map with fewer steps gives all of them):
+    what :func:`compact_png` keeps exactly so that colour bars stay smooth."""
+    cmaps: dict[str, Any] = {}
+    for ax in fig.axes:
+        for artist in [*ax.collections, *ax.images]:
+            cmap = getattr(artist, "cmap", None)
+            if cmap is not None and getattr(artist, "get_array", lambda: None)() is not None:
+                cmaps.setdefault(cmap.name, cmap)
+    if not cmaps:
+        return np.zeros((0, 3), np.uint8)
+    share = max(2, budget // len(cmaps))
+    steps = [cmap(np.linspace(0.0, 1.0, min(cmap.N, share)))[:, :3] for cmap in cmaps.values()]
+    colours = np.round(255.0 * np.concatenate(steps)).astype(np.uint8)
+    return np.unique(colours, axis=0)[:budget]
+
+
+_SVG_PNG = re.compile(rb'(href="data:image/png;base64,)([A-Za-z0-9+/=\s]+)(")')
+
+
+def _compact_svg(svg: bytes) -> bytes:
+    """The SVG with each embedded PNG (the rasterised particle maps) re-encoded by :func:`compact_png`."""
+
+    def recode(m: re.Match[bytes]) -> bytes:
+        png = compact_png(base64.b64decode(m.group(2)))
+        return m.group(1) + base64.b64encode(png) + m.group(3)
+
+    return _SVG_PNG.sub(recode, svg)
+
+
 def save_figure(
     fig_or_ax: Any, path: str | Path, formats: Sequence[str] = ("png", "svg")
 ) -> list[Path]:
-    """Write the figure as ``path`` with each suffix in ``formats``; returns the paths."""
+    """Write the figure as ``path`` with each suffix in ``formats``; returns the paths.
+
+    PNG and SVG files are made small (:func:`compact_png`; module docstring);
+    other formats are written as matplotlib writes them.
+    """
     fig = (
         fig_or_ax.figure
         if hasattr(fig_or_ax, "figure") and not isinstance(fig_or_ax, Figure)
@@ -91,8 +198,16 @@ def save_figure(
     written = []
     with paper_style():
         for fmt in formats:
-            out = base.with_suffix("." + fmt.lstrip("."))
-            fig.savefig(out, format=fmt.lstrip("."))
+            kind = fmt.lstrip(".")
+            out = base.with_suffix("." + kind)
+            buffer = io.BytesIO()
+            fig.savefig(buffer, format=kind)
+            data = buffer.getvalue()
+            if kind == "png":
+                data = compact_png(data, keep=scale_colors(fig))
+            elif kind == "svg":
+                data = _compact_svg(data)
+            out.write_bytes(data)
             written.append(out)
     return written
 
@@ -210,6 +325,7 @@ def particle_map(
             cmap=colormap,
             norm=norm,
             edgecolors="none",
+            rasterized=True,
         )
         coll.set_array(np.ma.masked_invalid(val))
         ax.add_collection(coll)

@@ -1,0 +1,52 @@
+"""The files of ``grainlab analyze``: ``particles.csv``, ``fabric.json`` and the figures.
+
+:func:`write_analysis` writes what :func:`grainlab.analysis.analyze_snapshot`
+computed, through io's writers (the JSON atomically, NaN as ``null``), and
+draws the figures with each measure's ``plot()``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from grainlab import plot
+from grainlab.analysis.analyze import AnalysisResult
+from grainlab.io.csv import write_particles_csv
+from grainlab.io.results import write_json_atomic
+
+__all__ = ["write_analysis"]
+
+
+def write_analysis(result: AnalysisResult, out_dir: str | Path, *, figures: bool = True) -> list[Path]:
+    """Write ``particles.csv``, ``fabric.json`` and (with ``figures``) the PNG + SVG
+    figures of ``result`` into ``out_dir`` (made if needed); returns the paths written."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = [write_particles_csv(out / "particles.csv", result.snapshot, result.particle_table())]
+    written.append(write_json_atomic(out / "fabric.json", result.summary()))
+    if not figures:
+        return written
+    snap = result.snapshot
+    band = result.found_band
+    written += plot.save_figure(result.anisotropy.plot(), out / "contact_normals")
+    if result.force_anisotropy is not None:
+        written += plot.save_figure(result.force_anisotropy.plot(), out / "normal_forces")
+    written += plot.save_figure(result.stability.plot(band=band), out / "map_stability_index")
+    ax = plot.particle_map(
+        snap.positions,
+        snap.radii,
+        np.where(snap.is_sample, result.stability.n_contacts, np.nan),
+        discrete=True,
+        cmap="viridis",
+        label="number of contacts",
+        band=band,
+    )
+    written += plot.save_figure(ax, out / "map_contacts")
+    if result.strain is not None:
+        written += plot.save_figure(result.strain.plot(band=band), out / "map_displacement")
+        written += plot.save_figure(
+            result.strain.plot(quantity="shear_strain", band=band), out / "map_shear_strain"
+        )
+    return written

@@ -1,0 +1,332 @@
+r"""The shear band of a biaxial run, found and accepted (or not) between two snapshots.
+
+:func:`find_band` fits the grains' local strain since a reference snapshot
+(:class:`~grainlab.analysis.LocalStrain`, on the **grains only**: membrane
+disks are much smaller than the grains and are not part of the sample; they
+would set the neighbour radius and the background strain) and searches it
+with :class:`~grainlab.analysis.ShearBand`. Grains whose centre lies within
+one mean diameter of the boundary (membrane disk centres and platen contact
+points; the grains' bounding box when there are neither) are left out of the
+search, since their one-sided neighbourhoods give spurious strains; they
+still belong to the band when they lie inside it. The candidate band is
+accepted when it
+
+1. passes ShearBand's own tests (:attr:`ShearBand.found
+   <grainlab.analysis.ShearBand.found>`): at least one mean grain diameter
+   thick, and its excess strain over the background at least twice the
+   largest excess elsewhere on the profile across it,
+2. crosses the sample: the centre line's chord through the grains is at
+   least 3/4 of the sample's smaller side and the band's grains cover at
+   least 3/4 of that chord (a slab that cuts off a corner is not a band),
+3. explains more of the strain variance (adjusted eta², as ShearBand scores
+   it) than the band found in each of 19 random rearrangements of the same
+   strain values over the same grains (p <= 0.05, fixed seed).
+
+Otherwise the band is "not found" and :attr:`BandNumbers.reason` says why.
+The **second band** (ShearBand's second pass, without the first band's
+grains and at least 20 degrees away from its direction: the conjugate band
+of a biaxial test) is reported in the ``second_*`` fields of
+:class:`BandNumbers` and accepted when it passes tests 1 and 2 (and the
+first band was found). Means of lambda in and out of the band are over
+grains with at least 2 contacts (the paper's 0.34 vs 0.31).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+
+from grainlab.analysis._util import finite_mean
+from grainlab.analysis.shear_band import ShearBand
+from grainlab.analysis.stability import StabilityIndex
+from grainlab.analysis.strain import LocalStrain
+from grainlab.snapshot import Snapshot
+
+__all__ = ["BandNumbers", "BandSearch", "band_labels", "find_band", "interior_grains", "slab_members"]
+
+#: Band acceptance: minimum thickness (mean diameters), crossing fractions, permutations.
+MIN_THICKNESS_D = 1.0
+CROSSING = 0.75
+N_PERMUTATIONS = 19
+#: Grains closer than this many mean diameters to the boundary are left out of the search.
+EDGE_D = 1.0
+#: Seed of the permutation test (fixed: the same run always gives the same p-value).
+PERMUTATION_SEED = 20240611
+
+
+@dataclass(frozen=True)
+class BandNumbers:
+    """The shear band between the initial snapshot and ``snapshot``."""
+
+    #: Snapshot compared with ``reference``.
+    snapshot: str
+    reference: str
+    axial_strain: float
+    #: Whether the band passed the acceptance tests (module docstring).
+    found: bool
+    #: Why it was not accepted ("" when found); names the candidate's numbers.
+    reason: str
+    #: Band direction, degrees in [0, 180), CCW from +x (NaN when not found).
+    angle_deg: float
+    #: Inclination to the horizontal (the sigma_3 direction), degrees in [0, 90].
+    inclination_deg: float
+    thickness_m: float
+    thickness_diameters: float
+    #: (peak - background) / peak of the strain profile.
+    contrast: float
+    #: Grains whose centre lies inside the band.
+    n_grains: int
+    #: Mean lambda of grains with >= 2 contacts inside / outside the band.
+    mean_lambda_inside: float
+    mean_lambda_outside: float
+    #: Permutation p-value of the band's eta² (1/20 is the smallest possible).
+    p_value: float
+    #: Band excess strain / largest excess elsewhere on its profile (ShearBand.prominence).
+    prominence: float = math.nan
+    #: The second (conjugate) band: accepted or not, and its numbers (NaN when
+    #: there is no candidate); same conventions as the first band's fields.
+    second_found: bool = False
+    second_reason: str = ""
+    second_angle_deg: float = math.nan
+    second_inclination_deg: float = math.nan
+    second_thickness_diameters: float = math.nan
+    second_contrast: float = math.nan
+    second_prominence: float = math.nan
+
+
+@dataclass
+class BandSearch:
+    """What :func:`find_band` found: the numbers and the accepted bands themselves."""
+
+    numbers: BandNumbers
+    #: The accepted band (None when not found).
+    band: ShearBand | None
+    #: (N,) displacement magnitude of every particle of the snapshot (m), NaN for membrane disks.
+    displacement: NDArray[np.float64]
+    #: The accepted second band (None when not found).
+    second: ShearBand | None = None
+
+
+def grains_only(snap: Snapshot) -> Snapshot:
+    """The sample grains alone (no contacts): what the local strain is fitted on."""
+    g = snap.is_sample
+    return Snapshot(
+        snap.positions[g],
+        snap.radii[g],
+        snap.ids[g],
+        kind=snap.kind[g],
+        box=snap.box,
+        periodic=snap.periodic,
+    )
+
+
+def interior_grains(snap: Snapshot, d_mean: float) -> NDArray[np.bool_]:
+    """(N_grains,) grains farther than :data:`EDGE_D` mean diameters from the boundary."""
+    g = snap.is_sample
+    pos = snap.positions[g]
+    points = [snap.positions[~g]]
+    wall = np.asarray(snap.contact_j) < 0
+    if wall.any():
+        if snap.contact_point is not None:
+            points.append(np.asarray(snap.contact_point)[wall])
+        else:
+            owner = np.asarray(snap.contact_i)[wall]
+            normals = np.asarray(snap.contact_normals())[wall]
+            points.append(snap.positions[owner] + snap.radii[owner][:, None] * normals)
+    boundary = np.vstack(points)
+    if boundary.shape[0]:
+        dist, _ = cKDTree(boundary).query(pos)
+        return np.asarray(dist > EDGE_D * d_mean)
+    inside = np.ones(pos.shape[0], bool)
+    for axis in (0, 1):
+        if not snap.periodic[axis] and pos.shape[0]:
+            x = pos[:, axis]
+            inside &= np.minimum(x - x.min(), x.max() - x) > EDGE_D * d_mean
+    return inside
+
+
+def _eta2(
+    pos: NDArray[np.float64], gamma: NDArray[np.float64], normal: NDArray[np.float64], width: float
+) -> float:
+    """Adjusted correlation ratio of ``gamma`` with bins across the slab (as ShearBand scores)."""
+    s = pos @ normal
+    b = ((s - s.min()) / width).astype(np.int64)
+    counts = np.bincount(b)
+    sums = np.bincount(b, weights=gamma)
+    occupied = counts > 0
+    m = gamma.size
+    mean = float(gamma.mean())
+    total = float(((gamma - mean) ** 2).sum())
+    if total <= 0.0:
+        return 0.0
+    between = float((sums[occupied] ** 2 / counts[occupied]).sum()) - m * mean**2
+    n_bins = int(occupied.sum())
+    return 1.0 - (1.0 - between / total) * (m - 1) / max(m - n_bins, 1)
+
+
+def find_band(
+    reference: Snapshot,
+    current: Snapshot,
+    stability: StabilityIndex,
+    *,
+    name: str = "",
+    reference_name: str = "",
+    axial_strain: float = math.nan,
+) -> BandSearch:
+    """The shear band of ``current`` since ``reference``, accepted or not (module docstring).
+
+    ``stability`` is ``current``'s computed :class:`StabilityIndex` (for the
+    means in and out of the band); ``name``, ``reference_name`` and
+    ``axial_strain`` label the :class:`BandNumbers`.
+    """
+    snap = current
+    g = snap.is_sample
+    grains = grains_only(snap)
+    strain = LocalStrain().compute(grains_only(reference), grains)
+    displacement = np.full(snap.n_particles, np.nan)
+    displacement[g] = strain.displacement_magnitude
+    pos, rad = grains.positions, grains.radii
+    d_mean = float(np.mean(2.0 * rad)) if rad.size else math.nan
+    gamma = strain.excess_shear_strain
+    interior = interior_grains(snap, d_mean)
+    valid = interior & np.isfinite(gamma)
+    lam = stability.stability_index[g]
+    counts = stability.n_contacts[g]
+
+    def missing(reason: str, **numbers: Any) -> BandSearch:
+        values: dict[str, Any] = {
+            "angle_deg": math.nan,
+            "inclination_deg": math.nan,
+            "thickness_m": math.nan,
+            "thickness_diameters": math.nan,
+            "contrast": math.nan,
+            "n_grains": 0,
+            "mean_lambda_inside": math.nan,
+            "mean_lambda_outside": math.nan,
+            "p_value": math.nan,
+        }
+        values.update(numbers)
+        return BandSearch(
+            BandNumbers(name, reference_name, axial_strain, False, reason, **values), None, displacement
+        )
+
+    if int(valid.sum()) < 10:
+        return missing(
+            f"only {int(valid.sum())} grains away from the boundary have a local strain "
+            "(at least 10 are needed)"
+        )
+    band = ShearBand(min_thickness=MIN_THICKNESS_D).compute(pos, gamma, rad, mask=interior)
+    side = float(np.ptp(pos, axis=0).min())
+    # significance against random rearrangements of the same strain values
+    width = band.bin_width * float(np.mean(2.0 * rad[interior]))
+    eta = _eta2(pos[valid], gamma[valid], band.normal, width)
+    rng = np.random.default_rng(PERMUTATION_SEED)
+    shuffled = gamma.copy()
+    null = np.empty(N_PERMUTATIONS)
+    for k in range(N_PERMUTATIONS):
+        shuffled[valid] = rng.permutation(gamma[valid])
+        trial = ShearBand(second=False).compute(pos, shuffled, rad, mask=interior)
+        null[k] = _eta2(pos[valid], shuffled[valid], trial.normal, width)
+    p_value = float((1 + np.sum(null >= eta)) / (N_PERMUTATIONS + 1))
+
+    problems = _band_problems(band, pos, d_mean, side)
+    if p_value > 0.05:
+        problems.append(
+            f"not significant (p = {p_value:.2f} against {N_PERMUTATIONS} random "
+            "rearrangements of the strain values)"
+        )
+    members = slab_members(band, pos)
+    use = counts >= 2
+    numbers: dict[str, Any] = {
+        "angle_deg": band.angle_degrees,
+        "inclination_deg": band.inclination_degrees,
+        "thickness_m": band.thickness,
+        "thickness_diameters": band.thickness_diameters,
+        "contrast": band.contrast,
+        "n_grains": int(members.sum()),
+        "mean_lambda_inside": finite_mean(lam, use & members),
+        "mean_lambda_outside": finite_mean(lam, use & ~members),
+        "p_value": p_value,
+        "prominence": band.prominence,
+    }
+    if problems:
+        return missing(
+            f"best candidate at {band.angle_degrees:.1f} deg, {band.thickness_diameters:.1f} "
+            "mean diameters thick: " + "; ".join(problems),
+            p_value=p_value,
+            prominence=band.prominence,
+        )
+    second = band.second
+    accepted_second = None
+    if second is not None:
+        second_problems = _band_problems(second, pos, d_mean, side)
+        numbers.update(
+            second_found=not second_problems,
+            second_reason=(
+                f"best candidate at {second.angle_degrees:.1f} deg, "
+                f"{second.thickness_diameters:.1f} mean diameters thick: "
+                + "; ".join(second_problems)
+                if second_problems
+                else ""
+            ),
+            second_angle_deg=second.angle_degrees,
+            second_inclination_deg=second.inclination_degrees,
+            second_thickness_diameters=second.thickness_diameters,
+            second_contrast=second.contrast,
+            second_prominence=second.prominence,
+        )
+        accepted_second = None if second_problems else second
+    return BandSearch(
+        BandNumbers(name, reference_name, axial_strain, True, "", **numbers),
+        band,
+        displacement,
+        accepted_second,
+    )
+
+
+def slab_members(band: ShearBand, pos: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Grains whose centre lies inside the band's slab (boundary grains included)."""
+    return np.asarray(np.abs((pos - band.center) @ band.normal) <= 0.5 * band.thickness)
+
+
+def _band_problems(
+    band: ShearBand, pos: NDArray[np.float64], d_mean: float, side: float
+) -> list[str]:
+    """Why a candidate band fails acceptance tests 1 and 2 (module docstring); [] if it passes."""
+    problems = [band.reason] if not band.found else []
+    tangent = np.array([np.cos(band.angle), np.sin(band.angle)])
+    s = (pos - band.center) @ band.normal
+    members = np.abs(s) <= 0.5 * band.thickness
+    # crossing: chord of the centre line through the grains and the members' cover of it
+    near = np.abs(s) <= max(0.5 * band.thickness, d_mean)
+    chord = float(np.ptp(pos[near] @ tangent)) if near.sum() > 1 else 0.0
+    span = float(np.ptp(pos[members] @ tangent)) if members.sum() > 1 else 0.0
+    if chord < CROSSING * side or span < CROSSING * chord:
+        problems.append(
+            f"does not cross the sample (its grains span {span / d_mean:.1f} mean diameters "
+            f"of a {chord / d_mean:.1f}-diameter chord; the sample's smaller side is "
+            f"{side / d_mean:.1f})"
+        )
+    return problems
+
+
+def band_labels(reference: Snapshot, current: Snapshot) -> NDArray[np.int32]:
+    """(N,) per particle of ``current``: 1 inside the accepted shear band, 2
+    inside its accepted conjugate band, 0 elsewhere (membrane disks, and every
+    particle when no band passes the tests): the bands the figures outline,
+    found in the grains' local strain since ``reference``."""
+    found = find_band(reference, current, StabilityIndex().compute(current), reference_name="")
+    labels = np.zeros(current.n_particles, np.int32)
+    grains = np.flatnonzero(current.is_sample)
+    pos = current.positions[grains]
+    if found.band is not None:
+        labels[grains[slab_members(found.band, pos)]] = 1
+        if found.second is not None:
+            second = grains[slab_members(found.second, pos)]
+            labels[second[labels[second] == 0]] = 2
+    return labels

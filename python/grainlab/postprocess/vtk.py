@@ -1,0 +1,150 @@
+"""ParaView export of a run: one ``.vtp`` per snapshot and a ``.pvd`` time series.
+
+:func:`export_vtk` reads a run's ``run.h5``, computes each snapshot's point
+data (:func:`snapshot_arrays`: the measures of :mod:`grainlab.analysis` and
+the bands of :func:`grainlab.postprocess.band.band_labels`) and writes them
+with :mod:`grainlab.io.vtk` (the file layout is described there and in
+docs/file-formats.md, "ParaView").
+
+The ``.pvd`` collection lists the files with their time value: the
+snapshots' axial strain when it is known for every snapshot and strictly
+increasing, else their time in s under the same condition, else their index.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from grainlab.analysis import LocalStrain, StabilityIndex, match_ids
+from grainlab.io.hdf5 import read_results
+from grainlab.io.vtk import as_vector3, contact_lines, exportable, write_pvd, write_vtp
+from grainlab.postprocess.band import band_labels
+
+__all__ = ["VtkExport", "export_vtk", "snapshot_arrays"]
+
+
+def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArray[Any]]:
+    """Point data of one :class:`~grainlab.snapshot.Snapshot` for the export.
+
+    ``reference`` is the run's first snapshot (``None`` or ``snap`` itself for
+    the first one): displacement, local shear strain and shear band are taken
+    against it. Keys, in order (units in docs/file-formats.md, "ParaView"):
+
+    ``id``, ``kind``, ``radius``, ``displacement`` (N, 3) (matched by id, NaN
+    for particles absent from the reference, 0 in the first snapshot),
+    ``rotation`` (only when the snapshot has rotations), ``n_contacts`` (walls
+    included), ``stability_index``, ``local_shear_strain`` (NaN in the first
+    snapshot), ``in_shear_band`` (0 outside, 1 in the dominant band, 2 in
+    the conjugate band: the bands the biaxial figures outline,
+    :func:`grainlab.postprocess.band.band_labels`), then every numeric per-particle field
+    of the snapshot (``velocity``, ...) under its own name, 2-vectors padded to
+    (N, 3); a field whose name is already taken above is left out.
+    """
+    n = snap.n_particles
+    out: dict[str, NDArray[Any]] = {
+        "id": np.asarray(snap.ids, np.int64),
+        "kind": np.asarray(snap.kind, np.int32),
+        "radius": np.asarray(snap.radii, np.float64),
+    }
+    first = reference is None or reference is snap
+    disp = np.zeros((n, 3))
+    gamma = np.full(n, np.nan)
+    band = np.zeros(n, np.int32)
+    if not first:
+        to_ref = match_ids(reference, snap)
+        ok = to_ref >= 0
+        disp[:, :2] = np.nan
+        disp[ok, :2] = snap.minimum_image(snap.positions[ok] - reference.positions[to_ref[ok]])
+        strain = LocalStrain().compute(reference, snap)
+        gamma = np.asarray(strain.shear_strain, np.float64)
+        # the bands the biaxial figures outline (grains away from the boundary,
+        # with the figures' acceptance tests): 1 dominant, 2 conjugate
+        try:
+            band = band_labels(reference, snap)
+        except ValueError:  # too few grains with a local strain: no band
+            pass
+    out["displacement"] = disp
+    if snap.rotations is not None:
+        out["rotation"] = np.asarray(snap.rotations, np.float64)
+    out["n_contacts"] = snap.contact_counts().astype(np.int32)
+    out["stability_index"] = np.asarray(StabilityIndex().compute(snap).stability_index, float)
+    out["local_shear_strain"] = gamma
+    out["in_shear_band"] = band
+    for name, value in snap.particle_fields.items():
+        a = np.asarray(value)
+        if name not in out and exportable(a):
+            out[name] = as_vector3(a)
+    return out
+
+
+def _time_axis(snaps: Sequence[Any]) -> tuple[str, list[float]]:
+    for quantity in ("axial_strain", "time"):
+        values = [getattr(s, quantity) for s in snaps]
+        if all(v is not None for v in values):
+            t = np.asarray(values, np.float64)
+            if np.all(np.diff(t) > 0):
+                return quantity, [float(v) for v in t]
+    return "index", [float(k) for k in range(len(snaps))]
+
+
+@dataclass(frozen=True)
+class VtkExport:
+    """What :func:`export_vtk` wrote."""
+
+    pvd: Path
+    files: tuple[Path, ...]
+    times: tuple[float, ...]
+    time_quantity: str  # "axial_strain", "time" or "index"
+
+
+def export_vtk(
+    run: str | os.PathLike[str],
+    out_dir: str | os.PathLike[str] | None = None,
+    *,
+    binary: bool = True,
+) -> VtkExport:
+    """Write one ``.vtp`` per snapshot of ``run`` (a run folder or its ``run.h5``) and a ``.pvd``.
+
+    Files go to ``out_dir`` (default ``<run folder>/vtk``) as ``snapshot_0000.vtp``, ...
+    (in the run's snapshot order) and ``run.pvd``. Each file's field data holds
+    ``axial_strain`` and ``time`` (when the snapshot has them) and the counts
+    of :func:`contact_lines`. Raises ValueError when the run has no snapshots.
+    """
+    path = Path(run)
+    h5 = path / "run.h5" if path.is_dir() else path
+    folder = Path(out_dir) if out_dir is not None else h5.parent / "vtk"
+    results = read_results(h5)
+    names = list(results.snapshot_names)
+    if not names:
+        raise ValueError(f"{h5}: the run has no snapshots to export")
+    snaps = [results.snapshot(name) for name in names]
+    quantity, times = _time_axis(snaps)
+    files = []
+    for k, snap in enumerate(snaps):
+        lines, line_data, left_out = contact_lines(snap)
+        field_data: dict[str, ArrayLike] = {
+            name: [getattr(snap, name)]
+            for name in ("axial_strain", "time")
+            if getattr(snap, name) is not None
+        }
+        field_data.update({name: [count] for name, count in left_out.items()})
+        files.append(
+            write_vtp(
+                folder / f"snapshot_{k:04d}.vtp",
+                snap.positions,
+                lines=lines,
+                point_data=snapshot_arrays(snap, snaps[0]),
+                line_data=line_data,
+                field_data=field_data,
+                binary=binary,
+            )
+        )
+    pvd = write_pvd(folder / "run.pvd", [(t, f.name) for t, f in zip(times, files, strict=True)])
+    return VtkExport(pvd, tuple(files), tuple(times), quantity)

@@ -1,0 +1,206 @@
+"""The import-layer contract of the package (ARCHITECTURE.md, "Layers").
+
+Every module of ``python/grainlab`` belongs to one layer; a module may import
+(at module level or inside a function) only modules of its own layer or of a
+layer below. io, besides, imports no analysis or plotting: it reads and
+writes, and computes nothing. The test walks the syntax tree of every module,
+so a lazy import inside a function counts too. It is run by ``make lint``.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "python" / "grainlab"
+
+#: Layers, lowest first: module prefix -> layer. A module takes the layer of its
+#: longest listed prefix; a module with no listed prefix is an error (give it one).
+LAYERS: dict[str, int] = {
+    # 0: the compiled engine and leaf helpers that import no other grainlab module
+    "grainlab._core": 0,
+    "grainlab._interrupt": 0,
+    "grainlab._kernels": 0,
+    "grainlab._mapping": 0,
+    "grainlab._notebook": 0,
+    "grainlab._progress": 0,
+    "grainlab._repr": 0,
+    "grainlab.paper": 0,
+    # 1: the engine API and the snapshot data model
+    "grainlab": 1,
+    "grainlab.simulation": 1,
+    "grainlab.snapshot": 1,
+    # 2: measures on snapshots and arrays (pure), and drawing
+    "grainlab.analysis": 2,
+    "grainlab.plot": 2,
+    # 3: files
+    "grainlab.io": 3,
+    # 4: making samples and running tests
+    "grainlab.samples": 4,
+    "grainlab.protocols": 4,
+    "grainlab.demo": 4,
+    # 5: what is done with finished runs
+    "grainlab.postprocess": 5,
+    "grainlab.report": 5,
+    "grainlab.reproduction": 5,
+    "grainlab.study": 5,
+    "grainlab.viewer": 5,
+    # 6: the command line
+    "grainlab.commands": 6,
+    "grainlab.cli": 6,
+    "grainlab.__main__": 6,
+}
+
+LAYER_NAMES = ("core", "model", "analysis", "io", "protocols", "post-processing", "command line")
+
+#: (importer prefix, imported prefix) pairs forbidden although the layers allow them.
+FORBIDDEN: tuple[tuple[str, str], ...] = (
+    ("grainlab.io", "grainlab.analysis"),
+    ("grainlab.io", "grainlab.plot"),
+)
+
+#: Known exceptions, each (importer, imported module): the biaxial driver still
+#: draws the fabric figures at the end of a run (its output phase), a job of the
+#: post-processing layer; the exception goes when that phase moves up.
+EXCEPTIONS: frozenset[tuple[str, str]] = frozenset(
+    {("grainlab.protocols.biaxial", "grainlab.postprocess.figures")}
+)
+
+
+def module_name(root: Path, path: Path) -> str:
+    """``grainlab.x.y`` of a file under ``root`` (the folder holding the package)."""
+    parts = list(path.relative_to(root).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def layer_of(module: str) -> tuple[int, str] | None:
+    """(layer, matched prefix) of a grainlab module; None when no prefix matches."""
+    parts = module.split(".")
+    for k in range(len(parts), 1, -1):
+        prefix = ".".join(parts[:k])
+        if prefix in LAYERS:
+            return LAYERS[prefix], prefix
+    return (LAYERS[module], module) if module == "grainlab" else None
+
+
+def _under(module: str, prefix: str) -> bool:
+    return module == prefix or module.startswith(prefix + ".")
+
+
+def imported_modules(tree: ast.AST, module: str, is_package: bool) -> list[tuple[int, str]]:
+    """(line, module) of every grainlab import in ``tree``, wherever it stands.
+
+    ``from grainlab import x`` counts as importing ``grainlab.x`` when ``x`` is
+    a submodule name in :data:`LAYERS` terms (else the package itself);
+    relative imports are resolved against ``module``.
+    """
+    package = module if is_package else module.rpartition(".")[0]
+    found: list[tuple[int, str]] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, alias.name) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                source = ".".join(base + ([node.module] if node.module else []))
+            else:
+                source = node.module or ""
+            for alias in node.names:
+                candidate = f"{source}.{alias.name}"
+                hit = layer_of(candidate)
+                found.append((node.lineno, candidate if hit and hit[1] == candidate else source))
+    return [(line, name) for line, name in found if _under(name, "grainlab")]
+
+
+def layer_violations(root: Path) -> tuple[list[str], set[tuple[str, str]]]:
+    """Every import in the package under ``root`` against the layer rule, as
+    ``module:line imports target (why)`` (modules without a layer are listed
+    too), and the :data:`EXCEPTIONS` that were met."""
+    problems: list[str] = []
+    met: set[tuple[str, str]] = set()
+    for path in sorted((root / "grainlab").rglob("*.py")):
+        module = module_name(root, path)
+        mine = layer_of(module)
+        if mine is None:
+            problems.append(f"{module}: no layer (add its prefix to LAYERS and ARCHITECTURE.md)")
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        for line, target in imported_modules(tree, module, path.name == "__init__.py"):
+            theirs = layer_of(target)
+            if theirs is None:
+                continue  # a module without a layer is reported as such
+            if (module, target) in EXCEPTIONS:
+                met.add((module, target))
+                continue
+            if theirs[0] > mine[0]:
+                problems.append(
+                    f"{module}:{line} imports {target}: layer {LAYER_NAMES[theirs[0]]} is above "
+                    f"{LAYER_NAMES[mine[0]]}"
+                )
+            for low, high in FORBIDDEN:
+                if _under(module, low) and _under(target, high):
+                    problems.append(f"{module}:{line} imports {target}: {low} imports no {high}")
+    return problems, met
+
+
+def test_every_import_follows_the_layer_rule():
+    problems, met = layer_violations(PACKAGE.parent)
+    assert problems == []
+    assert met == EXCEPTIONS, "an exception no longer needed: remove it from EXCEPTIONS"
+
+
+def _synthetic_package(root: Path, modules: dict[str, str]) -> Path:
+    for name, source in modules.items():
+        path = root.joinpath(*name.split(".")).with_suffix(".py")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(source, encoding="utf-8")
+    return root
+
+
+@pytest.mark.parametrize(
+    ("source", "expected"),
+    [
+        ("from grainlab.io.hdf5 import read_results\n", "grainlab.analysis.bad:1 imports grainlab.io.hdf5"),
+        ("def f():\n    from grainlab.report import write_report\n", "grainlab.analysis.bad:2 imports grainlab.report"),
+        ("from ..protocols import config\n", "grainlab.analysis.bad:1 imports grainlab.protocols:"),
+        ("import grainlab.postprocess\n", "grainlab.analysis.bad:1 imports grainlab.postprocess"),
+    ],
+)
+def test_a_forbidden_import_in_analysis_is_caught(tmp_path, source, expected):
+    root = _synthetic_package(
+        tmp_path,
+        {
+            "grainlab.__init__": "",
+            "grainlab.analysis.__init__": "",
+            "grainlab.analysis.bad": source,
+            "grainlab.snapshot": "",
+        },
+    )
+    problems, _ = layer_violations(root)
+    assert len(problems) == 1 and problems[0].startswith(expected), problems
+
+
+def test_io_may_not_import_analysis_even_lazily(tmp_path):
+    root = _synthetic_package(
+        tmp_path,
+        {"grainlab.io.__init__": "", "grainlab.io.vtk": "def f():\n    from grainlab.analysis import StabilityIndex\n"},
+    )
+    assert layer_violations(root)[0] == [
+        "grainlab.io.vtk:2 imports grainlab.analysis: grainlab.io imports no grainlab.analysis"
+    ]
+
+
+def test_allowed_imports_and_unknown_modules(tmp_path):
+    root = _synthetic_package(
+        tmp_path,
+        {
+            "grainlab.report.ok": "from grainlab import plot\nfrom grainlab.io import results\nimport grainlab\n",
+            "grainlab.analysis.ok": "from grainlab import snapshot, _core\nfrom . import fabric\n",
+            "grainlab.newthing": "",
+        },
+    )
+    assert layer_violations(root)[0] == ["grainlab.newthing: no layer (add its prefix to LAYERS and ARCHITECTURE.md)"]
