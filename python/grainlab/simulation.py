@@ -27,14 +27,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from grainlab import _core
+from grainlab import _core, paper
 from grainlab.snapshot import Snapshot
 
-#: Table 1 of the paper: contact stiffnesses (N/m), particle friction, density (kg/m^3).
-TABLE1_STIFFNESS_N_PER_M = 8.45e7
-TABLE1_FRICTION = 0.9
-TABLE1_DENSITY_KG_PER_M3 = 2.0e8
-TABLE1_LOCAL_DAMPING = 0.8
+#: Table 1 of the paper (:mod:`grainlab.paper`): contact stiffnesses (N/m), particle
+#: friction, density (kg/m^3), local damping.
+TABLE1_STIFFNESS_N_PER_M = paper.NORMAL_STIFFNESS_N_PER_M
+TABLE1_FRICTION = paper.FRICTION
+TABLE1_DENSITY_KG_PER_M3 = paper.DENSITY_KG_PER_M3
+TABLE1_LOCAL_DAMPING = paper.LOCAL_DAMPING
 
 #: Bits of :attr:`Simulation.fixity`.
 FIX_X, FIX_Y, FIX_ROTATION = 1, 2, 4

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from grainlab import paper
 from grainlab._mapping import flatten_keys
 
 
@@ -72,14 +73,14 @@ _POSITIVE = {"minimum": 0.0, "exclusive_minimum": True}
 
 #: Every key, with the paper's Table 1 values as defaults.
 FIELDS: dict[str, Field] = {
-    "sample.width": Field("length", 0.075, "sample width (Table 1: 75 mm)", **_POSITIVE),
-    "sample.height": Field("length", 0.150, "sample height (Table 1: 150 mm)", **_POSITIVE),
+    "sample.width": Field("length", paper.WIDTH_M, "sample width (Table 1: 75 mm)", **_POSITIVE),
+    "sample.height": Field("length", paper.HEIGHT_M, "sample height (Table 1: 150 mm)", **_POSITIVE),
     "sample.porosity": Field(
-        "strain", 0.12, "target nominal porosity of the radius expansion (Table 1: 0.12)",
+        "strain", paper.POROSITY, "target nominal porosity of the radius expansion (Table 1: 0.12)",
         minimum=0.0, maximum=1.0, exclusive_minimum=True, exclusive_maximum=True,
     ),
-    "sample.d_min": Field("length", 0.5e-3, "smallest grain diameter (Table 1: 0.5 mm)", **_POSITIVE),
-    "sample.d_max": Field("length", 3.0e-3, "largest grain diameter (Table 1: 3 mm)", **_POSITIVE),
+    "sample.d_min": Field("length", paper.D_MIN_M, "smallest grain diameter (Table 1: 0.5 mm)", **_POSITIVE),
+    "sample.d_max": Field("length", paper.D_MAX_M, "largest grain diameter (Table 1: 3 mm)", **_POSITIVE),
     "sample.grading": Field(
         "choice", "paper",
         "grain size distribution; 'curve' takes sample.sieve_sizes and sample.percent_passing",
@@ -98,18 +99,18 @@ FIELDS: dict[str, Field] = {
     "sample.max_generation_stress": Field(
         "stress", 5.0e6, "stress bound of the radius expansion", **_POSITIVE
     ),
-    "material.normal_stiffness": Field("stiffness", 8.45e7, "contact kn (Table 1)", **_POSITIVE),
-    "material.shear_stiffness": Field("stiffness", 8.45e7, "contact ks (Table 1)", **_POSITIVE),
-    "material.friction": Field("number", 0.9, "particle friction (Table 1: 0.9)", minimum=0.0),
-    "material.platen_friction": Field("number", 0.0, "particle-platen friction (Table 1: 0)", minimum=0.0),
-    "material.density": Field("density", 2.0e8, "scaled particle density (Table 1: 2e8 kg/m^3)", **_POSITIVE),
+    "material.normal_stiffness": Field("stiffness", paper.NORMAL_STIFFNESS_N_PER_M, "contact kn (Table 1)", **_POSITIVE),
+    "material.shear_stiffness": Field("stiffness", paper.SHEAR_STIFFNESS_N_PER_M, "contact ks (Table 1)", **_POSITIVE),
+    "material.friction": Field("number", paper.FRICTION, "particle friction (Table 1: 0.9)", minimum=0.0),
+    "material.platen_friction": Field("number", paper.PLATEN_FRICTION, "particle-platen friction (Table 1: 0)", minimum=0.0),
+    "material.density": Field("density", paper.DENSITY_KG_PER_M3, "scaled particle density (Table 1: 2e8 kg/m^3)", **_POSITIVE),
     "material.limiting_contact_pressure": Field(
-        "stress", 150.0e6, "p_y of the density scaling factor, paper Eq. 16 (Table 1: 150 MPa)", **_POSITIVE
+        "stress", paper.LIMITING_CONTACT_PRESSURE_PA, "p_y of the density scaling factor, paper Eq. 16 (Table 1: 150 MPa)", **_POSITIVE
     ),
     "material.local_damping": Field(
-        "number", 0.8, "local damping alpha (Table 1: 0.8)", minimum=0.0, maximum=1.0, exclusive_maximum=True
+        "number", paper.LOCAL_DAMPING, "local damping alpha (Table 1: 0.8)", minimum=0.0, maximum=1.0, exclusive_maximum=True
     ),
-    "consolidation.pressure": Field("stress", 1.0e5, "isotropic consolidation stress sigma_0 = sigma_3", **_POSITIVE),
+    "consolidation.pressure": Field("stress", paper.CONSOLIDATION_PRESSURE_PA, "isotropic consolidation stress sigma_0 = sigma_3", **_POSITIVE),
     "consolidation.friction": Field(
         "number", 0.0,
         "grain friction while consolidating (the generation's; Table 1 friction acts from the membrane on)",
@@ -124,7 +125,7 @@ FIELDS: dict[str, Field] = {
     "consolidation.max_steps": Field("integer", 2_000_000, "give up consolidating after this many steps", minimum=1),
     "boundary.kind": Field(
         "choice", "membrane",
-        "flexible lateral boundary (DESIGN §3): a bonded membrane (A) or the outermost grains (B)",
+        "flexible lateral boundary (docs/boundary.md): a bonded membrane (A) or the outermost grains (B)",
         choices=("membrane", "outer_particles"),
     ),
     "boundary.membrane_diameter": Field("length", 0.5e-3, "diameter of the membrane disks", **_POSITIVE),
@@ -137,7 +138,7 @@ FIELDS: dict[str, Field] = {
     ),
     "boundary.membrane_friction": Field("number", 0.0, "friction between grains and membrane disks", minimum=0.0),
     "shear.strain_rate": Field(
-        "strain_rate", 0.02 / 60.0,
+        "strain_rate", paper.STRAIN_RATE_PER_S,
         "axial strain rate (Table 1: 2 %/min); auto = the fastest with the heaviest grain's inertial "
         "number <= shear.inertial_number (20 %/min with Table 1)",
         **_POSITIVE, allow_auto=True,
@@ -148,7 +149,7 @@ FIELDS: dict[str, Field] = {
         exclusive_minimum=True,
     ),
     "shear.snapshot_strains": Field(
-        "strain_list", [0.0, 0.005, 0.007, 0.009, 0.015, 0.10],
+        "strain_list", list(paper.SNAPSHOT_STRAINS),
         "axial strains of the full snapshots (the paper's 0, 0.5, 0.7, 0.9, 1.5 and 10 %)",
     ),
     "shear.inertial_number": Field(

@@ -23,6 +23,7 @@ import numpy as np
 import grainlab
 from grainlab._mapping import flatten_keys
 from grainlab.io.hdf5 import Results, read_results
+from grainlab.paper import BIAXIAL_CLAIMS, TABLE1
 from grainlab.postprocess.band import BandNumbers
 from grainlab.protocols.config import FIELDS, QUICK
 from grainlab.report.angles import (
@@ -35,7 +36,6 @@ from grainlab.report.angles import (
 from grainlab.report.band import band_from_numbers
 from grainlab.report.figures import embedded_png, grading_figure, macro_figure
 from grainlab.report.html import EmbeddedFigure, fmt, is_usable_png
-from grainlab.report.paper import BIAXIAL_CLAIMS, TABLE1
 from grainlab.samples import PAPER_GRADING, UniformByMass, UniformByNumber
 from grainlab.samples.grading import Grading, GradingCurve
 

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from grainlab import paper
 from grainlab.reproduction.measures import END_WINDOW, relative_slope
 from grainlab.reproduction.verdicts import ProportionRule, SideRule, ValueRule
 
@@ -211,7 +212,7 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
           "R^2 of a straight line through the stress-ratio records from 0 to 0.5 %",
           SideRule(+1, 0.98), lambda m: m["macro"]["linear_r2"]),
     Claim("peak_near_1.5", "hardening from 0.5 % to the peak stress ratio at 1.5 % axial strain",
-          "Sec. 6, Figs. 8, 11", 0.015, "axial strain at the largest stress ratio (fraction)",
+          "Sec. 6, Figs. 8, 11", paper.STRAIN_AT_PEAK, "axial strain at the largest stress ratio (fraction)",
           ValueRule(0.010, 0.020), lambda m: m["macro"]["peak_axial_strain"]),
     Claim("softening_after_peak", "after the peak the critical state: a brittle failure, the stress ratio "
           "falls from its peak", "Sec. 6, Fig. 8; Abstract", None,
@@ -226,12 +227,12 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
     Claim("dilation_after", "then dilates", "Sec. 7, Fig. 18", None,
           "volumetric strain at the end of the test (compression positive)", SideRule(-1),
           lambda m: m["macro"]["final_volumetric_strain"]),
-    Claim("a_isotropic", "contact-normal anisotropy at the isotropic state a = 0.0034", "Sec. 6, Fig. 6", 0.0034,
+    Claim("a_isotropic", "contact-normal anisotropy at the isotropic state a = 0.0034", "Sec. 6, Fig. 6", paper.A_ISOTROPIC,
           "a of the snapshot at 0 % (the library's headline anisotropy)", ValueRule(0.0, 0.0068),
           lambda m: _initial(m)["a"]),
-    Claim("a_n_isotropic", "normal-force anisotropy at the isotropic state a_n = 0.009", "Sec. 6, Fig. 7", 0.009,
+    Claim("a_n_isotropic", "normal-force anisotropy at the isotropic state a_n = 0.009", "Sec. 6, Fig. 7", paper.A_N_ISOTROPIC,
           "a_n of the snapshot at 0 %", ValueRule(0.0, 0.018), lambda m: _initial(m)["a_n"]),
-    Claim("a_at_0.5", "the fabric anisotropy increases rapidly to around 0.18 at 0.5 %", "Sec. 6, Fig. 9", 0.18,
+    Claim("a_at_0.5", "the fabric anisotropy increases rapidly to around 0.18 at 0.5 %", "Sec. 6, Fig. 9", paper.A_AT_HALF_PERCENT,
           "a of the snapshot at 0.5 %", ValueRule(0.135, 0.225), lambda m: _at(m, 0.005)["a"]),
     Claim("a_largest_at_peak", "the strain of the largest fabric anisotropy is almost that of the peak "
           "stress ratio", "Sec. 6, Figs. 8, 9", 0.0,
@@ -243,10 +244,10 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
     Claim("a_constant_at_end", "and reaches a constant value (critical state)", "Sec. 6, Fig. 9", None,
           "relative change of a per 1 % axial strain over the end window", ValueRule(-0.02, 0.02),
           lambda m: _end_slope(m, "a")),
-    Claim("z_initial", "the coordination number is around 3.9 at 0 %", "Sec. 6, Fig. 10", 3.9,
+    Claim("z_initial", "the coordination number is around 3.9 at 0 %", "Sec. 6, Fig. 10", paper.Z_INITIAL,
           "grain-grain coordination number Z = 2 Nc / Np of the snapshot at 0 %", ValueRule(3.7, 4.1),
           lambda m: _initial(m)["coordination_number"]),
-    Claim("z_at_peak", "and around 3.0 at the peak strength", "Sec. 6, Fig. 10", 3.0,
+    Claim("z_at_peak", "and around 3.0 at the peak strength", "Sec. 6, Fig. 10", paper.Z_AT_PEAK,
           "Z of the snapshot nearest the peak", ValueRule(2.8, 3.2), lambda m: _peak(m)["coordination_number"]),
     Claim("z_constant_after_peak", "from the peak onward the coordination number is constant", "Sec. 6, Fig. 10",
           0.0, "(Z at the end - Z at the peak) / Z at the peak", ValueRule(-0.05, 0.05),
@@ -267,16 +268,16 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
     Claim("band_lambda_above_rest_all", "the same, lambda averaged over every grain", "Sec. 6, Fig. 13", 0.03,
           f"band minus rest at the peak snapshot, paired per seed; {_LAMBDA_ALL}", SideRule(+1),
           lambda m: _band(_peak(m), "inside_mean_lambda_all") - _band(_peak(m), "outside_mean_lambda_all")),
-    Claim("band_lambda_0.34", "mean lambda in the shear zone at the peak is 0.34", "Sec. 6", 0.34,
+    Claim("band_lambda_0.34", "mean lambda in the shear zone at the peak is 0.34", "Sec. 6", paper.LAMBDA_IN_BAND,
           f"band mean at the peak snapshot; {_LAMBDA_BAND}", ValueRule(0.325, 0.355),
           lambda m: _band(_peak(m), "inside_mean_lambda")),
-    Claim("rest_lambda_0.31", "mean lambda in the rest of the sample at the peak is 0.31", "Sec. 6", 0.31,
+    Claim("rest_lambda_0.31", "mean lambda in the rest of the sample at the peak is 0.31", "Sec. 6", paper.LAMBDA_OUTSIDE_BAND,
           f"rest mean at the peak snapshot; {_LAMBDA_BAND}", ValueRule(0.295, 0.325),
           lambda m: _band(_peak(m), "outside_mean_lambda")),
-    Claim("band_lambda_0.34_all", "mean lambda in the shear zone at the peak is 0.34 (every grain)", "Sec. 6", 0.34,
+    Claim("band_lambda_0.34_all", "mean lambda in the shear zone at the peak is 0.34 (every grain)", "Sec. 6", paper.LAMBDA_IN_BAND,
           f"band mean at the peak snapshot; {_LAMBDA_ALL}", ValueRule(0.325, 0.355),
           lambda m: _band(_peak(m), "inside_mean_lambda_all")),
-    Claim("rest_lambda_0.31_all", "mean lambda in the rest at the peak is 0.31 (every grain)", "Sec. 6", 0.31,
+    Claim("rest_lambda_0.31_all", "mean lambda in the rest at the peak is 0.31 (every grain)", "Sec. 6", paper.LAMBDA_OUTSIDE_BAND,
           f"rest mean at the peak snapshot; {_LAMBDA_ALL}", ValueRule(0.295, 0.325),
           lambda m: _band(_peak(m), "outside_mean_lambda_all")),
     Claim("band_mostly_two_contacts", "most grains in the shear band have two contacts at 1.5 % (0- and "

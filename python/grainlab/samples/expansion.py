@@ -53,6 +53,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from grainlab import paper
 from grainlab.analysis.fabric import CoordinationNumber
 from grainlab.samples.grading import PAPER_GRADING, Grading
 from grainlab.samples.placement import random_placement
@@ -69,9 +70,9 @@ __all__ = ["WALL_NAMES", "ExpansionError", "Sample", "expand_to_porosity"]
 WALL_NAMES = ("bottom", "right", "top", "left")
 
 #: Table 1 of the paper.
-_KN = 8.45e7
-_DENSITY = 2.0e8
-_DAMPING = 0.8
+_KN = paper.NORMAL_STIFFNESS_N_PER_M
+_DENSITY = paper.DENSITY_KG_PER_M3
+_DAMPING = paper.LOCAL_DAMPING
 #: Default stress bound of the expansion (mean wall stress in equilibrium), Pa.
 MAX_STRESS_PA = 5.0e6
 
