@@ -1,6 +1,6 @@
 """Speed of the stability index and the fabric measures on large snapshots.
 
-Goal (issue 4): lambda and the fabric measures for 1,000,000 particles with 4
+Goal: lambda and the fabric measures for 1,000,000 particles with 4
 contacts each in under 2 s. The snapshot is a square lattice with jittered
 positions (every particle has exactly 4 contacts, 2 contacts per particle),
 normal forces on every contact; contact normals are computed from the

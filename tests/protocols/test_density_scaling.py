@@ -1,5 +1,5 @@
-"""DESIGN §3: a strain rate whose density scaling factor (paper Eq. 16) exceeds
-1e-3 is warned about before any work."""
+"""A strain rate whose density scaling factor (paper Eq. 16) exceeds 1e-3 is
+warned about before any work (docs/biaxial.md, docs/contact-law.md)."""
 
 from __future__ import annotations
 

@@ -18,7 +18,7 @@ Local deformation gradient (Falk & Langer 1998)
     :math:`D^2_{min,i} = \sum_j |d_{ij} - F_i d^0_{ij}|^2` (m²). Particles with
     fewer than 2 non-collinear neighbours get NaN.
 
-Strain (compression positive, DESIGN.md §2)
+Strain (compression positive, docs/conventions.md)
     small: :math:`\varepsilon = I - \tfrac12(F + F^T)`;
     green: :math:`\varepsilon = -\tfrac12(F^T F - I)`.
     Volumetric strain :math:`\varepsilon_v = \varepsilon_{xx} +

@@ -1,4 +1,4 @@
-"""The flexible lateral boundary of the biaxial test (DESIGN §3, variant A):
+"""The flexible lateral boundary of the biaxial test (docs/boundary.md, variant A):
 a chain of small bonded membrane disks along each side of the sample, ends
 tied to the platens, loaded by the confining pressure as a follower load.
 

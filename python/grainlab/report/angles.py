@@ -1,6 +1,6 @@
 r"""Friction and dilation angles of a biaxial run, and the classical shear-band angles.
 
-Conventions (DESIGN.md §2): stresses and strains compression positive,
+Conventions (docs/conventions.md): stresses and strains compression positive,
 :math:`\sigma_1` the axial (vertical) stress, :math:`\sigma_3` the confining
 (horizontal) one; angles in radians here, degrees only in the report's text.
 A band's inclination is measured from the :math:`\sigma_3` direction (the
