@@ -36,11 +36,14 @@ def test_the_refusal_follows_the_record_interval_and_the_platen_travel():
     assert "2.55e-06 m in one time step" in travel and "1.0% of the smallest radius" in travel
     assert "at most 0.333 1/s" in travel
     # the estimate before any work: a tenth of the one-contact critical step of the smallest particle
-    config = resolve(overrides=["shear.strain_rate=1"])
+    config = resolve(overrides=["shear.strain_rate=0.8"])
     radius = 0.25e-3
-    dt = 0.1 * 0.5 * math.sqrt(2.0e8 * math.pi * radius**2 / (2 * 8.45e7))
-    assert biaxial.strain_rate_problem(1.0, dt, 0.150, radius, 0.0005) is None
+    dt = 0.1 * config["run.time_step_safety"] * math.sqrt(2.0e8 * math.pi * radius**2 / (2 * 8.45e7))
+    assert biaxial.strain_rate_problem(0.8, dt, 0.150, radius, 0.0005) is None
+    assert "at most 0.864 1/s" in biaxial.strain_rate_problem(1.0, dt, 0.150, radius, 0.0005)
     biaxial.check_strain_rate(config)  # passes here; the run's own, longer step refuses it later
+    with pytest.raises(ValueError, match="shear.strain_rate: 1 1/s is too fast"):
+        biaxial.check_strain_rate(resolve(overrides=["shear.strain_rate=1"]))
 
 
 def test_snapshot_strains_with_one_name_are_refused_before_any_work():

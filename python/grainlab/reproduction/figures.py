@@ -87,6 +87,13 @@ def _band_plot(ax: Any, runs: Sequence[Measures], name: str, label: str, color: 
         ax.fill_between(100 * x[ok], low[ok], high[ok], color=color, alpha=0.2, linewidth=0)
 
 
+def _legend(ax: Any) -> None:
+    """A legend of the labelled curves; none when nothing was drawn (a short run
+    without an accepted band has no band curves)."""
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(frameon=False, fontsize=7)
+
+
 def _strain_axis(ax: Any) -> None:
     ax.set_xlabel(r"axial strain $\varepsilon_{11}$ (%)")
     _limits_from_lines(ax)
@@ -149,7 +156,7 @@ def _fabric_figure(runs: Sequence[Measures], title: str) -> Figure:
         axes[2].set_ylabel(r"mean $\lambda$")
         for ax in axes:
             _strain_axis(ax)
-            ax.legend(frameon=False, fontsize=7)
+            _legend(ax)
         fig.suptitle(title + " (from the snapshots; line: mean over seeds, band: 95 % interval)", fontsize=9)
     return fig
 
@@ -180,7 +187,7 @@ def _band_figure(runs: Sequence[Measures], title: str) -> Figure:
         axes[5].set_ylabel("ROC AUC for band membership")
         for ax in axes:
             _strain_axis(ax)
-            ax.legend(frameon=False, fontsize=7)
+            _legend(ax)
         fig.suptitle(title + ": inside and outside the band the detector finds at each snapshot (dotted: the "
                      "paper's 0.34 / 0.31)", fontsize=9)
     return fig
