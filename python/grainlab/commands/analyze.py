@@ -154,6 +154,7 @@ def run(args: argparse.Namespace) -> int:
     columns = parse_columns(args.contact_columns)
     particle_columns = parse_columns(getattr(args, "columns", None), "--columns")
     boundary_types = parse_types(args.boundary_types)
+    ensure_output_folder(args.out)  # a bad --out is refused before the input is read
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", MissingKindWarning)
         snapshot = read_snapshot(
@@ -201,7 +202,6 @@ def run(args: argparse.Namespace) -> int:
                 "frame with --reference-timestep",
                 file=sys.stderr,
             )
-    ensure_output_folder(args.out)
     result = analyze_snapshot(
         snapshot,
         reference,

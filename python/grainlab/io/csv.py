@@ -208,7 +208,7 @@ def read_particles_csv(
 
     >>> import pathlib, tempfile, warnings
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "balls.csv"
-    >>> _ = f.write_text("ID,pos_x,pos_y,rad\n7,0,0,0.001\n8,0.002,0,0.001\n")
+    >>> _ = f.write_text("ID,pos_x,pos_y,rad\\n7,0,0,0.001\\n8,0.002,0,0.001\\n")
     >>> with warnings.catch_warnings():
     ...     warnings.simplefilter("ignore", MissingKindWarning)
     ...     s = read_particles_csv(f, columns={"id": "ID", "x": "pos_x", "y": "pos_y", "radius": "rad"},
