@@ -54,3 +54,38 @@ def test_walls_file_holds_lines_only(tmp_path):
     assert p.GetPoint(3) == (0.0, 0.04, 0.0)
     kinds = poly.GetCellData().GetArray("cell_kind")
     assert [kinds.GetValue(k) for k in range(2)] == [CELL_WALL, CELL_WALL]
+
+
+def test_export_writes_vtu_twins_and_the_walls(tmp_path):
+    meshio = pytest.importorskip("meshio")
+    vtk = pytest.importorskip("vtk")
+    from grainlab.io.hdf5 import ResultsWriter
+    from grainlab.io.walls import WALL_LINE, WALL_SEGMENT, WallGeometry
+    from grainlab.postprocess.vtk import export_vtk
+    from grainlab.snapshot import Snapshot
+
+    snap = Snapshot.from_geometry([[0.005, 0.001], [0.007, 0.001]], [1e-3, 1e-3], tolerance=1e-9, axial_strain=0.0)
+    walls = WallGeometry(
+        ("bottom", "top", "left"), [WALL_SEGMENT, WALL_SEGMENT, WALL_LINE],
+        [[0.0, 0.0], [0.02, 0.002], [0.004, 0.0]], [[0.02, 0.0], [0.0, 0.002], [0.004, 0.0]],
+        [[0.0, 1.0], [0.0, -1.0], [1.0, 0.0]], [True, True, True],
+    )
+    with ResultsWriter(tmp_path / "run.h5", kind="biaxial") as out:
+        out.write_snapshot("strain_0.0000", snap, walls=walls)
+        out.write_snapshot("strain_0.0100", snap.with_contacts(snap.contact_i, snap.contact_j))  # no walls
+    done = export_vtk(tmp_path)
+    assert [f.name for f in done.vtu_files] == ["snapshot_0000.vtu", "snapshot_0001.vtu"]
+    mesh = meshio.read(done.vtu_files[0])
+    np.testing.assert_array_equal(mesh.points[:, :2], snap.positions)
+    assert {b.type: len(b.data) for b in mesh.cells} == {"vertex": 2, "line": 1}
+    assert "stability_index" in mesh.point_data
+    assert [f.name for f in done.wall_files] == ["walls_0000.vtp"] and done.walls_pvd.name == "walls.pvd"
+    r = vtk.vtkXMLPolyDataReader()
+    r.SetFileName(str(done.wall_files[0]))
+    r.Update()
+    poly = r.GetOutput()
+    assert poly.GetNumberOfLines() == 3
+    pts = np.array([poly.GetPoint(k) for k in range(poly.GetNumberOfPoints())])[:, :2]
+    np.testing.assert_array_equal(pts[2:4], [[0.02, 0.002], [0.0, 0.002]])  # the top platen
+    left = pts[4:6]  # the infinite line x = 0.004, clipped: vertical, beyond the particles' extent
+    assert np.allclose(left[:, 0], 0.004) and left[:, 1].min() < 0.0 and left[:, 1].max() > 0.002

@@ -24,7 +24,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from grainlab.analysis import LocalStrain, StabilityIndex, match_ids
 from grainlab.io.hdf5 import read_results
-from grainlab.io.vtk import as_vector3, contact_lines, exportable, write_pvd, write_vtp
+from grainlab.io.vtk import (
+    as_vector3,
+    contact_lines,
+    exportable,
+    write_pvd,
+    write_vtp,
+    write_vtu,
+    write_walls_vtp,
+)
 from grainlab.postprocess.band import band_labels
 
 __all__ = ["VtkExport", "export_vtk", "snapshot_arrays"]
@@ -102,6 +110,11 @@ class VtkExport:
     files: tuple[Path, ...]
     times: tuple[float, ...]
     time_quantity: str  # "axial_strain", "time" or "index"
+    #: The same snapshots as UnstructuredGrid files (``snapshot_0000.vtu``, ...), for meshio.
+    vtu_files: tuple[Path, ...] = ()
+    #: The walls of each snapshot that stores them (``walls_0000.vtp``, ...) and their ``walls.pvd``.
+    wall_files: tuple[Path, ...] = ()
+    walls_pvd: Path | None = None
 
 
 def export_vtk(
@@ -115,7 +128,12 @@ def export_vtk(
     Files go to ``out_dir`` (default ``<run folder>/vtk``) as ``snapshot_0000.vtp``, ...
     (in the run's snapshot order) and ``run.pvd``. Each file's field data holds
     ``axial_strain`` and ``time`` (when the snapshot has them) and the counts
-    of :func:`contact_lines`. Raises ValueError when the run has no snapshots.
+    of :func:`contact_lines`. Beside each ``.vtp`` the same data as an
+    UnstructuredGrid ``snapshot_0000.vtu`` (:func:`grainlab.io.vtk.write_vtu`,
+    for meshio); when ``run.h5`` stores a snapshot's walls, its active walls
+    as lines in ``walls_0000.vtp`` (infinite walls clipped to the particles'
+    extent) and a ``walls.pvd`` collection on the same time axis. Raises
+    ValueError when the run has no snapshots.
     """
     path = Path(run)
     h5 = path / "run.h5" if path.is_dir() else path
@@ -126,8 +144,8 @@ def export_vtk(
         raise ValueError(f"{h5}: the run has no snapshots to export")
     snaps = [results.snapshot(name) for name in names]
     quantity, times = _time_axis(snaps)
-    files = []
-    for k, snap in enumerate(snaps):
+    files, grids, walls_written = [], [], []
+    for k, (name, snap) in enumerate(zip(names, snaps, strict=True)):
         lines, line_data, left_out = contact_lines(snap)
         field_data: dict[str, ArrayLike] = {
             name: [getattr(snap, name)]
@@ -135,16 +153,23 @@ def export_vtk(
             if getattr(snap, name) is not None
         }
         field_data.update({name: [count] for name, count in left_out.items()})
-        files.append(
-            write_vtp(
-                folder / f"snapshot_{k:04d}.vtp",
-                snap.positions,
-                lines=lines,
-                point_data=snapshot_arrays(snap, snaps[0]),
-                line_data=line_data,
-                field_data=field_data,
-                binary=binary,
-            )
+        content: dict[str, Any] = dict(
+            lines=lines,
+            point_data=snapshot_arrays(snap, snaps[0]),
+            line_data=line_data,
+            field_data=field_data,
+            binary=binary,
         )
+        files.append(write_vtp(folder / f"snapshot_{k:04d}.vtp", snap.positions, **content))
+        grids.append(write_vtu(folder / f"snapshot_{k:04d}.vtu", snap.positions, **content))
+        walls = results.walls(name)
+        if walls is not None:
+            r = np.asarray(snap.radii)[:, None]
+            extent = np.array([(snap.positions - r).min(axis=0), (snap.positions + r).max(axis=0)])
+            segments = walls.segments(extent)
+            walls_written.append((times[k], write_walls_vtp(folder / f"walls_{k:04d}.vtp", segments, binary=binary)))
     pvd = write_pvd(folder / "run.pvd", [(t, f.name) for t, f in zip(times, files, strict=True)])
-    return VtkExport(pvd, tuple(files), tuple(times), quantity)
+    walls_pvd = write_pvd(folder / "walls.pvd", [(t, f.name) for t, f in walls_written]) if walls_written else None
+    return VtkExport(
+        pvd, tuple(files), tuple(times), quantity, tuple(grids), tuple(f for _, f in walls_written), walls_pvd
+    )
