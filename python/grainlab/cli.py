@@ -25,6 +25,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "grainlab.commands.reproduce",
     "grainlab.commands.export",
     "grainlab.commands.report",
+    "grainlab.commands.view",
 )
 
 

@@ -22,6 +22,12 @@ def synthetic_run(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="session")
+def synthetic_results(tmp_path_factory) -> Path:
+    """The synthetic folder without a report (run.h5 only, no figures drawn): for what reads run.h5 alone."""
+    return write_synthetic_run(tmp_path_factory.mktemp("report") / "synthetic_results")
+
+
+@pytest.fixture(scope="session")
 def small_study(tmp_path_factory) -> Path:
     """A finished small study (no report yet)."""
     from grainlab.study import run_study

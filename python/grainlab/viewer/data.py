@@ -1,0 +1,146 @@
+"""What the viewer page shows of a run, gathered from its ``run.h5``.
+
+:func:`viewer_data` reads every snapshot of a results file and computes, per
+snapshot, the per-grain values the page colours by (the ones the ParaView
+export writes, :func:`grainlab.postprocess.vtk.snapshot_arrays`): the
+stability index lambda (:class:`~grainlab.analysis.StabilityIndex` with its
+defaults, the run's value), the number of contacts, the displacement and
+the rotation since the first snapshot, the local shear strain since it and
+the shear band labels; the particle–particle contacts with their normal
+forces; the accepted bands' outlines (:func:`grainlab.postprocess.band.find_band`);
+the walls when the file stores them; and the stress–strain curve of the
+time series.
+
+Arrays are quantised for the page: coordinates, radii and values as
+float32 (about 7 significant digits: a grain's lambda shows to 1e-6), codes
+and counts as uint8, contact ends as uint16 or uint32, each base64 encoded.
+"""
+
+from __future__ import annotations
+
+import base64
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.analysis import StabilityIndex, match_ids
+from grainlab.io.hdf5 import read_results
+from grainlab.io.vtk import contact_lines
+from grainlab.postprocess.band import find_band
+from grainlab.postprocess.vtk import snapshot_arrays
+
+__all__ = ["CURVE_COLUMNS", "encode", "viewer_data"]
+
+#: Time series columns drawn as the stress–strain curve (x, y), the first pair the file has.
+CURVE_COLUMNS = (("axial_strain", "stress_ratio"), ("axial_strain", "axial_stress_pa"))
+
+
+def encode(values: NDArray[Any], dtype: str) -> str:
+    """``values`` as base64 of little-endian ``dtype`` (``"f4"``, ``"u1"``, ``"u2"``, ``"u4"``)."""
+    return base64.b64encode(np.ascontiguousarray(values, dtype="<" + dtype).tobytes()).decode("ascii")
+
+
+def _band_outline(band: Any) -> dict[str, Any] | None:
+    if band is None:
+        return None
+    return {
+        "center": [float(v) for v in band.center],
+        "angle_deg": float(band.angle_degrees),
+        "thickness_m": float(band.thickness),
+    }
+
+
+def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str) -> dict[str, Any]:
+    arrays = snapshot_arrays(snap, first)
+    n = snap.n_particles
+    rotation = np.zeros(n)
+    if snap.rotations is not None and first.rotations is not None and snap is not first:
+        to_first = match_ids(first, snap)
+        ok = to_first >= 0
+        rotation = np.full(n, np.nan)
+        rotation[ok] = np.asarray(snap.rotations)[ok] - np.asarray(first.rotations)[to_first[ok]]
+    lines, line_data, _ = contact_lines(snap)
+    force = line_data.get("normal_force", np.full(len(lines), np.nan))
+    outline: dict[str, Any] = {"first": None, "second": None}
+    if snap is not first:
+        try:
+            search = find_band(first, snap, StabilityIndex().compute(snap), name=name)
+            outline = {"first": _band_outline(search.band), "second": _band_outline(search.second)}
+        except ValueError:  # too few grains with a local strain: no band
+            pass
+    disp = arrays["displacement"][:, :2]
+    out = {
+        "name": name,
+        "axial_strain": snap.axial_strain,
+        "time_s": snap.time,
+        "n": n,
+        "n_contacts": int(len(lines)),
+        "band": outline,
+        "walls": None if walls is None else walls.segments(_bounds(snap)).tolist(),
+        "arrays": {
+            "x": encode(snap.positions[:, 0], "f4"),
+            "y": encode(snap.positions[:, 1], "f4"),
+            "r": encode(snap.radii, "f4"),
+            "id": encode(snap.ids, "u4"),
+            "kind": encode(snap.kind, "u1"),
+            "lambda": encode(arrays["stability_index"], "f4"),
+            "contacts": encode(np.minimum(arrays["n_contacts"], 255), "u1"),
+            "dx": encode(disp[:, 0], "f4"),
+            "dy": encode(disp[:, 1], "f4"),
+            "rotation": encode(rotation, "f4"),
+            "strain": encode(arrays["local_shear_strain"], "f4"),
+            "in_band": encode(arrays["in_shear_band"], "u1"),
+            "ci": encode(lines[:, 0], index_dtype),
+            "cj": encode(lines[:, 1], index_dtype),
+            "fn": encode(force, "f4"),
+        },
+    }
+    return out
+
+
+def _bounds(snap: Any) -> NDArray[np.float64]:
+    r = np.asarray(snap.radii)[:, None]
+    return np.array([(snap.positions - r).min(axis=0), (snap.positions + r).max(axis=0)])
+
+
+def _finite(value: Any) -> float | None:
+    return None if value is None or not math.isfinite(float(value)) else float(value)
+
+
+def viewer_data(run: str | Path) -> dict[str, Any]:
+    """Everything the page shows of ``run`` (a run folder or its ``run.h5``), JSON-ready.
+
+    Raises ValueError when the run has no snapshots.
+    """
+    path = Path(run)
+    h5 = path / "run.h5" if path.is_dir() else path
+    results = read_results(h5)
+    names = list(results.snapshot_names)
+    if not names:
+        raise ValueError(f"{h5}: the run has no snapshots to view")
+    snaps = [results.snapshot(name) for name in names]
+    largest = max(s.n_particles for s in snaps)
+    index_dtype = "u2" if largest < 2**16 else "u4"
+    curve = None
+    for x, y in CURVE_COLUMNS:
+        if x in results.timeseries and y in results.timeseries:
+            xs, ys = results.timeseries[x], results.timeseries[y]
+            ok = np.isfinite(xs) & np.isfinite(ys)
+            curve = {"x": x, "y": y, "xs": encode(xs[ok], "f4"), "ys": encode(ys[ok], "f4"), "n": int(ok.sum())}
+            break
+    bounds = np.array([_bounds(s) for s in snaps])
+    return {
+        "title": f"{results.kind} run {h5.parent.name}",
+        "source": str(h5),
+        "index_dtype": index_dtype,
+        "bounds": [bounds[:, 0].min(axis=0).tolist(), bounds[:, 1].max(axis=0).tolist()],
+        "peak_stress_ratio": _finite(results.summary.get("peak_stress_ratio")),
+        "curve": curve,
+        "snapshots": [
+            _snapshot(name, snap, snaps[0], results.walls(name), index_dtype)
+            for name, snap in zip(names, snaps, strict=True)
+        ],
+    }

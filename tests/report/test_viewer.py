@@ -1,0 +1,151 @@
+"""``grainlab view``: the self-contained viewer page, its data, and the page in headless chromium
+(Playwright, as the reports' test_browser.py): offline, the slider and the colour change the
+picture, hovering a grain shows the run's lambda of that grain."""
+
+from __future__ import annotations
+
+import base64
+import json
+import re
+
+import numpy as np
+import pytest
+from report_helpers import chromium_or_skip, parse
+
+from grainlab.analysis import StabilityIndex
+from grainlab.cli import main
+from grainlab.io.hdf5 import read_results
+from grainlab.viewer import open_in_browser, write_viewer
+
+
+def _data(page) -> dict:
+    text = page.read_text(encoding="utf-8")
+    m = re.search(r'<script type="application/json" id="grainlab-data">(.*?)</script>', text, re.S)
+    return json.loads(m.group(1))
+
+
+def _decode(text: str, dtype: str) -> np.ndarray:
+    return np.frombuffer(base64.b64decode(text), dtype="<" + dtype)
+
+
+@pytest.fixture(scope="module")
+def viewer_page(synthetic_results, tmp_path_factory):
+    return write_viewer(synthetic_results, tmp_path_factory.mktemp("viewer") / "viewer.html")
+
+
+def test_the_page_needs_nothing_outside_itself(viewer_page):
+    text = viewer_page.read_text(encoding="utf-8")
+    page = parse(text)
+    for tag, attrs in page.tags:
+        assert "src" not in attrs and "href" not in attrs, (tag, attrs)  # inline script and style only
+    assert "http://" not in text and "https://" not in text and "@import" not in text
+    assert viewer_page.stat().st_size < 200_000  # 3 snapshots of ~450 disks, quantised
+
+
+def test_the_embedded_values_are_the_runs(viewer_page, synthetic_results):
+    data = _data(viewer_page)
+    results = read_results(synthetic_results / "run.h5")
+    assert [s["name"] for s in data["snapshots"]] == results.snapshot_names
+    last = results.snapshot(-1)
+    arrays = data["snapshots"][-1]["arrays"]
+    lam = StabilityIndex().compute(last).stability_index
+    np.testing.assert_array_equal(_decode(arrays["lambda"], "f4"), lam.astype(np.float32))
+    np.testing.assert_array_equal(_decode(arrays["x"], "f4"), last.positions[:, 0].astype(np.float32))
+    assert _decode(arrays["ci"], data["index_dtype"]).size == last.n_contacts  # no wall or periodic ones
+    first = data["snapshots"][0]["arrays"]
+    assert not _decode(first["dx"], "f4").any()  # displacements are since the first snapshot
+    # the synthetic band of simple shear at 60 degrees, found between the first and last snapshots
+    band = data["snapshots"][-1]["band"]["first"]
+    assert band is not None and abs(band["angle_deg"] % 180 - 60.0) < 10.0
+    assert data["curve"]["x"] == "axial_strain" and data["curve"]["y"] == "stress_ratio"
+    assert _decode(data["curve"]["ys"], "f4").max() == pytest.approx(4.0, rel=1e-3)  # the peak ratio
+
+
+def test_view_command(synthetic_results, tmp_path, capsys):
+    out = tmp_path / "page.html"
+    assert main(["view", str(synthetic_results), "--out", str(out), "--no-open"]) == 0
+    assert out.is_file() and "grainlab view:" in capsys.readouterr().out
+    assert main(["view", str(tmp_path), "--no-open"]) == 2  # no run.h5 there
+    assert "no run.h5 there" in capsys.readouterr().err
+
+
+def test_nothing_is_opened_without_a_display(monkeypatch, tmp_path):
+    import grainlab.viewer as viewer
+
+    monkeypatch.setattr(viewer.sys, "platform", "linux")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr(viewer.webbrowser, "open", lambda *a, **k: pytest.fail("a browser was opened"))
+    assert open_in_browser(tmp_path / "viewer.html") is False
+
+
+def _pixels(page) -> str:
+    return page.evaluate("document.getElementById('grains').toDataURL()")
+
+
+def test_the_page_in_chromium(viewer_page, synthetic_results):
+    from playwright.sync_api import sync_playwright
+
+    chromium = chromium_or_skip()
+    results = read_results(synthetic_results / "run.h5")
+    last = results.snapshot(-1)
+    lam = StabilityIndex().compute(last).stability_index
+    grains = np.flatnonzero((last.kind == 0) & (last.contact_counts() >= 3))
+    k = int(grains[np.argmax(lam[grains])])  # a grain with a distinctive lambda
+    problems: list[str] = []
+    requests: list[str] = []
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=chromium, args=["--no-sandbox"])
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 1000})
+            page.on("console", lambda m: problems.append(m.text) if m.type in ("error", "warning") else None)
+            page.on("pageerror", lambda e: problems.append(str(e)))
+            page.on("request", lambda r: requests.append(r.url))
+            page.goto(viewer_page.resolve().as_uri(), wait_until="load")
+            assert page.evaluate("grainlabViewer.snapshotCount") == 3
+            assert page.evaluate("grainlabViewer.current()") == 2  # opens on the last snapshot
+            last_picture = _pixels(page)
+            page.locator("#snapshot").fill("0")  # the slider: the first snapshot
+            assert page.evaluate("grainlabViewer.current()") == 0
+            first_picture = _pixels(page)
+            assert first_picture != last_picture
+            assert "0.00 %" in page.inner_text("#strain-label")
+            page.locator("#snapshot").fill("2")
+            assert _pixels(page) == last_picture  # the same snapshot, the same picture
+            page.select_option("#mode", "strain")
+            assert _pixels(page) != last_picture
+            page.select_option("#mode", "lambda")
+            x, y = page.evaluate(f"grainlabViewer.clientPosition({k})")
+            page.mouse.move(x, y)
+            assert page.is_visible("#tip")
+            shown = page.inner_text("#tip td[data-key='λ']")
+            particle = page.inner_text("#tip td[data-key='particle id']")
+        finally:
+            browser.close()
+    assert problems == []
+    assert all(url.startswith(("file:", "data:")) for url in requests), requests
+    assert int(particle) == int(last.ids[k])
+    assert float(shown) == pytest.approx(lam[k], abs=1e-6)
+
+
+def test_walls_stored_with_a_snapshot_are_drawn(tmp_path):
+    from grainlab.io.hdf5 import ResultsWriter
+    from grainlab.io.walls import WALL_SEGMENT, WallGeometry
+    from grainlab.snapshot import Snapshot
+    from grainlab.viewer.data import viewer_data
+
+    a, b = np.meshgrid(np.arange(10), np.arange(10), indexing="ij")
+    pos = np.c_[a.ravel(), b.ravel()] * 1e-3 + 1e-3
+    snap = Snapshot.from_geometry(pos, np.full(100, 0.5e-3), tolerance=1e-9, axial_strain=0.0)
+    moved = Snapshot.from_geometry(pos * [1.0, 0.99], np.full(100, 0.5e-3), tolerance=1e-9, axial_strain=0.01)
+    platens = WallGeometry(("bottom", "top"), [WALL_SEGMENT, WALL_SEGMENT], [[0.0, 0.0], [0.012, 0.0115]],
+                           [[0.012, 0.0], [0.0, 0.0115]], [[0.0, 1.0], [0.0, -1.0]], [True, True])
+    with ResultsWriter(tmp_path / "run.h5", kind="biaxial") as out:
+        out.append_rows({"axial_strain": [0.0, 0.01], "stress_ratio": [1.0, 2.0]})
+        out.write_snapshot("strain_0.0000", snap, walls=platens)
+        out.write_snapshot("strain_0.0100", moved)
+    data = viewer_data(tmp_path)
+    assert data["snapshots"][0]["walls"] == [[[0.0, 0.0], [0.012, 0.0]], [[0.012, 0.0115], [0.0, 0.0115]]]
+    assert data["snapshots"][1]["walls"] is None
+    dy = _decode(data["snapshots"][1]["arrays"]["dy"], "f4")
+    np.testing.assert_allclose(dy, (pos[:, 1] * -0.01).astype(np.float32), rtol=1e-5, atol=1e-12)
