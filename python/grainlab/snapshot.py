@@ -754,6 +754,11 @@ class Snapshot:
             owner = owner[boundary_end_groups(owner, key) == np.arange(owner.size)]
         return np.bincount(owner, minlength=self.n_particles)
 
+    def _repr_html_(self) -> str:
+        from grainlab._repr import snapshot_html
+
+        return snapshot_html(self)
+
     def __repr__(self) -> str:
         return (
             f"Snapshot(n_particles={self.n_particles}, n_contacts={self.n_contacts}, "

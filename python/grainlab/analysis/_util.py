@@ -30,6 +30,12 @@ class Computable:
     def _store(self, **results: Any) -> None:
         self._results = results
 
+    def _repr_html_(self) -> str:
+        """A small table for notebooks: the repr, the scalar results, the arrays' shapes and means."""
+        from grainlab._repr import measure_html
+
+        return measure_html(self)
+
 
 def contact_ends(
     snapshot: Snapshot, *, include_boundary: bool, boundary: str = "each"

@@ -1083,6 +1083,16 @@ class Results:
         """Snapshot names in the order written."""
         return [s.name for s in self.snapshots]
 
+    def __repr__(self) -> str:
+        from grainlab._repr import results_repr
+
+        return results_repr(self)
+
+    def _repr_html_(self) -> str:
+        from grainlab._repr import results_html
+
+        return results_html(self)
+
     def snapshot(self, name: str | int | None = None) -> Snapshot:
         """Load a snapshot: by name, by position in the order written (``-1`` the last), or the last."""
         info = _select(self.path, self.snapshots, name, None)

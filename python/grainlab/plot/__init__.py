@@ -36,6 +36,8 @@ from numpy.typing import ArrayLike, NDArray
 from PIL import Image
 from scipy.spatial import cKDTree
 
+from grainlab._notebook import new_figure, prepare_notebook
+
 __all__ = [
     "FIGURE_DPI",
     "PAPER_STYLE",
@@ -84,11 +86,14 @@ def paper_style() -> Iterator[None]:
 def new_axes(
     ax: Any = None, *, polar: bool = False, figsize: tuple[float, float] = (3.5, 3.0)
 ) -> Any:
-    """``ax`` itself, or new axes on a new paper-style figure (no pyplot)."""
+    """``ax`` itself, or new axes on a new paper-style figure (no pyplot, except in a
+    Jupyter notebook, where the figure is made through pyplot so that it is shown:
+    :func:`grainlab._notebook.new_figure`)."""
     if ax is not None:
         return ax
+    prepare_notebook()
     with paper_style():
-        fig = Figure(figsize=figsize, layout="constrained")
+        fig = new_figure(figsize=figsize, layout="constrained")
         return fig.add_subplot(projection="polar" if polar else None)
 
 
