@@ -23,7 +23,7 @@ import numpy as np
 import grainlab
 from grainlab._mapping import flatten_keys
 from grainlab.io.hdf5 import Results, read_results
-from grainlab.paper import BIAXIAL_CLAIMS, TABLE1
+from grainlab.paper import BIAXIAL_CLAIMS, STRAIN_RATE_PER_S, TABLE1
 from grainlab.postprocess.band import BandNumbers
 from grainlab.protocols.config import FIELDS, QUICK
 from grainlab.report.angles import (
@@ -378,7 +378,7 @@ def _paper_rows(r: BiaxialReport) -> list[tuple[str, str, str, str]]:
     run["min_radius"] = f"{fmt(1e3 * float(r.diameters.min()) / 2, 3)} mm"
     rate = _num(s.get("strain_rate"))
     run["strain_rate"] = (
-        f"{fmt(rate, 3)} 1/s ({fmt(6000 * rate, 3)} %/min, {fmt(rate / (0.02 / 60), 3)} x the paper's)"
+        f"{fmt(rate, 3)} 1/s ({fmt(6000 * rate, 3)} %/min, {fmt(rate / STRAIN_RATE_PER_S, 3)} x the paper's)"
         if math.isfinite(rate)
         else "n/a"
     )
