@@ -190,3 +190,18 @@ def test_a_checkpoint_from_before_new_keys_resumes_with_their_defaults():
     del old["sample"]["sieve_sizes"], old["sample"]["percent_passing"]
     assert biaxial._saved_config(old) == config.to_dict()
     assert biaxial._saved_config({"sample": {"porosity": 2.0}}) is None  # not a valid configuration
+
+
+@pytest.mark.slow
+def test_every_snapshot_stores_the_platens(quick_run):
+    results = read_results(quick_run / "run.h5")
+    initial_heights = []
+    for info in results.snapshots:
+        walls = results.walls(info.name)
+        active = dict(zip(walls.names, walls.active, strict=True))
+        assert active["bottom"] and active["top"] and sum(walls.active) == 2  # the box's sides are off
+        bottom, top = (list(walls.names).index(n) for n in ("bottom", "top"))
+        height = walls.a[top][1] - walls.a[bottom][1]
+        initial_heights.append(height / (1.0 - info.axial_strain))  # H = H0 (1 - axial strain)
+    assert len(initial_heights) >= 2
+    assert np.allclose(initial_heights, initial_heights[0], rtol=1e-9)

@@ -67,6 +67,7 @@ from grainlab.io.results import (
     write_json_atomic,
     write_text_atomic,
 )
+from grainlab.io.walls import WallGeometry
 from grainlab.protocols.boundary import (
     GrainBoundary,
     Membrane,
@@ -699,6 +700,12 @@ def _start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     }
 
 
+def _walls(sim: Simulation, run: _Run) -> WallGeometry:
+    """The walls now (the platens active, the consolidation box's sides not), named
+    as the run names them, for the snapshot."""
+    return WallGeometry.from_simulation(sim, names={wall_id: name for name, wall_id in run.walls.items()})
+
+
 def _shear(
     sim: Simulation,
     run: _Run,
@@ -715,7 +722,8 @@ def _shear(
     if shear["next"] == 0 and "0" in snap_steps and writer.n_rows == 0:
         record = _measure(sim, run, config)
         writer.append_timeseries(record, units=TIMESERIES_UNITS)
-        writer.write_snapshot(snapshot_name(0.0), _snapshot(sim, run, 0.0), step=sim.step_count)
+        writer.write_snapshot(snapshot_name(0.0), _snapshot(sim, run, 0.0), step=sim.step_count,
+                              walls=_walls(sim, run))
     last_checkpoint = time.perf_counter()
     done_strain = 0.0
     bar = progress_bar(
@@ -733,7 +741,8 @@ def _shear(
         key = str(steps[shear["next"]])
         if key in snap_steps:
             strain = snap_steps[key]
-            writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record["axial_strain"]), step=sim.step_count)
+            writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record["axial_strain"]),
+                                  step=sim.step_count, walls=_walls(sim, run))
         peak = run.peak or {"stress_ratio": -math.inf}
         if record["stress_ratio"] > peak["stress_ratio"]:
             run.peak = {
