@@ -96,10 +96,38 @@ pub fn linear_coulomb(
     reduced_mass: f64,
     shear_spring: &mut f64,
 ) -> ContactForce {
+    linear_coulomb_with::<true>(
+        model,
+        overlap,
+        normal_velocity,
+        tangential_velocity,
+        dt,
+        increment_time,
+        reduced_mass,
+        shear_spring,
+    )
+}
+
+/// [`linear_coulomb`], with the dashpots compiled out when `DASHPOTS` is false:
+/// for a model whose damping ratios are both 0 the two give the same bits (the
+/// dashpot terms are then skipped by [`linear_coulomb`] too), so a kernel that
+/// knows no model has a dashpot calls this one without the tests.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn linear_coulomb_with<const DASHPOTS: bool>(
+    model: &ContactModel,
+    overlap: f64,
+    normal_velocity: f64,
+    tangential_velocity: f64,
+    dt: f64,
+    increment_time: f64,
+    reduced_mass: f64,
+    shear_spring: &mut f64,
+) -> ContactForce {
     let elastic_normal = model.normal_stiffness * overlap;
     let mut normal = elastic_normal;
     let mut viscous_dissipation = 0.0;
-    if model.normal_damping_ratio > 0.0 {
+    if DASHPOTS && model.normal_damping_ratio > 0.0 {
         let c_n = 2.0 * model.normal_damping_ratio * (reduced_mass * model.normal_stiffness).sqrt();
         let damped = (normal - c_n * normal_velocity).max(0.0);
         // the dashpot's force (damped - normal) opposes the normal velocity; the
@@ -115,7 +143,7 @@ pub fn linear_coulomb(
         shear_spring,
     );
     let mut shear = *shear_spring;
-    if !update.sliding && model.shear_damping_ratio > 0.0 {
+    if DASHPOTS && !update.sliding && model.shear_damping_ratio > 0.0 {
         let c_s = 2.0 * model.shear_damping_ratio * (reduced_mass * model.shear_stiffness).sqrt();
         shear -= c_s * tangential_velocity;
         viscous_dissipation += c_s * tangential_velocity * tangential_velocity * dt;

@@ -120,6 +120,15 @@ impl MaterialTable {
         &self.models[index as usize]
     }
 
+    /// The model every pair of groups uses, if they all use one and it has no
+    /// dashpot: the force kernels then keep it in registers and skip the
+    /// dashpot terms (same results, fewer instructions).
+    pub fn single_undamped_model(&self) -> Option<ContactModel> {
+        let first = *self.models.first()?;
+        let undamped = first.normal_damping_ratio == 0.0 && first.shear_damping_ratio == 0.0;
+        (undamped && self.models.iter().all(|m| *m == first)).then_some(first)
+    }
+
     /// Largest normal or shear stiffness of any model involving group `g`.
     pub fn max_stiffness_for_group(&self, g: u8) -> f64 {
         (0..MAX_GROUPS as u8)

@@ -8,9 +8,17 @@
 //! step loop, the other workers wait for phases in a [`Team`], spinning, and
 //! each phase is handed to them with one atomic store. Results of a phase come
 //! back in block order, so every reduction is deterministic.
+//!
+//! On a shared machine a worker may not be running when a phase starts. A
+//! phase therefore never waits for a worker that has not joined it: worker 0
+//! takes every item nobody else took, and waits only for workers that are in
+//! the middle of an item. When the team still loses time (a worker descheduled
+//! in the middle of its items), a [`Pacer`] times the steps with and without
+//! the team and runs them on worker 0 alone while that is faster; which thread
+//! runs what never changes a result.
 use std::cell::UnsafeCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Mutex, OnceLock};
 use std::thread::Thread;
 use std::time::{Duration, Instant};
@@ -25,11 +33,18 @@ const YIELD: Duration = Duration::from_millis(2);
 
 type Job = dyn Fn(usize) + Sync;
 
+/// The gate word's flag: the current phase accepts workers.
+const OPEN: u64 = 1 << 31;
+/// The gate word's low bits: workers inside the current phase.
+const INSIDE: u64 = OPEN - 1;
+
 /// Workers of one `run` call, waiting for phases from worker 0.
 pub struct Team {
     size: usize,
-    epoch: AtomicUsize,
-    pending: AtomicUsize,
+    /// `(phase << 32) | OPEN? | workers inside`: a worker joins a phase by a
+    /// compare-exchange that succeeds only while it is open, so once worker 0
+    /// closed it no worker can start reading its job.
+    gate: CacheLine<AtomicU64>,
     quit: AtomicBool,
     panicked: AtomicBool,
     job: UnsafeCell<Option<*const Job>>,
@@ -37,8 +52,8 @@ pub struct Team {
     workers: Mutex<Vec<Thread>>,
 }
 
-// SAFETY: `job` is written only by worker 0 while no other worker reads it
-// (before publishing a new epoch, after all workers finished the previous one).
+// SAFETY: `job` is written only by worker 0 while the gate is closed and no
+// worker is inside a phase, and read only by workers that joined the open phase.
 unsafe impl Sync for Team {}
 
 impl Team {
@@ -46,8 +61,7 @@ impl Team {
     pub fn new(size: usize) -> Self {
         Team {
             size,
-            epoch: AtomicUsize::new(0),
-            pending: AtomicUsize::new(0),
+            gate: CacheLine(AtomicU64::new(0)),
             quit: AtomicBool::new(false),
             panicked: AtomicBool::new(false),
             job: UnsafeCell::new(None),
@@ -61,19 +75,27 @@ impl Team {
         self.size
     }
 
-    /// Runs `job(k)` on every worker `k` (worker 0 is the caller) and waits for all.
+    /// Runs `job(k)` on worker 0 (the caller) and on every worker `k` that
+    /// joins before worker 0's own `job(0)` returns, and waits for those. The
+    /// job must hand out its work so that `job(0)` returns only once all of it
+    /// is taken ([`map_blocks`] does): a worker that is not running is then
+    /// neither needed nor waited for.
     pub fn run<'a>(&self, job: &'a (dyn Fn(usize) + Sync + 'a)) {
         self.leader.get_or_init(std::thread::current);
         // SAFETY: the lifetime is erased only until this function returns, and it
-        // returns after every worker finished with the job.
+        // returns after every worker that joined finished with the job; no worker
+        // can join after the gate is closed below.
         let erased: *const Job =
             unsafe { std::mem::transmute::<&'a (dyn Fn(usize) + Sync + 'a), &'static Job>(job) };
         unsafe { *self.job.get() = Some(erased) };
-        self.pending.store(self.size - 1, Ordering::Release);
-        self.epoch.fetch_add(1, Ordering::AcqRel);
+        let gate = &self.gate.0;
+        // phases count from 1 (0 is "none served yet" for the workers)
+        let phase = ((gate.load(Ordering::Relaxed) >> 32) % 0xffff_ffff) + 1;
+        gate.store((phase << 32) | OPEN, Ordering::Release);
         self.wake_workers();
         job(0);
-        wait_until(|| self.pending.load(Ordering::Acquire) == 0);
+        gate.fetch_and(!OPEN, Ordering::AcqRel);
+        wait_until(|| gate.load(Ordering::Acquire) & INSIDE == 0);
         if self.panicked.load(Ordering::Acquire) {
             panic!("a grainlab worker thread panicked");
         }
@@ -85,23 +107,32 @@ impl Team {
             .lock()
             .expect("worker list")
             .push(std::thread::current());
-        let mut seen = 0usize;
+        let gate = &self.gate.0;
+        let mut served = 0u64;
         loop {
-            let mut next = seen;
+            let mut word = 0;
             wait_until(|| {
-                next = self.epoch.load(Ordering::Acquire);
-                next != seen || self.quit.load(Ordering::Acquire)
+                word = gate.load(Ordering::Acquire);
+                (word & OPEN != 0 && word >> 32 != served) || self.quit.load(Ordering::Acquire)
             });
-            if next == seen {
+            if word & OPEN == 0 || word >> 32 == served {
                 return; // dismissed
             }
-            seen = next;
-            // SAFETY: published before the epoch we just observed (Acquire).
-            let job = unsafe { (*self.job.get()).expect("a job with the epoch") };
+            if gate
+                .compare_exchange(word, word + 1, Ordering::AcqRel, Ordering::Acquire)
+                .is_err()
+            {
+                continue; // closed meanwhile, or another worker joined first: look again
+            }
+            served = word >> 32;
+            // SAFETY: published before the phase was opened, and the phase cannot
+            // end while this worker is inside it.
+            let job = unsafe { (*self.job.get()).expect("a job with the phase") };
             if catch_unwind(AssertUnwindSafe(|| unsafe { (*job)(index) })).is_err() {
                 self.panicked.store(true, Ordering::Release);
             }
-            if self.pending.fetch_sub(1, Ordering::AcqRel) == 1 {
+            let before = gate.fetch_sub(1, Ordering::AcqRel);
+            if before & INSIDE == 1 && before & OPEN == 0 {
                 if let Some(leader) = self.leader.get() {
                     leader.unpark();
                 }
@@ -144,6 +175,110 @@ fn wait_until(mut ready: impl FnMut() -> bool) {
             std::thread::yield_now();
         } else {
             std::thread::park_timeout(Duration::from_micros(200));
+        }
+    }
+}
+
+/// Steps timed per window of the [`Pacer`].
+const PACER_WINDOW: u32 = 32;
+/// Windows between two tries of the mode not in use, at first and at most.
+const PACER_FIRST_TRY: u32 = 4;
+const PACER_LAST_TRY: u32 = 256;
+
+/// Decides, window by window, whether the steps run with the team or on
+/// worker 0 alone: whichever took less time per step when last timed. The mode
+/// in use is timed every window; the other one is tried for a window now and
+/// then, less often each time the try confirms the choice, so that a team
+/// that helps costs almost nothing to keep and a busy core is noticed within
+/// a window. Windows with a neighbour rebuild are not counted (a rebuild costs
+/// as much as many steps). Results do not depend on the mode.
+#[derive(Debug, Clone)]
+pub struct Pacer {
+    alone: bool,
+    trying: bool,
+    /// Latest seconds per step with the team (`[0]`) and alone (`[1]`).
+    per_step: [Option<f64>; 2],
+    steps: u32,
+    clean: bool,
+    start: Option<Instant>,
+    windows: u32,
+    try_every: u32,
+}
+
+impl Default for Pacer {
+    fn default() -> Self {
+        Pacer {
+            alone: false,
+            trying: false,
+            per_step: [None, None],
+            steps: 0,
+            clean: true,
+            start: None,
+            windows: 0,
+            try_every: PACER_FIRST_TRY,
+        }
+    }
+}
+
+impl Pacer {
+    /// Whether the next step runs on worker 0 alone.
+    pub fn alone(&self) -> bool {
+        self.alone
+    }
+
+    /// Starts timing (at the start of a `run` call: time between calls is not
+    /// the steps').
+    pub fn start(&mut self) {
+        self.steps = 0;
+        self.clean = true;
+        self.start = Some(Instant::now());
+    }
+
+    /// Counts a step (`rebuilt`: it rebuilt the neighbour lists) and, at the
+    /// end of a window, chooses the mode of the next one.
+    pub fn step_done(&mut self, rebuilt: bool) {
+        self.clean &= !rebuilt;
+        self.steps += 1;
+        if self.steps < PACER_WINDOW {
+            return;
+        }
+        let now = Instant::now();
+        let mode = self.alone as usize;
+        if let (true, Some(start)) = (self.clean, self.start) {
+            let t = (now - start).as_secs_f64() / self.steps as f64;
+            self.choose(mode, t);
+        }
+        self.steps = 0;
+        self.clean = true;
+        self.start = Some(now);
+    }
+
+    /// Takes `t` seconds per step in `mode` (0 team, 1 alone) and sets the next mode.
+    fn choose(&mut self, mode: usize, t: f64) {
+        self.per_step[mode] = Some(t);
+        let other = 1 - mode;
+        let better_other = self.per_step[other].is_some_and(|o| o < t);
+        if self.trying {
+            // the window just timed tried `mode`
+            self.trying = false;
+            if better_other {
+                self.alone = other == 1;
+                self.try_every = (2 * self.try_every).min(PACER_LAST_TRY);
+            } else {
+                self.try_every = PACER_FIRST_TRY;
+            }
+            self.windows = 0;
+        } else if better_other {
+            self.alone = other == 1;
+            self.try_every = PACER_FIRST_TRY;
+            self.windows = 0;
+        } else {
+            self.windows += 1;
+            if self.windows >= self.try_every {
+                self.trying = true;
+                self.alone = other == 1;
+                self.windows = 0;
+            }
         }
     }
 }
@@ -319,6 +454,16 @@ impl<T> DisjointWriter<T> {
     #[allow(clippy::mut_from_ref)]
     pub unsafe fn get(&self, k: usize) -> &mut T {
         &mut *self.0.add(k)
+    }
+
+    /// Mutable access to elements `lo..hi`.
+    ///
+    /// # Safety
+    /// As [`DisjointWriter::get`], for every element of the range.
+    #[inline(always)]
+    #[allow(clippy::mut_from_ref)]
+    pub unsafe fn range(&self, lo: usize, hi: usize) -> &mut [T] {
+        std::slice::from_raw_parts_mut(self.0.add(lo), hi - lo)
     }
 }
 

@@ -28,11 +28,11 @@ use crate::error::{require_non_negative, require_positive, EngineError, Result};
 use crate::integrate::{
     integrate_chunk, IntegrationInputs, IntegrationStep, IntegrationTally, MotionChunk,
 };
-use crate::law::{elastic_energy, linear_coulomb, ContactForce};
+use crate::law::{elastic_energy, linear_coulomb, linear_coulomb_with, ContactForce};
 use crate::material::{ContactModel, MaterialTable};
 use crate::neighbor::NeighborList;
 use crate::parallel::{
-    even_bounds, map_blocks, split_ranges, DisjointWriter, Team, PARALLEL_MIN_PARTICLES,
+    even_bounds, map_blocks, split_ranges, DisjointWriter, Pacer, Team, PARALLEL_MIN_PARTICLES,
 };
 use crate::state::Particles;
 use crate::vec2::{add, dot, mat_vec, norm, perp, scale, sub, Mat2, Vec2};
@@ -143,6 +143,9 @@ pub struct Simulation {
     /// Whether any particle has an external force or torque (scanned once per run call).
     #[serde(skip)]
     external_loads: bool,
+    /// Whether the steps run with the team or on one thread (timed, `parallel::Pacer`).
+    #[serde(skip)]
+    pacer: Pacer,
 }
 
 impl Simulation {
@@ -188,6 +191,7 @@ impl Simulation {
             cross_forces: Vec::new(),
             boundary_load: Vec::new(),
             external_loads: false,
+            pacer: Pacer::default(),
         };
         sim.make_pool()?;
         Ok(sim)
@@ -811,12 +815,17 @@ impl Simulation {
         self.external_loads = p.external_force.iter().any(|f| *f != [0.0, 0.0])
             || p.external_torque.iter().any(|&t| t != 0.0);
         let steps = |sim: &mut Simulation, team: Option<&Team>| -> Result<()> {
+            sim.pacer.start();
             for k in 0..n {
+                // with a team, the pacer may run a step on this thread alone
+                let team = team.filter(|_| !sim.pacer.alone());
+                let builds = sim.neighbors.build_count;
                 if measure_last && k + 1 == n {
                     sim.step::<true>(team)?;
                 } else {
                     sim.step::<false>(team)?;
                 }
+                sim.pacer.step_done(sim.neighbors.build_count != builds);
             }
             Ok(())
         };
@@ -989,6 +998,9 @@ impl Simulation {
             external_torque: &p.external_torque,
             mass: &p.mass,
             gravity: self.params.gravity,
+            no_loads: self.chains.is_empty()
+                && !self.external_loads
+                && self.params.gravity == [0.0, 0.0],
         };
         let blocks: Vec<BlockWork<'_>> = shear_parts
             .into_iter()
@@ -1019,9 +1031,7 @@ impl Simulation {
             // write their own slots of the buffer.
             unsafe {
                 let (lo, hi) = block_ranges[b];
-                for q in lo..hi {
-                    reset.apply(q, &force, &torque);
-                }
+                reset.apply(lo, hi, &force, &torque);
                 let mut tally =
                     kernel.run::<MEASURE, _>(ranges[b].0, work.shear, work.sliding, &mut direct);
                 if buffer_cross {
@@ -1756,21 +1766,42 @@ struct ResetKernel<'a> {
     external_torque: &'a [f64],
     mass: &'a [f64],
     gravity: Vec2,
+    /// No pressure chain, gravity or external force or torque: every external
+    /// force is +-0, so `f_e + m g` is +0 whatever its sign, and the torques
+    /// (+-0) are copied as they are.
+    no_loads: bool,
 }
 
 impl ResetKernel<'_> {
+    /// Resets the resultants of particles `lo..hi` to their external loads.
+    ///
     /// # Safety
-    /// `q` in bounds and owned by the calling task.
+    /// `lo..hi` in bounds and owned by the calling task.
     #[inline(always)]
-    unsafe fn apply(&self, q: usize, force: &DisjointWriter<Vec2>, torque: &DisjointWriter<f64>) {
-        let fe = self.external_force[q];
-        let m = self.mass[q];
-        let mut f = [fe[0] + m * self.gravity[0], fe[1] + m * self.gravity[1]];
-        if let Some(load) = self.boundary_load {
-            f = add(f, load[q]);
+    unsafe fn apply(
+        &self,
+        lo: usize,
+        hi: usize,
+        force: &DisjointWriter<Vec2>,
+        torque: &DisjointWriter<f64>,
+    ) {
+        if self.no_loads {
+            force.range(lo, hi).fill([0.0; 2]);
+            torque
+                .range(lo, hi)
+                .copy_from_slice(&self.external_torque[lo..hi]);
+            return;
         }
-        *force.get(q) = f;
-        *torque.get(q) = self.external_torque[q];
+        for q in lo..hi {
+            let fe = self.external_force[q];
+            let m = self.mass[q];
+            let mut f = [fe[0] + m * self.gravity[0], fe[1] + m * self.gravity[1]];
+            if let Some(load) = self.boundary_load {
+                f = add(f, load[q]);
+            }
+            *force.get(q) = f;
+            *torque.get(q) = self.external_torque[q];
+        }
     }
 }
 
@@ -1798,6 +1829,7 @@ macro_rules! pair_kernel {
             dt: $sim.params.time_step,
             increment_time: $increment_time,
             max_overlap_ratio: $sim.params.max_overlap_ratio,
+            single_model: $sim.materials.single_undamped_model(),
         }
     };
 }
@@ -1819,6 +1851,8 @@ pub(crate) struct PairKernel<'a> {
     dt: f64,
     increment_time: f64,
     max_overlap_ratio: f64,
+    /// The one model of every pair when there is one and it has no dashpot.
+    single_model: Option<ContactModel>,
 }
 
 impl PairKernel<'_> {
@@ -1834,7 +1868,44 @@ impl PairKernel<'_> {
         sliding: &mut [bool],
         sink: &mut S,
     ) -> ContactTally {
+        // the loop specialised on what is fixed for the whole call: the same
+        // arithmetic in every variant, minus the tests whose outcome is known
+        match (
+            self.velocity_gradient.is_some(),
+            self.single_model.is_some(),
+        ) {
+            (false, false) => self.pairs::<MEASURE, false, false, S>(first, shear, sliding, sink),
+            (false, true) => self.pairs::<MEASURE, false, true, S>(first, shear, sliding, sink),
+            (true, false) => self.pairs::<MEASURE, true, false, S>(first, shear, sliding, sink),
+            (true, true) => self.pairs::<MEASURE, true, true, S>(first, shear, sliding, sink),
+        }
+    }
+
+    /// The loop of [`PairKernel::run`]: `DEFORMING` when the cell has a velocity
+    /// gradient, `SINGLE` when [`PairKernel::single_model`] is set.
+    ///
+    /// # Safety
+    /// As [`PairKernel::run`].
+    #[inline(always)]
+    unsafe fn pairs<
+        const MEASURE: bool,
+        const DEFORMING: bool,
+        const SINGLE: bool,
+        S: ForceSink,
+    >(
+        &self,
+        first: usize,
+        shear: &mut [f64],
+        sliding: &mut [bool],
+        sink: &mut S,
+    ) -> ContactTally {
         let mut tally = ContactTally::default();
+        let gradient = self.velocity_gradient.unwrap_or([[0.0; 2]; 2]);
+        let single = self
+            .single_model
+            .unwrap_or(ContactModel::linear(1.0, 1.0, 0.0));
+        let max_overlap_ratio = self.max_overlap_ratio;
+        let mut overlap_violation = false;
         debug_assert!(first + shear.len() <= self.pair_i.len());
         for (k, (spring, slide)) in shear.iter_mut().zip(sliding.iter_mut()).enumerate() {
             let pair = first + k;
@@ -1872,31 +1943,50 @@ impl PairKernel<'_> {
                 *self.velocity.get_unchecked(j),
                 *self.velocity.get_unchecked(i),
             );
-            if let Some(l) = &self.velocity_gradient {
-                dv = add(dv, mat_vec(l, d));
+            if DEFORMING {
+                dv = add(dv, mat_vec(&gradient, d));
             }
             let vn = dot(dv, n);
             let vt = dot(dv, t)
                 - (*self.angular_velocity.get_unchecked(i) * ri
                     + *self.angular_velocity.get_unchecked(j) * rj);
-            let model = self.materials.by_index(*self.model.get_unchecked(pair));
-            let reduced_mass =
-                if model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0 {
-                    let (mi, mj) = (self.mass[i], self.mass[j]);
-                    mi * mj / (mi + mj)
-                } else {
-                    0.0
-                };
-            let c = linear_coulomb(
-                model,
-                overlap,
-                vn,
-                vt,
-                self.dt,
-                self.increment_time,
-                reduced_mass,
-                spring,
-            );
+            let model = if SINGLE {
+                &single
+            } else {
+                self.materials.by_index(*self.model.get_unchecked(pair))
+            };
+            let reduced_mass = if !SINGLE
+                && (model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0)
+            {
+                let (mi, mj) = (self.mass[i], self.mass[j]);
+                mi * mj / (mi + mj)
+            } else {
+                0.0
+            };
+            let (dt, increment_time) = (self.dt, self.increment_time);
+            let c = if SINGLE {
+                linear_coulomb_with::<false>(
+                    model,
+                    overlap,
+                    vn,
+                    vt,
+                    dt,
+                    increment_time,
+                    reduced_mass,
+                    spring,
+                )
+            } else {
+                linear_coulomb(
+                    model,
+                    overlap,
+                    vn,
+                    vt,
+                    dt,
+                    increment_time,
+                    reduced_mass,
+                    spring,
+                )
+            };
             *slide = c.sliding;
             sink.record(k, overlap, n, &c, *spring);
             let f = [
@@ -1906,15 +1996,14 @@ impl PairKernel<'_> {
             sink.add(k, i, j, f, -ri * c.shear, -rj * c.shear);
             tally.friction += c.friction_dissipation;
             tally.viscous += c.viscous_dissipation;
-            if overlap > self.max_overlap_ratio * ri.min(rj) {
-                tally.overlap_violation = true;
-            }
+            overlap_violation |= overlap > max_overlap_ratio * ri.min(rj);
             if MEASURE {
                 tally.elastic += elastic_energy(model, model.normal_stiffness * overlap, *spring);
                 tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
                 tally.contacts += 1;
             }
         }
+        tally.overlap_violation = overlap_violation;
         tally
     }
 }

@@ -36,7 +36,7 @@ impl Hash {
 /// The hash of everything the trajectory consists of (see the module doc).
 fn trajectory_hash(sim: &Simulation) -> u64 {
     let mut h = Hash::new();
-    let p = (&sim.particles);
+    let p = &sim.particles;
     for x in sim.to_external(&p.position) {
         h.f64(x[0]);
         h.f64(x[1]);
@@ -52,7 +52,7 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
         h.f64(w);
     }
     let ext = |k: u32| sim.external_index(k as usize) as u64;
-    let pairs = &(&sim.neighbors).pairs;
+    let pairs = &sim.neighbors.pairs;
     let mut springs: Vec<(u64, u64, i8, i8, u64)> = (0..pairs.len())
         .filter(|&k| pairs.shear[k] != 0.0)
         .map(|k| {
@@ -76,7 +76,7 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
         h.word(s1 as u64);
         h.word(bits);
     }
-    let wp = &(&sim.neighbors).wall_pairs;
+    let wp = &sim.neighbors.wall_pairs;
     let mut wall_springs: Vec<(u32, u64, u64)> = (0..wp.wall.len())
         .filter(|&k| wp.shear[k] != 0.0)
         .map(|k| (wp.wall[k], ext(wp.particle[k]), wp.shear[k].to_bits()))
@@ -88,7 +88,7 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
         h.word(q);
         h.word(bits);
     }
-    for b in &(&sim.bonds).list {
+    for b in &sim.bonds.list {
         h.word(ext(b.i));
         h.word(ext(b.j));
         h.f64(b.shear);
@@ -116,7 +116,7 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
         h.f64(x);
     }
     h.word(sim.step_count);
-    h.word((&sim.neighbors).build_count);
+    h.word(sim.neighbors.build_count);
     h.0
 }
 
@@ -138,7 +138,7 @@ fn check(
             sim.run(n).unwrap();
             done += n;
         }
-        assert!((&sim.neighbors).build_count > 1, "{name}: no rebuild");
+        assert!(sim.neighbors.build_count > 1, "{name}: no rebuild");
         let got = trajectory_hash(&sim);
         assert!(
             got == expected,
@@ -241,7 +241,7 @@ fn sliding_layers(threads: usize) -> Simulation {
     )
     .unwrap();
     sim.add_wall(floor);
-    let n = (&sim.particles).len();
+    let n = sim.particles.len();
     sim.change_velocities(|v, w| {
         for k in 0..n {
             v[k] = [rng.uniform(-0.01, 0.04), rng.uniform(-0.005, 0.005)];
