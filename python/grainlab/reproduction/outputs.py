@@ -191,12 +191,14 @@ def rate_family(plan: ReproductionPlan) -> list[tuple[float, Variant]]:
 
 
 def _band_difference(m: dict[str, Any] | None) -> float:
+    """Band minus rest mean lambda (grains with >= 2 contacts) at the peak snapshot,
+    the band's grains as the claims take them (:func:`~grainlab.reproduction.claims._band`)."""
+    from grainlab.reproduction.claims import _band
+
     if m is None:
         return math.nan
     row = m["snapshots"][m["peak_snapshot"]]
-    if not row.get("band_found"):
-        return math.nan
-    return float(row.get("inside_mean_lambda") or math.nan) - float(row.get("outside_mean_lambda") or math.nan)
+    return _band(row, "inside_mean_lambda") - _band(row, "outside_mean_lambda")
 
 
 _RATE_QUANTITIES = {
