@@ -140,11 +140,12 @@ def test_default_strain_rate_keeps_inertial_number_at_the_bound():
     rate = biaxial.default_strain_rate(config, max_diameter=3e-3, min_radius=0.25e-3)
     # heaviest grain, effective mass m / (1 - alpha) under local damping alpha = 0.8
     inertial = rate * 3e-3 * np.sqrt(2e8 / (0.2 * 1e5))
-    assert inertial == pytest.approx(1e-3)
-    assert biaxial.inertial_number(config, rate, 3e-3) == pytest.approx(1e-3)
+    assert inertial == pytest.approx(1e-4)
+    assert biaxial.inertial_number(config, rate, 3e-3) == pytest.approx(1e-4)
     eq16 = rate * 0.25e-3 * np.sqrt(2e8 / 1e5)
-    assert eq16 <= 1e-3
-    assert rate == pytest.approx(3.33e-3, rel=0.01)
+    assert eq16 <= 1e-4
+    # with Table 1 the auto rate is the rate study's fastest converged one, the paper's 2 %/min
+    assert rate == pytest.approx(0.02 / 60.0, rel=1e-12)
 
 
 @pytest.mark.slow

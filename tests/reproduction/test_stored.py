@@ -21,3 +21,14 @@ def test_an_unknown_campaign_is_refused():
     with pytest.raises(ValueError, match="name: expected one of main, rates, rate1"):
         stored_claims("nope")
     assert set(CAMPAIGNS) == {"main", "rates", "rate1"}
+
+
+def test_the_shipped_campaign_judges_every_biaxial_claim():
+    from grainlab.reproduction.claims import BIAXIAL_CLAIMS
+
+    verdicts = paper_scale_verdicts()
+    assert {c.id for c in BIAXIAL_CLAIMS} <= set(verdicts)
+    assert all(v["seeds"] == 5 for v in verdicts.values())
+    assert verdicts["band_lambda_above_rest"]["verdict"] in ("reproduced", "not reproduced", "inconclusive")
+    rates = stored_claims("rate1")
+    assert {e["rate"] for e in rates["rate_convergence"]} == {"2%/min", "4%/min", "8%/min"}

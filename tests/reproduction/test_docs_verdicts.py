@@ -1,0 +1,37 @@
+"""The paper-scale verdicts quoted in docs/reproduction.md are the stored campaign's:
+every generated block equals claims_markdown of the claims.json it names."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from grainlab.reproduction.markdown import (
+    claims_markdown,
+    generated_blocks,
+    update_generated_blocks,
+)
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_generated_blocks_match_their_stored_claims():
+    blocks = generated_blocks((ROOT / "docs" / "reproduction.md").read_text(encoding="utf-8"))
+    assert len(blocks) >= 3  # the main ensemble, the rates, the slowest rate
+    for path, level, body in blocks:
+        document = json.loads((ROOT / path).read_text(encoding="utf-8"))
+        assert body == claims_markdown(document, level), f"{path}: rerun python -m grainlab.reproduction.markdown"
+
+
+def test_a_stale_block_is_rewritten(tmp_path):
+    doc = {"variant": "paper", "seeds": [1, 2], "grainlab_version": "x", "verdict_counts": {"reproduced": 1},
+           "claims": [{"id": "c", "paper_value": 1.0, "mean": 1.0, "ci95": [0.9, 1.1], "n": 2,
+                       "verdict": "reproduced"}]}
+    (tmp_path / "c.json").write_text(json.dumps(doc))
+    page = tmp_path / "page.md"
+    page.write_text("intro\n<!-- generated from c.json by claims_markdown(level=3) -->\nold\n"
+                    "<!-- end of generated block -->\noutro\n")
+    assert update_generated_blocks(page, tmp_path) == 1
+    text = page.read_text()
+    assert text.startswith("intro\n") and text.endswith("outro\n") and "old" not in text
+    assert "### Claims: paper" in text and "| `c` | 1 | 1 | [0.9, 1.1] | 2 | reproduced |" in text
