@@ -209,6 +209,13 @@ _RATE_QUANTITIES = {
 }
 
 
+def _tolerance(reference: np.ndarray) -> float:
+    """max(3 % of the reference's seed mean, its seed standard deviation): how far a
+    mean may differ from it and still count as the same."""
+    scatter = float(np.std(reference, ddof=1)) if reference.size > 1 else 0.0
+    return max(RATE_TOLERANCE * abs(float(reference.mean())), scatter)
+
+
 def rate_convergence(family: Sequence[tuple[float, list[dict[str, Any] | None]]]) -> list[dict[str, Any]]:
     """For each rate r with a run at r/2: is each quantity's seed mean at r within
     max(3 % of its value at r/2, the seed standard deviation at r/2) of the mean at r/2?
@@ -231,8 +238,7 @@ def rate_convergence(family: Sequence[tuple[float, list[dict[str, Any] | None]]]
             if a.size == 0 or b.size == 0:
                 quantities[name] = {"at_rate": None, "at_half_rate": None, "tolerance": None, "within": None}
                 continue
-            scatter = float(np.std(b, ddof=1)) if b.size > 1 else 0.0
-            tolerance = max(RATE_TOLERANCE * abs(float(b.mean())), scatter)
+            tolerance = _tolerance(b)
             quantities[name] = {
                 "at_rate": float(a.mean()), "at_half_rate": float(b.mean()),
                 "difference": float(a.mean() - b.mean()), "tolerance": tolerance,
@@ -306,8 +312,7 @@ def variant_comparison(measures: Sequence[dict[str, Any] | None], reference: Seq
                                 "n": 0, "tolerance": None, "within": None}
             continue
         d = a[both] - b[both]
-        scatter = float(np.std(b[both], ddof=1)) if both.sum() > 1 else 0.0
-        tolerance = max(RATE_TOLERANCE * abs(float(b[both].mean())), scatter)
+        tolerance = _tolerance(b[both])
         low, high = t_interval(d) if d.size > 1 else (math.nan, math.nan)
         quantities[name] = {
             "mean": float(a[both].mean()), "reference_mean": float(b[both].mean()),
