@@ -129,10 +129,16 @@ def install_membrane(
     sim.set_contact_model(1, MEMBRANE_GROUP, ContactModel(grain_model.normal_stiffness, grain_model.shear_stiffness, 0.0))
     # The chain holds together by its bonds and wrinkles as the sample shortens, as
     # a latex membrane does; its disks from third neighbours on touch one another
-    # (frictionless, at the bond stiffness), so that a fold cannot pass through the
-    # chain. A chain that crossed itself would enclose a lobe whose follower load
-    # points outward and inflates it without bound.
-    sim.set_contact_model(MEMBRANE_GROUP, MEMBRANE_GROUP, ContactModel(bond_stiffness, bond_stiffness, 0.0))
+    # (frictionless, at the grains' normal stiffness), so that a fold cannot pass
+    # through the chain. A chain that crossed itself would enclose a lobe whose
+    # follower load points outward and inflates it without bound; at the (hundred
+    # times softer) bond stiffness the confining pressure closes a fold to half a
+    # radius and the overlap guard stops the run.
+    sim.set_contact_model(
+        MEMBRANE_GROUP,
+        MEMBRANE_GROUP,
+        ContactModel(grain_model.normal_stiffness, grain_model.shear_stiffness, 0.0),
+    )
     fixity = sim.fixity.copy()
     ends = [left_ids[0], left_ids[-1], right_ids[0], right_ids[-1]]
     fixity[ends] |= FIX_Y

@@ -182,6 +182,9 @@ SCHEDULER_TIMEOUT_S = 10.0
 
 
 def default_workers() -> int:
+    """The cores this process may run on (``taskset`` and cgroup affinity count)."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(len(os.sched_getaffinity(0)), 1)
     return os.cpu_count() or 1
 
 
