@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from grainlab.simulation import FIX_Y, ContactModel, Simulation, Wall
 
@@ -244,16 +245,100 @@ def outer_grains(
     return [int(g) for g in chosen[np.sort(keep)]]
 
 
+#: Two grains whose surfaces are closer than this many mean grain diameters are
+#: neighbours along the boundary of variant B (a contact that opens for a moment
+#: does not break the chain).
+CONTOUR_GAP_DIAMETERS = 0.1
+
+
+def _neighbour_lists(
+    positions: NDArray[np.float64], radii: NDArray[np.float64], gap: float
+) -> list[NDArray[np.int64]]:
+    """For each disk, the disks whose surfaces are within ``gap`` of its own."""
+    tree = cKDTree(positions)
+    pairs = tree.query_pairs(2.0 * float(radii.max()) + gap, output_type="ndarray")
+    if len(pairs):
+        i, j = pairs[:, 0], pairs[:, 1]
+        distance = np.linalg.norm(positions[i] - positions[j], axis=1)
+        pairs = pairs[distance - radii[i] - radii[j] < gap]
+    both = np.concatenate([pairs, pairs[:, ::-1]]) if len(pairs) else np.empty((0, 2), np.int64)
+    order = np.argsort(both[:, 0], kind="stable")
+    starts = np.searchsorted(both[order, 0], np.arange(len(positions) + 1))
+    partners = both[order, 1]
+    return [partners[starts[k] : starts[k + 1]] for k in range(len(positions))]
+
+
+def outer_contour(
+    positions: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    grains: NDArray[np.int64],
+    y0: float,
+    y1: float,
+    side: str,
+    gap: float,
+) -> list[int]:
+    """The grains along one side of the sample's outer contour, each touching the
+    next (surfaces within ``gap``): the paper's "particles at the edges of the
+    sample which formed continuous boundaries".
+
+    The walk starts at the outermost grain touching the platen it starts from
+    (the bottom one on the ``"left"``, walked upwards; the top one on the
+    ``"right"``, walked downwards: the sample on the right, as the engine's
+    pressure chains expect) and at each grain goes on to the neighbour that comes
+    first turning clockwise from the way it came, which keeps the outside on its
+    left, until it reaches a grain touching the other platen. A grain reached
+    again cuts off the loop walked since (a grain hanging off the contour by one
+    contact is not part of it). Raises ``ValueError`` when the contact network
+    has no such path."""
+    x = positions[grains]
+    r = radii[grains]
+    neighbours = _neighbour_lists(x, r, gap)
+    connected = np.array([len(n) > 0 for n in neighbours])
+    if side == "left":
+        near_start, near_end, outward, back = x[:, 1] - r < y0 + gap, x[:, 1] + r > y1 - gap, -(x[:, 0] - r), (0.0, -1.0)
+    elif side == "right":
+        near_start, near_end, outward, back = x[:, 1] + r > y1 - gap, x[:, 1] - r < y0 + gap, x[:, 0] + r, (0.0, 1.0)
+    else:
+        raise ValueError(f"side: expected 'left' or 'right', got {side!r}")
+    candidates = np.flatnonzero(near_start & connected)
+    if len(candidates) == 0:
+        raise ValueError(f"{side} contour: no grain touches the platen it starts from")
+    current = int(candidates[np.argmax(outward[candidates])])
+    heading_back = float(np.arctan2(back[1], back[0]))
+    chain = [current]
+    place = {current: 0}
+    for _ in range(4 * len(grains)):
+        if near_end[current]:
+            return [int(grains[k]) for k in chain]
+        partners = neighbours[current]
+        d = x[partners] - x[current]
+        turn = np.mod(heading_back - np.arctan2(d[:, 1], d[:, 0]), 2.0 * np.pi)
+        turn[turn < 1e-12] = 2.0 * np.pi  # straight back only from a dead end
+        following = int(partners[np.argmin(turn)])
+        heading_back = float(np.arctan2(-d[np.argmin(turn), 1], -d[np.argmin(turn), 0]))
+        if following in place:
+            for k in chain[place[following] + 1 :]:
+                del place[k]
+            del chain[place[following] + 1 :]
+        else:
+            place[following] = len(chain)
+            chain.append(following)
+        current = following
+    raise ValueError(f"{side} contour: the walk did not reach the other platen")
+
+
 @dataclass(frozen=True)
 class GrainBoundary:
-    """Variant B: the confining pressure acts on the sample's outermost grains,
-    re-identified as the boundary changes (Kuhn 1995; Cheung & O'Sullivan 2008)."""
+    """Variant B: the confining pressure acts on the grains of the sample's outer
+    contour, each touching the next, re-identified as the boundary changes (Kuhn
+    1995; Cheung & O'Sullivan 2008)."""
 
     chains: tuple[int, int]
     bottom_wall: int
     top_wall: int
     n_grains: int
     bin_height: float
+    """The mean grain diameter, m: the scale of the contour's contact gap."""
     pressure: float
     left: list[int]
     right: list[int]
@@ -279,13 +364,23 @@ class GrainBoundary:
         )
 
     def identify(self, sim: Simulation) -> GrainBoundary:
-        """Re-identifies the outermost grains and moves the follower loads onto them."""
+        """Re-identifies the grains of the outer contour on each side
+        (:func:`outer_contour`) and moves the follower loads onto them. Where the
+        contact network has no path from platen to platen on a side, that side
+        keeps its previous chain (or, at the first identification, takes the
+        outermost grain of each slice ``bin_height`` high, :func:`outer_grains`)."""
         grains = np.arange(self.n_grains)
         y0 = float(sim.wall(self.bottom_wall).points[0, 1])
         y1 = float(sim.wall(self.top_wall).points[0, 1])
         x, r = sim.positions, sim.radii
-        left = outer_grains(x, r, grains, y0, y1, "left", self.bin_height)
-        right = outer_grains(x, r, grains, y0, y1, "right", self.bin_height)
+        gap = CONTOUR_GAP_DIAMETERS * self.bin_height
+        chains = []
+        for side, previous in (("left", self.left), ("right", self.right)):
+            try:
+                chains.append(outer_contour(x, r, grains, y0, y1, side, gap))
+            except ValueError:
+                chains.append(previous or outer_grains(x, r, grains, y0, y1, side, self.bin_height))
+        left, right = chains
         sim.set_pressure_chain(self.chains[0], left, self.pressure, start_wall=self.bottom_wall, end_wall=self.top_wall)
         sim.set_pressure_chain(self.chains[1], right, self.pressure, start_wall=self.top_wall, end_wall=self.bottom_wall)
         return GrainBoundary(
