@@ -41,7 +41,7 @@ TABLE1_LOCAL_DAMPING = paper.LOCAL_DAMPING
 FIX_X, FIX_Y, FIX_ROTATION = 1, 2, 4
 
 #: Number of material groups (contact models are set per pair of groups).
-MAX_GROUPS = 16
+MAX_GROUPS = _core.MAX_GROUPS
 
 #: Group that walls get by default, so particle-wall contacts can differ from particle-particle ones.
 WALL_GROUP = 1

@@ -37,15 +37,15 @@ fn main() {
     cell.velocity_gradient = [[-rate, 0.0], [0.0, rate]];
     sim.set_cell(Some(cell)).unwrap();
     sim.run(100).unwrap();
-    let z0 = 2.0 * sim.measurements.contact_count as f64 / n as f64;
-    let builds0 = sim.neighbors.build_count;
+    let z0 = 2.0 * sim.measurements().contact_count as f64 / n as f64;
+    let builds0 = sim.neighbors().build_count;
     let start = Instant::now();
     sim.run(steps).unwrap();
     let elapsed = start.elapsed().as_secs_f64();
-    let z1 = 2.0 * sim.measurements.contact_count as f64 / n as f64;
+    let z1 = 2.0 * sim.measurements().contact_count as f64 / n as f64;
     println!(
         "particle_steps_per_s={:.6e} threads={threads} seconds={elapsed:.4} z_start={z0:.3} z_end={z1:.3} rebuilds={}",
         n as f64 * steps as f64 / elapsed,
-        sim.neighbors.build_count - builds0
+        sim.neighbors().build_count - builds0
     );
 }

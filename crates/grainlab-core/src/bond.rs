@@ -3,6 +3,10 @@
 //! Bonded pairs are excluded from the frictional contact law.
 use serde::{Deserialize, Serialize};
 
+use crate::cell::{minimum_image, PeriodicCell};
+use crate::state::Particles;
+use crate::vec2::{add, dot, mat_vec, norm, perp, scale, sub, Mat2, Vec2};
+
 /// One bond; forces follow the sign conventions of [`crate::law`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Bond {
@@ -72,5 +76,49 @@ impl Bonds {
     /// True without bonds.
     pub fn is_empty(&self) -> bool {
         self.list.is_empty()
+    }
+}
+
+/// A bond's geometry and forces at the current state.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BondForce {
+    /// Unit normal from `i` to `j`.
+    pub normal: Vec2,
+    /// Centre distance (m).
+    pub distance: f64,
+    /// Normal force on `j` (N), positive in compression.
+    pub normal_force: f64,
+    /// Shear force on `j` along `perp(normal)` (N): the updated spring.
+    pub shear_force: f64,
+}
+
+/// Evaluates `bond` at the current state, adding `-ks v_t increment_time` to `shear`
+/// (its spring: the bond's own, or a copy for a query).
+#[inline]
+pub(crate) fn bond_force(
+    bond: &Bond,
+    p: &Particles,
+    cell: Option<&PeriodicCell>,
+    velocity_gradient: Option<Mat2>,
+    increment_time: f64,
+    shear: &mut f64,
+) -> BondForce {
+    let (i, j) = (bond.i as usize, bond.j as usize);
+    let d = minimum_image(cell, sub(p.position[j], p.position[i]));
+    let dist = norm(d);
+    let n = scale(d, 1.0 / dist);
+    let t = perp(n);
+    let mut dv = sub(p.velocity[j], p.velocity[i]);
+    if let Some(l) = &velocity_gradient {
+        dv = add(dv, mat_vec(l, d));
+    }
+    let (ri, rj) = (p.radius[i], p.radius[j]);
+    let vt = dot(dv, t) - (p.angular_velocity[i] * ri + p.angular_velocity[j] * rj);
+    *shear -= bond.shear_stiffness * vt * increment_time;
+    BondForce {
+        normal: n,
+        distance: dist,
+        normal_force: bond.normal_stiffness * (bond.rest_length - dist),
+        shear_force: *shear,
     }
 }

@@ -168,3 +168,21 @@ pub fn affine_velocity(l: &Mat2, d: Vec2) -> Vec2 {
 pub fn advance(x: Vec2, v: Vec2, s: f64) -> Vec2 {
     add(x, scale(v, s))
 }
+
+/// Nearest-image branch vector for bonds.
+pub fn minimum_image(cell: Option<&PeriodicCell>, d: Vec2) -> Vec2 {
+    match cell {
+        Some(c) if c.periodic[0] || c.periodic[1] => {
+            let zero = c.origin;
+            let f = c.fractional(add(zero, d));
+            let mut shift = [0i8; 2];
+            for k in 0..2 {
+                if c.periodic[k] {
+                    shift[k] = -(f[k].round() as i8);
+                }
+            }
+            add(d, c.image_offset(shift))
+        }
+        _ => d,
+    }
+}

@@ -83,3 +83,30 @@ pub fn require_finite(field: &str, value: f64) -> Result<()> {
         ))
     }
 }
+
+/// Checks that every value is finite; the error names the first that is not
+/// (`field[k]`).
+pub fn require_finite_values(field: &str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|x| !x.is_finite()) {
+        Some(k) => Err(EngineError::invalid(
+            format!("{field}[{k}]"),
+            format!("must be finite, got {}", values[k]),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Checks that every point is finite; the error names the first that is not
+/// (`field[k]`).
+pub fn require_finite_points(field: &str, points: &[[f64; 2]]) -> Result<()> {
+    match points
+        .iter()
+        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        Some(k) => Err(EngineError::invalid(
+            format!("{field}[{k}]"),
+            format!("must be finite, got {:?}", points[k]),
+        )),
+        None => Ok(()),
+    }
+}

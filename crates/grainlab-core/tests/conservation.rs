@@ -9,30 +9,34 @@ fn agitate(sim: &mut grainlab_core::Simulation, spin: bool) {
     sim.run(1).unwrap();
     let elastic = sim.energy().elastic;
     let mut rng = Rng::new(5);
+    // the setters take the user's (external) order, the engine keeps its own
+    let p = sim.particles();
     let (mass, inertia, radius) = (
-        sim.particles.mass.clone(),
-        sim.particles.inertia.clone(),
-        sim.particles.radius.clone(),
+        sim.to_external(&p.mass),
+        sim.to_external(&p.inertia),
+        sim.to_external(&p.radius),
     );
-    sim.change_velocities(|velocity, omega| {
-        let mut kinetic = 0.0;
-        for k in 0..velocity.len() {
-            velocity[k] = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
-            omega[k] = if spin {
-                rng.uniform(-1.0, 1.0) / radius[k]
-            } else {
-                0.0
-            };
-            let v = velocity[k];
-            kinetic +=
-                0.5 * mass[k] * (v[0] * v[0] + v[1] * v[1]) + 0.5 * inertia[k] * omega[k].powi(2);
-        }
-        let s = (elastic / kinetic).sqrt();
-        for k in 0..velocity.len() {
-            velocity[k] = [velocity[k][0] * s, velocity[k][1] * s];
-            omega[k] *= s;
-        }
-    });
+    let n = mass.len();
+    let (mut velocity, mut omega) = (vec![[0.0; 2]; n], vec![0.0; n]);
+    let mut kinetic = 0.0;
+    for k in 0..n {
+        velocity[k] = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
+        omega[k] = if spin {
+            rng.uniform(-1.0, 1.0) / radius[k]
+        } else {
+            0.0
+        };
+        let v = velocity[k];
+        kinetic +=
+            0.5 * mass[k] * (v[0] * v[0] + v[1] * v[1]) + 0.5 * inertia[k] * omega[k].powi(2);
+    }
+    let s = (elastic / kinetic).sqrt();
+    for k in 0..n {
+        velocity[k] = [velocity[k][0] * s, velocity[k][1] * s];
+        omega[k] *= s;
+    }
+    sim.set_velocities(&velocity).unwrap();
+    sim.set_angular_velocities(&omega).unwrap();
 }
 
 #[test]
@@ -44,9 +48,9 @@ fn energy_is_conserved_in_a_dense_frictionless_packing() {
     sim.run(1).unwrap();
     let e0 = mechanical_energy(&sim);
     assert!(
-        sim.measurements.contact_count > 7000,
+        sim.measurements().contact_count > 7000,
         "not dense: {} contacts",
-        sim.measurements.contact_count
+        sim.measurements().contact_count
     );
     let mut worst = 0.0f64;
     for _ in 0..100 {
@@ -66,7 +70,7 @@ fn energy_ledger_balances_with_friction_and_damping() {
     // kinetic + elastic + dissipated (friction, local damping) stays constant.
     let mut sim = bench_packing(0.5, 0.2, 2);
     agitate(&mut sim, true);
-    let mut params = sim.params;
+    let mut params = sim.params();
     params.local_damping = 0.3;
     sim.set_params(params).unwrap();
     sim.run(1).unwrap();
@@ -151,14 +155,15 @@ fn momentum_is_conserved_without_walls() {
     // Newton's third law in every contact: total linear momentum is constant.
     let mut sim = dense_periodic(16, 1.0e-3, 0.9, 21, 2);
     let mut rng = Rng::new(1);
-    sim.change_velocities(|velocity, omega| {
-        for (v, w) in velocity.iter_mut().zip(omega.iter_mut()) {
-            *v = [rng.uniform(-0.01, 0.01), rng.uniform(-0.01, 0.01)];
-            *w = rng.uniform(-5.0, 5.0);
-        }
-    });
+    set_random_motion(
+        &mut sim,
+        &mut rng,
+        (-0.01, 0.01),
+        (-0.01, 0.01),
+        (-5.0, 5.0),
+    );
     let momentum = |sim: &grainlab_core::Simulation| {
-        let p = &sim.particles;
+        let p = &sim.particles();
         (0..p.len()).fold([0.0, 0.0], |acc, k| {
             [
                 acc[0] + p.mass[k] * p.velocity[k][0],
@@ -166,8 +171,8 @@ fn momentum_is_conserved_without_walls() {
             ]
         })
     };
-    let scale: f64 = (0..sim.particles.len())
-        .map(|k| sim.particles.mass[k] * 0.01)
+    let scale: f64 = (0..sim.particles().len())
+        .map(|k| sim.particles().mass[k] * 0.01)
         .sum();
     let p0 = momentum(&sim);
     sim.run(3000).unwrap();

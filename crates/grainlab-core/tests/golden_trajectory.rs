@@ -36,7 +36,7 @@ impl Hash {
 /// The hash of everything the trajectory consists of (see the module doc).
 fn trajectory_hash(sim: &Simulation) -> u64 {
     let mut h = Hash::new();
-    let p = &sim.particles;
+    let p = sim.particles();
     for x in sim.to_external(&p.position) {
         h.f64(x[0]);
         h.f64(x[1]);
@@ -52,7 +52,7 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
         h.f64(w);
     }
     let ext = |k: u32| sim.external_index(k as usize) as u64;
-    let pairs = &sim.neighbors.pairs;
+    let pairs = &sim.neighbors().pairs;
     let mut springs: Vec<(u64, u64, i8, i8, u64)> = (0..pairs.len())
         .filter(|&k| pairs.shear[k] != 0.0)
         .map(|k| {
@@ -76,7 +76,7 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
         h.word(s1 as u64);
         h.word(bits);
     }
-    let wp = &sim.neighbors.wall_pairs;
+    let wp = &sim.neighbors().wall_pairs;
     let mut wall_springs: Vec<(u32, u64, u64)> = (0..wp.wall.len())
         .filter(|&k| wp.shear[k] != 0.0)
         .map(|k| (wp.wall[k], ext(wp.particle[k]), wp.shear[k].to_bits()))
@@ -88,12 +88,12 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
         h.word(q);
         h.word(bits);
     }
-    for b in &sim.bonds.list {
+    for b in &sim.bonds().list {
         h.word(ext(b.i));
         h.word(ext(b.j));
         h.f64(b.shear);
     }
-    for wall in &sim.walls {
+    for wall in sim.walls() {
         h.f64(wall.displacement[0]);
         h.f64(wall.displacement[1]);
         h.f64(wall.velocity[0]);
@@ -111,12 +111,12 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
         e.wall_work,
         e.external_work,
         e.boundary_work,
-        sim.time,
+        sim.time(),
     ] {
         h.f64(x);
     }
-    h.word(sim.step_count);
-    h.word(sim.neighbors.build_count);
+    h.word(sim.step_count());
+    h.word(sim.neighbors().build_count);
     h.0
 }
 
@@ -138,7 +138,7 @@ fn check(
             sim.run(n).unwrap();
             done += n;
         }
-        assert!(sim.neighbors.build_count > 1, "{name}: no rebuild");
+        assert!(sim.neighbors().build_count > 1, "{name}: no rebuild");
         let got = trajectory_hash(&sim);
         assert!(
             got == expected,
@@ -184,10 +184,10 @@ fn membrane_box(threads: usize) -> Simulation {
 /// local damping.
 fn sheared_packing(threads: usize) -> Simulation {
     let mut sim = bench_packing(0.9, 0.2, threads);
-    let mut cell = sim.cell.clone().unwrap();
+    let mut cell = sim.cell().cloned().unwrap();
     cell.velocity_gradient = [[-0.05, 0.0], [0.0, 0.05]];
     sim.set_cell(Some(cell)).unwrap();
-    let mut p = sim.params;
+    let mut p = sim.params();
     p.local_damping = 0.1;
     sim.set_params(p).unwrap();
     sim
@@ -197,7 +197,7 @@ fn sheared_packing(threads: usize) -> Simulation {
 /// velocity gradient with an off-diagonal term), the serial path.
 fn simple_shear(threads: usize) -> Simulation {
     let mut sim = dense_periodic(18, 1.0e-3, 0.3, 21, threads);
-    let mut cell = sim.cell.clone().unwrap();
+    let mut cell = sim.cell().cloned().unwrap();
     cell.velocity_gradient = [[0.0, 0.4], [0.0, 0.0]];
     sim.set_cell(Some(cell)).unwrap();
     sim
@@ -241,13 +241,13 @@ fn sliding_layers(threads: usize) -> Simulation {
     )
     .unwrap();
     sim.add_wall(floor);
-    let n = sim.particles.len();
-    sim.change_velocities(|v, w| {
-        for k in 0..n {
-            v[k] = [rng.uniform(-0.01, 0.04), rng.uniform(-0.005, 0.005)];
-            w[k] = rng.uniform(-40.0, 40.0);
-        }
-    });
+    set_random_motion(
+        &mut sim,
+        &mut rng,
+        (-0.01, 0.04),
+        (-0.005, 0.005),
+        (-40.0, 40.0),
+    );
     sim
 }
 
@@ -256,7 +256,7 @@ fn a_servo_walled_box_follows_its_recorded_trajectory() {
     let sim = check("servo box", servo_box, 3000, 1000, 0xbd85_c2ed_09bd_4e08);
     // the servo walls moved, and the stress on them is near its target
     for id in [1, 2] {
-        let w = &sim.walls[id];
+        let w = &sim.walls()[id];
         assert!(w.displacement != [0.0, 0.0]);
         assert!(w.contact_count > 30);
     }
@@ -271,7 +271,7 @@ fn a_membrane_box_follows_its_recorded_trajectory() {
         750,
         0x8adc_d926_a98f_cbc0,
     );
-    assert!(sim.walls[2].displacement[0] > 0.0 && sim.energy().boundary_work != 0.0);
+    assert!(sim.walls()[2].displacement[0] > 0.0 && sim.energy().boundary_work != 0.0);
 }
 
 #[test]
@@ -307,5 +307,5 @@ fn sliding_layers_follow_their_recorded_trajectory() {
     );
     // the disks slid (friction dissipated energy) and rest on the floor
     assert!(sim.energy().friction_dissipated > 0.0);
-    assert!(sim.measurements.wall_contact_count > 20);
+    assert!(sim.measurements().wall_contact_count > 20);
 }

@@ -12,9 +12,9 @@ use std::collections::BTreeSet;
 /// Contacts by brute force over all pairs and all images within one cell, as
 /// external index pairs.
 fn brute_force(sim: &Simulation) -> BTreeSet<(u32, u32)> {
-    let p = &sim.particles;
+    let p = &sim.particles();
     let mut out = BTreeSet::new();
-    let images: Vec<[i8; 2]> = match &sim.cell {
+    let images: Vec<[i8; 2]> = match sim.cell() {
         Some(c) => {
             let sx: Vec<i8> = if c.periodic[0] {
                 vec![-1, 0, 1]
@@ -35,7 +35,7 @@ fn brute_force(sim: &Simulation) -> BTreeSet<(u32, u32)> {
     for i in 0..p.len() {
         for j in i + 1..p.len() {
             for &s in &images {
-                let off = sim.cell.as_ref().map_or([0.0; 2], |c| c.image_offset(s));
+                let off = sim.cell().map_or([0.0; 2], |c| c.image_offset(s));
                 let d = sub(add(p.position[j], off), p.position[i]);
                 let reach = p.radius[i] + p.radius[j];
                 if dot(d, d) < reach * reach {
@@ -92,12 +92,11 @@ fn random_sim(seed: u64, periodic: bool, deform: bool, threads: usize) -> Simula
         }
         sim.set_cell(Some(cell)).unwrap();
     }
-    sim.change_velocities(|velocity, _| {
-        for v in velocity.iter_mut() {
-            // up to 5 m/s: 50 um per step, a large fraction of the small radii and of the skin
-            *v = [rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0)];
-        }
-    });
+    // up to 5 m/s: 50 um per step, a large fraction of the small radii and of the skin
+    let velocity: Vec<[f64; 2]> = (0..n)
+        .map(|_| [rng.uniform(-5.0, 5.0), rng.uniform(-5.0, 5.0)])
+        .collect();
+    sim.set_velocities(&velocity).unwrap();
     sim
 }
 
@@ -114,7 +113,7 @@ fn check_over_time(mut sim: Simulation, steps: usize) {
         checked += expected.len();
     }
     assert!(checked > 100, "too few contacts to be a test: {checked}");
-    assert!(sim.neighbors.build_count > 3, "lists were never rebuilt");
+    assert!(sim.neighbors().build_count > 3, "lists were never rebuilt");
 }
 
 #[test]
@@ -150,15 +149,15 @@ fn moving_walls_never_miss_a_contact() {
     )
     .unwrap();
     let id = sim.add_wall(wall);
-    sim.walls[id].velocity = [40.0, 0.0]; // sweeps across the box
+    sim.set_wall_velocity(id, [40.0, 0.0]).unwrap(); // sweeps across the box
     for step in 0..120 {
         sim.run(1).unwrap();
         let wc = sim.wall_contacts().unwrap();
         let got: BTreeSet<u32> = wc.particle.iter().copied().collect();
-        let p = &sim.particles;
+        let p = &sim.particles();
         let expected: BTreeSet<u32> = (0..p.len())
             .filter(|&q| {
-                sim.walls[id]
+                sim.walls()[id]
                     .disk_contact(p.position[q], p.radius[q])
                     .overlap
                     > 0.0

@@ -7,9 +7,9 @@ use grainlab_core::Simulation;
 
 /// Every spring of the simulation: contacts, wall contacts, bonds (internal order).
 fn springs(sim: &Simulation) -> Vec<f64> {
-    let mut all = sim.neighbors.pairs.shear.clone();
-    all.extend(&sim.neighbors.wall_pairs.shear);
-    all.extend(sim.bonds.list.iter().map(|b| b.shear));
+    let mut all = sim.neighbors().pairs.shear.clone();
+    all.extend(&sim.neighbors().wall_pairs.shear);
+    all.extend(sim.bonds().list.iter().map(|b| b.shear));
     all
 }
 
@@ -21,16 +21,16 @@ fn the_first_step_from_full_step_velocities_adds_no_shear() {
     let mut sim = boxed_packing(16, 0.5, 3, 1);
     assert!(!sim.shear_increment_pending());
     sim.run(1).unwrap();
-    let m = sim.measurements;
+    let m = sim.measurements();
     assert!(m.contact_count > 150 && m.wall_contact_count > 20, "{m:?}");
     assert!(springs(&sim).iter().all(|&s| s == 0.0));
     assert!(sim.shear_increment_pending());
     sim.run(1).unwrap();
     let nonzero = |v: &[f64]| v.iter().filter(|&&s| s != 0.0).count();
-    assert!(nonzero(&sim.neighbors.pairs.shear) > 150);
-    assert!(nonzero(&sim.neighbors.wall_pairs.shear) > 20);
+    assert!(nonzero(&sim.neighbors().pairs.shear) > 150);
+    assert!(nonzero(&sim.neighbors().wall_pairs.shear) > 20);
     assert_eq!(
-        nonzero(&sim.bonds.list.iter().map(|b| b.shear).collect::<Vec<_>>()),
+        nonzero(&sim.bonds().list.iter().map(|b| b.shear).collect::<Vec<_>>()),
         15
     );
 }
@@ -44,12 +44,16 @@ fn velocities_set_between_steps_count_the_last_displacement_once() {
     straight.run(1).unwrap();
     let expected = springs(&straight);
     // setting velocities first adds that same displacement, at the same velocities ...
-    changed.change_velocities(|v, w| {
-        for (vk, wk) in v.iter_mut().zip(w.iter_mut()) {
-            *vk = [-0.5 * vk[0], 2.0 * vk[1]];
-            *wk = -*wk;
-        }
-    });
+    let p = changed.particles();
+    let v: Vec<[f64; 2]> = p
+        .velocity
+        .iter()
+        .map(|v| [-0.5 * v[0], 2.0 * v[1]])
+        .collect();
+    let w: Vec<f64> = p.angular_velocity.iter().map(|w| -w).collect();
+    let (v, w) = (changed.to_external(&v), changed.to_external(&w));
+    changed.set_velocities(&v).unwrap();
+    changed.set_angular_velocities(&w).unwrap();
     assert!(!changed.shear_increment_pending());
     assert_eq!(springs(&changed), expected);
     // ... and the step from the new full-step velocities adds nothing more
@@ -70,14 +74,14 @@ fn positions_set_between_steps_are_a_jump_not_a_displacement() {
     // a tiny jump of every disk: the springs take the last step's displacement
     // first and nothing from the jump
     let mut rng = Rng::new(9);
-    moved.change_positions(|x| {
-        for xk in x.iter_mut() {
-            *xk = [
-                xk[0] + rng.uniform(-1e-9, 1e-9),
-                xk[1] + rng.uniform(-1e-9, 1e-9),
-            ];
-        }
-    });
+    let mut x = moved.to_external(&moved.particles().position);
+    for xk in x.iter_mut() {
+        *xk = [
+            xk[0] + rng.uniform(-1e-9, 1e-9),
+            xk[1] + rng.uniform(-1e-9, 1e-9),
+        ];
+    }
+    moved.set_positions(&x).unwrap();
     assert_eq!(springs(&moved), expected);
     // the next step adds no increment (only a cap where the overlap shrank)
     moved.run(1).unwrap();
@@ -96,7 +100,7 @@ fn positions_set_between_steps_are_a_jump_not_a_displacement() {
 
 /// The touching pairs' springs and sliding flags by external `(i, j)`.
 fn by_pair(sim: &Simulation) -> std::collections::HashMap<(usize, usize), (f64, bool)> {
-    let p = &sim.neighbors.pairs;
+    let p = &sim.neighbors().pairs;
     (0..p.len())
         .filter(|&k| p.shear[k] != 0.0)
         .map(|k| {

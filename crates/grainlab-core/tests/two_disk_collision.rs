@@ -26,24 +26,21 @@ fn collide(alpha: f64) -> (f64, f64) {
         max_overlap_ratio: 0.9,
     })
     .unwrap();
-    sim.change_velocities(|v, _| {
-        v[0] = [v0, 0.0];
-        v[1] = [-v0, 0.0];
-    });
+    sim.set_velocities(&[[v0, 0.0], [-v0, 0.0]]).unwrap();
     let (mut start, mut end) = (None, None);
     for _ in 0..20_000 {
         sim.run(1).unwrap();
-        let touching = sim.measurements.contact_count > 0;
+        let touching = sim.measurements().contact_count > 0;
         if touching && start.is_none() {
-            start = Some(sim.time - dt);
+            start = Some(sim.time() - dt);
         }
         if !touching && start.is_some() && end.is_none() {
-            end = Some(sim.time - dt);
+            end = Some(sim.time() - dt);
             break;
         }
     }
     let duration = end.unwrap() - start.unwrap();
-    let v = sim.to_external(&sim.particles.velocity); // the engine keeps its own order
+    let v = sim.to_external(&sim.particles().velocity); // the engine keeps its own order
     let v_after = v[1][0] - v[0][0];
     (duration, v_after / (2.0 * v0))
 }

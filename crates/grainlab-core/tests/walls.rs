@@ -36,15 +36,15 @@ fn normal_impact_on_a_wall() {
     let t_c = std::f64::consts::PI * (mass() / KN).sqrt();
     let dt = t_c / 2000.0;
     let mut sim = floor_sim(ContactModel::linear(KN, KN, 0.3), dt, 0.0, R + 1e-7);
-    sim.change_velocities(|v, _| v[0] = [0.0, -0.1]);
+    sim.set_velocities(&[[0.0, -0.1]]).unwrap();
     let (mut start, mut end) = (None, None);
     for _ in 0..10_000 {
         sim.run(1).unwrap();
-        let touching = sim.walls[0].contact_count > 0;
+        let touching = sim.walls()[0].contact_count > 0;
         if touching && start.is_none() {
-            start = Some(sim.time - dt);
+            start = Some(sim.time() - dt);
         } else if !touching && start.is_some() {
-            end = Some(sim.time - dt);
+            end = Some(sim.time() - dt);
             break;
         }
     }
@@ -53,7 +53,7 @@ fn normal_impact_on_a_wall() {
         (duration / t_c - 1.0).abs() < 0.005,
         "duration {duration} vs {t_c}"
     );
-    let e = sim.particles.velocity[0][1] / 0.1;
+    let e = sim.particles().velocity[0][1] / 0.1;
     assert!((e - 1.0).abs() < 0.005, "restitution {e}");
 }
 
@@ -66,18 +66,18 @@ fn oblique_impact_in_gross_sliding() {
     let t_c = std::f64::consts::PI * (mass() / KN).sqrt();
     let dt = t_c / 4000.0;
     let mut sim = floor_sim(ContactModel::linear(KN, KN, mu), dt, 0.0, R + 1e-7);
-    sim.change_velocities(|v, _| v[0] = [vt, -vn]);
+    sim.set_velocities(&[[vt, -vn]]).unwrap();
     let mut touched = false;
     for _ in 0..20_000 {
         sim.run(1).unwrap();
-        let touching = sim.walls[0].contact_count > 0;
+        let touching = sim.walls()[0].contact_count > 0;
         touched |= touching;
         if touched && !touching {
             break;
         }
     }
-    let v = sim.particles.velocity[0];
-    let w = sim.particles.angular_velocity[0];
+    let v = sim.particles().velocity[0];
+    let w = sim.particles().angular_velocity[0];
     let e = v[1] / vn;
     assert!((e - 1.0).abs() < 0.005, "normal restitution {e}");
     let vt_expected = vt - mu * (1.0 + e) * vn;
@@ -105,12 +105,12 @@ fn sliding_disk_ends_in_pure_rolling_at_two_thirds_speed() {
     let dt = t_c / 50.0;
     let overlap = mass() * g / KN;
     let mut sim = floor_sim(model, dt, g, R - overlap);
-    sim.change_velocities(|v, _| v[0] = [v0, 0.0]);
+    sim.set_velocities(&[[v0, 0.0]]).unwrap();
     // sliding lasts v0 / (3 mu g) ~ 14 ms; run 40 ms
     let steps = (0.04 / dt) as u64;
     sim.run(steps).unwrap();
-    let v = sim.particles.velocity[0][0];
-    let w = sim.particles.angular_velocity[0];
+    let v = sim.particles().velocity[0][0];
+    let w = sim.particles().angular_velocity[0];
     assert!(
         (v / (2.0 * v0 / 3.0) - 1.0).abs() < 0.01,
         "final speed {v}, expected {}",
@@ -168,13 +168,13 @@ fn servo_wall_reaches_its_target_stress() {
     )
     .unwrap();
     sim.run(20_000).unwrap();
-    let stress = sim.walls[top].normal_stress(l);
+    let stress = sim.walls()[top].normal_stress(l);
     assert!(
         (stress / target - 1.0).abs() < 0.01,
         "servo stress {stress} vs {target}"
     );
     // static equilibrium: the opposite wall carries the same load
-    let bottom = sim.walls[0].normal_stress(l);
+    let bottom = sim.walls()[0].normal_stress(l);
     assert!(
         (bottom / target - 1.0).abs() < 0.02,
         "bottom stress {bottom}"

@@ -25,6 +25,8 @@ fn density_scaling_factor(strain_rate: f64, density: f64, min_radius: f64, press
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", grainlab_core::VERSION)?;
+    // the number of material groups: groups are 0..MAX_GROUPS
+    m.add("MAX_GROUPS", grainlab_core::state::MAX_GROUPS)?;
     m.add(
         "SimulationUnstableError",
         m.py().get_type::<SimulationUnstableError>(),

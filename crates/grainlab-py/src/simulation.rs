@@ -9,6 +9,17 @@ use pyo3::types::{PyBytes, PyDict};
 
 use crate::convert::{points, points_to_py, same_length, to_py_err, values, values_to_py};
 
+/// A particle array in external (user) order as a read-only NumPy array:
+/// `points` for `(N, 2)` arrays, `values` for `(N,)` ones.
+macro_rules! particle_array {
+    ($self:ident, $py:ident, points $field:ident) => {
+        points_to_py($py, &$self.sim.to_external(&$self.sim.particles().$field))
+    };
+    ($self:ident, $py:ident, values $field:ident) => {
+        values_to_py($py, &$self.sim.to_external(&$self.sim.particles().$field))
+    };
+}
+
 /// Steps run between checks for Ctrl-C.
 const STEPS_PER_SIGNAL_CHECK: u64 = 2000;
 
@@ -98,12 +109,12 @@ impl Engine {
 
     #[getter]
     fn step_count(&self) -> u64 {
-        self.sim.step_count
+        self.sim.step_count()
     }
 
     #[getter]
     fn time(&self) -> f64 {
-        self.sim.time
+        self.sim.time()
     }
 
     #[getter]
@@ -117,25 +128,25 @@ impl Engine {
 
     #[getter]
     fn neighbor_builds(&self) -> u64 {
-        self.sim.neighbors.build_count
+        self.sim.neighbors().build_count
     }
 
     #[getter]
     fn n_particles(&self) -> usize {
-        self.sim.particles.len()
+        self.sim.particles().len()
     }
 
     // ---- parameters ----
 
     #[getter]
     fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let p = self.sim.params;
+        let p = self.sim.params();
         let d = PyDict::new(py);
         d.set_item("time_step", p.time_step)?;
         d.set_item("local_damping", p.local_damping)?;
         d.set_item("gravity", (p.gravity[0], p.gravity[1]))?;
         d.set_item("max_overlap_ratio", p.max_overlap_ratio)?;
-        d.set_item("skin", self.sim.neighbors.skin)?;
+        d.set_item("skin", self.sim.neighbors().skin)?;
         Ok(d)
     }
 
@@ -195,9 +206,12 @@ impl Engine {
         if group_a as usize >= grainlab_core::state::MAX_GROUPS
             || group_b as usize >= grainlab_core::state::MAX_GROUPS
         {
-            return Err(PyValueError::new_err("group: out of range 0..16"));
+            return Err(PyValueError::new_err(format!(
+                "group: out of range 0..{}",
+                grainlab_core::state::MAX_GROUPS
+            )));
         }
-        let m = self.sim.materials.get(group_a, group_b);
+        let m = self.sim.materials().get(group_a, group_b);
         let d = PyDict::new(py);
         d.set_item("normal_stiffness", m.normal_stiffness)?;
         d.set_item("shear_stiffness", m.shear_stiffness)?;
@@ -212,178 +226,122 @@ impl Engine {
 
     #[getter]
     fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        points_to_py(py, &self.sim.to_external(&self.sim.particles.position))
+        particle_array!(self, py, points position)
     }
     #[getter]
     fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        points_to_py(py, &self.sim.to_external(&self.sim.particles.velocity))
+        particle_array!(self, py, points velocity)
     }
     #[getter]
     fn forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        points_to_py(py, &self.sim.to_external(&self.sim.particles.force))
+        particle_array!(self, py, points force)
     }
     #[getter]
     fn external_forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        points_to_py(
-            py,
-            &self.sim.to_external(&self.sim.particles.external_force),
-        )
+        particle_array!(self, py, points external_force)
     }
     #[getter]
     fn rotations<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.to_external(&self.sim.particles.rotation))
+        particle_array!(self, py, values rotation)
     }
     #[getter]
     fn angular_velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(
-            py,
-            &self.sim.to_external(&self.sim.particles.angular_velocity),
-        )
+        particle_array!(self, py, values angular_velocity)
     }
     #[getter]
     fn torques<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.to_external(&self.sim.particles.torque))
+        particle_array!(self, py, values torque)
     }
     #[getter]
     fn external_torques<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(
-            py,
-            &self.sim.to_external(&self.sim.particles.external_torque),
-        )
+        particle_array!(self, py, values external_torque)
     }
     #[getter]
     fn radii<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.to_external(&self.sim.particles.radius))
+        particle_array!(self, py, values radius)
     }
     #[getter]
     fn densities<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.to_external(&self.sim.particles.density))
+        particle_array!(self, py, values density)
     }
     #[getter]
     fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.to_external(&self.sim.particles.mass))
+        particle_array!(self, py, values mass)
     }
     #[getter]
     fn inertias<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.to_external(&self.sim.particles.inertia))
+        particle_array!(self, py, values inertia)
     }
     #[getter]
     fn groups<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.to_external(&self.sim.particles.group))
+        particle_array!(self, py, values group)
     }
     #[getter]
     fn fixity<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        values_to_py(py, &self.sim.to_external(&self.sim.particles.fixity))
+        particle_array!(self, py, values fixity)
     }
+
+    // The engine validates the values (naming the field and the index); the
+    // glue checks the shapes and the lengths.
 
     fn set_positions(&mut self, positions: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
         let v = points("positions", &positions)?;
-        same_length("positions", v.len(), self.sim.particles.len())?;
-        check_finite_points("positions", &v)?;
-        let internal = self.sim.to_internal(&v);
-        self.sim
-            .change_positions(|position| position.copy_from_slice(&internal));
-        Ok(())
+        same_length("positions", v.len(), self.sim.particles().len())?;
+        self.sim.set_positions(&v).map_err(to_py_err)
     }
 
     fn set_velocities(&mut self, velocities: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
         let v = points("velocities", &velocities)?;
-        same_length("velocities", v.len(), self.sim.particles.len())?;
-        check_finite_points("velocities", &v)?;
-        let internal = self.sim.to_internal(&v);
-        self.sim
-            .change_velocities(|velocity, _| velocity.copy_from_slice(&internal));
-        Ok(())
+        same_length("velocities", v.len(), self.sim.particles().len())?;
+        self.sim.set_velocities(&v).map_err(to_py_err)
     }
 
     fn set_external_forces(&mut self, forces: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
         let v = points("external_forces", &forces)?;
-        same_length("external_forces", v.len(), self.sim.particles.len())?;
-        check_finite_points("external_forces", &v)?;
-        self.sim.particles.external_force = self.sim.to_internal(&v);
-        Ok(())
+        same_length("external_forces", v.len(), self.sim.particles().len())?;
+        self.sim.set_external_forces(&v).map_err(to_py_err)
     }
 
     fn set_rotations(&mut self, rotations: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         let v = values(&rotations);
-        same_length("rotations", v.len(), self.sim.particles.len())?;
-        check_finite("rotations", &v)?;
-        self.sim.particles.rotation = self.sim.to_internal(&v);
-        Ok(())
+        same_length("rotations", v.len(), self.sim.particles().len())?;
+        self.sim.set_rotations(&v).map_err(to_py_err)
     }
 
     fn set_angular_velocities(&mut self, omega: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         let v = values(&omega);
-        same_length("angular_velocities", v.len(), self.sim.particles.len())?;
-        check_finite("angular_velocities", &v)?;
-        let internal = self.sim.to_internal(&v);
-        self.sim
-            .change_velocities(|_, omega| omega.copy_from_slice(&internal));
-        Ok(())
+        same_length("angular_velocities", v.len(), self.sim.particles().len())?;
+        self.sim.set_angular_velocities(&v).map_err(to_py_err)
     }
 
     fn set_external_torques(&mut self, torques: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         let v = values(&torques);
-        same_length("external_torques", v.len(), self.sim.particles.len())?;
-        check_finite("external_torques", &v)?;
-        self.sim.particles.external_torque = self.sim.to_internal(&v);
-        Ok(())
+        same_length("external_torques", v.len(), self.sim.particles().len())?;
+        self.sim.set_external_torques(&v).map_err(to_py_err)
     }
 
     fn set_radii(&mut self, radii: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         let v = values(&radii);
-        same_length("radii", v.len(), self.sim.particles.len())?;
-        for (k, &r) in v.iter().enumerate() {
-            grainlab_core::error::require_positive(&format!("radii[{k}]"), r).map_err(to_py_err)?;
-        }
-        // new radii change the overlaps: the last step's displacement is counted first
-        self.sim.catch_up_shear_springs();
-        self.sim.particles.radius = self.sim.to_internal(&v);
-        self.sim.particles.update_mass_properties();
-        self.sim.invalidate_neighbors();
-        Ok(())
+        same_length("radii", v.len(), self.sim.particles().len())?;
+        self.sim.set_radii(&v).map_err(to_py_err)
     }
 
     fn set_densities(&mut self, densities: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         let v = values(&densities);
-        same_length("densities", v.len(), self.sim.particles.len())?;
-        for (k, &r) in v.iter().enumerate() {
-            grainlab_core::error::require_positive(&format!("densities[{k}]"), r)
-                .map_err(to_py_err)?;
-        }
-        self.sim.particles.density = self.sim.to_internal(&v);
-        self.sim.particles.update_mass_properties();
-        Ok(())
+        same_length("densities", v.len(), self.sim.particles().len())?;
+        self.sim.set_densities(&v).map_err(to_py_err)
     }
 
     fn set_groups(&mut self, groups: PyReadonlyArray1<'_, u8>) -> PyResult<()> {
         let v = values(&groups);
-        same_length("groups", v.len(), self.sim.particles.len())?;
-        if let Some((k, g)) = v
-            .iter()
-            .enumerate()
-            .find(|(_, &g)| g as usize >= grainlab_core::state::MAX_GROUPS)
-        {
-            return Err(PyValueError::new_err(format!(
-                "groups[{k}]: group {g} out of range 0..16"
-            )));
-        }
-        self.sim.catch_up_shear_springs();
-        self.sim.particles.group = self.sim.to_internal(&v);
-        self.sim.invalidate_neighbors();
-        Ok(())
+        same_length("groups", v.len(), self.sim.particles().len())?;
+        self.sim.set_groups(&v).map_err(to_py_err)
     }
 
     fn set_fixity(&mut self, fixity: PyReadonlyArray1<'_, u8>) -> PyResult<()> {
         let v = values(&fixity);
-        same_length("fixity", v.len(), self.sim.particles.len())?;
-        if let Some((k, f)) = v.iter().enumerate().find(|(_, &f)| f > 7) {
-            return Err(PyValueError::new_err(format!(
-                "fixity[{k}]: {f} is not a combination of 1 (x), 2 (y), 4 (rotation)"
-            )));
-        }
-        self.sim.particles.fixity = self.sim.to_internal(&v);
-        Ok(())
+        same_length("fixity", v.len(), self.sim.particles().len())?;
+        self.sim.set_fixity(&v).map_err(to_py_err)
     }
 
     // ---- periodic cell ----
@@ -403,8 +361,7 @@ impl Engine {
             periodic: [periodic.0, periodic.1],
             velocity_gradient: self
                 .sim
-                .cell
-                .as_ref()
+                .cell()
                 .map_or([[0.0; 2]; 2], |c| c.velocity_gradient),
         };
         self.sim.set_cell(Some(cell)).map_err(to_py_err)
@@ -422,7 +379,7 @@ impl Engine {
                 g.shape()
             )));
         }
-        let Some(cell) = self.sim.cell.clone() else {
+        let Some(cell) = self.sim.cell().cloned() else {
             return Err(PyValueError::new_err(
                 "velocity_gradient: set a periodic cell first",
             ));
@@ -434,7 +391,7 @@ impl Engine {
 
     #[getter]
     fn cell<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let Some(c) = &self.sim.cell else {
+        let Some(c) = self.sim.cell() else {
             return Ok(None);
         };
         let d = PyDict::new(py);
@@ -480,7 +437,7 @@ impl Engine {
 
     #[getter]
     fn n_walls(&self) -> usize {
-        self.sim.walls.len()
+        self.sim.walls().len()
     }
 
     fn set_wall_velocity(&mut self, wall_id: usize, velocity: Vec<f64>) -> PyResult<()> {
@@ -512,8 +469,8 @@ impl Engine {
         self.sim.translate_wall(wall_id, d).map_err(to_py_err)
     }
 
-    fn wall_state<'py>(&mut self, py: Python<'py>, wall_id: usize) -> PyResult<Bound<'py, PyDict>> {
-        let wall = self.sim.wall_mut(wall_id).map_err(to_py_err)?.clone();
+    fn wall_state<'py>(&self, py: Python<'py>, wall_id: usize) -> PyResult<Bound<'py, PyDict>> {
+        let wall = self.sim.wall(wall_id).map_err(to_py_err)?;
         let d = PyDict::new(py);
         match wall.shape {
             WallShape::Segment { a, b } => {
@@ -597,7 +554,7 @@ impl Engine {
 
     #[getter]
     fn n_pressure_chains(&self) -> usize {
-        self.sim.chains.len()
+        self.sim.pressure_chain_count()
     }
 
     // ---- bonds ----
@@ -618,7 +575,7 @@ impl Engine {
 
     #[getter]
     fn n_bonds(&self) -> usize {
-        self.sim.bonds.len()
+        self.sim.bonds().len()
     }
 
     // ---- contacts and diagnostics ----
@@ -654,7 +611,7 @@ impl Engine {
 
     #[getter]
     fn measurements<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let m = self.sim.measurements;
+        let m = self.sim.measurements();
         let d = PyDict::new(py);
         d.set_item("step", m.step)?;
         d.set_item("contact_count", m.contact_count)?;
@@ -692,27 +649,4 @@ impl Engine {
             sim: Simulation::from_bytes(data).map_err(to_py_err)?,
         })
     }
-}
-
-fn check_finite_points(field: &str, v: &[[f64; 2]]) -> PyResult<()> {
-    if let Some(k) = v
-        .iter()
-        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
-    {
-        return Err(PyValueError::new_err(format!(
-            "{field}[{k}]: must be finite, got {:?}",
-            v[k]
-        )));
-    }
-    Ok(())
-}
-
-fn check_finite(field: &str, v: &[f64]) -> PyResult<()> {
-    if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-        return Err(PyValueError::new_err(format!(
-            "{field}[{k}]: must be finite, got {}",
-            v[k]
-        )));
-    }
-    Ok(())
 }

@@ -22,6 +22,26 @@ impl Rng {
     }
 }
 
+/// Gives every disk (in the user's order) a velocity uniform in `vx` x `vy`
+/// (m/s) and an angular velocity uniform in `omega` (rad/s), drawn per disk
+/// in that order.
+pub fn set_random_motion(
+    sim: &mut Simulation,
+    rng: &mut Rng,
+    vx: (f64, f64),
+    vy: (f64, f64),
+    omega: (f64, f64),
+) {
+    let n = sim.particles().len();
+    let (mut v, mut w) = (vec![[0.0; 2]; n], vec![0.0; n]);
+    for k in 0..n {
+        v[k] = [rng.uniform(vx.0, vx.1), rng.uniform(vy.0, vy.1)];
+        w[k] = rng.uniform(omega.0, omega.1);
+    }
+    sim.set_velocities(&v).unwrap();
+    sim.set_angular_velocities(&w).unwrap();
+}
+
 pub const KN: f64 = 8.45e7;
 pub const DENSITY: f64 = 2.0e8;
 
@@ -135,8 +155,7 @@ pub fn boxed_packing(n_side: usize, friction: f64, seed: u64, threads: usize) ->
     use grainlab_core::{StepParameters, Wall, WallShape};
     let s = 1.0e-3;
     let (mut sim, mut rng) = jittered_grid(n_side, s, friction, seed, threads);
-    let n = sim.particles.len();
-    let dt = sim.params.time_step;
+    let dt = sim.params().time_step;
     sim.set_params(StepParameters {
         time_step: dt,
         local_damping: 0.3,
@@ -160,11 +179,12 @@ pub fn boxed_packing(n_side: usize, friction: f64, seed: u64, threads: usize) ->
     for b in 0..n_side - 1 {
         sim.add_bond(b, b + 1, 0.1 * KN, 0.1 * KN, None).unwrap();
     }
-    sim.change_velocities(|v, w| {
-        for k in 0..n {
-            v[k] = [rng.uniform(-0.02, 0.02), rng.uniform(-0.02, 0.02)];
-            w[k] = rng.uniform(-20.0, 20.0);
-        }
-    });
+    set_random_motion(
+        &mut sim,
+        &mut rng,
+        (-0.02, 0.02),
+        (-0.02, 0.02),
+        (-20.0, 20.0),
+    );
     sim
 }

@@ -1,0 +1,507 @@
+//! The pair kernel: the contact law over a run of listed pairs, with where
+//! its forces go (straight onto the particles, into a buffer, into records),
+//! the reset of the resultants, the buffered cross-stripe forces, and the
+//! particle-wall contact.
+use crate::cell::PeriodicCell;
+use crate::contact::ContactGeometry;
+use crate::law::{elastic_energy, linear_coulomb, linear_coulomb_with, ContactForce};
+use crate::material::{ContactModel, MaterialTable};
+use crate::parallel::DisjointWriter;
+use crate::state::Particles;
+use crate::vec2::{add, dot, mat_vec, perp, scale, sub, Mat2, Vec2};
+use crate::wall::Wall;
+
+/// Per-block sums of the contact phase.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct ContactTally {
+    pub(crate) friction: f64,
+    pub(crate) viscous: f64,
+    pub(crate) elastic: f64,
+    pub(crate) force_sum: f64,
+    pub(crate) contacts: usize,
+    pub(crate) overlap_violation: bool,
+}
+
+impl ContactTally {
+    /// Adds another tally's sums (merged in stripe order, for the same bits).
+    pub(crate) fn merge(&mut self, o: &ContactTally) {
+        self.friction += o.friction;
+        self.viscous += o.viscous;
+        self.elastic += o.elastic;
+        self.force_sum += o.force_sum;
+        self.contacts += o.contacts;
+        self.overlap_violation |= o.overlap_violation;
+    }
+}
+
+/// Particle `q` against `wall` at the current state: the geometry and the
+/// contact law's forces on the particle, updating `spring` (the pair's shear
+/// spring, or a copy for a query) over `increment_time`; `None`, with the
+/// spring zeroed, when they do not touch.
+#[inline]
+pub(crate) fn wall_contact(
+    wall: &Wall,
+    model: &ContactModel,
+    p: &Particles,
+    q: usize,
+    dt: f64,
+    increment_time: f64,
+    spring: &mut f64,
+) -> Option<(ContactGeometry, ContactForce)> {
+    let r = p.radius[q];
+    let g = wall.disk_contact(p.position[q], r);
+    if g.overlap <= 0.0 {
+        *spring = 0.0;
+        return None;
+    }
+    let n = g.normal;
+    let t = perp(n);
+    let dv = sub(p.velocity[q], wall.velocity);
+    let vn = dot(dv, n);
+    let vt = dot(dv, t) - p.angular_velocity[q] * r;
+    let c = linear_coulomb(
+        model,
+        g.overlap,
+        vn,
+        vt,
+        dt,
+        increment_time,
+        p.mass[q],
+        spring,
+    );
+    Some((g, c))
+}
+
+/// Where a pair's force goes: straight onto the particles, or into a buffer slot.
+pub(crate) trait ForceSink {
+    /// Adds force `f` on `j` (its opposite on `i`) and the torques, for local pair `k`.
+    ///
+    /// # Safety
+    /// The caller owns `i` and `j` (direct sink) or slot `k` (buffer).
+    unsafe fn add(&mut self, k: usize, i: usize, j: usize, f: Vec2, torque_i: f64, torque_j: f64);
+    /// Local pair `k` is not in contact.
+    fn skip(&mut self, k: usize);
+    /// Local pair `k` is in contact with `overlap`, unit normal `n`, forces `c` and
+    /// (updated) shear spring `spring`; only the contact list keeps it.
+    #[inline(always)]
+    fn record(&mut self, _k: usize, _overlap: f64, _n: Vec2, _c: &ContactForce, _spring: f64) {}
+}
+
+/// Throws the forces away (the springs' catch-up).
+pub(crate) struct NullSink;
+
+impl ForceSink for NullSink {
+    #[inline(always)]
+    unsafe fn add(&mut self, _: usize, _: usize, _: usize, _: Vec2, _: f64, _: f64) {}
+    #[inline(always)]
+    fn skip(&mut self, _k: usize) {}
+}
+
+/// A particle pair's contact as the force evaluation saw it, for the contact list.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PairRecord {
+    /// Overlap (m).
+    pub(crate) overlap: f64,
+    /// Unit normal from `i` to `j`.
+    pub(crate) normal: Vec2,
+    /// Elastic normal force `kn * overlap` (N).
+    pub(crate) elastic_normal: f64,
+    /// Shear spring after the update (N).
+    pub(crate) shear_spring: f64,
+    /// Whether the spring is at the Coulomb cap.
+    pub(crate) sliding: bool,
+}
+
+/// Keeps every contact's record, in pair order (`None`: not in contact).
+pub(crate) struct RecordSink {
+    pub(crate) records: Vec<Option<PairRecord>>,
+}
+
+impl ForceSink for RecordSink {
+    #[inline(always)]
+    unsafe fn add(&mut self, _: usize, _: usize, _: usize, _: Vec2, _: f64, _: f64) {}
+    #[inline(always)]
+    fn skip(&mut self, _k: usize) {}
+    fn record(&mut self, k: usize, overlap: f64, n: Vec2, c: &ContactForce, spring: f64) {
+        self.records[k] = Some(PairRecord {
+            overlap,
+            normal: n,
+            elastic_normal: c.elastic_normal,
+            shear_spring: spring,
+            sliding: c.sliding,
+        });
+    }
+}
+
+/// Adds each pair's forces straight onto its two particles (a stripe's interior
+/// pairs, and on one thread the pairs across stripes).
+pub(crate) struct DirectSink<'a> {
+    pub(crate) force: &'a DisjointWriter<Vec2>,
+    pub(crate) torque: &'a DisjointWriter<f64>,
+}
+
+impl ForceSink for DirectSink<'_> {
+    #[inline(always)]
+    unsafe fn add(&mut self, _k: usize, i: usize, j: usize, f: Vec2, torque_i: f64, torque_j: f64) {
+        let fj = self.force.get(j);
+        fj[0] += f[0];
+        fj[1] += f[1];
+        let fi = self.force.get(i);
+        fi[0] -= f[0];
+        fi[1] -= f[1];
+        *self.torque.get(i) += torque_i;
+        *self.torque.get(j) += torque_j;
+    }
+
+    #[inline(always)]
+    fn skip(&mut self, _k: usize) {}
+}
+
+/// Keeps each cross-stripe pair's force in its own slot; the stripes'
+/// integration applies them ([`CrossForces::apply`]).
+pub(crate) struct BufferSink<'a> {
+    pub(crate) slots: &'a mut [PairForce],
+}
+
+impl ForceSink for BufferSink<'_> {
+    #[inline(always)]
+    unsafe fn add(
+        &mut self,
+        k: usize,
+        _i: usize,
+        _j: usize,
+        f: Vec2,
+        torque_i: f64,
+        torque_j: f64,
+    ) {
+        self.slots[k] = PairForce {
+            force: f,
+            torque_i,
+            torque_j,
+            active: true,
+        };
+    }
+
+    #[inline(always)]
+    fn skip(&mut self, k: usize) {
+        self.slots[k].active = false;
+    }
+}
+
+/// The buffered forces of cross-block pairs and, per block, which of them touch it.
+pub(crate) struct CrossForces<'a> {
+    pub(crate) pair_i: &'a [u32],
+    pub(crate) pair_j: &'a [u32],
+    pub(crate) first: usize,
+    pub(crate) forces: &'a [PairForce],
+    pub(crate) touch: &'a [u32],
+    pub(crate) touch_start: &'a [usize],
+}
+
+impl CrossForces<'_> {
+    /// Adds block `b`'s cross-pair forces to `force`/`torque`, which start at particle `lo`.
+    pub(crate) fn apply(&self, b: usize, lo: usize, force: &mut [Vec2], torque: &mut [f64]) {
+        if self.touch_start.len() <= b + 1 {
+            return;
+        }
+        for &entry in &self.touch[self.touch_start[b]..self.touch_start[b + 1]] {
+            let c = (entry >> 1) as usize;
+            let pf = &self.forces[c];
+            if !pf.active {
+                continue;
+            }
+            let k = self.first + c;
+            if entry & 1 == 1 {
+                let q = self.pair_j[k] as usize - lo;
+                force[q][0] += pf.force[0];
+                force[q][1] += pf.force[1];
+                torque[q] += pf.torque_j;
+            } else {
+                let q = self.pair_i[k] as usize - lo;
+                force[q][0] -= pf.force[0];
+                force[q][1] -= pf.force[1];
+                torque[q] += pf.torque_i;
+            }
+        }
+    }
+}
+
+/// A cross-block pair's force, computed in parallel and applied afterwards.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PairForce {
+    pub(crate) force: Vec2,
+    pub(crate) torque_i: f64,
+    pub(crate) torque_j: f64,
+    pub(crate) active: bool,
+}
+
+impl PairForce {
+    pub(crate) const NONE: PairForce = PairForce {
+        force: [0.0; 2],
+        torque_i: 0.0,
+        torque_j: 0.0,
+        active: false,
+    };
+}
+
+/// One block's share of the contact phase.
+pub(crate) struct BlockWork<'a> {
+    pub(crate) block: usize,
+    pub(crate) shear: &'a mut [f64],
+    pub(crate) sliding: &'a mut [bool],
+    pub(crate) cross_shear: &'a mut [f64],
+    pub(crate) cross_sliding: &'a mut [bool],
+    pub(crate) cross_forces: &'a mut [PairForce],
+}
+
+/// The reset of step 2: each particle's resultant starts from its external
+/// force, gravity and follower load, its torque from its external torque.
+pub(crate) struct ResetKernel<'a> {
+    pub(crate) boundary_load: Option<&'a [Vec2]>,
+    pub(crate) external_force: &'a [Vec2],
+    pub(crate) external_torque: &'a [f64],
+    pub(crate) mass: &'a [f64],
+    pub(crate) gravity: Vec2,
+    /// No pressure chain, gravity or external force or torque: every external
+    /// force is +-0, so `f_e + m g` is +0 whatever its sign, and the torques
+    /// (+-0) are copied as they are.
+    pub(crate) no_loads: bool,
+}
+
+impl ResetKernel<'_> {
+    /// Resets the resultants of particles `lo..hi` to their external loads.
+    ///
+    /// # Safety
+    /// `lo..hi` in bounds and owned by the calling task.
+    #[inline(always)]
+    pub(crate) unsafe fn apply(
+        &self,
+        lo: usize,
+        hi: usize,
+        force: &DisjointWriter<Vec2>,
+        torque: &DisjointWriter<f64>,
+    ) {
+        if self.no_loads {
+            force.range(lo, hi).fill([0.0; 2]);
+            torque
+                .range(lo, hi)
+                .copy_from_slice(&self.external_torque[lo..hi]);
+            return;
+        }
+        for q in lo..hi {
+            let fe = self.external_force[q];
+            let m = self.mass[q];
+            let mut f = [fe[0] + m * self.gravity[0], fe[1] + m * self.gravity[1]];
+            if let Some(load) = self.boundary_load {
+                f = add(f, load[q]);
+            }
+            *force.get(q) = f;
+            *torque.get(q) = self.external_torque[q];
+        }
+    }
+}
+
+/// A [`PairKernel`] over the particles `$p` and pair list `$pairs` of simulation
+/// `$sim` (a macro, so that the shear springs can be borrowed mutably apart).
+macro_rules! pair_kernel {
+    ($sim:expr, $p:expr, $pairs:expr, $increment_time:expr) => {
+        PairKernel {
+            position: &$p.position,
+            velocity: &$p.velocity,
+            angular_velocity: &$p.angular_velocity,
+            radius: &$p.radius,
+            mass: &$p.mass,
+            pair_i: &$pairs.i,
+            pair_j: &$pairs.j,
+            shift: &$pairs.shift,
+            model: &$pairs.model,
+            materials: &$sim.materials,
+            cell: $sim.cell.as_ref(),
+            velocity_gradient: $sim
+                .cell
+                .as_ref()
+                .filter(|c| c.is_deforming())
+                .map(|c| c.velocity_gradient),
+            dt: $sim.params.time_step,
+            increment_time: $increment_time,
+            max_overlap_ratio: $sim.params.max_overlap_ratio,
+            single_model: $sim.materials.single_undamped_model(),
+        }
+    };
+}
+pub(crate) use pair_kernel;
+
+/// The contact law over a run of listed pairs: what it reads of the particles,
+/// the pair list, the materials and the step.
+pub(crate) struct PairKernel<'a> {
+    pub(crate) position: &'a [Vec2],
+    pub(crate) velocity: &'a [Vec2],
+    pub(crate) angular_velocity: &'a [f64],
+    pub(crate) radius: &'a [f64],
+    pub(crate) mass: &'a [f64],
+    pub(crate) pair_i: &'a [u32],
+    pub(crate) pair_j: &'a [u32],
+    pub(crate) shift: &'a [[i8; 2]],
+    pub(crate) model: &'a [u16],
+    pub(crate) materials: &'a MaterialTable,
+    pub(crate) cell: Option<&'a PeriodicCell>,
+    pub(crate) velocity_gradient: Option<Mat2>,
+    pub(crate) dt: f64,
+    pub(crate) increment_time: f64,
+    pub(crate) max_overlap_ratio: f64,
+    /// The one model of every pair when there is one and it has no dashpot.
+    pub(crate) single_model: Option<ContactModel>,
+}
+
+impl PairKernel<'_> {
+    /// Evaluates pairs `first..first + shear.len()`, adding forces to both particles.
+    ///
+    /// # Safety
+    /// Concurrent callers must touch disjoint particles.
+    #[inline(always)]
+    pub(crate) unsafe fn run<const MEASURE: bool, S: ForceSink>(
+        &self,
+        first: usize,
+        shear: &mut [f64],
+        sliding: &mut [bool],
+        sink: &mut S,
+    ) -> ContactTally {
+        // the loop specialised on what is fixed for the whole call: the same
+        // arithmetic in every variant, minus the tests whose outcome is known
+        match (
+            self.velocity_gradient.is_some(),
+            self.single_model.is_some(),
+        ) {
+            (false, false) => self.pairs::<MEASURE, false, false, S>(first, shear, sliding, sink),
+            (false, true) => self.pairs::<MEASURE, false, true, S>(first, shear, sliding, sink),
+            (true, false) => self.pairs::<MEASURE, true, false, S>(first, shear, sliding, sink),
+            (true, true) => self.pairs::<MEASURE, true, true, S>(first, shear, sliding, sink),
+        }
+    }
+
+    /// The loop of [`PairKernel::run`]: `DEFORMING` when the cell has a velocity
+    /// gradient, `SINGLE` when [`PairKernel::single_model`] is set.
+    ///
+    /// # Safety
+    /// As [`PairKernel::run`].
+    #[inline(always)]
+    unsafe fn pairs<
+        const MEASURE: bool,
+        const DEFORMING: bool,
+        const SINGLE: bool,
+        S: ForceSink,
+    >(
+        &self,
+        first: usize,
+        shear: &mut [f64],
+        sliding: &mut [bool],
+        sink: &mut S,
+    ) -> ContactTally {
+        let mut tally = ContactTally::default();
+        let gradient = self.velocity_gradient.unwrap_or([[0.0; 2]; 2]);
+        let single = self
+            .single_model
+            .unwrap_or(ContactModel::linear(1.0, 1.0, 0.0));
+        let max_overlap_ratio = self.max_overlap_ratio;
+        let mut overlap_violation = false;
+        debug_assert!(first + shear.len() <= self.pair_i.len());
+        for (k, (spring, slide)) in shear.iter_mut().zip(sliding.iter_mut()).enumerate() {
+            let pair = first + k;
+            // SAFETY: the neighbour list holds pairs `first..first + shear.len()` of
+            // particles that exist (`NeighborList::build`), so every index below is
+            // in bounds; the checks would cost a tenth of the loop
+            let i = *self.pair_i.get_unchecked(pair) as usize;
+            let j = *self.pair_j.get_unchecked(pair) as usize;
+            debug_assert!(i < self.position.len() && j < self.position.len());
+            let xi = *self.position.get_unchecked(i);
+            let mut xj = *self.position.get_unchecked(j);
+            let s = *self.shift.get_unchecked(pair);
+            if s != [0, 0] {
+                if let Some(c) = self.cell {
+                    xj = add(xj, c.image_offset(s));
+                }
+            }
+            let d = sub(xj, xi);
+            let (ri, rj) = (*self.radius.get_unchecked(i), *self.radius.get_unchecked(j));
+            let reach = ri + rj;
+            let dist_sq = dot(d, d);
+            if dist_sq >= reach * reach {
+                if *spring != 0.0 || *slide {
+                    *spring = 0.0;
+                    *slide = false;
+                }
+                sink.skip(k);
+                continue;
+            }
+            let dist = dist_sq.sqrt();
+            let n = scale(d, 1.0 / dist);
+            let overlap = reach - dist;
+            let t = perp(n);
+            let mut dv = sub(
+                *self.velocity.get_unchecked(j),
+                *self.velocity.get_unchecked(i),
+            );
+            if DEFORMING {
+                dv = add(dv, mat_vec(&gradient, d));
+            }
+            let vn = dot(dv, n);
+            let vt = dot(dv, t)
+                - (*self.angular_velocity.get_unchecked(i) * ri
+                    + *self.angular_velocity.get_unchecked(j) * rj);
+            let model = if SINGLE {
+                &single
+            } else {
+                self.materials.by_index(*self.model.get_unchecked(pair))
+            };
+            let reduced_mass = if !SINGLE
+                && (model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0)
+            {
+                let (mi, mj) = (self.mass[i], self.mass[j]);
+                mi * mj / (mi + mj)
+            } else {
+                0.0
+            };
+            let (dt, increment_time) = (self.dt, self.increment_time);
+            let c = if SINGLE {
+                linear_coulomb_with::<false>(
+                    model,
+                    overlap,
+                    vn,
+                    vt,
+                    dt,
+                    increment_time,
+                    reduced_mass,
+                    spring,
+                )
+            } else {
+                linear_coulomb(
+                    model,
+                    overlap,
+                    vn,
+                    vt,
+                    dt,
+                    increment_time,
+                    reduced_mass,
+                    spring,
+                )
+            };
+            *slide = c.sliding;
+            sink.record(k, overlap, n, &c, *spring);
+            let f = [
+                c.normal * n[0] + c.shear * t[0],
+                c.normal * n[1] + c.shear * t[1],
+            ];
+            sink.add(k, i, j, f, -ri * c.shear, -rj * c.shear);
+            tally.friction += c.friction_dissipation;
+            tally.viscous += c.viscous_dissipation;
+            overlap_violation |= overlap > max_overlap_ratio * ri.min(rj);
+            if MEASURE {
+                tally.elastic += elastic_energy(model, model.normal_stiffness * overlap, *spring);
+                tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
+                tally.contacts += 1;
+            }
+        }
+        tally.overlap_violation = overlap_violation;
+        tally
+    }
+}

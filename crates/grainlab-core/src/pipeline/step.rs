@@ -1,0 +1,629 @@
+//! The step pipeline: [`Simulation::run`] and the stages of one step, in the
+//! order of the module documentation of [`crate::pipeline`].
+use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
+
+use super::pair_kernel::{
+    pair_kernel, wall_contact, BlockWork, BufferSink, ContactTally, CrossForces, DirectSink,
+    PairForce, PairKernel, ResetKernel,
+};
+use super::Simulation;
+use crate::bond::bond_force;
+use crate::diagnostics::Measurements;
+use crate::error::Result;
+use crate::integrate::{
+    integrate_chunk, IntegrationInputs, IntegrationStep, IntegrationTally, MotionChunk,
+};
+use crate::law::elastic_energy;
+use crate::parallel::{
+    even_bounds, map_blocks, split_ranges, DisjointWriter, Team, PARALLEL_MIN_PARTICLES,
+};
+use crate::vec2::{add, dot, perp, scale, sub, Mat2, Vec2};
+
+/// The tallies of the stripes, in stripe order, then the bonds'.
+fn merge_tallies(stripes: &[ContactTally], bonds: &ContactTally) -> ContactTally {
+    let mut contacts = ContactTally::default();
+    for t in stripes {
+        contacts.merge(t);
+    }
+    contacts.merge(bonds);
+    contacts
+}
+
+impl Simulation {
+    /// Runs `n` steps without measuring any of them (faster; dissipation is still tallied).
+    pub fn advance(&mut self, n: u64) -> Result<()> {
+        self.run_steps(n, false)
+    }
+
+    /// Runs `n` steps; the last one is measured (see [`Simulation::measurements`]).
+    pub fn run(&mut self, n: u64) -> Result<()> {
+        self.run_steps(n, true)
+    }
+
+    /// The step loop, on the simulation's pool when it has one and the system is
+    /// large enough: one broadcast per call, worker 0 steps, the others serve phases.
+    fn run_steps(&mut self, n: u64, measure_last: bool) -> Result<()> {
+        self.check_consistent()?;
+        // external loads cannot change during a run call: scan them once, not every step
+        let p = &self.particles;
+        self.external_loads = p.external_force.iter().any(|f| *f != [0.0, 0.0])
+            || p.external_torque.iter().any(|&t| t != 0.0);
+        let steps = |sim: &mut Simulation, team: Option<&Team>| -> Result<()> {
+            sim.pacer.start();
+            for k in 0..n {
+                // with a team, the pacer may run a step on this thread alone
+                let team = team.filter(|_| !sim.pacer.alone());
+                let builds = sim.neighbors.build_count;
+                if measure_last && k + 1 == n {
+                    sim.step::<true>(team)?;
+                } else {
+                    sim.step::<false>(team)?;
+                }
+                sim.pacer.step_done(sim.neighbors.build_count != builds);
+            }
+            Ok(())
+        };
+        let pool = match self.pool.take() {
+            Some(pool) if self.particles.len() >= PARALLEL_MIN_PARTICLES && n > 0 => pool,
+            other => {
+                self.pool = other;
+                return steps(self, None);
+            }
+        };
+        let team = Team::new(self.threads);
+        let this = SimPtr(self as *mut Simulation);
+        let results = pool.broadcast(|ctx| {
+            if ctx.index() == 0 {
+                // SAFETY: only worker 0 touches the simulation outside of team
+                // phases, and the phases obey the block ownership rules.
+                let sim = unsafe { &mut *this.get() };
+                let out = catch_unwind(AssertUnwindSafe(|| steps(sim, Some(&team))));
+                team.dismiss();
+                Some(out)
+            } else {
+                team.serve(ctx.index());
+                None
+            }
+        });
+        self.pool = Some(pool);
+        match results.into_iter().next().flatten() {
+            Some(Ok(result)) => result,
+            Some(Err(panic)) => resume_unwind(panic),
+            None => unreachable!("worker 0 always reports"),
+        }
+    }
+
+    /// One step, as the list of its stages (the module documentation gives
+    /// their order and what each does); `MEASURE` adds kinetic and elastic
+    /// energy, contact counts and the unbalanced force ratio.
+    fn step<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Result<()> {
+        self.ensure_neighbors()?;
+        self.boundary_loads();
+        let mut stripes = self.particle_contacts::<MEASURE>(team);
+        let bonds = self.bond_forces::<MEASURE>();
+        let (walls, wall_work) = self.wall_forces::<MEASURE>();
+        if team.is_none() {
+            self.cross_pairs_in_order::<MEASURE>(&mut stripes);
+        }
+        let contacts = merge_tallies(&stripes, &bonds);
+        self.servo_walls();
+        let motion = self.integrate::<MEASURE>(team);
+        self.move_walls();
+        self.deform_cell();
+        self.track_displacements(&motion);
+        self.book_energy(&contacts, &walls, wall_work, &motion);
+        if MEASURE {
+            self.record_measurements(&contacts, &bonds, &walls, &motion);
+        }
+        self.advance_clock();
+        // keep the lists valid between steps, so that queries see every contact;
+        // the rebuild happens at the same state as it would at the next step's start
+        self.ensure_neighbors()?;
+        self.check_step(&motion, &contacts, &walls)
+    }
+
+    /// Step 6: servo walls set their velocity from this step's force.
+    fn servo_walls(&mut self) {
+        let dt = self.params.time_step;
+        for wall in self.walls.iter_mut().filter(|w| w.active) {
+            wall.update_servo(dt);
+        }
+    }
+
+    /// Step 8a: active walls translate at their velocity (and remember the
+    /// displacement for the work ledger).
+    fn move_walls(&mut self) {
+        let dt = self.params.time_step;
+        for wall in self.walls.iter_mut() {
+            let d = scale(wall.velocity, dt);
+            wall.last_step_displacement = if wall.active { d } else { [0.0; 2] };
+            if wall.active && d != [0.0, 0.0] {
+                wall.translate(d);
+            }
+        }
+    }
+
+    /// Step 8b: a deforming periodic cell takes its step of the imposed flow.
+    fn deform_cell(&mut self) {
+        let dt = self.params.time_step;
+        if let Some(cell) = &mut self.cell {
+            if cell.is_deforming() {
+                let m = cell.step_map(dt);
+                cell.deform(&m);
+            }
+        }
+    }
+
+    /// Step 8c: the largest displacements since the last build, for the
+    /// rebuild criterion.
+    fn track_displacements(&mut self, motion: &IntegrationTally) {
+        let n = &mut self.neighbors;
+        n.max_fluctuation_sq = n.max_fluctuation_sq.max(motion.max_fluctuation_sq);
+        n.max_displacement_sq = n.max_displacement_sq.max(motion.max_displacement_sq);
+    }
+
+    /// Step 8d: the energy ledger's dissipation and work of this step.
+    fn book_energy(
+        &mut self,
+        contacts: &ContactTally,
+        walls: &ContactTally,
+        wall_work: f64,
+        motion: &IntegrationTally,
+    ) {
+        let ledger = &mut self.ledger;
+        ledger.friction_dissipated += contacts.friction + walls.friction;
+        ledger.viscous_dissipated += contacts.viscous + walls.viscous;
+        ledger.damping_dissipated += motion.damping_dissipated;
+        ledger.wall_work += wall_work;
+        ledger.external_work += motion.external_work;
+        ledger.boundary_work += motion.boundary_work;
+    }
+
+    /// Step 8e, measured steps only: kinetic and elastic energy, contact
+    /// counts and the mean unbalanced force ratio.
+    fn record_measurements(
+        &mut self,
+        contacts: &ContactTally,
+        bonds: &ContactTally,
+        walls: &ContactTally,
+        motion: &IntegrationTally,
+    ) {
+        let ledger = &mut self.ledger;
+        ledger.kinetic = motion.kinetic;
+        ledger.elastic = contacts.elastic + walls.elastic;
+        let force_sum = contacts.force_sum + walls.force_sum;
+        let n_forces = contacts.contacts + walls.contacts;
+        let mean_contact = if n_forces > 0 {
+            force_sum / n_forces as f64
+        } else {
+            0.0
+        };
+        let mean_unbalanced = if motion.free_count > 0 {
+            motion.unbalanced_force_sum / motion.free_count as f64
+        } else {
+            0.0
+        };
+        self.measurements = Measurements {
+            step: self.step_count,
+            contact_count: contacts.contacts - bonds.contacts,
+            wall_contact_count: walls.contacts,
+            mean_unbalanced_force_ratio: if mean_contact > 0.0 {
+                mean_unbalanced / mean_contact
+            } else if mean_unbalanced > 0.0 {
+                f64::INFINITY
+            } else {
+                0.0
+            },
+            energy: self.ledger,
+        };
+    }
+
+    /// Step 8f: time advances; the next force evaluation adds the shear
+    /// increment of this step's displacement.
+    fn advance_clock(&mut self) {
+        self.half_kick_pending = false;
+        self.springs_current = false;
+        self.step_count += 1;
+        self.time += self.params.time_step;
+    }
+
+    /// Step 9: a non-finite state or an overlap beyond the limit stops the run.
+    fn check_step(
+        &self,
+        motion: &IntegrationTally,
+        contacts: &ContactTally,
+        walls: &ContactTally,
+    ) -> Result<()> {
+        if motion.non_finite {
+            return Err(self.non_finite_error());
+        }
+        if contacts.overlap_violation || walls.overlap_violation {
+            return Err(self.overlap_error());
+        }
+        Ok(())
+    }
+
+    /// Steps 2-3: reset resultants, then particle-particle contact forces; returns
+    /// each stripe's tally. With a team the pairs across stripes are evaluated in
+    /// the same phase into a buffer that each stripe's integration applies (step
+    /// 7); without one they wait for [`Simulation::cross_pairs_in_order`].
+    fn particle_contacts<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Vec<ContactTally> {
+        let increment_time = self.increment_time();
+        let buffer_cross = team.is_some();
+        let n_blocks = self.neighbors.block_ranges.len();
+        let pairs = &mut self.neighbors.pairs;
+        let starts = &pairs.block_start;
+        // interior pairs of each block, then the cross-block pairs shared out evenly
+        let cross_start = starts[n_blocks];
+        let n_pairs = pairs.len();
+        let cross_ranges: Vec<(usize, usize)> = even_bounds(n_pairs - cross_start, n_blocks)
+            .into_iter()
+            .map(|(lo, hi)| (cross_start + lo, cross_start + hi))
+            .collect();
+        let mut ranges: Vec<(usize, usize)> =
+            (0..n_blocks).map(|b| (starts[b], starts[b + 1])).collect();
+        ranges.extend(&cross_ranges);
+        let mut shear_parts = split_ranges(&mut pairs.shear, &ranges);
+        let mut sliding_parts = split_ranges(&mut pairs.sliding, &ranges);
+        let cross_shear = shear_parts.split_off(n_blocks);
+        let cross_sliding = sliding_parts.split_off(n_blocks);
+        // every slot is rewritten by the kernel (a force or `skip`), so no clearing
+        self.cross_forces
+            .resize(n_pairs - cross_start, PairForce::NONE);
+        let local: Vec<(usize, usize)> = cross_ranges
+            .iter()
+            .map(|&(lo, hi)| (lo - cross_start, hi - cross_start))
+            .collect();
+        let cross_buffers = split_ranges(&mut self.cross_forces, &local);
+
+        let p = &mut self.particles;
+        let force = DisjointWriter::new(&mut p.force);
+        let torque = DisjointWriter::new(&mut p.torque);
+        let kernel = pair_kernel!(self, p, pairs, increment_time);
+        let reset = ResetKernel {
+            boundary_load: (!self.chains.is_empty()).then_some(self.boundary_load.as_slice()),
+            external_force: &p.external_force,
+            external_torque: &p.external_torque,
+            mass: &p.mass,
+            gravity: self.params.gravity,
+            no_loads: self.chains.is_empty()
+                && !self.external_loads
+                && self.params.gravity == [0.0, 0.0],
+        };
+        let blocks: Vec<BlockWork<'_>> = shear_parts
+            .into_iter()
+            .zip(sliding_parts)
+            .zip(cross_shear.into_iter().zip(cross_sliding))
+            .zip(cross_buffers)
+            .enumerate()
+            .map(
+                |(b, (((shear, sliding), (cross_shear, cross_sliding)), cross_forces))| BlockWork {
+                    block: b,
+                    shear,
+                    sliding,
+                    cross_shear,
+                    cross_sliding,
+                    cross_forces,
+                },
+            )
+            .collect();
+        let block_ranges = &self.neighbors.block_ranges;
+        let tallies = map_blocks(team, blocks, |work| {
+            let b = work.block;
+            let mut direct = DirectSink {
+                force: &force,
+                torque: &torque,
+            };
+            // SAFETY: block b resets and writes only the forces of its own particles
+            // (interior pairs have both particles in block b); cross pairs only
+            // write their own slots of the buffer.
+            unsafe {
+                let (lo, hi) = block_ranges[b];
+                reset.apply(lo, hi, &force, &torque);
+                let mut tally =
+                    kernel.run::<MEASURE, _>(ranges[b].0, work.shear, work.sliding, &mut direct);
+                if buffer_cross {
+                    let mut buffered = BufferSink {
+                        slots: work.cross_forces,
+                    };
+                    let cross = kernel.run::<MEASURE, _>(
+                        ranges[n_blocks + b].0,
+                        work.cross_shear,
+                        work.cross_sliding,
+                        &mut buffered,
+                    );
+                    tally.merge(&cross);
+                }
+                tally
+            }
+        });
+        // with a buffer the cross-block forces are applied by each block's
+        // integration (step 7)
+        tallies
+    }
+
+    /// Step 5b, on one thread: the pairs across stripes, after bonds and walls,
+    /// in pair order and in the same chunks as a team would evaluate them, adding
+    /// their forces straight onto the particles. Each particle then receives the
+    /// same additions in the same order as from the buffer (which a stripe's
+    /// integration applies after the bonds and walls, in pair order), and each
+    /// stripe's tally the same merges: the same bits without the buffer.
+    fn cross_pairs_in_order<const MEASURE: bool>(&mut self, tallies: &mut [ContactTally]) {
+        let increment_time = self.increment_time();
+        let n_blocks = self.neighbors.block_ranges.len();
+        let pairs = &mut self.neighbors.pairs;
+        let cross_start = pairs.block_start[n_blocks];
+        let chunks = even_bounds(pairs.len() - cross_start, n_blocks);
+        let p = &mut self.particles;
+        let force = DisjointWriter::new(&mut p.force);
+        let torque = DisjointWriter::new(&mut p.torque);
+        let kernel = pair_kernel!(self, p, pairs, increment_time);
+        let mut direct = DirectSink {
+            force: &force,
+            torque: &torque,
+        };
+        for (tally, &(lo, hi)) in tallies.iter_mut().zip(&chunks) {
+            let (lo, hi) = (cross_start + lo, cross_start + hi);
+            // SAFETY: one thread; the pairs index particles that exist
+            let cross = unsafe {
+                kernel.run::<MEASURE, _>(
+                    lo,
+                    &mut pairs.shear[lo..hi],
+                    &mut pairs.sliding[lo..hi],
+                    &mut direct,
+                )
+            };
+            tally.merge(&cross);
+        }
+    }
+
+    /// Step 4: bonds (sequential; chains of membrane disks are short).
+    fn bond_forces<const MEASURE: bool>(&mut self) -> ContactTally {
+        let mut tally = ContactTally::default();
+        let increment_time = self.increment_time();
+        let l = self.deforming_gradient();
+        for bond in self.bonds.list.iter_mut() {
+            let copy = *bond;
+            let b = bond_force(
+                &copy,
+                &self.particles,
+                self.cell.as_ref(),
+                l,
+                increment_time,
+                &mut bond.shear,
+            );
+            let (i, j) = (copy.i as usize, copy.j as usize);
+            let p = &mut self.particles;
+            let f = add(
+                scale(b.normal, b.normal_force),
+                scale(perp(b.normal), b.shear_force),
+            );
+            p.force[j] = add(p.force[j], f);
+            p.force[i] = sub(p.force[i], f);
+            p.torque[i] -= p.radius[i] * b.shear_force;
+            p.torque[j] -= p.radius[j] * b.shear_force;
+            if MEASURE {
+                let (fn_, fs) = (b.normal_force, b.shear_force);
+                tally.elastic +=
+                    0.5 * fn_ * fn_ / copy.normal_stiffness + 0.5 * fs * fs / copy.shear_stiffness;
+                tally.force_sum += (fn_ * fn_ + fs * fs).sqrt();
+                tally.contacts += 1;
+            }
+        }
+        tally
+    }
+
+    /// Step 5: particle-wall contacts; returns the tally and the walls' work over
+    /// their last step's displacement.
+    fn wall_forces<const MEASURE: bool>(&mut self) -> (ContactTally, f64) {
+        let mut tally = ContactTally::default();
+        let previous_force: Vec<Vec2> = self.walls.iter().map(|w| w.force).collect();
+        for wall in &mut self.walls {
+            wall.force = [0.0; 2];
+            wall.contact_count = 0;
+            wall.stiffness_sum = 0.0;
+        }
+        let dt = self.params.time_step;
+        let increment_time = self.increment_time();
+        let wp = &mut self.neighbors.wall_pairs;
+        for k in 0..wp.wall.len() {
+            let wall = &mut self.walls[wp.wall[k] as usize];
+            let q = wp.particle[k] as usize;
+            let model = self.materials.by_index(wp.model[k]);
+            let Some((g, c)) = wall_contact(
+                wall,
+                model,
+                &self.particles,
+                q,
+                dt,
+                increment_time,
+                &mut wp.shear[k],
+            ) else {
+                wp.sliding[k] = false;
+                continue;
+            };
+            wp.sliding[k] = c.sliding;
+            let p = &mut self.particles;
+            let r = p.radius[q];
+            let n = g.normal;
+            let f = add(scale(n, c.normal), scale(perp(n), c.shear));
+            p.force[q] = add(p.force[q], f);
+            p.torque[q] -= r * c.shear;
+            wall.force = sub(wall.force, f);
+            wall.contact_count += 1;
+            wall.stiffness_sum += model.normal_stiffness;
+            tally.friction += c.friction_dissipation;
+            tally.viscous += c.viscous_dissipation;
+            if g.overlap > self.params.max_overlap_ratio * r {
+                tally.overlap_violation = true;
+            }
+            if MEASURE {
+                tally.elastic += elastic_energy(model, c.elastic_normal, wp.shear[k]);
+                tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
+                tally.contacts += 1;
+            }
+        }
+        // the work of a wall on the particles over its last step's displacement d,
+        // with the trapezoid of the forces before and after it: the counterpart of
+        // leapfrog's kinetic energy and the springs' elastic energy (docs/contact-law.md)
+        let work = self
+            .walls
+            .iter()
+            .zip(&previous_force)
+            .map(|(w, f0)| -0.5 * dot(add(*f0, w.force), w.last_step_displacement))
+            .sum();
+        (tally, work)
+    }
+
+    /// Step 7: leapfrog with local damping in parallel chunks.
+    fn integrate<const MEASURE: bool>(&mut self, team: Option<&Team>) -> IntegrationTally {
+        // with a team the cross-block forces wait in the buffer (else they are applied)
+        let buffered = team.is_some();
+        let dt = self.params.time_step;
+        let step_map = self
+            .cell
+            .as_ref()
+            .filter(|c| c.is_deforming())
+            .map(|c| (c.origin, c.step_map(dt)));
+        let accumulated_map: Mat2 = match &step_map {
+            Some((_, m)) => self.neighbors.advance_map(m).accumulated_map,
+            None => self.neighbors.reference().accumulated_map,
+        };
+        let p = &mut self.particles;
+        let has_external = self.params.gravity != [0.0, 0.0] || self.external_loads;
+        let step = IntegrationStep {
+            dt,
+            kick: if self.half_kick_pending { 0.5 * dt } else { dt },
+            half_kick: self.half_kick_pending,
+            alpha: self.params.local_damping,
+            gravity: self.params.gravity,
+            has_external,
+            step_map,
+            accumulated_map,
+        };
+        let inputs = IntegrationInputs {
+            inv_mass: &p.inv_mass,
+            inv_inertia: &p.inv_inertia,
+            mass: &p.mass,
+            inertia: &p.inertia,
+            fixity: &p.fixity,
+            external_force: &p.external_force,
+            external_torque: &p.external_torque,
+            boundary_load: (!self.chains.is_empty()).then_some(self.boundary_load.as_slice()),
+            reference: self.neighbors.reference().reference,
+        };
+        // the stripes of the contact phase: a worker integrates (first) the
+        // stripes whose contacts it just computed
+        let bounds = self.neighbors.block_ranges.clone();
+        let cross = CrossForces {
+            pair_i: &self.neighbors.pairs.i,
+            pair_j: &self.neighbors.pairs.j,
+            first: self
+                .neighbors
+                .pairs
+                .block_start
+                .last()
+                .copied()
+                .unwrap_or(0),
+            forces: &self.cross_forces,
+            touch: &self.neighbors.cross_touch,
+            touch_start: &self.neighbors.cross_touch_start,
+        };
+        type Work<'w> = (
+            usize,
+            usize,
+            &'w mut [Vec2],
+            &'w mut [Vec2],
+            &'w mut [f64],
+            &'w mut [f64],
+            &'w mut [Vec2],
+            &'w mut [f64],
+        );
+        let chunks: Vec<Work<'_>> = split_ranges(&mut p.position, &bounds)
+            .into_iter()
+            .zip(split_ranges(&mut p.velocity, &bounds))
+            .zip(split_ranges(&mut p.rotation, &bounds))
+            .zip(split_ranges(&mut p.angular_velocity, &bounds))
+            .zip(split_ranges(&mut p.force, &bounds))
+            .zip(split_ranges(&mut p.torque, &bounds))
+            .zip(&bounds)
+            .enumerate()
+            .map(
+                |(
+                    b,
+                    (
+                        (((((position, velocity), rotation), angular_velocity), force), torque),
+                        &(lo, _),
+                    ),
+                )| {
+                    (
+                        b,
+                        lo,
+                        position,
+                        velocity,
+                        rotation,
+                        angular_velocity,
+                        force,
+                        torque,
+                    )
+                },
+            )
+            .collect();
+        let tallies = map_blocks(
+            team,
+            chunks,
+            |(b, lo, position, velocity, rotation, angular_velocity, force, torque)| {
+                if buffered {
+                    // the cross-block pairs touching this block, in pair order, as a
+                    // sequential pass over all of them adds them
+                    cross.apply(b, lo, force, torque);
+                }
+                let chunk = MotionChunk {
+                    lo,
+                    position,
+                    velocity,
+                    rotation,
+                    angular_velocity,
+                    force,
+                    torque,
+                };
+                integrate_chunk::<MEASURE>(chunk, &inputs, &step)
+            },
+        );
+        let mut total = IntegrationTally::default();
+        for t in &tallies {
+            total.merge(t);
+        }
+        total
+    }
+
+    /// Step 2a: the follower loads of the pressure chains at the current positions.
+    pub(crate) fn boundary_loads(&mut self) {
+        if self.chains.is_empty() {
+            return;
+        }
+        self.boundary_load.clear();
+        self.boundary_load.resize(self.particles.len(), [0.0; 2]);
+        for chain in &self.chains {
+            chain.apply(
+                &self.particles.position,
+                &self.walls,
+                &mut self.boundary_load,
+            );
+        }
+    }
+}
+
+/// The simulation handed to worker 0 of a broadcast.
+struct SimPtr(*mut Simulation);
+
+// SAFETY: the pointer is dereferenced by worker 0 only, while `run_steps` holds
+// the exclusive borrow it came from.
+unsafe impl Send for SimPtr {}
+unsafe impl Sync for SimPtr {}
+
+impl SimPtr {
+    fn get(&self) -> *mut Simulation {
+        self.0
+    }
+}
