@@ -68,18 +68,28 @@ class ContactModel:
     """False: the two groups do not interact at all (they pass through each other)."""
 
 
+def _tangent(normal: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``rot90(n) = (-n_y, n_x)`` of each row."""
+    return np.column_stack([-normal[:, 1], normal[:, 0]])
+
+
 @dataclass(frozen=True)
 class Contacts:
-    """Particle-particle contacts (and bonds) as parallel arrays, sorted by ``(i, j)``.
+    """Particle-particle contacts (and bonds) as parallel arrays, sorted by ``(i, j)``,
+    in the one force convention of grainlab's Python side, the snapshot's
+    (docs/conventions.md, "Contact forces"):
 
-    ``normal`` is the unit vector from ``i`` to ``j``; ``normal_force`` (N, >= 0
-    unless bonded) and ``shear_force`` (N, along ``(-n_y, n_x)``) act on ``j``,
-    their opposites on ``i``. Every row is one consistent state: the forces at
-    the current positions exactly as the next step's force evaluation computes
-    them, ``normal_force = kn * overlap`` and the shear spring with the increment
-    of the displacement since the last evaluation, capped at ``mu * normal_force``;
-    ``sliding`` is true exactly where ``|shear_force| = mu * normal_force``.
-    Forces are the elastic parts (no dashpot forces); see docs/contact-law.md.
+    ``normal`` is the unit vector from ``i`` to ``j``; ``normal_force`` is the
+    normal force's magnitude, compression positive (N, >= 0 unless bonded);
+    ``shear_force`` is the tangential force **on i** along ``t = (-n_y, n_x)``
+    (N, signed). The force on ``i`` is ``-normal_force n + shear_force t``
+    (:attr:`force_on_i`), its opposite acts on ``j``. Every row is one
+    consistent state: the forces at the current positions exactly as the next
+    step's force evaluation computes them, ``normal_force = kn * overlap`` and
+    the shear spring with the increment of the displacement since the last
+    evaluation, capped at ``mu * normal_force``; ``sliding`` is true exactly
+    where ``|shear_force| = mu * normal_force``. Forces are the elastic parts
+    (no dashpot forces); see docs/contact-law.md.
     """
 
     i: NDArray[np.uint32]
@@ -95,11 +105,18 @@ class Contacts:
     def __len__(self) -> int:
         return len(self.i)
 
+    @property
+    def force_on_i(self) -> NDArray[np.float64]:
+        """(Nc, 2) force on particle ``i`` from ``j``, N (its opposite acts on ``j``)."""
+        return -self.normal_force[:, None] * self.normal + self.shear_force[:, None] * _tangent(self.normal)
+
 
 @dataclass(frozen=True)
 class WallContacts:
-    """Particle-wall contacts, in the same consistent state as :class:`Contacts`;
-    ``normal`` points from the wall to the particle and the forces act on the particle."""
+    """Particle-wall contacts, in the same consistent state and the same convention
+    as :class:`Contacts` with the wall as ``j``: ``normal`` points from the particle
+    to the wall, ``normal_force`` is compression positive and ``shear_force`` acts
+    on the particle along ``(-n_y, n_x)``."""
 
     wall: NDArray[np.uint32]
     particle: NDArray[np.uint32]
@@ -112,6 +129,11 @@ class WallContacts:
 
     def __len__(self) -> int:
         return len(self.wall)
+
+    @property
+    def force_on_particle(self) -> NDArray[np.float64]:
+        """(Nw, 2) force of the wall on the particle, N."""
+        return -self.normal_force[:, None] * self.normal + self.shear_force[:, None] * _tangent(self.normal)
 
 
 def _readonly(array: Any) -> NDArray[Any]:
@@ -723,11 +745,15 @@ class Simulation:
         """Current particle-particle contacts (overlap > 0) and bonds, with the forces
         the next step will apply (the state is not changed)."""
         d = self._engine.contacts()
+        d["shear_force"] = -d["shear_force"]  # the engine reports it on j
         return Contacts(**{k: _readonly(v) for k, v in d.items()})
 
     def wall_contacts(self) -> WallContacts:
         """Current particle-wall contacts, with the forces the next step will apply."""
         d = self._engine.wall_contacts()
+        # the engine's normal points from the wall to the particle, its shear along rot90 of that
+        d["normal"] = -d["normal"]
+        d["shear_force"] = -d["shear_force"]
         return WallContacts(**{k: _readonly(v) for k, v in d.items()})
 
     @property
@@ -757,9 +783,8 @@ class Simulation:
     def snapshot(self, *, kind: ArrayLike | None = None, **metadata: Any) -> Snapshot:
         """The current state as an analysis :class:`~grainlab.snapshot.Snapshot`.
 
-        Converts the engine's conventions to the snapshot's: shear forces are
-        given on particle ``i`` (the engine reports them on ``j``), and wall
-        normals point from the particle to the wall. ``kind`` gives each
+        Contacts and wall contacts are in the snapshot's convention already
+        (:meth:`contacts`, :meth:`wall_contacts`). ``kind`` gives each
         particle's :class:`~grainlab.snapshot.ParticleKind`; ``metadata`` may set
         ``time`` and ``axial_strain`` and any other key. The particles'
         ``velocity`` (m/s, (N, 2)) and ``angular_velocity`` (rad/s, (N,)) travel
@@ -778,16 +803,16 @@ class Simulation:
             contact_point=c.point,
             contact_normal=c.normal,
             normal_force=c.normal_force,
-            shear_force=-c.shear_force,
+            shear_force=c.shear_force,
             overlap=c.overlap,
             sliding=c.sliding,
             bonded=c.bonded,
             wall_i=w.particle,
             wall_id=w.wall,
             wall_point=w.point,
-            wall_normal=-w.normal,
+            wall_normal=w.normal,
             wall_normal_force=w.normal_force,
-            wall_shear_force=-w.shear_force,
+            wall_shear_force=w.shear_force,
             wall_overlap=w.overlap,
             wall_sliding=w.sliding,
             time=time,

@@ -50,18 +50,17 @@ def resultants(sim: Simulation) -> tuple[np.ndarray, np.ndarray]:
     """Force and torque on every particle from the reported contacts, bonds and wall contacts."""
     c, w = sim.contacts(), sim.wall_contacts()
     n = sim.n_particles
-    t = np.column_stack([-c.normal[:, 1], c.normal[:, 0]])
-    f = c.normal_force[:, None] * c.normal + c.shear_force[:, None] * t
+    f = c.force_on_i  # on i; its opposite on j
     force, torque = np.zeros((n, 2)), np.zeros(n)
     for k in (0, 1):
-        force[:, k] += np.bincount(c.j, f[:, k], minlength=n) - np.bincount(c.i, f[:, k], minlength=n)
+        force[:, k] += np.bincount(c.i, f[:, k], minlength=n) - np.bincount(c.j, f[:, k], minlength=n)
     r = sim.radii
-    torque -= np.bincount(c.i, r[c.i] * c.shear_force, minlength=n) + np.bincount(c.j, r[c.j] * c.shear_force, minlength=n)
-    tw = np.column_stack([-w.normal[:, 1], w.normal[:, 0]])
-    fw = w.normal_force[:, None] * w.normal + w.shear_force[:, None] * tw
+    # shear on i along t at r_i n from i, its opposite on j at -r_j n from j: both turn the same way
+    torque += np.bincount(c.i, r[c.i] * c.shear_force, minlength=n) + np.bincount(c.j, r[c.j] * c.shear_force, minlength=n)
+    fw = w.force_on_particle
     for k in (0, 1):
         force[:, k] += np.bincount(w.particle, fw[:, k], minlength=n)
-    torque -= np.bincount(w.particle, r[w.particle] * w.shear_force, minlength=n)
+    torque += np.bincount(w.particle, r[w.particle] * w.shear_force, minlength=n)
     return force, torque
 
 
@@ -112,7 +111,8 @@ def test_a_new_contact_reports_the_increment_it_will_get():
         if new.sum() >= 3:
             break
     assert new.sum() >= 3
-    # its spring was zero: the shear is -ks v_t dt at the current state, capped
+    # its spring was zero: the shear on i is ks v_t dt at the current state (along the motion
+    # of j past i), capped
     x, v, w, r = sim.positions, sim.velocities, sim.angular_velocities, sim.radii
     i, j = c.i[new].astype(int), c.j[new].astype(int)
     side = sim.cell["a"][0]
@@ -122,7 +122,7 @@ def test_a_new_contact_reports_the_increment_it_will_get():
     dv = v[j] - v[i] + d @ grad.T
     t = np.column_stack([-c.normal[new, 1], c.normal[new, 0]])
     vt = (dv * t).sum(1) - (w[i] * r[i] + w[j] * r[j])
-    increment = -KN * vt * sim.time_step
+    increment = KN * vt * sim.time_step
     expected = np.clip(increment, -MU * c.normal_force[new], MU * c.normal_force[new])
     np.testing.assert_allclose(c.shear_force[new], expected, rtol=1e-9, atol=1e-9 * np.abs(increment).max())
     assert np.any(expected != 0)

@@ -198,8 +198,10 @@ def test_snapshot_carries_the_contacts_with_the_analysis_conventions(dense_perio
     snap = sim.snapshot(axial_strain=0.0)
     z = CoordinationNumber().compute(snap)
     assert z.coordination_number == pytest.approx(2 * len(c) / sim.n_particles, rel=1e-12)
-    # the snapshot's shear force acts on i: its opposite is the engine's (on j)
-    np.testing.assert_array_equal(snap.shear_force[: len(c)], -c.shear_force)
+    # one convention on the Python side: the snapshot's contacts are the simulation's
+    assert np.any(c.shear_force != 0)
+    np.testing.assert_array_equal(snap.shear_force[: len(c)], c.shear_force)
+    np.testing.assert_array_equal(snap.contact_normal[: len(c)], c.normal)
 
 
 def test_snapshot_wall_contacts_point_to_the_wall():
@@ -208,6 +210,11 @@ def test_snapshot_wall_contacts_point_to_the_wall():
     snap = sim.snapshot()
     assert snap.contact_j.tolist() == [-1]
     np.testing.assert_allclose(snap.contact_normal[0], [0.0, -1.0])
+    w = sim.wall_contacts()
+    np.testing.assert_allclose(w.normal[0], [0.0, -1.0])
+    # the floor pushes the disk up: compression positive along the normal to the wall
+    np.testing.assert_allclose(w.force_on_particle[0], [0.0, w.normal_force[0]])
+    assert w.normal_force[0] == pytest.approx(sim.contact_model(0, 1).normal_stiffness * 0.1e-3)
 
 
 def test_pressure_chain_pushes_with_pressure_times_span():

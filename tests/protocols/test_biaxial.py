@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 
 import grainlab.protocols.biaxial as biaxial
+import grainlab.protocols.biaxial.driver as driver
+import grainlab.protocols.biaxial.phases as phases
 from grainlab.analysis import StabilityIndex
 from grainlab.cli import main
 from grainlab.io.hdf5 import read_results
@@ -90,7 +92,7 @@ def test_resumed_run_ends_with_the_same_results(tmp_path, monkeypatch):
     config = resolve(overrides=overrides, quick=True)
     straight = biaxial.run_biaxial(config, tmp_path / "straight", progress=False)
 
-    real_measure = biaxial._measure
+    real_measure = phases._measure
     calls = {"n": 0}
 
     def dying_measure(*args, **kwargs):
@@ -99,14 +101,14 @@ def test_resumed_run_ends_with_the_same_results(tmp_path, monkeypatch):
             raise KeyboardInterrupt("simulated kill during shearing")
         return real_measure(*args, **kwargs)
 
-    monkeypatch.setattr(biaxial, "_measure", dying_measure)
+    monkeypatch.setattr(phases, "_measure", dying_measure)
     killed = tmp_path / "killed"
     with pytest.raises(KeyboardInterrupt):
         biaxial.run_biaxial(config, killed, progress=False)
     # a killed run leaves nothing that looks complete
     assert not (killed / "run.h5").exists() and not (killed / "summary.json").exists()
     assert (killed / "checkpoint.h5").exists()
-    monkeypatch.setattr(biaxial, "_measure", real_measure)
+    monkeypatch.setattr(phases, "_measure", real_measure)
     resumed = biaxial.run_biaxial(config, killed, resume=True, progress=False)
 
     a = read_results(straight.out_dir / "run.h5")
@@ -177,7 +179,7 @@ def test_a_run_stopped_before_its_first_checkpoint_starts_over(tmp_path, monkeyp
     def generate(*args, **kwargs):
         raise RuntimeError("generation reached")
 
-    monkeypatch.setattr(biaxial, "_generate", generate)
+    monkeypatch.setattr(driver, "_generate", generate)
     with pytest.raises(RuntimeError, match="generation reached"):
         biaxial.run_biaxial(resolve(quick=True), tmp_path, progress=False)
     with pytest.raises(ValueError, match="nothing to resume"):
@@ -189,8 +191,8 @@ def test_a_checkpoint_from_before_new_keys_resumes_with_their_defaults():
     old = config.to_dict()
     del old["material"]["limiting_contact_pressure"]  # keys added since
     del old["sample"]["sieve_sizes"], old["sample"]["percent_passing"]
-    assert biaxial._saved_config(old) == config.to_dict()
-    assert biaxial._saved_config({"sample": {"porosity": 2.0}}) is None  # not a valid configuration
+    assert driver._saved_config(old) == config.to_dict()
+    assert driver._saved_config({"sample": {"porosity": 2.0}}) is None  # not a valid configuration
 
 
 @pytest.mark.slow

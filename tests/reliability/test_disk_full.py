@@ -15,6 +15,8 @@ import pytest
 from reliability_factories import TINY_TOML, assert_same_run, tiny_config
 
 import grainlab.protocols.biaxial as biaxial
+import grainlab.protocols.biaxial.driver as driver
+import grainlab.protocols.biaxial.outputs as outputs
 from grainlab.cli import main
 from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, read_results
 from grainlab.io.results import is_disk_full
@@ -41,8 +43,8 @@ def _full_at(function, n):
     [
         ("a record", (ResultsWriter, "append_timeseries"), 3),
         ("a snapshot", (ResultsWriter, "write_snapshot"), 2),
-        ("the final checkpoint", (biaxial, "write_checkpoint"), 4),
-        ("the figures", (biaxial, "_figures"), 1),
+        ("the final checkpoint", (driver, "write_checkpoint"), 4),
+        ("the figures", (outputs, "_figures"), 1),
     ],
 )
 def test_a_full_disk_stops_with_one_line_and_the_run_resumes(tmp_path, monkeypatch, capsys, fast_figures,
@@ -89,12 +91,13 @@ import os, sys
 sys.path.insert(0, {tests!r})
 import reliability_factories as stand_ins
 import grainlab.postprocess.figures as figures
-import grainlab.protocols.biaxial as biaxial
+import grainlab.protocols.biaxial.outputs as outputs
+import grainlab.protocols.biaxial.phases as phases
 from grainlab.cli import main
 
-biaxial._figures = stand_ins.fake_curves
+outputs._figures = stand_ins.fake_curves
 figures.fabric_figures = stand_ins.fake_fabric_figures
-measure, calls = biaxial._measure, []
+measure, calls = phases._measure, []
 
 def filling_measure(*args, **kwargs):
     calls.append(1)
@@ -107,7 +110,7 @@ def filling_measure(*args, **kwargs):
             os.close(fd)
     return measure(*args, **kwargs)
 
-biaxial._measure = filling_measure
+phases._measure = filling_measure
 sys.exit(main(sys.argv[1:]))
 """
 

@@ -17,6 +17,9 @@ from reliability_factories import TINY_TOML, assert_same_run, tiny_config
 
 import grainlab.postprocess.figures as figures
 import grainlab.protocols.biaxial as biaxial
+import grainlab.protocols.biaxial.driver as driver
+import grainlab.protocols.biaxial.outputs as outputs
+import grainlab.protocols.biaxial.phases as phases
 from grainlab.cli import main
 from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, read_results, write_checkpoint
 
@@ -54,23 +57,23 @@ def _before(function, n=1):
 
 def _stop_at(monkeypatch, where: str) -> None:
     if where == "generation":
-        monkeypatch.setattr(biaxial, "_generate", _after(biaxial._generate))
+        monkeypatch.setattr(driver, "_generate", _after(driver._generate))
     elif where.startswith("checkpoint "):  # 1 generated, 2 consolidated, 3 boundary installed, 4 sheared
-        monkeypatch.setattr(biaxial, "write_checkpoint", _after(write_checkpoint, int(where.split()[1])))
+        monkeypatch.setattr(driver, "write_checkpoint", _after(write_checkpoint, int(where.split()[1])))
     elif where == "shearing":
-        monkeypatch.setattr(biaxial, "_measure", _before(biaxial._measure, 3))
+        monkeypatch.setattr(phases, "_measure", _before(phases._measure, 3))
     elif where == "summary":
         monkeypatch.setattr(ResultsWriter, "write_summary", _before(ResultsWriter.write_summary))
     elif where == "finalized":
         monkeypatch.setattr(ResultsWriter, "finalize", _after(ResultsWriter.finalize))
     elif where == "timeseries.csv":
-        monkeypatch.setattr(biaxial, "write_text_atomic", _before(biaxial.write_text_atomic))
+        monkeypatch.setattr(outputs, "write_text_atomic", _before(outputs.write_text_atomic))
     elif where == "figures":
-        monkeypatch.setattr(biaxial, "_figures", _before(biaxial._figures))
+        monkeypatch.setattr(outputs, "_figures", _before(outputs._figures))
     elif where == "fabric figures":
         monkeypatch.setattr(figures, "fabric_figures", _before(figures.fabric_figures))
     elif where == "summary.json":
-        monkeypatch.setattr(biaxial, "write_json_atomic", _after(biaxial.write_json_atomic))
+        monkeypatch.setattr(outputs, "write_json_atomic", _after(outputs.write_json_atomic))
     else:  # pragma: no cover
         raise AssertionError(where)
 
@@ -188,14 +191,14 @@ import os, sys, time
 sys.path.insert(0, {tests!r})
 import reliability_factories as stand_ins
 import grainlab.postprocess.figures as figures
-import grainlab.protocols.biaxial as biaxial
+import grainlab.protocols.biaxial.outputs as outputs
 from grainlab.cli import main
 
 def slow_curves(timeseries, out):
     time.sleep(float(os.environ.get("STAND_IN_SECONDS", "0")))
     return stand_ins.fake_curves(timeseries, out)
 
-biaxial._figures = slow_curves
+outputs._figures = slow_curves
 figures.fabric_figures = stand_ins.fake_fabric_figures
 sys.exit(main(sys.argv[1:]))
 """

@@ -37,7 +37,7 @@ from grainlab import paper
 from grainlab.reproduction.measures import END_WINDOW, relative_slope
 from grainlab.reproduction.verdicts import ProportionRule, SideRule, ValueRule
 
-__all__ = ["BIAXIAL_CLAIMS", "RATE_CLAIMS", "STUDY_CLAIMS", "Claim", "evaluate", "single_run_rows"]
+__all__ = ["BIAXIAL_CLAIMS", "RATE_CLAIMS", "STUDY_CLAIMS", "Claim", "band_measure", "evaluate", "single_run_rows"]
 
 Measures = Mapping[str, Any]
 Rule = ValueRule | SideRule | ProportionRule
@@ -156,7 +156,7 @@ def _at(m: Measures, strain: float, tolerance: float = 0.001) -> Mapping[str, An
     return best
 
 
-def _band(row: Mapping[str, Any], key: str) -> float:
+def band_measure(row: Mapping[str, Any], key: str) -> float:
     """A band measure of a snapshot: the band's grains (the band accepted at the
     snapshot, or else the first accepted after it, matched by id) against the
     rest; NaN when no band is accepted at or after the snapshot."""
@@ -264,56 +264,56 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
           "at both)", SideRule(-1), lambda m: _band_share(_peak(m)) - _band_share(_at(m, 0.005))),
     Claim("band_lambda_above_rest", "mean lambda in the shear zone at the peak (0.34) above the rest (0.31)",
           "Sec. 6, Fig. 13", 0.03, f"band minus rest at the peak snapshot, paired per seed; {_LAMBDA_BAND}",
-          SideRule(+1), lambda m: _band(_peak(m), "inside_mean_lambda") - _band(_peak(m), "outside_mean_lambda")),
+          SideRule(+1), lambda m: band_measure(_peak(m), "inside_mean_lambda") - band_measure(_peak(m), "outside_mean_lambda")),
     Claim("band_lambda_above_rest_all", "the same, lambda averaged over every grain", "Sec. 6, Fig. 13", 0.03,
           f"band minus rest at the peak snapshot, paired per seed; {_LAMBDA_ALL}", SideRule(+1),
-          lambda m: _band(_peak(m), "inside_mean_lambda_all") - _band(_peak(m), "outside_mean_lambda_all")),
+          lambda m: band_measure(_peak(m), "inside_mean_lambda_all") - band_measure(_peak(m), "outside_mean_lambda_all")),
     Claim("band_lambda_0.34", "mean lambda in the shear zone at the peak is 0.34", "Sec. 6", paper.LAMBDA_IN_BAND,
           f"band mean at the peak snapshot; {_LAMBDA_BAND}", ValueRule(0.325, 0.355),
-          lambda m: _band(_peak(m), "inside_mean_lambda")),
+          lambda m: band_measure(_peak(m), "inside_mean_lambda")),
     Claim("rest_lambda_0.31", "mean lambda in the rest of the sample at the peak is 0.31", "Sec. 6", paper.LAMBDA_OUTSIDE_BAND,
           f"rest mean at the peak snapshot; {_LAMBDA_BAND}", ValueRule(0.295, 0.325),
-          lambda m: _band(_peak(m), "outside_mean_lambda")),
+          lambda m: band_measure(_peak(m), "outside_mean_lambda")),
     Claim("band_lambda_0.34_all", "mean lambda in the shear zone at the peak is 0.34 (every grain)", "Sec. 6", paper.LAMBDA_IN_BAND,
           f"band mean at the peak snapshot; {_LAMBDA_ALL}", ValueRule(0.325, 0.355),
-          lambda m: _band(_peak(m), "inside_mean_lambda_all")),
+          lambda m: band_measure(_peak(m), "inside_mean_lambda_all")),
     Claim("rest_lambda_0.31_all", "mean lambda in the rest at the peak is 0.31 (every grain)", "Sec. 6", paper.LAMBDA_OUTSIDE_BAND,
           f"rest mean at the peak snapshot; {_LAMBDA_ALL}", ValueRule(0.295, 0.325),
-          lambda m: _band(_peak(m), "outside_mean_lambda_all")),
+          lambda m: band_measure(_peak(m), "outside_mean_lambda_all")),
     Claim("band_mostly_two_contacts", "most grains in the shear band have two contacts at 1.5 % (0- and "
           "1-contact grains filtered out)", "Sec. 6, Fig. 13a", None,
           "share of the band's grains with >= 2 contacts that have exactly 2, at the 1.5 % snapshot",
-          SideRule(+1, 0.5), lambda m: _band(_at(m, 0.015), "inside_fraction_2_of_load_bearing")),
+          SideRule(+1, 0.5), lambda m: band_measure(_at(m, 0.015), "inside_fraction_2_of_load_bearing")),
     Claim("rest_three_or_more", "the rest of the grains have at least three contacts", "Sec. 6, Fig. 13b", None,
           "share of the other grains with >= 2 contacts that have >= 3, at the 1.5 % snapshot",
-          SideRule(+1, 0.5), lambda m: _band(_at(m, 0.015), "outside_fraction_3_or_more_of_load_bearing")),
+          SideRule(+1, 0.5), lambda m: band_measure(_at(m, 0.015), "outside_fraction_3_or_more_of_load_bearing")),
     Claim("band_more_two_contact_grains", "two-contact grains are more common in the band than in the rest",
           "Sec. 6, Fig. 13", None, "share of 2-contact grains (of those with >= 2) band minus rest at 1.5 %, "
           "paired per seed", SideRule(+1),
-          lambda m: _band(_at(m, 0.015), "inside_fraction_2_of_load_bearing")
-          - _band(_at(m, 0.015), "outside_fraction_2_of_load_bearing")),
+          lambda m: band_measure(_at(m, 0.015), "inside_fraction_2_of_load_bearing")
+          - band_measure(_at(m, 0.015), "outside_fraction_2_of_load_bearing")),
     Claim("band_lambda_above_half", "the shear zone is represented by grains with lambda above 0.5",
           "Sec. 6, Fig. 12", 0.5, "share of grains with lambda > 0.5, band minus rest at the peak snapshot, "
           "paired per seed (every grain)", SideRule(+1),
-          lambda m: _band(_peak(m), "inside_fraction_lambda_above_half")
-          - _band(_peak(m), "outside_fraction_lambda_above_half")),
+          lambda m: band_measure(_peak(m), "inside_fraction_lambda_above_half")
+          - band_measure(_peak(m), "outside_fraction_lambda_above_half")),
     Claim("rest_less_stable", "the remainder of the sample also becomes less stable", "Sec. 6, Fig. 12", None,
           f"rest mean lambda at the peak minus the sample's at 0 %; {_LAMBDA_BAND}", SideRule(+1),
-          lambda m: _band(_peak(m), "outside_mean_lambda") - _initial(m)["mean_lambda"]),
+          lambda m: band_measure(_peak(m), "outside_mean_lambda") - _initial(m)["mean_lambda"]),
     Claim("band_rotation_larger", "grains rotate more in the shear band than in the rest (turbulent shear)",
           "Sec. 6 (after Cheung and O'Sullivan; Wu et al.)", None,
           "mean |rotation| since 0 %, band minus rest at the peak snapshot, paired per seed", SideRule(+1),
-          lambda m: _band(_peak(m), "inside_mean_abs_rotation_rad") - _band(_peak(m), "outside_mean_abs_rotation_rad")),
+          lambda m: band_measure(_peak(m), "inside_mean_abs_rotation_rad") - band_measure(_peak(m), "outside_mean_abs_rotation_rad")),
     Claim("band_z_below_rest", "the shear zone coincides with the smallest coordination number",
           "Sec. 7", None, "grain-grain contacts per grain, band minus rest at the peak snapshot, paired per seed",
           SideRule(-1),
-          lambda m: _band(_peak(m), "inside_coordination_number") - _band(_peak(m), "outside_coordination_number")),
+          lambda m: band_measure(_peak(m), "inside_coordination_number") - band_measure(_peak(m), "outside_coordination_number")),
     Claim("lambda_locates_band", "lambda at particle level shows the shear band (Fig. 12)", "Sec. 6, Fig. 12; "
           "Sec. 7", None, "ROC AUC of per-grain lambda for band membership at the peak snapshot (every grain)",
-          SideRule(+1, 0.6), lambda m: _band(_peak(m), "auc_lambda")),
+          SideRule(+1, 0.6), lambda m: band_measure(_peak(m), "auc_lambda")),
     Claim("lambda_field_locates_band", "the lambda field shows the shear band", "Sec. 6, Fig. 12", None,
           "ROC AUC of lambda averaged over 2 mean diameters for band membership at the peak snapshot",
-          SideRule(+1, 0.6), lambda m: _band(_peak(m), "auc_lambda_field")),
+          SideRule(+1, 0.6), lambda m: band_measure(_peak(m), "auc_lambda_field")),
     Claim("lambda_marks_band_at_0.5", "at 0.5 % lambda already shows a discontinuity surrounded by more "
           "stable grains", "Sec. 6, Fig. 12b", None,
           "ROC AUC of per-grain lambda at the 0.5 % snapshot for the grains of the band found at the peak",

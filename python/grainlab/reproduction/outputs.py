@@ -192,13 +192,13 @@ def rate_family(plan: ReproductionPlan) -> list[tuple[float, Variant]]:
 
 def _band_difference(m: dict[str, Any] | None) -> float:
     """Band minus rest mean lambda (grains with >= 2 contacts) at the peak snapshot,
-    the band's grains as the claims take them (:func:`~grainlab.reproduction.claims._band`)."""
-    from grainlab.reproduction.claims import _band
+    the band's grains as the claims take them (:func:`~grainlab.reproduction.claims.band_measure`)."""
+    from grainlab.reproduction.claims import band_measure
 
     if m is None:
         return math.nan
     row = m["snapshots"][m["peak_snapshot"]]
-    return _band(row, "inside_mean_lambda") - _band(row, "outside_mean_lambda")
+    return band_measure(row, "inside_mean_lambda") - band_measure(row, "outside_mean_lambda")
 
 
 _RATE_QUANTITIES = {

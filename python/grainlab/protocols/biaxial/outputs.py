@@ -1,0 +1,115 @@
+"""A finished biaxial run's outputs: the summary, ``timeseries.csv`` and
+``summary.json``, and the figures drawn from ``run.h5`` (with
+:mod:`grainlab.plot` and :mod:`grainlab.postprocess.figures`)."""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import grainlab
+from grainlab._interrupt import raise_if_interrupted
+from grainlab.io.results import RESULTS_FILE, write_json_atomic, write_text_atomic
+from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
+from grainlab.protocols.biaxial.state import _Run
+from grainlab.protocols.config import BiaxialConfig
+
+#: The paper's reported values, for the summary and the docs.
+PAPER_VALUES = {
+    "coordination_number_initial": Z_INITIAL,
+    "coordination_number_at_peak": Z_AT_PEAK,
+    "axial_strain_at_peak": STRAIN_AT_PEAK,
+}
+
+
+@dataclass(frozen=True)
+class BiaxialResult:
+    """What ``grainlab biaxial`` reports: the summary and where the files are."""
+
+    out_dir: Path
+    summary: dict[str, Any]
+
+    def one_line(self) -> str:
+        s = self.summary
+        return (
+            f"grainlab biaxial: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}, "
+            f"Z0 {s['coordination_number_initial']:.2f}; peak sigma1/sigma3 {s['peak_stress_ratio']:.2f} "
+            f"at {100 * s['axial_strain_at_peak']:.2f} % axial strain; strain rate {s['strain_rate']:.3g} 1/s; "
+            f"{s['wall_time_s']:.1f} s -> {self.out_dir}"
+        )
+
+
+def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
+    shear = run.shear
+    first = {k: float(v[0]) for k, v in timeseries.items()}
+    last = {k: float(v[-1]) for k, v in timeseries.items()}
+    peak = run.peak or {}
+    return {
+        "n_particles": run.n_grains,
+        "n_membrane_disks": run.consolidation.get("membrane_disks", 0),
+        "porosity_initial": shear["porosity_initial"],
+        "porosity_after_consolidation": run.consolidation["porosity"],
+        "porosity_after_consolidation_overlap_corrected": run.consolidation["porosity_overlap_corrected"],
+        "porosity_generated": run.sample.get("porosity"),
+        "porosity_generated_overlap_corrected": run.sample.get("porosity_overlap_corrected"),
+        "generation_stress_pa": run.sample.get("mean_wall_stress_pa"),
+        "coordination_number_initial": first["coordination_number"],
+        "coordination_number_at_peak": peak.get("coordination_number"),
+        "coordination_number_final": last["coordination_number"],
+        "peak_stress_ratio": peak.get("stress_ratio"),
+        "axial_strain_at_peak": peak.get("axial_strain"),
+        "volumetric_strain_at_peak": peak.get("volumetric_strain"),
+        "final_stress_ratio": last["stress_ratio"],
+        "final_volumetric_strain": last["volumetric_strain"],
+        "max_contraction": float(np.max(timeseries["volumetric_strain"])),
+        "strain_rate": shear["strain_rate"],
+        "inertial_number": shear["inertial_number"],
+        "inertial_number_mean_diameter": shear["inertial_number_mean_diameter"],
+        "density_scaling_factor": shear["density_scaling_factor"],
+        "time_step_s": run.consolidation["time_step_s"],
+        "records": len(timeseries["axial_strain"]),
+        "wall_time_s": total_s,
+        "wall_time_by_phase_s": dict(run.wall_time),
+        "paper": PAPER_VALUES,
+        "grainlab_version": grainlab.__version__,
+    }
+
+
+def _csv(timeseries: dict[str, np.ndarray]) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer)
+    names = list(timeseries)
+    writer.writerow(names)
+    for row in zip(*(timeseries[k] for k in names), strict=True):
+        writer.writerow([repr(float(v)) for v in row])
+    return buffer.getvalue()
+
+
+def _figures(timeseries: dict[str, np.ndarray], out: Path) -> list[Path]:
+    from grainlab.plot import biaxial_curves
+
+    return biaxial_curves(timeseries, out)
+
+
+def _write_outputs(out: Path) -> dict[str, Any]:
+    """``timeseries.csv``, the figures and ``summary.json``, all from the finished
+    ``run.h5``: a run stopped while they were written finishes them with ``--resume``."""
+    from grainlab.io.hdf5 import read_results
+    from grainlab.postprocess.figures import fabric_figures
+
+    results = read_results(out / RESULTS_FILE)
+    raise_if_interrupted()  # a Ctrl-C that h5py's clean-up swallowed stops the run here
+    summary = dict(results.summary)
+    write_text_atomic(out / "timeseries.csv", _csv(results.timeseries))
+    _figures(results.timeseries, out)
+    raise_if_interrupted()
+    # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
+    summary["fabric"] = fabric_figures(out).numbers.summary()
+    raise_if_interrupted()
+    write_json_atomic(out / "summary.json", summary)
+    return summary

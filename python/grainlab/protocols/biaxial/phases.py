@@ -1,0 +1,400 @@
+"""The biaxial test's phases: generate, consolidate, install the boundary,
+start and run the shearing. Each takes the simulation and the run state and
+leaves the run in its next phase."""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+import warnings
+from collections.abc import Callable
+
+import numpy as np
+
+import grainlab
+from grainlab._interrupt import raise_if_interrupted
+from grainlab._progress import progress_bar
+from grainlab.io.hdf5 import ResultsWriter, snapshot_name
+from grainlab.protocols.biaxial.rates import (
+    default_strain_rate,
+    inertial_number,
+    strain_rate_problem,
+)
+from grainlab.protocols.biaxial.records import (
+    TIMESERIES_UNITS,
+    _area,
+    _measure,
+    _platens,
+    _snapshot,
+    _walls,
+)
+from grainlab.protocols.biaxial.state import CHUNK_STEPS, BiaxialError, _boundary, _Run
+from grainlab.protocols.boundary import (
+    GrainBoundary,
+    Membrane,
+    install_grain_boundary,
+    install_membrane,
+    membrane_breach,
+    set_platen_velocity,
+)
+from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
+from grainlab.samples import (
+    PAPER_GRADING,
+    GradingCurve,
+    UniformByMass,
+    UniformByNumber,
+    expand_to_porosity,
+    overlap_corrected_porosity,
+)
+from grainlab.simulation import ContactModel, Simulation
+
+
+def _grading(config: BiaxialConfig) -> UniformByNumber | UniformByMass | GradingCurve:
+    kind = config["sample.grading"]
+    d_min, d_max = config["sample.d_min"], config["sample.d_max"]
+    if kind == "uniform_by_number":
+        return UniformByNumber(d_min, d_max)
+    if kind == "uniform_by_mass":
+        return UniformByMass(d_min, d_max)
+    if kind == "curve":
+        return GradingCurve(config["sample.sieve_sizes"], config["sample.percent_passing"])
+    if (d_min, d_max) != (PAPER_GRADING.d_min, PAPER_GRADING.d_max):
+        raise ValueError(
+            "sample.grading: 'paper' is the 0.5-3 mm curve; with other sample.d_min/d_max "
+            "choose 'uniform_by_number' or 'uniform_by_mass'"
+        )
+    return PAPER_GRADING
+
+
+def _threads(config: BiaxialConfig) -> int:
+    threads = config["run.threads"]
+    return (os.cpu_count() or 1) if threads == "auto" else int(threads)
+
+
+def _grain_model(config: BiaxialConfig) -> ContactModel:
+    return ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.friction"]
+    )
+
+
+def _platen_model(config: BiaxialConfig) -> ContactModel:
+    return ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.platen_friction"]
+    )
+
+
+def _generate(config: BiaxialConfig, threads: int, progress: bool) -> tuple[Simulation, _Run]:
+    start = time.perf_counter()
+    box = (0.0, 0.0, config["sample.width"], config["sample.height"])
+    sample = expand_to_porosity(
+        box,
+        config["sample.porosity"],
+        _grading(config),
+        seed=config["sample.seed"],
+        friction=config["sample.generation_friction"],
+        wall_friction=config["material.platen_friction"],
+        normal_stiffness=config["material.normal_stiffness"],
+        shear_stiffness=config["material.shear_stiffness"],
+        density=config["material.density"],
+        local_damping=config["material.local_damping"],
+        max_stress_pa=config["sample.max_generation_stress"],
+        threads=threads,
+        progress=progress,
+        keep_simulation=True,
+    )
+    sim = sample.simulation
+    n = sim.n_particles
+    sim.densities = np.full(n, config["material.density"])  # generation may scale densities
+    info = {k: v for k, v in sample.to_dict().items() if isinstance(v, int | float | str | bool) or v is None}
+    run = _Run(
+        phase="consolidate",
+        n_grains=n,
+        grain_density=config["material.density"],
+        walls={"bottom": 0, "right": 1, "top": 2, "left": 3},
+        wall_time={"generate": time.perf_counter() - start},
+        sample=info,
+        consolidation={},
+    )
+    return sim, run
+
+
+def _consolidate(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
+    start = time.perf_counter()
+    consolidation_model = ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["consolidation.friction"]
+    )
+    sim.set_contact_model(0, 0, consolidation_model)
+    sim.set_contact_model(0, 1, _platen_model(config))
+    sim.local_damping = config["material.local_damping"]
+    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+    target = config["consolidation.pressure"]
+    tolerance = config["consolidation.tolerance"]
+    limit = config["consolidation.unbalanced_force_ratio"]
+    max_steps = config["consolidation.max_steps"]
+    speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
+    bar = progress_bar(max_steps, "consolidating", enabled=progress, unit="step")
+
+    def show(state: BoxState, steps: int) -> None:
+        bar.update(CHUNK_STEPS)
+        bar.set_postfix_str(f"sxx {state.stress_xx_pa / 1e3:.1f} kPa, syy {state.stress_yy_pa / 1e3:.1f} kPa, "
+                            f"unbalanced {sim.unbalanced_force_ratio:.1e}")
+
+    walls = {name: sim.wall(run.walls[name]) for name in BOX_WALLS}
+    state, steps, converged = servo_box(
+        sim, walls, target, tolerance=tolerance, unbalanced_force_limit=limit, max_steps=max_steps,
+        max_speed_m_per_s=speed, chunk_steps=CHUNK_STEPS, after_chunk=show,
+    )
+    if not converged:
+        bar.close()
+        raise BiaxialError(
+            f"consolidation did not converge in {steps} steps: wall stresses {state.stress_xx_pa / 1e3:.1f} / "
+            f"{state.stress_yy_pa / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa +- {tolerance:.0%}), unbalanced "
+            f"force ratio {sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise consolidation.max_steps"
+        )
+    sxx, syy, width, height = state.stress_xx_pa, state.stress_yy_pa, state.width_m, state.height_m
+    bar.close()
+    grains = np.arange(run.n_grains)
+    radii = sim.radii[grains]
+    area = width * height
+    box = (float(sim.wall(run.walls["left"]).points[0, 0]), float(sim.wall(run.walls["bottom"]).points[0, 1]))
+    run.consolidation = {
+        "steps": steps,
+        "stress_xx_pa": sxx,
+        "stress_yy_pa": syy,
+        "width_m": width,
+        "height_m": height,
+        "porosity": 1.0 - float(np.pi * np.sum(radii**2)) / area,
+        "porosity_overlap_corrected": overlap_corrected_porosity(
+            sim.positions[grains], radii, (box[0], box[1], box[0] + width, box[1] + height)
+        ),
+        "coordination_number": sim.coordination_number,
+        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
+        "time_step_s": sim.time_step,
+    }
+    run.wall_time["consolidate"] = time.perf_counter() - start
+    run.phase = "boundary"
+
+
+def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
+    start = time.perf_counter()
+    walls = run.walls
+    left_x = float(sim.wall(walls["left"]).points[0, 0])
+    right_x = float(sim.wall(walls["right"]).points[0, 0])
+    y_bottom = float(sim.wall(walls["bottom"]).points[0, 1])
+    y_top = float(sim.wall(walls["top"]).points[0, 1])
+    # the rigid box goes; platens three sample widths long take the place of its
+    # top and bottom, so that the sample can bulge and still bear on them
+    for name in ("left", "right", "bottom", "top"):
+        sim.wall(walls[name]).active = False
+    reach = left_x - (right_x - left_x), right_x + (right_x - left_x)
+    bottom = sim.add_segment_wall((reach[0], y_bottom), (reach[1], y_bottom))  # sample on the left
+    top = sim.add_segment_wall((reach[1], y_top), (reach[0], y_top))
+    walls["bottom"], walls["top"] = bottom.id, top.id
+    sim.set_contact_model(0, 0, _grain_model(config))  # Table 1 friction from here on
+    sim.set_contact_model(0, 1, _platen_model(config))
+    limit = config["consolidation.unbalanced_force_ratio"]
+    steps = 0
+    if config["boundary.kind"] == "membrane":
+        membrane = install_membrane(
+            sim,
+            left_x=left_x,
+            right_x=right_x,
+            bottom=bottom,
+            top=top,
+            diameter=config["boundary.membrane_diameter"],
+            overlap=config["boundary.membrane_overlap"],
+            bond_stiffness=config["boundary.membrane_stiffness"],
+            friction=config["boundary.membrane_friction"],
+            grain_model=_grain_model(config),
+            density=config["material.density"],
+            pressure=config["consolidation.pressure"],
+        )
+        run.consolidation["membrane_disks"] = len(membrane.left) + len(membrane.right)
+        run.membrane = membrane.to_dict()
+        sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+        # The platens hold sigma_0 while the membrane takes over and friction
+        # switches on, so that shearing starts from an isotropic state: they
+        # stand still while their stress stays within the tolerance of sigma_0,
+        # and are servo-controlled to it (the engine's servo, as in the
+        # consolidation) from the first chunk that ends outside it until the
+        # sample is in equilibrium. The membrane's end disks keep their place: the
+        # platens move by micrometres.
+        target = config["consolidation.pressure"]
+        tolerance = config["consolidation.tolerance"]
+        max_speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)
+        servo = False
+        while True:
+            sim.run(CHUNK_STEPS)
+            steps += CHUNK_STEPS
+            platens = _platens(sim, membrane)
+            sigma_1 = platens.axial_stress_pa
+            settled = abs(sigma_1 / target - 1.0) < tolerance
+            if not settled or servo:
+                servo = True
+                for platen in (bottom, top):
+                    platen.servo(target, platens.width_m, relaxation=0.5, max_speed_m_per_s=max_speed)
+            if settled and sim.unbalanced_force_ratio < limit:
+                break
+            if steps >= config["consolidation.max_steps"]:
+                break
+        if servo:
+            bottom.velocity = (0.0, 0.0)
+            top.velocity = (0.0, 0.0)
+        if not settled:
+            warnings.warn(
+                f"boundary phase: consolidation.max_steps reached with the platens at {sigma_1 / 1e3:.1f} kPa "
+                f"(sigma_0 {target / 1e3:.1f} kPa +- {tolerance:.0%}): shearing starts from there",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+        run.consolidation["platen_stress_pa"] = sigma_1
+    else:
+        radii = sim.radii[: run.n_grains]
+        grains = install_grain_boundary(
+            sim,
+            n_grains=run.n_grains,
+            bottom=bottom,
+            top=top,
+            pressure=config["consolidation.pressure"],
+            bin_height=float(2 * radii.mean()),
+        )
+        while True:
+            sim.run(CHUNK_STEPS)
+            steps += CHUNK_STEPS
+            grains = grains.identify(sim)
+            if sim.unbalanced_force_ratio < limit or steps >= config["consolidation.max_steps"]:
+                break
+        run.membrane = grains.to_dict()
+    run.consolidation["boundary_steps"] = steps
+    run.wall_time["boundary"] = time.perf_counter() - start
+    run.phase = "shear"
+
+
+def _start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
+    boundary = _boundary(run)
+    grains = np.arange(run.n_grains)
+    radii = sim.radii[grains]
+    rate = config["shear.strain_rate"]
+    max_d = float(2 * radii.max())
+    if rate == "auto":
+        rate = default_strain_rate(config, config["sample.d_max"], 0.5 * config["sample.d_min"])
+    bottom, top = sim.wall(boundary.bottom_wall), sim.wall(boundary.top_wall)
+    height0 = float(top.points[0, 1] - bottom.points[0, 1])
+    area0 = _area(sim, boundary)
+    speed = 0.5 * rate * height0
+    if isinstance(boundary, Membrane):
+        set_platen_velocity(sim, boundary, speed)
+    else:
+        bottom.velocity = (0.0, speed)
+        top.velocity = (0.0, -speed)
+    dt = sim.time_step
+    steps_per_strain = 1.0 / (rate * dt)
+    final = config["shear.final_strain"]
+    interval = config["shear.record_interval"]
+    targets = {round(k * interval * steps_per_strain) for k in range(1, int(round(final / interval)) + 1)}
+    snaps = [s for s in config["shear.snapshot_strains"] if s <= final + 1e-12]
+    targets |= {round(s * steps_per_strain) for s in snaps if s > 0}
+    root = math.sqrt(config["material.density"] / config["consolidation.pressure"])
+    run.shear = {
+        "strain_rate": rate,
+        "platen_speed_m_per_s": speed,
+        "height0": height0,
+        "area0": area0,
+        "start_step": sim.step_count,
+        "record_steps": sorted(targets),
+        "snapshot_steps": {str(round(s * steps_per_strain)): s for s in snaps},
+        "next": 0,
+        "inertial_number": inertial_number(config, rate, max_d),
+        "inertial_number_mean_diameter": rate * float(2 * radii.mean()) * root,
+        "density_scaling_factor": grainlab.density_scaling_factor(
+            rate, config["material.density"], float(radii.min()), config["material.limiting_contact_pressure"]
+        ),
+        "porosity_initial": 1.0 - float(np.pi * np.sum(radii**2)) / area0,
+    }
+
+
+def _shear(
+    sim: Simulation,
+    run: _Run,
+    config: BiaxialConfig,
+    writer: ResultsWriter,
+    save: Callable[[], None],
+    progress: bool,
+) -> None:
+    start = time.perf_counter() - run.wall_time.get("shear", 0.0)
+    shear = run.shear
+    steps = shear["record_steps"]
+    snap_steps = shear["snapshot_steps"]
+    final = config["shear.final_strain"]
+    if shear["next"] == 0 and "0" in snap_steps and writer.n_rows == 0:
+        record = _measure(sim, run, config)
+        writer.append_timeseries(record, units=TIMESERIES_UNITS)
+        writer.write_snapshot(snapshot_name(0.0), _snapshot(sim, run, 0.0), step=sim.step_count,
+                              walls=_walls(sim, run))
+    last_checkpoint = time.perf_counter()
+    done_strain = 0.0
+    bar = progress_bar(
+        round(100 * final, 3),
+        "shearing",
+        enabled=progress,
+        unit="% strain",
+        bar_format="{l_bar}{bar}| {n:.2f}/{total:.1f} % [{elapsed}<{remaining}{postfix}]",
+    )
+    while shear["next"] < len(steps):
+        target = shear["start_step"] + steps[shear["next"]]
+        sim.run(target - sim.step_count)
+        record = _measure(sim, run, config)
+        writer.append_timeseries(record, units=TIMESERIES_UNITS)
+        key = str(steps[shear["next"]])
+        if key in snap_steps:
+            strain = snap_steps[key]
+            writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record["axial_strain"]),
+                                  step=sim.step_count, walls=_walls(sim, run))
+        peak = run.peak or {"stress_ratio": -math.inf}
+        if record["stress_ratio"] > peak["stress_ratio"]:
+            run.peak = {
+                "stress_ratio": record["stress_ratio"],
+                "axial_strain": record["axial_strain"],
+                "coordination_number": record["coordination_number"],
+                "volumetric_strain": record["volumetric_strain"],
+            }
+        if run.membrane.get("kind") == GrainBoundary.kind:
+            run.membrane = GrainBoundary.from_dict(run.membrane).identify(sim).to_dict()
+        else:
+            breach = membrane_breach(sim, Membrane.from_dict(run.membrane))
+            if breach is not None:
+                bar.close()
+                raise BiaxialError(
+                    f"shearing stopped at {100 * record['axial_strain']:.2f} % axial strain: {breach}"
+                )
+        shear["next"] += 1
+        raise_if_interrupted()
+        bar.update(100 * record["axial_strain"] - done_strain)
+        done_strain = 100 * record["axial_strain"]
+        bar.set_postfix_str(f"ratio {record['stress_ratio']:.2f}")
+        if time.perf_counter() - last_checkpoint > config["run.checkpoint_interval"]:
+            run.wall_time["shear"] = time.perf_counter() - start
+            save()
+            last_checkpoint = time.perf_counter()
+    bar.close()
+    run.wall_time["shear"] = time.perf_counter() - start
+    run.phase = "done"
+
+
+def _check_shear_plan(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
+    """The shearing phase's records and snapshots fall on distinct time steps,
+    checked with the run's own time step before the first record."""
+    shear = run.shear
+    problem = strain_rate_problem(
+        shear["strain_rate"], sim.time_step, shear["height0"], float(sim.radii.min()), config["shear.record_interval"]
+    )
+    if problem is not None:
+        raise BiaxialError(f"shear.strain_rate: {problem}; start again with a slower rate in another folder")
+    wanted = [s for s in config["shear.snapshot_strains"] if s <= config["shear.final_strain"] + 1e-12]
+    if len(shear["snapshot_steps"]) < len(wanted):
+        raise BiaxialError(
+            f"shear.snapshot_strains: two of {wanted} fall on the same time step "
+            f"({sim.time_step:.3g} s at {shear['strain_rate']:.3g} 1/s); keep them further apart"
+        )

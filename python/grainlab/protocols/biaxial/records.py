@@ -1,0 +1,179 @@
+"""The biaxial run's measurements: one record of the shearing phase (stresses,
+strains, energies, fabric) and the state as a snapshot with its walls."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from grainlab.analysis import fabric_summary
+from grainlab.analysis.stress import love_weber_stress
+from grainlab.io.walls import WallGeometry
+from grainlab.protocols.biaxial.state import _boundary, _Run
+from grainlab.protocols.boundary import GrainBoundary, Membrane, sample_area
+from grainlab.protocols.config import BiaxialConfig
+from grainlab.simulation import Simulation
+from grainlab.snapshot import ParticleKind, Snapshot
+
+TIMESERIES_UNITS = {
+    "anisotropy": "1",
+    "anisotropy_direction_rad": "rad",
+    "anisotropy_binned": "1",
+    "anisotropy_fourier": "1",
+    "force_anisotropy": "1",
+    "force_anisotropy_binned": "1",
+    "mean_stability_index": "1",
+    "mean_stability_index_all": "1",
+    "mechanical_coordination_number": "1",
+    "step": "1",
+    "time_s": "s",
+    "axial_strain": "1",
+    "axial_stress_pa": "Pa",
+    "confining_pressure_pa": "Pa",
+    "confining_stress_felt_pa": "Pa",
+    "stress_ratio": "1",
+    "stress_ratio_mobilised": "1",
+    "volumetric_strain": "1",
+    "area_m2": "m^2",
+    "height_m": "m",
+    "love_weber_xx_pa": "Pa",
+    "love_weber_yy_pa": "Pa",
+    "love_weber_xy_pa": "Pa",
+    "coordination_number": "1",
+    "unbalanced_force_ratio": "1",
+    "kinetic_energy_j": "J",
+    "elastic_energy_j": "J",
+    "friction_dissipated_j": "J",
+    "damping_dissipated_j": "J",
+    "boundary_work_j": "J",
+    "wall_work_j": "J",
+}
+
+
+
+@dataclass(frozen=True)
+class _Platens:
+    """The platens' state: sample height and area, and the mean axial stress
+    of the two platens over the sample's mean width (area over height)."""
+
+    height_m: float
+    area_m2: float
+    width_m: float
+    axial_stress_pa: float
+
+
+def _platens(sim: Simulation, boundary: Membrane | GrainBoundary) -> _Platens:
+    bottom, top = sim.wall(boundary.bottom_wall), sim.wall(boundary.top_wall)
+    height = float(top.points[0, 1] - bottom.points[0, 1])
+    area = _area(sim, boundary)
+    width = area / height
+    axial_force = 0.5 * (float(top.force[1]) - float(bottom.force[1]))
+    return _Platens(height, area, width, axial_force / width)
+
+
+def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, float]:
+    """One record of the shearing phase."""
+    boundary = _boundary(run)
+    shear = run.shear
+    platens = _platens(sim, boundary)
+    height, area, sigma_1 = platens.height_m, platens.area_m2, platens.axial_stress_pa
+    sigma_3 = config["consolidation.pressure"]
+
+    c = sim.contacts()
+    w = sim.wall_contacts()
+    n = run.n_grains
+    f_on_j = -c.force_on_i
+    grain_i, grain_j = c.i < n, c.j < n
+    if isinstance(boundary, Membrane):
+        # confining stress the grains feel: force of the grains on the membrane, per side, over the height
+        left = np.zeros(sim.n_particles, dtype=bool)
+        left[boundary.left] = True
+        right = np.zeros(sim.n_particles, dtype=bool)
+        right[boundary.right] = True
+        on_membrane = np.zeros((len(c), 2))
+        on_membrane[grain_i & ~grain_j] = f_on_j[grain_i & ~grain_j]
+        on_membrane[~grain_i & grain_j] = -f_on_j[~grain_i & grain_j]
+        membrane_particle = np.where(grain_i, c.j, c.i)
+        felt_left = -on_membrane[left[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
+        felt_right = on_membrane[right[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
+    else:
+        # the follower loads act on the grains themselves: the pressure over the full height
+        felt_left = felt_right = boundary.pressure
+    wall_force = w.force_on_particle
+    grains = np.zeros(sim.n_particles, dtype=bool)
+    grains[:n] = True
+    lw = love_weber_stress(
+        sim.positions,
+        c.i,
+        c.j,
+        c.point,
+        f_on_j,
+        area,
+        grains,
+        wall_particle=w.particle,
+        wall_point=w.point,
+        wall_force_on_particle=wall_force,
+    )
+    grain_contacts = int(np.count_nonzero(grain_i & grain_j & ~c.bonded))
+    fabric = _fabric(sim, run)
+    energy = sim.energy
+    return {
+        "step": float(sim.step_count),
+        "time_s": sim.time,
+        "axial_strain": (shear["height0"] - height) / shear["height0"],
+        "axial_stress_pa": sigma_1,
+        "confining_pressure_pa": sigma_3,
+        "confining_stress_felt_pa": 0.5 * (felt_left + felt_right),
+        "stress_ratio": sigma_1 / sigma_3,
+        "stress_ratio_mobilised": (sigma_1 - sigma_3) / (sigma_1 + sigma_3),
+        "volumetric_strain": (shear["area0"] - area) / shear["area0"],
+        "area_m2": area,
+        "height_m": height,
+        "love_weber_xx_pa": float(lw[0, 0]),
+        "love_weber_yy_pa": float(lw[1, 1]),
+        "love_weber_xy_pa": float(lw[0, 1]),
+        "coordination_number": 2.0 * grain_contacts / n,
+        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
+        "kinetic_energy_j": energy["kinetic"],
+        "elastic_energy_j": energy["elastic"],
+        "friction_dissipated_j": energy["friction_dissipated"],
+        "damping_dissipated_j": energy["damping_dissipated"],
+        "boundary_work_j": energy["boundary_work"],
+        "wall_work_j": energy["wall_work"],
+        **fabric,
+    }
+
+
+def _fabric(sim: Simulation, run: _Run) -> dict[str, float]:
+    """Fabric measures of the grains (membrane disks excluded as particles):
+    anisotropy of contact normals and normal forces (the exact estimate, and
+    Eq. 7-8 on the histogram as ``*_binned``), the mean stability index (Sec. 5)
+    and the mechanical coordination number."""
+    summary = fabric_summary(_snapshot(sim, run, 0.0))
+    summary.pop("coordination_number")  # the record's own, grain-grain contacts
+    return summary
+
+
+def _area(sim: Simulation, boundary: Membrane | GrainBoundary) -> float:
+    return sample_area(sim, boundary) if isinstance(boundary, Membrane) else boundary.area(sim)
+
+
+def _snapshot(sim: Simulation, run: _Run, strain: float) -> Snapshot:
+    """The state as a snapshot: grains, membrane disks labelled by chain (left 0, right 1)."""
+    kind = np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8)
+    kind[run.n_grains :] = int(ParticleKind.MEMBRANE)
+    body = np.full(sim.n_particles, -1, dtype=np.int64)
+    if run.membrane is not None and run.membrane.get("kind") == GrainBoundary.kind:
+        kind[run.membrane["left"] + run.membrane["right"]] = int(ParticleKind.BOUNDARY)
+    elif run.membrane is not None:
+        body[run.membrane["left"]] = 0
+        body[run.membrane["right"]] = 1
+    snap = sim.snapshot(kind=kind, axial_strain=strain, step=sim.step_count)
+    return snap.with_boundary_bodies(body)
+
+
+def _walls(sim: Simulation, run: _Run) -> WallGeometry:
+    """The walls now (the platens active, the consolidation box's sides not), named
+    as the run names them, for the snapshot."""
+    return WallGeometry.from_simulation(sim, names={wall_id: name for name, wall_id in run.walls.items()})
