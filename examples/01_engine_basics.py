@@ -39,7 +39,7 @@ print(sim)
 for _ in range(10):
     sim.run(8_000)
     print(
-        f"t = {sim.time:6.3f} s  KE = {sim.energy['kinetic']:.3e} J  "
+        f"t = {sim.time:6.3f} s  KE = {sim.energy.kinetic:.3e} J  "
         f"Z = {sim.coordination_number:.2f}  unbalanced = {sim.unbalanced_force_ratio:.2e}"
     )
 

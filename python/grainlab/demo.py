@@ -125,7 +125,7 @@ def compress(
                 "porosity": 1.0 - np.pi * np.sum(sim.radii**2) / (state.width_m * state.height_m),
                 "coordination_number": sim.coordination_number,
                 "unbalanced_force_ratio": sim.unbalanced_force_ratio,
-                "kinetic_energy_j": sim.energy["kinetic"],
+                "kinetic_energy_j": sim.energy.kinetic,
             }
         )
         bar.update(2000)

@@ -136,6 +136,50 @@ class WallContacts:
         return -self.normal_force[:, None] * self.normal + self.shear_force[:, None] * _tangent(self.normal)
 
 
+@dataclass(frozen=True)
+class Energy:
+    """The energy ledger, J per m of thickness (docs/contact-law.md, "Energy bookkeeping"):
+    ``kinetic`` and ``elastic`` at the last measured step; the dissipated and
+    work terms summed since step 0; ``balance`` = kinetic + elastic + dissipated
+    - work, constant in exact arithmetic."""
+
+    kinetic: float
+    elastic: float
+    friction_dissipated: float
+    viscous_dissipated: float
+    damping_dissipated: float
+    wall_work: float
+    external_work: float
+    boundary_work: float
+    """Work of the pressure chains' follower loads."""
+    balance: float
+
+
+@dataclass(frozen=True)
+class PeriodicCell:
+    """The periodic cell: ``origin`` and cell vectors ``a`` and ``b`` (m), which
+    directions are ``periodic``, the imposed ``velocity_gradient`` ``L[i][j] =
+    dv_i/dx_j`` (1/s) and the cell's ``area`` (m^2)."""
+
+    origin: tuple[float, float]
+    a: tuple[float, float]
+    b: tuple[float, float]
+    periodic: tuple[bool, bool]
+    velocity_gradient: tuple[tuple[float, float], tuple[float, float]]
+    area: float
+
+
+@dataclass(frozen=True)
+class PressureChainState:
+    """One pressure chain: its ``particles`` in order (the sample on their right),
+    its ``pressure`` (Pa) and the walls anchoring its ends (ids, or None)."""
+
+    particles: list[int]
+    pressure: float
+    start_wall: int | None
+    end_wall: int | None
+
+
 def _readonly(array: Any) -> NDArray[Any]:
     array.flags.writeable = False
     return array
@@ -643,9 +687,10 @@ class Simulation:
         self._engine.set_velocity_gradient(g)
 
     @property
-    def cell(self) -> dict[str, Any] | None:
-        """The periodic cell (origin, cell vectors a and b, periodicity, velocity gradient, area), or None."""
-        return self._engine.cell
+    def cell(self) -> PeriodicCell | None:
+        """The periodic cell, or None."""
+        cell = self._engine.cell
+        return None if cell is None else PeriodicCell(**cell)
 
     # ---- walls ----
 
@@ -716,9 +761,10 @@ class Simulation:
             _wall_id(end_wall),
         )
 
-    def pressure_chain(self, chain_id: int) -> dict[str, Any]:
+    def pressure_chain(self, chain_id: int) -> PressureChainState:
         """A chain's ``particles`` (in order), ``pressure`` (Pa), ``start_wall``, ``end_wall``."""
-        return dict(self._engine.pressure_chain(int(chain_id)))
+        d = self._engine.pressure_chain(int(chain_id))
+        return PressureChainState(list(d["particles"]), float(d["pressure"]), d["start_wall"], d["end_wall"])
 
     # ---- bonds ----
 
@@ -772,13 +818,9 @@ class Simulation:
         return float(self._engine.measurements["mean_unbalanced_force_ratio"])
 
     @property
-    def energy(self) -> dict[str, float]:
-        """Energy ledger (J per m thickness): ``kinetic`` and ``elastic`` at the last
-        measured step; ``friction_dissipated``, ``viscous_dissipated``,
-        ``damping_dissipated``, ``wall_work``, ``external_work``, ``boundary_work``
-        (pressure chains) summed since step 0; ``balance`` = kinetic + elastic +
-        dissipated - work, constant in exact arithmetic."""
-        return dict(self._engine.energy)
+    def energy(self) -> Energy:
+        """The energy ledger (:class:`Energy`)."""
+        return Energy(**self._engine.energy)
 
     def snapshot(self, *, kind: ArrayLike | None = None, **metadata: Any) -> Snapshot:
         """The current state as an analysis :class:`~grainlab.snapshot.Snapshot`.

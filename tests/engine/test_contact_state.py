@@ -115,10 +115,10 @@ def test_a_new_contact_reports_the_increment_it_will_get():
     # of j past i), capped
     x, v, w, r = sim.positions, sim.velocities, sim.angular_velocities, sim.radii
     i, j = c.i[new].astype(int), c.j[new].astype(int)
-    side = sim.cell["a"][0]
+    side = sim.cell.a[0]
     d = x[j] - x[i]
     d -= side * np.round(d / side)
-    grad = np.array(sim.cell["velocity_gradient"])
+    grad = np.array(sim.cell.velocity_gradient)
     dv = v[j] - v[i] + d @ grad.T
     t = np.column_stack([-c.normal[new, 1], c.normal[new, 0]])
     vt = (dv * t).sum(1) - (w[i] * r[i] + w[j] * r[j])

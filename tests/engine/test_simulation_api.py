@@ -143,7 +143,7 @@ def test_homogeneous_deformation_maps_a_particle_affinely():
     expected = np.linalg.matrix_power(step, 100) @ np.array([0.02, 0.03])
     np.testing.assert_allclose(sim.positions[0], expected, rtol=1e-12)
     cell = sim.cell
-    np.testing.assert_allclose(cell["a"], np.linalg.matrix_power(step, 100) @ [0.05, 0.0], rtol=1e-12)
+    np.testing.assert_allclose(cell.a, np.linalg.matrix_power(step, 100) @ [0.05, 0.0], rtol=1e-12)
 
 
 def test_periodic_images_interact_across_the_boundary():
@@ -231,11 +231,11 @@ def test_pressure_chain_pushes_with_pressure_times_span():
     sim.run(20_000)
     assert wall.force[0] == pytest.approx(pressure * height, rel=1e-6)
     assert wall.normal_stress(height) == pytest.approx(pressure, rel=1e-6)
-    assert sim.pressure_chain(chain)["particles"] == list(range(10))
+    assert sim.pressure_chain(chain).particles == list(range(10))
     # the follower load did the work stored in the contacts and lost to damping
     e = sim.energy
-    assert e["boundary_work"] > 0
-    assert e["balance"] == pytest.approx(0.0, abs=1e-3 * e["boundary_work"])
+    assert e.boundary_work > 0
+    assert e.balance == pytest.approx(0.0, abs=1e-3 * e.boundary_work)
 
 
 def test_inactive_wall_lets_particles_through():

@@ -532,10 +532,10 @@ class _Expansion:
             energy = sim.energy
             # rms overlap of the linear contacts from their elastic energy sum(kn delta^2 / 2)
             n_contacts = sim.contact_count + sum(w.contact_count for w in self.walls.walls)
-            rms_overlap = math.sqrt(2.0 * max(energy["elastic"], 0.0) / (s.normal_stiffness * max(n_contacts, 1)))
+            rms_overlap = math.sqrt(2.0 * max(energy.elastic, 0.0) / (s.normal_stiffness * max(n_contacts, 1)))
             if rms_overlap < s.stress_free_overlap * self.r_min:
                 return "stress-free", done
-            if energy["kinetic"] > energy["elastic"]:
+            if energy.kinetic > energy.elastic:
                 # no load-bearing network: free disks feel no local damping and would fly
                 # for ever; stop them, and let the remaining contacts push apart
                 sim.velocities = np.zeros((sim.n_particles, 2))

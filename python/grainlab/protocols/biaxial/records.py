@@ -135,12 +135,12 @@ def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, flo
         "love_weber_xy_pa": float(lw[0, 1]),
         "coordination_number": 2.0 * grain_contacts / n,
         "unbalanced_force_ratio": sim.unbalanced_force_ratio,
-        "kinetic_energy_j": energy["kinetic"],
-        "elastic_energy_j": energy["elastic"],
-        "friction_dissipated_j": energy["friction_dissipated"],
-        "damping_dissipated_j": energy["damping_dissipated"],
-        "boundary_work_j": energy["boundary_work"],
-        "wall_work_j": energy["wall_work"],
+        "kinetic_energy_j": energy.kinetic,
+        "elastic_energy_j": energy.elastic,
+        "friction_dissipated_j": energy.friction_dissipated,
+        "damping_dissipated_j": energy.damping_dissipated,
+        "boundary_work_j": energy.boundary_work,
+        "wall_work_j": energy.wall_work,
         **fabric,
     }
 
