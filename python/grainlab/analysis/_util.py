@@ -112,7 +112,7 @@ def repeated_boundary_contacts(snapshot: Snapshot, used: NDArray[np.bool_]) -> N
     owner = np.where(on_i, ci, np.where(cj >= 0, cj, 0))
     on_sample = on_i | ((cj >= 0) & sample[owner])
     key = np.where(used & on_sample, np.where(on_i, keys[:, 0], keys[:, 1]), -1)
-    return boundary_end_groups(owner, key) != np.arange(ci.size)
+    return np.asarray(boundary_end_groups(owner, key) != np.arange(ci.size), dtype=bool)
 
 
 def _merged_angles(

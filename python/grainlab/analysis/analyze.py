@@ -231,7 +231,7 @@ def analyze_snapshot(
         strain = LocalStrain(neighbours=strain_neighbours, cutoff=strain_cutoff).compute(
             reference, snapshot
         )
-        missing = int((reference.index_of(snapshot.ids) < 0).sum())
+        missing = int((reference.index_of(np.asarray(snapshot.ids)) < 0).sum())
         if missing:
             notes.append(f"{missing} particles have no match (by id) in the reference snapshot")
         if int(np.isfinite(strain.excess_shear_strain[snapshot.is_sample]).sum()) >= 10:

@@ -87,13 +87,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, _kernels
 from grainlab.analysis._util import (
-    TWO_PI,
     Computable,
     contact_ends,
     has_boundary,
     repeated_boundary_contacts,
 )
-from grainlab.snapshot import BOUNDARY_COUNTING, Snapshot
+from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot
 
 __all__ = [
     "EDGE_TOLERANCE_RAD",
@@ -358,8 +357,8 @@ class CoordinationNumber(Computable):
         sample = snapshot.is_sample
         fast = _kernels.compiled() and not has_boundary(snapshot)
         if fast:  # no wall, no membrane: each contact counts for both its particles
-            counts = np.bincount(snapshot.contact_i, minlength=n)
-            counts += np.bincount(snapshot.contact_j, minlength=n)
+            counts = np.bincount(np.asarray(snapshot.contact_i), minlength=n)
+            counts += np.bincount(np.asarray(snapshot.contact_j), minlength=n)
         else:
             owner, _, used = contact_ends(
                 snapshot, include_boundary=self.include_boundary, boundary=self.boundary
@@ -528,17 +527,18 @@ class ContactAnisotropy(Computable):
         cj = np.asarray(snapshot.contact_j)
         if self.weight == "normal_force" and snapshot.normal_force is None:
             raise ValueError("normal_force: the snapshot has no contact forces (needed for a_n)")
+        used: slice | NDArray[np.bool_]
         if _kernels.compiled() and not has_boundary(snapshot):
             used = slice(None)  # every contact is between sample particles
             n_used = ci.size
         else:
             sample = snapshot.is_sample
-            used = (
+            mask = (
                 np.ones(ci.shape, bool) if self.include_boundary else ~snapshot.is_boundary_contact
             )
             # a contact between two membrane particles is not part of the sample's fabric
-            used &= sample[ci] | ((cj >= 0) & sample[np.where(cj >= 0, cj, 0)])
-            n_used = int(used.sum())
+            mask &= sample[ci] | ((cj >= 0) & sample[np.where(cj >= 0, cj, 0)])
+            used, n_used = mask, int(mask.sum())
         angles = np.asarray(snapshot.contact_angles())[used]
         weights = None
         if self.weight == "normal_force":

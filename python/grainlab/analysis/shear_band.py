@@ -588,7 +588,9 @@ class ShearBand(Computable):
         return np.abs(diff) < _SECOND_SEPARATION
 
     @staticmethod
-    def _subset(p: NDArray[np.float64], g: NDArray[np.float64], k: int, rng: np.random.Generator):
+    def _subset(
+        p: NDArray[np.float64], g: NDArray[np.float64], k: int, rng: np.random.Generator
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         if p.shape[0] <= k:
             return p, g
         pick = rng.choice(p.shape[0], size=k, replace=False)
@@ -774,7 +776,9 @@ class ShearBand(Computable):
         )
 
 
-def _clip_line(p0: NDArray[np.float64], t: NDArray[np.float64], ext: NDArray[np.float64]):
+def _clip_line(
+    p0: NDArray[np.float64], t: NDArray[np.float64], ext: NDArray[np.float64]
+) -> NDArray[np.float64] | None:
     """Segment of the line p0 + u t inside the rectangle ext, or None."""
     lo, hi = -np.inf, np.inf
     for axis in (0, 1):

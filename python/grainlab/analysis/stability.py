@@ -53,8 +53,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, _kernels
-from grainlab.analysis._util import TWO_PI, Computable, contact_ends, finite_mean, has_boundary
-from grainlab.snapshot import BOUNDARY_COUNTING, Snapshot
+from grainlab.analysis._util import Computable, contact_ends, finite_mean, has_boundary
+from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot
 
 __all__ = ["StabilityIndex", "stability_index", "stability_index_of_angles"]
 

@@ -57,7 +57,7 @@ __all__ = ["LocalStrain", "match_ids", "neighbour_pairs"]
 
 def match_ids(reference: Snapshot, current: Snapshot) -> NDArray[np.int64]:
     """(N_current,) index in ``reference`` of each current particle, -1 if absent."""
-    return reference.index_of(current.ids)
+    return reference.index_of(np.asarray(current.ids))
 
 
 def neighbour_pairs(

@@ -182,7 +182,8 @@ def run(args: argparse.Namespace) -> int:
             ref_format = "particles-csv"  # its names are those --columns maps
         if ref_step is None and ref_format == "lammps-dump":
             ref_step = list_timesteps(args.reference)[0]
-        first = {"snapshot": 0} if ref_step is None and ref_format == "grainlab-hdf5" else {}  # strain 0
+        # a run.h5 reference without a step: its first snapshot (strain 0)
+        first = 0 if ref_step is None and ref_format == "grainlab-hdf5" else None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", MissingKindWarning)  # said once, for INPUT
             reference = read_snapshot(
@@ -193,7 +194,7 @@ def run(args: argparse.Namespace) -> int:
                 columns=columns if args.reference_contacts else None,
                 boundary_types=boundary_types,
                 particle_columns=particle_columns if ref_format != "grainlab-hdf5" else None,
-                **first,
+                snapshot=first,
             )
         if _same_configuration(snapshot, reference):
             print(

@@ -8,7 +8,7 @@ from grainlab.protocols.biaxial import run_biaxial
 from grainlab.protocols.config import resolve
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = subparsers.add_parser(
         "biaxial",
         help="the paper's biaxial test: sample, consolidation, membrane, shearing",

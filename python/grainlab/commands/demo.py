@@ -7,7 +7,7 @@ import argparse
 from grainlab.demo import compress
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = subparsers.add_parser(
         "demo",
         help="engine demo: compress a random disk assembly to 100 kPa in servo walls",

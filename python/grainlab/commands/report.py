@@ -10,7 +10,7 @@ from pathlib import Path
 from grainlab.report import write_report
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = subparsers.add_parser(
         "report",
         help="a self-contained report.html of a biaxial run or of the packing study",

@@ -20,7 +20,7 @@ from grainlab.reproduction.runs import (
 )
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = subparsers.add_parser(
         "reproduce",
         help="does the paper's finding hold? an ensemble of runs, every claim with a verdict",

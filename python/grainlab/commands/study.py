@@ -9,7 +9,7 @@ from grainlab.study.packing import GENERATION_FRICTION_SEARCH
 from grainlab.study.paper import run_study
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = subparsers.add_parser(
         "study",
         help="the paper's packing study: 11 irregular + 8 hexagonal packings, Figs. 15-17",

@@ -7,7 +7,7 @@ import argparse
 from grainlab.study.plan import load_plan, run_sweep
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = subparsers.add_parser(
         "sweep",
         help="a parameter sweep (grid or zip) of packing or biaxial runs",

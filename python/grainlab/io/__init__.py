@@ -98,14 +98,19 @@ def detect_format(path: str | Path) -> str:
     )
 
 
+# the keywords every reader below takes (read_snapshot passes them on)
+_PathOrNone = str | Path | None
+_Columns = Mapping[str, str] | None
+
+
 def _no_timestep(fmt: str, timestep: int | None) -> None:
     if timestep is not None:
         raise ValueError(f"timestep: only applies to LAMMPS dumps and run.h5, not to a {fmt}")
 
 
 def _read_csv(
-    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
-    particle_columns=None,
+    path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
+    columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
 ) -> Snapshot:
     _no_timestep("particles CSV", timestep)
     if len(boundary_types):
@@ -120,8 +125,8 @@ def _read_csv(
 
 
 def _read_pfc(
-    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
-    particle_columns=None,
+    path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
+    columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
 ) -> Snapshot:
     _no_timestep("PFC ball table", timestep)
     if len(boundary_types):
@@ -131,7 +136,9 @@ def _read_pfc(
     )
 
 
-def _points_only(fmt: str, contacts, timestep, columns, particle_columns) -> None:
+def _points_only(
+    fmt: str, contacts: _PathOrNone, timestep: int | None, columns: _Columns, particle_columns: _Columns
+) -> None:
     _no_timestep(fmt, timestep)
     for name, value in (("contacts", contacts), ("contact columns", columns),
                         ("particle columns", particle_columns)):
@@ -140,8 +147,8 @@ def _points_only(fmt: str, contacts, timestep, columns, particle_columns) -> Non
 
 
 def _read_yade(
-    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
-    particle_columns=None,
+    path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
+    columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
 ) -> Snapshot:
     _points_only("YADE text export", contacts, timestep, columns, particle_columns)
     if len(boundary_types):
@@ -150,16 +157,16 @@ def _read_yade(
 
 
 def _read_vtk(
-    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
-    particle_columns=None,
+    path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
+    columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
 ) -> Snapshot:
     _points_only("legacy VTK file", contacts, timestep, columns, particle_columns)
     return read_legacy_vtk(path, tolerance=tolerance, boundary_types=boundary_types)
 
 
 def _read_dump(
-    path: Path, *, contacts=None, timestep=None, tolerance=0.0, columns=None, boundary_types=(),
-    particle_columns=None,
+    path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
+    columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
 ) -> Snapshot:
     if particle_columns:
         raise ValueError("particle columns: only apply to CSV files (a LAMMPS dump names its columns)")

@@ -91,6 +91,7 @@ def planar(
     meta: dict[str, Any] = {"z_policy": z_policy, "z_spread_m": spread}
     if z_policy == "project":
         return Planar(np.ones(n, bool), radii, z, meta)
+    assert z0 is not None  # check_z_policy ran before any reading
     h = z - float(z0)
     keep = np.abs(h) < radii
     if not keep.any():

@@ -57,7 +57,7 @@ def snapshot_from_points(
     fields = {name: value[keep] for name, value in fields.items()}
     metadata = {**metadata, **plan.metadata}
     kwargs: dict[str, Any] = dict(ids=ids, kind=kind, particle_fields=fields, metadata=metadata)
-    if plan.spheres:
+    if plan.spheres and plan.z is not None:
         i, j, normals = sphere_contacts(
             path, positions, plan.z, plan.radii, ids, tolerance=tolerance, box=None, periodic=(False, False)
         )

@@ -247,7 +247,9 @@ def read_particles_csv(
             raise FileFormatError(
                 path, int(numbers[k]), f"column 'kind': unknown code {int(kind[k])}"
             )
-    extra = {n: v for n, v in col.items() if n not in PARTICLE_COLUMNS + ("rotation", "kind")}
+    extra: dict[str, NDArray[Any]] = {
+        n: v for n, v in col.items() if n not in PARTICLE_COLUMNS + ("rotation", "kind")
+    }
     if BODY_FIELD in col:
         body = integral_column(path, col[BODY_FIELD], numbers, BODY_FIELD)
         bad = body < -1
@@ -277,7 +279,7 @@ def read_particles_csv(
     if contacts is not None:
         snap = Snapshot(positions, radius, **kwargs)
         return attach_contacts_csv(snap, contacts, columns=contact_map)
-    if detect and plan.spheres:
+    if detect and plan.spheres and plan.z is not None:
         i, j, normals = sphere_contacts(
             path, positions, plan.z, radius, ids, tolerance=tolerance, box=None, periodic=(False, False)
         )
@@ -388,8 +390,8 @@ def write_contacts_csv(
     """Write the particle–particle contacts as ``i,j[,normal_force,shear_force]`` (by id)."""
     pp = np.asarray(snapshot.contact_j) >= 0
     cols: dict[str, NDArray[Any]] = {
-        "i": np.asarray(snapshot.ids)[snapshot.contact_i[pp]],
-        "j": np.asarray(snapshot.ids)[snapshot.contact_j[pp]],
+        "i": np.asarray(snapshot.ids)[np.asarray(snapshot.contact_i)[pp]],
+        "j": np.asarray(snapshot.ids)[np.asarray(snapshot.contact_j)[pp]],
     }
     if snapshot.normal_force is not None:
         cols["normal_force"] = np.asarray(snapshot.normal_force)[pp]
@@ -416,8 +418,8 @@ def _write_table(path: str | Path, cols: Mapping[str, NDArray[Any]], float_forma
         body = rendered[0].astype(object)
         for r in rendered[1:]:
             body = body + "," + r.astype(object)
-        text = header + "\n" + "\n".join(body.tolist()) + "\n"
+        content = header + "\n" + "\n".join(body.tolist()) + "\n"
     else:
-        text = header + "\n"
-    p.write_text(text, encoding="utf-8")
+        content = header + "\n"
+    p.write_text(content, encoding="utf-8")
     return p

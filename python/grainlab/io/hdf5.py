@@ -344,7 +344,7 @@ def _check_format(
         raise error(path, f"not a grainlab file of format {expected!r} ({found})")
     raw = f.attrs.get("format_version")
     try:
-        version = int(raw)  # type: ignore[arg-type]
+        version = int(raw)
     except (TypeError, ValueError):
         raise error(path, f"format_version: missing or not an integer ({raw!r})") from None
     if version not in readers:
@@ -635,6 +635,7 @@ class ResultsWriter:
         if buffered:
             writer._publish_or_close()
         elif image is not None:  # continued on disk: the image becomes the partial file
+            assert buffer is not None  # the image was opened in memory
             f.flush()
             data = buffer.getvalue()
             f.close()

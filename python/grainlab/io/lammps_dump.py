@@ -384,6 +384,7 @@ def read_lammps_dump(
     zn = {"x": "z", "xu": "zu", "xs": "zs", "xsu": "zsu"}[xn]
     z = col[zn] if zn in col else None
     if z is not None and zn in ("zs", "zsu"):
+        assert frame.box is not None  # the scaled x and y needed it (refused above)
         z = frame.box[2, 0] + z * (frame.box[2, 1] - frame.box[2, 0])
     plan = planar(path, where, z, radius, z_policy=z_policy, z0=z0, column=zn)
     check_geometry(path, np.c_[x, y][plan.keep], plan.radii, numbers[plan.keep], (xn, yn))
@@ -446,7 +447,7 @@ def read_lammps_dump(
     if contacts is not None:
         snap = Snapshot(positions, radius, **snap_kwargs)
         return attach_lammps_contacts(snap, contacts, timestep=frame.timestep, columns=columns)
-    if detect and plan.spheres:
+    if detect and plan.spheres and plan.z is not None:
         i, j, normals = sphere_contacts(
             path, positions, plan.z, radius, snap_kwargs["ids"], tolerance=tolerance,
             box=box2, periodic=snap_kwargs["periodic"],
@@ -606,7 +607,10 @@ def attach_lammps_contacts(
         "not touching were dropped"
     )
     metadata["contact_columns"] = {role: frame.columns[k] for role, k in roles.items()}
-    sel = lambda a: None if a is None else a[keep]  # noqa: E731
+
+    def sel(a: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
+        return None if a is None else a[keep]
+
     return dataclasses.replace(
         snapshot,
         contact_i=i[keep],

@@ -252,7 +252,7 @@ def _write_xml(
         if dataset == "UnstructuredGrid"
         else {"NumberOfVerts": str(nv), "NumberOfLines": str(m), "NumberOfStrips": "0", "NumberOfPolys": "0"}
     )
-    piece = ET.SubElement(poly, "Piece", NumberOfPoints=str(n), **counts)
+    piece = ET.SubElement(poly, "Piece", {"NumberOfPoints": str(n), **counts})
     pd = ET.SubElement(piece, "PointData")
     for name, value in (point_data or {}).items():
         _data_array(pd, name, _prepare(name, value, n), binary)
@@ -315,7 +315,7 @@ def write_pvd(
 def as_vector3(a: NDArray[Any]) -> NDArray[Any]:
     """(N, 2) vectors padded with z = 0, so that ParaView's vector filters apply."""
     if a.ndim == 2 and a.shape[1] == 2:
-        return np.c_[a, np.zeros(a.shape[0], a.dtype)]
+        return np.column_stack((a, np.zeros(a.shape[0], a.dtype)))
     return a
 
 

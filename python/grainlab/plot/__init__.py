@@ -25,7 +25,7 @@ import io
 import re
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import matplotlib as mpl
 import numpy as np
@@ -37,6 +37,9 @@ from PIL import Image
 from scipy.spatial import cKDTree
 
 from grainlab._notebook import new_figure, prepare_notebook
+
+if TYPE_CHECKING:
+    from matplotlib.typing import RcKeyType  # matplotlib >= 3.9 (typing only)
 
 __all__ = [
     "FIGURE_DPI",
@@ -57,7 +60,7 @@ __all__ = [
 FIGURE_DPI = 200
 
 #: rcParams for paper figures: serif text, small sizes, thin lines, no clutter.
-PAPER_STYLE: dict[str, Any] = {
+PAPER_STYLE: dict[RcKeyType, Any] = {
     "font.family": "serif",
     "font.size": 9,
     "axes.labelsize": 9,
@@ -123,7 +126,7 @@ def compact_png(data: bytes, *, dpi: float | None = None, keep: ArrayLike | None
         size = (max(1, round(image.width * scale)), max(1, round(image.height * scale)))
         image = image.resize(size, Image.Resampling.LANCZOS)
         out_dpi = dpi
-    if image.getextrema()[3][0] < 255:  # transparent pixels: an RGBA palette
+    if int(np.asarray(image.getchannel("A")).min()) < 255:  # transparent pixels: an RGBA palette
         palette = image.quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
     else:
         rgb = image.convert("RGB")
@@ -305,6 +308,7 @@ def particle_map(
     ax = new_axes(ax, figsize=(3.5, float(np.clip(3.0 * aspect, 2.0, 7.0))))
     with paper_style():
         finite = np.isfinite(val)
+        ticks: list[int] = []  # one per colour of a discrete map
         if discrete:
             lo = int(np.nanmin(val[finite])) if finite.any() else 0
             hi = int(np.nanmax(val[finite])) if finite.any() else 1
@@ -312,13 +316,14 @@ def particle_map(
             hi = max(int(vmax) if vmax is not None else hi, lo + 1)
             colormap = mpl.colormaps[cmap].resampled(hi - lo + 1)
             norm: Normalize = BoundaryNorm(np.arange(lo - 0.5, hi + 1.0), colormap.N)
+            ticks = list(range(lo, hi + 1))
         else:
             colormap = mpl.colormaps[cmap]
-            lo = vmin if vmin is not None else (float(np.min(val[finite])) if finite.any() else 0.0)
-            hi = vmax if vmax is not None else (float(np.max(val[finite])) if finite.any() else 1.0)
-            if hi <= lo:
-                hi = lo + 1.0
-            norm = Normalize(lo, hi)
+            low = vmin if vmin is not None else (float(np.min(val[finite])) if finite.any() else 0.0)
+            high = vmax if vmax is not None else (float(np.max(val[finite])) if finite.any() else 1.0)
+            if high <= low:
+                high = low + 1.0
+            norm = Normalize(low, high)
         colormap = colormap.with_extremes(bad=nan_color)
         coll = EllipseCollection(
             widths=2 * rad,
@@ -344,9 +349,7 @@ def particle_map(
         if colorbar:
             cb = ax.figure.colorbar(coll, ax=ax, shrink=0.8)
             if discrete:
-                cb.set_ticks(
-                    np.arange(int(norm.boundaries[0] + 0.5), int(norm.boundaries[-1] + 0.5))
-                )
+                cb.set_ticks(ticks)
             if label:
                 cb.set_label(label)
         if band is not None:

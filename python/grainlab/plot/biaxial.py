@@ -180,7 +180,7 @@ def shared_map_figure(
             _annotate(ax, panel)
         cb = fig.colorbar(axes[0].collections[0], ax=axes, shrink=0.8, label=label)
         if discrete:
-            ticks = np.arange(round(lo), round(hi) + 1)
+            ticks = list(range(round(lo), round(hi) + 1))
             cb.set_ticks(ticks)
             names = [str(t) for t in ticks]
             if hi >= COUNT_CAP:

@@ -15,9 +15,10 @@ import math
 import re
 import tomllib
 from collections.abc import Iterable, Mapping
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 from grainlab import paper
 from grainlab._mapping import flatten_keys
@@ -69,7 +70,14 @@ class Field:
         return text
 
 
-_POSITIVE = {"minimum": 0.0, "exclusive_minimum": True}
+class _Range(TypedDict, total=False):
+    """Range keywords of :class:`Field` shared by many keys."""
+
+    minimum: float
+    exclusive_minimum: bool
+
+
+_POSITIVE: _Range = {"minimum": 0.0, "exclusive_minimum": True}
 
 #: Every key, with the paper's Table 1 values as defaults.
 FIELDS: dict[str, Field] = {
@@ -318,7 +326,7 @@ def resolve(
     return BiaxialConfig(resolved)
 
 
-def _grading_curve(v: dict[str, Any], given: set[str]) -> None:
+def _grading_curve(v: dict[str, Any], given: AbstractSet[str]) -> None:
     """Checks a 'curve' grading's sieve data and takes d_min and d_max from it
     (a d_min or d_max given as well must agree with the curve's ends)."""
     sizes, passing = v["sample.sieve_sizes"], v["sample.percent_passing"]
@@ -349,7 +357,7 @@ def _grading_curve(v: dict[str, Any], given: set[str]) -> None:
     v["sample.d_min"], v["sample.d_max"] = sizes[0], sizes[-1]
 
 
-def _check_consistency(v: dict[str, Any], given: set[str] = frozenset()) -> None:
+def _check_consistency(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
     _grading_curve(v, given)
     if v["sample.d_min"] > v["sample.d_max"]:
         raise ConfigError(

@@ -173,13 +173,13 @@ def _readable(key: str, value: Any, summary: dict[str, Any], threads: int | None
         return "auto"
     if isinstance(value, bool) or not isinstance(value, int | float | list):
         return str(value)
-    if isinstance(value, list) and not value:
-        return "none"
-    if kind == "strain_list":
-        return ", ".join(f"{100 * v:g}" for v in value) + " %"
-    if kind == "length_list":
-        return ", ".join(f"{v:g}" for v in value) + " (" + ", ".join(f"{1e3 * v:g}" for v in value) + " mm)"
     if isinstance(value, list):
+        if not value:
+            return "none"
+        if kind == "strain_list":
+            return ", ".join(f"{100 * v:g}" for v in value) + " %"
+        if kind == "length_list":
+            return ", ".join(f"{v:g}" for v in value) + " (" + ", ".join(f"{1e3 * v:g}" for v in value) + " mm)"
         return ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in value)
     if kind == "length":
         return f"{value:g} ({1e3 * value:g} mm)"

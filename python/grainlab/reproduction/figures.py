@@ -215,7 +215,7 @@ def _study_figure(studies: Sequence[Measures], title: str) -> Figure:
     return fig
 
 
-def _rate_figure(family: Sequence[tuple[float, Sequence[Measures]]]) -> Figure:
+def _rate_figure(family: Sequence[tuple[float, Sequence[Measures | None]]]) -> Figure:
     with plot.paper_style():
         fig = Figure(figsize=(5.0, 3.2), layout="constrained")
         ax = fig.add_subplot()
@@ -248,8 +248,8 @@ def draw_figures(plan: ReproductionPlan, results: Mapping[tuple[str, str, str], 
     drawn: dict[str, Path] = {}
     for v in plan.variants:
         kind = "study" if v.kind == "study" else "biaxial"
-        runs = [results.get((v.name, str(s), kind)) for s in plan.seeds]
-        runs = [m for m in runs if m is not None]
+        found = [results.get((v.name, str(s), kind)) for s in plan.seeds]
+        runs = [m for m in found if m is not None]
         if not runs:
             continue
         stem = variant_folder(v.name)

@@ -20,10 +20,13 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from grainlab.analysis.stability import StabilityIndex
 
 #: Analysis options a variant may set, with their defaults.
 ANALYSIS_DEFAULTS: dict[str, Any] = {"boundary_contacts": "body"}
@@ -34,7 +37,7 @@ END_WINDOW = 0.3
 LINEAR_TO = 0.005
 
 
-def _stability(options: Mapping[str, Any]):
+def _stability(options: Mapping[str, Any]) -> StabilityIndex:
     from grainlab.analysis.stability import StabilityIndex
 
     counting = {"body": "body", "raw": "each"}[options.get("boundary_contacts", "body")]
@@ -153,8 +156,9 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
     peak_pos = (1 + int(np.argmin([abs(strains[k] - macro["peak_axial_strain"]) for k in order[1:]]))
                 if len(order) > 1 else 0)
     peak_ids: NDArray[np.int64] = np.zeros(0, np.int64)
-    if members[peak_pos] is not None:
-        peak_ids = np.asarray(snaps[peak_pos].ids)[members[peak_pos][0]]
+    peak_members = members[peak_pos]
+    if peak_members is not None:
+        peak_ids = np.asarray(snaps[peak_pos].ids)[peak_members[0]]
     eps_ts = np.asarray(ts["axial_strain"], dtype=np.float64)
     q_ts = np.asarray(ts["stress_ratio"], dtype=np.float64)
     finite = np.isfinite(q_ts) & np.isfinite(eps_ts)

@@ -42,10 +42,13 @@ import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from grainlab.io.results import write_json_atomic
-from grainlab.study.campaign import Run, make_run
+from grainlab.study.campaign import CampaignResult, Run, make_run
+
+if TYPE_CHECKING:
+    from grainlab.protocols.config import BiaxialConfig
 
 __all__ = [
     "DEFAULT_SEEDS",
@@ -289,7 +292,7 @@ class ReproductionPlan:
             params["quick"] = True
         return params
 
-    def biaxial_config(self, variant: Variant, seed: int):
+    def biaxial_config(self, variant: Variant, seed: int) -> BiaxialConfig:
         """The resolved :class:`~grainlab.protocols.config.BiaxialConfig` of a biaxial run."""
         from grainlab.protocols.config import resolve
 
@@ -354,7 +357,7 @@ def run_reproduction(
     workers: int | None = None,
     scheduler: Any = None,
     progress: bool = False,
-):
+) -> CampaignResult:
     """Runs (or resumes) every run of ``plan`` into ``out_dir``; one row per run in
     ``runs.csv``. Returns the :class:`~grainlab.study.campaign.CampaignResult`."""
     from grainlab.study.campaign import run_campaign

@@ -3,7 +3,8 @@
 ``grainlab reproduce`` runs at paper scale take hours; their ``claims.json``
 documents are kept in ``grainlab/reproduction/paper_scale/`` (one per campaign
 folder: ``main.json``, the 2 %/min ensemble; ``rates.json``, the faster rates,
-boundary B and the time-step check; ``rate1.json``, 1 %/min). docs/reproduction.md
+boundary B and the time-step check; ``rate1.json``, 1 %/min; ``study.json``, the
+packing study generated with friction 0 and 0.9). docs/reproduction.md
 quotes their tables (a test keeps them equal) and ``report.html`` shows, beside
 a run's own value of each claim, the verdict of the ensemble.
 """
@@ -18,7 +19,7 @@ from typing import Any
 __all__ = ["CAMPAIGNS", "paper_scale_verdicts", "stored_claims"]
 
 #: The stored campaign documents, by name.
-CAMPAIGNS = ("main", "rates", "rate1")
+CAMPAIGNS = ("main", "rates", "rate1", "study")
 
 
 @cache
@@ -30,7 +31,10 @@ def stored_claims(name: str = "main") -> dict[str, Any] | None:
     path = resources.files("grainlab.reproduction") / "paper_scale" / f"{name}.json"
     if not path.is_file():
         return None
-    return json.loads(path.read_text(encoding="utf-8"))
+    data = json.loads(path.read_text(encoding="utf-8"))
+    if not isinstance(data, dict):
+        raise ValueError(f"{path}: a stored campaign is a JSON object, got {type(data).__name__}")
+    return data
 
 
 def paper_scale_verdicts(document: dict[str, Any] | None = None) -> dict[str, dict[str, Any]]:

@@ -178,7 +178,7 @@ class UniformByMass(_UniformRange):
         if self._b == self._a:
             return (d >= self._a).astype(np.float64)
         x = np.clip(d, self._a, self._b)
-        return (1.0 / self._a - 1.0 / x) / (1.0 / self._a - 1.0 / self._b)
+        return np.asarray((1.0 / self._a - 1.0 / x) / (1.0 / self._a - 1.0 / self._b), np.float64)
 
     def number_ppf(self, u: ArrayLike) -> NDArray[np.float64]:
         u = np.asarray(u, dtype=np.float64)
@@ -295,7 +295,7 @@ class GradingCurve(Grading):
         g = self._inverse_variable
         lo, hi = sizes[k], sizes[k + 1]
         frac = (g(lo) - g(x)) / (g(lo) - g(hi))
-        return self._cum[k] + frac * (self._cum[k + 1] - self._cum[k])
+        return np.asarray(self._cum[k] + frac * (self._cum[k + 1] - self._cum[k]), np.float64)
 
     def number_ppf(self, u: ArrayLike) -> NDArray[np.float64]:
         sizes = self.sieve_sizes_m

@@ -166,12 +166,15 @@ def load_finished(run: Run, out_dir: str | os.PathLike[str]) -> dict[str, Any] |
         saved = json.loads(path.read_text())
     except (OSError, json.JSONDecodeError):
         return None
+    if not isinstance(saved, dict) or not isinstance(saved.get("row"), dict):
+        return None  # not a result file of this grainlab: run again
     same = saved.get("run", {})
     if same.get("kind") != run.kind or same.get("seed") != run.seed or same.get("params") != json.loads(
         json.dumps(run.params)
     ):
         return None
-    return saved["row"]
+    row: dict[str, Any] = saved["row"]
+    return row
 
 
 # ---- execution -----------------------------------------------------------------
@@ -300,7 +303,9 @@ def _run_dask(todo: Sequence[Run], out: Path, scheduler: str | Any, threads: int
             "--scheduler: Dask is not installed; pip install 'grainlab[cluster]'"
         ) from error
     own = not isinstance(scheduler, Client)
-    if own:
+    if isinstance(scheduler, Client):
+        client = scheduler
+    else:
         try:
             client = Client(scheduler, timeout=SCHEDULER_TIMEOUT_S)
         except (OSError, TimeoutError) as error:
@@ -308,8 +313,6 @@ def _run_dask(todo: Sequence[Run], out: Path, scheduler: str | Any, threads: int
                 f"--scheduler: cannot reach a Dask scheduler at {scheduler} within {SCHEDULER_TIMEOUT_S:g} s "
                 f"({error}); check the address and that the scheduler is running"
             ) from None
-    else:
-        client = scheduler
     try:
         futures = [
             client.submit(execute_run, run, str(out), threads, key=f"grainlab-{out.name}-{run.name}-{run.seed}",

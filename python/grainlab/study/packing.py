@@ -33,7 +33,7 @@ import math
 import time
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 
@@ -204,6 +204,22 @@ def measure(snapshot: Snapshot) -> dict[str, float]:
     return {k: summary[k] for k in keys}
 
 
+class _ExpansionOptions(TypedDict, total=False):
+    """The keywords of a packing's radius expansion (``expand_to_porosity``)."""
+
+    seed: int
+    wall_friction: float
+    normal_stiffness: float
+    shear_stiffness: float
+    density: float
+    local_damping: float
+    max_stress_pa: float
+    threads: int
+    progress: bool
+    keep_simulation: bool
+    density_scaling: bool
+
+
 def _irregular(p: PackingParams) -> dict[str, Any]:
     from grainlab.samples import (
         ExpansionError,
@@ -214,7 +230,7 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
 
     box = (0.0, 0.0, p.width, p.height)
     grading = UniformByNumber(p.d_min, p.d_max)
-    common = dict(
+    common = _ExpansionOptions(
         seed=p.seed,
         wall_friction=p.platen_friction,
         normal_stiffness=p.normal_stiffness,
@@ -231,7 +247,7 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
 
     def generate(porosity: float, density_scaling: bool, search: bool) -> tuple[Any, Any]:
         """(sample, friction search or None) at ``porosity``."""
-        options = {**common, "density_scaling": density_scaling}
+        options: _ExpansionOptions = {**common, "density_scaling": density_scaling}
         if search:
             found = expand_with_friction_search(
                 box, porosity, grading, friction_range=(0.0, p.friction),

@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from grainlab._mapping import flatten_keys
-from grainlab.study.campaign import Run, make_run
+from grainlab.study.campaign import CampaignResult, Run, make_run
 
 PLAN_KEYS = ("base", "mode", "seed", "config", "quick", "fixed", "vary", "name")
 
@@ -202,7 +202,8 @@ def load_plan(path: str | os.PathLike[str]) -> Plan:
 
 
 def run_sweep(plan: Plan | str | os.PathLike[str], out_dir: str | os.PathLike[str], *,
-              workers: int | None = None, scheduler: Any = None, progress: bool = False):
+              workers: int | None = None, scheduler: Any = None,
+              progress: bool = False) -> CampaignResult:
     """Runs (or resumes) a sweep; ``sweep.csv`` in ``out_dir``, each run in ``runs/run_NNNN``."""
     from grainlab.io.results import write_text_atomic
     from grainlab.study.campaign import run_campaign
