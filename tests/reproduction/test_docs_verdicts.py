@@ -35,3 +35,15 @@ def test_a_stale_block_is_rewritten(tmp_path):
     text = page.read_text()
     assert text.startswith("intro\n") and text.endswith("outro\n") and "old" not in text
     assert "### Claims: paper" in text and "| `c` | 1 | 1 | [0.9, 1.1] | 2 | reproduced |" in text
+
+
+def test_the_default_run_quoted_in_biaxial_md_is_the_campaign_seed_1():
+    # docs/biaxial.md quotes the default run, which is seed 1 of the stored main ensemble
+    document = json.loads((ROOT / "python/grainlab/reproduction/paper_scale/main.json").read_text(encoding="utf-8"))
+    rows = {row["id"]: row for row in document["claims"]}
+    seed_1 = document["seeds"].index(1)
+    page = (ROOT / "docs" / "biaxial.md").read_text(encoding="utf-8")
+    z0 = rows["z_initial"]["per_seed"][seed_1]
+    peak_strain = rows["peak_near_1.5"]["per_seed"][seed_1]
+    assert f"| coordination number, initial | {z0:.2f} |" in page
+    assert f"at {100 * peak_strain:.2f} % axial strain |" in page

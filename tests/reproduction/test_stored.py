@@ -18,9 +18,9 @@ def test_verdicts_by_claim_from_a_document():
 
 
 def test_an_unknown_campaign_is_refused():
-    with pytest.raises(ValueError, match="name: expected one of main, rates, rate1"):
+    with pytest.raises(ValueError, match="name: expected one of main, rates, rate1, study"):
         stored_claims("nope")
-    assert set(CAMPAIGNS) == {"main", "rates", "rate1"}
+    assert set(CAMPAIGNS) == {"main", "rates", "rate1", "study"}
 
 
 def test_the_shipped_campaign_judges_every_biaxial_claim():
@@ -32,3 +32,12 @@ def test_the_shipped_campaign_judges_every_biaxial_claim():
     assert verdicts["band_lambda_above_rest"]["verdict"] in ("reproduced", "not reproduced", "inconclusive")
     rates = stored_claims("rate1")
     assert {e["rate"] for e in rates["rate_convergence"]} == {"2%/min", "4%/min", "8%/min"}
+
+
+def test_the_shipped_packing_study_judges_every_study_claim():
+    from grainlab.reproduction.claims import STUDY_CLAIMS
+
+    study = stored_claims("study")
+    assert study is not None and study["variant"] == "study:generation_friction=0"
+    for block in study["variants"]:
+        assert {c.id for c in STUDY_CLAIMS} <= {row["id"] for row in block["claims"]}

@@ -141,10 +141,11 @@ def default_strain_rate(config: BiaxialConfig, max_diameter: float, min_radius: 
     The inertial number is taken for the heaviest grain and with local
     damping's effective mass ``m / (1 - alpha)``:
     ``I = rate * d_max * sqrt(rho / ((1 - alpha) sigma_3))``. The bound's default,
-    1e-4, is this number at the fastest rate that the paper-scale rate study
-    found converged (docs/reproduction.md): 2 %/min with Table 1, where 4 and
-    8 %/min gave higher peaks and more dilation than 2 %/min beyond the seed
-    scatter. For another material or sample, ``auto`` keeps that inertial
+    1e-4, is this number at the paper's 2 %/min with Table 1: in the
+    paper-scale rate study (docs/reproduction.md) no faster rate matched
+    2 %/min (4 and 8 %/min dilated more beyond the seed scatter, 8 %/min also
+    peaked higher), and 2 %/min itself did not match 1 %/min, so ``auto`` is
+    the paper's rate, not a converged one. For another material or sample, ``auto`` keeps that inertial
     number, which the study did not test. Eq. 16: ``rate * r_min * sqrt(rho /
     p_y)`` with the limiting contact pressure ``p_y`` (Table 1: 150 MPa), far
     from binding with Table 1.
