@@ -53,6 +53,6 @@ def quick_biaxial_run(tmp_path_factory) -> Path:
     from grainlab.cli import main
 
     out = tmp_path_factory.mktemp("biaxial") / "quick"
-    # 20 %/min (the "auto" rate with Table 1): ten times the default 2 %/min, so the session stays fast
+    # 20 %/min: ten times the default 2 %/min, so the test session stays fast
     assert main(["biaxial", "--quick", "--strain-rate", "20%/min", "--out", str(out), "--no-progress"]) == 0
     return out
