@@ -314,8 +314,9 @@ def outer_contour(
         d = x[partners] - x[current]
         turn = np.mod(heading_back - np.arctan2(d[:, 1], d[:, 0]), 2.0 * np.pi)
         turn[turn < 1e-12] = 2.0 * np.pi  # straight back only from a dead end
-        following = int(partners[np.argmin(turn)])
-        heading_back = float(np.arctan2(-d[np.argmin(turn), 1], -d[np.argmin(turn), 0]))
+        pick = int(np.argmin(turn))
+        following = int(partners[pick])
+        heading_back = float(np.arctan2(-d[pick, 1], -d[pick, 0]))
         if following in place:
             for k in chain[place[following] + 1 :]:
                 del place[k]
