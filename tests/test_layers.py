@@ -21,6 +21,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "python" / "grainlab"
 LAYERS: dict[str, int] = {
     # 0: the compiled engine and leaf helpers that import no other grainlab module
     "grainlab._core": 0,
+    "grainlab._cores": 0,
     "grainlab._interrupt": 0,
     "grainlab._kernels": 0,
     "grainlab._mapping": 0,

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from grainlab._cores import available_cores
 from grainlab.io.results import write_json_atomic, write_text_atomic
 
 RESULT_FILE = "result.json"
@@ -186,9 +187,7 @@ SCHEDULER_TIMEOUT_S = 10.0
 
 def default_workers() -> int:
     """The cores this process may run on (``taskset`` and cgroup affinity count)."""
-    if hasattr(os, "sched_getaffinity"):
-        return max(len(os.sched_getaffinity(0)), 1)
-    return os.cpu_count() or 1
+    return available_cores()
 
 
 @dataclass

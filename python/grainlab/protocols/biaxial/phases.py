@@ -5,7 +5,6 @@ leaves the run in its next phase."""
 from __future__ import annotations
 
 import math
-import os
 import time
 import warnings
 from collections.abc import Callable
@@ -13,6 +12,7 @@ from collections.abc import Callable
 import numpy as np
 
 import grainlab
+from grainlab._cores import available_cores
 from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
 from grainlab.io.hdf5 import ResultsWriter, snapshot_name
@@ -70,7 +70,7 @@ def _grading(config: BiaxialConfig) -> UniformByNumber | UniformByMass | Grading
 
 def _threads(config: BiaxialConfig) -> int:
     threads = config["run.threads"]
-    return (os.cpu_count() or 1) if threads == "auto" else int(threads)
+    return available_cores() if threads == "auto" else int(threads)
 
 
 def _grain_model(config: BiaxialConfig) -> ContactModel:
