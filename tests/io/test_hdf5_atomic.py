@@ -325,6 +325,7 @@ def test_a_full_disk_keeps_the_published_file_and_the_old_checkpoint(tmp_path, m
     import errno
 
     import grainlab.io.hdf5 as hdf5
+    from grainlab.io.hdf5 import checkpoint, writer
 
     out = ResultsWriter(tmp_path, buffered=True)
     out.append_timeseries({"axial_strain": 0.0})
@@ -335,7 +336,8 @@ def test_a_full_disk_keeps_the_published_file_and_the_old_checkpoint(tmp_path, m
     def full(*args, **kwargs):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(hdf5, "write_bytes_atomic", full)
+    monkeypatch.setattr(writer, "write_bytes_atomic", full)
+    monkeypatch.setattr(checkpoint, "write_bytes_atomic", full)
     with pytest.raises(OSError, match="No space left"):
         out.publish()
     with pytest.raises(OSError, match="No space left"):

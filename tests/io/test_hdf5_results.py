@@ -10,7 +10,6 @@ import pytest
 
 from grainlab.io import FileFormatError, read_snapshot
 from grainlab.io.hdf5 import (
-    _READERS_BY_VERSION,
     FORMAT_VERSION,
     ResultsFileError,
     ResultsWriter,
@@ -20,6 +19,7 @@ from grainlab.io.hdf5 import (
     snapshot_name,
     write_checkpoint,
 )
+from grainlab.io.hdf5.reader import _READERS_BY_VERSION
 from grainlab.snapshot import ParticleKind, Snapshot
 
 CONFIG = {

@@ -1,0 +1,225 @@
+"""One snapshot as an HDF5 group (``/snapshots/<name>`` of a results file): its
+name, its datasets and attributes written and read, and what the group says
+about it without loading it (:class:`SnapshotInfo`)."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from grainlab.io.hdf5._layout import _check_name, _dumps, _read_text, _write_text
+from grainlab.io.hdf5.errors import ResultsFileError
+from grainlab.snapshot import Snapshot
+
+__all__ = ["SnapshotInfo", "snapshot_name"]
+
+# Units of the snapshot datasets and of well-known per-particle / per-contact fields.
+_SNAPSHOT_UNITS = {
+    "positions": "m",
+    "radii": "m",
+    "ids": "",
+    "rotations": "rad",
+    "kind": "",
+    "contact_i": "",
+    "contact_j": "",
+    "normal_force": "N",
+    "shear_force": "N",
+    "contact_normal": "",
+    "contact_point": "m",
+    "box": "m",
+}
+_FIELD_UNITS = {
+    "overlap": "m",
+    "velocity": "m/s",
+    "force": "N",
+    "angular_velocity": "rad/s",
+    "torque": "N m",
+    "displacement": "m",
+}
+
+
+def snapshot_name(axial_strain: float, *, digits: int = 4, prefix: str = "strain") -> str:
+    """A stable snapshot name from an axial strain (a fraction, not percent).
+
+    ``f"{prefix}_{axial_strain:.{digits}f}"``, with ``-0`` written as ``0``.
+    Two strains that round to the same name give the same name, which
+    :meth:`ResultsWriter.write_snapshot` refuses unless ``overwrite=True``.
+
+    >>> snapshot_name(0.005), snapshot_name(0.015), snapshot_name(0.1)
+    ('strain_0.0050', 'strain_0.0150', 'strain_0.1000')
+    >>> snapshot_name(-1e-9), snapshot_name(0.00705, digits=5)
+    ('strain_0.0000', 'strain_0.00705')
+    """
+    value = float(axial_strain)
+    if not math.isfinite(value):
+        raise ValueError(f"axial_strain: must be finite, got {value!r}")
+    if not 0 <= int(digits) <= 12:
+        raise ValueError(f"digits: must be in 0..12, got {digits!r}")
+    text = f"{value:.{int(digits)}f}"
+    if text.startswith("-") and float(text) == 0.0:
+        text = text[1:]
+    return f"{prefix}_{text}"
+
+
+# ------------------------------------------------------------------ snapshot <-> group
+def _write_array(
+    group: h5py.Group,
+    name: str,
+    data: ArrayLike,
+    *,
+    units: str | None,
+    compression: str | None,
+    where: str,
+) -> None:
+    a = np.asarray(data)
+    if a.dtype.kind not in "biuf":
+        raise ValueError(f"{where}: cannot store dtype {a.dtype} (numbers or booleans only)")
+    kwargs: dict[str, Any] = {}
+    if compression and a.size:
+        kwargs.update(compression=compression, shuffle=True)
+    ds = group.create_dataset(name, data=a, **kwargs)
+    if units is not None:
+        ds.attrs["units"] = units
+
+
+def _write_snapshot_group(
+    group: h5py.Group, snapshot: Snapshot, *, compression: str | None, step: int | None
+) -> None:
+    def put(name: str, value: ArrayLike | None) -> None:
+        if value is not None:
+            _write_array(
+                group,
+                name,
+                value,
+                units=_SNAPSHOT_UNITS[name],
+                compression=compression,
+                where=f"snapshot.{name}",
+            )
+
+    metadata = _dumps(dict(snapshot.metadata), "snapshot.metadata")
+    for name in ("positions", "radii", "ids", "rotations", "kind", "contact_i", "contact_j"):
+        put(name, getattr(snapshot, name))
+    for name in ("normal_force", "shear_force", "contact_normal", "contact_point", "box"):
+        put(name, getattr(snapshot, name))
+    for owner in ("contact_fields", "particle_fields"):
+        sub = group.create_group(owner, track_order=True)
+        for key, value in getattr(snapshot, owner).items():
+            _check_name(f"snapshot.{owner}", key)
+            _write_array(
+                sub,
+                key,
+                value,
+                units=_FIELD_UNITS.get(key),
+                compression=compression,
+                where=f"snapshot.{owner}[{key!r}]",
+            )
+    _write_text(group, "metadata", metadata)
+    group.attrs["n_particles"] = np.int64(snapshot.n_particles)
+    group.attrs["n_contacts"] = np.int64(snapshot.n_contacts)
+    group.attrs["periodic"] = np.array(snapshot.periodic, dtype=np.int8)
+    if snapshot.time is not None:
+        group.attrs["time"] = np.float64(snapshot.time)
+    if snapshot.axial_strain is not None:
+        group.attrs["axial_strain"] = np.float64(snapshot.axial_strain)
+    if step is not None:
+        group.attrs["step"] = np.int64(step)
+
+
+def _read_snapshot_group_v1(group: h5py.Group, path: Path) -> Snapshot:
+    def get(name: str) -> NDArray[Any] | None:
+        return group[name][()] if name in group else None
+
+    def fields(owner: str) -> dict[str, NDArray[Any]]:
+        if owner not in group:
+            return {}
+        sub = group[owner]
+        return {key: sub[key][()] for key in sub}
+
+    try:
+        metadata = json.loads(_read_text(group["metadata"])) if "metadata" in group else {}
+    except json.JSONDecodeError as error:
+        raise ResultsFileError(path, f"{group.name}/metadata: not valid JSON ({error})") from None
+    attrs = group.attrs
+    periodic = tuple(bool(p) for p in attrs.get("periodic", (0, 0)))
+    try:
+        return Snapshot(
+            positions=group["positions"][()],
+            radii=group["radii"][()],
+            ids=get("ids"),
+            rotations=get("rotations"),
+            kind=get("kind"),
+            contact_i=get("contact_i"),
+            contact_j=get("contact_j"),
+            normal_force=get("normal_force"),
+            shear_force=get("shear_force"),
+            contact_normal=get("contact_normal"),
+            contact_point=get("contact_point"),
+            contact_fields=fields("contact_fields"),
+            particle_fields=fields("particle_fields"),
+            box=get("box"),
+            periodic=periodic,  # type: ignore[arg-type]
+            time=float(attrs["time"]) if "time" in attrs else None,
+            axial_strain=float(attrs["axial_strain"]) if "axial_strain" in attrs else None,
+            metadata=metadata,
+        )
+    except KeyError as error:
+        raise ResultsFileError(path, f"{group.name}: missing dataset ({error})") from None
+    except ValueError as error:
+        raise ResultsFileError(path, f"{group.name}: invalid snapshot ({error})") from None
+
+
+@dataclass(frozen=True)
+class SnapshotInfo:
+    """What a results file says about one of its snapshots, without loading it."""
+
+    #: Group name under ``/snapshots``.
+    name: str
+    #: Position in the order written (0 first).
+    index: int
+    #: Simulated time, s (None if not recorded).
+    time: float | None
+    #: Axial strain, compression positive, a fraction (None if not recorded).
+    axial_strain: float | None
+    #: Engine step count (None if not recorded).
+    step: int | None
+    #: Number of particles N.
+    n_particles: int
+    #: Number of contacts Nc (particle–particle and wall).
+    n_contacts: int
+
+
+def _snapshot_order(group: h5py.Group) -> list[tuple[str, int]]:
+    out = []
+    for name in group:
+        index = group[name].attrs.get("index")
+        if index is not None:
+            out.append((name, int(index)))
+    return sorted(out, key=lambda item: item[1])
+
+
+def _snapshot_infos_v1(f: h5py.File) -> tuple[SnapshotInfo, ...]:
+    if "snapshots" not in f:
+        return ()
+    group = f["snapshots"]
+    infos = []
+    for name, index in _snapshot_order(group):
+        a = group[name].attrs
+        infos.append(
+            SnapshotInfo(
+                name=name,
+                index=index,
+                time=float(a["time"]) if "time" in a else None,
+                axial_strain=float(a["axial_strain"]) if "axial_strain" in a else None,
+                step=int(a["step"]) if "step" in a else None,
+                n_particles=int(a.get("n_particles", group[name]["positions"].shape[0])),
+                n_contacts=int(a.get("n_contacts", 0)),
+            )
+        )
+    return tuple(infos)
