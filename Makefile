@@ -22,9 +22,12 @@ test-fast:  ## the quick local loop: engine tests and pytest without slow physic
 	cargo test --release -p grainlab-core
 	python -m pytest -m "not slow" -q
 
-bench:  ## side by side: the common throughput case (grainlab vs LAMMPS), the million-disk analysis (NumPy vs compiled)
-	python benchmarks/throughput.py
-	python benchmarks/analysis_large.py
+bench:  ## every speed figure of docs/engine.md, side by side, medians (about 25 minutes on a quiet 2-core machine)
+	python benchmarks/throughput.py --repeat 9
+	python benchmarks/shared_machine.py --repeat 5
+	python benchmarks/throughput_large.py --repeat 3
+	python benchmarks/analysis_large.py --repeat 3
+	python benchmarks/biaxial_default.py --repeat 1
 
 bench-engine:  ## the engine alone (no Python): the throughput case from Rust
 	cargo run --release -p grainlab-core --example throughput -- 1
