@@ -155,7 +155,7 @@ def _check_shape(name: str, a: NDArray[Any], shape: tuple[int | None, ...]) -> N
         raise ValueError(f"{name}: expected shape {want}, got {a.shape}")
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class Snapshot:
     """One state of a 2D disk assembly: particles and their contacts.
 
@@ -216,70 +216,88 @@ class Snapshot:
 
     positions: NDArray[np.float64]
     radii: NDArray[np.float64]
-    ids: NDArray[np.int64] | None = None
-    rotations: NDArray[np.float64] | None = None
-    kind: NDArray[np.int8] | None = None
-    contact_i: NDArray[np.int64] | None = None
-    contact_j: NDArray[np.int64] | None = None
-    normal_force: NDArray[np.float64] | None = None
-    shear_force: NDArray[np.float64] | None = None
-    contact_normal: NDArray[np.float64] | None = None
-    contact_point: NDArray[np.float64] | None = None
-    contact_fields: Mapping[str, NDArray[Any]] = field(default_factory=dict)
-    particle_fields: Mapping[str, NDArray[Any]] = field(default_factory=dict)
-    box: NDArray[np.float64] | None = None
-    periodic: tuple[bool, bool] = (False, False)
-    time: float | None = None
-    axial_strain: float | None = None
-    metadata: Mapping[str, Any] = field(default_factory=dict)
-    _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
+    ids: NDArray[np.int64]
+    rotations: NDArray[np.float64] | None
+    kind: NDArray[np.int8]
+    contact_i: NDArray[np.int64]
+    contact_j: NDArray[np.int64]
+    normal_force: NDArray[np.float64] | None
+    shear_force: NDArray[np.float64] | None
+    contact_normal: NDArray[np.float64] | None
+    contact_point: NDArray[np.float64] | None
+    contact_fields: Mapping[str, NDArray[Any]]
+    particle_fields: Mapping[str, NDArray[Any]]
+    box: NDArray[np.float64] | None
+    periodic: tuple[bool, bool]
+    time: float | None
+    axial_strain: float | None
+    metadata: Mapping[str, Any]
+    _cache: dict[str, NDArray[Any]] = field(init=False, repr=False, compare=False)
 
     # ------------------------------------------------------------------ build
-    def __post_init__(self) -> None:
-        put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+    def __init__(
+        self,
+        positions: ArrayLike,
+        radii: ArrayLike,
+        ids: ArrayLike | None = None,
+        rotations: ArrayLike | None = None,
+        kind: ArrayLike | None = None,
+        contact_i: ArrayLike | None = None,
+        contact_j: ArrayLike | None = None,
+        normal_force: ArrayLike | None = None,
+        shear_force: ArrayLike | None = None,
+        contact_normal: ArrayLike | None = None,
+        contact_point: ArrayLike | None = None,
+        contact_fields: Mapping[str, ArrayLike] | None = None,
+        particle_fields: Mapping[str, ArrayLike] | None = None,
+        box: ArrayLike | None = None,
+        periodic: tuple[bool, bool] = (False, False),
+        time: float | None = None,
+        axial_strain: float | None = None,
+        metadata: Mapping[str, Any] | None = None,
+    ) -> None:
+        # the inputs are checked and stored as read-only arrays (the dataclass is
+        # frozen, so the fields are set through object.__setattr__ once, here)
+        def put(name: str, value: object) -> None:
+            object.__setattr__(self, name, value)
 
-        positions = _as_float("positions", self.positions, (None, 2))
-        n = positions.shape[0]
-        radii = _as_float("radii", self.radii, (n,))
-        if np.any(radii <= 0.0):
-            k = int(np.argmax(radii <= 0.0))
-            raise ValueError(f"radii: must be > 0, got {radii[k]!r} at index {k}")
-        ids = np.arange(n, dtype=np.int64) if self.ids is None else _as_int("ids", self.ids, (n,))
+        put("_cache", {})
+        pos = _as_float("positions", positions, (None, 2))
+        n = pos.shape[0]
+        rad = _as_float("radii", radii, (n,))
+        if np.any(rad <= 0.0):
+            k = int(np.argmax(rad <= 0.0))
+            raise ValueError(f"radii: must be > 0, got {rad[k]!r} at index {k}")
+        labels = np.arange(n, dtype=np.int64) if ids is None else _as_int("ids", ids, (n,))
         if n > 1:
-            order = np.argsort(ids, kind="stable")
-            dup = ids[order[1:]] == ids[order[:-1]]
+            order = np.argsort(labels, kind="stable")
+            dup = labels[order[1:]] == labels[order[:-1]]
             if dup.any():
-                raise ValueError(f"ids: duplicate id {int(ids[order[1:]][dup][0])}")
-        put("positions", _readonly(positions))
-        put("radii", _readonly(radii))
-        put("ids", _readonly(ids))
+                raise ValueError(f"ids: duplicate id {int(labels[order[1:]][dup][0])}")
+        put("positions", _readonly(pos))
+        put("radii", _readonly(rad))
+        put("ids", _readonly(labels))
 
-        if self.rotations is not None:
-            put("rotations", _readonly(_as_float("rotations", self.rotations, (n,))))
-        if self.kind is None:
-            kind = np.zeros(n, dtype=np.int8)
+        turns = None if rotations is None else _as_float("rotations", rotations, (n,))
+        put("rotations", None if turns is None else _readonly(turns))
+        if kind is None:
+            codes = np.zeros(n, dtype=np.int8)
         else:
-            kind = _as_int("kind", self.kind, (n,))
+            given = _as_int("kind", kind, (n,))
             allowed = [int(k) for k in ParticleKind]
-            bad = ~np.isin(kind, allowed)
+            bad = ~np.isin(given, allowed)
             if bad.any():
-                raise ValueError(f"kind: unknown code {int(kind[bad][0])} (allowed {allowed})")
-            kind = kind.astype(np.int8)
-        put("kind", _readonly(kind))
+                raise ValueError(f"kind: unknown code {int(given[bad][0])} (allowed {allowed})")
+            codes = given.astype(np.int8)
+        put("kind", _readonly(codes))
 
-        if (self.contact_i is None) != (self.contact_j is None):
+        if (contact_i is None) != (contact_j is None):
             raise ValueError("contact_i / contact_j: give both or neither")
         ci = (
-            np.zeros(0, np.int64)
-            if self.contact_i is None
-            else _as_int("contact_i", self.contact_i, (None,))
+            np.zeros(0, np.int64) if contact_i is None else _as_int("contact_i", contact_i, (None,))
         )
         nc = ci.shape[0]
-        cj = (
-            np.zeros(0, np.int64)
-            if self.contact_j is None
-            else _as_int("contact_j", self.contact_j, (nc,))
-        )
+        cj = np.zeros(0, np.int64) if contact_j is None else _as_int("contact_j", contact_j, (nc,))
         if nc:
             if ci.min() < 0 or ci.max() >= n:
                 k = int(np.argmax((ci < 0) | (ci >= n)))
@@ -299,14 +317,14 @@ class Snapshot:
         put("contact_i", _readonly(ci))
         put("contact_j", _readonly(cj))
 
-        for name in ("normal_force", "shear_force"):
-            value = getattr(self, name)
-            if value is not None:
-                put(name, _readonly(_as_float(name, value, (nc,))))
-        if self.contact_point is not None:
-            put("contact_point", _readonly(_as_float("contact_point", self.contact_point, (nc, 2))))
-        if self.contact_normal is not None:
-            normal = _as_float("contact_normal", self.contact_normal, (nc, 2))
+        for name, value in (("normal_force", normal_force), ("shear_force", shear_force)):
+            put(name, None if value is None else _readonly(_as_float(name, value, (nc,))))
+        point = (
+            None if contact_point is None else _as_float("contact_point", contact_point, (nc, 2))
+        )
+        put("contact_point", None if point is None else _readonly(point))
+        if contact_normal is not None:
+            normal = _as_float("contact_normal", contact_normal, (nc, 2))
             length = np.hypot(normal[:, 0], normal[:, 1])
             bad = np.abs(length - 1.0) > 1e-6
             if bad.any():
@@ -315,55 +333,56 @@ class Snapshot:
                     f"contact_normal: not a unit vector at contact {k} (length {length[k]:.6g})"
                 )
             put("contact_normal", _readonly(normal))
-        elif nc and np.any(cj < 0) and self.contact_point is None:
-            raise ValueError(
-                "contact_normal: wall contacts (contact_j < 0) need contact_normal or contact_point"
-            )
+        else:
+            put("contact_normal", None)
+            if nc and np.any(cj < 0) and contact_point is None:
+                raise ValueError(
+                    "contact_normal: wall contacts (contact_j < 0) need contact_normal or "
+                    "contact_point"
+                )
 
         put(
             "contact_fields",
             {
                 k: _readonly(self._field(k, v, nc, "contact_fields"))
-                for k, v in dict(self.contact_fields).items()
+                for k, v in dict(contact_fields or {}).items()
             },
         )
-        put(
-            "particle_fields",
-            {
-                k: _readonly(self._field(k, v, n, "particle_fields"))
-                for k, v in dict(self.particle_fields).items()
-            },
-        )
-
-        if BODY_FIELD in self.particle_fields:
-            labels = _as_int(f"particle_fields[{BODY_FIELD!r}]", self.particle_fields[BODY_FIELD], (n,))
-            if labels.size and labels.min() < -1:
-                k = int(np.argmin(labels))
+        per_particle = {
+            k: _readonly(self._field(k, v, n, "particle_fields"))
+            for k, v in dict(particle_fields or {}).items()
+        }
+        if BODY_FIELD in per_particle:
+            body = _as_int(f"particle_fields[{BODY_FIELD!r}]", per_particle[BODY_FIELD], (n,))
+            if body.size and body.min() < -1:
+                k = int(np.argmin(body))
                 raise ValueError(
                     f"particle_fields[{BODY_FIELD!r}]: body labels must be >= 0 (or -1 for none), "
-                    f"got {int(labels[k])} at index {k}"
+                    f"got {int(body[k])} at index {k}"
                 )
-            put("particle_fields", {**self.particle_fields, BODY_FIELD: _readonly(labels)})
+            per_particle[BODY_FIELD] = _readonly(body)
+        put("particle_fields", per_particle)
 
-        periodic = tuple(bool(p) for p in self.periodic)
-        if len(periodic) != 2:
-            raise ValueError(f"periodic: expected two flags (x, y), got {self.periodic!r}")
-        put("periodic", periodic)
-        if self.box is not None:
-            box = _as_float("box", self.box, (2, 2))
-            if np.any(box[:, 1] <= box[:, 0]):
-                raise ValueError(f"box: need xlo < xhi and ylo < yhi, got {box.tolist()}")
-            put("box", _readonly(box))
-        elif any(periodic):
+        flags = tuple(bool(p) for p in periodic)
+        if len(flags) != 2:
+            raise ValueError(f"periodic: expected two flags (x, y), got {periodic!r}")
+        put("periodic", (flags[0], flags[1]))
+        if box is not None:
+            bounds = _as_float("box", box, (2, 2))
+            if np.any(bounds[:, 1] <= bounds[:, 0]):
+                raise ValueError(f"box: need xlo < xhi and ylo < yhi, got {bounds.tolist()}")
+            put("box", _readonly(bounds))
+        elif any(flags):
             raise ValueError("box: a periodic direction needs the box bounds")
-        for name in ("time", "axial_strain"):
-            value = getattr(self, name)
-            if value is not None:
-                value = float(value)
-                if not np.isfinite(value):
-                    raise ValueError(f"{name}: must be finite, got {value}")
-                put(name, value)
-        put("metadata", dict(self.metadata))
+        else:
+            put("box", None)
+        for name, scalar in (("time", time), ("axial_strain", axial_strain)):
+            if scalar is not None:
+                scalar = float(scalar)
+                if not np.isfinite(scalar):
+                    raise ValueError(f"{name}: must be finite, got {scalar}")
+            put(name, scalar)
+        put("metadata", dict(metadata or {}))
 
     @staticmethod
     def _field(key: str, value: ArrayLike, length: int, owner: str) -> NDArray[Any]:
@@ -464,7 +483,7 @@ class Snapshot:
             wall: ArrayLike | None,
             width: int | None,
             fill: Any,
-        ):
+        ) -> NDArray[Any] | None:
             if particle is None and wall is None:
                 return None
             if particle is None:
@@ -508,14 +527,14 @@ class Snapshot:
         """The same snapshot with ``particle_fields["body"]`` set to ``body`` (N,) int:
         the chain (>= 0) each membrane particle belongs to, -1 for other particles."""
         return dataclasses.replace(
-            self, particle_fields={**self.particle_fields, BODY_FIELD: body}
+            self, particle_fields={**self.particle_fields, BODY_FIELD: np.asarray(body)}
         )
 
     def with_contacts(
         self, contact_i: ArrayLike, contact_j: ArrayLike, **contact_arrays: Any
     ) -> Snapshot:
         """The same particles with a new contact list (other contact arrays reset)."""
-        reset = dict(
+        reset: dict[str, Any] = dict(
             normal_force=None,
             shear_force=None,
             contact_normal=None,
@@ -523,14 +542,19 @@ class Snapshot:
             contact_fields={},
         )
         reset.update(contact_arrays)
-        return dataclasses.replace(self, contact_i=contact_i, contact_j=contact_j, **reset)
+        return dataclasses.replace(
+            self, contact_i=np.asarray(contact_i), contact_j=np.asarray(contact_j), **reset
+        )
 
     def select_contacts(self, mask: ArrayLike) -> Snapshot:
         """The same particles with only the contacts where ``mask`` is true."""
         m = np.asarray(mask, dtype=bool)
         if m.shape != (self.n_contacts,):
             raise ValueError(f"mask: expected shape ({self.n_contacts},), got {m.shape}")
-        take = lambda a: None if a is None else np.asarray(a)[m]  # noqa: E731
+
+        def take(a: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
+            return None if a is None else a[m]
+
         return dataclasses.replace(
             self,
             contact_i=self.contact_i[m],
@@ -561,12 +585,12 @@ class Snapshot:
     @property
     def is_sample(self) -> NDArray[np.bool_]:
         """(N,) mask of the particles that belong to the sample (kind != MEMBRANE)."""
-        return np.asarray(self.kind) != ParticleKind.MEMBRANE
+        return np.asarray(self.kind != ParticleKind.MEMBRANE, dtype=np.bool_)
 
     @property
     def is_wall_contact(self) -> NDArray[np.bool_]:
         """(Nc,) mask of the contacts with a wall (``contact_j < 0``)."""
-        return np.asarray(self.contact_j) < 0
+        return self.contact_j < 0
 
     @property
     def wall_ids(self) -> NDArray[np.int64]:
@@ -577,8 +601,8 @@ class Snapshot:
     @property
     def is_boundary_contact(self) -> NDArray[np.bool_]:
         """(Nc,) mask of contacts with a wall or with a membrane particle."""
-        cj = np.asarray(self.contact_j)
-        membrane = np.asarray(self.kind) == ParticleKind.MEMBRANE
+        cj = self.contact_j
+        membrane = np.asarray(self.kind == ParticleKind.MEMBRANE, dtype=np.bool_)
         wall = cj < 0
         partner = np.where(wall, 0, cj)
         return wall | (membrane[partner] & ~wall) | membrane[self.contact_i]
@@ -665,6 +689,7 @@ class Snapshot:
         if not any(self.periodic):
             return d
         d = np.array(d, dtype=np.float64, copy=True)
+        assert self.box is not None  # the constructor refuses a periodic direction without it
         lengths = self.box[:, 1] - self.box[:, 0]
         for axis in (0, 1):
             if self.periodic[axis]:
@@ -684,15 +709,17 @@ class Snapshot:
         ci = self.contact_i
         cj = self.contact_j
         if _kernels.compiled() and not (cj.size and cj.min() < 0):
-            lengths = [None, None]
+            lengths: list[float | None] = [None, None]
             if any(self.periodic):
+                assert self.box is not None  # the constructor refuses periodic without it
                 span = self.box[:, 1] - self.box[:, 0]
                 lengths = [float(span[a]) if self.periodic[a] else None for a in (0, 1)]
             normals, angles = _core.contact_normals(
                 np.ascontiguousarray(self.positions),
                 np.ascontiguousarray(ci),
                 np.ascontiguousarray(cj),
-                *lengths,
+                lengths[0],
+                lengths[1],
                 _kernels.threads(),
             )
             self._cache["normals"] = _readonly(normals)
@@ -842,15 +869,15 @@ def detect_contacts(
         raise ValueError(f"positions: expected shape (N, 2) or (N, 3), got {pos.shape}")
     if rad.shape != (pos.shape[0],):
         raise ValueError(f"radii: expected shape ({pos.shape[0]},), got {rad.shape}")
-    periodic = tuple(bool(p) for p in periodic)
+    flags = tuple(bool(p) for p in periodic)
     periods: list[tuple[float, float] | None] = [None, None]
-    if any(periodic):
+    if any(flags):
         if box is None:
             raise ValueError("box: a periodic direction needs the box bounds")
         b = _as_float("box", box, (2, 2))
         lengths = b[:, 1] - b[:, 0]
         for axis in (0, 1):
-            if periodic[axis]:
+            if flags[axis]:
                 periods[axis] = (float(b[axis, 0]), float(lengths[axis]))
     i, j = _core.detect_contacts(
         np.ascontiguousarray(pos),
@@ -874,9 +901,9 @@ def _detect_contacts_numpy(
     """The k-d tree reference of :func:`detect_contacts` (same arguments and result)."""
     if pos.shape[0] < 2:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    periodic = tuple(bool(p) for p in periodic)
+    flags = tuple(bool(p) for p in periodic)
     boxsize = None
-    if any(periodic):
+    if any(flags):
         if box is None:
             raise ValueError("box: a periodic direction needs the box bounds")
         b = np.asarray(box, dtype=np.float64)
@@ -884,7 +911,7 @@ def _detect_contacts_numpy(
         pos = pos.copy()
         boxsize = np.zeros(2)
         for axis in (0, 1):
-            if periodic[axis]:
+            if flags[axis]:
                 pos[:, axis] = np.mod(pos[:, axis] - b[axis, 0], lengths[axis])
                 pos[pos[:, axis] >= lengths[axis], axis] = 0.0
                 boxsize[axis] = lengths[axis]
