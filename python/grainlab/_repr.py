@@ -7,6 +7,7 @@ themselves.
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import math
 from collections.abc import Iterable, Mapping
@@ -112,5 +113,9 @@ def measure_html(measure: Any) -> str:
     results = getattr(measure, "_results", None)
     if results is None:
         return html_table(repr(measure), [("results", "not computed: call compute(...) first")])
-    rows = [(name, value) for name, value in results.items() if not name.startswith("_")]
+    rows = [
+        (f.name, getattr(results, f.name))
+        for f in dataclasses.fields(results)
+        if not f.name.startswith("_")
+    ]
     return html_table(repr(measure), rows)

@@ -48,7 +48,7 @@ def random_disks(
 def results(measure, snapshot: Snapshot) -> dict[str, object]:
     """Every result of a computed measure, by name."""
     measure.compute(snapshot)
-    return dict(measure._results)
+    return dict(vars(measure._results))
 
 
 def assert_same(new: dict, old: dict, *, exact: bool = False) -> None:

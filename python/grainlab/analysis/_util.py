@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Generic, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -10,24 +10,33 @@ from numpy.typing import NDArray
 from grainlab import _kernels
 from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot, boundary_end_groups
 
+#: A measure's results record (see :class:`Computable`).
+R = TypeVar("R")
+
 
 class NotComputedError(AttributeError):
     """Raised when a result property is read before ``compute`` ran."""
 
 
-class Computable:
-    """Base for freud-style analysis objects: results raise until computed."""
+class Computable(Generic[R]):
+    """Base for freud-style analysis objects: results raise until computed.
 
-    _results: dict[str, Any] | None = None
+    ``R`` is the measure's results record, a frozen dataclass with one typed
+    field per result; ``compute`` stores one with :meth:`_store`.
+    """
 
-    def _result(self, name: str) -> Any:
+    _results: R | None = None
+
+    def _computed(self, name: str) -> R:
+        """The results record, read for the result ``name`` (named in the error
+        raised before ``compute`` ran)."""
         if self._results is None:
             raise NotComputedError(
                 f"{type(self).__name__}.{name} is not available: call compute(...) first"
             )
-        return self._results[name]
+        return self._results
 
-    def _store(self, **results: Any) -> None:
+    def _store(self, results: R) -> None:
         self._results = results
 
     def _repr_html_(self) -> str:

@@ -47,6 +47,7 @@ Example
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -88,7 +89,7 @@ def roc_auc(scores: ArrayLike, labels: ArrayLike) -> float:
     if pos.size == 0 or neg.size == 0:
         return math.nan
     u = mannwhitneyu(pos, neg, alternative="two-sided", method="asymptotic").statistic
-    return float(u) / (pos.size * neg.size)
+    return float(u) / float(pos.size * neg.size)
 
 
 def coarse_grained(positions: ArrayLike, values: ArrayLike, radius: float) -> NDArray[np.float64]:
@@ -149,7 +150,18 @@ def _group(
     }
 
 
-class BandFabric(Computable):
+@dataclass(frozen=True, eq=False)
+class _BandFabricResults:
+    """The results of :class:`BandFabric` (see its properties)."""
+
+    inside: dict[str, float]
+    outside: dict[str, float]
+    auc_lambda: float
+    auc_lambda_field: float
+    lambda_field: NDArray[np.float64]
+
+
+class BandFabric(Computable[_BandFabricResults]):
     """Fabric of the grains inside and outside a band, and the AUC of lambda
     as a classifier of band membership (module docstring).
 
@@ -221,38 +233,40 @@ class BandFabric(Computable):
         radius = self.coarse_radius * float(np.mean(d)) if n else 1.0
         field = coarse_grained(pos, lam, radius) if n else np.zeros(0)
         self._store(
-            inside=_group(band, lam, counts, grain, rot),
-            outside=_group(~band, lam, counts, grain, rot),
-            auc_lambda=roc_auc(lam, band),
-            auc_lambda_field=roc_auc(field, band),
-            lambda_field=field,
+            _BandFabricResults(
+                inside=_group(band, lam, counts, grain, rot),
+                outside=_group(~band, lam, counts, grain, rot),
+                auc_lambda=roc_auc(lam, band),
+                auc_lambda_field=roc_auc(field, band),
+                lambda_field=field,
+            )
         )
         return self
 
     @property
     def inside(self) -> dict[str, float]:
         """:data:`GROUP_MEASURES` of the band's grains."""
-        return self._result("inside")
+        return self._computed("inside").inside
 
     @property
     def outside(self) -> dict[str, float]:
         """:data:`GROUP_MEASURES` of the grains outside the band."""
-        return self._result("outside")
+        return self._computed("outside").outside
 
     @property
     def auc_lambda(self) -> float:
         """ROC AUC of per-grain lambda for band membership."""
-        return self._result("auc_lambda")
+        return self._computed("auc_lambda").auc_lambda
 
     @property
     def auc_lambda_field(self) -> float:
         """ROC AUC of the coarse-grained lambda field for band membership."""
-        return self._result("auc_lambda_field")
+        return self._computed("auc_lambda_field").auc_lambda_field
 
     @property
     def lambda_field(self) -> NDArray[np.float64]:
         """(N,) lambda averaged over ``coarse_radius`` mean diameters around each grain."""
-        return self._result("lambda_field")
+        return self._computed("lambda_field").lambda_field
 
     def summary(self) -> dict[str, Any]:
         """Every number, JSON-ready: ``inside_*``, ``outside_*``, the AUCs."""

@@ -80,6 +80,7 @@ Normal-force anisotropy a_n
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -294,11 +295,25 @@ def fabric_tensor(normals: ArrayLike, weights: ArrayLike | None = None) -> NDArr
     xx = np.dot(w, n[:, 0] * n[:, 0])
     yy = np.dot(w, n[:, 1] * n[:, 1])
     xy = np.dot(w, n[:, 0] * n[:, 1])
-    return np.array([[xx, xy], [xy, yy]]) / total
+    tensor: NDArray[np.float64] = np.array([[xx, xy], [xy, yy]]) / total
+    return tensor
 
 
 # --------------------------------------------------------------------------- classes
-class CoordinationNumber(Computable):
+@dataclass(frozen=True, eq=False)
+class _CoordinationNumberResults:
+    """The results of :class:`CoordinationNumber` (see its properties)."""
+
+    coordination_number: float
+    mechanical_coordination_number: float
+    n_contacts: NDArray[np.int64]
+    rattlers: NDArray[np.bool_]
+    count_distribution: NDArray[np.float64]
+    n_particles: int
+    n_contacts_total: int
+
+
+class CoordinationNumber(Computable[_CoordinationNumberResults]):
     r"""Coordination number Z, mechanical coordination number Z_m, contact counts.
 
     .. math:: Z = \frac{2 N_c}{N_p}, \qquad Z_m = \frac{2 N_c^m}{N_p^m}
@@ -394,50 +409,52 @@ class CoordinationNumber(Computable):
         if n_p:
             dist /= n_p
         self._store(
-            coordination_number=z,
-            mechanical_coordination_number=z_m,
-            n_contacts=counts,
-            rattlers=rat,
-            count_distribution=dist,
-            n_particles=n_p,
-            n_contacts_total=int(a.size),
+            _CoordinationNumberResults(
+                coordination_number=z,
+                mechanical_coordination_number=z_m,
+                n_contacts=counts,
+                rattlers=rat,
+                count_distribution=dist,
+                n_particles=n_p,
+                n_contacts_total=int(a.size),
+            )
         )
         return self
 
     @property
     def coordination_number(self) -> float:
         """Z = 2 Nc / Np."""
-        return self._result("coordination_number")
+        return self._computed("coordination_number").coordination_number
 
     @property
     def mechanical_coordination_number(self) -> float:
         """Z_m over the particles left after iterative rattler removal."""
-        return self._result("mechanical_coordination_number")
+        return self._computed("mechanical_coordination_number").mechanical_coordination_number
 
     @property
     def n_contacts(self) -> NDArray[np.int64]:
         """(N,) contacts per particle."""
-        return self._result("n_contacts")
+        return self._computed("n_contacts").n_contacts
 
     @property
     def rattlers(self) -> NDArray[np.bool_]:
         """(N,) mask of the rattlers."""
-        return self._result("rattlers")
+        return self._computed("rattlers").rattlers
 
     @property
     def count_distribution(self) -> NDArray[np.float64]:
         """Fraction of sample particles with k contacts, k = 0, 1, 2, ..."""
-        return self._result("count_distribution")
+        return self._computed("count_distribution").count_distribution
 
     @property
     def n_particles(self) -> int:
         """N_p, the number of sample particles."""
-        return self._result("n_particles")
+        return self._computed("n_particles").n_particles
 
     @property
     def n_contacts_total(self) -> int:
         """N_c, the number of contacts used."""
-        return self._result("n_contacts_total")
+        return self._computed("n_contacts_total").n_contacts_total
 
     def plot(self, ax: Any = None) -> Any:
         """Bar chart of the contact-count distribution; returns the axes."""
@@ -452,7 +469,21 @@ class CoordinationNumber(Computable):
         )
 
 
-class ContactAnisotropy(Computable):
+@dataclass(frozen=True, eq=False)
+class _ContactAnisotropyResults:
+    """The results of :class:`ContactAnisotropy` (see its properties)."""
+
+    histogram: NDArray[np.float64]
+    bin_edges: NDArray[np.float64]
+    anisotropy: float
+    direction: float
+    anisotropy_binned: float
+    direction_binned: float
+    fabric_tensor: NDArray[np.float64]
+    total: float
+
+
+class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
     r"""Contact-normal (or normal-force) distribution and its anisotropy (Eq. 6–8).
 
     Fitted distribution (Eq. 6): :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos
@@ -561,26 +592,28 @@ class ContactAnisotropy(Computable):
         else:
             af, tf = anisotropy_fourier(angles, weights)
         self._store(
-            histogram=values,
-            bin_edges=edges,
-            anisotropy=af,
-            direction=tf,
-            anisotropy_binned=a7,
-            direction_binned=t7,
-            fabric_tensor=phi,
-            total=float(n_used if weights is None else weights.sum()),
+            _ContactAnisotropyResults(
+                histogram=values,
+                bin_edges=edges,
+                anisotropy=af,
+                direction=tf,
+                anisotropy_binned=a7,
+                direction_binned=t7,
+                fabric_tensor=phi,
+                total=float(n_used if weights is None else weights.sum()),
+            )
         )
         return self
 
     @property
     def histogram(self) -> NDArray[np.float64]:
         """(bins,) bin contents, each contact counted in both directions."""
-        return self._result("histogram")
+        return self._computed("histogram").histogram
 
     @property
     def bin_edges(self) -> NDArray[np.float64]:
         """(bins + 1,) bin edges, rad."""
-        return self._result("bin_edges")
+        return self._computed("bin_edges").bin_edges
 
     @property
     def bin_centers(self) -> NDArray[np.float64]:
@@ -591,42 +624,42 @@ class ContactAnisotropy(Computable):
     @property
     def anisotropy(self) -> float:
         """a (or a_n), exact: twice the modulus of the mean of exp(2 i theta)."""
-        return self._result("anisotropy")
+        return self._computed("anisotropy").anisotropy
 
     @property
     def direction(self) -> float:
         """theta_a, exact: half the argument of the mean of exp(2 i theta), rad in [0, pi)."""
-        return self._result("direction")
+        return self._computed("direction").direction
 
     @property
     def anisotropy_binned(self) -> float:
         """a (or a_n) by Eq. 7 as printed, from the histogram."""
-        return self._result("anisotropy_binned")
+        return self._computed("anisotropy_binned").anisotropy_binned
 
     @property
     def direction_binned(self) -> float:
         """theta_a by Eq. 8 (atan2 form) from the histogram, rad in [0, pi)."""
-        return self._result("direction_binned")
+        return self._computed("direction_binned").direction_binned
 
     @property
     def anisotropy_fourier(self) -> float:
         """The exact a, :attr:`anisotropy` under its earlier name."""
-        return self._result("anisotropy")
+        return self._computed("anisotropy").anisotropy
 
     @property
     def direction_fourier(self) -> float:
         """The exact theta_a, :attr:`direction` under its earlier name."""
-        return self._result("direction")
+        return self._computed("direction").direction
 
     @property
     def fabric_tensor(self) -> NDArray[np.float64]:
         """(2, 2) fabric tensor (force-weighted for weight='normal_force')."""
-        return self._result("fabric_tensor")
+        return self._computed("fabric_tensor").fabric_tensor
 
     @property
     def total(self) -> float:
         """Contacts used (or their total normal force, N)."""
-        return self._result("total")
+        return self._computed("total").total
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Polar diagram with the fitted E(theta) (paper Figs. 6–7); returns the axes."""

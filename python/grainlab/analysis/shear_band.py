@@ -306,7 +306,35 @@ def _band_profile(
     return _Profile(centers, prof, smooth, keep, background, peak, edge(left, left - 1), edge(right, right + 1))
 
 
-class ShearBand(Computable):
+@dataclass(frozen=True, eq=False)
+class _ShearBandResults:
+    """The results of :class:`ShearBand` (see its properties)."""
+
+    found: bool
+    reason: str
+    angle: float
+    thickness: float
+    thickness_diameters: float
+    center: NDArray[np.float64]
+    normal: NDArray[np.float64]
+    members: NDArray[np.bool_]
+    mean_lambda_inside: float
+    mean_lambda_outside: float
+    contrast: float
+    prominence: float
+    score: float
+    peak_strain: float
+    background_strain: float
+    profile: tuple[NDArray[np.float64], NDArray[np.float64]]
+    profile_crossing: NDArray[np.bool_]
+    second: ShearBand | None
+    mean_diameter: float
+    positions: NDArray[np.float64]
+    radii: NDArray[np.float64]
+    shear_strain: NDArray[np.float64]
+
+
+class ShearBand(Computable[_ShearBandResults]):
     r"""Locate the dominant shear band (and a second one) in a per-particle strain field.
 
     See the module docstring for the method and for how to read the angle.
@@ -461,28 +489,30 @@ class ShearBand(Computable):
             second = self._second_band(data, rest, angle, stability_index, n_contacts)
         peak = profile.peak
         self._store(
-            found=not problems,
-            reason="; ".join(problems),
-            angle=angle,
-            thickness=float(profile.thickness),
-            thickness_diameters=float(profile.thickness / data.d_mean),
-            center=center,
-            normal=normal,
-            members=members,
-            mean_lambda_inside=lam_in,
-            mean_lambda_outside=lam_out,
-            contrast=float(excess / peak) if peak > 0 and excess > 0 else 0.0,
-            prominence=float(prominence),
-            score=score,
-            peak_strain=peak,
-            background_strain=profile.background,
-            profile=(profile.centers - profile.s_mid, profile.mean_strain),
-            profile_crossing=profile.crossing,
-            second=second,
-            mean_diameter=data.d_mean,
-            positions=data.pos,
-            radii=data.rad,
-            shear_strain=data.gamma,
+            _ShearBandResults(
+                found=not problems,
+                reason="; ".join(problems),
+                angle=angle,
+                thickness=float(profile.thickness),
+                thickness_diameters=float(profile.thickness / data.d_mean),
+                center=center,
+                normal=normal,
+                members=members,
+                mean_lambda_inside=lam_in,
+                mean_lambda_outside=lam_out,
+                contrast=float(excess / peak) if peak > 0 and excess > 0 else 0.0,
+                prominence=float(prominence),
+                score=score,
+                peak_strain=peak,
+                background_strain=profile.background,
+                profile=(profile.centers - profile.s_mid, profile.mean_strain),
+                profile_crossing=profile.crossing,
+                second=second,
+                mean_diameter=data.d_mean,
+                positions=data.pos,
+                radii=data.rad,
+                shear_strain=data.gamma,
+            )
         )
         return self
 
@@ -585,7 +615,8 @@ class ShearBand(Computable):
         if self._avoid is None:
             return np.zeros(angles.shape, bool)
         diff = np.mod(angles - self._avoid + 0.5 * np.pi, np.pi) - 0.5 * np.pi
-        return np.abs(diff) < _SECOND_SEPARATION
+        close: NDArray[np.bool_] = np.abs(diff) < _SECOND_SEPARATION
+        return close
 
     @staticmethod
     def _subset(
@@ -599,17 +630,17 @@ class ShearBand(Computable):
     @property
     def found(self) -> bool:
         """Whether the band passed the acceptance tests (thickness, prominence)."""
-        return bool(self._result("found"))
+        return self._computed("found").found
 
     @property
     def reason(self) -> str:
         """Why the band was not accepted ("" when :attr:`found`)."""
-        return self._result("reason")
+        return self._computed("reason").reason
 
     @property
     def angle(self) -> float:
         """Band direction, rad in [0, pi), CCW from +x."""
-        return self._result("angle")
+        return self._computed("angle").angle
 
     @property
     def angle_degrees(self) -> float:
@@ -630,84 +661,84 @@ class ShearBand(Computable):
     @property
     def thickness(self) -> float:
         """Band thickness, m."""
-        return self._result("thickness")
+        return self._computed("thickness").thickness
 
     @property
     def thickness_diameters(self) -> float:
         """Band thickness in mean particle diameters."""
-        return self._result("thickness_diameters")
+        return self._computed("thickness_diameters").thickness_diameters
 
     @property
     def mean_diameter(self) -> float:
         """Mean diameter of the particles considered, m."""
-        return self._result("mean_diameter")
+        return self._computed("mean_diameter").mean_diameter
 
     @property
     def center(self) -> NDArray[np.float64]:
         """(2,) a point on the centre line, m."""
-        return self._result("center")
+        return self._computed("center").center
 
     @property
     def normal(self) -> NDArray[np.float64]:
         """(2,) unit normal of the band."""
-        return self._result("normal")
+        return self._computed("normal").normal
 
     @property
     def members(self) -> NDArray[np.bool_]:
         """(N,) particles inside the band."""
-        return self._result("members")
+        return self._computed("members").members
 
     @property
     def mean_lambda_inside(self) -> float:
         """Mean stability index of the band's particles."""
-        return self._result("mean_lambda_inside")
+        return self._computed("mean_lambda_inside").mean_lambda_inside
 
     @property
     def mean_lambda_outside(self) -> float:
         """Mean stability index of the other particles."""
-        return self._result("mean_lambda_outside")
+        return self._computed("mean_lambda_outside").mean_lambda_outside
 
     @property
     def contrast(self) -> float:
         """(peak - background) / peak of the strain profile, in [0, 1]."""
-        return self._result("contrast")
+        return self._computed("contrast").contrast
 
     @property
     def prominence(self) -> float:
         """Excess strain of the band over the background divided by the largest
         excess elsewhere on the profile (inf when nothing else is above it)."""
-        return self._result("prominence")
+        return self._computed("prominence").prominence
 
     @property
     def score(self) -> float:
         """Adjusted eta² of the strain with the bins across the band (share of
         the strain variance that the profile explains), at the band's angle."""
-        return self._result("score")
+        return self._computed("score").score
 
     @property
     def peak_strain(self) -> float:
         """Largest (3-bin smoothed) mean strain across the band."""
-        return self._result("peak_strain")
+        return self._computed("peak_strain").peak_strain
 
     @property
     def background_strain(self) -> float:
         """Median strain of the particles considered."""
-        return self._result("background_strain")
+        return self._computed("background_strain").background_strain
 
     @property
     def profile(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Distance from the centre line (m) and mean strain of each bin."""
-        return self._result("profile")
+        return self._computed("profile").profile
 
     @property
     def profile_crossing(self) -> NDArray[np.bool_]:
         """(B,) bins of :attr:`profile` that cross the sample (used for the peak)."""
-        return self._result("profile_crossing")
+        return self._computed("profile_crossing").profile_crossing
 
     @property
     def second(self) -> ShearBand | None:
         """The band found once this band's particles are removed, or None."""
-        return self._result("second")
+        return self._computed("second").second
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (NaN and inf as None, angles in degrees), with
@@ -739,7 +770,7 @@ class ShearBand(Computable):
         ``extent`` defaults to the bounding box of the particles.
         """
         if extent is None:
-            pos = self._result("positions")
+            pos = self._computed("positions").positions
             extent = np.array(
                 [[pos[:, 0].min(), pos[:, 0].max()], [pos[:, 1].min(), pos[:, 1].max()]]
             )
@@ -758,9 +789,9 @@ class ShearBand(Computable):
         from grainlab import plot
 
         ax = plot.particle_map(
-            self._result("positions"),
-            self._result("radii"),
-            self._result("shear_strain"),
+            self._computed("positions").positions,
+            self._computed("radii").radii,
+            self._computed("shear_strain").shear_strain,
             ax=ax,
             label=r"local shear strain $\gamma$",
             **kwargs,

@@ -47,6 +47,7 @@ operation.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -69,7 +70,8 @@ def _group_deviation(angles: NDArray[np.float64], n: int) -> NDArray[np.float64]
     diff = a[:, :, None] - a[:, None, :]
     np.abs(diff, out=diff)
     np.minimum(diff, TWO_PI - diff, out=diff)
-    return diff.sum(axis=2).min(axis=1)
+    deviation: NDArray[np.float64] = diff.sum(axis=2).min(axis=1)
+    return deviation
 
 
 def stability_index(
@@ -148,7 +150,18 @@ def stability_index_of_angles(angles: ArrayLike, *, degrees: bool = False) -> fl
     return float(lam[0])
 
 
-class StabilityIndex(Computable):
+@dataclass(frozen=True, eq=False)
+class _StabilityIndexResults:
+    """The results of :class:`StabilityIndex` (see its properties)."""
+
+    stability_index: NDArray[np.float64]
+    n_contacts: NDArray[np.int64]
+    mean: float
+    mean_all: float
+    snapshot: Snapshot
+
+
+class StabilityIndex(Computable[_StabilityIndexResults]):
     r"""Geometrical stability index lambda of every particle (paper Sec. 5).
 
     See the module docstring for the formula. Contact angles come from the
@@ -226,40 +239,42 @@ class StabilityIndex(Computable):
         sample = snapshot.is_sample
         lam[~sample] = np.nan
         self._store(
-            stability_index=lam,
-            n_contacts=counts,
-            mean=finite_mean(lam, sample & (counts >= 2)),
-            mean_all=finite_mean(lam, sample),
-            snapshot=snapshot,
+            _StabilityIndexResults(
+                stability_index=lam,
+                n_contacts=counts,
+                mean=finite_mean(lam, sample & (counts >= 2)),
+                mean_all=finite_mean(lam, sample),
+                snapshot=snapshot,
+            )
         )
         return self
 
     @property
     def stability_index(self) -> NDArray[np.float64]:
         """(N,) lambda per particle; NaN for membrane particles."""
-        return self._result("stability_index")
+        return self._computed("stability_index").stability_index
 
     @property
     def n_contacts(self) -> NDArray[np.int64]:
         """(N,) number of contacts per particle used for lambda (boundary bodies
         counted as ``boundary`` says)."""
-        return self._result("n_contacts")
+        return self._computed("n_contacts").n_contacts
 
     @property
     def mean(self) -> float:
         """Mean lambda over sample particles with >= 2 contacts."""
-        return self._result("mean")
+        return self._computed("mean").mean
 
     @property
     def mean_all(self) -> float:
         """Mean lambda over all sample particles (0/1 contact counted as 1)."""
-        return self._result("mean_all")
+        return self._computed("mean_all").mean_all
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Particle map coloured by lambda (paper Fig. 12); returns the axes."""
         from grainlab import plot
 
-        snap = self._result("snapshot")
+        snap = self._computed("snapshot").snapshot
         return plot.particle_map(
             snap.positions,
             snap.radii,
