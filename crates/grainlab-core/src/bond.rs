@@ -92,12 +92,34 @@ pub(crate) struct BondForce {
     pub shear_force: f64,
 }
 
+/// What the bond law reads of the particles (slices, so that the law can run
+/// while the resultants are being written elsewhere).
+#[derive(Clone, Copy)]
+pub(crate) struct BondMotion<'a> {
+    pub position: &'a [Vec2],
+    pub velocity: &'a [Vec2],
+    pub angular_velocity: &'a [f64],
+    pub radius: &'a [f64],
+}
+
+impl<'a> BondMotion<'a> {
+    /// The particles' positions, velocities and radii.
+    pub(crate) fn of(p: &'a Particles) -> Self {
+        BondMotion {
+            position: &p.position,
+            velocity: &p.velocity,
+            angular_velocity: &p.angular_velocity,
+            radius: &p.radius,
+        }
+    }
+}
+
 /// Evaluates `bond` at the current state, adding `-ks v_t increment_time` to `shear`
 /// (its spring: the bond's own, or a copy for a query).
 #[inline]
 pub(crate) fn bond_force(
     bond: &Bond,
-    p: &Particles,
+    p: &BondMotion<'_>,
     cell: Option<&PeriodicCell>,
     velocity_gradient: Option<Mat2>,
     increment_time: f64,
@@ -121,4 +143,59 @@ pub(crate) fn bond_force(
         normal_force: bond.normal_stiffness * (bond.rest_length - dist),
         shear_force: *shear,
     }
+}
+
+/// A bond's forces of this step, computed with the contact phase and added to
+/// the particles after it, in bond order.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct BondSlot {
+    /// Force on `j` (N); its opposite acts on `i`.
+    pub force: Vec2,
+    /// `r_i` times the shear force (N m), taken from `i`'s torque.
+    pub torque_i: f64,
+    /// `r_j` times the shear force (N m), taken from `j`'s torque.
+    pub torque_j: f64,
+    /// Elastic energy of the two springs (J), measured steps only.
+    pub elastic: f64,
+    /// Magnitude of the force (N), measured steps only.
+    pub force_norm: f64,
+}
+
+/// Evaluates `bond` at the current state (updating its shear spring over
+/// `increment_time`) into the slot its forces wait in.
+#[inline]
+pub(crate) fn bond_slot<const MEASURE: bool>(
+    bond: &mut Bond,
+    p: &BondMotion<'_>,
+    cell: Option<&PeriodicCell>,
+    velocity_gradient: Option<Mat2>,
+    increment_time: f64,
+) -> BondSlot {
+    let copy = *bond;
+    let b = bond_force(
+        &copy,
+        p,
+        cell,
+        velocity_gradient,
+        increment_time,
+        &mut bond.shear,
+    );
+    let (i, j) = (copy.i as usize, copy.j as usize);
+    let f = add(
+        scale(b.normal, b.normal_force),
+        scale(perp(b.normal), b.shear_force),
+    );
+    let mut slot = BondSlot {
+        force: f,
+        torque_i: p.radius[i] * b.shear_force,
+        torque_j: p.radius[j] * b.shear_force,
+        ..BondSlot::default()
+    };
+    if MEASURE {
+        let (fn_, fs) = (b.normal_force, b.shear_force);
+        slot.elastic =
+            0.5 * fn_ * fn_ / copy.normal_stiffness + 0.5 * fs * fs / copy.shear_stiffness;
+        slot.force_norm = (fn_ * fn_ + fs * fs).sqrt();
+    }
+    slot
 }

@@ -48,37 +48,109 @@ impl PressureChain {
 
     /// Adds the chain's follower loads to `load` (indexed by particle).
     pub fn apply(&self, position: &[Vec2], walls: &[Wall], load: &mut [Vec2]) {
+        for (k, &q) in self.particles.iter().enumerate() {
+            self.add_load_of(k, position, walls, &mut load[q as usize]);
+        }
+    }
+
+    /// Adds the follower load of the chain's `k`-th particle to `load`: the
+    /// pressure on the half-segments next to it, and for an end particle the
+    /// segment to its anchor, added in this order.
+    #[inline]
+    pub fn add_load_of(&self, k: usize, position: &[Vec2], walls: &[Wall], load: &mut Vec2) {
         let m = self.particles.len();
         if m == 0 || self.pressure == 0.0 {
             return;
         }
         let at = |k: usize| position[self.particles[k] as usize];
-        let start = match self.start_wall {
+        let start = || match self.start_wall {
             Some(w) => anchor_on(&walls[w as usize], at(0)),
             None => at(0),
         };
-        let end = match self.end_wall {
+        let end = || match self.end_wall {
             Some(w) => anchor_on(&walls[w as usize], at(m - 1)),
             None => at(m - 1),
         };
         let p = self.pressure;
-        let mut add = |k: usize, d: Vec2, factor: f64| {
+        let mut add = |d: Vec2, factor: f64| {
             // rotCW(d) = (d_y, -d_x)
-            let q = self.particles[k] as usize;
-            load[q][0] += factor * d[1];
-            load[q][1] -= factor * d[0];
+            load[0] += factor * d[1];
+            load[1] -= factor * d[0];
         };
         if m == 1 {
-            add(0, sub(end, start), p);
+            add(sub(end(), start()), p);
+        } else if k == 0 {
+            add(sub(at(1), at(0)), 0.5 * p);
+            add(sub(at(0), start()), p);
+        } else if k == m - 1 {
+            add(sub(at(m - 1), at(m - 2)), 0.5 * p);
+            add(sub(end(), at(m - 1)), p);
+        } else {
+            add(sub(at(k + 1), at(k - 1)), 0.5 * p);
+        }
+    }
+}
+
+/// The entries `(chain, k)` of the pressure chains whose particle lies in each
+/// block of particles, in chain order then `k` order: the order in which
+/// [`PressureChain::apply`] over the chains in turn adds to each particle, so a
+/// block's loads can be computed apart with the same bits.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ChainBlocks {
+    entries: Vec<(u32, u32)>,
+    start: Vec<usize>,
+}
+
+impl ChainBlocks {
+    /// The entries of `chains` per block of `block_ranges` (contiguous, in
+    /// order); none when the blocks do not cover the chains' particles.
+    pub(crate) fn new(chains: &[PressureChain], block_ranges: &[(usize, usize)]) -> Self {
+        let mut per_block: Vec<Vec<(u32, u32)>> = vec![Vec::new(); block_ranges.len()];
+        for (c, chain) in chains.iter().enumerate() {
+            for (k, &q) in chain.particles.iter().enumerate() {
+                let b = block_ranges.partition_point(|&(_, hi)| hi <= q as usize);
+                match per_block.get_mut(b) {
+                    Some(list) => list.push((c as u32, k as u32)),
+                    // blocks of an older list: the rebuild before the next step makes new ones
+                    None => return ChainBlocks::default(),
+                }
+            }
+        }
+        let mut start = Vec::with_capacity(block_ranges.len() + 1);
+        start.push(0);
+        let mut entries = Vec::new();
+        for list in per_block {
+            entries.extend(list);
+            start.push(entries.len());
+        }
+        ChainBlocks { entries, start }
+    }
+
+    /// Length of the block index (blocks + 1; 0 when never built).
+    pub(crate) fn start_len(&self) -> usize {
+        self.start.len()
+    }
+
+    /// Sets the loads of block `b`'s particles `lo..hi` (`load` holds them from
+    /// `lo`): zero, plus the follower loads of the chains.
+    pub(crate) fn block_loads(
+        &self,
+        b: usize,
+        lo: usize,
+        chains: &[PressureChain],
+        position: &[Vec2],
+        walls: &[Wall],
+        load: &mut [Vec2],
+    ) {
+        load.fill([0.0; 2]);
+        if self.start.len() <= b + 1 {
             return;
         }
-        add(0, sub(at(1), at(0)), 0.5 * p);
-        add(0, sub(at(0), start), p);
-        for k in 1..m - 1 {
-            add(k, sub(at(k + 1), at(k - 1)), 0.5 * p);
+        for &(c, k) in &self.entries[self.start[b]..self.start[b + 1]] {
+            let chain = &chains[c as usize];
+            let q = chain.particles[k as usize] as usize;
+            chain.add_load_of(k as usize, position, walls, &mut load[q - lo]);
         }
-        add(m - 1, sub(at(m - 1), at(m - 2)), 0.5 * p);
-        add(m - 1, sub(end, at(m - 1)), p);
     }
 }
 

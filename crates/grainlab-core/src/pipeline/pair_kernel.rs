@@ -2,6 +2,7 @@
 //! its forces go (straight onto the particles, into a buffer, into records),
 //! the reset of the resultants, the buffered cross-stripe forces, and the
 //! particle-wall contact.
+use crate::bond::{Bond, BondSlot};
 use crate::cell::PeriodicCell;
 use crate::contact::ContactGeometry;
 use crate::law::{elastic_energy, linear_coulomb, linear_coulomb_with, ContactForce};
@@ -252,12 +253,15 @@ pub(crate) struct BlockWork<'a> {
     pub(crate) cross_shear: &'a mut [f64],
     pub(crate) cross_sliding: &'a mut [bool],
     pub(crate) cross_forces: &'a mut [PairForce],
+    /// The block's share of the bonds, and the slots of their forces.
+    pub(crate) bonds: &'a mut [Bond],
+    pub(crate) bond_slots: &'a mut [BondSlot],
 }
 
 /// The reset of step 2: each particle's resultant starts from its external
 /// force, gravity and follower load, its torque from its external torque.
 pub(crate) struct ResetKernel<'a> {
-    pub(crate) boundary_load: Option<&'a [Vec2]>,
+    pub(crate) boundary_load: Option<&'a DisjointWriter<Vec2>>,
     pub(crate) external_force: &'a [Vec2],
     pub(crate) external_torque: &'a [f64],
     pub(crate) mass: &'a [f64],
@@ -293,7 +297,7 @@ impl ResetKernel<'_> {
             let m = self.mass[q];
             let mut f = [fe[0] + m * self.gravity[0], fe[1] + m * self.gravity[1]];
             if let Some(load) = self.boundary_load {
-                f = add(f, load[q]);
+                f = add(f, *load.get(q));
             }
             *force.get(q) = f;
             *torque.get(q) = self.external_torque[q];

@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 use super::pair_kernel::{
     pair_kernel, wall_contact, NullSink, PairForce, PairKernel, PairRecord, RecordSink,
 };
-use crate::bond::{bond_force, Bond, BondForce, Bonds};
-use crate::boundary::PressureChain;
+use crate::bond::{bond_force, Bond, BondForce, BondMotion, BondSlot, Bonds};
+use crate::boundary::{ChainBlocks, PressureChain};
 use crate::cell::{minimum_image, PeriodicCell};
 use crate::contact::{disk_disk, ContactGeometry};
 use crate::diagnostics::{EnergyLedger, Measurements};
@@ -98,9 +98,16 @@ pub struct Simulation {
     pub(crate) pool: Option<ThreadPool>,
     #[serde(skip)]
     pub(crate) cross_forces: Vec<PairForce>,
+    /// The bonds' forces of this step, in bond order (`step::bond_forces`).
+    #[serde(skip)]
+    pub(crate) bond_slots: Vec<BondSlot>,
     /// Follower loads of this step, per internal particle (recomputed every step).
     #[serde(skip)]
     pub(crate) boundary_load: Vec<Vec2>,
+    /// The chains' entries per block of particles, for the loads' reset (kept
+    /// current by `run` and every rebuild).
+    #[serde(skip)]
+    pub(crate) chain_blocks: ChainBlocks,
     /// Whether any particle has an external force or torque (scanned once per run call).
     #[serde(skip)]
     pub(crate) external_loads: bool,
@@ -150,7 +157,9 @@ impl Simulation {
             threads,
             pool: None,
             cross_forces: Vec::new(),
+            bond_slots: Vec::new(),
             boundary_load: Vec::new(),
+            chain_blocks: ChainBlocks::default(),
             external_loads: false,
             pacer: Pacer::default(),
         };
@@ -710,7 +719,7 @@ impl Simulation {
             let copy = *bond;
             bond_force(
                 &copy,
-                &self.particles,
+                &BondMotion::of(&self.particles),
                 self.cell.as_ref(),
                 l,
                 dt,
@@ -785,7 +794,7 @@ impl Simulation {
                 let mut shear = b.shear;
                 bond_force(
                     b,
-                    &self.particles,
+                    &BondMotion::of(&self.particles),
                     self.cell.as_ref(),
                     l,
                     increment_time,
@@ -897,6 +906,7 @@ impl Simulation {
         for chain in self.chains.iter_mut() {
             chain.remap(&new_of_old);
         }
+        self.chain_blocks = ChainBlocks::new(&self.chains, &self.neighbors.block_ranges);
         for (k, &e) in self.order.iter().enumerate() {
             self.rank[e as usize] = k as u32;
         }

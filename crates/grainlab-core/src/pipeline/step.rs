@@ -7,7 +7,8 @@ use super::pair_kernel::{
     PairForce, PairKernel, ResetKernel,
 };
 use super::Simulation;
-use crate::bond::bond_force;
+use crate::bond::{bond_slot, BondMotion, BondSlot};
+use crate::boundary::ChainBlocks;
 use crate::diagnostics::Measurements;
 use crate::error::Result;
 use crate::integrate::{
@@ -44,6 +45,8 @@ impl Simulation {
     /// large enough: one broadcast per call, worker 0 steps, the others serve phases.
     fn run_steps(&mut self, n: u64, measure_last: bool) -> Result<()> {
         self.check_consistent()?;
+        // the chains cannot change during a run call (a rebuild maps them along)
+        self.chain_blocks = ChainBlocks::new(&self.chains, &self.neighbors.block_ranges);
         // external loads cannot change during a run call: scan them once, not every step
         let p = &self.particles;
         self.external_loads = p.external_force.iter().any(|f| *f != [0.0, 0.0])
@@ -98,9 +101,8 @@ impl Simulation {
     /// energy, contact counts and the unbalanced force ratio.
     fn step<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Result<()> {
         self.ensure_neighbors()?;
-        self.boundary_loads();
         let mut stripes = self.particle_contacts::<MEASURE>(team);
-        let bonds = self.bond_forces::<MEASURE>();
+        let bonds = self.apply_bond_forces::<MEASURE>();
         let (walls, wall_work) = self.wall_forces::<MEASURE>();
         if team.is_none() {
             self.cross_pairs_in_order::<MEASURE>(&mut stripes);
@@ -275,13 +277,32 @@ impl Simulation {
             .map(|&(lo, hi)| (lo - cross_start, hi - cross_start))
             .collect();
         let cross_buffers = split_ranges(&mut self.cross_forces, &local);
+        // the bonds shared out evenly too; their forces wait in slots
+        let n_bonds = self.bonds.list.len();
+        let bond_ranges = even_bounds(n_bonds, n_blocks);
+        self.bond_slots.resize(n_bonds, BondSlot::default());
+        let bond_parts = split_ranges(&mut self.bonds.list, &bond_ranges);
+        let bond_slot_parts = split_ranges(&mut self.bond_slots, &bond_ranges);
+        let velocity_gradient = self
+            .cell
+            .as_ref()
+            .filter(|c| c.is_deforming())
+            .map(|c| c.velocity_gradient);
 
+        // the chains' follower loads, each block its own particles' (step 2a)
+        let has_chains = !self.chains.is_empty();
+        if has_chains {
+            self.boundary_load.resize(self.particles.len(), [0.0; 2]);
+        }
+        let boundary_load = DisjointWriter::new(&mut self.boundary_load);
+        debug_assert!(!has_chains || self.chain_blocks.start_len() == n_blocks + 1);
+        let (chains, chain_blocks, walls) = (&self.chains, &self.chain_blocks, &self.walls);
         let p = &mut self.particles;
         let force = DisjointWriter::new(&mut p.force);
         let torque = DisjointWriter::new(&mut p.torque);
         let kernel = pair_kernel!(self, p, pairs, increment_time);
         let reset = ResetKernel {
-            boundary_load: (!self.chains.is_empty()).then_some(self.boundary_load.as_slice()),
+            boundary_load: has_chains.then_some(&boundary_load),
             external_force: &p.external_force,
             external_torque: &p.external_torque,
             mass: &p.mass,
@@ -295,18 +316,34 @@ impl Simulation {
             .zip(sliding_parts)
             .zip(cross_shear.into_iter().zip(cross_sliding))
             .zip(cross_buffers)
+            .zip(bond_parts.into_iter().zip(bond_slot_parts))
             .enumerate()
             .map(
-                |(b, (((shear, sliding), (cross_shear, cross_sliding)), cross_forces))| BlockWork {
+                |(
+                    b,
+                    (
+                        (((shear, sliding), (cross_shear, cross_sliding)), cross_forces),
+                        (bonds, bond_slots),
+                    ),
+                )| BlockWork {
                     block: b,
                     shear,
                     sliding,
                     cross_shear,
                     cross_sliding,
                     cross_forces,
+                    bonds,
+                    bond_slots,
                 },
             )
             .collect();
+        let motion = BondMotion {
+            position: &p.position,
+            velocity: &p.velocity,
+            angular_velocity: &p.angular_velocity,
+            radius: &p.radius,
+        };
+        let cell = self.cell.as_ref();
         let block_ranges = &self.neighbors.block_ranges;
         let tallies = map_blocks(team, blocks, |work| {
             let b = work.block;
@@ -319,6 +356,16 @@ impl Simulation {
             // write their own slots of the buffer.
             unsafe {
                 let (lo, hi) = block_ranges[b];
+                if has_chains {
+                    chain_blocks.block_loads(
+                        b,
+                        lo,
+                        chains,
+                        kernel.position,
+                        walls,
+                        boundary_load.range(lo, hi),
+                    );
+                }
                 reset.apply(lo, hi, &force, &torque);
                 let mut tally =
                     kernel.run::<MEASURE, _>(ranges[b].0, work.shear, work.sliding, &mut direct);
@@ -333,6 +380,15 @@ impl Simulation {
                         &mut buffered,
                     );
                     tally.merge(&cross);
+                }
+                for (bond, slot) in work.bonds.iter_mut().zip(work.bond_slots.iter_mut()) {
+                    *slot = bond_slot::<MEASURE>(
+                        bond,
+                        &motion,
+                        cell,
+                        velocity_gradient,
+                        increment_time,
+                    );
                 }
                 tally
             }
@@ -377,36 +433,21 @@ impl Simulation {
         }
     }
 
-    /// Step 4: bonds (sequential; chains of membrane disks are short).
-    fn bond_forces<const MEASURE: bool>(&mut self) -> ContactTally {
+    /// Step 4: the bonds' forces, computed with the contact phase
+    /// ([`Simulation::particle_contacts`]), added to the particles in bond order.
+    fn apply_bond_forces<const MEASURE: bool>(&mut self) -> ContactTally {
         let mut tally = ContactTally::default();
-        let increment_time = self.increment_time();
-        let l = self.deforming_gradient();
-        for bond in self.bonds.list.iter_mut() {
-            let copy = *bond;
-            let b = bond_force(
-                &copy,
-                &self.particles,
-                self.cell.as_ref(),
-                l,
-                increment_time,
-                &mut bond.shear,
-            );
-            let (i, j) = (copy.i as usize, copy.j as usize);
-            let p = &mut self.particles;
-            let f = add(
-                scale(b.normal, b.normal_force),
-                scale(perp(b.normal), b.shear_force),
-            );
+        let p = &mut self.particles;
+        for (bond, slot) in self.bonds.list.iter().zip(&self.bond_slots) {
+            let (i, j) = (bond.i as usize, bond.j as usize);
+            let f = slot.force;
             p.force[j] = add(p.force[j], f);
             p.force[i] = sub(p.force[i], f);
-            p.torque[i] -= p.radius[i] * b.shear_force;
-            p.torque[j] -= p.radius[j] * b.shear_force;
+            p.torque[i] -= slot.torque_i;
+            p.torque[j] -= slot.torque_j;
             if MEASURE {
-                let (fn_, fs) = (b.normal_force, b.shear_force);
-                tally.elastic +=
-                    0.5 * fn_ * fn_ / copy.normal_stiffness + 0.5 * fs * fs / copy.shear_stiffness;
-                tally.force_sum += (fn_ * fn_ + fs * fs).sqrt();
+                tally.elastic += slot.elastic;
+                tally.force_sum += slot.force_norm;
                 tally.contacts += 1;
             }
         }
@@ -595,22 +636,6 @@ impl Simulation {
             total.merge(t);
         }
         total
-    }
-
-    /// Step 2a: the follower loads of the pressure chains at the current positions.
-    pub(crate) fn boundary_loads(&mut self) {
-        if self.chains.is_empty() {
-            return;
-        }
-        self.boundary_load.clear();
-        self.boundary_load.resize(self.particles.len(), [0.0; 2]);
-        for chain in &self.chains {
-            chain.apply(
-                &self.particles.position,
-                &self.walls,
-                &mut self.boundary_load,
-            );
-        }
     }
 }
 
