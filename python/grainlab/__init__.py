@@ -16,6 +16,7 @@ from grainlab.simulation import (
     Simulation,
     Wall,
     WallContacts,
+    WallState,
 )
 
 __all__ = [
@@ -31,6 +32,7 @@ __all__ = [
     "SimulationUnstableError",
     "Wall",
     "WallContacts",
+    "WallState",
     "__version__",
     "density_scaling_factor",
 ]

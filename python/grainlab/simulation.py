@@ -20,9 +20,10 @@ True
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Generic, Literal, TypeVar, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -180,9 +181,11 @@ class PressureChainState:
     end_wall: int | None
 
 
-def _readonly(array: Any) -> NDArray[Any]:
-    array.flags.writeable = False
-    return array
+def _readonly(array: object) -> NDArray[Any]:
+    """The engine's array itself (``asarray`` makes no copy of an array), marked read-only."""
+    marked = np.asarray(array)
+    marked.flags.writeable = False
+    return marked
 
 
 def _points(name: str, value: ArrayLike, n: int | None = None) -> NDArray[np.float64]:
@@ -233,10 +236,127 @@ def _index_list(name: str, value: ArrayLike, n: int) -> list[int]:
     return [int(v) for v in array]
 
 
+def _codes(name: str, value: ArrayLike, n: int, largest: int, meaning: str) -> NDArray[np.uint8]:
+    """Per-particle integer codes in 0..largest as uint8; ``meaning`` (with ``{v}``
+    for the bad value) says what a code out of range is."""
+    array = _values(name, value, n, dtype=np.int64)
+    if np.any((array < 0) | (array > largest)):
+        k = int(np.argwhere((array < 0) | (array > largest))[0, 0])
+        raise ValueError(f"{name}[{k}]: " + meaning.format(v=array[k]))
+    return array.astype(np.uint8)
+
+
+def _groups(name: str, value: ArrayLike, n: int) -> NDArray[np.uint8]:
+    return _codes(name, value, n, MAX_GROUPS - 1, f"group {{v}} out of range 0..{MAX_GROUPS - 1}")
+
+
+def _fixity(name: str, value: ArrayLike, n: int) -> NDArray[np.uint8]:
+    return _codes(name, value, n, 7, "{v} is not a sum of 1 (x), 2 (y), 4 (rotation)")
+
+
+#: The element type of a per-particle array (np.float64, np.uint8).
+Element = TypeVar("Element", bound=np.generic)
+
+
+class _ParticleArray(property, Generic[Element]):
+    """A per-particle array of :class:`Simulation`: a property named after the
+    engine's array, with the docstring ``doc``.
+
+    Reading gives a read-only copy of the engine's array. With a
+    ``convert(name, value, n)`` (``_points`` for (N, 2), ``_values`` for (N,),
+    ``_groups``, ``_fixity``) the property is settable: a whole array assigned
+    is checked and converted by it (errors name the property) and handed to the
+    engine's ``set_<name>``; without, it is read-only (no setter).
+    """
+
+    def __init__(
+        self, doc: str, *, convert: Callable[[str, ArrayLike, int], NDArray[Any]] | None = None
+    ) -> None:
+        super().__init__(self._read, None if convert is None else self._write, None, doc)
+        self.__doc__ = doc  # a property subclass keeps its doc in the instance
+        self._convert = convert
+        self.name = ""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        # property's own __set_name__ names the property in its errors ("has no setter");
+        # typeshed's property lacks it though CPython's has it since 3.10
+        super().__set_name__(owner, name)  # type: ignore[misc]
+        self.name = name
+
+    def _read(self, sim: Simulation) -> NDArray[Element]:
+        return _readonly(getattr(sim._engine, self.name))
+
+    def _write(self, sim: Simulation, value: ArrayLike) -> None:
+        assert self._convert is not None  # _write is the setter only when there is a convert
+        getattr(sim._engine, f"set_{self.name}")(self._convert(self.name, value, sim.n_particles))
+
+    @overload
+    def __get__(self, sim: None, owner: type | None = None) -> _ParticleArray[Element]: ...
+    @overload
+    def __get__(self, sim: Simulation, owner: type | None = None) -> NDArray[Element]: ...
+    def __get__(
+        self, sim: Simulation | None, owner: type | None = None
+    ) -> NDArray[Element] | _ParticleArray[Element]:
+        if sim is None:
+            return self
+        return self._read(sim)
+
+
 def _wall_id(wall: Wall | int | None) -> int | None:
     if wall is None:
         return None
     return wall.id if isinstance(wall, Wall) else int(wall)
+
+
+@dataclass(frozen=True)
+class WallState:
+    """One wall's state, read from the engine in one call (:attr:`Wall.state`).
+
+    ``points`` are the end points ``(a, b)`` of a segment or the one ``(point,)``
+    of a line (m); ``inward_normal`` points to the particles' side; ``force`` is
+    the particles' force on the wall in the last step (N per m thickness),
+    ``contact_count`` the particles touching it then; ``displacement`` (m) is the
+    total since the wall was created, ``velocity`` (m/s) the current one.
+    ``control`` is ``"velocity"`` or ``"servo"``; a servo wall has its settings
+    (:meth:`Wall.servo`), the others None there.
+    """
+
+    id: int
+    kind: Literal["segment", "line"]
+    points: tuple[tuple[float, float], ...]
+    inward_normal: tuple[float, float]
+    velocity: tuple[float, float]
+    force: tuple[float, float]
+    contact_count: int
+    displacement: tuple[float, float]
+    group: int
+    active: bool
+    control: Literal["velocity", "servo"]
+    target_stress_pa: float | None = None
+    loaded_length_m: float | None = None
+    relaxation: float | None = None
+    max_speed_m_per_s: float | None = None
+
+    @classmethod
+    def _from_engine(cls, wall_id: int, state: _core._WallState) -> WallState:
+        kind = state["kind"]
+        return cls(
+            id=wall_id,
+            kind=kind,
+            points=(state["a"], state["b"]) if kind == "segment" else (state["point"],),
+            inward_normal=state["inward_normal"],
+            velocity=state["velocity"],
+            force=state["force"],
+            contact_count=int(state["contact_count"]),
+            displacement=state["displacement"],
+            group=int(state["group"]),
+            active=bool(state["active"]),
+            control=state["control"],
+            target_stress_pa=state.get("target_stress"),
+            loaded_length_m=state.get("loaded_length"),
+            relaxation=state.get("relaxation"),
+            max_speed_m_per_s=state.get("max_speed"),
+        )
 
 
 class Wall:
@@ -244,50 +364,52 @@ class Wall:
 
     The *inward normal* points to the particles' side: for a segment ``a -> b``
     it is the left normal; for a line, the normal given. Stresses are compression
-    positive along it.
+    positive along it. Each property below reads the wall's whole :attr:`state`
+    from the engine; read :attr:`state` once to use several of its values.
     """
 
     def __init__(self, engine: _core.Engine, wall_id: int) -> None:
         self._engine = engine
         self.id = wall_id
 
-    def _state(self) -> dict[str, Any]:
-        return self._engine.wall_state(self.id)
+    @property
+    def state(self) -> WallState:
+        """The wall's state now (:class:`WallState`), read from the engine in one call."""
+        return WallState._from_engine(self.id, self._engine.wall_state(self.id))
 
     @property
     def kind(self) -> str:
         """``"segment"`` or ``"line"``."""
-        return str(self._state()["kind"])
+        return self.state.kind
 
     @property
     def points(self) -> NDArray[np.float64]:
         """End points ``[[ax, ay], [bx, by]]`` of a segment, or ``[point]`` of a line (m)."""
-        s = self._state()
-        return np.array([s["a"], s["b"]] if s["kind"] == "segment" else [s["point"]])
+        return np.array(self.state.points)
 
     @property
     def inward_normal(self) -> NDArray[np.float64]:
-        return np.array(self._state()["inward_normal"])
+        return np.array(self.state.inward_normal)
 
     @property
     def force(self) -> NDArray[np.float64]:
         """Force exerted by the particles on the wall in the last step (N per m thickness)."""
-        return np.array(self._state()["force"])
+        return np.array(self.state.force)
 
     @property
     def contact_count(self) -> int:
         """Particles touching the wall in the last step."""
-        return int(self._state()["contact_count"])
+        return self.state.contact_count
 
     @property
     def displacement(self) -> NDArray[np.float64]:
         """Total displacement since the wall was created (m)."""
-        return np.array(self._state()["displacement"])
+        return np.array(self.state.displacement)
 
     @property
     def velocity(self) -> NDArray[np.float64]:
         """Current velocity (m/s); setting it switches the wall to velocity control."""
-        return np.array(self._state()["velocity"])
+        return np.array(self.state.velocity)
 
     @velocity.setter
     def velocity(self, value: ArrayLike) -> None:
@@ -296,7 +418,7 @@ class Wall:
     @property
     def active(self) -> bool:
         """An inactive wall has no contacts and stays put (e.g. side walls replaced by a membrane)."""
-        return bool(self._state()["active"])
+        return self.state.active
 
     @active.setter
     def active(self, value: bool) -> None:
@@ -305,13 +427,15 @@ class Wall:
     @property
     def control(self) -> str:
         """``"velocity"`` or ``"servo"``."""
-        return str(self._state()["control"])
+        return self.state.control
 
     def normal_stress(self, loaded_length_m: float) -> float:
         """Normal stress from the last step's force over ``loaded_length_m``, compression positive (Pa)."""
         if not loaded_length_m > 0:
             raise ValueError(f"loaded_length_m: must be > 0, got {loaded_length_m}")
-        return float(-np.dot(self.force, self.inward_normal) / loaded_length_m)
+        state = self.state
+        force, normal = np.array(state.force), np.array(state.inward_normal)
+        return float(-np.dot(force, normal) / loaded_length_m)
 
     def servo(
         self,
@@ -335,7 +459,8 @@ class Wall:
         self._engine.move_wall(self.id, list(_vector("displacement", displacement)))
 
     def __repr__(self) -> str:
-        return f"Wall(id={self.id}, kind={self.kind!r}, control={self.control!r})"
+        state = self.state
+        return f"Wall(id={self.id}, kind={state.kind!r}, control={state.control!r})"
 
 
 class Simulation:
@@ -406,7 +531,7 @@ class Simulation:
         return sim
 
     def _set_parameters(self, **changes: Any) -> None:
-        p = dict(self._engine.parameters)
+        p: dict[str, Any] = dict(self._engine.parameters)
         p.pop("skin")
         p.update(changes)
         self._engine.set_parameters(
@@ -518,130 +643,55 @@ class Simulation:
 
     # ---- particle arrays (read-only copies; assign a whole array to change) ----
 
-    @property
-    def positions(self) -> NDArray[np.float64]:
+    positions = _ParticleArray[np.float64](
         """(N, 2) centres (m). Inside a periodic cell they are wrapped when the
         neighbour lists are rebuilt, so they may stray slightly outside between builds.
         Positions you set are a jump: the shear springs first take the last step's
-        displacement and nothing from the jump (docs/contact-law.md)."""
-        return _readonly(self._engine.positions)
-
-    @positions.setter
-    def positions(self, value: ArrayLike) -> None:
-        self._engine.set_positions(_points("positions", value, self.n_particles))
-
-    @property
-    def velocities(self) -> NDArray[np.float64]:
+        displacement and nothing from the jump (docs/contact-law.md).""",
+        convert=_points,
+    )
+    velocities = _ParticleArray[np.float64](
         """(N, 2) velocities (m/s): half-step values v(n - 1/2) once stepped. Values
         you set are taken as full-step values: the next step kicks by dt/2 and adds
         no shear increment, and the shear springs first take the displacement the
-        last step made at the old velocities (docs/contact-law.md)."""
-        return _readonly(self._engine.velocities)
-
-    @velocities.setter
-    def velocities(self, value: ArrayLike) -> None:
-        self._engine.set_velocities(_points("velocities", value, self.n_particles))
-
-    @property
-    def rotations(self) -> NDArray[np.float64]:
-        """(N,) rotation angles (rad, counter-clockwise)."""
-        return _readonly(self._engine.rotations)
-
-    @rotations.setter
-    def rotations(self, value: ArrayLike) -> None:
-        self._engine.set_rotations(_values("rotations", value, self.n_particles))
-
-    @property
-    def angular_velocities(self) -> NDArray[np.float64]:
-        """(N,) angular velocities (rad/s, counter-clockwise)."""
-        return _readonly(self._engine.angular_velocities)
-
-    @angular_velocities.setter
-    def angular_velocities(self, value: ArrayLike) -> None:
-        self._engine.set_angular_velocities(_values("angular_velocities", value, self.n_particles))
-
-    @property
-    def radii(self) -> NDArray[np.float64]:
-        """(N,) radii (m); setting them updates masses and inertias."""
-        return _readonly(self._engine.radii)
-
-    @radii.setter
-    def radii(self, value: ArrayLike) -> None:
-        self._engine.set_radii(_values("radii", value, self.n_particles))
-
-    @property
-    def densities(self) -> NDArray[np.float64]:
-        """(N,) densities (kg/m^3)."""
-        return _readonly(self._engine.densities)
-
-    @densities.setter
-    def densities(self, value: ArrayLike) -> None:
-        self._engine.set_densities(_values("densities", value, self.n_particles))
-
-    @property
-    def masses(self) -> NDArray[np.float64]:
-        """(N,) masses ``rho pi r^2`` (kg per m thickness)."""
-        return _readonly(self._engine.masses)
-
-    @property
-    def inertias(self) -> NDArray[np.float64]:
+        last step made at the old velocities (docs/contact-law.md).""",
+        convert=_points,
+    )
+    rotations = _ParticleArray[np.float64](
+        """(N,) rotation angles (rad, counter-clockwise).""", convert=_values
+    )
+    angular_velocities = _ParticleArray[np.float64](
+        """(N,) angular velocities (rad/s, counter-clockwise).""", convert=_values
+    )
+    radii = _ParticleArray[np.float64](
+        """(N,) radii (m); setting them updates masses and inertias.""", convert=_values
+    )
+    densities = _ParticleArray[np.float64]("""(N,) densities (kg/m^3).""", convert=_values)
+    masses = _ParticleArray[np.float64]("""(N,) masses ``rho pi r^2`` (kg per m thickness).""")
+    inertias = _ParticleArray[np.float64](
         """(N,) moments of inertia ``m r^2 / 2`` (kg m^2 per m thickness)."""
-        return _readonly(self._engine.inertias)
-
-    @property
-    def forces(self) -> NDArray[np.float64]:
+    )
+    forces = _ParticleArray[np.float64](
         """(N, 2) resultant forces of the last step before damping (N)."""
-        return _readonly(self._engine.forces)
-
-    @property
-    def torques(self) -> NDArray[np.float64]:
+    )
+    torques = _ParticleArray[np.float64](
         """(N,) resultant torques of the last step before damping (N m)."""
-        return _readonly(self._engine.torques)
-
-    @property
-    def external_forces(self) -> NDArray[np.float64]:
-        """(N, 2) constant external forces applied every step (N)."""
-        return _readonly(self._engine.external_forces)
-
-    @external_forces.setter
-    def external_forces(self, value: ArrayLike) -> None:
-        self._engine.set_external_forces(_points("external_forces", value, self.n_particles))
-
-    @property
-    def external_torques(self) -> NDArray[np.float64]:
-        """(N,) constant external torques (N m)."""
-        return _readonly(self._engine.external_torques)
-
-    @external_torques.setter
-    def external_torques(self, value: ArrayLike) -> None:
-        self._engine.set_external_torques(_values("external_torques", value, self.n_particles))
-
-    @property
-    def groups(self) -> NDArray[np.uint8]:
-        """(N,) material groups in 0..15 (contact models are set per pair of groups)."""
-        return _readonly(self._engine.groups)
-
-    @groups.setter
-    def groups(self, value: ArrayLike) -> None:
-        array = _values("groups", value, self.n_particles, dtype=np.int64)
-        if np.any((array < 0) | (array >= MAX_GROUPS)):
-            k = int(np.argwhere((array < 0) | (array >= MAX_GROUPS))[0, 0])
-            raise ValueError(f"groups[{k}]: group {array[k]} out of range 0..{MAX_GROUPS - 1}")
-        self._engine.set_groups(array.astype(np.uint8))
-
-    @property
-    def fixity(self) -> NDArray[np.uint8]:
+    )
+    external_forces = _ParticleArray[np.float64](
+        """(N, 2) constant external forces applied every step (N).""", convert=_points
+    )
+    external_torques = _ParticleArray[np.float64](
+        """(N,) constant external torques (N m).""", convert=_values
+    )
+    groups = _ParticleArray[np.uint8](
+        """(N,) material groups in 0..15 (contact models are set per pair of groups).""",
+        convert=_groups,
+    )
+    fixity = _ParticleArray[np.uint8](
         """(N,) prescribed degrees of freedom: sums of FIX_X (1), FIX_Y (2),
-        FIX_ROTATION (4). A prescribed velocity keeps the value it has."""
-        return _readonly(self._engine.fixity)
-
-    @fixity.setter
-    def fixity(self, value: ArrayLike) -> None:
-        array = _values("fixity", value, self.n_particles, dtype=np.int64)
-        if np.any((array < 0) | (array > 7)):
-            k = int(np.argwhere((array < 0) | (array > 7))[0, 0])
-            raise ValueError(f"fixity[{k}]: {array[k]} is not a sum of 1 (x), 2 (y), 4 (rotation)")
-        self._engine.set_fixity(array.astype(np.uint8))
+        FIX_ROTATION (4). A prescribed velocity keeps the value it has.""",
+        convert=_fixity,
+    )
 
     # ---- contact models ----
 
@@ -675,7 +725,10 @@ class Simulation:
         hi = _vector("upper", upper)
         if not (hi[0] > lo[0] and hi[1] > lo[1]):
             raise ValueError(f"upper: must exceed lower in x and y, got lower={lo}, upper={hi}")
-        self._engine.set_cell(list(lo), [hi[0] - lo[0], 0.0], [0.0, hi[1] - lo[1]], tuple(map(bool, periodic)))
+        flags = tuple(bool(p) for p in periodic)
+        if len(flags) != 2:
+            raise ValueError(f"periodic: expected two flags (x, y), got {periodic!r}")
+        self._engine.set_cell(list(lo), [hi[0] - lo[0], 0.0], [0.0, hi[1] - lo[1]], (flags[0], flags[1]))
 
     def set_velocity_gradient(self, gradient: ArrayLike) -> None:
         """Imposes a homogeneous deformation of the periodic cell: ``L[i][j] = dv_i/dx_j``
