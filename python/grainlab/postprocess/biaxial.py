@@ -127,24 +127,28 @@ class FabricNumbers:
     @property
     def band_angle_deg(self) -> float:
         """Band angle at the peak snapshot, degrees (NaN when not found)."""
-        return self.band.angle_deg if self.band_found else math.nan  # type: ignore[union-attr]
+        band = self.band
+        return band.angle_deg if band is not None and band.found else math.nan
 
     @property
     def band_thickness_diameters(self) -> float:
         """Band thickness at the peak snapshot in mean grain diameters (NaN when not found)."""
-        return self.band.thickness_diameters if self.band_found else math.nan  # type: ignore[union-attr]
+        band = self.band
+        return band.thickness_diameters if band is not None and band.found else math.nan
 
     @property
     def mean_lambda_in_band(self) -> float:
-        return self.band.mean_lambda_inside if self.band_found else math.nan  # type: ignore[union-attr]
+        band = self.band
+        return band.mean_lambda_inside if band is not None and band.found else math.nan
 
     @property
     def mean_lambda_outside_band(self) -> float:
-        return self.band.mean_lambda_outside if self.band_found else math.nan  # type: ignore[union-attr]
+        band = self.band
+        return band.mean_lambda_outside if band is not None and band.found else math.nan
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready dict (NaN as None, paths as strings)."""
-        return json_safe(
+        summary: dict[str, Any] = json_safe(
             {
                 "results_path": str(self.results_path),
                 "peak_row": self.peak_row,
@@ -166,6 +170,7 @@ class FabricNumbers:
                 "notes": list(self.notes),
             }
         )
+        return summary
 
     def lines(self) -> list[str]:
         """Human-readable lines for a summary or report."""

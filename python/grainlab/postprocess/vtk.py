@@ -61,11 +61,10 @@ def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArra
         "kind": np.asarray(snap.kind, np.int32),
         "radius": np.asarray(snap.radii, np.float64),
     }
-    first = reference is None or reference is snap
     disp = np.zeros((n, 3))
     gamma = np.full(n, np.nan)
     band = np.zeros(n, np.int32)
-    if not first:
+    if reference is not None and reference is not snap:
         to_ref = match_ids(reference, snap)
         ok = to_ref >= 0
         disp[:, :2] = np.nan

@@ -132,7 +132,8 @@ def _num(value: Any) -> float:
 
 
 def _snaps(m: Measures) -> list[Mapping[str, Any]]:
-    return m["snapshots"]
+    snapshots: list[Mapping[str, Any]] = m["snapshots"]
+    return snapshots
 
 
 def _initial(m: Measures) -> Mapping[str, Any]:

@@ -238,7 +238,7 @@ def _snapshot_row(reference: Any, snap: Any, labels: NDArray[np.int32] | None,
     return row
 
 
-def measure_study(rows: list[Mapping[str, Any]]) -> dict[str, Any]:
+def measure_study(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """The packing-study numbers of one seed from its rows (``study.csv`` columns;
     failed rows left out). Fits are least squares (:func:`scipy.stats.linregress`)."""
     from scipy.stats import linregress

@@ -71,9 +71,14 @@ def _measure_task(kind: str, path: str, options: list[dict[str, Any]]) -> tuple[
         return [None] * len(options), f"{path}: {type(error).__name__}: {error}"
 
 
-def _tasks(plan: ReproductionPlan, out: Path) -> dict[tuple[str, str, str], tuple[str, str, dict[str, Any]]]:
+#: A run to measure, by (variant, seed, kind), and what to measure: (kind, path, options).
+TaskKey = tuple[str, str, str]
+Task = tuple[str, str, dict[str, Any]]
+
+
+def _tasks(plan: ReproductionPlan, out: Path) -> dict[TaskKey, Task]:
     """(variant, seed, kind) -> (kind, path, options) of every run that has finished."""
-    tasks = {}
+    tasks: dict[TaskKey, Task] = {}
     for v in plan.variants:
         source = plan.variant(v.runs_variant)
         for seed in plan.seeds:
@@ -88,18 +93,20 @@ def _tasks(plan: ReproductionPlan, out: Path) -> dict[tuple[str, str, str], tupl
     return tasks
 
 
-def _compute(tasks: dict, workers: int | None, progress: bool) -> tuple[dict, list[str]]:
+def _compute(
+    tasks: dict[TaskKey, Task], workers: int | None, progress: bool
+) -> tuple[dict[TaskKey, dict[str, Any] | None], list[str]]:
     """Measures every run once (a biaxial run under every analysis option its variants ask
     for), in ``workers`` local processes; returns the measures by task key and notes."""
     from grainlab._progress import progress_bar
 
-    results: dict = {}
+    results: dict[TaskKey, dict[str, Any] | None] = {}
     notes: list[str] = []
-    jobs: dict[tuple[str, str], dict[str, list]] = {}  # (kind, path) -> options text -> task keys
+    jobs: dict[tuple[str, str], dict[str, list[TaskKey]]] = {}  # (kind, path) -> options text -> task keys
     for key, (kind, path, options) in tasks.items():
         jobs.setdefault((kind, path), {}).setdefault(json.dumps(options, sort_keys=True), []).append(key)
 
-    def collect(job: tuple[str, str], values: list, note: str) -> None:
+    def collect(job: tuple[str, str], values: list[dict[str, Any] | None], note: str) -> None:
         for keys, value in zip(jobs[job].values(), values, strict=True):
             for key in keys:
                 results[key] = value
@@ -230,7 +237,7 @@ def rate_convergence(family: Sequence[tuple[float, list[dict[str, Any] | None]]]
         if not half:
             continue
         slow = family[half[0]][1]
-        quantities = {}
+        quantities: dict[str, dict[str, float | bool | None]] = {}
         for name, get in _RATE_QUANTITIES.items():
             a = np.array([float(get(m)) for m in measures], dtype=np.float64)
             b = np.array([float(get(m)) for m in slow], dtype=np.float64)

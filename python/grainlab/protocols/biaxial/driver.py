@@ -210,16 +210,18 @@ def run_biaxial(
             sim, run = _generate(config, threads, progress)
             elapsed_before = 0.0
 
-        def save() -> None:
-            state = run.to_dict()
-            state["config"] = config.to_dict()
-            state["elapsed_s"] = elapsed_before + time.perf_counter() - started
-            state["rows"] = writer.n_rows
-            state["snapshots"] = list(writer.snapshot_names)
-            image = np.frombuffer(writer.publish(), dtype=np.uint8)
-            write_checkpoint(checkpoint_path, sim.to_bytes(), state, arrays={_RESULTS_IMAGE: image})
-
         if writer is not None:
+            results = writer  # the writer as the checkpoints see it
+
+            def save() -> None:
+                state = run.to_dict()
+                state["config"] = config.to_dict()
+                state["elapsed_s"] = elapsed_before + time.perf_counter() - started
+                state["rows"] = results.n_rows
+                state["snapshots"] = list(results.snapshot_names)
+                image = np.frombuffer(results.publish(), dtype=np.uint8)
+                write_checkpoint(checkpoint_path, sim.to_bytes(), state, arrays={_RESULTS_IMAGE: image})
+
             if not resume:
                 save()
             if run.phase == "consolidate":

@@ -45,7 +45,7 @@ class BiaxialResult:
 
 
 def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
-    shear = run.shear
+    shear = run.shear_plan()
     first = {k: float(v[0]) for k, v in timeseries.items()}
     last = {k: float(v[-1]) for k, v in timeseries.items()}
     peak = run.peak or {}

@@ -324,7 +324,7 @@ def _shear(
     progress: bool,
 ) -> None:
     start = time.perf_counter() - run.wall_time.get("shear", 0.0)
-    shear = run.shear
+    shear = run.shear_plan()
     steps = shear["record_steps"]
     snap_steps = shear["snapshot_steps"]
     final = config["shear.final_strain"]
@@ -360,10 +360,11 @@ def _shear(
                 "coordination_number": record["coordination_number"],
                 "volumetric_strain": record["volumetric_strain"],
             }
-        if run.membrane.get("kind") == GrainBoundary.kind:
-            run.membrane = GrainBoundary.from_dict(run.membrane).identify(sim).to_dict()
+        boundary = _boundary(run)
+        if isinstance(boundary, GrainBoundary):
+            run.membrane = boundary.identify(sim).to_dict()
         else:
-            breach = membrane_breach(sim, Membrane.from_dict(run.membrane))
+            breach = membrane_breach(sim, boundary)
             if breach is not None:
                 bar.close()
                 raise BiaxialError(
@@ -386,7 +387,7 @@ def _shear(
 def _check_shear_plan(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     """The shearing phase's records and snapshots fall on distinct time steps,
     checked with the run's own time step before the first record."""
-    shear = run.shear
+    shear = run.shear_plan()
     problem = strain_rate_problem(
         shear["strain_rate"], sim.time_step, shear["height0"], float(sim.radii.min()), config["shear.record_interval"]
     )

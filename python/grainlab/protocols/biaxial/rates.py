@@ -155,7 +155,7 @@ def default_strain_rate(config: BiaxialConfig, max_diameter: float, min_radius: 
     bound = config["shear.inertial_number"]
     inertial = max_diameter * math.sqrt(rho / ((1.0 - alpha) * p))
     eq16 = min_radius * math.sqrt(rho / config["material.limiting_contact_pressure"])
-    return bound / max(inertial, eq16)
+    return float(bound) / max(inertial, eq16)
 
 
 def inertial_number(config: BiaxialConfig, rate: float, diameter: float) -> float:

@@ -75,7 +75,7 @@ def _platens(sim: Simulation, boundary: Membrane | GrainBoundary) -> _Platens:
 def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, float]:
     """One record of the shearing phase."""
     boundary = _boundary(run)
-    shear = run.shear
+    shear = run.shear_plan()
     platens = _platens(sim, boundary)
     height, area, sigma_1 = platens.height_m, platens.area_m2, platens.axial_stress_pa
     sigma_3 = config["consolidation.pressure"]

@@ -36,11 +36,24 @@ class _Run:
     def to_dict(self) -> dict[str, Any]:
         return dict(self.__dict__)
 
+    def boundary_state(self) -> dict[str, Any]:
+        """The lateral boundary's record (:attr:`membrane`), set by the boundary phase."""
+        if self.membrane is None:
+            raise BiaxialError(f"the run has no lateral boundary yet (phase {self.phase!r})")
+        return self.membrane
+
+    def shear_plan(self) -> dict[str, Any]:
+        """The shearing phase's plan and progress (:attr:`shear`), set when shearing starts."""
+        if self.shear is None:
+            raise BiaxialError(f"the run has no shearing plan yet (phase {self.phase!r})")
+        return self.shear
+
 
 
 
 def _boundary(run: _Run) -> Membrane | GrainBoundary:
     """The run's lateral boundary (the membrane, or variant B's grain chains)."""
-    if run.membrane.get("kind") == GrainBoundary.kind:
-        return GrainBoundary.from_dict(run.membrane)
-    return Membrane.from_dict(run.membrane)
+    boundary = run.boundary_state()
+    if boundary.get("kind") == GrainBoundary.kind:
+        return GrainBoundary.from_dict(boundary)
+    return Membrane.from_dict(boundary)
