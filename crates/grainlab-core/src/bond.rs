@@ -116,7 +116,7 @@ impl<'a> BondMotion<'a> {
 
 /// Evaluates `bond` at the current state, adding `-ks v_t increment_time` to `shear`
 /// (its spring: the bond's own, or a copy for a query).
-#[inline]
+#[inline(always)]
 pub(crate) fn bond_force(
     bond: &Bond,
     p: &BondMotion<'_>,

@@ -148,8 +148,17 @@ impl ChainBlocks {
         }
         for &(c, k) in &self.entries[self.start[b]..self.start[b + 1]] {
             let chain = &chains[c as usize];
-            let q = chain.particles[k as usize] as usize;
-            chain.add_load_of(k as usize, position, walls, &mut load[q - lo]);
+            let (k, ps) = (k as usize, chain.particles.as_slice());
+            let q = ps[k] as usize - lo;
+            if k > 0 && k + 1 < ps.len() && chain.pressure != 0.0 {
+                // an inner particle, as `add_load_of` adds it
+                let d = sub(position[ps[k + 1] as usize], position[ps[k - 1] as usize]);
+                let factor = 0.5 * chain.pressure;
+                load[q][0] += factor * d[1];
+                load[q][1] -= factor * d[0];
+            } else {
+                chain.add_load_of(k, position, walls, &mut load[q]);
+            }
         }
     }
 }

@@ -129,6 +129,13 @@ impl MaterialTable {
         (undamped && self.models.iter().all(|m| *m == first)).then_some(first)
     }
 
+    /// Whether no model of the table has a dashpot.
+    pub fn undamped(&self) -> bool {
+        self.models
+            .iter()
+            .all(|m| m.normal_damping_ratio == 0.0 && m.shear_damping_ratio == 0.0)
+    }
+
     /// Largest normal or shear stiffness of any model involving group `g`.
     pub fn max_stiffness_for_group(&self, g: u8) -> f64 {
         (0..MAX_GROUPS as u8)

@@ -17,6 +17,7 @@
 //! and may be evaluated concurrently with other blocks; pairs across blocks
 //! come last. Shear history is carried over from the previous list by pair key.
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use serde::{Deserialize, Serialize};
 
@@ -425,8 +426,9 @@ impl NeighborList {
         }
 
         // 5. carry the history of touching pairs over, correcting shifts for the wraps
-        let mut history: HashMap<(u32, u32, [i8; 2]), (f64, bool)> = HashMap::new();
         let old = &self.pairs;
+        let mut history: PairMap<(u32, u32, [i8; 2]), (f64, bool)> = PairMap::default();
+        history.reserve(old.len());
         for k in 0..old.len() {
             if old.shear[k] != 0.0 || old.sliding[k] {
                 let (i, j) = (old.i[k] as usize, old.j[k] as usize);
@@ -454,7 +456,7 @@ impl NeighborList {
         }
 
         // 6. wall pairs
-        let mut wall_history: HashMap<(u32, u32), (f64, bool)> = HashMap::new();
+        let mut wall_history: PairMap<(u32, u32), (f64, bool)> = PairMap::default();
         let old = &self.wall_pairs;
         for k in 0..old.wall.len() {
             if old.shear[k] != 0.0 || old.sliding[k] {
@@ -633,4 +635,55 @@ fn counting_sort(bins: &[u32], n_bins: usize) -> (Vec<usize>, Vec<u32>) {
         fill[b as usize] += 1;
     }
     (start, members)
+}
+
+/// A map keyed by particle indices, for the history carry-over of a rebuild:
+/// only inserted into and looked up (never iterated), so its hash function
+/// cannot change a result, and a multiplicative one is much cheaper than the
+/// default (which resists adversarial keys, which indices are not).
+type PairMap<K, V> = HashMap<K, V, BuildHasherDefault<IndexHasher>>;
+
+/// Multiply-rotate hashing of the integers of a key.
+#[derive(Default)]
+struct IndexHasher(u64);
+
+impl IndexHasher {
+    #[inline(always)]
+    fn mix(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
+}
+
+impl Hasher for IndexHasher {
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.mix(u64::from(b));
+        }
+    }
+
+    #[inline]
+    fn write_u8(&mut self, x: u8) {
+        self.mix(u64::from(x));
+    }
+
+    #[inline]
+    fn write_u32(&mut self, x: u32) {
+        self.mix(u64::from(x));
+    }
+
+    #[inline]
+    fn write_u64(&mut self, x: u64) {
+        self.mix(x);
+    }
+
+    #[inline]
+    fn write_usize(&mut self, x: usize) {
+        self.mix(x as u64);
+    }
 }

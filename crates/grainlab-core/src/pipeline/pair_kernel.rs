@@ -330,6 +330,7 @@ macro_rules! pair_kernel {
             increment_time: $increment_time,
             max_overlap_ratio: $sim.params.max_overlap_ratio,
             single_model: $sim.materials.single_undamped_model(),
+            undamped: $sim.materials.undamped(),
         }
     };
 }
@@ -355,6 +356,8 @@ pub(crate) struct PairKernel<'a> {
     pub(crate) max_overlap_ratio: f64,
     /// The one model of every pair when there is one and it has no dashpot.
     pub(crate) single_model: Option<ContactModel>,
+    /// No model has a dashpot.
+    pub(crate) undamped: bool,
 }
 
 impl PairKernel<'_> {
@@ -375,16 +378,33 @@ impl PairKernel<'_> {
         match (
             self.velocity_gradient.is_some(),
             self.single_model.is_some(),
+            self.undamped,
         ) {
-            (false, false) => self.pairs::<MEASURE, false, false, S>(first, shear, sliding, sink),
-            (false, true) => self.pairs::<MEASURE, false, true, S>(first, shear, sliding, sink),
-            (true, false) => self.pairs::<MEASURE, true, false, S>(first, shear, sliding, sink),
-            (true, true) => self.pairs::<MEASURE, true, true, S>(first, shear, sliding, sink),
+            (false, false, false) => {
+                self.pairs::<MEASURE, false, false, true, S>(first, shear, sliding, sink)
+            }
+            (false, false, true) => {
+                self.pairs::<MEASURE, false, false, false, S>(first, shear, sliding, sink)
+            }
+            (false, true, _) => {
+                self.pairs::<MEASURE, false, true, false, S>(first, shear, sliding, sink)
+            }
+            (true, false, false) => {
+                self.pairs::<MEASURE, true, false, true, S>(first, shear, sliding, sink)
+            }
+            (true, false, true) => {
+                self.pairs::<MEASURE, true, false, false, S>(first, shear, sliding, sink)
+            }
+            (true, true, _) => {
+                self.pairs::<MEASURE, true, true, false, S>(first, shear, sliding, sink)
+            }
         }
     }
 
     /// The loop of [`PairKernel::run`]: `DEFORMING` when the cell has a velocity
-    /// gradient, `SINGLE` when [`PairKernel::single_model`] is set.
+    /// gradient, `SINGLE` when [`PairKernel::single_model`] is set, `DASHPOTS`
+    /// unless no model has a dashpot (whose terms are then skipped, as the law
+    /// skips them for a zero damping ratio).
     ///
     /// # Safety
     /// As [`PairKernel::run`].
@@ -393,6 +413,7 @@ impl PairKernel<'_> {
         const MEASURE: bool,
         const DEFORMING: bool,
         const SINGLE: bool,
+        const DASHPOTS: bool,
         S: ForceSink,
     >(
         &self,
@@ -408,18 +429,23 @@ impl PairKernel<'_> {
             .unwrap_or(ContactModel::linear(1.0, 1.0, 0.0));
         let max_overlap_ratio = self.max_overlap_ratio;
         let mut overlap_violation = false;
-        debug_assert!(first + shear.len() <= self.pair_i.len());
-        for (k, (spring, slide)) in shear.iter_mut().zip(sliding.iter_mut()).enumerate() {
-            let pair = first + k;
-            // SAFETY: the neighbour list holds pairs `first..first + shear.len()` of
-            // particles that exist (`NeighborList::build`), so every index below is
-            // in bounds; the checks would cost a tenth of the loop
-            let i = *self.pair_i.get_unchecked(pair) as usize;
-            let j = *self.pair_j.get_unchecked(pair) as usize;
+        // the pairs' columns cut to this run, so one index walks them all
+        let n = shear.len().min(sliding.len());
+        let pair_i = &self.pair_i[first..first + n];
+        let pair_j = &self.pair_j[first..first + n];
+        let shifts = &self.shift[first..first + n];
+        let models = &self.model[first..first + n];
+        for k in 0..n {
+            let (spring, slide) = (&mut shear[k], &mut sliding[k]);
+            // SAFETY: the neighbour list holds pairs of particles that exist
+            // (`NeighborList::build`), so every particle index below is in
+            // bounds; the checks would cost a tenth of the loop
+            let i = pair_i[k] as usize;
+            let j = pair_j[k] as usize;
             debug_assert!(i < self.position.len() && j < self.position.len());
             let xi = *self.position.get_unchecked(i);
             let mut xj = *self.position.get_unchecked(j);
-            let s = *self.shift.get_unchecked(pair);
+            let s = shifts[k];
             if s != [0, 0] {
                 if let Some(c) = self.cell {
                     xj = add(xj, c.image_offset(s));
@@ -455,9 +481,9 @@ impl PairKernel<'_> {
             let model = if SINGLE {
                 &single
             } else {
-                self.materials.by_index(*self.model.get_unchecked(pair))
+                self.materials.by_index(models[k])
             };
-            let reduced_mass = if !SINGLE
+            let reduced_mass = if DASHPOTS
                 && (model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0)
             {
                 let (mi, mj) = (self.mass[i], self.mass[j]);
@@ -466,7 +492,7 @@ impl PairKernel<'_> {
                 0.0
             };
             let (dt, increment_time) = (self.dt, self.increment_time);
-            let c = if SINGLE {
+            let c = if !DASHPOTS {
                 linear_coulomb_with::<false>(
                     model,
                     overlap,
