@@ -45,6 +45,9 @@ RUN_FILES = (RESULTS_FILE, RESULTS_FILE + PARTIAL_SUFFIX, CHECKPOINT_FILE)
 OUTPUT_FILES = ("timeseries.csv", "summary.json", "report.html", "fig[0-9][0-9]_*.png", "fig[0-9][0-9]_*.svg")
 #: Name of the checkpoint array that holds the partial results file (:meth:`ResultsWriter.publish`).
 _RESULTS_IMAGE = "results_partial"
+#: HDF5 filter of run.h5's snapshot arrays (with byte shuffling): lossless, read by any
+#: HDF5 reader; a paper-scale run's snapshots shrink to about two thirds (6.1 to 4.1 MB).
+RESULTS_COMPRESSION = "gzip"
 
 
 def _saved_config(saved: Any) -> dict[str, Any] | None:
@@ -143,13 +146,17 @@ def _reopen_results(out: Path, run: _Run, checkpoint: Any) -> ResultsWriter | No
         )
     image = checkpoint.arrays.get(_RESULTS_IMAGE)
     if image is not None:  # the partial file as it was at the checkpoint, whatever became of it since
-        return ResultsWriter.restore(out, np.asarray(image, dtype=np.uint8).tobytes(), buffered=True)
+        return ResultsWriter.restore(
+            out, np.asarray(image, dtype=np.uint8).tobytes(), compression=RESULTS_COMPRESSION, buffered=True
+        )
     if not partial.exists():
         raise ValueError(
             f"--resume: {partial} is missing and {out / CHECKPOINT_FILE} (written by an earlier grainlab) "
             "cannot rebuild it; start the run again in a new folder"
         )
-    return ResultsWriter.resume(out, timeseries_rows=run.rows, snapshots=run.snapshots or [], buffered=True)
+    return ResultsWriter.resume(
+        out, timeseries_rows=run.rows, snapshots=run.snapshots or [], compression=RESULTS_COMPRESSION, buffered=True
+    )
 
 
 def run_biaxial(
@@ -205,7 +212,7 @@ def run_biaxial(
                     f"--out: {out} already holds a run; use --resume to continue it or choose another folder"
                 )
             refuse_overwrite(out, OUTPUT_FILES, why="a biaxial run writes its own")
-            writer = ResultsWriter(out, kind="biaxial", buffered=True)  # HDF5 never writes the disk itself
+            writer = ResultsWriter(out, kind="biaxial", compression=RESULTS_COMPRESSION, buffered=True)  # HDF5 never writes the disk itself
             writer.write_config(config.to_dict())
             sim, run = _generate(config, threads, progress)
             elapsed_before = 0.0
