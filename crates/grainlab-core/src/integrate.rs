@@ -109,10 +109,14 @@ impl IntegrationTally {
     }
 }
 
-/// `sign(v)` with `sign(0) = 0`, without branches.
+/// `sign(v)` with `sign(0) = 0` (and 0 for NaN), without branches: the
+/// compiler selects among the three constants.
 #[inline(always)]
 fn signum0(v: f64) -> f64 {
-    ((v > 0.0) as i32 - (v < 0.0) as i32) as f64
+    // each mask keeps its constant or gives +0
+    let positive = f64::from_bits((v > 0.0) as u64 * 1.0f64.to_bits());
+    let negative = f64::from_bits((v < 0.0) as u64 * (-1.0f64).to_bits());
+    positive + negative
 }
 
 /// One kick of one degree of freedom with local damping; returns `(v_new, F_d)`.
