@@ -208,3 +208,19 @@ def test_every_snapshot_stores_the_platens(quick_run):
         initial_heights.append(height / (1.0 - info.axial_strain))  # H = H0 (1 - axial strain)
     assert len(initial_heights) >= 2
     assert np.allclose(initial_heights, initial_heights[0], rtol=1e-9)
+
+
+@pytest.mark.slow
+def test_snapshot_arrays_are_stored_compressed(quick_run):
+    # run.h5 keeps the snapshots small with HDF5's lossless gzip and byte shuffling
+    import h5py
+
+    with h5py.File(quick_run / "run.h5", "r") as f:
+        group = f["snapshots/strain_0.1000"]
+        stored = raw = 0
+        for name in ("positions", "radii", "contact_i", "contact_j", "normal_force", "shear_force"):
+            ds = group[name]
+            assert ds.compression == driver.RESULTS_COMPRESSION and ds.shuffle, name
+            stored += ds.id.get_storage_size()
+            raw += ds.size * ds.dtype.itemsize
+        assert stored < 0.8 * raw  # the pair indices and radii shrink most
