@@ -38,22 +38,9 @@ from grainlab.snapshot import Snapshot
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-import lammps_runner  # noqa: E402
+from throughput import PACKING, tiled_packing  # noqa: E402
 
-PACKING = HERE / "data" / "dense-4000-disks.xyr"
 STAGES = ("detection", "lambda", "Z + a")
-
-
-def tiled_packing(tiles: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Positions (N, 2), radii (N,) and the box of the packing tiled ``tiles`` x ``tiles``."""
-    side, disks = lammps_runner.read_xyr(PACKING)
-    disks = np.asarray(disks, dtype=float)
-    ox, oy = np.meshgrid(np.arange(tiles), np.arange(tiles), indexing="ij")
-    offsets = np.c_[ox.ravel(), oy.ravel()] * side
-    positions = (disks[None, :, :2] + offsets[:, None, :]).reshape(-1, 2)
-    radii = np.tile(disks[:, 2], tiles * tiles)
-    box = np.array([[0.0, tiles * side], [0.0, tiles * side]])
-    return positions, radii, box
 
 
 def one_run(positions, radii, box) -> tuple[dict[str, float], dict[str, object]]:

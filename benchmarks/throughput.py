@@ -39,18 +39,31 @@ STRAIN_RATE = 3.676e-3
 TIME_STEP = 1.36e-4
 
 
-def grainlab_run(threads: int, steps: int, warmup: int = 100) -> dict[str, float]:
+def tiled_packing(tiles: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions (N, 2), radii (N,) and the box ``[[xlo, xhi], [ylo, yhi]]`` of the
+    common packing tiled ``tiles`` x ``tiles`` times (1: the packing itself)."""
     side, disks = lammps_runner.read_xyr(PACKING)
     disks = np.asarray(disks, dtype=float)
+    ox, oy = np.meshgrid(np.arange(tiles), np.arange(tiles), indexing="ij")
+    offsets = np.c_[ox.ravel(), oy.ravel()] * side
+    positions = (disks[None, :, :2] + offsets[:, None, :]).reshape(-1, 2)
+    radii = np.tile(disks[:, 2], tiles * tiles)
+    box = np.array([[0.0, tiles * side], [0.0, tiles * side]])
+    return positions, radii, box
+
+
+def grainlab_run(threads: int, steps: int, warmup: int = 100, tiles: int = 1) -> dict[str, float]:
+    """``steps`` timed steps of the common case (tiled ``tiles`` x ``tiles``) after ``warmup`` untimed ones."""
+    positions, radii, box = tiled_packing(tiles)
     sim = grainlab.Simulation(
-        disks[:, :2],
-        disks[:, 2],
+        positions,
+        radii,
         2.0e8,
         contact_model=grainlab.ContactModel(8.45e7, 8.45e7, 0.9),
         time_step=TIME_STEP,
         threads=threads,
     )
-    sim.set_periodic_cell((0.0, 0.0), (side, side))
+    sim.set_periodic_cell(box[:, 0], box[:, 1] - box[:, 0])
     sim.run(warmup)
     z_start = sim.coordination_number
     sim.set_velocity_gradient([[-STRAIN_RATE, 0.0], [0.0, STRAIN_RATE]])
@@ -58,7 +71,7 @@ def grainlab_run(threads: int, steps: int, warmup: int = 100) -> dict[str, float
     sim.run(steps)
     elapsed = time.perf_counter() - start
     return {
-        "particle_steps_per_s": len(disks) * steps / elapsed,
+        "particle_steps_per_s": len(radii) * steps / elapsed,
         "seconds": elapsed,
         "z_start": z_start,
         "z_end": sim.coordination_number,

@@ -8,7 +8,8 @@ warm-up steps, then ``--steps`` timed steps (the same strain, so the same contac
 disk, at both sizes). Prints the particle-steps per second of every
 run, the medians, the large size's speed as a fraction of the small one's (a cache
 or memory-bandwidth wall shows as a fraction well below 1), and the resident memory
-the engine added per disk. The last line printed is one JSON object.
+the first run of the large size added per disk (the engine's state and the packing's
+arrays). The last line printed is one JSON object.
 
     python benchmarks/throughput_large.py                  # 2 threads, 3 repeats, 400 steps
     python benchmarks/throughput_large.py --threads 1 --repeat 5
@@ -21,15 +22,11 @@ import json
 import resource
 import statistics
 import sys
-import time
 from pathlib import Path
-
-import grainlab
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from analysis_large import tiled_packing  # noqa: E402
-from throughput import STRAIN_RATE, TIME_STEP  # noqa: E402
+from throughput import grainlab_run  # noqa: E402
 
 SIZES = {"100,000": 5, "1,024,000": 16}
 
@@ -37,32 +34,6 @@ SIZES = {"100,000": 5, "1,024,000": 16}
 def _rss_kib() -> int:
     """Peak resident memory of this process so far, KiB (Linux)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-
-
-def tiled_run(tiles: int, threads: int, steps: int, warmup: int = 100) -> dict[str, float]:
-    """Particle-steps per second of ``steps`` timed steps of the tiled case."""
-    positions, radii, box = tiled_packing(tiles)
-    before = _rss_kib()
-    sim = grainlab.Simulation(
-        positions,
-        radii,
-        2.0e8,
-        contact_model=grainlab.ContactModel(8.45e7, 8.45e7, 0.9),
-        time_step=TIME_STEP,
-        threads=threads,
-    )
-    sim.set_periodic_cell((box[0, 0], box[1, 0]), (box[0, 1] - box[0, 0], box[1, 1] - box[1, 0]))
-    sim.run(warmup)
-    sim.set_velocity_gradient([[-STRAIN_RATE, 0.0], [0.0, STRAIN_RATE]])
-    start = time.perf_counter()
-    sim.run(steps)
-    elapsed = time.perf_counter() - start
-    grown = max(_rss_kib() - before, 0) * 1024.0
-    return {
-        "particle_steps_per_s": len(radii) * steps / elapsed,
-        "bytes_per_disk": grown / len(radii),
-        "coordination_number": sim.coordination_number,
-    }
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -77,16 +48,18 @@ def main(argv: list[str] | None = None) -> int:
     speeds: dict[str, list[float]] = {name: [] for name in SIZES}
     memory: dict[str, float] = {}
     print(f"tiled common case, {args.threads} thread(s), {args.repeat} repetitions")
-    # the large size first: its peak resident memory is then the engine's own growth
+    # the large size first: the growth of the peak resident memory is then its run's
     order = sorted(SIZES, key=lambda name: -SIZES[name])
     for rep in range(args.repeat):
         for name in order:
-            r = tiled_run(SIZES[name], args.threads, args.steps)
+            before = _rss_kib()
+            r = grainlab_run(args.threads, args.steps, tiles=SIZES[name])
             speeds[name].append(r["particle_steps_per_s"])
-            memory.setdefault(name, r["bytes_per_disk"])
+            n_disks = int(name.replace(",", ""))
+            memory.setdefault(name, max(_rss_kib() - before, 0) * 1024.0 / n_disks)
             print(
                 f"run {rep + 1}: {name} disks, {args.steps} steps: {r['particle_steps_per_s']:.3e} particle-steps/s "
-                f"(Z {r['coordination_number']:.2f})",
+                f"(Z {r['z_end']:.2f})",
                 flush=True,
             )
     medians = {name: statistics.median(v) for name, v in speeds.items()}
