@@ -125,8 +125,7 @@ impl MaterialTable {
     /// dashpot terms (same results, fewer instructions).
     pub fn single_undamped_model(&self) -> Option<ContactModel> {
         let first = *self.models.first()?;
-        let undamped = first.normal_damping_ratio == 0.0 && first.shear_damping_ratio == 0.0;
-        (undamped && self.models.iter().all(|m| *m == first)).then_some(first)
+        (self.undamped() && self.models.iter().all(|m| *m == first)).then_some(first)
     }
 
     /// Whether no model of the table has a dashpot.

@@ -16,8 +16,6 @@
 //! particles in block `b` are stored contiguously (`block_start[b]..block_start[b+1]`)
 //! and may be evaluated concurrently with other blocks; pairs across blocks
 //! come last. Shear history is carried over from the previous list by pair key.
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
 
 use serde::{Deserialize, Serialize};
 
@@ -639,51 +637,6 @@ fn counting_sort(bins: &[u32], n_bins: usize) -> (Vec<usize>, Vec<u32>) {
 
 /// A map keyed by particle indices, for the history carry-over of a rebuild:
 /// only inserted into and looked up (never iterated), so its hash function
-/// cannot change a result, and a multiplicative one is much cheaper than the
-/// default (which resists adversarial keys, which indices are not).
-type PairMap<K, V> = HashMap<K, V, BuildHasherDefault<IndexHasher>>;
-
-/// Multiply-rotate hashing of the integers of a key.
-#[derive(Default)]
-struct IndexHasher(u64);
-
-impl IndexHasher {
-    #[inline(always)]
-    fn mix(&mut self, x: u64) {
-        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x517c_c1b7_2722_0a95);
-    }
-}
-
-impl Hasher for IndexHasher {
-    #[inline]
-    fn finish(&self) -> u64 {
-        self.0
-    }
-
-    #[inline]
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.mix(u64::from(b));
-        }
-    }
-
-    #[inline]
-    fn write_u8(&mut self, x: u8) {
-        self.mix(u64::from(x));
-    }
-
-    #[inline]
-    fn write_u32(&mut self, x: u32) {
-        self.mix(u64::from(x));
-    }
-
-    #[inline]
-    fn write_u64(&mut self, x: u64) {
-        self.mix(x);
-    }
-
-    #[inline]
-    fn write_usize(&mut self, x: usize) {
-        self.mix(x as u64);
-    }
-}
+/// cannot change a result, and rustc-hash's multiplicative one is much cheaper
+/// than the default (which resists adversarial keys, which indices are not).
+type PairMap<K, V> = rustc_hash::FxHashMap<K, V>;
