@@ -139,12 +139,12 @@ def run_dir(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="module")
 def drawn(run_dir, tmp_path_factory):
-    """fabric_figures on the synthetic run (default peak), with the maps recorded."""
+    """fabric_figures on the synthetic run (default peak), drawn in this process with the maps recorded."""
     out = tmp_path_factory.mktemp("figures")
     spy = _MapSpy()
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(plot, "particle_map", spy)
-        figures = fabric_figures(run_dir, out)
+        figures = fabric_figures(run_dir, out, workers=0)
     return figures, out, spy
 
 
@@ -235,7 +235,7 @@ def test_maps_draw_membrane_disks_grey_and_outline_the_band(drawn, run_dir):
 def test_a_band_that_is_not_there_is_not_outlined(run_dir, tmp_path, monkeypatch):
     spy = _MapSpy()
     monkeypatch.setattr(plot, "particle_map", spy)
-    figures = fabric_figures(run_dir, tmp_path, peak_snapshot="strain_0.0050")
+    figures = fabric_figures(run_dir, tmp_path, peak_snapshot="strain_0.0050", workers=0)
     n = figures.numbers
     assert n.band is not None and not n.band.found
     assert n.band.reason and np.isnan(n.band.angle_deg) and np.isnan(n.band_angle_deg)

@@ -21,8 +21,10 @@ from __future__ import annotations
 
 import base64
 import contextlib
+import hashlib
 import io
 import re
+from collections import OrderedDict
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -41,6 +43,8 @@ from grainlab._notebook import new_figure, prepare_notebook
 if TYPE_CHECKING:
     from matplotlib.typing import RcKeyType  # matplotlib >= 3.9 (typing only)
 
+    from grainlab.plot.workers import FigureTask
+
 __all__ = [
     "FIGURE_DPI",
     "PAPER_STYLE",
@@ -50,6 +54,7 @@ __all__ = [
     "mean_lambda_series",
     "new_axes",
     "outline_shear_band",
+    "page_png",
     "paper_style",
     "particle_map",
     "polar_distribution",
@@ -58,6 +63,8 @@ __all__ = [
 
 #: Resolution of the figure files (PNG, and the raster particle maps inside SVGs), dots per inch.
 FIGURE_DPI = 200
+#: Resolution of a figure file's copy embedded in a page (report.html shows figures at 1.3 x 96 pixels per inch).
+PAGE_DPI = 150
 
 #: rcParams for paper figures: serif text, small sizes, thin lines, no clutter.
 PAPER_STYLE: dict[RcKeyType, Any] = {
@@ -157,6 +164,36 @@ def _nearest_palette_image(rgb: NDArray[np.uint8], entries: NDArray[np.uint8]) -
     return image
 
 
+#: Page copies of the latest figure files (:func:`page_png`), by the digest of the file's PNG.
+_PAGE_COPIES_KEPT = 32
+_page_copies: OrderedDict[bytes, bytes] = OrderedDict()
+
+
+def _png_digest(png: bytes) -> bytes:
+    return hashlib.blake2b(png, digest_size=24).digest()
+
+
+def _keep_page_png(digest: bytes, page: bytes) -> None:
+    """Keeps ``page``, the page copy of the PNG with ``digest`` (:func:`_png_digest`),
+    made here or in a worker process (:mod:`grainlab.plot.workers`)."""
+    _page_copies[digest] = page
+    _page_copies.move_to_end(digest)
+    while len(_page_copies) > _PAGE_COPIES_KEPT:
+        _page_copies.popitem(last=False)
+
+
+def page_png(png: bytes) -> bytes:
+    """A figure file's PNG as a page embeds it: at most :data:`PAGE_DPI`, its palette
+    kept (:func:`compact_png`). The copies of the latest figure files are kept, so
+    that a report written after the figures does not make them again."""
+    key = _png_digest(png)
+    page = _page_copies.get(key)
+    if page is None:
+        page = compact_png(png, dpi=PAGE_DPI)
+        _keep_page_png(key, page)
+    return page
+
+
 def scale_colors(fig: Figure, budget: int = 128) -> NDArray[np.uint8]:
     """(k, 3) RGB steps of the colour maps in ``fig`` (at most ``budget`` in
     all, shared between the maps; a map with fewer steps gives all of them):
@@ -209,7 +246,10 @@ def save_figure(
             kind = fmt.lstrip(".")
             out = base.with_suffix("." + kind)
             buffer = io.BytesIO()
-            fig.savefig(buffer, format=kind)
+            if kind == "png":  # re-encoded below: stored uncompressed here, the pixels are the same
+                fig.savefig(buffer, format=kind, pil_kwargs={"compress_level": 0})
+            else:
+                fig.savefig(buffer, format=kind)
             data = buffer.getvalue()
             if kind == "png":
                 data = compact_png(data, keep=scale_colors(fig))
@@ -467,25 +507,48 @@ def strain_series(
     return ax
 
 
-def biaxial_curves(timeseries: dict[str, Any], out_dir: str | Path) -> list[Path]:
-    """The macro curves of a biaxial test, PNG and SVG, into ``out_dir``:
-    ``stress_ratio`` (Fig. 8), ``volumetric_strain`` (Fig. 10) and
-    ``coordination_number`` (Fig. 18) against axial strain."""
-    out = Path(out_dir)
-    eps = timeseries["axial_strain"]
-    written: list[Path] = []
+def _strain_figure(
+    axial_strain: ArrayLike, values: ArrayLike, ylabel: str, percent: bool, reference: float | None
+) -> Figure:
+    """One of :func:`biaxial_curves`' figures: :func:`strain_series` on a new paper-style figure."""
+    with paper_style():
+        fig = Figure(figsize=(3.5, 3.0), layout="constrained")
+        ax = fig.add_subplot()
+    strain_series(axial_strain, values, ylabel, percent=percent, reference=reference, ax=ax)
+    return fig
+
+
+def curve_tasks(timeseries: dict[str, Any]) -> list[FigureTask]:
+    """The figures of :func:`biaxial_curves` as tasks for a :class:`~grainlab.plot.workers.FigurePool`."""
+    from grainlab.plot.workers import FigureTask
+
+    eps = np.asarray(timeseries["axial_strain"], dtype=np.float64)
     figures = (
-        ("fig08_stress_ratio", timeseries["stress_ratio"], r"stress ratio $\sigma_1/\sigma_3$", False, 1.0),
+        ("fig08_stress_ratio", "stress_ratio", r"stress ratio $\sigma_1/\sigma_3$", False, 1.0),
         (
             "fig10_volumetric_strain",
-            timeseries["volumetric_strain"],
+            "volumetric_strain",
             r"volumetric strain $\varepsilon_v$ (%, compression positive)",
             True,
             0.0,
         ),
-        ("fig18_coordination_number", timeseries["coordination_number"], "coordination number $Z$", False, None),
+        ("fig18_coordination_number", "coordination_number", "coordination number $Z$", False, None),
     )
-    for name, values, label, percent, reference in figures:
-        ax = strain_series(eps, values, label, percent=percent, reference=reference)
-        written += save_figure(ax, out / name)
-    return written
+    return [
+        FigureTask(name, _strain_figure, (eps, np.asarray(timeseries[column], dtype=np.float64), label, percent, ref))
+        for name, column, label, percent, ref in figures
+    ]
+
+
+def biaxial_curves(timeseries: dict[str, Any], out_dir: str | Path, *, workers: int | None = None) -> list[Path]:
+    """The macro curves of a biaxial test, PNG and SVG, into ``out_dir``:
+    ``stress_ratio`` (Fig. 8), ``volumetric_strain`` (Fig. 10) and
+    ``coordination_number`` (Fig. 18) against axial strain, drawn side by side
+    in up to ``workers`` processes (0: here), or in the pool of an enclosing
+    ``with FigurePool()`` block (:mod:`grainlab.plot.workers`)."""
+    from grainlab.plot.workers import figure_pool
+
+    tasks = curve_tasks(timeseries)
+    with figure_pool(workers, tasks=len(tasks)) as pool:
+        files = pool.draw(tasks, out_dir).result()
+    return [path for paths in files.values() for path in paths]

@@ -26,7 +26,9 @@ __all__ = [
     "BandOutline",
     "MapPanel",
     "PolarPanel",
+    "anisotropy_figure",
     "displacement_figure",
+    "mean_lambda_figure",
     "polar_figure",
     "series_figure",
     "shared_map_figure",
@@ -216,3 +218,32 @@ def series_figure(
         ax.legend(frameon=False)
         ax.set_xlim(left=min(0.0, 100 * float(np.nanmin(eps))))
     return fig
+
+
+def anisotropy_figure(
+    axial_strain: NDArray[np.float64],
+    anisotropy: NDArray[np.float64],
+    force_anisotropy: NDArray[np.float64],
+    peak_axial_strain: float,
+) -> Figure:
+    """Fig. 9: a and a_n against axial strain (:func:`grainlab.plot.anisotropy_series`), the peak marked."""
+
+    def draw(ax: Any) -> Any:
+        return plot.anisotropy_series(axial_strain, anisotropy, normal_force=force_anisotropy, ax=ax)
+
+    return series_figure(axial_strain, draw, peak_axial_strain)
+
+
+def mean_lambda_figure(
+    axial_strain: NDArray[np.float64],
+    mean_lambda: NDArray[np.float64],
+    mean_lambda_all: NDArray[np.float64] | None,
+    peak_axial_strain: float,
+) -> Figure:
+    """Fig. 14: mean lambda (and over every grain, when given) against axial strain
+    (:func:`grainlab.plot.mean_lambda_series`), the peak marked."""
+
+    def draw(ax: Any) -> Any:
+        return plot.mean_lambda_series(axial_strain, mean_lambda, mean_lambda_all=mean_lambda_all, ax=ax)
+
+    return series_figure(axial_strain, draw, peak_axial_strain)

@@ -33,9 +33,13 @@ grains with at least 2 contacts (the paper's 0.34 vs 0.31).
 
 from __future__ import annotations
 
+import hashlib
 import math
-from dataclasses import dataclass
-from typing import Any
+from collections import OrderedDict
+from collections.abc import Mapping, Sequence
+from concurrent.futures import Future
+from dataclasses import dataclass, fields, replace
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -47,7 +51,20 @@ from grainlab.analysis.stability import StabilityIndex
 from grainlab.analysis.strain import LocalStrain
 from grainlab.snapshot import Snapshot
 
-__all__ = ["BandNumbers", "BandSearch", "band_labels", "find_band", "interior_grains", "slab_members"]
+if TYPE_CHECKING:
+    from grainlab.io.hdf5 import Results
+    from grainlab.plot.workers import FigurePool
+
+__all__ = [
+    "BandNumbers",
+    "BandSearch",
+    "band_labels",
+    "find_band",
+    "interior_grains",
+    "keep_searches",
+    "search_ahead",
+    "slab_members",
+]
 
 #: Band acceptance: minimum thickness (mean diameters), crossing fractions, permutations.
 MIN_THICKNESS_D = 1.0
@@ -169,6 +186,46 @@ def _eta2(
     return 1.0 - (1.0 - between / total) * (m - 1) / max(m - n_bins, 1)
 
 
+#: Searches kept by :func:`find_band` (the latest ones), by the digest of what they read.
+_SEARCHES_KEPT = 16
+_searches: OrderedDict[bytes, BandSearch] = OrderedDict()
+
+
+def _feed(digest: Any, value: Any) -> None:
+    if isinstance(value, np.ndarray) and not value.dtype.hasobject:
+        digest.update(f"{value.dtype.str}{value.shape}".encode())
+        digest.update(np.ascontiguousarray(value).view(np.uint8).reshape(-1).data)
+    elif isinstance(value, np.ndarray):
+        _feed(digest, value.tolist())
+    elif isinstance(value, Mapping):
+        digest.update(b"{")
+        for key in sorted(value, key=repr):
+            _feed(digest, key)
+            _feed(digest, value[key])
+        digest.update(b"}")
+    elif isinstance(value, tuple | list):
+        digest.update(b"(")
+        for item in value:
+            _feed(digest, item)
+        digest.update(b")")
+    else:
+        digest.update(f"{type(value).__name__}:{value!r}".encode())
+    digest.update(b"|")
+
+
+def _search_key(reference: Snapshot, current: Snapshot, stability: StabilityIndex) -> bytes:
+    """A digest of everything a band search reads: both snapshots' data (every field,
+    not their caches) and the stability index's per-particle values."""
+    digest = hashlib.blake2b(digest_size=24)
+    for snap in (reference, current):
+        for f in fields(snap):
+            if not f.name.startswith("_"):
+                _feed(digest, getattr(snap, f.name))
+    _feed(digest, np.asarray(stability.stability_index))
+    _feed(digest, np.asarray(stability.n_contacts))
+    return digest.digest()
+
+
 def find_band(
     reference: Snapshot,
     current: Snapshot,
@@ -183,7 +240,68 @@ def find_band(
     ``stability`` is ``current``'s computed :class:`StabilityIndex` (for the
     means in and out of the band); ``name``, ``reference_name`` and
     ``axial_strain`` label the :class:`BandNumbers`.
+
+    The search (twenty band fits: the band and its permutation test) is kept
+    for the latest few pairs of snapshots: the same snapshots searched again,
+    read again from the file or not (the figures' and the claims' searches of
+    one run), give the kept result, labelled anew, without a second search.
     """
+    key = _search_key(reference, current, stability)
+    found = _searches.get(key)
+    if found is None:
+        found = _search(reference, current, stability)
+    _keep(key, found)
+    numbers = replace(found.numbers, snapshot=name, reference=reference_name, axial_strain=axial_strain)
+    return BandSearch(numbers, found.band, found.displacement.copy(), found.second)
+
+
+def _keep(key: bytes, found: BandSearch) -> None:
+    _searches[key] = found
+    _searches.move_to_end(key)
+    while len(_searches) > _SEARCHES_KEPT:
+        _searches.popitem(last=False)
+
+
+def _pair(results: Results, reference: str, current: str) -> tuple[Snapshot, Snapshot, StabilityIndex]:
+    ref, cur = results.snapshot(reference), results.snapshot(current)
+    return ref, cur, StabilityIndex().compute(cur)
+
+
+def _search_in_file(path: str, reference: str, current: str) -> tuple[bytes, BandSearch]:
+    """A worker's search of two snapshots of ``run.h5`` at ``path`` (the stability
+    index of :func:`band_labels`), with the digest :func:`find_band` keeps it by."""
+    from grainlab.io.hdf5 import read_results
+
+    ref, cur, stability = _pair(read_results(path), reference, current)
+    return _search_key(ref, cur, stability), _search(ref, cur, stability)
+
+
+def search_ahead(results: Results, pairs: Sequence[tuple[str, str]], pool: FigurePool) -> list[Future[Any]]:
+    """Starts in ``pool`` the band searches of :func:`band_labels` for the snapshot
+    pairs ``(reference, current)`` of ``results`` that :func:`find_band` does not
+    keep yet (at most as many as it keeps); :func:`keep_searches` waits for them
+    and keeps them, so that the searches made next find them done."""
+    todo = []
+    for reference, current in pairs[:_SEARCHES_KEPT]:
+        if _search_key(*_pair(results, reference, current)) not in _searches:
+            todo.append(pool.submit(_search_in_file, str(results.path), reference, current))
+    return todo
+
+
+def keep_searches(started: Sequence[Future[Any]]) -> None:
+    """Waits for the searches of :func:`search_ahead` and keeps them for :func:`find_band`.
+    One that failed is left out: the search made next does it again and reports its error."""
+    for future in started:
+        try:
+            key, found = future.result()
+        except Exception:  # noqa: S112, PERF203 - redone (and its error raised) by the search itself
+            continue
+        _keep(key, found)
+
+
+def _search(reference: Snapshot, current: Snapshot, stability: StabilityIndex) -> BandSearch:
+    """:func:`find_band`'s search, its numbers unlabelled (no snapshot names, NaN strain)."""
+    name, reference_name, axial_strain = "", "", math.nan
     snap = current
     g = snap.is_sample
     grains = grains_only(snap)

@@ -1,7 +1,9 @@
 """The paper's Figs. 6, 7, 9, 11, 12, 13 and 14 of a biaxial run, as PNG + SVG files.
 
 :func:`fabric_figures` measures the run (:func:`~grainlab.postprocess.biaxial.analyse_run`),
-turns its states into panels and draws them with :mod:`grainlab.plot.biaxial`.
+turns its states into panels and draws them with :mod:`grainlab.plot.biaxial`,
+side by side in worker processes (:class:`~grainlab.plot.workers.FigurePool`:
+the same files as drawn one after the other).
 Maps draw the membrane disks light grey (NaN); a found band is outlined
 dashed (its second, conjugate band dotted) and the panel title gives its
 inclination to the horizontal and thickness; a band that was searched and
@@ -17,24 +19,24 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
-from grainlab import plot
 from grainlab.plot.biaxial import (
     COUNT_CAP,
     BandOutline,
     MapPanel,
     PolarPanel,
+    anisotropy_figure,
     displacement_figure,
+    mean_lambda_figure,
     polar_figure,
-    series_figure,
     shared_map_figure,
 )
+from grainlab.plot.workers import FigureTask, figure_pool
 from grainlab.postprocess.band import BandSearch
 from grainlab.postprocess.biaxial import FabricNumbers, RunAnalysis, RunState, analyse_run
 
-__all__ = ["FIGURES", "FabricFigures", "fabric_figures"]
+__all__ = ["FIGURES", "FabricFigures", "fabric_figures", "figure_tasks"]
 
 #: Figure names (file stems), in the paper's order.
 FIGURES: tuple[str, ...] = (
@@ -110,21 +112,21 @@ def _panel(analysis: RunAnalysis, k: int, st: RunState, values: NDArray[np.float
     return MapPanel(st.snap.positions, st.snap.radii, values, _title(k, st), note, outlines)
 
 
-def _displacements(analysis: RunAnalysis) -> Figure | None:
+def _displacements(analysis: RunAnalysis) -> FigureTask | None:
     states = _distinct([analysis.states["peak"], analysis.states["final"]])
     searched = [(st, b) for st in states if (b := analysis.band_of(st)) is not None]
     if not searched:
         return None
     panels = [_panel(analysis, k, st, b.displacement) for k, (st, b) in enumerate(searched)]
-    return displacement_figure(panels, analysis.states["initial"].name)
+    return FigureTask("fig11_displacement", displacement_figure, (panels, analysis.states["initial"].name), cost=3.0)
 
 
-def _maps(analysis: RunAnalysis, values: Any, **style: Any) -> Figure:
+def _maps(name: str, analysis: RunAnalysis, values: Any, **style: Any) -> FigureTask:
     states = _distinct([analysis.states[r] for r in ("initial", "peak", "final")])
     panels = [
         _panel(analysis, k, st, np.asarray(values(st), dtype=np.float64)) for k, st in enumerate(states)
     ]
-    return shared_map_figure(panels, **style)
+    return FigureTask(name, shared_map_figure, (panels,), style, cost=4.0)
 
 
 def _contact_counts(st: RunState) -> NDArray[np.float64]:
@@ -132,18 +134,51 @@ def _contact_counts(st: RunState) -> NDArray[np.float64]:
     return np.where(st.snap.is_sample, counts, np.nan)
 
 
-def _series(analysis: RunAnalysis, which: str) -> Figure:
+def _series(analysis: RunAnalysis, which: str) -> FigureTask:
     ts = analysis.results.timeseries
-    eps = ts["axial_strain"]
+    eps, peak = ts["axial_strain"], analysis.numbers.peak_axial_strain
+    if which == "anisotropy":
+        return FigureTask("fig09_anisotropy", anisotropy_figure, (eps, ts["anisotropy"], ts["force_anisotropy"], peak))
+    return FigureTask(
+        "fig14_mean_stability_index",
+        mean_lambda_figure,
+        (eps, ts["mean_stability_index"], ts.get("mean_stability_index_all"), peak),
+    )
 
-    def draw(ax: Any) -> Any:
-        if which == "anisotropy":
-            return plot.anisotropy_series(eps, ts["anisotropy"], normal_force=ts["force_anisotropy"], ax=ax)
-        return plot.mean_lambda_series(
-            eps, ts["mean_stability_index"], mean_lambda_all=ts.get("mean_stability_index_all"), ax=ax
-        )
 
-    return series_figure(eps, draw, analysis.numbers.peak_axial_strain)
+def figure_tasks(analysis: RunAnalysis) -> list[FigureTask]:
+    """The figures of :func:`fabric_figures` for the measured run, in the paper's order
+    (``fig11_displacement`` only with a band searched), each with its drawing cost."""
+    states = analysis.states
+    polar_states = _distinct([states["initial"], states["peak"]])
+    polar = [PolarPanel(_title(k, st), st.normals) for k, st in enumerate(polar_states)]
+    polar_forces = [PolarPanel(_title(k, st), st.forces) for k, st in enumerate(polar_states)]
+    tasks = [
+        FigureTask("fig06_contact_normals", polar_figure, (polar, False), cost=2.0),
+        FigureTask("fig07_normal_forces", polar_figure, (polar_forces, True), cost=2.5),
+        _series(analysis, "anisotropy"),
+        _displacements(analysis),
+        _maps(
+            "fig12_stability_index",
+            analysis,
+            lambda st: st.stability.stability_index,
+            label=r"geometrical stability index $\lambda$",
+            suptitle=r"Geometrical stability index $\lambda$ of the grains",
+            vmin=0.0,
+            vmax=1.0,
+        ),
+        _maps(
+            "fig13_contact_count",
+            analysis,
+            _contact_counts,
+            label="number of contacts",
+            discrete=True,
+            suptitle="Number of contacts per grain (boundary contacts included)",
+            vmin=0.0,
+        ),
+        _series(analysis, "lambda"),
+    ]
+    return [task for task in tasks if task is not None]
 
 
 def fabric_figures(
@@ -151,6 +186,7 @@ def fabric_figures(
     out_dir: str | Path | None = None,
     *,
     peak_snapshot: str | int | None = None,
+    workers: int | None = None,
 ) -> FabricFigures:
     """Draw the paper's Figs. 6, 7, 9, 11, 12, 13, 14 of a biaxial run, PNG + SVG.
 
@@ -164,6 +200,10 @@ def fabric_figures(
         The snapshot standing for the peak state, by name or position;
         default the snapshot (other than the first) closest in axial strain
         to the peak of ``stress_ratio``.
+    workers
+        The most worker processes drawing the figures side by side (0: all
+        in this process); inside a ``with FigurePool()`` block they are drawn
+        in that pool instead (:mod:`grainlab.plot.workers`).
 
     Returns
     -------
@@ -182,37 +222,7 @@ def fabric_figures(
     """
     analysis = analyse_run(run_dir, peak_snapshot)
     out = Path(out_dir) if out_dir is not None else analysis.results.path.parent
-    out.mkdir(parents=True, exist_ok=True)
-    states = analysis.states
-    polar = [PolarPanel(_title(k, st), st.normals) for k, st in enumerate(_distinct([states["initial"], states["peak"]]))]
-    polar_forces = [
-        PolarPanel(_title(k, st), st.forces) for k, st in enumerate(_distinct([states["initial"], states["peak"]]))
-    ]
-    drawn: dict[str, Figure | None] = {
-        "fig06_contact_normals": polar_figure(polar, forces=False),
-        "fig07_normal_forces": polar_figure(polar_forces, forces=True),
-        "fig09_anisotropy": _series(analysis, "anisotropy"),
-        "fig11_displacement": _displacements(analysis),
-        "fig12_stability_index": _maps(
-            analysis,
-            lambda st: st.stability.stability_index,
-            label=r"geometrical stability index $\lambda$",
-            suptitle=r"Geometrical stability index $\lambda$ of the grains",
-            vmin=0.0,
-            vmax=1.0,
-        ),
-        "fig13_contact_count": _maps(
-            analysis,
-            _contact_counts,
-            label="number of contacts",
-            discrete=True,
-            suptitle="Number of contacts per grain (boundary contacts included)",
-            vmin=0.0,
-        ),
-        "fig14_mean_stability_index": _series(analysis, "lambda"),
-    }
-    files: dict[str, list[Path]] = {}
-    for name, fig in drawn.items():
-        if fig is not None:
-            files[name] = plot.save_figure(fig, out / name)
-    return FabricFigures(files, analysis.numbers)
+    tasks = figure_tasks(analysis)
+    with figure_pool(workers, tasks=len(tasks)) as pool:
+        drawn = pool.draw(tasks, out).result()
+    return FabricFigures(drawn, analysis.numbers)

@@ -484,11 +484,35 @@ def gather_biaxial(
     shear-band numbers are ``summary.json``'s (those the figures show) unless
     the fabric figures are drawn here, in which case they are the new ones.
     """
-    from grainlab.plot import biaxial_curves
-    from grainlab.postprocess import FIGURES, fabric_figures, fabric_numbers
+    from grainlab.plot.workers import FigurePool
+    from grainlab.postprocess.band import keep_searches, search_ahead
 
     folder = Path(folder)
     results = check_biaxial_folder(folder)
+    # the claims' band searches (the slow part of the report) run in worker processes
+    # while the figures and the report's own numbers are made here
+    with FigurePool(tasks=len(results.snapshot_names)) as pool:
+        started = search_ahead(results, _claim_pairs(results), pool)
+        report = _gather(folder, results, redraw, dilation_window)
+        keep_searches(started)
+    report.claim_rows = _claim_rows(folder, report.notes)
+    return report
+
+
+def _claim_pairs(results: Results) -> list[tuple[str, str]]:
+    """The snapshot pairs whose bands the claims measure (:func:`grainlab.reproduction.measures.measure_biaxial`):
+    each snapshot against the first, in the order of their axial strains."""
+    infos = list(results.snapshots)
+    strains = [math.nan if info.axial_strain is None else float(info.axial_strain) for info in infos]
+    order = sorted(range(len(infos)), key=lambda k: strains[k])
+    return [(infos[order[0]].name, infos[k].name) for k in order[1:]]
+
+
+def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float) -> BiaxialReport:
+    """:func:`gather_biaxial` but the claims."""
+    from grainlab.plot import biaxial_curves
+    from grainlab.postprocess import FIGURES, fabric_figures, fabric_numbers
+
     ts = results.timeseries
     summary = dict(results.summary)
     saved = _read_summary_json(folder)
@@ -594,7 +618,6 @@ def gather_biaxial(
         notes=notes + [f"fabric figures: {n}" for n in (fabric or {}).get("notes", [])],
     )
     report.paper_rows = _paper_rows(report)
-    report.claim_rows = _claim_rows(folder, report.notes)
     return report
 
 

@@ -24,23 +24,24 @@ from grainlab.samples.grading import Grading
 
 __all__ = ["DPI", "embedded_png", "grading_figure", "macro_figure", "png_bytes"]
 
-#: Resolution of the report's own figures.
-DPI = 150
+#: Resolution of the report's own figures, and of the figure files' copies it embeds.
+DPI = plot.PAGE_DPI
 
 
 def png_bytes(fig: Figure) -> bytes:
     """The figure as compact PNG bytes (paper style, tight bounding box, :data:`DPI`,
     a 256-colour palette: :func:`grainlab.plot.compact_png`)."""
     buffer = io.BytesIO()
-    with plot.paper_style():
-        fig.savefig(buffer, format="png", dpi=DPI)
+    with plot.paper_style():  # stored uncompressed here: re-encoded below, the pixels are the same
+        fig.savefig(buffer, format="png", dpi=DPI, pil_kwargs={"compress_level": 0})
     return plot.compact_png(buffer.getvalue(), keep=plot.scale_colors(fig))
 
 
 def embedded_png(png: bytes) -> bytes:
     """A figure file's PNG as the page embeds it: at most :data:`DPI` (the page
-    shows figures at 1.3 x 96 pixels per inch), palette kept (:func:`grainlab.plot.compact_png`)."""
-    return plot.compact_png(png, dpi=DPI)
+    shows figures at 1.3 x 96 pixels per inch), palette kept (:func:`grainlab.plot.page_png`:
+    the copy made when the figure was drawn, if it was drawn by this process's figure pool)."""
+    return plot.page_png(png)
 
 
 def _cumulative(d: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -90,26 +90,33 @@ def _csv(timeseries: dict[str, np.ndarray]) -> str:
     return buffer.getvalue()
 
 
-def _figures(timeseries: dict[str, np.ndarray], out: Path) -> list[Path]:
-    from grainlab.plot import biaxial_curves
+def _figures(timeseries: dict[str, np.ndarray], out: Path) -> None:
+    """Starts the macro curves (Figs. 8, 10, 18) in the current figure pool: they are
+    drawn while the snapshots are measured, and finished when the pool closes."""
+    from grainlab.plot import curve_tasks
+    from grainlab.plot.workers import figure_pool
 
-    return biaxial_curves(timeseries, out)
+    with figure_pool(tasks=3) as pool:
+        pool.draw(curve_tasks(timeseries), out)
 
 
 def _write_outputs(out: Path) -> dict[str, Any]:
     """``timeseries.csv``, the figures and ``summary.json``, all from the finished
-    ``run.h5``: a run stopped while they were written finishes them with ``--resume``."""
+    ``run.h5``: a run stopped while they were written finishes them with ``--resume``.
+    The figures are drawn side by side in worker processes, with their copies
+    for the report (:class:`~grainlab.plot.workers.FigurePool`)."""
     from grainlab.io.hdf5 import read_results
-    from grainlab.postprocess.figures import fabric_figures
+    from grainlab.plot.workers import FigurePool
+    from grainlab.postprocess import figures
 
     results = read_results(out / RESULTS_FILE)
     raise_if_interrupted()  # a Ctrl-C that h5py's clean-up swallowed stops the run here
     summary = dict(results.summary)
     write_text_atomic(out / "timeseries.csv", _csv(results.timeseries))
-    _figures(results.timeseries, out)
-    raise_if_interrupted()
-    # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
-    summary["fabric"] = fabric_figures(out).numbers.summary()
+    with FigurePool(tasks=3 + len(figures.FIGURES), page_copies=True):
+        _figures(results.timeseries, out)
+        # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
+        summary["fabric"] = figures.fabric_figures(out).numbers.summary()
     raise_if_interrupted()
     write_json_atomic(out / "summary.json", summary)
     return summary
