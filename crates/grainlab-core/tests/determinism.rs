@@ -84,15 +84,7 @@ fn full_fingerprint(sim: &mut Simulation) -> Vec<u64> {
             .iter()
             .flat_map(|f| f.map(f64::to_bits)),
     );
-    let c = sim.contacts().unwrap();
-    bits.extend(c.i.iter().chain(&c.j).map(|&k| k as u64));
-    bits.extend(
-        c.normal_force
-            .iter()
-            .chain(&c.shear_force)
-            .map(|f| f.to_bits()),
-    );
-    bits.extend(c.sliding.iter().map(|&s| s as u64));
+    bits.extend(contact_list_bits(sim));
     let w = sim.wall_contacts().unwrap();
     bits.extend(w.particle.iter().map(|&k| k as u64));
     bits.extend(

@@ -121,7 +121,9 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
 }
 
 /// `build` run `steps` steps (in blocks of `block`, each call's last step
-/// measured) on 1 and 2 threads: both must give `expected`.
+/// measured) on 1 and 2 threads, with undamped pairs four at a time (where the
+/// processor can) and one at a time: every run must give `expected`, and the
+/// contact lists of both loops must be the same bits.
 fn check(
     name: &str,
     build: impl Fn(usize) -> Simulation,
@@ -131,20 +133,30 @@ fn check(
 ) -> Simulation {
     let mut last = None;
     for threads in [1, 2] {
-        let mut sim = build(threads);
-        let mut done = 0;
-        while done < steps {
-            let n = block.min(steps - done);
-            sim.run(n).unwrap();
-            done += n;
+        let mut lists = Vec::new();
+        for vector in [true, false] {
+            let mut sim = build(threads);
+            let used = sim.set_vector_pairs(vector);
+            let mut done = 0;
+            while done < steps {
+                let n = block.min(steps - done);
+                sim.run(n).unwrap();
+                done += n;
+            }
+            assert!(sim.neighbors().build_count > 1, "{name}: no rebuild");
+            let got = trajectory_hash(&sim);
+            assert!(
+                got == expected,
+                "{name}, {threads} thread(s), four pairs at a time {used}: trajectory hash \
+                 {got:#018x}, recorded {expected:#018x}"
+            );
+            lists.push(contact_list_bits(&mut sim));
+            last = Some(sim);
         }
-        assert!(sim.neighbors().build_count > 1, "{name}: no rebuild");
-        let got = trajectory_hash(&sim);
         assert!(
-            got == expected,
-            "{name}, {threads} thread(s): trajectory hash {got:#018x}, recorded {expected:#018x}"
+            lists[0] == lists[1],
+            "{name}: the contact lists of the two loops differ"
         );
-        last = Some(sim);
     }
     last.unwrap()
 }
@@ -308,4 +320,47 @@ fn sliding_layers_follow_their_recorded_trajectory() {
     // the disks slid (friction dissipated energy) and rest on the floor
     assert!(sim.energy().friction_dissipated > 0.0);
     assert!(sim.measurements().wall_contact_count > 20);
+}
+
+/// The common packing sheared in two groups of disks with three different
+/// undamped models (grain-grain, grain-other, other-other), so that every pair
+/// reads its own model: the four-pair loop and the one-pair loop must end in
+/// the same bits, on 1 and 2 threads.
+#[test]
+fn two_groups_with_their_own_models_give_the_same_bits_four_pairs_at_a_time() {
+    let build = |threads: usize| {
+        let mut sim = bench_packing(0.5, 0.2, threads);
+        let n = sim.particles().len();
+        let groups: Vec<u8> = (0..n).map(|k| (k % 3 == 0) as u8).collect();
+        sim.set_groups(&groups).unwrap();
+        sim.set_contact_model(0, 1, ContactModel::linear(0.7 * KN, 0.4 * KN, 0.2))
+            .unwrap();
+        sim.set_contact_model(1, 1, ContactModel::linear(1.3 * KN, 0.9 * KN, 0.05))
+            .unwrap();
+        let mut cell = sim.cell().cloned().unwrap();
+        cell.velocity_gradient = [[-0.2, 0.05], [0.0, 0.2]];
+        sim.set_cell(Some(cell)).unwrap();
+        sim
+    };
+    for threads in [1, 2] {
+        let mut runs = Vec::new();
+        for vector in [true, false] {
+            let mut sim = build(threads);
+            sim.set_vector_pairs(vector);
+            for _ in 0..3 {
+                sim.run(500).unwrap();
+            }
+            assert!(sim.neighbors().build_count > 1, "no rebuild");
+            assert!(sim.energy().friction_dissipated > 0.0, "no contact slid");
+            runs.push((trajectory_hash(&sim), contact_list_bits(&mut sim)));
+        }
+        assert_eq!(
+            runs[0].0, runs[1].0,
+            "{threads} thread(s): trajectories differ"
+        );
+        assert!(
+            runs[0].1 == runs[1].1,
+            "{threads} thread(s): contact lists differ"
+        );
+    }
 }

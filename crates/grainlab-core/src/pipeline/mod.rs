@@ -26,11 +26,13 @@
 //! (every one in the user's particle order, keeping the contact history in
 //! step) and queries; `step.rs` the step as a list of named stages;
 //! `pair_kernel.rs` the contact law over the pair lists, the reset and the
-//! particle-wall contact; `checks.rs` the consistency checks and the errors
+//! particle-wall contact; `pair_lanes.rs` its undamped loop four pairs at a
+//! time (AVX2, the same bits); `checks.rs` the consistency checks and the errors
 //! of an unstable run. The bond law is in [`crate::bond`], the nearest image
 //! in [`crate::cell`].
 mod checks;
 mod pair_kernel;
+mod pair_lanes;
 pub mod simulation;
 mod step;
 

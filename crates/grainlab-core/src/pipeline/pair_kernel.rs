@@ -331,6 +331,7 @@ macro_rules! pair_kernel {
             max_overlap_ratio: $sim.params.max_overlap_ratio,
             single_model: $sim.materials.single_undamped_model(),
             undamped: $sim.materials.undamped(),
+            vector: $sim.vector_pairs,
         }
     };
 }
@@ -358,6 +359,8 @@ pub(crate) struct PairKernel<'a> {
     pub(crate) single_model: Option<ContactModel>,
     /// No model has a dashpot.
     pub(crate) undamped: bool,
+    /// Whether undamped pairs run four at a time ([`crate::Simulation::vector_pairs`]).
+    pub(crate) vector: bool,
 }
 
 impl PairKernel<'_> {
@@ -404,7 +407,9 @@ impl PairKernel<'_> {
     /// The loop of [`PairKernel::run`]: `DEFORMING` when the cell has a velocity
     /// gradient, `SINGLE` when [`PairKernel::single_model`] is set, `DASHPOTS`
     /// unless no model has a dashpot (whose terms are then skipped, as the law
-    /// skips them for a zero damping ratio).
+    /// skips them for a zero damping ratio). Without dashpots, and when
+    /// [`PairKernel::vector`] is set, four pairs at a time
+    /// ([`PairKernel::pairs_by_four`], the same bits).
     ///
     /// # Safety
     /// As [`PairKernel::run`].
@@ -422,116 +427,276 @@ impl PairKernel<'_> {
         sliding: &mut [bool],
         sink: &mut S,
     ) -> ContactTally {
+        // (`vector` is never set where the four-pair loop does not exist)
+        if !DASHPOTS && self.vector {
+            #[cfg(target_arch = "x86_64")]
+            return self
+                .pairs_by_four::<MEASURE, DEFORMING, SINGLE, S>(first, shear, sliding, sink);
+        }
         let mut tally = ContactTally::default();
-        let gradient = self.velocity_gradient.unwrap_or([[0.0; 2]; 2]);
-        let single = self
-            .single_model
-            .unwrap_or(ContactModel::linear(1.0, 1.0, 0.0));
-        let max_overlap_ratio = self.max_overlap_ratio;
-        let mut overlap_violation = false;
-        // the pairs' columns cut to this run, so one index walks them all
-        let n = shear.len().min(sliding.len());
-        let pair_i = &self.pair_i[first..first + n];
-        let pair_j = &self.pair_j[first..first + n];
-        let shifts = &self.shift[first..first + n];
-        let models = &self.model[first..first + n];
-        for k in 0..n {
-            let (spring, slide) = (&mut shear[k], &mut sliding[k]);
-            // SAFETY: the neighbour list holds pairs of particles that exist
-            // (`NeighborList::build`), so every particle index below is in
-            // bounds; the checks would cost a tenth of the loop
-            let i = pair_i[k] as usize;
-            let j = pair_j[k] as usize;
-            debug_assert!(i < self.position.len() && j < self.position.len());
-            let xi = *self.position.get_unchecked(i);
-            let mut xj = *self.position.get_unchecked(j);
-            let s = shifts[k];
-            if s != [0, 0] {
-                if let Some(c) = self.cell {
-                    xj = add(xj, c.image_offset(s));
-                }
-            }
-            let d = sub(xj, xi);
-            let (ri, rj) = (*self.radius.get_unchecked(i), *self.radius.get_unchecked(j));
-            let reach = ri + rj;
-            let dist_sq = dot(d, d);
-            if dist_sq >= reach * reach {
-                if *spring != 0.0 || *slide {
-                    *spring = 0.0;
-                    *slide = false;
-                }
-                sink.skip(k);
-                continue;
-            }
-            let dist = dist_sq.sqrt();
-            let n = scale(d, 1.0 / dist);
-            let overlap = reach - dist;
-            let t = perp(n);
-            let mut dv = sub(
-                *self.velocity.get_unchecked(j),
-                *self.velocity.get_unchecked(i),
+        let fixed = self.loop_constants();
+        let columns = self.columns(first, shear.len().min(sliding.len()));
+        let all = 0..columns.len();
+        self.pairs_one_at_a_time::<MEASURE, DEFORMING, SINGLE, DASHPOTS, S>(
+            &fixed, &columns, all, shear, sliding, sink, &mut tally,
+        );
+        tally
+    }
+
+    /// Local pairs `range` of `columns`, one at a time ([`PairKernel::one_pair`]).
+    ///
+    /// # Safety
+    /// As [`PairKernel::run`].
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn pairs_one_at_a_time<
+        const MEASURE: bool,
+        const DEFORMING: bool,
+        const SINGLE: bool,
+        const DASHPOTS: bool,
+        S: ForceSink,
+    >(
+        &self,
+        fixed: &LoopConstants,
+        columns: &PairColumns<'_>,
+        range: std::ops::Range<usize>,
+        shear: &mut [f64],
+        sliding: &mut [bool],
+        sink: &mut S,
+        tally: &mut ContactTally,
+    ) {
+        for k in range {
+            self.one_pair::<MEASURE, DEFORMING, SINGLE, DASHPOTS, S>(
+                fixed,
+                columns,
+                k,
+                &mut shear[k],
+                &mut sliding[k],
+                sink,
+                tally,
             );
-            if DEFORMING {
-                dv = add(dv, mat_vec(&gradient, d));
+        }
+    }
+
+    /// What the pair loop reads of the kernel once per call.
+    #[inline(always)]
+    pub(super) fn loop_constants(&self) -> LoopConstants {
+        LoopConstants {
+            gradient: self.velocity_gradient.unwrap_or([[0.0; 2]; 2]),
+            single: self
+                .single_model
+                .unwrap_or(ContactModel::linear(1.0, 1.0, 0.0)),
+        }
+    }
+
+    /// The pairs' columns `first..first + n`, so that one index walks them all.
+    #[inline(always)]
+    pub(super) fn columns(&self, first: usize, n: usize) -> PairColumns<'_> {
+        PairColumns {
+            i: &self.pair_i[first..first + n],
+            j: &self.pair_j[first..first + n],
+            shift: &self.shift[first..first + n],
+            model: &self.model[first..first + n],
+        }
+    }
+
+    /// The contact model of local pair `k`.
+    #[inline(always)]
+    pub(super) fn model_of<'m, const SINGLE: bool>(
+        &'m self,
+        fixed: &'m LoopConstants,
+        columns: &PairColumns<'_>,
+        k: usize,
+    ) -> &'m ContactModel {
+        if SINGLE {
+            &fixed.single
+        } else {
+            self.materials.by_index(columns.model[k])
+        }
+    }
+
+    /// Local pair `k` of `columns`: the law, its forces into `sink`, its sums into `tally`.
+    ///
+    /// # Safety
+    /// As [`PairKernel::run`].
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn one_pair<
+        const MEASURE: bool,
+        const DEFORMING: bool,
+        const SINGLE: bool,
+        const DASHPOTS: bool,
+        S: ForceSink,
+    >(
+        &self,
+        fixed: &LoopConstants,
+        columns: &PairColumns<'_>,
+        k: usize,
+        spring: &mut f64,
+        slide: &mut bool,
+        sink: &mut S,
+        tally: &mut ContactTally,
+    ) {
+        // SAFETY: the neighbour list holds pairs of particles that exist
+        // (`NeighborList::build`), so every particle index below is in
+        // bounds; the checks would cost a tenth of the loop
+        let i = columns.i[k] as usize;
+        let j = columns.j[k] as usize;
+        debug_assert!(i < self.position.len() && j < self.position.len());
+        let xi = *self.position.get_unchecked(i);
+        let mut xj = *self.position.get_unchecked(j);
+        let s = columns.shift[k];
+        if s != [0, 0] {
+            if let Some(c) = self.cell {
+                xj = add(xj, c.image_offset(s));
             }
-            let vn = dot(dv, n);
-            let vt = dot(dv, t)
-                - (*self.angular_velocity.get_unchecked(i) * ri
-                    + *self.angular_velocity.get_unchecked(j) * rj);
-            let model = if SINGLE {
-                &single
-            } else {
-                self.materials.by_index(models[k])
-            };
-            let reduced_mass = if DASHPOTS
-                && (model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0)
-            {
+        }
+        let d = sub(xj, xi);
+        let (ri, rj) = (*self.radius.get_unchecked(i), *self.radius.get_unchecked(j));
+        let reach = ri + rj;
+        let dist_sq = dot(d, d);
+        if dist_sq >= reach * reach {
+            no_contact(sink, k, spring, slide);
+            return;
+        }
+        let dist = dist_sq.sqrt();
+        let n = scale(d, 1.0 / dist);
+        let overlap = reach - dist;
+        let t = perp(n);
+        let mut dv = sub(
+            *self.velocity.get_unchecked(j),
+            *self.velocity.get_unchecked(i),
+        );
+        if DEFORMING {
+            dv = add(dv, mat_vec(&fixed.gradient, d));
+        }
+        let vn = dot(dv, n);
+        let vt = dot(dv, t)
+            - (*self.angular_velocity.get_unchecked(i) * ri
+                + *self.angular_velocity.get_unchecked(j) * rj);
+        let model = self.model_of::<SINGLE>(fixed, columns, k);
+        let reduced_mass =
+            if DASHPOTS && (model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0) {
                 let (mi, mj) = (self.mass[i], self.mass[j]);
                 mi * mj / (mi + mj)
             } else {
                 0.0
             };
-            let (dt, increment_time) = (self.dt, self.increment_time);
-            let c = if !DASHPOTS {
-                linear_coulomb_with::<false>(
-                    model,
-                    overlap,
-                    vn,
-                    vt,
-                    dt,
-                    increment_time,
-                    reduced_mass,
-                    spring,
-                )
-            } else {
-                linear_coulomb(
-                    model,
-                    overlap,
-                    vn,
-                    vt,
-                    dt,
-                    increment_time,
-                    reduced_mass,
-                    spring,
-                )
-            };
-            *slide = c.sliding;
-            sink.record(k, overlap, n, &c, *spring);
-            let f = [
-                c.normal * n[0] + c.shear * t[0],
-                c.normal * n[1] + c.shear * t[1],
-            ];
-            sink.add(k, i, j, f, -ri * c.shear, -rj * c.shear);
-            tally.friction += c.friction_dissipation;
-            tally.viscous += c.viscous_dissipation;
-            overlap_violation |= overlap > max_overlap_ratio * ri.min(rj);
-            if MEASURE {
-                tally.elastic += elastic_energy(model, model.normal_stiffness * overlap, *spring);
-                tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
-                tally.contacts += 1;
-            }
-        }
-        tally.overlap_violation = overlap_violation;
-        tally
+        let (dt, increment_time) = (self.dt, self.increment_time);
+        let c = if !DASHPOTS {
+            linear_coulomb_with::<false>(
+                model,
+                overlap,
+                vn,
+                vt,
+                dt,
+                increment_time,
+                reduced_mass,
+                spring,
+            )
+        } else {
+            linear_coulomb(
+                model,
+                overlap,
+                vn,
+                vt,
+                dt,
+                increment_time,
+                reduced_mass,
+                spring,
+            )
+        };
+        let f = [
+            c.normal * n[0] + c.shear * t[0],
+            c.normal * n[1] + c.shear * t[1],
+        ];
+        let contact = PairContact {
+            k,
+            i,
+            j,
+            ri,
+            rj,
+            overlap,
+            normal: n,
+            force: f,
+        };
+        self.finish_contact::<MEASURE, S>(&contact, &c, model, *spring, slide, sink, tally);
     }
+
+    /// A touching pair's bookkeeping after the law: its sliding flag, the record,
+    /// the forces and torques into `sink`, the sums into `tally`.
+    ///
+    /// # Safety
+    /// As [`ForceSink::add`].
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn finish_contact<const MEASURE: bool, S: ForceSink>(
+        &self,
+        p: &PairContact,
+        c: &ContactForce,
+        model: &ContactModel,
+        spring: f64,
+        slide: &mut bool,
+        sink: &mut S,
+        tally: &mut ContactTally,
+    ) {
+        *slide = c.sliding;
+        sink.record(p.k, p.overlap, p.normal, c, spring);
+        sink.add(p.k, p.i, p.j, p.force, -p.ri * c.shear, -p.rj * c.shear);
+        tally.friction += c.friction_dissipation;
+        tally.viscous += c.viscous_dissipation;
+        tally.overlap_violation |= p.overlap > self.max_overlap_ratio * p.ri.min(p.rj);
+        if MEASURE {
+            tally.elastic += elastic_energy(model, model.normal_stiffness * p.overlap, spring);
+            tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
+            tally.contacts += 1;
+        }
+    }
+}
+
+/// A pair that is not in contact: its history is cleared (written only when
+/// set, so that a spring of -0 stays as it is) and its sink slot skipped.
+#[inline(always)]
+pub(super) fn no_contact<S: ForceSink>(sink: &mut S, k: usize, spring: &mut f64, slide: &mut bool) {
+    if *spring != 0.0 || *slide {
+        *spring = 0.0;
+        *slide = false;
+    }
+    sink.skip(k);
+}
+
+/// What the pair loop reads once per call: the cell's velocity gradient (zero
+/// when it does not deform) and the single model (a placeholder without one).
+pub(super) struct LoopConstants {
+    pub(super) gradient: Mat2,
+    pub(super) single: ContactModel,
+}
+
+/// The pair list's columns over one run of pairs.
+pub(super) struct PairColumns<'a> {
+    pub(super) i: &'a [u32],
+    pub(super) j: &'a [u32],
+    pub(super) shift: &'a [[i8; 2]],
+    pub(super) model: &'a [u16],
+}
+
+impl PairColumns<'_> {
+    /// Number of pairs.
+    #[inline(always)]
+    pub(super) fn len(&self) -> usize {
+        self.i.len()
+    }
+}
+
+/// A touching pair as the law saw it: local index `k`, particles `i` and `j`,
+/// radii, overlap (m), unit normal from `i` to `j`, force on `j` (N).
+pub(super) struct PairContact {
+    pub(super) k: usize,
+    pub(super) i: usize,
+    pub(super) j: usize,
+    pub(super) ri: f64,
+    pub(super) rj: f64,
+    pub(super) overlap: f64,
+    pub(super) normal: Vec2,
+    pub(super) force: Vec2,
 }

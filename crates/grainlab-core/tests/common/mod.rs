@@ -188,3 +188,28 @@ pub fn boxed_packing(n_side: usize, friction: f64, seed: u64, threads: usize) ->
     );
     sim
 }
+
+/// The contact list's every field, as bits.
+pub fn contact_list_bits(sim: &mut Simulation) -> Vec<u64> {
+    let c = sim.contacts().unwrap();
+    let mut bits: Vec<u64> = Vec::new();
+    for k in 0..c.i.len() {
+        bits.extend([
+            c.i[k] as u64,
+            c.j[k] as u64,
+            c.sliding[k] as u64,
+            c.bonded[k] as u64,
+        ]);
+        let v = [
+            c.point[k][0],
+            c.point[k][1],
+            c.normal[k][0],
+            c.normal[k][1],
+            c.overlap[k],
+            c.normal_force[k],
+            c.shear_force[k],
+        ];
+        bits.extend(v.iter().map(|x| x.to_bits()));
+    }
+    bits
+}
