@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from grainlab.plot.workers import FigurePool
 from grainlab.protocols.biaxial import run_biaxial
 from grainlab.protocols.config import resolve
 
@@ -40,10 +41,13 @@ def run(args: argparse.Namespace) -> int:
     if args.strain_rate is not None:
         overrides.append(f"shear.strain_rate={args.strain_rate}")
     config = resolve(args.config, overrides, quick=args.quick)
-    result = run_biaxial(config, args.out, resume=args.resume, progress=args.progress)
-    print(result.one_line())
-    if args.no_report or (args.resume and (result.out_dir / "report.html").exists()):
-        return 0  # a report is written last (atomically): one there is this finished run's
-    from grainlab.commands.report import write_after_run
+    # one set of worker processes draws the run's figures and then serves the report
+    # (started when the figures are drawn: none while the test runs)
+    with FigurePool(page_copies=not args.no_report):
+        result = run_biaxial(config, args.out, resume=args.resume, progress=args.progress)
+        print(result.one_line())
+        if args.no_report or (args.resume and (result.out_dir / "report.html").exists()):
+            return 0  # a report is written last (atomically): one there is this finished run's
+        from grainlab.commands.report import write_after_run
 
-    return write_after_run(result.out_dir, "biaxial", quiet=args.quiet)
+        return write_after_run(result.out_dir, "biaxial", quiet=args.quiet)

@@ -241,11 +241,14 @@ class FigurePool:
 
 
 @contextlib.contextmanager
-def figure_pool(workers: int | None = None, *, tasks: int = MAX_WORKERS) -> Iterator[FigurePool]:
-    """The current :class:`FigurePool` (of an enclosing ``with`` block), or a new one for this block."""
+def figure_pool(
+    workers: int | None = None, *, tasks: int = MAX_WORKERS, page_copies: bool = False
+) -> Iterator[FigurePool]:
+    """The current :class:`FigurePool` (of an enclosing ``with`` block, with its own
+    settings), or a new one with these for this block."""
     pool = _current.get()
     if pool is not None:
         yield pool
         return
-    with FigurePool(workers, tasks=tasks) as pool:
+    with FigurePool(workers, tasks=tasks, page_copies=page_copies) as pool:
         yield pool

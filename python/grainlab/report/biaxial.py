@@ -484,16 +484,18 @@ def gather_biaxial(
     shear-band numbers are ``summary.json``'s (those the figures show) unless
     the fabric figures are drawn here, in which case they are the new ones.
     """
-    from grainlab.plot.workers import FigurePool
+    from grainlab.plot.workers import figure_pool
     from grainlab.postprocess.band import keep_searches, search_ahead
 
     folder = Path(folder)
     results = check_biaxial_folder(folder)
     # the claims' band searches (the slow part of the report) run in worker processes
-    # while the figures and the report's own numbers are made here
-    with FigurePool(tasks=len(results.snapshot_names)) as pool:
+    # (those of an enclosing figure pool, e.g. grainlab biaxial's) while the figures and
+    # the report's own numbers are made here
+    with figure_pool(tasks=len(results.snapshot_names)) as pool:
         started = search_ahead(results, _claim_pairs(results), pool)
         report = _gather(folder, results, redraw, dilation_window)
+        import grainlab.reproduction.claims  # noqa: F401 - imported (scipy.stats: ~1 s) while the workers search
         keep_searches(started)
     report.claim_rows = _claim_rows(folder, report.notes)
     return report

@@ -104,16 +104,18 @@ def _write_outputs(out: Path) -> dict[str, Any]:
     """``timeseries.csv``, the figures and ``summary.json``, all from the finished
     ``run.h5``: a run stopped while they were written finishes them with ``--resume``.
     The figures are drawn side by side in worker processes, with their copies
-    for the report (:class:`~grainlab.plot.workers.FigurePool`)."""
+    for the report, in the figure pool open around the run (``grainlab biaxial``'s,
+    which then serves the report) or in one of their own
+    (:class:`~grainlab.plot.workers.FigurePool`)."""
     from grainlab.io.hdf5 import read_results
-    from grainlab.plot.workers import FigurePool
+    from grainlab.plot.workers import figure_pool
     from grainlab.postprocess import figures
 
     results = read_results(out / RESULTS_FILE)
     raise_if_interrupted()  # a Ctrl-C that h5py's clean-up swallowed stops the run here
     summary = dict(results.summary)
     write_text_atomic(out / "timeseries.csv", _csv(results.timeseries))
-    with FigurePool(tasks=3 + len(figures.FIGURES), page_copies=True):
+    with figure_pool(tasks=3 + len(figures.FIGURES), page_copies=True):
         _figures(results.timeseries, out)
         # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
         summary["fabric"] = figures.fabric_figures(out).numbers.summary()
