@@ -61,8 +61,10 @@ __all__ = [
     "band_labels",
     "find_band",
     "interior_grains",
+    "keep_searched",
     "keep_searches",
     "search_ahead",
+    "searched",
     "slab_members",
 ]
 
@@ -260,6 +262,18 @@ def _keep(key: bytes, found: BandSearch) -> None:
     _searches.move_to_end(key)
     while len(_searches) > _SEARCHES_KEPT:
         _searches.popitem(last=False)
+
+
+def searched() -> list[tuple[bytes, BandSearch]]:
+    """The searches :func:`find_band` keeps, oldest first, by digest: what a worker
+    process sends back for :func:`keep_searched` to keep in the process that asked."""
+    return list(_searches.items())
+
+
+def keep_searched(searches: Sequence[tuple[bytes, BandSearch]]) -> None:
+    """Keeps the searches of :func:`searched` (made in another process) for :func:`find_band`."""
+    for key, found in searches:
+        _keep(key, found)
 
 
 def _pair(results: Results, reference: str, current: str) -> tuple[Snapshot, Snapshot, StabilityIndex]:
