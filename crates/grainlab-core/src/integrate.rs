@@ -51,6 +51,9 @@ pub struct IntegrationStep {
     pub step_map: Option<(Vec2, Mat2)>,
     /// Accumulated map since the neighbour-list build.
     pub accumulated_map: Mat2,
+    /// Whether free particles are integrated two at a time (AVX2; set only
+    /// where the processor has it): the same bits as one at a time.
+    pub vector: bool,
 }
 
 /// The mutable state of one contiguous chunk of particles `lo..lo + len`.
@@ -125,7 +128,7 @@ fn signum0(v: f64) -> f64 {
 /// NaN-handling sequence (the same bits: equal values are equal bits, squares
 /// being never -0).
 #[inline(always)]
-fn running_max(max: f64, value: f64) -> f64 {
+pub(crate) fn running_max(max: f64, value: f64) -> f64 {
     if value > max {
         value
     } else {
@@ -135,7 +138,13 @@ fn running_max(max: f64, value: f64) -> f64 {
 
 /// One kick of one degree of freedom with local damping; returns `(v_new, F_d)`.
 #[inline(always)]
-fn kick<const DAMPED: bool>(v: f64, f: f64, inv_m: f64, alpha: f64, kick: f64) -> (f64, f64) {
+pub(crate) fn kick<const DAMPED: bool>(
+    v: f64,
+    f: f64,
+    inv_m: f64,
+    alpha: f64,
+    kick: f64,
+) -> (f64, f64) {
     let fd = if DAMPED {
         -alpha * f.abs() * signum0(v)
     } else {
@@ -159,73 +168,197 @@ pub fn integrate_chunk<const MEASURE: bool>(
 }
 
 /// The loop of [`integrate_chunk`], specialised on local damping and on the
-/// periodic cell's deformation so that neither costs anything when absent.
+/// periodic cell's deformation so that neither costs anything when absent;
+/// two particles at a time where the step allows it ([`IntegrationStep::vector`]).
 #[inline(always)]
 fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bool>(
     chunk: MotionChunk<'_>,
     inputs: &IntegrationInputs<'_>,
     step: &IntegrationStep,
 ) -> IntegrationTally {
-    let mut tally = IntegrationTally::default();
-    let dt = step.dt;
-    let alpha = step.alpha;
-    let (origin, map) = step
-        .step_map
-        .unwrap_or(([0.0; 2], [[1.0, 0.0], [0.0, 1.0]]));
-    let acc = step.accumulated_map;
-    // affine image of a reference point: origin + M_acc (x_ref - origin) = shift + M_acc x_ref
-    let acc_shift = sub(origin, mat_vec(&acc, origin));
-    let map_shift = sub(origin, mat_vec(&map, origin));
-    let n = chunk.position.len();
-    let lo = chunk.lo;
-    let force = &chunk.force[..n];
-    let torque = &chunk.torque[..n];
-    let velocity = &mut chunk.velocity[..n];
-    let angular_velocity = &mut chunk.angular_velocity[..n];
-    let rotation = &mut chunk.rotation[..n];
-    let position = &mut chunk.position[..n];
-    let mass = &inputs.mass[lo..lo + n];
-    let inv_mass = &inputs.inv_mass[lo..lo + n];
-    let inv_inertia = &inputs.inv_inertia[lo..lo + n];
-    let fixity = &inputs.fixity[lo..lo + n];
-    let reference = &inputs.reference[lo..lo + n];
-    let mut damping_work = 0.0;
-    let mut max_fluctuation_sq = 0.0f64;
-    let mut max_displacement_sq = 0.0f64;
-    let mut finite = true;
+    let mut kernel = ChunkKernel::new(chunk, inputs, step);
+    let mut sums = ChunkSums::default();
+    let n = kernel.position.len();
+    #[cfg(target_arch = "x86_64")]
+    if step.vector {
+        // SAFETY: `vector` is set only where the processor has AVX2
+        unsafe { kernel.particles_by_two::<MEASURE, DAMPED, DEFORMING>(&mut sums) };
+        return sums.finish::<DEFORMING>(step);
+    }
     for k in 0..n {
-        let fix = fixity[k];
-        let f = force[k];
-        let v_old = velocity[k];
-        let w_old = angular_velocity[k];
+        kernel.one_particle::<MEASURE, DAMPED, DEFORMING>(k, &mut sums);
+    }
+    sums.finish::<DEFORMING>(step)
+}
+
+/// What the integration of one chunk reads and writes, cut to the chunk, and
+/// the step's constants.
+pub(crate) struct ChunkKernel<'a> {
+    pub(crate) lo: usize,
+    pub(crate) force: &'a [Vec2],
+    pub(crate) torque: &'a [f64],
+    pub(crate) velocity: &'a mut [Vec2],
+    pub(crate) angular_velocity: &'a mut [f64],
+    pub(crate) rotation: &'a mut [f64],
+    pub(crate) position: &'a mut [Vec2],
+    pub(crate) mass: &'a [f64],
+    pub(crate) inv_mass: &'a [f64],
+    pub(crate) inv_inertia: &'a [f64],
+    pub(crate) fixity: &'a [u8],
+    pub(crate) reference: &'a [Vec2],
+    pub(crate) inputs: &'a IntegrationInputs<'a>,
+    pub(crate) step: &'a IntegrationStep,
+    /// The step's affine map and its shift: `x -> map_shift + map x`.
+    pub(crate) map: Mat2,
+    pub(crate) map_shift: Vec2,
+    /// The accumulated map and its shift, for the reference points.
+    pub(crate) acc: Mat2,
+    pub(crate) acc_shift: Vec2,
+}
+
+/// The running sums of one chunk's integration.
+#[derive(Default)]
+pub(crate) struct ChunkSums {
+    pub(crate) tally: IntegrationTally,
+    pub(crate) damping_work: f64,
+    pub(crate) max_fluctuation_sq: f64,
+    pub(crate) max_displacement_sq: f64,
+    /// Whether a non-finite position or angular velocity appeared.
+    pub(crate) non_finite: bool,
+}
+
+impl ChunkSums {
+    /// The chunk's tally.
+    fn finish<const DEFORMING: bool>(mut self, step: &IntegrationStep) -> IntegrationTally {
+        self.tally.damping_dissipated = -self.damping_work * step.kick;
+        self.tally.max_displacement_sq = self.max_displacement_sq;
+        self.tally.max_fluctuation_sq = if DEFORMING {
+            self.max_fluctuation_sq
+        } else {
+            self.max_displacement_sq
+        };
+        self.tally.non_finite = self.non_finite;
+        self.tally
+    }
+}
+
+impl<'a> ChunkKernel<'a> {
+    fn new(
+        chunk: MotionChunk<'a>,
+        inputs: &'a IntegrationInputs<'a>,
+        step: &'a IntegrationStep,
+    ) -> Self {
+        let (origin, map) = step
+            .step_map
+            .unwrap_or(([0.0; 2], [[1.0, 0.0], [0.0, 1.0]]));
+        let acc = step.accumulated_map;
+        let n = chunk.position.len();
+        let lo = chunk.lo;
+        ChunkKernel {
+            lo,
+            force: &chunk.force[..n],
+            torque: &chunk.torque[..n],
+            velocity: &mut chunk.velocity[..n],
+            angular_velocity: &mut chunk.angular_velocity[..n],
+            rotation: &mut chunk.rotation[..n],
+            position: &mut chunk.position[..n],
+            mass: &inputs.mass[lo..lo + n],
+            inv_mass: &inputs.inv_mass[lo..lo + n],
+            inv_inertia: &inputs.inv_inertia[lo..lo + n],
+            fixity: &inputs.fixity[lo..lo + n],
+            reference: &inputs.reference[lo..lo + n],
+            inputs,
+            step,
+            map,
+            // affine image of a reference point: origin + M_acc (x_ref - origin) = shift + M_acc x_ref
+            map_shift: sub(origin, mat_vec(&map, origin)),
+            acc,
+            acc_shift: sub(origin, mat_vec(&acc, origin)),
+        }
+    }
+
+    /// Particle `k` of the chunk over the step.
+    #[inline(always)]
+    pub(crate) fn one_particle<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bool>(
+        &mut self,
+        k: usize,
+        sums: &mut ChunkSums,
+    ) {
+        let step = self.step;
+        let (dt, alpha) = (step.dt, step.alpha);
+        let fix = self.fixity[k];
+        let f = self.force[k];
+        let v_old = self.velocity[k];
+        let w_old = self.angular_velocity[k];
         let (mut v, mut w) = (v_old, w_old);
         let mut fd = [0.0; 3];
+        let inv_m = self.inv_mass[k];
         if fix == 0 {
-            (v[0], fd[0]) = kick::<DAMPED>(v_old[0], f[0], inv_mass[k], alpha, step.kick);
-            (v[1], fd[1]) = kick::<DAMPED>(v_old[1], f[1], inv_mass[k], alpha, step.kick);
-            (w, fd[2]) = kick::<DAMPED>(w_old, torque[k], inv_inertia[k], alpha, step.kick);
+            (v[0], fd[0]) = kick::<DAMPED>(v_old[0], f[0], inv_m, alpha, step.kick);
+            (v[1], fd[1]) = kick::<DAMPED>(v_old[1], f[1], inv_m, alpha, step.kick);
+            (w, fd[2]) =
+                kick::<DAMPED>(w_old, self.torque[k], self.inv_inertia[k], alpha, step.kick);
         } else {
             if fix & FIX_X == 0 {
-                (v[0], fd[0]) = kick::<DAMPED>(v_old[0], f[0], inv_mass[k], alpha, step.kick);
+                (v[0], fd[0]) = kick::<DAMPED>(v_old[0], f[0], inv_m, alpha, step.kick);
             }
             if fix & FIX_Y == 0 {
-                (v[1], fd[1]) = kick::<DAMPED>(v_old[1], f[1], inv_mass[k], alpha, step.kick);
+                (v[1], fd[1]) = kick::<DAMPED>(v_old[1], f[1], inv_m, alpha, step.kick);
             }
             if fix & FIX_ROTATION == 0 {
-                (w, fd[2]) = kick::<DAMPED>(w_old, torque[k], inv_inertia[k], alpha, step.kick);
+                (w, fd[2]) =
+                    kick::<DAMPED>(w_old, self.torque[k], self.inv_inertia[k], alpha, step.kick);
             }
         }
+        self.book::<MEASURE, DAMPED>(k, [v_old, v], [w_old, w], fd, sums);
+        let mut x = self.position[k];
+        x[0] += dt * v[0];
+        x[1] += dt * v[1];
+        let r = self.reference[k];
+        if DEFORMING {
+            x = crate::vec2::add(self.map_shift, mat_vec(&self.map, x));
+            let u = sub(x, crate::vec2::add(self.acc_shift, mat_vec(&self.acc, r)));
+            sums.max_fluctuation_sq =
+                running_max(sums.max_fluctuation_sq, u[0] * u[0] + u[1] * u[1]);
+        }
+        let d = sub(x, r);
+        let d2 = d[0] * d[0] + d[1] * d[1];
+        sums.max_displacement_sq = running_max(sums.max_displacement_sq, d2);
+        sums.non_finite |= !(x[0].is_finite() & x[1].is_finite() & w.is_finite());
+        self.position[k] = x;
+        self.velocity[k] = v;
+        self.angular_velocity[k] = w;
+        self.rotation[k] += dt * w;
+    }
+
+    /// The energy sums of particle `k` (in particle order): the work of local
+    /// damping, external forces, gravity and follower loads, and on a measured
+    /// step the kinetic energy and the unbalanced force; `v` and `w` are the
+    /// velocities before and after the kick, `fd` the damping forces.
+    #[inline(always)]
+    pub(crate) fn book<const MEASURE: bool, const DAMPED: bool>(
+        &self,
+        k: usize,
+        [v_old, v]: [Vec2; 2],
+        [w_old, w]: [f64; 2],
+        fd: [f64; 3],
+        sums: &mut ChunkSums,
+    ) {
+        let step = self.step;
+        let inputs = self.inputs;
+        let fix = self.fixity[k];
         // the work of a force F(n) in leapfrog's exact energy identity (with the
         // kinetic energy below) is F(n) . (v(n-1/2) + v(n+1/2)) / 2 * kick, where the
         // kick is dt, or dt/2 on the first step from full-step velocities
         let v_full = [0.5 * (v_old[0] + v[0]), 0.5 * (v_old[1] + v[1])];
         let w_full = 0.5 * (w_old + w);
         if DAMPED {
-            damping_work += fd[0] * v_full[0] + fd[1] * v_full[1] + fd[2] * w_full;
+            sums.damping_work += fd[0] * v_full[0] + fd[1] * v_full[1] + fd[2] * w_full;
         }
+        let tally = &mut sums.tally;
         if step.has_external {
-            let p = lo + k;
-            let m = mass[k];
+            let p = self.lo + k;
+            let m = self.mass[k];
             let fe = inputs.external_force[p];
             let fx = if fix & FIX_X == 0 {
                 fe[0] + m * step.gravity[0]
@@ -252,44 +385,19 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
             } else {
                 (v, w)
             };
-            tally.kinetic += 0.5 * mass[k] * (v_old[0] * vk[0] + v_old[1] * vk[1])
-                + 0.5 * inputs.inertia[lo + k] * w_old * wk;
+            tally.kinetic += 0.5 * self.mass[k] * (v_old[0] * vk[0] + v_old[1] * vk[1])
+                + 0.5 * inputs.inertia[self.lo + k] * w_old * wk;
             if fix == 0 {
+                let f = self.force[k];
                 tally.unbalanced_force_sum += (f[0] * f[0] + f[1] * f[1]).sqrt();
                 tally.free_count += 1;
             }
         }
         if let Some(load) = inputs.boundary_load {
-            let fb = load[lo + k];
+            let fb = load[self.lo + k];
             let fx = if fix & FIX_X == 0 { fb[0] } else { 0.0 };
             let fy = if fix & FIX_Y == 0 { fb[1] } else { 0.0 };
             tally.boundary_work += (fx * v_full[0] + fy * v_full[1]) * step.kick;
         }
-        let mut x = position[k];
-        x[0] += dt * v[0];
-        x[1] += dt * v[1];
-        let r = reference[k];
-        if DEFORMING {
-            x = crate::vec2::add(map_shift, mat_vec(&map, x));
-            let u = sub(x, crate::vec2::add(acc_shift, mat_vec(&acc, r)));
-            max_fluctuation_sq = running_max(max_fluctuation_sq, u[0] * u[0] + u[1] * u[1]);
-        }
-        let d = sub(x, r);
-        let d2 = d[0] * d[0] + d[1] * d[1];
-        max_displacement_sq = running_max(max_displacement_sq, d2);
-        finite &= x[0].is_finite() & x[1].is_finite() & w.is_finite();
-        position[k] = x;
-        velocity[k] = v;
-        angular_velocity[k] = w;
-        rotation[k] += dt * w;
     }
-    tally.damping_dissipated = -damping_work * step.kick;
-    tally.max_displacement_sq = max_displacement_sq;
-    tally.max_fluctuation_sq = if DEFORMING {
-        max_fluctuation_sq
-    } else {
-        max_displacement_sq
-    };
-    tally.non_finite = !finite;
-    tally
 }

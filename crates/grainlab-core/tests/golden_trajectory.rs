@@ -121,9 +121,9 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
 }
 
 /// `build` run `steps` steps (in blocks of `block`, each call's last step
-/// measured) on 1 and 2 threads, with undamped pairs four at a time (where the
-/// processor can) and one at a time: every run must give `expected`, and the
-/// contact lists of both loops must be the same bits.
+/// measured) on 1 and 2 threads, with the vector kernels (where the processor
+/// can) and the scalar ones: every run must give `expected`, and the contact
+/// lists of both must be the same bits.
 fn check(
     name: &str,
     build: impl Fn(usize) -> Simulation,
@@ -136,7 +136,7 @@ fn check(
         let mut lists = Vec::new();
         for vector in [true, false] {
             let mut sim = build(threads);
-            let used = sim.set_vector_pairs(vector);
+            let used = sim.set_simd(vector);
             let mut done = 0;
             while done < steps {
                 let n = block.min(steps - done);
@@ -147,7 +147,7 @@ fn check(
             let got = trajectory_hash(&sim);
             assert!(
                 got == expected,
-                "{name}, {threads} thread(s), four pairs at a time {used}: trajectory hash \
+                "{name}, {threads} thread(s), vector kernels {used}: trajectory hash \
                  {got:#018x}, recorded {expected:#018x}"
             );
             lists.push(contact_list_bits(&mut sim));
@@ -327,7 +327,7 @@ fn sliding_layers_follow_their_recorded_trajectory() {
 /// reads its own model: the four-pair loop and the one-pair loop must end in
 /// the same bits, on 1 and 2 threads.
 #[test]
-fn two_groups_with_their_own_models_give_the_same_bits_four_pairs_at_a_time() {
+fn two_groups_with_their_own_models_give_the_same_bits_with_the_vector_kernels() {
     let build = |threads: usize| {
         let mut sim = bench_packing(0.5, 0.2, threads);
         let n = sim.particles().len();
@@ -346,7 +346,7 @@ fn two_groups_with_their_own_models_give_the_same_bits_four_pairs_at_a_time() {
         let mut runs = Vec::new();
         for vector in [true, false] {
             let mut sim = build(threads);
-            sim.set_vector_pairs(vector);
+            sim.set_simd(vector);
             for _ in 0..3 {
                 sim.run(500).unwrap();
             }

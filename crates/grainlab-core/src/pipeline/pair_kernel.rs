@@ -331,7 +331,7 @@ macro_rules! pair_kernel {
             max_overlap_ratio: $sim.params.max_overlap_ratio,
             single_model: $sim.materials.single_undamped_model(),
             undamped: $sim.materials.undamped(),
-            vector: $sim.vector_pairs,
+            vector: $sim.simd,
         }
     };
 }
@@ -359,7 +359,7 @@ pub(crate) struct PairKernel<'a> {
     pub(crate) single_model: Option<ContactModel>,
     /// No model has a dashpot.
     pub(crate) undamped: bool,
-    /// Whether undamped pairs run four at a time ([`crate::Simulation::vector_pairs`]).
+    /// Whether undamped pairs run four at a time ([`crate::Simulation::set_simd`]).
     pub(crate) vector: bool,
 }
 

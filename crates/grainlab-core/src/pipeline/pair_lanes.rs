@@ -22,15 +22,11 @@ use std::arch::x86_64::*;
 
 use super::pair_kernel::{no_contact, ContactTally, ForceSink, PairKernel};
 use crate::law::{elastic_energy, ContactForce};
+use crate::simd::spill;
 
 /// `_mm256_permute4x64_pd`'s selector that swaps lanes 1 and 2: pairs in
 /// memory order into register order and back.
 const SWAP_MIDDLE: i32 = 0b11_01_10_00;
-
-/// Whether this processor runs the four-pair loop (AVX2, checked once).
-pub(crate) fn available() -> bool {
-    std::arch::is_x86_feature_detected!("avx2")
-}
 
 /// Four values, one per pair, into register order.
 #[inline]
@@ -46,15 +42,6 @@ unsafe fn unpack(a: [__m128d; 4]) -> (__m256d, __m256d) {
     let low = _mm256_insertf128_pd(_mm256_castpd128_pd256(a[0]), a[1], 1);
     let high = _mm256_insertf128_pd(_mm256_castpd128_pd256(a[2]), a[3], 1);
     (_mm256_unpacklo_pd(low, high), _mm256_unpackhi_pd(low, high))
-}
-
-/// A register's lanes, in register order.
-#[inline]
-#[target_feature(enable = "avx2")]
-unsafe fn spill(v: __m256d) -> [f64; 4] {
-    let mut out = [0.0; 4];
-    _mm256_storeu_pd(out.as_mut_ptr(), v);
-    out
 }
 
 /// A register's lanes in pair order.
@@ -86,7 +73,7 @@ impl PairKernel<'_> {
     /// rest one at a time.
     ///
     /// # Safety
-    /// As [`PairKernel::run`]; the processor has AVX2 ([`available`]).
+    /// As [`PairKernel::run`]; the processor has AVX2 ([`crate::simd::available`]).
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn pairs_by_four<
         const MEASURE: bool,
@@ -120,14 +107,12 @@ impl PairKernel<'_> {
         let velocity = self.velocity.as_ptr() as *const f64;
         let mut k0 = 0;
         while k0 + 4 <= n {
-            // gather: each pair's indices, radii, angular velocities and the
-            // position and velocity vectors of both particles (j at its image)
+            // gather the geometry: each pair's indices, radii and the positions
+            // of both particles (j at its image); the motion only if one touches
             let mut ij = [[0usize; 2]; 4];
-            let (mut ri, mut rj, mut wi, mut wj) = ([0.0; 4], [0.0; 4], [0.0; 4], [0.0; 4]);
+            let (mut ri, mut rj) = ([0.0; 4], [0.0; 4]);
             let mut xi = [_mm_setzero_pd(); 4];
             let mut xj = [_mm_setzero_pd(); 4];
-            let mut vi = [_mm_setzero_pd(); 4];
-            let mut vj = [_mm_setzero_pd(); 4];
             for l in 0..4 {
                 let k = k0 + l;
                 let (i, j) = (columns.i[k] as usize, columns.j[k] as usize);
@@ -135,8 +120,6 @@ impl PairKernel<'_> {
                 ij[l] = [i, j];
                 ri[l] = *self.radius.get_unchecked(i);
                 rj[l] = *self.radius.get_unchecked(j);
-                wi[l] = *self.angular_velocity.get_unchecked(i);
-                wj[l] = *self.angular_velocity.get_unchecked(j);
                 xi[l] = _mm_loadu_pd(position.add(2 * i));
                 xj[l] = _mm_loadu_pd(position.add(2 * j));
                 let s = columns.shift[k];
@@ -146,8 +129,6 @@ impl PairKernel<'_> {
                         xj[l] = _mm_add_pd(xj[l], _mm_loadu_pd(offset.as_ptr()));
                     }
                 }
-                vi[l] = _mm_loadu_pd(velocity.add(2 * i));
-                vj[l] = _mm_loadu_pd(velocity.add(2 * j));
             }
             let (xi_x, xi_y) = unpack(xi);
             let (xj_x, xj_y) = unpack(xj);
@@ -175,6 +156,16 @@ impl PairKernel<'_> {
             // t = perp(n) = (-n_y, n_x)
             let tx = _mm256_xor_pd(ny, sign_bit);
             let ty = nx;
+            let (mut wi, mut wj) = ([0.0; 4], [0.0; 4]);
+            let mut vi = [_mm_setzero_pd(); 4];
+            let mut vj = [_mm_setzero_pd(); 4];
+            for l in 0..4 {
+                let [i, j] = ij[l];
+                wi[l] = *self.angular_velocity.get_unchecked(i);
+                wj[l] = *self.angular_velocity.get_unchecked(j);
+                vi[l] = _mm_loadu_pd(velocity.add(2 * i));
+                vj[l] = _mm_loadu_pd(velocity.add(2 * j));
+            }
             let (vi_x, vi_y) = unpack(vi);
             let (vj_x, vj_y) = unpack(vj);
             let mut dvx = _mm256_sub_pd(vj_x, vi_x);

@@ -114,17 +114,17 @@ pub struct Simulation {
     /// Whether the steps run with the team or on one thread (timed, `parallel::Pacer`).
     #[serde(skip)]
     pub(crate) pacer: Pacer,
-    /// Whether undamped particle pairs are evaluated four at a time
-    /// ([`Simulation::set_vector_pairs`]); on by default where the processor can.
-    #[serde(skip, default = "vector_pairs_available")]
-    pub(crate) vector_pairs: bool,
+    /// Whether the step's vector kernels run ([`Simulation::set_simd`]); on by
+    /// default where the processor can.
+    #[serde(skip, default = "simd_available")]
+    pub(crate) simd: bool,
 }
 
-/// Whether this processor can evaluate undamped pairs four at a time (AVX2).
-fn vector_pairs_available() -> bool {
+/// Whether this processor runs the step's vector kernels (AVX2).
+fn simd_available() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        super::pair_lanes::available()
+        crate::simd::available()
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
@@ -178,7 +178,7 @@ impl Simulation {
             chain_blocks: ChainBlocks::default(),
             external_loads: false,
             pacer: Pacer::default(),
-            vector_pairs: vector_pairs_available(),
+            simd: simd_available(),
         };
         sim.make_pool()?;
         Ok(sim)
@@ -377,18 +377,19 @@ impl Simulation {
         Ok(())
     }
 
-    /// Evaluates undamped particle pairs four at a time (`true`, the default
-    /// where the processor has AVX2) or one at a time; the results are the same
-    /// bits either way, only the speed differs. Returns whether the four-pair
-    /// loop is now in use (never on a processor without AVX2).
-    pub fn set_vector_pairs(&mut self, enabled: bool) -> bool {
-        self.vector_pairs = enabled && vector_pairs_available();
-        self.vector_pairs
+    /// Runs the step's vector kernels (`true`, the default where the processor
+    /// has AVX2: undamped particle pairs four at a time, free particles
+    /// integrated two at a time) or the scalar ones; the results are the same
+    /// bits either way, only the speed differs. Returns whether the vector
+    /// kernels are now in use (never on a processor without AVX2).
+    pub fn set_simd(&mut self, enabled: bool) -> bool {
+        self.simd = enabled && simd_available();
+        self.simd
     }
 
-    /// Whether undamped particle pairs are evaluated four at a time.
-    pub fn vector_pairs(&self) -> bool {
-        self.vector_pairs
+    /// Whether the step's vector kernels run ([`Simulation::set_simd`]).
+    pub fn simd(&self) -> bool {
+        self.simd
     }
 
     /// Sets the Verlet skin (m, > 0).

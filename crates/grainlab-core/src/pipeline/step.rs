@@ -541,6 +541,7 @@ impl Simulation {
             has_external,
             step_map,
             accumulated_map,
+            vector: self.simd,
         };
         let inputs = IntegrationInputs {
             inv_mass: &p.inv_mass,
