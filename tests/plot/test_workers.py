@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -131,3 +132,32 @@ def test_workers_do_not_run_the_calling_script_again(tmp_path):
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines() == ["script ran", "figures 6"]
     assert len(list(Path(tmp_path / "out").glob("fig*.png"))) == 3
+
+
+#: Starts a worker on a long task, prints its process id and kills itself.
+KILLED = """\
+import os, signal, time
+from grainlab.plot.workers import FigurePool
+pool = FigurePool(2, tasks=2)
+pool.submit(time.sleep, 30)
+time.sleep(3)
+print(*pool._executor._processes, flush=True)
+os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+@needs_two_cores
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers end with their parent on Linux")
+def test_workers_end_when_the_process_that_started_them_is_killed(tmp_path):
+    script = tmp_path / "killed.py"
+    script.write_text(KILLED)
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, check=False)
+    assert done.returncode == -9
+    pids = [int(p) for p in done.stdout.split()]
+    assert pids
+    deadline = time.monotonic() + 10
+    alive = pids
+    while alive and time.monotonic() < deadline:
+        time.sleep(0.1)
+        alive = [p for p in pids if Path(f"/proc/{p}").exists()]
+    assert not alive, f"workers {alive} outlived the process that started them"

@@ -13,21 +13,23 @@ open files is inherited, and they import grainlab only, never the script that
 started them (which therefore needs no ``if __name__ == "__main__":`` guard: a
 script calling :func:`grainlab.protocols.biaxial.run_biaxial` at its top level
 is not run again in them); their numerical libraries run on one thread each
-(the workers are the parallelism). At most
-:data:`MAX_WORKERS`, no more than the cores this process may use. There are
+(the workers are the parallelism). At most :data:`MAX_WORKERS` start, no more
+than the cores this process may use. There are
 none, and every task runs here when submitted, on one core, with
 ``workers=0``, or inside a worker process of another pool (a campaign that
 runs several tests at once already uses the cores). Figure functions called
 inside a ``with FigurePool()`` block draw in that pool (:func:`figure_pool`),
-so that one set of workers serves a whole post-processing step. Results come back in the
-order submitted. An exception raised in a worker is raised again here, with
+so that one set of workers serves a whole post-processing step. Results come
+back in the order submitted. An exception raised in a worker is raised again here, with
 the worker's traceback as its cause and a note naming the figure. Workers
-ignore Ctrl-C: this process receives it and stops them.
+ignore Ctrl-C (this process receives it and stops them) and, on Linux, end
+with this process, however it ends.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import multiprocessing
 import os
 import signal
@@ -51,6 +53,9 @@ __all__ = ["MAX_WORKERS", "FigurePool", "FigureTask", "PendingFigures", "figure_
 MAX_WORKERS = 4
 
 T = TypeVar("T")
+
+#: prctl option: the signal a process gets when its parent ends (linux/prctl.h).
+_PR_SET_PDEATHSIG = 1
 
 
 @dataclass(frozen=True)
@@ -85,8 +90,16 @@ def _draw_and_save(task: FigureTask, out_dir: Path, page_copy: bool) -> _Drawn:
     return paths, (_png_digest(data), compact_png(data, dpi=PAGE_DPI))
 
 
-def _ignore_interrupts() -> None:
+def _start_worker(parent: int) -> None:
+    """A worker's set-up: Ctrl-C is for the process that started it; on Linux it is
+    killed when that process ends, however it ends (a killed run leaves no worker
+    drawing on into its folder)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+        if os.getppid() != parent:  # ended before the request was made
+            os._exit(1)
 
 
 #: Environment of the workers: one thread for the numerical libraries (the workers
@@ -172,9 +185,10 @@ class FigurePool:
     none, every task runs here); ``tasks``: how many tasks are expected, so that
     no more workers start than there is work for; ``page_copies``: each PNG's
     copy for a page (:func:`grainlab.plot.page_png`) is made where the figure was
-    drawn, for a report written next. Workers start with the first submission. Inside the ``with`` block the pool is the current one
-    (:func:`figure_pool`); leaving the block waits for every task and raises the
-    first failure of figures nobody waited for.
+    drawn, for a report written next. Workers start with the first submission.
+    Inside the ``with`` block the pool is the current one (:func:`figure_pool`);
+    leaving the block waits for every task and raises the first failure of
+    figures nobody waited for.
     """
 
     def __init__(self, workers: int | None = None, *, tasks: int = MAX_WORKERS, page_copies: bool = False) -> None:
@@ -223,7 +237,8 @@ class FigurePool:
             self._executor = ProcessPoolExecutor(
                 max_workers=self.workers,
                 mp_context=multiprocessing.get_context("spawn"),
-                initializer=_ignore_interrupts,
+                initializer=_start_worker,
+                initargs=(os.getpid(),),
             )
         with _starting_workers():  # a submission may start a worker
             return self._executor.submit(function, *args)
