@@ -115,14 +115,18 @@ impl PairKernel<'_> {
             let mut xj = [_mm_setzero_pd(); 4];
             for l in 0..4 {
                 let k = k0 + l;
-                let (i, j) = (columns.i[k] as usize, columns.j[k] as usize);
+                // SAFETY: k < n, the length of every column (`PairKernel::columns`)
+                let (i, j) = (
+                    *columns.i.get_unchecked(k) as usize,
+                    *columns.j.get_unchecked(k) as usize,
+                );
                 debug_assert!(i < self.position.len() && j < self.position.len());
                 ij[l] = [i, j];
                 ri[l] = *self.radius.get_unchecked(i);
                 rj[l] = *self.radius.get_unchecked(j);
                 xi[l] = _mm_loadu_pd(position.add(2 * i));
                 xj[l] = _mm_loadu_pd(position.add(2 * j));
-                let s = columns.shift[k];
+                let s = *columns.shift.get_unchecked(k);
                 if s != [0, 0] {
                     if let Some(c) = self.cell {
                         let offset = c.image_offset(s);
@@ -143,7 +147,12 @@ impl PairKernel<'_> {
             if touching_bits == 0 {
                 for l in 0..4 {
                     let k = k0 + l;
-                    no_contact(sink, k, &mut shear[k], &mut sliding[k]);
+                    no_contact(
+                        sink,
+                        k,
+                        shear.get_unchecked_mut(k),
+                        sliding.get_unchecked_mut(k),
+                    );
                 }
                 k0 += 4;
                 continue;
@@ -241,7 +250,7 @@ impl PairKernel<'_> {
             _mm256_storeu_pd(spring_ptr, _mm256_permute4x64_pd::<SWAP_MIDDLE>(new_spring));
             let sliding_bits = pair_order(_mm256_movemask_pd(slides));
             for l in 0..4 {
-                sliding[k0 + l] = sliding_bits & (1 << l) != 0;
+                *sliding.get_unchecked_mut(k0 + l) = sliding_bits & (1 << l) != 0;
             }
             let touching_bits = pair_order(touching_bits as i32);
             let mut idle = !touching_bits & 0b1111;
