@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from grainlab.plot.workers import FigurePool
 from grainlab.protocols.biaxial import run_biaxial
 from grainlab.protocols.config import resolve
 
@@ -41,6 +40,8 @@ def run(args: argparse.Namespace) -> int:
     if args.strain_rate is not None:
         overrides.append(f"shear.strain_rate={args.strain_rate}")
     config = resolve(args.config, overrides, quick=args.quick)
+    from grainlab.plot.workers import FigurePool  # matplotlib: imported once the command is valid
+
     # one set of worker processes draws the run's figures and then serves the report
     # (started when the figures are drawn: none while the test runs)
     with FigurePool(page_copies=not args.no_report):

@@ -40,11 +40,12 @@ from contextvars import ContextVar, Token
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
-from typing import Any, TypeVar
-
-from matplotlib.figure import Figure
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from grainlab._cores import available_cores
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["MAX_WORKERS", "FigurePool", "FigureTask", "PendingFigures", "figure_pool", "worker_count"]
 
