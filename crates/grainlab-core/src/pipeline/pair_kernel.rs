@@ -292,16 +292,21 @@ impl ResetKernel<'_> {
                 .copy_from_slice(&self.external_torque[lo..hi]);
             return;
         }
-        for q in lo..hi {
-            let fe = self.external_force[q];
-            let m = self.mass[q];
-            let mut f = [fe[0] + m * self.gravity[0], fe[1] + m * self.gravity[1]];
-            if let Some(load) = self.boundary_load {
-                f = add(f, *load.get(q));
+        // the block's slices, so that the loop keeps its pointers in registers
+        let forces = force.range(lo, hi);
+        let loads = self.boundary_load.map(|load| &*load.range(lo, hi));
+        let (external, mass) = (&self.external_force[lo..hi], &self.mass[lo..hi]);
+        let g = self.gravity;
+        for (q, f) in forces.iter_mut().enumerate() {
+            let (fe, m) = (external[q], mass[q]);
+            *f = [fe[0] + m * g[0], fe[1] + m * g[1]];
+            if let Some(loads) = loads {
+                *f = add(*f, loads[q]);
             }
-            *force.get(q) = f;
-            *torque.get(q) = self.external_torque[q];
         }
+        torque
+            .range(lo, hi)
+            .copy_from_slice(&self.external_torque[lo..hi]);
     }
 }
 
