@@ -31,6 +31,7 @@
 //! of an unstable run. The bond law is in [`crate::bond`], the nearest image
 //! in [`crate::cell`].
 mod checks;
+mod deferred;
 mod pair_kernel;
 mod pair_lanes;
 pub mod simulation;

@@ -2,6 +2,7 @@
 use rayon::ThreadPool;
 use serde::{Deserialize, Serialize};
 
+use super::deferred::{DeferredIndex, WallSlot};
 use super::pair_kernel::{
     pair_kernel, wall_contact, NullSink, PairForce, PairKernel, PairRecord, RecordSink,
 };
@@ -108,6 +109,14 @@ pub struct Simulation {
     /// current by `run` and every rebuild).
     #[serde(skip)]
     pub(crate) chain_blocks: ChainBlocks,
+    /// The bonds' and wall pairs' entries per block of particles, for adding
+    /// their forces in the integration (kept current like `chain_blocks`).
+    #[serde(skip)]
+    pub(crate) deferred_index: DeferredIndex,
+    /// The wall contacts' forces of this step, per wall pair, when a team adds
+    /// them in the integration.
+    #[serde(skip)]
+    pub(crate) wall_slots: Vec<WallSlot>,
     /// Whether any particle has an external force or torque (scanned once per run call).
     #[serde(skip)]
     pub(crate) external_loads: bool,
@@ -176,6 +185,8 @@ impl Simulation {
             bond_slots: Vec::new(),
             boundary_load: Vec::new(),
             chain_blocks: ChainBlocks::default(),
+            deferred_index: DeferredIndex::default(),
+            wall_slots: Vec::new(),
             external_loads: false,
             pacer: Pacer::default(),
             simd: simd_available(),
@@ -938,11 +949,23 @@ impl Simulation {
         for chain in self.chains.iter_mut() {
             chain.remap(&new_of_old);
         }
-        self.chain_blocks = ChainBlocks::new(&self.chains, &self.neighbors.block_ranges);
+        self.index_blocks();
         for (k, &e) in self.order.iter().enumerate() {
             self.rank[e as usize] = k as u32;
         }
         Ok(())
+    }
+
+    /// The per-block indexes of the chains, bonds and wall pairs, for the
+    /// current blocks (at the start of a run call and after every rebuild).
+    pub(crate) fn index_blocks(&mut self) {
+        let blocks = &self.neighbors.block_ranges;
+        self.chain_blocks = ChainBlocks::new(&self.chains, blocks);
+        self.deferred_index = DeferredIndex::new(
+            &self.bonds.list,
+            &self.neighbors.wall_pairs.particle,
+            blocks,
+        );
     }
 
     /// External (user) index of internal particle slot `k`. The engine keeps

@@ -2,13 +2,13 @@
 //! order of the module documentation of [`crate::pipeline`].
 use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 
+use super::deferred::{DeferredForces, WallSlot};
 use super::pair_kernel::{
     pair_kernel, wall_contact, BlockWork, BufferSink, ContactTally, CrossForces, DirectSink,
     PairForce, PairKernel, ResetKernel,
 };
 use super::Simulation;
 use crate::bond::{bond_slot, BondMotion, BondSlot};
-use crate::boundary::ChainBlocks;
 use crate::diagnostics::Measurements;
 use crate::error::Result;
 use crate::integrate::{
@@ -45,8 +45,9 @@ impl Simulation {
     /// large enough: one broadcast per call, worker 0 steps, the others serve phases.
     fn run_steps(&mut self, n: u64, measure_last: bool) -> Result<()> {
         self.check_consistent()?;
-        // the chains cannot change during a run call (a rebuild maps them along)
-        self.chain_blocks = ChainBlocks::new(&self.chains, &self.neighbors.block_ranges);
+        // the chains and bonds cannot change during a run call (a rebuild maps
+        // them along and indexes them again)
+        self.index_blocks();
         // external loads cannot change during a run call: scan them once, not every step
         let p = &self.particles;
         self.external_loads = p.external_force.iter().any(|f| *f != [0.0, 0.0])
@@ -102,14 +103,21 @@ impl Simulation {
     fn step<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Result<()> {
         self.ensure_neighbors()?;
         let mut stripes = self.particle_contacts::<MEASURE>(team);
-        let bonds = self.apply_bond_forces::<MEASURE>();
-        let (walls, wall_work) = self.wall_forces::<MEASURE>();
+        // with a team, each block's integration adds the bonds' and walls' forces
+        let defer = team.is_some()
+            && self.deferred_index.fits(
+                self.neighbors.block_ranges.len(),
+                self.bonds.list.len(),
+                self.neighbors.wall_pairs.wall.len(),
+            );
+        let bonds = self.apply_bond_forces::<MEASURE>(!defer);
+        let (walls, wall_work) = self.wall_forces::<MEASURE>(defer);
         if team.is_none() {
             self.cross_pairs_in_order::<MEASURE>(&mut stripes);
         }
         let contacts = merge_tallies(&stripes, &bonds);
         self.servo_walls();
-        let motion = self.integrate::<MEASURE>(team);
+        let motion = self.integrate::<MEASURE>(team, defer);
         self.move_walls();
         self.deform_cell();
         self.track_displacements(&motion);
@@ -434,17 +442,24 @@ impl Simulation {
     }
 
     /// Step 4: the bonds' forces, computed with the contact phase
-    /// ([`Simulation::particle_contacts`]), added to the particles in bond order.
-    fn apply_bond_forces<const MEASURE: bool>(&mut self) -> ContactTally {
+    /// ([`Simulation::particle_contacts`]), added to the particles in bond order
+    /// (`apply`; else each block's integration adds them, `pipeline::deferred`),
+    /// and their tally.
+    fn apply_bond_forces<const MEASURE: bool>(&mut self, apply: bool) -> ContactTally {
         let mut tally = ContactTally::default();
+        if !apply && !MEASURE {
+            return tally;
+        }
         let p = &mut self.particles;
         for (bond, slot) in self.bonds.list.iter().zip(&self.bond_slots) {
-            let (i, j) = (bond.i as usize, bond.j as usize);
-            let f = slot.force;
-            p.force[j] = add(p.force[j], f);
-            p.force[i] = sub(p.force[i], f);
-            p.torque[i] -= slot.torque_i;
-            p.torque[j] -= slot.torque_j;
+            if apply {
+                let (i, j) = (bond.i as usize, bond.j as usize);
+                let f = slot.force;
+                p.force[j] = add(p.force[j], f);
+                p.force[i] = sub(p.force[i], f);
+                p.torque[i] -= slot.torque_i;
+                p.torque[j] -= slot.torque_j;
+            }
             if MEASURE {
                 tally.elastic += slot.elastic;
                 tally.force_sum += slot.force_norm;
@@ -454,9 +469,10 @@ impl Simulation {
         tally
     }
 
-    /// Step 5: particle-wall contacts; returns the tally and the walls' work over
-    /// their last step's displacement.
-    fn wall_forces<const MEASURE: bool>(&mut self) -> (ContactTally, f64) {
+    /// Step 5: particle-wall contacts, their forces added to the particles (or,
+    /// `defer`, kept in slots for each block's integration to add); returns the
+    /// tally and the walls' work over their last step's displacement.
+    fn wall_forces<const MEASURE: bool>(&mut self, defer: bool) -> (ContactTally, f64) {
         let mut tally = ContactTally::default();
         let previous_force: Vec<Vec2> = self.walls.iter().map(|w| w.force).collect();
         for wall in &mut self.walls {
@@ -467,6 +483,9 @@ impl Simulation {
         let dt = self.params.time_step;
         let increment_time = self.increment_time();
         let wp = &mut self.neighbors.wall_pairs;
+        if defer {
+            self.wall_slots.resize(wp.wall.len(), WallSlot::default());
+        }
         for k in 0..wp.wall.len() {
             let wall = &mut self.walls[wp.wall[k] as usize];
             let q = wp.particle[k] as usize;
@@ -481,6 +500,9 @@ impl Simulation {
                 &mut wp.shear[k],
             ) else {
                 wp.sliding[k] = false;
+                if defer {
+                    self.wall_slots[k].active = false;
+                }
                 continue;
             };
             wp.sliding[k] = c.sliding;
@@ -488,8 +510,16 @@ impl Simulation {
             let r = p.radius[q];
             let n = g.normal;
             let f = add(scale(n, c.normal), scale(perp(n), c.shear));
-            p.force[q] = add(p.force[q], f);
-            p.torque[q] -= r * c.shear;
+            if defer {
+                self.wall_slots[k] = WallSlot {
+                    force: f,
+                    torque: r * c.shear,
+                    active: true,
+                };
+            } else {
+                p.force[q] = add(p.force[q], f);
+                p.torque[q] -= r * c.shear;
+            }
             wall.force = sub(wall.force, f);
             wall.contact_count += 1;
             wall.stiffness_sum += model.normal_stiffness;
@@ -516,8 +546,14 @@ impl Simulation {
         (tally, work)
     }
 
-    /// Step 7: leapfrog with local damping in parallel chunks.
-    fn integrate<const MEASURE: bool>(&mut self, team: Option<&Team>) -> IntegrationTally {
+    /// Step 7: leapfrog with local damping in parallel chunks; with a team each
+    /// chunk first adds its particles' deferred bond and wall forces (`defer`),
+    /// then their cross-block pairs.
+    fn integrate<const MEASURE: bool>(
+        &mut self,
+        team: Option<&Team>,
+        defer: bool,
+    ) -> IntegrationTally {
         // with a team the cross-block forces wait in the buffer (else they are applied)
         let buffered = team.is_some();
         let dt = self.params.time_step;
@@ -571,6 +607,13 @@ impl Simulation {
             touch: &self.neighbors.cross_touch,
             touch_start: &self.neighbors.cross_touch_start,
         };
+        let deferred = DeferredForces {
+            index: &self.deferred_index,
+            bonds: &self.bonds.list,
+            bond_slots: &self.bond_slots,
+            wall_particles: &self.neighbors.wall_pairs.particle,
+            wall_slots: &self.wall_slots,
+        };
         type Work<'w> = (
             usize,
             usize,
@@ -615,6 +658,10 @@ impl Simulation {
             team,
             chunks,
             |(b, lo, position, velocity, rotation, angular_velocity, force, torque)| {
+                if defer {
+                    // the bonds, then the wall contacts, as their serial passes add them
+                    deferred.apply(b, lo, force, torque);
+                }
                 if buffered {
                     // the cross-block pairs touching this block, in pair order, as a
                     // sequential pass over all of them adds them

@@ -1,0 +1,256 @@
+//! The bonds' and the walls' forces of a step, added to the particles by each
+//! block's integration instead of by one thread between the two parallel phases.
+//!
+//! On one thread the forces reach a particle in this order: its block's
+//! interior pairs, the bonds in bond order, the wall contacts in wall-pair
+//! order, then the pairs across blocks. With a team the bonds and the wall
+//! contacts wait in slots; each block's integration adds, to its own particles,
+//! first the bond slots that touch them in bond order, then their wall slots in
+//! wall-pair order, then the cross pairs, so every particle receives the same
+//! additions in the same order on any number of threads, and the bits do not
+//! change. The particles' force arrays stay in the cache of the worker that
+//! owns their block, instead of crossing to the thread that ran the serial pass.
+use crate::bond::{Bond, BondSlot};
+use crate::vec2::{add, sub, Vec2};
+
+/// A wall contact's force on its particle this step (set by the wall pass).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct WallSlot {
+    /// Force on the particle (N).
+    pub force: Vec2,
+    /// Taken from the particle's torque (N m): its radius times the shear force.
+    pub torque: f64,
+    /// Whether the pair touched (a pair in the list may be apart).
+    pub active: bool,
+}
+
+/// For each block, the entries of a list whose particle lies in the block, in
+/// list order (CSR: `entries[start[b]..start[b + 1]]`).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct BlockTouches {
+    entries: Vec<u32>,
+    start: Vec<usize>,
+}
+
+impl BlockTouches {
+    /// The touches of `(particle, entry)` items given in list order; `None`
+    /// when a particle lies outside `block_ranges` (blocks of an older list).
+    fn new(
+        block_ranges: &[(usize, usize)],
+        items: impl Iterator<Item = (usize, u32)>,
+    ) -> Option<Self> {
+        let mut per_block: Vec<Vec<u32>> = vec![Vec::new(); block_ranges.len()];
+        for (q, entry) in items {
+            let b = block_ranges.partition_point(|&(_, hi)| hi <= q);
+            if b >= block_ranges.len() || q < block_ranges[b].0 {
+                return None;
+            }
+            per_block[b].push(entry);
+        }
+        let mut start = Vec::with_capacity(block_ranges.len() + 1);
+        start.push(0);
+        let mut entries = Vec::new();
+        for list in per_block {
+            entries.extend(list);
+            start.push(entries.len());
+        }
+        Some(BlockTouches { entries, start })
+    }
+
+    fn of_block(&self, b: usize) -> &[u32] {
+        &self.entries[self.start[b]..self.start[b + 1]]
+    }
+
+    fn covers(&self, n_blocks: usize, n_entries: usize) -> bool {
+        self.start.len() == n_blocks + 1 && self.entries.len() == n_entries
+    }
+}
+
+/// The bond and wall touches of the current blocks (kept current by `run` and
+/// every rebuild, like the chains' block index).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct DeferredIndex {
+    /// `(bond << 1) | side` (side 0: the bond's `i`, 1: its `j`).
+    bonds: BlockTouches,
+    /// Wall-pair indices.
+    walls: BlockTouches,
+    /// Whether the index matches the bonds, wall pairs and blocks it was built from.
+    valid: bool,
+}
+
+impl DeferredIndex {
+    /// The index of `bonds` and of the wall pairs' particles `wall_particles`
+    /// over `block_ranges`; not valid (the forces are then added on one thread)
+    /// when a particle lies outside the blocks.
+    pub(crate) fn new(
+        bonds: &[Bond],
+        wall_particles: &[u32],
+        block_ranges: &[(usize, usize)],
+    ) -> Self {
+        let bond_items = bonds.iter().enumerate().flat_map(|(k, b)| {
+            let k = k as u32;
+            [(b.i as usize, k << 1), (b.j as usize, (k << 1) | 1)]
+        });
+        let wall_items = wall_particles
+            .iter()
+            .enumerate()
+            .map(|(k, &q)| (q as usize, k as u32));
+        match (
+            BlockTouches::new(block_ranges, bond_items),
+            BlockTouches::new(block_ranges, wall_items),
+        ) {
+            (Some(bonds), Some(walls)) => DeferredIndex {
+                bonds,
+                walls,
+                valid: true,
+            },
+            _ => DeferredIndex::default(),
+        }
+    }
+
+    /// Whether the index serves `n_blocks` blocks, `n_bonds` bonds and `n_wall_pairs` wall pairs.
+    pub(crate) fn fits(&self, n_blocks: usize, n_bonds: usize, n_wall_pairs: usize) -> bool {
+        self.valid
+            && self.bonds.covers(n_blocks, 2 * n_bonds)
+            && self.walls.covers(n_blocks, n_wall_pairs)
+    }
+}
+
+/// The slots of one step, ready to be added block by block.
+pub(crate) struct DeferredForces<'a> {
+    pub(crate) index: &'a DeferredIndex,
+    pub(crate) bonds: &'a [Bond],
+    pub(crate) bond_slots: &'a [BondSlot],
+    pub(crate) wall_particles: &'a [u32],
+    pub(crate) wall_slots: &'a [WallSlot],
+}
+
+impl DeferredForces<'_> {
+    /// Adds the bond and wall forces on block `b`'s particles to `force` /
+    /// `torque` (which start at particle `lo`), as the serial passes add them.
+    pub(crate) fn apply(&self, b: usize, lo: usize, force: &mut [Vec2], torque: &mut [f64]) {
+        for &entry in self.index.bonds.of_block(b) {
+            let k = (entry >> 1) as usize;
+            let (bond, slot) = (&self.bonds[k], &self.bond_slots[k]);
+            if entry & 1 == 1 {
+                let q = bond.j as usize - lo;
+                force[q] = add(force[q], slot.force);
+                torque[q] -= slot.torque_j;
+            } else {
+                let q = bond.i as usize - lo;
+                force[q] = sub(force[q], slot.force);
+                torque[q] -= slot.torque_i;
+            }
+        }
+        for &k in self.index.walls.of_block(b) {
+            let slot = &self.wall_slots[k as usize];
+            if slot.active {
+                let q = self.wall_particles[k as usize] as usize - lo;
+                force[q] = add(force[q], slot.force);
+                torque[q] -= slot.torque;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bond(i: u32, j: u32) -> Bond {
+        Bond {
+            i,
+            j,
+            normal_stiffness: 1.0,
+            shear_stiffness: 1.0,
+            rest_length: 1.0,
+            shear: 0.0,
+        }
+    }
+
+    #[test]
+    fn every_bond_end_and_wall_pair_lands_in_its_block_in_list_order() {
+        let blocks = [(0, 3), (3, 5), (5, 8)];
+        let bonds = [bond(0, 4), bond(6, 1), bond(3, 4)];
+        let index = DeferredIndex::new(&bonds, &[7, 2, 5], &blocks);
+        assert!(index.fits(3, 3, 3));
+        assert!(!index.fits(3, 4, 3));
+        assert_eq!(index.bonds.of_block(0), &[0 << 1, (1 << 1) | 1]);
+        assert_eq!(index.bonds.of_block(1), &[1, 2 << 1, (2 << 1) | 1]);
+        assert_eq!(index.bonds.of_block(2), &[1 << 1]);
+        assert_eq!(index.walls.of_block(0), &[1]);
+        assert!(index.walls.of_block(1).is_empty());
+        assert_eq!(index.walls.of_block(2), &[0, 2]);
+    }
+
+    #[test]
+    fn a_particle_outside_the_blocks_leaves_the_index_invalid() {
+        let index = DeferredIndex::new(&[bond(0, 9)], &[], &[(0, 3), (3, 5)]);
+        assert!(!index.fits(2, 1, 0));
+    }
+
+    #[test]
+    fn block_by_block_adds_what_the_serial_passes_add_bit_for_bit() {
+        // awkward magnitudes, so that any change of the addition order shows
+        let blocks = [(0, 2), (2, 4)];
+        let bonds = [bond(0, 3), bond(2, 0), bond(1, 2)];
+        let bond_slots: Vec<BondSlot> = (0..3)
+            .map(|k| BondSlot {
+                force: [1e16 / (k as f64 + 3.0), -0.1 * (k as f64 + 1.0)],
+                torque_i: 1e-3 * (k as f64 + 0.7),
+                torque_j: 3.3e8 * (k as f64 - 1.1),
+                ..BondSlot::default()
+            })
+            .collect();
+        let wall_particles = [0, 3, 0, 1];
+        let wall_slots: Vec<WallSlot> = (0..4)
+            .map(|k| WallSlot {
+                force: [0.3 * k as f64 - 1e15, 1e-7 / (k as f64 + 1.0)],
+                torque: 7e7 * k as f64 + 0.1,
+                active: k != 1,
+            })
+            .collect();
+        let start_force: Vec<Vec2> = (0..4).map(|q| [0.1 * q as f64 + 1.0, 1e17]).collect();
+        let start_torque: Vec<f64> = (0..4).map(|q| 1e-9 * (q as f64 + 1.0)).collect();
+        // the serial passes: bonds in bond order, then the wall contacts in order
+        let (mut force, mut torque) = (start_force.clone(), start_torque.clone());
+        for (b, s) in bonds.iter().zip(&bond_slots) {
+            let (i, j) = (b.i as usize, b.j as usize);
+            force[j] = add(force[j], s.force);
+            force[i] = sub(force[i], s.force);
+            torque[i] -= s.torque_i;
+            torque[j] -= s.torque_j;
+        }
+        for (&q, s) in wall_particles.iter().zip(&wall_slots) {
+            if s.active {
+                force[q as usize] = add(force[q as usize], s.force);
+                torque[q as usize] -= s.torque;
+            }
+        }
+        let index = DeferredIndex::new(&bonds, &wall_particles, &blocks);
+        let deferred = DeferredForces {
+            index: &index,
+            bonds: &bonds,
+            bond_slots: &bond_slots,
+            wall_particles: &wall_particles,
+            wall_slots: &wall_slots,
+        };
+        let (mut blocked_force, mut blocked_torque) = (start_force, start_torque);
+        for (b, &(lo, hi)) in blocks.iter().enumerate() {
+            deferred.apply(
+                b,
+                lo,
+                &mut blocked_force[lo..hi],
+                &mut blocked_torque[lo..hi],
+            );
+        }
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(&blocked_force.concat()),
+            bits(&force.concat()),
+            "forces"
+        );
+        assert_eq!(bits(&blocked_torque), bits(&torque), "torques");
+        assert_ne!(force[0], [1.0, 1e17], "the case adds something");
+    }
+}
