@@ -28,6 +28,7 @@ bench:  ## every speed figure of docs/engine.md, side by side, medians (about 25
 	python benchmarks/throughput_large.py --repeat 3
 	python benchmarks/analysis_large.py --repeat 3
 	python benchmarks/biaxial_default.py --repeat 1
+	python benchmarks/consolidation.py
 
 bench-engine:  ## the engine alone (no Python): the throughput case from Rust
 	cargo run --release -p grainlab-core --example throughput -- 1

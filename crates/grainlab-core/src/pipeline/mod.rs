@@ -10,6 +10,8 @@
 //!    from full-step velocities (see [`Simulation::catch_up_shear_springs`]).
 //! 4. **Bonds**: linear normal and shear springs that carry tension.
 //! 5. **Wall contacts**: the same law against walls; walls sum their force.
+//!    With a team the forces of 4 and 5 wait in slots, and each block's
+//!    integration (7) adds its own particles' in the same order (`deferred.rs`).
 //! 6. **Servo**: servo-controlled walls set their velocity from this step's force.
 //! 7. **Integrate**: leapfrog with local damping, in parallel chunks; the
 //!    periodic cell's affine map is applied to positions; displacements since
@@ -27,7 +29,8 @@
 //! step) and queries; `step.rs` the step as a list of named stages;
 //! `pair_kernel.rs` the contact law over the pair lists, the reset and the
 //! particle-wall contact; `pair_lanes.rs` its undamped loop four pairs at a
-//! time (AVX2, the same bits); `checks.rs` the consistency checks and the errors
+//! time (AVX2, the same bits); `deferred.rs` the bond and wall forces added
+//! block by block; `checks.rs` the consistency checks and the errors
 //! of an unstable run. The bond law is in [`crate::bond`], the nearest image
 //! in [`crate::cell`].
 mod checks;

@@ -120,7 +120,15 @@ def _generate(config: BiaxialConfig, threads: int, progress: bool) -> tuple[Simu
     return sim, run
 
 
-def _consolidate(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
+def _consolidate(
+    sim: Simulation,
+    run: _Run,
+    config: BiaxialConfig,
+    progress: bool,
+    on_chunk: Callable[[BoxState, int], None] | None = None,
+) -> None:
+    """Servo-controls the box to the confining pressure until equilibrium;
+    ``on_chunk(state, steps)`` after every chunk (``benchmarks/consolidation.py``)."""
     start = time.perf_counter()
     consolidation_model = ContactModel(
         config["material.normal_stiffness"], config["material.shear_stiffness"], config["consolidation.friction"]
@@ -140,6 +148,8 @@ def _consolidate(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bo
         bar.update(CHUNK_STEPS)
         bar.set_postfix_str(f"sxx {state.stress_xx_pa / 1e3:.1f} kPa, syy {state.stress_yy_pa / 1e3:.1f} kPa, "
                             f"unbalanced {sim.unbalanced_force_ratio:.1e}")
+        if on_chunk is not None:
+            on_chunk(state, steps)
 
     walls = {name: sim.wall(run.walls[name]) for name in BOX_WALLS}
     state, steps, converged = servo_box(
