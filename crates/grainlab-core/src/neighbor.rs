@@ -424,20 +424,7 @@ impl NeighborList {
         }
 
         // 5. carry the history of touching pairs over, correcting shifts for the wraps
-        let old = &self.pairs;
-        let mut history: PairMap<(u32, u32, [i8; 2]), (f64, bool)> = PairMap::default();
-        history.reserve(old.len());
-        for k in 0..old.len() {
-            if old.shear[k] != 0.0 || old.sliding[k] {
-                let (i, j) = (old.i[k] as usize, old.j[k] as usize);
-                let s = old.shift[k];
-                let shift = [
-                    s[0] - wraps[j][0] + wraps[i][0],
-                    s[1] - wraps[j][1] + wraps[i][1],
-                ];
-                history.insert((old.i[k], old.j[k], shift), (old.shear[k], old.sliding[k]));
-            }
-        }
+        let history = PairHistory::new(&self.pairs, &wraps, n);
         let mut pairs = PairList::default();
         for list in &per_block {
             pairs.block_start.push(pairs.len());
@@ -445,7 +432,7 @@ impl NeighborList {
                 let model =
                     MaterialTable::index(particles.group[i as usize], particles.group[j as usize]);
                 pairs.push(i, j, shift, model);
-                if let Some(&(shear, sliding)) = history.get(&(i, j, shift)) {
+                if let Some((shear, sliding)) = history.get(i, j, shift) {
                     let k = pairs.len() - 1;
                     pairs.shear[k] = shear;
                     pairs.sliding[k] = sliding;
@@ -633,6 +620,58 @@ fn counting_sort(bins: &[u32], n_bins: usize) -> (Vec<usize>, Vec<u32>) {
         fill[b as usize] += 1;
     }
     (start, members)
+}
+
+/// The old list's touching pairs (a shear spring or sliding), renumbered, with
+/// their image shifts corrected for this rebuild's wraps, grouped by their first
+/// particle `i` (a counting sort: CSR over `i`), for the carry-over. A new pair
+/// finds its history among the few entries of its `i`; the new pairs come in
+/// increasing `i` within each block's list, so the lookups walk the entries
+/// nearly in order, where a hash map of millions of pairs missed the cache on
+/// every insert and lookup.
+struct PairHistory {
+    /// Offsets of each particle's entries (`n + 1`).
+    start: Vec<u32>,
+    /// `(j, shift, shear, sliding)` per touching pair, grouped by `i`.
+    entries: Vec<(u32, [i8; 2], f64, bool)>,
+}
+
+impl PairHistory {
+    /// The touching pairs of `old` (renumbered, `i < j`) among `n` particles;
+    /// `wraps` are the new indices' wraps of this rebuild.
+    fn new(old: &PairList, wraps: &[[i8; 2]], n: usize) -> Self {
+        let touching = |k: usize| old.shear[k] != 0.0 || old.sliding[k];
+        let mut start = vec![0u32; n + 1];
+        for k in (0..old.len()).filter(|&k| touching(k)) {
+            start[old.i[k] as usize + 1] += 1;
+        }
+        for q in 0..n {
+            start[q + 1] += start[q];
+        }
+        let mut fill: Vec<u32> = start[..n].to_vec();
+        let mut entries = vec![(0u32, [0i8; 2], 0.0, false); start[n] as usize];
+        for k in (0..old.len()).filter(|&k| touching(k)) {
+            let (i, j) = (old.i[k] as usize, old.j[k] as usize);
+            let s = old.shift[k];
+            let shift = [
+                s[0] - wraps[j][0] + wraps[i][0],
+                s[1] - wraps[j][1] + wraps[i][1],
+            ];
+            let slot = &mut fill[i];
+            entries[*slot as usize] = (old.j[k], shift, old.shear[k], old.sliding[k]);
+            *slot += 1;
+        }
+        PairHistory { start, entries }
+    }
+
+    /// The shear spring and sliding flag of pair `(i, j, shift)`, if it touched.
+    fn get(&self, i: u32, j: u32, shift: [i8; 2]) -> Option<(f64, bool)> {
+        let (lo, hi) = (self.start[i as usize], self.start[i as usize + 1]);
+        self.entries[lo as usize..hi as usize]
+            .iter()
+            .find(|e| e.0 == j && e.1 == shift)
+            .map(|e| (e.2, e.3))
+    }
 }
 
 /// A map keyed by particle indices, for the history carry-over of a rebuild:
