@@ -4,7 +4,10 @@
 //! On one thread the forces reach a particle in this order: its block's
 //! interior pairs, the bonds in bond order, the wall contacts in wall-pair
 //! order, then the pairs across blocks. With a team the bonds and the wall
-//! contacts wait in slots; each block's integration adds, to its own particles,
+//! contacts are evaluated in the contact phase (each block its share of the
+//! bonds and the wall pairs of its own particles) and wait in slots; the walls'
+//! forces and the tally are then summed over the slots in wall-pair order, and
+//! each block's integration adds, to its own particles,
 //! first the bond slots that touch them in bond order, then their wall slots in
 //! wall-pair order, then the cross pairs, so every particle receives the same
 //! additions in the same order on any number of threads, and the bits do not
@@ -13,13 +16,23 @@
 use crate::bond::{Bond, BondSlot};
 use crate::vec2::{add, sub, Vec2};
 
-/// A wall contact's force on its particle this step (set by the wall pass).
+/// A wall contact's force on its particle this step, and its terms of the
+/// step's tally (evaluated by the block that owns the particle, in the contact
+/// phase; summed onto the walls and the tally in wall-pair order afterwards).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct WallSlot {
     /// Force on the particle (N).
     pub force: Vec2,
     /// Taken from the particle's torque (N m): its radius times the shear force.
     pub torque: f64,
+    /// Energy dissipated by sliding and by the dashpots this step (J).
+    pub friction: f64,
+    pub viscous: f64,
+    /// Elastic energy (J) and force magnitude (N), measured steps only.
+    pub elastic: f64,
+    pub force_norm: f64,
+    /// The overlap exceeds the allowed fraction of the radius.
+    pub overlap_violation: bool,
     /// Whether the pair touched (a pair in the list may be apart).
     pub active: bool,
 }
@@ -106,6 +119,11 @@ impl DeferredIndex {
             },
             _ => DeferredIndex::default(),
         }
+    }
+
+    /// The wall pairs whose particle lies in block `b`, in wall-pair order.
+    pub(crate) fn walls_of_block(&self, b: usize) -> &[u32] {
+        self.walls.of_block(b)
     }
 
     /// Whether the index serves `n_blocks` blocks, `n_bonds` bonds and `n_wall_pairs` wall pairs.
@@ -208,6 +226,7 @@ mod tests {
                 force: [0.3 * k as f64 - 1e15, 1e-7 / (k as f64 + 1.0)],
                 torque: 7e7 * k as f64 + 0.1,
                 active: k != 1,
+                ..WallSlot::default()
             })
             .collect();
         let start_force: Vec<Vec2> = (0..4).map(|q| [0.1 * q as f64 + 1.0, 1e17]).collect();

@@ -35,6 +35,27 @@ impl ContactTally {
     }
 }
 
+/// What a particle-wall contact reads of the particles.
+pub(crate) struct DiskState<'a> {
+    pub(crate) position: &'a [Vec2],
+    pub(crate) velocity: &'a [Vec2],
+    pub(crate) angular_velocity: &'a [f64],
+    pub(crate) radius: &'a [f64],
+    pub(crate) mass: &'a [f64],
+}
+
+impl<'a> DiskState<'a> {
+    pub(crate) fn of(p: &'a Particles) -> Self {
+        DiskState {
+            position: &p.position,
+            velocity: &p.velocity,
+            angular_velocity: &p.angular_velocity,
+            radius: &p.radius,
+            mass: &p.mass,
+        }
+    }
+}
+
 /// Particle `q` against `wall` at the current state: the geometry and the
 /// contact law's forces on the particle, updating `spring` (the pair's shear
 /// spring, or a copy for a query) over `increment_time`; `None`, with the
@@ -43,7 +64,7 @@ impl ContactTally {
 pub(crate) fn wall_contact(
     wall: &Wall,
     model: &ContactModel,
-    p: &Particles,
+    p: &DiskState<'_>,
     q: usize,
     dt: f64,
     increment_time: f64,

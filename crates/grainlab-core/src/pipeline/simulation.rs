@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use super::deferred::{DeferredIndex, WallSlot};
 use super::pair_kernel::{
-    pair_kernel, wall_contact, NullSink, PairForce, PairKernel, PairRecord, RecordSink,
+    pair_kernel, wall_contact, DiskState, NullSink, PairForce, PairKernel, PairRecord, RecordSink,
 };
 use crate::bond::{bond_force, Bond, BondForce, BondMotion, BondSlot, Bonds};
 use crate::boundary::{ChainBlocks, PressureChain};
@@ -774,7 +774,8 @@ impl Simulation {
             let wall = &self.walls[wp.wall[k] as usize];
             let model = self.materials.by_index(wp.model[k]);
             let q = wp.particle[k] as usize;
-            match wall_contact(wall, model, &self.particles, q, dt, dt, &mut wp.shear[k]) {
+            let disks = DiskState::of(&self.particles);
+            match wall_contact(wall, model, &disks, q, dt, dt, &mut wp.shear[k]) {
                 Some((_, c)) => {
                     wp.sliding[k] = c.sliding;
                     friction += c.friction_dissipation;
@@ -816,7 +817,7 @@ impl Simulation {
                 wall_contact(
                     wall,
                     model,
-                    &self.particles,
+                    &DiskState::of(&self.particles),
                     q,
                     dt,
                     increment_time,

@@ -5,7 +5,7 @@ use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 use super::deferred::{DeferredForces, WallSlot};
 use super::pair_kernel::{
     pair_kernel, wall_contact, BlockWork, BufferSink, ContactTally, CrossForces, DirectSink,
-    PairForce, PairKernel, ResetKernel,
+    DiskState, PairForce, PairKernel, ResetKernel,
 };
 use super::Simulation;
 use crate::bond::{bond_slot, BondMotion, BondSlot};
@@ -102,14 +102,15 @@ impl Simulation {
     /// energy, contact counts and the unbalanced force ratio.
     fn step<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Result<()> {
         self.ensure_neighbors()?;
-        let mut stripes = self.particle_contacts::<MEASURE>(team);
-        // with a team, each block's integration adds the bonds' and walls' forces
+        // with a team, the blocks evaluate their particles' wall contacts in the
+        // contact phase, and each block's integration adds the bonds' and walls' forces
         let defer = team.is_some()
             && self.deferred_index.fits(
                 self.neighbors.block_ranges.len(),
                 self.bonds.list.len(),
                 self.neighbors.wall_pairs.wall.len(),
             );
+        let mut stripes = self.particle_contacts::<MEASURE>(team, defer);
         let bonds = self.apply_bond_forces::<MEASURE>(!defer);
         let (walls, wall_work) = self.wall_forces::<MEASURE>(defer);
         if team.is_none() {
@@ -257,7 +258,11 @@ impl Simulation {
     /// each stripe's tally. With a team the pairs across stripes are evaluated in
     /// the same phase into a buffer that each stripe's integration applies (step
     /// 7); without one they wait for [`Simulation::cross_pairs_in_order`].
-    fn particle_contacts<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Vec<ContactTally> {
+    fn particle_contacts<const MEASURE: bool>(
+        &mut self,
+        team: Option<&Team>,
+        defer: bool,
+    ) -> Vec<ContactTally> {
         let increment_time = self.increment_time();
         let buffer_cross = team.is_some();
         let n_blocks = self.neighbors.block_ranges.len();
@@ -353,6 +358,28 @@ impl Simulation {
         };
         let cell = self.cell.as_ref();
         let block_ranges = &self.neighbors.block_ranges;
+        // the wall pairs, each evaluated by the block of its particle (`defer`)
+        let wp = &mut self.neighbors.wall_pairs;
+        if defer {
+            self.wall_slots.resize(wp.wall.len(), WallSlot::default());
+        }
+        let wall_pairs = WallPairWork {
+            wall: &wp.wall,
+            particle: &wp.particle,
+            model: &wp.model,
+            shear: DisjointWriter::new(&mut wp.shear),
+            sliding: DisjointWriter::new(&mut wp.sliding),
+            slots: DisjointWriter::new(&mut self.wall_slots),
+        };
+        let disks = DiskState {
+            position: &p.position,
+            velocity: &p.velocity,
+            angular_velocity: &p.angular_velocity,
+            radius: &p.radius,
+            mass: &p.mass,
+        };
+        let (materials, deferred_index) = (&self.materials, &self.deferred_index);
+        let (dt, max_overlap_ratio) = (self.params.time_step, self.params.max_overlap_ratio);
         let tallies = map_blocks(team, blocks, |work| {
             let b = work.block;
             let mut direct = DirectSink {
@@ -397,6 +424,40 @@ impl Simulation {
                         velocity_gradient,
                         increment_time,
                     );
+                }
+                if defer {
+                    // SAFETY: each wall pair is in the list of one block only
+                    for &k in deferred_index.walls_of_block(b) {
+                        let k = k as usize;
+                        let wall = &walls[wall_pairs.wall[k] as usize];
+                        let model = materials.by_index(wall_pairs.model[k]);
+                        let q = wall_pairs.particle[k] as usize;
+                        let spring = wall_pairs.shear.get(k);
+                        let contact =
+                            wall_contact(wall, model, &disks, q, dt, increment_time, spring);
+                        let slot = wall_pairs.slots.get(k);
+                        let Some((g, c)) = contact else {
+                            *wall_pairs.sliding.get(k) = false;
+                            slot.active = false;
+                            continue;
+                        };
+                        *wall_pairs.sliding.get(k) = c.sliding;
+                        let r = disks.radius[q];
+                        let n = g.normal;
+                        *slot = WallSlot {
+                            force: add(scale(n, c.normal), scale(perp(n), c.shear)),
+                            torque: r * c.shear,
+                            friction: c.friction_dissipation,
+                            viscous: c.viscous_dissipation,
+                            overlap_violation: g.overlap > max_overlap_ratio * r,
+                            active: true,
+                            ..WallSlot::default()
+                        };
+                        if MEASURE {
+                            slot.elastic = elastic_energy(model, c.elastic_normal, *spring);
+                            slot.force_norm = (c.normal * c.normal + c.shear * c.shear).sqrt();
+                        }
+                    }
                 }
                 tally
             }
@@ -470,8 +531,10 @@ impl Simulation {
     }
 
     /// Step 5: particle-wall contacts, their forces added to the particles (or,
-    /// `defer`, kept in slots for each block's integration to add); returns the
-    /// tally and the walls' work over their last step's displacement.
+    /// `defer`, evaluated by the blocks in the contact phase and kept in slots for
+    /// each block's integration to add: here only summed onto the walls and the
+    /// tally, in wall-pair order); returns the tally and the walls' work over
+    /// their last step's displacement.
     fn wall_forces<const MEASURE: bool>(&mut self, defer: bool) -> (ContactTally, f64) {
         let mut tally = ContactTally::default();
         let previous_force: Vec<Vec2> = self.walls.iter().map(|w| w.force).collect();
@@ -483,54 +546,57 @@ impl Simulation {
         let dt = self.params.time_step;
         let increment_time = self.increment_time();
         let wp = &mut self.neighbors.wall_pairs;
-        if defer {
-            self.wall_slots.resize(wp.wall.len(), WallSlot::default());
-        }
         for k in 0..wp.wall.len() {
             let wall = &mut self.walls[wp.wall[k] as usize];
-            let q = wp.particle[k] as usize;
             let model = self.materials.by_index(wp.model[k]);
-            let Some((g, c)) = wall_contact(
-                wall,
-                model,
-                &self.particles,
-                q,
-                dt,
-                increment_time,
-                &mut wp.shear[k],
-            ) else {
-                wp.sliding[k] = false;
-                if defer {
-                    self.wall_slots[k].active = false;
+            let slot = if defer {
+                match self.wall_slots[k] {
+                    slot if slot.active => slot,
+                    _ => continue,
                 }
-                continue;
-            };
-            wp.sliding[k] = c.sliding;
-            let p = &mut self.particles;
-            let r = p.radius[q];
-            let n = g.normal;
-            let f = add(scale(n, c.normal), scale(perp(n), c.shear));
-            if defer {
-                self.wall_slots[k] = WallSlot {
-                    force: f,
-                    torque: r * c.shear,
-                    active: true,
-                };
             } else {
+                let q = wp.particle[k] as usize;
+                let disks = DiskState::of(&self.particles);
+                let contact =
+                    wall_contact(wall, model, &disks, q, dt, increment_time, &mut wp.shear[k]);
+                let Some((g, c)) = contact else {
+                    wp.sliding[k] = false;
+                    continue;
+                };
+                wp.sliding[k] = c.sliding;
+                let p = &mut self.particles;
+                let r = p.radius[q];
+                let n = g.normal;
+                let f = add(scale(n, c.normal), scale(perp(n), c.shear));
                 p.force[q] = add(p.force[q], f);
                 p.torque[q] -= r * c.shear;
-            }
-            wall.force = sub(wall.force, f);
+                WallSlot {
+                    force: f,
+                    friction: c.friction_dissipation,
+                    viscous: c.viscous_dissipation,
+                    overlap_violation: g.overlap > self.params.max_overlap_ratio * r,
+                    elastic: if MEASURE {
+                        elastic_energy(model, c.elastic_normal, wp.shear[k])
+                    } else {
+                        0.0
+                    },
+                    force_norm: if MEASURE {
+                        (c.normal * c.normal + c.shear * c.shear).sqrt()
+                    } else {
+                        0.0
+                    },
+                    ..WallSlot::default()
+                }
+            };
+            wall.force = sub(wall.force, slot.force);
             wall.contact_count += 1;
             wall.stiffness_sum += model.normal_stiffness;
-            tally.friction += c.friction_dissipation;
-            tally.viscous += c.viscous_dissipation;
-            if g.overlap > self.params.max_overlap_ratio * r {
-                tally.overlap_violation = true;
-            }
+            tally.friction += slot.friction;
+            tally.viscous += slot.viscous;
+            tally.overlap_violation |= slot.overlap_violation;
             if MEASURE {
-                tally.elastic += elastic_energy(model, c.elastic_normal, wp.shear[k]);
-                tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
+                tally.elastic += slot.elastic;
+                tally.force_sum += slot.force_norm;
                 tally.contacts += 1;
             }
         }
@@ -699,4 +765,16 @@ impl SimPtr {
     fn get(&self) -> *mut Simulation {
         self.0
     }
+}
+
+/// The wall pairs as the contact phase's blocks evaluate them: each block its
+/// own particles' pairs (`DeferredIndex::walls_of_block`), writing only their
+/// springs, flags and slots.
+struct WallPairWork<'a> {
+    wall: &'a [u32],
+    particle: &'a [u32],
+    model: &'a [u16],
+    shear: DisjointWriter<f64>,
+    sliding: DisjointWriter<bool>,
+    slots: DisjointWriter<WallSlot>,
 }
