@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::cell::{minimum_image, PeriodicCell};
-use crate::state::Particles;
+use crate::state::ParticleMotion;
 use crate::vec2::{add, dot, mat_vec, norm, perp, scale, sub, Mat2, Vec2};
 
 /// One bond; forces follow the sign conventions of [`crate::law`].
@@ -92,34 +92,12 @@ pub(crate) struct BondForce {
     pub shear_force: f64,
 }
 
-/// What the bond law reads of the particles (slices, so that the law can run
-/// while the resultants are being written elsewhere).
-#[derive(Clone, Copy)]
-pub(crate) struct BondMotion<'a> {
-    pub position: &'a [Vec2],
-    pub velocity: &'a [Vec2],
-    pub angular_velocity: &'a [f64],
-    pub radius: &'a [f64],
-}
-
-impl<'a> BondMotion<'a> {
-    /// The particles' positions, velocities and radii.
-    pub(crate) fn of(p: &'a Particles) -> Self {
-        BondMotion {
-            position: &p.position,
-            velocity: &p.velocity,
-            angular_velocity: &p.angular_velocity,
-            radius: &p.radius,
-        }
-    }
-}
-
 /// Evaluates `bond` at the current state, adding `-ks v_t increment_time` to `shear`
 /// (its spring: the bond's own, or a copy for a query).
 #[inline(always)]
 pub(crate) fn bond_force(
     bond: &Bond,
-    p: &BondMotion<'_>,
+    p: &ParticleMotion<'_>,
     cell: Option<&PeriodicCell>,
     velocity_gradient: Option<Mat2>,
     increment_time: f64,
@@ -166,7 +144,7 @@ pub(crate) struct BondSlot {
 #[inline]
 pub(crate) fn bond_slot<const MEASURE: bool>(
     bond: &mut Bond,
-    p: &BondMotion<'_>,
+    p: &ParticleMotion<'_>,
     cell: Option<&PeriodicCell>,
     velocity_gradient: Option<Mat2>,
     increment_time: f64,

@@ -13,6 +13,7 @@
 //! the bulging boundary.
 use serde::{Deserialize, Serialize};
 
+use crate::parallel::BlockLists;
 use crate::vec2::{dot, scale, sub, Vec2};
 use crate::wall::{Wall, WallShape};
 
@@ -97,38 +98,26 @@ impl PressureChain {
 /// block's loads can be computed apart with the same bits.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct ChainBlocks {
-    entries: Vec<(u32, u32)>,
-    start: Vec<usize>,
+    /// `(chain, position in the chain)` per block.
+    lists: BlockLists<(u32, u32)>,
 }
 
 impl ChainBlocks {
     /// The entries of `chains` per block of `block_ranges` (contiguous, in
     /// order); none when the blocks do not cover the chains' particles.
     pub(crate) fn new(chains: &[PressureChain], block_ranges: &[(usize, usize)]) -> Self {
-        let mut per_block: Vec<Vec<(u32, u32)>> = vec![Vec::new(); block_ranges.len()];
-        for (c, chain) in chains.iter().enumerate() {
-            for (k, &q) in chain.particles.iter().enumerate() {
-                let b = block_ranges.partition_point(|&(_, hi)| hi <= q as usize);
-                match per_block.get_mut(b) {
-                    Some(list) => list.push((c as u32, k as u32)),
-                    // blocks of an older list: the rebuild before the next step makes new ones
-                    None => return ChainBlocks::default(),
-                }
-            }
-        }
-        let mut start = Vec::with_capacity(block_ranges.len() + 1);
-        start.push(0);
-        let mut entries = Vec::new();
-        for list in per_block {
-            entries.extend(list);
-            start.push(entries.len());
-        }
-        ChainBlocks { entries, start }
+        let items = chains.iter().enumerate().flat_map(|(c, chain)| {
+            (chain.particles.iter().enumerate())
+                .map(move |(k, &q)| (q as usize, (c as u32, k as u32)))
+        });
+        // blocks of an older list: the rebuild before the next step makes new ones
+        let lists = BlockLists::new(block_ranges, items).unwrap_or_default();
+        ChainBlocks { lists }
     }
 
-    /// Length of the block index (blocks + 1; 0 when never built).
-    pub(crate) fn start_len(&self) -> usize {
-        self.start.len()
+    /// The number of blocks the index serves (0 when never built).
+    pub(crate) fn n_blocks(&self) -> usize {
+        self.lists.n_blocks()
     }
 
     /// Sets the loads of block `b`'s particles `lo..hi` (`load` holds them from
@@ -143,10 +132,7 @@ impl ChainBlocks {
         load: &mut [Vec2],
     ) {
         load.fill([0.0; 2]);
-        if self.start.len() <= b + 1 {
-            return;
-        }
-        for &(c, k) in &self.entries[self.start[b]..self.start[b + 1]] {
+        for &(c, k) in self.lists.of_block(b) {
             let chain = &chains[c as usize];
             let (k, ps) = (k as usize, chain.particles.as_slice());
             let q = ps[k] as usize - lo;

@@ -467,6 +467,72 @@ impl<T> DisjointWriter<T> {
     }
 }
 
+/// Items grouped by the block of particles each belongs to, in their given
+/// order within a block (CSR: block `b`'s are `entries[start[b]..start[b + 1]]`),
+/// so that each block can work through its own items in the order a pass over
+/// all of them would.
+#[derive(Debug, Clone)]
+pub(crate) struct BlockLists<T> {
+    entries: Vec<T>,
+    start: Vec<usize>,
+}
+
+impl<T> Default for BlockLists<T> {
+    fn default() -> Self {
+        BlockLists {
+            entries: Vec::new(),
+            start: Vec::new(),
+        }
+    }
+}
+
+impl<T: Clone> BlockLists<T> {
+    /// `(particle, item)` pairs, in order, grouped by the block of `block_ranges`
+    /// (contiguous, in order) that holds the particle; `None` when a particle
+    /// lies outside them (blocks of an older list).
+    pub(crate) fn new(
+        block_ranges: &[(usize, usize)],
+        items: impl Iterator<Item = (usize, T)>,
+    ) -> Option<Self> {
+        let mut per_block: Vec<Vec<T>> = vec![Vec::new(); block_ranges.len()];
+        for (q, item) in items {
+            let b = block_ranges.partition_point(|&(_, hi)| hi <= q);
+            if b >= block_ranges.len() || q < block_ranges[b].0 {
+                return None;
+            }
+            per_block[b].push(item);
+        }
+        let mut start = Vec::with_capacity(block_ranges.len() + 1);
+        start.push(0);
+        let mut entries = Vec::new();
+        for list in per_block {
+            entries.extend(list);
+            start.push(entries.len());
+        }
+        Some(BlockLists { entries, start })
+    }
+}
+
+impl<T> BlockLists<T> {
+    /// Block `b`'s items (none when the lists were never built).
+    pub(crate) fn of_block(&self, b: usize) -> &[T] {
+        match (self.start.get(b), self.start.get(b + 1)) {
+            (Some(&lo), Some(&hi)) => &self.entries[lo..hi],
+            _ => &[],
+        }
+    }
+
+    /// The number of blocks the lists were built for (0 when never built).
+    pub(crate) fn n_blocks(&self) -> usize {
+        self.start.len().saturating_sub(1)
+    }
+
+    /// The number of items over every block.
+    pub(crate) fn len(&self) -> usize {
+        self.entries.len()
+    }
+}
+
 /// Splits `0..n` into `parts` contiguous ranges of near-equal length.
 pub fn even_bounds(n: usize, parts: usize) -> Vec<(usize, usize)> {
     let parts = parts.max(1);

@@ -209,3 +209,27 @@ impl Particles {
         self.radius.iter().fold(0.0, |a, &b| a.max(b))
     }
 }
+
+/// What the contact and bond laws read of the particles: slices, so that the
+/// laws can run while the resultants are being written elsewhere.
+#[derive(Clone, Copy)]
+pub(crate) struct ParticleMotion<'a> {
+    pub position: &'a [Vec2],
+    pub velocity: &'a [Vec2],
+    pub angular_velocity: &'a [f64],
+    pub radius: &'a [f64],
+    pub mass: &'a [f64],
+}
+
+impl<'a> ParticleMotion<'a> {
+    /// The particles' positions, velocities, radii and masses.
+    pub(crate) fn of(p: &'a Particles) -> Self {
+        ParticleMotion {
+            position: &p.position,
+            velocity: &p.velocity,
+            angular_velocity: &p.angular_velocity,
+            radius: &p.radius,
+            mass: &p.mass,
+        }
+    }
+}

@@ -14,6 +14,7 @@
 //! change. The particles' force arrays stay in the cache of the worker that
 //! owns their block, instead of crossing to the thread that ran the serial pass.
 use crate::bond::{Bond, BondSlot};
+use crate::parallel::BlockLists;
 use crate::vec2::{add, sub, Vec2};
 
 /// A wall contact's force on its particle this step, and its terms of the
@@ -37,56 +38,14 @@ pub(crate) struct WallSlot {
     pub active: bool,
 }
 
-/// For each block, the entries of a list whose particle lies in the block, in
-/// list order (CSR: `entries[start[b]..start[b + 1]]`).
-#[derive(Debug, Clone, Default)]
-pub(crate) struct BlockTouches {
-    entries: Vec<u32>,
-    start: Vec<usize>,
-}
-
-impl BlockTouches {
-    /// The touches of `(particle, entry)` items given in list order; `None`
-    /// when a particle lies outside `block_ranges` (blocks of an older list).
-    fn new(
-        block_ranges: &[(usize, usize)],
-        items: impl Iterator<Item = (usize, u32)>,
-    ) -> Option<Self> {
-        let mut per_block: Vec<Vec<u32>> = vec![Vec::new(); block_ranges.len()];
-        for (q, entry) in items {
-            let b = block_ranges.partition_point(|&(_, hi)| hi <= q);
-            if b >= block_ranges.len() || q < block_ranges[b].0 {
-                return None;
-            }
-            per_block[b].push(entry);
-        }
-        let mut start = Vec::with_capacity(block_ranges.len() + 1);
-        start.push(0);
-        let mut entries = Vec::new();
-        for list in per_block {
-            entries.extend(list);
-            start.push(entries.len());
-        }
-        Some(BlockTouches { entries, start })
-    }
-
-    fn of_block(&self, b: usize) -> &[u32] {
-        &self.entries[self.start[b]..self.start[b + 1]]
-    }
-
-    fn covers(&self, n_blocks: usize, n_entries: usize) -> bool {
-        self.start.len() == n_blocks + 1 && self.entries.len() == n_entries
-    }
-}
-
 /// The bond and wall touches of the current blocks (kept current by `run` and
 /// every rebuild, like the chains' block index).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct DeferredIndex {
     /// `(bond << 1) | side` (side 0: the bond's `i`, 1: its `j`).
-    bonds: BlockTouches,
+    bonds: BlockLists<u32>,
     /// Wall-pair indices.
-    walls: BlockTouches,
+    walls: BlockLists<u32>,
     /// Whether the index matches the bonds, wall pairs and blocks it was built from.
     valid: bool,
 }
@@ -109,8 +68,8 @@ impl DeferredIndex {
             .enumerate()
             .map(|(k, &q)| (q as usize, k as u32));
         match (
-            BlockTouches::new(block_ranges, bond_items),
-            BlockTouches::new(block_ranges, wall_items),
+            BlockLists::new(block_ranges, bond_items),
+            BlockLists::new(block_ranges, wall_items),
         ) {
             (Some(bonds), Some(walls)) => DeferredIndex {
                 bonds,
@@ -128,9 +87,8 @@ impl DeferredIndex {
 
     /// Whether the index serves `n_blocks` blocks, `n_bonds` bonds and `n_wall_pairs` wall pairs.
     pub(crate) fn fits(&self, n_blocks: usize, n_bonds: usize, n_wall_pairs: usize) -> bool {
-        self.valid
-            && self.bonds.covers(n_blocks, 2 * n_bonds)
-            && self.walls.covers(n_blocks, n_wall_pairs)
+        let covers = |lists: &BlockLists<u32>, n| lists.n_blocks() == n_blocks && lists.len() == n;
+        self.valid && covers(&self.bonds, 2 * n_bonds) && covers(&self.walls, n_wall_pairs)
     }
 }
 

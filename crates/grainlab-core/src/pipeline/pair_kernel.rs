@@ -8,7 +8,7 @@ use crate::contact::ContactGeometry;
 use crate::law::{elastic_energy, linear_coulomb, linear_coulomb_with, ContactForce};
 use crate::material::{ContactModel, MaterialTable};
 use crate::parallel::DisjointWriter;
-use crate::state::Particles;
+use crate::state::ParticleMotion;
 use crate::vec2::{add, dot, mat_vec, perp, scale, sub, Mat2, Vec2};
 use crate::wall::Wall;
 
@@ -35,27 +35,6 @@ impl ContactTally {
     }
 }
 
-/// What a particle-wall contact reads of the particles.
-pub(crate) struct DiskState<'a> {
-    pub(crate) position: &'a [Vec2],
-    pub(crate) velocity: &'a [Vec2],
-    pub(crate) angular_velocity: &'a [f64],
-    pub(crate) radius: &'a [f64],
-    pub(crate) mass: &'a [f64],
-}
-
-impl<'a> DiskState<'a> {
-    pub(crate) fn of(p: &'a Particles) -> Self {
-        DiskState {
-            position: &p.position,
-            velocity: &p.velocity,
-            angular_velocity: &p.angular_velocity,
-            radius: &p.radius,
-            mass: &p.mass,
-        }
-    }
-}
-
 /// Particle `q` against `wall` at the current state: the geometry and the
 /// contact law's forces on the particle, updating `spring` (the pair's shear
 /// spring, or a copy for a query) over `increment_time`; `None`, with the
@@ -64,7 +43,7 @@ impl<'a> DiskState<'a> {
 pub(crate) fn wall_contact(
     wall: &Wall,
     model: &ContactModel,
-    p: &DiskState<'_>,
+    p: &ParticleMotion<'_>,
     q: usize,
     dt: f64,
     increment_time: f64,

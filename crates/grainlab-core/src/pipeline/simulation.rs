@@ -4,9 +4,9 @@ use serde::{Deserialize, Serialize};
 
 use super::deferred::{DeferredIndex, WallSlot};
 use super::pair_kernel::{
-    pair_kernel, wall_contact, DiskState, NullSink, PairForce, PairKernel, PairRecord, RecordSink,
+    pair_kernel, wall_contact, NullSink, PairForce, PairKernel, PairRecord, RecordSink,
 };
-use crate::bond::{bond_force, Bond, BondForce, BondMotion, BondSlot, Bonds};
+use crate::bond::{bond_force, Bond, BondForce, BondSlot, Bonds};
 use crate::boundary::{ChainBlocks, PressureChain};
 use crate::cell::{minimum_image, PeriodicCell};
 use crate::contact::{disk_disk, ContactGeometry};
@@ -19,7 +19,7 @@ use crate::law::ContactForce;
 use crate::material::{ContactModel, MaterialTable};
 use crate::neighbor::NeighborList;
 use crate::parallel::Pacer;
-use crate::state::Particles;
+use crate::state::{ParticleMotion, Particles};
 use crate::vec2::{add, norm, sub, Mat2, Vec2};
 use crate::wall::{Wall, WallControl};
 
@@ -762,7 +762,7 @@ impl Simulation {
             let copy = *bond;
             bond_force(
                 &copy,
-                &BondMotion::of(&self.particles),
+                &ParticleMotion::of(&self.particles),
                 self.cell.as_ref(),
                 l,
                 dt,
@@ -770,12 +770,12 @@ impl Simulation {
             );
         }
         let wp = &mut self.neighbors.wall_pairs;
+        let motion = ParticleMotion::of(&self.particles);
         for k in 0..wp.wall.len() {
             let wall = &self.walls[wp.wall[k] as usize];
             let model = self.materials.by_index(wp.model[k]);
             let q = wp.particle[k] as usize;
-            let disks = DiskState::of(&self.particles);
-            match wall_contact(wall, model, &disks, q, dt, dt, &mut wp.shear[k]) {
+            match wall_contact(wall, model, &motion, q, dt, dt, &mut wp.shear[k]) {
                 Some((_, c)) => {
                     wp.sliding[k] = c.sliding;
                     friction += c.friction_dissipation;
@@ -817,7 +817,7 @@ impl Simulation {
                 wall_contact(
                     wall,
                     model,
-                    &DiskState::of(&self.particles),
+                    &ParticleMotion::of(&self.particles),
                     q,
                     dt,
                     increment_time,
@@ -838,7 +838,7 @@ impl Simulation {
                 let mut shear = b.shear;
                 bond_force(
                     b,
-                    &BondMotion::of(&self.particles),
+                    &ParticleMotion::of(&self.particles),
                     self.cell.as_ref(),
                     l,
                     increment_time,

@@ -5,10 +5,10 @@ use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 use super::deferred::{DeferredForces, WallSlot};
 use super::pair_kernel::{
     pair_kernel, wall_contact, BlockWork, BufferSink, ContactTally, CrossForces, DirectSink,
-    DiskState, PairForce, PairKernel, ResetKernel,
+    PairForce, PairKernel, ResetKernel,
 };
 use super::Simulation;
-use crate::bond::{bond_slot, BondMotion, BondSlot};
+use crate::bond::{bond_slot, BondSlot};
 use crate::diagnostics::Measurements;
 use crate::error::Result;
 use crate::integrate::{
@@ -18,6 +18,7 @@ use crate::law::elastic_energy;
 use crate::parallel::{
     even_bounds, map_blocks, split_ranges, DisjointWriter, Team, PARALLEL_MIN_PARTICLES,
 };
+use crate::state::ParticleMotion;
 use crate::vec2::{add, dot, perp, scale, sub, Mat2, Vec2};
 
 /// The tallies of the stripes, in stripe order, then the bonds'.
@@ -308,7 +309,7 @@ impl Simulation {
             self.boundary_load.resize(self.particles.len(), [0.0; 2]);
         }
         let boundary_load = DisjointWriter::new(&mut self.boundary_load);
-        debug_assert!(!has_chains || self.chain_blocks.start_len() == n_blocks + 1);
+        debug_assert!(!has_chains || self.chain_blocks.n_blocks() == n_blocks);
         let (chains, chain_blocks, walls) = (&self.chains, &self.chain_blocks, &self.walls);
         let p = &mut self.particles;
         let force = DisjointWriter::new(&mut p.force);
@@ -350,11 +351,13 @@ impl Simulation {
                 },
             )
             .collect();
-        let motion = BondMotion {
+        // what the bond and wall laws read (not the resultants the blocks write)
+        let motion = ParticleMotion {
             position: &p.position,
             velocity: &p.velocity,
             angular_velocity: &p.angular_velocity,
             radius: &p.radius,
+            mass: &p.mass,
         };
         let cell = self.cell.as_ref();
         let block_ranges = &self.neighbors.block_ranges;
@@ -370,13 +373,6 @@ impl Simulation {
             shear: DisjointWriter::new(&mut wp.shear),
             sliding: DisjointWriter::new(&mut wp.sliding),
             slots: DisjointWriter::new(&mut self.wall_slots),
-        };
-        let disks = DiskState {
-            position: &p.position,
-            velocity: &p.velocity,
-            angular_velocity: &p.angular_velocity,
-            radius: &p.radius,
-            mass: &p.mass,
         };
         let (materials, deferred_index) = (&self.materials, &self.deferred_index);
         let (dt, max_overlap_ratio) = (self.params.time_step, self.params.max_overlap_ratio);
@@ -434,7 +430,7 @@ impl Simulation {
                         let q = wall_pairs.particle[k] as usize;
                         let spring = wall_pairs.shear.get(k);
                         let contact =
-                            wall_contact(wall, model, &disks, q, dt, increment_time, spring);
+                            wall_contact(wall, model, &motion, q, dt, increment_time, spring);
                         let slot = wall_pairs.slots.get(k);
                         let Some((g, c)) = contact else {
                             *wall_pairs.sliding.get(k) = false;
@@ -442,7 +438,7 @@ impl Simulation {
                             continue;
                         };
                         *wall_pairs.sliding.get(k) = c.sliding;
-                        let r = disks.radius[q];
+                        let r = motion.radius[q];
                         let n = g.normal;
                         *slot = WallSlot {
                             force: add(scale(n, c.normal), scale(perp(n), c.shear)),
@@ -556,9 +552,15 @@ impl Simulation {
                 }
             } else {
                 let q = wp.particle[k] as usize;
-                let disks = DiskState::of(&self.particles);
-                let contact =
-                    wall_contact(wall, model, &disks, q, dt, increment_time, &mut wp.shear[k]);
+                let contact = wall_contact(
+                    wall,
+                    model,
+                    &ParticleMotion::of(&self.particles),
+                    q,
+                    dt,
+                    increment_time,
+                    &mut wp.shear[k],
+                );
                 let Some((g, c)) = contact else {
                     wp.sliding[k] = false;
                     continue;
