@@ -46,14 +46,12 @@ pub(crate) struct DeferredIndex {
     bonds: BlockLists<u32>,
     /// Wall-pair indices.
     walls: BlockLists<u32>,
-    /// Whether the index matches the bonds, wall pairs and blocks it was built from.
-    valid: bool,
 }
 
 impl DeferredIndex {
     /// The index of `bonds` and of the wall pairs' particles `wall_particles`
-    /// over `block_ranges`; not valid (the forces are then added on one thread)
-    /// when a particle lies outside the blocks.
+    /// over `block_ranges`; empty, so that it fits no blocks (the forces are then
+    /// added on one thread), when a particle lies outside them.
     pub(crate) fn new(
         bonds: &[Bond],
         wall_particles: &[u32],
@@ -71,11 +69,7 @@ impl DeferredIndex {
             BlockLists::new(block_ranges, bond_items),
             BlockLists::new(block_ranges, wall_items),
         ) {
-            (Some(bonds), Some(walls)) => DeferredIndex {
-                bonds,
-                walls,
-                valid: true,
-            },
+            (Some(bonds), Some(walls)) => DeferredIndex { bonds, walls },
             _ => DeferredIndex::default(),
         }
     }
@@ -88,7 +82,7 @@ impl DeferredIndex {
     /// Whether the index serves `n_blocks` blocks, `n_bonds` bonds and `n_wall_pairs` wall pairs.
     pub(crate) fn fits(&self, n_blocks: usize, n_bonds: usize, n_wall_pairs: usize) -> bool {
         let covers = |lists: &BlockLists<u32>, n| lists.n_blocks() == n_blocks && lists.len() == n;
-        self.valid && covers(&self.bonds, 2 * n_bonds) && covers(&self.walls, n_wall_pairs)
+        covers(&self.bonds, 2 * n_bonds) && covers(&self.walls, n_wall_pairs)
     }
 }
 
