@@ -63,9 +63,40 @@ def contact_ends(
     first contact's direction if the mean vanishes). ``"each"`` keeps every
     contact.
 
+    Order: first the ends on the ``i`` side of the used contacts, in
+    contact-list order, then those on the ``j`` side (a merged end sits where
+    the first end of its group does); :func:`contact_ends_in_list_order` gives
+    each particle's ends in the order of the contact list instead.
+
     Returns ``owner (K,)``, ``angle (K,)`` in [0, 2 pi) and the (Nc,) mask of
     the contacts used.
     """
+    owner, ends, keep, _ = _contact_ends(snapshot, include_boundary, boundary)
+    return owner, ends, keep
+
+
+def contact_ends_in_list_order(
+    snapshot: Snapshot, *, include_boundary: bool, boundary: str = "each"
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
+    """:func:`contact_ends` (the same ends, owners and angles, bit for bit) in the
+    order of the snapshot's contact list.
+
+    Contact ``c`` (``i``-``j``) gives its end on ``i``, then its end on ``j``,
+    before contact ``c + 1``'s ends, so each particle's ends come in the order
+    of its contacts in the list (the creation order, in a code that keeps
+    it). A merged boundary end (``boundary="body"``) sits where the first of
+    the particle's contacts with that body, in list order, is.
+    """
+    owner, ends, keep, source = _contact_ends(snapshot, include_boundary, boundary)
+    order = np.argsort(source, kind="stable")  # a contact's i end before its j end
+    return owner[order], ends[order], keep
+
+
+def _contact_ends(
+    snapshot: Snapshot, include_boundary: bool, boundary: str
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.int64]]:
+    """:func:`contact_ends`, with the (K,) index of the contact each end comes
+    from (of a merged end, the smallest of its group)."""
     if boundary not in BOUNDARY_COUNTING:
         raise ValueError(f"boundary: must be 'body' or 'each', got {boundary!r}")
     ci = np.asarray(snapshot.contact_i)
@@ -76,7 +107,9 @@ def contact_ends(
         angle_j = angle + np.pi
         angle_j[angle_j >= TWO_PI] -= TWO_PI
         owner = np.concatenate([ci, cj])
-        return owner, np.concatenate([angle, angle_j]), np.ones(ci.shape, bool)
+        index = np.arange(ci.size, dtype=np.int64)
+        source = np.concatenate([index, index])
+        return owner, np.concatenate([angle, angle_j]), np.ones(ci.shape, bool), source
     keep = np.ones(ci.shape, bool) if include_boundary else ~snapshot.is_boundary_contact
     sample = snapshot.is_sample
     pp = keep & (cj >= 0)
@@ -86,6 +119,8 @@ def contact_ends(
     angle_j[angle_j >= TWO_PI] -= TWO_PI
     owner = np.concatenate([ci[on_i], cj[on_j]])
     ends = np.concatenate([angle[on_i], angle_j])
+    index = np.arange(ci.size, dtype=np.int64)
+    source = np.concatenate([index[on_i], index[on_j]])
     if boundary == "body" and include_boundary and owner.size:
         keys = snapshot.boundary_body_keys()
         key = np.concatenate([keys[on_i, 0], keys[on_j, 1]])
@@ -98,9 +133,11 @@ def contact_ends(
                 else np.maximum(np.concatenate([force[on_i], force[on_j]]), 0.0)
             )
             ends = _merged_angles(ends, groups, weight)
+            earliest = np.full(owner.size, ci.size, dtype=np.int64)
+            np.minimum.at(earliest, groups, source)
             first = groups == np.arange(owner.size)
-            owner, ends = owner[first], ends[first]
-    return owner, ends, keep
+            owner, ends, source = owner[first], ends[first], earliest[first]
+    return owner, ends, keep, source
 
 
 def has_boundary(snapshot: Snapshot) -> bool:

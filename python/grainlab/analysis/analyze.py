@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 
 from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
 from grainlab.analysis.shear_band import ShearBand
-from grainlab.analysis.stability import StabilityIndex
+from grainlab.analysis.stability import DEFAULT_READING, StabilityIndex
 from grainlab.analysis.strain import LocalStrain
 from grainlab.snapshot import Snapshot
 
@@ -74,6 +74,12 @@ class AnalysisResult:
             "mean_lambda_all": num(self.stability.mean_all),
             "lambda_includes_boundary_contacts": self.stability.include_boundary,
             "lambda_boundary_counting": self.stability.boundary,
+            # only under a reading of Eq. 9-11 other than the default (the file is unchanged then)
+            **(
+                {"lambda_reading": self.stability.reading}
+                if self.stability.reading != DEFAULT_READING
+                else {}
+            ),
             "band_found": b is not None,
             "band_reason": (
                 candidate.reason
@@ -181,6 +187,9 @@ def analyze_snapshot(
     fabric_include_boundary: bool = False,
     strain_neighbours: str = "radius",
     strain_cutoff: float | None = None,
+    lambda_slots: str = "angular",
+    lambda_anchor: str = "min",
+    lambda_deviation: str = "sum",
 ) -> AnalysisResult:
     """Compute the fabric measures, lambda, and (with a reference) strain and shear band.
 
@@ -201,11 +210,22 @@ def analyze_snapshot(
         for Z and the anisotropies (default no).
     strain_neighbours, strain_cutoff
         Neighbourhood of the local strain fit (see :class:`LocalStrain`).
+    lambda_slots, lambda_anchor, lambda_deviation
+        The reading of Eq. 9-11 for lambda: :class:`StabilityIndex`'s
+        ``slots``, ``anchor`` and ``deviation`` (default ``"angular"``,
+        ``"min"``, ``"sum"``; checked before any work). Under another reading
+        the summary also carries ``lambda_reading``.
 
     Returns
     -------
     AnalysisResult
     """
+    stability = StabilityIndex(  # checks the reading before any work
+        include_boundary=lambda_include_boundary,
+        slots=lambda_slots,
+        anchor=lambda_anchor,
+        deviation=lambda_deviation,
+    )
     notes: list[str] = []
     coordination = CoordinationNumber(
         min_contacts=min_contacts, include_boundary=fabric_include_boundary
@@ -220,7 +240,7 @@ def analyze_snapshot(
         ).compute(snapshot)
     else:
         notes.append("no contact forces in the input: a_n not computed")
-    stability = StabilityIndex(include_boundary=lambda_include_boundary).compute(snapshot)
+    stability.compute(snapshot)
     strain = band = None
     if reference is None:
         notes.append(

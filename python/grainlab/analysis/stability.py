@@ -24,7 +24,7 @@ For a particle with ``n`` contacts at angles sorted counter-clockwise,
 Equal spacing gives 0; contacts at 0° and 90° give 1/4; at 0°, 60°, 120° give
 1/3, the largest value three equal disks around a fourth can reach.
 
-Range: lambda is not bounded by 1. For ``n >= 2`` contacts it lies in
+Range (the default reading): lambda is not bounded by 1. For ``n >= 2`` contacts it lies in
 :math:`[0, \lfloor n^2/4 \rfloor / n]` (1/2, 2/3, 1, 6/5, 3/2, 12/7, 2, 20/9,
 5/2 for n = 2 ... 10), reached when all contacts sit at one angle, where
 every reference gives :math:`dS_n = \sum_m \min(m, n - m)\,2\pi/n`. So
@@ -34,6 +34,35 @@ arrangements gives at most 1/3 (n = 2, 3, 4; 1/5 for n = 5, 0 for the only
 n = 6 arrangement). Many small disks touching one
 side of a grain, as membrane disks do, could exceed 1: :class:`StabilityIndex`
 therefore counts each boundary body once by default (``boundary="body"``).
+
+Readings (docs/fabric.md, "Readings of Eqs. 9-11"): Eq. 9-10 leave room for
+other readings, three keyword options of :class:`StabilityIndex`,
+:func:`stability_index` and :func:`stability_index_of_angles`, the defaults
+being the one above (``"angular/min/sum"``, the text's "the minimum value of
+dSn is D"):
+
+* ``slots``: which stable position each contact is compared with.
+  ``"angular"`` (default) as above; ``"list"``: the contact ``m`` places after
+  ``k`` in the order the contacts are *given* (wrapping around), as a code
+  keeping its contacts in creation order (PFC) would read "starting with the
+  first contact point"; ``"nearest"``: each contact with the nearest position
+  of :math:`S_n` anchored at ``k``,
+  :math:`\min_m |\operatorname{wrap}(\phi_j - \phi_k - 2\pi m/n)|` (several
+  contacts may share one), never more than ``"angular"`` (each term at most
+  :math:`\pi/n`).
+* ``anchor``: ``"min"`` (default, Eq. 10) :math:`D = \min_k dS_n^{(k)}`, or
+  ``"mean"``: :math:`D = \frac{1}{n}\sum_k dS_n^{(k)}` (>= the minimum).
+* ``deviation``: ``"sum"`` (default, Eq. 9 as written) or ``"per_contact"``:
+  ``D / (n - 1)``, the mean over the ``n - 1`` deviations summed (the
+  reference's own is 0); the same lambda for ``n = 2``.
+
+0- and 1-contact particles get 1 under every reading. Contacts at 0°, 60°,
+120°: ``angular`` 1/3 (``min/sum``), 4/9 (``mean/sum``), 1/6
+(``min/per_contact``), 2/9 (``mean/per_contact``); ``nearest`` 1/6, 2/9, 1/12,
+1/9; ``list`` as ``angular`` when the contacts are given in that order, but
+given as 0°, 120°, 60° it gives 1/2, 2/3, 1/4, 1/3. The default reading runs
+in the compiled kernel; the others in NumPy only
+(:func:`_stability_index_numpy`, the same grouping by contact count).
 
 Implementation: writing :math:`e_j = \phi_j - 2\pi j/n`, the deviation of
 contact ``j`` from reference ``k`` is :math:`|\operatorname{wrap}(e_j - e_k)|`
@@ -54,13 +83,47 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, _kernels
-from grainlab.analysis._util import Computable, contact_ends, finite_mean, has_boundary
+from grainlab.analysis._util import (
+    Computable,
+    contact_ends,
+    contact_ends_in_list_order,
+    finite_mean,
+    has_boundary,
+)
 from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot
 
-__all__ = ["StabilityIndex", "stability_index", "stability_index_of_angles"]
+__all__ = [
+    "DEFAULT_READING",
+    "LAMBDA_ANCHORS",
+    "LAMBDA_DEVIATIONS",
+    "LAMBDA_SLOTS",
+    "StabilityIndex",
+    "stability_index",
+    "stability_index_of_angles",
+]
+
+#: Readings of Eq. 9-11 (module docstring), the default first in each.
+LAMBDA_SLOTS = ("angular", "list", "nearest")
+LAMBDA_ANCHORS = ("min", "mean")
+LAMBDA_DEVIATIONS = ("sum", "per_contact")
+#: :attr:`StabilityIndex.reading` of the default reading.
+DEFAULT_READING = f"{LAMBDA_SLOTS[0]}/{LAMBDA_ANCHORS[0]}/{LAMBDA_DEVIATIONS[0]}"
 
 #: Rows per block in the (m, n, n) kernel, to bound temporary memory.
 _BLOCK_ELEMENTS = 1 << 21
+
+
+def _check_reading(slots: str, anchor: str, deviation: str) -> bool:
+    """Validate a reading of Eq. 9-11; True when it is the default one."""
+    for option, value, allowed in (
+        ("slots", slots, LAMBDA_SLOTS),
+        ("anchor", anchor, LAMBDA_ANCHORS),
+        ("deviation", deviation, LAMBDA_DEVIATIONS),
+    ):
+        if value not in allowed:
+            names = ", ".join(repr(a) for a in allowed)
+            raise ValueError(f"{option}: must be one of {names}, got {value!r}")
+    return (slots, anchor, deviation) == (LAMBDA_SLOTS[0], LAMBDA_ANCHORS[0], LAMBDA_DEVIATIONS[0])
 
 
 def _group_deviation(angles: NDArray[np.float64], n: int) -> NDArray[np.float64]:
@@ -74,8 +137,39 @@ def _group_deviation(angles: NDArray[np.float64], n: int) -> NDArray[np.float64]
     return deviation
 
 
+def _group_reading(
+    angles: NDArray[np.float64], n: int, slots: str, anchor: str, deviation: str
+) -> NDArray[np.float64]:
+    """lambda of an (m, n) block of contact angles in [0, 2 pi], each row in the
+    order its contacts were given, under any reading (module docstring)."""
+    step = TWO_PI / n
+    if slots == "nearest":
+        diff = angles[:, None, :] - angles[:, :, None]  # [row, k, j] = phi_j - phi_k
+        np.mod(diff, step, out=diff)
+        np.minimum(diff, step - diff, out=diff)
+    else:
+        a = np.sort(angles, axis=1) if slots == "angular" else angles.copy()
+        a -= step * np.arange(n)
+        diff = a[:, None, :] - a[:, :, None]  # e_j - e_k, within (-4 pi, 4 pi) for "list"
+        np.abs(diff, out=diff)
+        np.mod(diff, TWO_PI, out=diff)
+        np.minimum(diff, TWO_PI - diff, out=diff)
+    per_reference = diff.sum(axis=2)  # dS_n^(k), [row, k]
+    d = per_reference.min(axis=1) if anchor == "min" else per_reference.mean(axis=1)
+    if deviation == "per_contact":
+        d /= n - 1
+    lam: NDArray[np.float64] = d / TWO_PI
+    return lam
+
+
 def stability_index(
-    owner: ArrayLike, angles: ArrayLike, n_particles: int
+    owner: ArrayLike,
+    angles: ArrayLike,
+    n_particles: int,
+    *,
+    slots: str = "angular",
+    anchor: str = "min",
+    deviation: str = "sum",
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Stability index of every particle from its contact ends.
 
@@ -88,38 +182,57 @@ def stability_index(
         Angle of each end on its particle, CCW from +x (any real value; taken
         modulo 2 pi).
     n_particles : int
+    slots : {"angular", "list", "nearest"}, default "angular"
+    anchor : {"min", "mean"}, default "min"
+    deviation : {"sum", "per_contact"}, default "sum"
+        The reading of Eq. 9-11 (module docstring). With ``slots="list"`` each
+        particle's ends are taken in the order they appear in ``owner`` /
+        ``angles`` (a stable sort by owner keeps it). The default reading runs
+        in the compiled kernel, the others in NumPy.
 
     Returns
     -------
     lam : (n_particles,) float
-        lambda >= 0 (at most floor(n^2/4)/n for n contacts; see the module
-        docstring); 1 for particles with 0 or 1 contact.
+        lambda >= 0 (at most floor(n^2/4)/n for n contacts under the default
+        reading; see the module docstring); 1 for particles with 0 or 1
+        contact.
     counts : (n_particles,) int
         Number of contacts of each particle.
     """
+    default = _check_reading(slots, anchor, deviation)
     owner = np.asarray(owner, dtype=np.int64).reshape(-1)
     ang = np.asarray(angles, dtype=np.float64).reshape(-1)
     if owner.shape != ang.shape:
         raise ValueError(f"angles: expected shape {owner.shape}, got {ang.shape}")
     if owner.size and (owner.min() < 0 or owner.max() >= n_particles):
         raise ValueError(f"owner: indices must be in [0, {n_particles})")
-    if _kernels.compiled():  # the kernel takes the angles modulo 2 pi itself
+    if default and _kernels.compiled():  # the kernel takes the angles modulo 2 pi itself
         lam, counts = _core.stability_index(
             np.ascontiguousarray(owner), np.ascontiguousarray(ang), int(n_particles), _kernels.threads()
         )
         return lam, counts
-    return _stability_index_numpy(owner, np.mod(ang, TWO_PI), n_particles)
+    return _stability_index_numpy(
+        owner, np.mod(ang, TWO_PI), n_particles, slots=slots, anchor=anchor, deviation=deviation
+    )
 
 
 def _stability_index_numpy(
-    owner: NDArray[np.int64], ang: NDArray[np.float64], n_particles: int
+    owner: NDArray[np.int64],
+    ang: NDArray[np.float64],
+    n_particles: int,
+    *,
+    slots: str = "angular",
+    anchor: str = "min",
+    deviation: str = "sum",
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """The NumPy reference of :func:`stability_index` (angles already in [0, 2 pi])."""
+    """The NumPy reference of :func:`stability_index` (angles already in [0, 2 pi]),
+    the only implementation of the non-default readings."""
+    default = _check_reading(slots, anchor, deviation)
     counts = np.bincount(owner, minlength=n_particles)
     lam = np.ones(n_particles, dtype=np.float64)
     if owner.size == 0:
         return lam, counts
-    order = np.argsort(owner)
+    order = np.argsort(owner, kind="stable")  # each particle's ends as given ("list")
     ang_sorted = ang[order]
     offsets = np.cumsum(counts) - counts
     degrees = np.unique(counts)
@@ -131,22 +244,38 @@ def _stability_index_numpy(
         for start in range(0, rows.size, block):
             r = rows[start : start + block]
             group = ang_sorted[offsets[r][:, None] + cols]
-            lam[r] = _group_deviation(group, n) / TWO_PI
+            if default:
+                lam[r] = _group_deviation(group, n) / TWO_PI
+            else:
+                lam[r] = _group_reading(group, n, slots, anchor, deviation)
     return lam, counts
 
 
-def stability_index_of_angles(angles: ArrayLike, *, degrees: bool = False) -> float:
-    """lambda of one particle with contacts at ``angles`` (rad, or degrees).
+def stability_index_of_angles(
+    angles: ArrayLike,
+    *,
+    degrees: bool = False,
+    slots: str = "angular",
+    anchor: str = "min",
+    deviation: str = "sum",
+) -> float:
+    """lambda of one particle with contacts at ``angles`` (rad, or degrees), in
+    the order given (which only ``slots="list"`` reads).
 
     >>> stability_index_of_angles([0, 60, 120], degrees=True)
     0.3333333333333333
     >>> stability_index_of_angles([0, 90], degrees=True)
     0.25
+    >>> stability_index_of_angles([0, 120, 60], degrees=True, slots="list")
+    0.5
     """
+    _check_reading(slots, anchor, deviation)
     a = np.asarray(angles, dtype=np.float64).reshape(-1)
     if degrees:
         a = np.radians(a)
-    lam, _ = stability_index(np.zeros(a.size, np.int64), a, 1)
+    lam, _ = stability_index(
+        np.zeros(a.size, np.int64), a, 1, slots=slots, anchor=anchor, deviation=deviation
+    )
     return float(lam[0])
 
 
@@ -185,12 +314,26 @@ class StabilityIndex(Computable[_StabilityIndexResults]):
         discretisation does not change lambda. ``"each"``: every contact
         counts, each membrane disk touched as a neighbour (then lambda can
         exceed 1 along the membrane).
+    slots : {"angular", "list", "nearest"}, default "angular"
+    anchor : {"min", "mean"}, default "min"
+    deviation : {"sum", "per_contact"}, default "sum"
+        Keyword only: the reading of Eq. 9-11 (module docstring; docs/fabric.md,
+        "Readings of Eqs. 9-11"). The default, the text's "the minimum value of
+        dSn is D" with contacts taken in angular order, runs in the compiled
+        kernel; the others in NumPy. ``slots="list"`` takes each particle's
+        contacts in the order of the snapshot's contact list: contact ``c``
+        (``i``-``j``) gives the end on ``i`` and the end on ``j`` at position
+        ``c``, so a particle's ends come in the order of its contacts in the
+        list, whichever side of them it is on; with ``boundary="body"`` the
+        one end of a boundary body sits where the particle's first contact
+        with that body (in list order) is.
 
     Attributes (after :meth:`compute`)
     ----------------------------------
     stability_index : (N,) float
-        lambda >= 0 (0/1-contact particles 1; above 1 only with five or more
-        crowded contacts); NaN for membrane particles (not part of the sample).
+        lambda >= 0 (0/1-contact particles 1; under the default reading above 1
+        only with five or more crowded contacts); NaN for membrane particles
+        (not part of the sample).
     n_contacts : (N,) int
         Number of contacts used for each particle, counted as lambda counts
         them (each boundary body once with ``boundary="body"``; 0 for
@@ -214,15 +357,46 @@ class StabilityIndex(Computable[_StabilityIndexResults]):
     0.333333333333
     """
 
-    def __init__(self, include_boundary: bool = True, boundary: str = "body") -> None:
+    def __init__(
+        self,
+        include_boundary: bool = True,
+        boundary: str = "body",
+        *,
+        slots: str = "angular",
+        anchor: str = "min",
+        deviation: str = "sum",
+    ) -> None:
         if boundary not in BOUNDARY_COUNTING:
             raise ValueError(f"boundary: must be 'body' or 'each', got {boundary!r}")
+        _check_reading(slots, anchor, deviation)
         self.include_boundary = bool(include_boundary)
         self.boundary = boundary
+        self.slots = slots
+        self.anchor = anchor
+        self.deviation = deviation
+
+    @property
+    def reading(self) -> str:
+        """The reading of Eq. 9-11 as ``"slots/anchor/deviation"`` (default
+        ``"angular/min/sum"``)."""
+        return f"{self.slots}/{self.anchor}/{self.deviation}"
 
     def compute(self, snapshot: Snapshot) -> StabilityIndex:
         """Compute lambda for every particle of ``snapshot``; returns ``self``."""
-        if _kernels.compiled() and not has_boundary(snapshot):
+        if not _check_reading(self.slots, self.anchor, self.deviation):
+            # NumPy only; the ends in contact-list order, which "list" reads
+            owner, ends, _ = contact_ends_in_list_order(
+                snapshot, include_boundary=self.include_boundary, boundary=self.boundary
+            )
+            lam, counts = stability_index(
+                owner,
+                ends,
+                snapshot.n_particles,
+                slots=self.slots,
+                anchor=self.anchor,
+                deviation=self.deviation,
+            )
+        elif _kernels.compiled() and not has_boundary(snapshot):
             # no wall, no membrane: the kernel takes both ends of every contact itself
             lam, counts = _core.stability_index_of_contacts(
                 np.ascontiguousarray(snapshot.contact_i),
@@ -288,5 +462,6 @@ class StabilityIndex(Computable[_StabilityIndexResults]):
 
     def __repr__(self) -> str:
         return (
-            f"StabilityIndex(include_boundary={self.include_boundary}, boundary={self.boundary!r})"
+            f"StabilityIndex(include_boundary={self.include_boundary}, boundary={self.boundary!r}, "
+            f"slots={self.slots!r}, anchor={self.anchor!r}, deviation={self.deviation!r})"
         )

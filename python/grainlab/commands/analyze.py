@@ -48,6 +48,8 @@ def parse_types(text: str | None) -> tuple[int, ...]:
 
 def register(subparsers: Any) -> None:
     """Add the ``analyze`` subcommand."""
+    from grainlab.analysis.stability import LAMBDA_ANCHORS, LAMBDA_DEVIATIONS, LAMBDA_SLOTS
+
     p = subparsers.add_parser(
         "analyze",
         help="fabric, stability index, strain and shear band of a snapshot",
@@ -116,6 +118,28 @@ def register(subparsers: Any) -> None:
         "--lambda-exclude-boundary",
         action="store_true",
         help="leave wall and membrane contacts out of lambda (default: counted)",
+    )
+    p.add_argument(
+        "--lambda-slots",
+        choices=LAMBDA_SLOTS,
+        default=LAMBDA_SLOTS[0],
+        help="reading of Eq. 9: each contact is compared with the stable position as many places "
+        "on from the reference in angular order (angular), in contact-list order (list), or with "
+        "the nearest one (nearest); default angular",
+    )
+    p.add_argument(
+        "--lambda-anchor",
+        choices=LAMBDA_ANCHORS,
+        default=LAMBDA_ANCHORS[0],
+        help="reading of Eq. 10: D the minimum (Eq. 10) or the mean of dSn over the n "
+        "reference contacts (default min)",
+    )
+    p.add_argument(
+        "--lambda-deviation",
+        choices=LAMBDA_DEVIATIONS,
+        default=LAMBDA_DEVIATIONS[0],
+        help="reading of Eq. 9: D the sum of the deviations (Eq. 9) or per contact, "
+        "divided by n - 1 (default sum)",
     )
     p.add_argument(
         "--no-figures", action="store_true", help="write only particles.csv and fabric.json"
@@ -209,6 +233,9 @@ def run(args: argparse.Namespace) -> int:
         bins=args.bins,
         min_contacts=args.min_contacts,
         lambda_include_boundary=not args.lambda_exclude_boundary,
+        lambda_slots=getattr(args, "lambda_slots", "angular"),
+        lambda_anchor=getattr(args, "lambda_anchor", "min"),
+        lambda_deviation=getattr(args, "lambda_deviation", "sum"),
     )
     write_analysis(result, Path(args.out), figures=not args.no_figures)
     s = result.summary()
@@ -222,6 +249,8 @@ def run(args: argparse.Namespace) -> int:
         f"Zm = {f(s['mechanical_Z'])}, a = {f(s['a'])}, a_n = {f(s['a_n'])}, "
         f"mean lambda = {f(s['mean_lambda'])}"
     )
+    if "lambda_reading" in s:  # said only when not the default reading
+        line += f" ({s['lambda_reading']})"
     if s["band_angle_deg"] is not None:
         line += (
             f", band {f(s['band_angle_deg'], '.1f')} deg x "

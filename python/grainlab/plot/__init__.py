@@ -25,7 +25,7 @@ import hashlib
 import io
 import re
 from collections import OrderedDict
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -49,6 +49,7 @@ __all__ = [
     "FIGURE_DPI",
     "PAPER_STYLE",
     "anisotropy_series",
+    "band_strata",
     "compact_png",
     "contact_count_distribution",
     "mean_lambda_series",
@@ -415,6 +416,29 @@ def contact_count_distribution(fractions: ArrayLike, *, ax: Any = None) -> Any:
         ax.set_xlabel("number of contacts")
         ax.set_ylabel("fraction of particles")
         ax.set_xticks(np.arange(f.size))
+    return ax
+
+
+def band_strata(strata: Mapping[str, Mapping[str, float]], *, ax: Any = None,
+                errors: Mapping[str, tuple[float, float]] | None = None) -> Any:
+    """Mean lambda of the band's grains and of the rest, side by side for each
+    contact-number stratum (``strata``: label -> ``mean_inside``, ``mean_outside``,
+    ``n_inside``, ``n_outside``, as :class:`~grainlab.analysis.BandContacts` gives);
+    ``errors``: optional (inside, outside) half-widths per label."""
+    labels = list(strata)
+    x = np.arange(len(labels), dtype=np.float64)
+    ax = new_axes(ax)
+    with paper_style():
+        for shift, side, colour, name in ((-0.2, "inside", "C3", "band"), (0.2, "outside", "0.6", "rest")):
+            values = [float(strata[k][f"mean_{side}"]) for k in labels]
+            err = None if errors is None else [errors[k][0 if side == "inside" else 1] for k in labels]
+            ax.bar(x + shift, values, width=0.4, color=colour, edgecolor="0.2", linewidth=0.6, label=name,
+                   yerr=err, capsize=2 if err is not None else 0)
+        ax.set_xticks(x)
+        ax.set_xticklabels([f"n = {k}" for k in labels])
+        ax.set_xlabel("contacts of the grain (as lambda counts them)")
+        ax.set_ylabel(r"mean $\lambda$")
+        ax.legend(frameon=False)
     return ax
 
 
