@@ -28,6 +28,7 @@ LAYERS: dict[str, int] = {
     "grainlab._notebook": 0,
     "grainlab._progress": 0,
     "grainlab._repr": 0,
+    "grainlab._child": 0,
     "grainlab.paper": 0,
     # 1: the engine API and the snapshot data model
     "grainlab": 1,

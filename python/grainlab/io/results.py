@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import fcntl
 import json
 import math
 import os
@@ -42,6 +43,7 @@ __all__ = [
     "CHECKPOINT_FILE",
     "RESULTS_FILE",
     "atomic_path",
+    "FolderBusyError",
     "ensure_output_folder",
     "fsync_directory",
     "fsync_file",
@@ -51,6 +53,7 @@ __all__ = [
     "write_bytes_atomic",
     "write_json_atomic",
     "write_text_atomic",
+    "writer_lock",
 ]
 
 #: Name of the results file of a run folder.
@@ -302,3 +305,34 @@ def is_disk_full(error: BaseException) -> bool:
 
 def _reason(error: OSError) -> str:
     return error.strerror or str(error)
+
+
+class FolderBusyError(ValueError):
+    """Another process is writing the results folder (:func:`writer_lock`): refused
+    before any work, as bad input is (the command line exits with code 2)."""
+
+
+@contextlib.contextmanager
+def writer_lock(folder: str | os.PathLike[str], *, option: str = "--out") -> Iterator[Path]:
+    """Hold the one-writer lock of the existing results ``folder`` while the block runs.
+
+    The lock is an exclusive ``flock`` on the folder itself (no lock file is
+    left in it): a second process that asks for it while the first holds it
+    gets :class:`FolderBusyError` at once, naming the folder. The kernel
+    releases it when the holder closes it or dies, however it dies, so a killed
+    run leaves no stale lock and ``--resume`` can continue it. Locks are
+    per open file: the same process taking it twice is refused as well.
+    """
+    path = Path(folder)
+    fd = os.open(path, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise FolderBusyError(
+                f"{option}: {path} is being written by another grainlab run; wait for it to end or "
+                "choose another folder"
+            ) from None
+        yield path
+    finally:
+        os.close(fd)

@@ -29,7 +29,6 @@ with this process, however it ends.
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import multiprocessing
 import os
 import signal
@@ -42,6 +41,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any, TypeVar
 
+from grainlab._child import die_with_parent
 from grainlab._cores import available_cores
 
 if TYPE_CHECKING:
@@ -54,10 +54,6 @@ __all__ = ["MAX_WORKERS", "FigurePool", "FigureTask", "PendingFigures", "figure_
 MAX_WORKERS = 4
 
 T = TypeVar("T")
-
-#: prctl option: the signal a process gets when its parent ends (linux/prctl.h).
-_PR_SET_PDEATHSIG = 1
-
 
 @dataclass(frozen=True)
 class FigureTask:
@@ -96,11 +92,7 @@ def _start_worker(parent: int) -> None:
     killed when that process ends, however it ends (a killed run leaves no worker
     drawing on into its folder)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if sys.platform.startswith("linux"):
-        with contextlib.suppress(OSError, AttributeError):
-            ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
-        if os.getppid() != parent:  # ended before the request was made
-            os._exit(1)
+    die_with_parent(parent)
 
 
 #: Environment of the workers: one thread for the numerical libraries (the workers

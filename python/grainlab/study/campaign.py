@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from grainlab._child import die_with_parent
 from grainlab._cores import available_cores
 from grainlab.io.results import write_json_atomic, write_text_atomic
 
@@ -282,7 +283,9 @@ def _run_local(todo: Sequence[Run], out: Path, workers: int, threads: int,
 
     # spawn: the engine's thread pool must not be forked
     context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=context) as pool:
+    # the workers end with this process: a killed campaign leaves none writing on into its runs
+    with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=context,
+                             initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(execute_run, run, str(out), threads): run for run in todo}
         for future in as_completed(futures):
             run = futures[future]

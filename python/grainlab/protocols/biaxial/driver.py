@@ -21,6 +21,7 @@ from grainlab.io.results import (
     ensure_output_folder,
     is_disk_full,
     refuse_overwrite,
+    writer_lock,
 )
 from grainlab.protocols.biaxial.outputs import BiaxialResult, _summary, _write_outputs
 from grainlab.protocols.biaxial.phases import (
@@ -180,7 +181,6 @@ def run_biaxial(
     :func:`grainlab._progress.progress_bar`).
     """
     out = Path(out_dir)
-    checkpoint_path = out / CHECKPOINT_FILE
     started = time.perf_counter()
     check_strain_rate(config)  # a rate refused needs no warning about its inertia
     check_density_scaling(config)
@@ -188,6 +188,14 @@ def run_biaxial(
     if resume and not out.exists():
         raise ValueError(f"--resume: {out} does not exist: nothing to resume")
     ensure_output_folder(out, create=not resume)
+    with writer_lock(out):  # one writer per folder: a second run on it is refused at once
+        return _run_locked(config, out, resume=resume, progress=progress, started=started, threads=threads)
+
+
+def _run_locked(config: BiaxialConfig, out: Path, *, resume: bool, progress: bool, started: float,
+                threads: int) -> BiaxialResult:
+    """:func:`run_biaxial` once it holds the folder's writer lock."""
+    checkpoint_path = out / CHECKPOINT_FILE
     if resume and not checkpoint_path.exists():
         finished = _finished_run(out, config)
         if finished is not None:
