@@ -9,6 +9,8 @@ from pathlib import Path
 from grainlab.reproduction.markdown import (
     claims_markdown,
     generated_blocks,
+    sensitivity_blocks,
+    sensitivity_markdown,
     update_generated_blocks,
 )
 
@@ -21,6 +23,34 @@ def test_generated_blocks_match_their_stored_claims():
     for path, level, body in blocks:
         document = json.loads((ROOT / path).read_text(encoding="utf-8"))
         assert body == claims_markdown(document, level), f"{path}: rerun python -m grainlab.reproduction.markdown"
+
+
+def test_sensitivity_tables_match_their_stored_claims():
+    for paths, body in sensitivity_blocks((ROOT / "docs" / "reproduction.md").read_text(encoding="utf-8")):
+        documents = [json.loads((ROOT / p).read_text(encoding="utf-8")) for p in paths]
+        assert body == sensitivity_markdown(documents), "rerun python -m grainlab.reproduction.markdown"
+
+
+def test_a_sensitivity_table_has_a_column_per_variant_and_marks_partial_counts(tmp_path):
+    def block(variant, rows):
+        return {"variant": variant, "kind": "biaxial", "seeds": [1, 2, 3], "claims": rows}
+
+    row = {"id": "band_lambda_above_rest", "mean": 0.012, "n": 3, "verdict": "reproduced"}
+    partial = {"id": "band_lambda_above_rest", "mean": -0.5, "n": 2, "verdict": "not reproduced"}
+    docs = [{"variants": [block("paper", [row]), {"variant": "rates", "kind": "rate", "claims": []}]},
+            {"variants": [block("band:final", [partial])]}]
+    text = sensitivity_markdown(docs, ["band_lambda_above_rest", "z_initial"])
+    lines = text.splitlines()
+    assert lines[0] == "| claim | `paper` (3) | `band:final` (3) |"
+    assert lines[2] == "| `band_lambda_above_rest` | yes 0.012 | **no** -0.5 (n 2) |"
+    assert lines[3] == "| `z_initial` |  |  |"
+    (tmp_path / "a.json").write_text(json.dumps(docs[0]))
+    (tmp_path / "b.json").write_text(json.dumps(docs[1]))
+    page = tmp_path / "page.md"
+    page.write_text("<!-- generated from a.json b.json by sensitivity_markdown() -->\nstale\n"
+                    "<!-- end of generated block -->\n")
+    assert update_generated_blocks(page, tmp_path) == 1
+    assert "stale" not in page.read_text() and "| `band_lambda_0.34` |" in page.read_text()
 
 
 def test_a_stale_block_is_rewritten(tmp_path):

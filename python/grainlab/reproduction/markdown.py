@@ -16,7 +16,8 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
-__all__ = ["claims_markdown", "generated_blocks", "update_generated_blocks"]
+__all__ = ["SENSITIVITY_CLAIMS", "claims_markdown", "generated_blocks", "sensitivity_blocks",
+           "sensitivity_markdown", "update_generated_blocks"]
 
 #: Rate-convergence and comparison quantities, as the tables name them.
 QUANTITY_LABELS = {
@@ -145,6 +146,68 @@ GENERATED_BLOCK = re.compile(
 )
 
 
+#: The rows of the verdict-sensitivity table: the claims about the band and lambda, and
+#: the initial state's, in the order docs/reproduction.md discusses them.
+SENSITIVITY_CLAIMS: tuple[str, ...] = (
+    "band_lambda_above_rest",
+    "band_lambda_above_rest_all",
+    "band_lambda_above_rest_at_end",
+    "band_lambda_above_rest_all_at_end",
+    "band_lambda_above_rest_at_equal_contacts",
+    "lambda_locates_band_at_equal_contacts",
+    "lambda_adds_to_contacts",
+    "band_lambda_0.34",
+    "rest_lambda_0.31",
+    "band_lambda_0.34_all",
+    "rest_lambda_0.31_all",
+    "band_lambda_above_half",
+    "lambda_locates_band",
+    "lambda_field_locates_band",
+    "band_at_peak",
+    "band_z_below_rest",
+    "lambda_tracks_coordination",
+    "z_initial",
+    "z_initial_mechanical",
+    "a_isotropic",
+)
+
+
+def sensitivity_markdown(documents: Sequence[dict[str, Any]], claims: Sequence[str] = SENSITIVITY_CLAIMS) -> str:
+    """The verdict-sensitivity table: one row per claim of ``claims``, one column per
+    variant block (rate families left out) of each document in turn; each cell the
+    verdict (yes / **no** / ?) and the seed mean, with n when it is not the block's
+    seed count; empty where the variant has no such claim."""
+    blocks = [b for d in documents for b in d.get("variants", []) if b.get("kind") != "rate"]
+    header = ["claim"] + [f"`{b['variant']}` ({len(b.get('seeds', []))})" for b in blocks]
+    by = [{r["id"]: r for r in b["claims"]} for b in blocks]
+    rows = []
+    for claim in claims:
+        cells = [f"`{claim}`"]
+        for b, rows_of in zip(blocks, by, strict=True):
+            r = rows_of.get(claim)
+            if r is None:
+                cells.append("")
+                continue
+            n = "" if r["n"] == len(b.get("seeds", [])) else f" (n {r['n']})"
+            cells.append(f"{SHORT.get(r['verdict'], r['verdict'])} {_num(r['mean'])}{n}")
+        rows.append(cells)
+    return "\n".join(_table(header, rows)) + "\n"
+
+
+#: A verdict-sensitivity table generated from stored ``claims.json`` documents (paths
+#: relative to the repository root, separated by spaces).
+SENSITIVITY_BLOCK = re.compile(
+    r"(<!-- generated from (?P<paths>[^>]+?) by sensitivity_markdown\(\) -->\n)(?P<body>.*?)"
+    r"(<!-- end of generated block -->)",
+    re.S,
+)
+
+
+def sensitivity_blocks(text: str) -> list[tuple[list[str], str]]:
+    """(paths, body) of every verdict-sensitivity block of ``text``."""
+    return [(m["paths"].split(), m["body"]) for m in SENSITIVITY_BLOCK.finditer(text)]
+
+
 def generated_blocks(text: str) -> list[tuple[str, int, str]]:
     """(path, level, body) of every generated block of ``text``."""
     return [(m["path"], int(m["level"]), m["body"]) for m in GENERATED_BLOCK.finditer(text)]
@@ -160,9 +223,14 @@ def update_generated_blocks(page: str | Path, root: str | Path) -> int:
         document = json.loads((Path(root) / m["path"]).read_text(encoding="utf-8"))
         return m.group(1) + claims_markdown(document, int(m["level"])) + m.group(5)
 
+    def table(m: re.Match[str]) -> str:
+        documents = [json.loads((Path(root) / p).read_text(encoding="utf-8")) for p in m["paths"].split()]
+        return m.group(1) + sensitivity_markdown(documents) + m.group(4)
+
     new, count = GENERATED_BLOCK.subn(body, text)
+    new, tables = SENSITIVITY_BLOCK.subn(table, new)
     page.write_text(new, encoding="utf-8")
-    return count
+    return count + tables
 
 
 if __name__ == "__main__":  # python -m grainlab.reproduction.markdown docs/reproduction.md
