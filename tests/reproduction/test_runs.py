@@ -40,6 +40,14 @@ def test_variants_by_name():
     raw = parse_variant("lambda_raw")
     assert raw.kind == "analysis" and raw.source == "paper" and raw.analysis == {"boundary_contacts": "raw"}
     assert parse_variant("lambda_raw:boundary_b").source == "boundary_b"
+    reading = parse_variant("lambda:slots=nearest,deviation=per_contact")
+    assert reading.kind == "analysis" and reading.source == "paper"
+    assert reading.analysis == {"lambda_slots": "nearest", "lambda_deviation": "per_contact"}
+    band = parse_variant("band:displacement")
+    assert band.kind == "analysis" and band.source == "paper" and band.analysis == {"band": "displacement"}
+    plan = ReproductionPlan.build(2, ["band:final", "lambda:anchor=mean"])
+    assert [v.name for v in plan.variants] == ["paper", "band:final", "lambda:anchor=mean"]
+    assert len(plan.runs()) == 2  # the analysis variants run nothing of their own
 
 
 @pytest.mark.parametrize(
@@ -52,6 +60,10 @@ def test_variants_by_name():
         ("set:sample.porosity=1.5", "sample.porosity"),
         ("set:porosity", "key=value"),
         ("lambda_raw:study", "reads a biaxial variant"),
+        ("lambda:slots=sideways", "slots must be one of angular, list, nearest"),
+        ("lambda:colour=red", "unknown lambda option 'colour'"),
+        ("band:strain", "band:displacement, band:lambda or band:final"),
+        ("band:eyeballed", "band:displacement, band:lambda or band:final"),
     ],
 )
 def test_bad_variants_name_the_problem(name, message):

@@ -7,6 +7,8 @@ raise until computed, ``plot(ax=None)``) backed by plain NumPy functions.
 """
 
 from grainlab.analysis.analyze import AnalysisResult, analyze_snapshot, fabric_summary
+from grainlab.analysis.band_contacts import BandContacts
+from grainlab.analysis.band_readings import DisplacementBand
 from grainlab.analysis.fabric import (
     EDGE_TOLERANCE_RAD,
     ContactAnisotropy,
@@ -24,8 +26,10 @@ from grainlab.analysis.strain import LocalStrain, match_ids, neighbour_pairs
 __all__ = [
     "EDGE_TOLERANCE_RAD",
     "AnalysisResult",
+    "BandContacts",
     "ContactAnisotropy",
     "CoordinationNumber",
+    "DisplacementBand",
     "LocalStrain",
     "ShearBand",
     "StabilityIndex",

@@ -29,6 +29,14 @@ of a biaxial test) is reported in the ``second_*`` fields of
 :class:`BandNumbers` and accepted when it passes tests 1 and 2 (and the
 first band was found). Means of lambda in and out of the band are over
 grains with at least 2 contacts (the paper's 0.34 vs 0.31).
+
+**Other readings of the band.** :func:`find_field_band` runs the same search
+and the same acceptance (one code path: :func:`find_band` is the field band of
+the excess local strain) on any per-grain field; Fig. 12's band is its band of
+:func:`lambda_indicator`, the grains with lambda > 0.5. :func:`displacement_band`
+reads Fig. 11's band, the zone between two blocks of the grains' displacement
+field (:class:`~grainlab.analysis.DisplacementBand`, with its own acceptance).
+:func:`band_labels` labels the grains by any of the three readings.
 """
 
 from __future__ import annotations
@@ -42,13 +50,14 @@ from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
 from grainlab.analysis._util import finite_mean
+from grainlab.analysis.band_readings import MIN_GRAINS, DisplacementBand
 from grainlab.analysis.shear_band import ShearBand
 from grainlab.analysis.stability import StabilityIndex
-from grainlab.analysis.strain import LocalStrain
+from grainlab.analysis.strain import LocalStrain, match_ids
 from grainlab.snapshot import Snapshot
 
 if TYPE_CHECKING:
@@ -56,13 +65,18 @@ if TYPE_CHECKING:
     from grainlab.plot.workers import FigurePool
 
 __all__ = [
+    "LAMBDA_LIMIT",
+    "READINGS",
     "BandNumbers",
     "BandSearch",
     "band_labels",
+    "displacement_band",
     "find_band",
+    "find_field_band",
     "interior_grains",
     "keep_searched",
     "keep_searches",
+    "lambda_indicator",
     "search_ahead",
     "searched",
     "slab_members",
@@ -76,6 +90,10 @@ N_PERMUTATIONS = 19
 EDGE_D = 1.0
 #: Seed of the permutation test (fixed: the same run always gives the same p-value).
 PERMUTATION_SEED = 20240611
+#: Fig. 12's band is the zone of grains with lambda above this (:func:`lambda_indicator`).
+LAMBDA_LIMIT = 0.5
+#: The readings of :func:`band_labels`: local strain, displacement (Fig. 11), lambda (Fig. 12).
+READINGS = ("strain", "displacement", "lambda")
 
 
 @dataclass(frozen=True)
@@ -315,16 +333,43 @@ def keep_searches(started: Sequence[Future[Any]]) -> None:
 
 def _search(reference: Snapshot, current: Snapshot, stability: StabilityIndex) -> BandSearch:
     """:func:`find_band`'s search, its numbers unlabelled (no snapshot names, NaN strain)."""
-    name, reference_name, axial_strain = "", "", math.nan
-    snap = current
-    g = snap.is_sample
-    grains = grains_only(snap)
+    g = current.is_sample
+    grains = grains_only(current)
     strain = LocalStrain().compute(grains_only(reference), grains)
-    displacement = np.full(snap.n_particles, np.nan)
+    displacement = np.full(current.n_particles, np.nan)
     displacement[g] = strain.displacement_magnitude
-    pos, rad = grains.positions, grains.radii
+    return _accepted_band(current, strain.excess_shear_strain, stability, displacement, _STRAIN_WORDS)
+
+
+@dataclass(frozen=True)
+class _Words:
+    """How the reasons of :func:`_accepted_band` name the field searched."""
+
+    #: "only 7 grains away from the boundary have {having}"
+    having: str
+    #: "against 19 random rearrangements of the {values}"
+    values: str
+
+
+_STRAIN_WORDS = _Words("a local strain", "strain values")
+_FIELD_WORDS = _Words("a finite value of the field", "field values")
+
+
+def _accepted_band(
+    snap: Snapshot,
+    field: NDArray[np.float64],
+    stability: StabilityIndex,
+    displacement: NDArray[np.float64],
+    words: _Words,
+) -> BandSearch:
+    """The band of the per-grain ``field`` (N_grains,) of ``snap`` and its acceptance
+    (module docstring): the one code path of the strain band (:func:`find_band`) and
+    of the band in any field (:func:`find_field_band`), its numbers unlabelled."""
+    name, reference_name, axial_strain = "", "", math.nan
+    g = snap.is_sample
+    pos, rad = snap.positions[g], snap.radii[g]
     d_mean = float(np.mean(2.0 * rad)) if rad.size else math.nan
-    gamma = strain.excess_shear_strain
+    gamma = field
     interior = interior_grains(snap, d_mean)
     valid = interior & np.isfinite(gamma)
     lam = stability.stability_index[g]
@@ -349,12 +394,12 @@ def _search(reference: Snapshot, current: Snapshot, stability: StabilityIndex) -
 
     if int(valid.sum()) < 10:
         return missing(
-            f"only {int(valid.sum())} grains away from the boundary have a local strain "
+            f"only {int(valid.sum())} grains away from the boundary have {words.having} "
             "(at least 10 are needed)"
         )
     band = ShearBand(min_thickness=MIN_THICKNESS_D).compute(pos, gamma, rad, mask=interior)
     side = float(np.ptp(pos, axis=0).min())
-    # significance against random rearrangements of the same strain values
+    # significance against random rearrangements of the same values
     width = band.bin_width * float(np.mean(2.0 * rad[interior]))
     eta = _eta2(pos[valid], gamma[valid], band.normal, width)
     rng = np.random.default_rng(PERMUTATION_SEED)
@@ -370,7 +415,7 @@ def _search(reference: Snapshot, current: Snapshot, stability: StabilityIndex) -
     if p_value > 0.05:
         problems.append(
             f"not significant (p = {p_value:.2f} against {N_PERMUTATIONS} random "
-            "rearrangements of the strain values)"
+            f"rearrangements of the {words.values})"
         )
     members = slab_members(band, pos)
     use = counts >= 2
@@ -447,14 +492,111 @@ def _band_problems(
     return problems
 
 
-def band_labels(reference: Snapshot, current: Snapshot) -> NDArray[np.int32]:
+def lambda_indicator(stability: StabilityIndex) -> NDArray[np.float64]:
+    """(N,) 1.0 for the grains whose lambda exceeds :data:`LAMBDA_LIMIT` (0.5),
+    0.0 for the others, NaN for membrane disks: the field of Fig. 12's band.
+
+    0- and 1-contact grains have lambda = 1 (they cannot be stable) and count as
+    above the limit, as the paper's maps colour them."""
+    lam = np.asarray(stability.stability_index, dtype=np.float64)
+    return np.where(np.isfinite(lam), (lam > LAMBDA_LIMIT).astype(np.float64), np.nan)
+
+
+def find_field_band(
+    snapshot: Snapshot,
+    field: ArrayLike,
+    stability: StabilityIndex | None = None,
+    *,
+    name: str = "",
+    axial_strain: float = math.nan,
+) -> BandSearch:
+    """The band of a per-grain ``field`` of ``snapshot``, accepted as the strain band is.
+
+    ``field`` is (N,) per particle of ``snapshot`` (membrane disks' entries are
+    not read) or (N_grains,) per sample grain, in the grains' order; NaN
+    entries are left out. The search and its acceptance are :func:`find_band`'s
+    (the module docstring: ShearBand's tests, crossing the sample, the
+    permutation test against 19 rearrangements of the field's values; edge
+    grains left out of the search), on ``field`` instead of the local strain.
+    ``stability`` (``snapshot``'s computed :class:`StabilityIndex`, computed
+    with the defaults when None) gives the means of lambda in and out of the
+    band. There is no reference state: :attr:`BandSearch.displacement` is NaN
+    and :attr:`BandNumbers.reference` empty. Searches are not kept.
+
+    **Fig. 12's band** is :func:`lambda_indicator`'s field, ``lambda > 0.5``
+    per grain (``band_labels(..., reading="lambda")``). The indicator, not
+    lambda coarse-grained over a disk of 2 mean diameters: it is the paper's
+    reading of the figure (the zone of grains with lambda above 0.5), and the
+    permutation test needs values that are exchangeable between grains when
+    there is no band. A coarse-grained field is correlated over its disk, so
+    that every rearrangement of its values is rougher than the field itself
+    and any smooth field would pass as significant; ShearBand smooths its
+    profile across the band anyway (over about 2 mean diameters).
+    """
+    g = snapshot.is_sample
+    values = np.asarray(field, dtype=np.float64)
+    n_grains = int(g.sum())
+    if values.shape == (snapshot.n_particles,):
+        values = values[g]
+    elif values.shape != (n_grains,):
+        raise ValueError(
+            f"field: expected shape ({snapshot.n_particles},) (particles) or ({n_grains},) "
+            f"(grains), got {values.shape}"
+        )
+    if stability is None:
+        stability = StabilityIndex().compute(snapshot)
+    found = _accepted_band(
+        snapshot, values.copy(), stability, np.full(snapshot.n_particles, np.nan), _FIELD_WORDS
+    )
+    numbers = replace(found.numbers, snapshot=name, axial_strain=axial_strain)
+    return BandSearch(numbers, found.band, found.displacement, found.second)
+
+
+def displacement_band(reference: Snapshot, current: Snapshot) -> DisplacementBand | None:
+    """:class:`~grainlab.analysis.DisplacementBand` of ``current``'s grains since
+    ``reference`` (Fig. 11's reading; grains only, matched by id, membrane disks
+    left out), indexed like ``current``'s grains; None when fewer than
+    :data:`~grainlab.analysis.band_readings.MIN_GRAINS` grains are matched."""
+    ref, cur = grains_only(reference), grains_only(current)
+    to_ref = match_ids(ref, cur)
+    matched = to_ref >= 0
+    if int(matched.sum()) < MIN_GRAINS:
+        return None
+    disp = np.full((cur.n_particles, 2), np.nan)
+    disp[matched] = cur.minimum_image(cur.positions[matched] - ref.positions[to_ref[matched]])
+    return DisplacementBand().compute(cur.positions, disp, cur.radii)
+
+
+def band_labels(reference: Snapshot, current: Snapshot, reading: str = "strain") -> NDArray[np.int32]:
     """(N,) per particle of ``current``: 1 inside the accepted shear band, 2
     inside its accepted conjugate band, 0 elsewhere (membrane disks, and every
-    particle when no band passes the tests): the bands the figures outline,
-    found in the grains' local strain since ``reference``."""
-    found = find_band(reference, current, StabilityIndex().compute(current), reference_name="")
+    particle when no band passes the tests).
+
+    ``reading`` (one of :data:`READINGS`) says where the band is read:
+
+    * ``"strain"`` (default): the bands the figures outline, found in the
+      grains' local strain since ``reference`` (:func:`find_band`);
+    * ``"displacement"``: the zone between the two blocks of the grains'
+      displacements since ``reference`` (:func:`displacement_band`, Fig. 11):
+      label 1 for its members, no conjugate band;
+    * ``"lambda"``: the band of the grains with lambda > 0.5 in ``current``
+      (:func:`find_field_band` on :func:`lambda_indicator`, ``StabilityIndex()``
+      defaults; Fig. 12), with its conjugate band as for the strain.
+    """
+    if reading not in READINGS:
+        raise ValueError(f"reading: must be one of {', '.join(map(repr, READINGS))}, got {reading!r}")
     labels = np.zeros(current.n_particles, np.int32)
     grains = np.flatnonzero(current.is_sample)
+    if reading == "displacement":
+        moved = displacement_band(reference, current)
+        if moved is not None and moved.found:
+            labels[grains[moved.members]] = 1
+        return labels
+    stability = StabilityIndex().compute(current)
+    if reading == "lambda":
+        found = find_field_band(current, lambda_indicator(stability), stability)
+    else:
+        found = find_band(reference, current, stability, reference_name="")
     pos = current.positions[grains]
     if found.band is not None:
         labels[grains[slab_members(found.band, pos)]] = 1

@@ -203,6 +203,41 @@ def _found(row: Mapping[str, Any]) -> float:
     return 1.0 if row.get("band_found") else 0.0
 
 
+_EQUAL_N = "Sec. 6, Fig. 13, read at equal contact number"
+
+
+def _stratum_claim(label: str) -> Claim:
+    return Claim(
+        f"band_lambda_above_rest_n{label.replace('+', 'plus')}",
+        f"band lambda above the rest's among grains with {label} contacts", _EQUAL_N, None,
+        f"band minus rest mean lambda of the grains with {label} contacts (as lambda counts them) at the "
+        "peak snapshot, paired per seed", SideRule(+1),
+        lambda m: band_measure(_peak(m), f"stratum_{label}_difference"))
+
+
+#: The band against the rest at equal contact number, and what lambda adds to the contact
+#: number (grainlab.analysis.band_contacts): the paper's band claim with the contact count held
+#: fixed, which tells a new fabric quantity from a proxy of Z and of the rattlers.
+_STRATA_CLAIMS: tuple[Claim, ...] = (
+    Claim("band_lambda_above_rest_at_equal_contacts", "band lambda above the rest's at equal contact number",
+          _EQUAL_N, None, "band minus rest mean lambda within the strata n = 2, 3, 4, >= 5, pooled with "
+          "Mantel-Haenszel weights, at the peak snapshot, paired per seed", SideRule(+1),
+          lambda m: band_measure(_peak(m), "stratified_lambda_difference")),
+    *(_stratum_claim(label) for label in ("2", "3", "4", "5+")),
+    Claim("lambda_locates_band_at_equal_contacts", "lambda tells band grains from the rest among grains with "
+          "the same number of contacts", _EQUAL_N, None, "ROC AUC of lambda for band membership within the "
+          "strata, pooled over band-rest pairs, at the peak snapshot", SideRule(+1, 0.5),
+          lambda m: band_measure(_peak(m), "auc_lambda_within_contacts")),
+    Claim("contacts_locate_band", "the contact number alone tells band grains from the rest (the reference "
+          "of the next claim)", "Sec. 7", None, "out-of-sample ROC AUC of a logistic model of band membership "
+          "on the contact-number class (0, 1, 2, 3, 4, >= 5), every grain, at the peak snapshot",
+          SideRule(+1, 0.5), lambda m: band_measure(_peak(m), "auc_contacts")),
+    Claim("lambda_adds_to_contacts", "lambda adds to the contact number in telling band grains from the rest",
+          _EQUAL_N, None, "out-of-sample ROC AUC of the contact-number model with lambda (its own slope per "
+          "class n >= 2) minus without, every grain, at the peak snapshot, paired per seed", SideRule(+1),
+          lambda m: band_measure(_peak(m), "auc_gain_lambda")),
+)
+
 _LAMBDA_BAND = "the library's mean over grains with >= 2 contacts"
 _LAMBDA_ALL = "the mean over every grain, 0- and 1-contact grains at lambda = 1"
 
@@ -250,6 +285,13 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
           lambda m: _initial(m)["coordination_number"]),
     Claim("z_at_peak", "and around 3.0 at the peak strength", "Sec. 6, Fig. 10", paper.Z_AT_PEAK,
           "Z of the snapshot nearest the peak", ValueRule(2.8, 3.2), lambda m: _peak(m)["coordination_number"]),
+    Claim("z_initial_mechanical", "the same, read as the mechanical coordination number (rattlers removed)",
+          "Sec. 6, Fig. 10", paper.Z_INITIAL, "mechanical coordination number Z_m (grains with fewer than 2 "
+          "contacts removed until none is left) of the snapshot at 0 %", ValueRule(3.7, 4.1),
+          lambda m: _initial(m)["mechanical_coordination_number"]),
+    Claim("z_at_peak_mechanical", "around 3.0 at the peak, read as the mechanical coordination number",
+          "Sec. 6, Fig. 10", paper.Z_AT_PEAK, "Z_m of the snapshot nearest the peak", ValueRule(2.8, 3.2),
+          lambda m: _peak(m)["mechanical_coordination_number"]),
     Claim("z_constant_after_peak", "from the peak onward the coordination number is constant", "Sec. 6, Fig. 10",
           0.0, "(Z at the end - Z at the peak) / Z at the peak", ValueRule(-0.05, 0.05),
           lambda m: _final(m)["coordination_number"] / _peak(m)["coordination_number"] - 1.0),
@@ -269,6 +311,14 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
     Claim("band_lambda_above_rest_all", "the same, lambda averaged over every grain", "Sec. 6, Fig. 13", 0.03,
           f"band minus rest at the peak snapshot, paired per seed; {_LAMBDA_ALL}", SideRule(+1),
           lambda m: band_measure(_peak(m), "inside_mean_lambda_all") - band_measure(_peak(m), "outside_mean_lambda_all")),
+    Claim("band_lambda_above_rest_at_end", "the same at the end of the test (10 %)", "Sec. 6, Figs. 12, 13", 0.03,
+          f"band minus rest at the last snapshot, paired per seed; {_LAMBDA_BAND}", SideRule(+1),
+          lambda m: band_measure(_final(m), "inside_mean_lambda") - band_measure(_final(m), "outside_mean_lambda")),
+    Claim("band_lambda_above_rest_all_at_end", "the same at the end of the test, every grain", "Sec. 6, Figs. 12, 13",
+          0.03, f"band minus rest at the last snapshot, paired per seed; {_LAMBDA_ALL}", SideRule(+1),
+          lambda m: band_measure(_final(m), "inside_mean_lambda_all")
+          - band_measure(_final(m), "outside_mean_lambda_all")),
+    *_STRATA_CLAIMS,
     Claim("band_lambda_0.34", "mean lambda in the shear zone at the peak is 0.34", "Sec. 6", paper.LAMBDA_IN_BAND,
           f"band mean at the peak snapshot; {_LAMBDA_BAND}", ValueRule(0.325, 0.355),
           lambda m: band_measure(_peak(m), "inside_mean_lambda")),

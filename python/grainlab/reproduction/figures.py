@@ -3,9 +3,11 @@ seeds against axial strain (PNG at a modest resolution, for ``reproduction.html`
 
 For each biaxial variant: ``macro_<variant>`` (stress ratio, volumetric
 strain), ``fabric_<variant>`` (a, Z, mean lambda, the paper's values marked)
-and ``band_<variant>`` (the band-resolved fabric: lambda inside and outside
+``band_<variant>`` (the band-resolved fabric: lambda inside and outside
 the band under both conventions, Z, the share of 2-contact grains, rotation,
-and the ROC AUC of lambda as a classifier of band membership). For each study
+and the ROC AUC of lambda as a classifier of band membership) and
+``strata_<variant>`` (band and rest at the peak at equal contact number, and the
+AUCs of lambda, of the contact number and of both). For each study
 variant ``study_<variant>`` (Figs. 15-17 with every seed); ``rates`` for a
 rate family.
 """
@@ -193,6 +195,121 @@ def _band_figure(runs: Sequence[Measures], title: str) -> Figure:
     return fig
 
 
+def _peak_row(m: Measures) -> Mapping[str, Any]:
+    row: Mapping[str, Any] = m["snapshots"][m["peak_snapshot"]]
+    return row
+
+
+def _known(name: str) -> Callable[[Mapping[str, Any]], float]:
+    """A band measure of a snapshot row whose band grains are known (as the claims read them)."""
+    def get(row: Mapping[str, Any]) -> float:
+        value = row.get(name) if row.get("band_members_known") else None
+        return math.nan if value is None else float(value)
+
+    return get
+
+
+def _strata_figure(runs: Sequence[Measures], title: str) -> Figure:
+    """lambda inside and outside the band at the peak per contact-number stratum (means
+    over seeds, 95 % intervals), and the AUCs of lambda, of the contact number and of both."""
+    from grainlab.analysis.band_contacts import STRATA
+
+    labels = [label for label, _, _ in STRATA]
+    peaks = [_peak_row(m) for m in runs]
+    strata: dict[str, dict[str, float]] = {}
+    errors: dict[str, tuple[float, float]] = {}
+    for label in labels:
+        sides = []
+        for side in ("inside", "outside"):
+            v = np.array([_known(f"stratum_{label}_mean_{side}")(r) for r in peaks], dtype=np.float64)
+            v = v[np.isfinite(v)]
+            mean = float(v.mean()) if v.size else math.nan
+            ci = t_interval(v) if v.size >= 2 else (mean, mean)
+            strata.setdefault(label, {})[f"mean_{side}"] = mean
+            sides.append(mean - ci[0])
+        errors[label] = (sides[0], sides[1])
+    with plot.paper_style():
+        fig = Figure(figsize=(9.0, 3.4), layout="constrained")
+        left, right = fig.subplots(1, 2)
+        plot.band_strata(strata, ax=left, errors=errors)
+        left.set_title("at the peak: band and rest at equal contact number", fontsize=8)
+        scores = (("auc_lambda", r"$\lambda$ (every grain)"), ("auc_lambda_within_contacts", r"$\lambda$ within n"),
+                  ("auc_contacts", "n alone"), ("auc_contacts_lambda", r"n and $\lambda$"))
+        for k, (key, _) in enumerate(scores):
+            v = np.array([_known(key)(r) for r in peaks], dtype=np.float64)
+            v = v[np.isfinite(v)]
+            right.plot(np.full(v.size, k) + np.linspace(-0.15, 0.15, v.size) if v.size else [], v, "o",
+                       color="0.6", markersize=3)
+            if v.size >= 2:
+                lo, hi = t_interval(v)
+                right.errorbar([k], [v.mean()], yerr=[[v.mean() - lo], [hi - v.mean()]], color="C3", marker="s",
+                               capsize=3)
+        right.axhline(0.5, color="0.4", linewidth=0.8, linestyle="--")
+        right.set_xticks(range(len(scores)))
+        right.set_xticklabels([label for _, label in scores])
+        right.set_ylabel("ROC AUC for band membership (out of sample for the models)")
+        right.set_title("what tells band grains from the rest (dots: seeds)", fontsize=8)
+        fig.suptitle(title, fontsize=9)
+    return fig
+
+
+def band_readings_figure(run_dir: str | Path, title: str = "") -> Figure:
+    """The band readings over one run's displacement map, at the snapshot nearest the
+    stress-ratio peak and at the last one: grains coloured by their displacement since
+    0 %, the displacement map's two-block split (accepted or not, with its share of the
+    residual removed), and the bands accepted in the local strain and in lambda > 0.5."""
+    from grainlab.analysis.stability import StabilityIndex
+    from grainlab.io.hdf5 import read_results
+    from grainlab.postprocess.band import (
+        displacement_band,
+        find_band,
+        find_field_band,
+        lambda_indicator,
+    )
+    from grainlab.reproduction.measures import macro_measures
+
+    results = read_results(run_dir)
+    def strain(info: Any) -> float:
+        return math.nan if info.axial_strain is None else float(info.axial_strain)
+
+    infos = sorted(results.snapshots, key=strain)
+    peak = macro_measures(results.timeseries)["peak_axial_strain"]
+    chosen = [min(infos[1:], key=lambda i: abs(strain(i) - peak)), infos[-1]]
+    reference = results.snapshot(infos[0].name)
+    with plot.paper_style():
+        fig = Figure(figsize=(8.0, 7.0), layout="constrained")
+        axes = fig.subplots(1, 2)
+        for ax, info in zip(axes, chosen, strict=True):
+            snap = results.snapshot(info.name)
+            stability = StabilityIndex().compute(snap)
+            strain_band = find_band(reference, snap, stability)
+            grains = np.asarray(snap.is_sample)
+            plot.particle_map(snap.positions[grains], snap.radii[grains], 1e3 * strain_band.displacement[grains],
+                              ax=ax, cmap="Greys", label="displacement since 0 % (mm)")
+            moved = displacement_band(reference, snap)
+            if moved is not None:
+                for k, seg in enumerate(moved.outline()):
+                    verdict = "accepted" if moved.found else "not accepted"
+                    ax.plot(seg[:, 0], seg[:, 1], color="C1", linewidth=1.4,
+                            label=(f"two-block split ({verdict};\nremoves {moved.residual_reduction:.2f} "
+                                   "of the residual)") if k == 0 else None)
+            if strain_band.band is not None:
+                plot.outline_shear_band(ax, strain_band.band, color="crimson", linestyle="--")
+            field = find_field_band(snap, lambda_indicator(stability), stability)
+            if field.band is not None:
+                for k, seg in enumerate(field.band.outline()):
+                    ax.plot(seg[:, 0], seg[:, 1], color="C0", linestyle=":", linewidth=1.4,
+                            label=r"$\lambda > 0.5$ zone (accepted)" if k == 0 else None)
+            ax.set_title(f"{100 * strain(info):.2f} % axial strain"
+                         + ("" if strain_band.band is not None else "; no strain band accepted"), fontsize=8)
+            ax.legend(frameon=True, framealpha=0.85, fontsize=6, loc="upper left")
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+        fig.suptitle(title or "readings of the band", fontsize=9)
+    return fig
+
+
 def _study_figure(studies: Sequence[Measures], title: str) -> Figure:
     with plot.paper_style():
         fig = Figure(figsize=(10.0, 3.2), layout="constrained")
@@ -240,8 +357,10 @@ def _rate_figure(family: Sequence[tuple[float, Sequence[Measures | None]]]) -> F
 
 
 def draw_figures(plan: ReproductionPlan, results: Mapping[tuple[str, str, str], Measures | None],
-                 folder: str | Path) -> dict[str, Path]:
-    """Draws every figure of the reproduction into ``folder``; returns name -> PNG path."""
+                 folder: str | Path, *, runs_root: str | Path | None = None) -> dict[str, Path]:
+    """Draws every figure of the reproduction into ``folder``; returns name -> PNG path.
+    ``runs_root`` (the reproduction folder): with a ``band:`` variant, the band readings
+    over the first seed's displacement map (:func:`band_readings_figure`)."""
     from grainlab.reproduction.outputs import rate_family
 
     out = Path(folder)
@@ -260,6 +379,13 @@ def draw_figures(plan: ReproductionPlan, results: Mapping[tuple[str, str, str], 
         drawn[f"macro_{stem}"] = _save(_macro_figure(runs, title), out / f"macro_{stem}.png")
         drawn[f"fabric_{stem}"] = _save(_fabric_figure(runs, title), out / f"fabric_{stem}.png")
         drawn[f"band_{stem}"] = _save(_band_figure(runs, title), out / f"band_{stem}.png")
+        drawn[f"strata_{stem}"] = _save(_strata_figure(runs, title), out / f"strata_{stem}.png")
+    if runs_root is not None and any(v.name.startswith("band:") for v in plan.variants):
+        first = plan.biaxial_folder(runs_root, plan.variant("paper"), plan.seeds[0])
+        if (first / "run.h5").exists():
+            drawn["band_readings"] = _save(
+                band_readings_figure(first, f"paper, seed {plan.seeds[0]}: the readings of the band"),
+                out / "band_readings.png")
     family = rate_family(plan)
     if len(family) >= 2:
         runs_by_rate = [(rate, [results.get((v.name, str(s), "biaxial")) for s in plan.seeds]) for rate, v in family]

@@ -28,8 +28,18 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from grainlab.analysis.stability import StabilityIndex
 
-#: Analysis options a variant may set, with their defaults.
-ANALYSIS_DEFAULTS: dict[str, Any] = {"boundary_contacts": "body"}
+#: Analysis options a variant may set, with their defaults: how lambda counts the boundary
+#: ("body" or "raw") and reads Eqs. 9-11 (StabilityIndex's slots, anchor and deviation), and
+#: which reading of the shear band gives the band's grains (:data:`BAND_READINGS`).
+ANALYSIS_DEFAULTS: dict[str, Any] = {"boundary_contacts": "body", "lambda_slots": "angular",
+                                     "lambda_anchor": "min", "lambda_deviation": "sum", "band": "strain"}
+#: The readings of the band: the detector in the local strain (the default); the zone that
+#: separates the two moving blocks in the displacement map (Fig. 11: the best two-block split's
+#: transition zone at each snapshot, accepted or not, as the paper reads it without a test;
+#: ``band_found`` counts accepted ones); the zone of lambda > 0.5 (Fig. 12), found and accepted at
+#: each snapshot as the strain band is (grainlab.postprocess.band); and the band accepted last in
+#: the local strain (at 10 %) carried back to every snapshot by id.
+BAND_READINGS: tuple[str, ...] = ("strain", "displacement", "lambda", "final")
 
 #: Share of the test's final strain that the end window ("a constant at the end") covers.
 END_WINDOW = 0.3
@@ -41,7 +51,9 @@ def _stability(options: Mapping[str, Any]) -> StabilityIndex:
     from grainlab.analysis.stability import StabilityIndex
 
     counting = {"body": "body", "raw": "each"}[options.get("boundary_contacts", "body")]
-    return StabilityIndex(boundary=counting)
+    return StabilityIndex(boundary=counting, slots=options.get("lambda_slots", "angular"),
+                          anchor=options.get("lambda_anchor", "min"),
+                          deviation=options.get("lambda_deviation", "sum"))
 
 
 def _finite(x: Any) -> float:
@@ -121,6 +133,7 @@ def _fabric_of(snap: Any, options: Mapping[str, Any]) -> dict[str, Any]:
             "a_binned": _finite(getattr(normals, "anisotropy_binned", math.nan)),
             "a_n": _finite(forces.anisotropy) if forces is not None else math.nan,
             "coordination_number": _finite(z.coordination_number),
+            "mechanical_coordination_number": _finite(z.mechanical_coordination_number),
             "mean_lambda": _finite(stability.mean),
             "mean_lambda_all": _finite(stability.mean_all),
         },
@@ -151,14 +164,26 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
     strains = [_snapshot_strain(info) for info in infos]
     order = sorted(range(len(infos)), key=lambda k: strains[k])
     snaps = [results.snapshot(infos[k].name) for k in order]
-    labels = [None] + [band_labels(snaps[0], snap) for snap in snaps[1:]]
-    members = _band_members(snaps, labels)
     peak_pos = (1 + int(np.argmin([abs(strains[k] - macro["peak_axial_strain"]) for k in order[1:]]))
                 if len(order) > 1 else 0)
-    peak_ids: NDArray[np.int64] = np.zeros(0, np.int64)
-    peak_members = members[peak_pos]
-    if peak_members is not None:
-        peak_ids = np.asarray(snaps[peak_pos].ids)[peak_members[0]]
+    readings: dict[str, tuple[list[NDArray[np.int32] | None], list[tuple[NDArray[np.bool_], int] | None]]] = {}
+
+    def bands(reading: str) -> tuple[list[NDArray[np.int32] | None], list[tuple[NDArray[np.bool_], int] | None]]:
+        """Each snapshot's band labels and band grains under ``reading`` (each found once)."""
+        if reading not in readings:
+            if reading not in BAND_READINGS:
+                raise ValueError(f"band: expected one of {', '.join(BAND_READINGS)}, got {reading!r}")
+            if reading == "displacement":
+                labels, candidates = _displacement_readings(snaps)
+                readings[reading] = (labels, _band_members(snaps, candidates))
+                return readings[reading]
+            found = "strain" if reading == "final" else reading
+            labels = readings[found][0] if found in readings else (
+                [None] + [band_labels(snaps[0], snap, reading=found) for snap in snaps[1:]])
+            members = _final_band_members(snaps, labels) if reading == "final" else _band_members(snaps, labels)
+            readings[reading] = (labels, members)
+        return readings[reading]
+
     eps_ts = np.asarray(ts["axial_strain"], dtype=np.float64)
     q_ts = np.asarray(ts["stress_ratio"], dtype=np.float64)
     finite = np.isfinite(q_ts) & np.isfinite(eps_ts)
@@ -174,6 +199,11 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
     out = []
     for given in options:
         opts = {**ANALYSIS_DEFAULTS, **dict(given)}
+        labels, members = bands(str(opts["band"]))
+        peak_ids: NDArray[np.int64] = np.zeros(0, np.int64)
+        peak_members = members[peak_pos]
+        if peak_members is not None:
+            peak_ids = np.asarray(snaps[peak_pos].ids)[peak_members[0]]
         rows = []
         for k, snap, band, member in zip(order, snaps, labels, members, strict=True):
             row = {"name": infos[k].name, "axial_strain": strains[k],
@@ -204,12 +234,48 @@ def _band_members(snaps: Sequence[Any], labels: Sequence[NDArray[np.int32] | Non
     return out
 
 
+def _displacement_readings(snaps: Sequence[Any]) -> tuple[list[NDArray[np.int32] | None],
+                                                          list[NDArray[np.int32] | None]]:
+    """The displacement map's band at each snapshot since the first: labels of the band
+    accepted (1; zeros when the two-block fit fails the acceptance test), and labels of
+    the best two-block split's transition zone, accepted or not: the paper reads its
+    band off the displacement map (Fig. 11) with no test, so the band's grains are the
+    candidate's, while ``band_found`` counts accepted bands only."""
+    from grainlab.postprocess.band import displacement_band
+
+    accepted: list[NDArray[np.int32] | None] = [None]
+    candidates: list[NDArray[np.int32] | None] = [None]
+    for snap in snaps[1:]:
+        moved = displacement_band(snaps[0], snap)
+        grains = np.flatnonzero(np.asarray(snap.is_sample))
+        zone = np.zeros(snap.n_particles, np.int32)
+        if moved is not None:
+            zone[grains[np.asarray(moved.members)]] = 1
+        accepted.append(zone if moved is not None and moved.found else np.zeros(snap.n_particles, np.int32))
+        candidates.append(zone)
+    return accepted, candidates
+
+
+def _final_band_members(snaps: Sequence[Any], labels: Sequence[NDArray[np.int32] | None]
+                        ) -> list[tuple[NDArray[np.bool_], int] | None]:
+    """Per snapshot, the grains of the band accepted last (at the end of the test, when
+    it is accepted there), matched by id: the final band carried back; None at every
+    snapshot when no band is ever accepted."""
+    for k in range(len(snaps) - 1, -1, -1):
+        band = labels[k]
+        if band is not None and np.any(np.asarray(band) > 0):
+            ids = np.asarray(snaps[k].ids)[np.asarray(band) > 0]
+            return [(np.isin(np.asarray(s.ids), ids) & np.asarray(s.is_sample), k) for s in snaps]
+    return [None] * len(snaps)
+
+
 def _snapshot_row(reference: Any, snap: Any, labels: NDArray[np.int32] | None,
                   member: tuple[NDArray[np.bool_], int] | None, peak_ids: NDArray[np.int64],
                   options: Mapping[str, Any]) -> dict[str, Any]:
     """Fabric of one snapshot, and inside / outside the band's grains (``member``,
     :func:`_band_members`). ``band_found``: a band is accepted at this snapshot
     itself; ``band_members_known``: at this snapshot or a later one."""
+    from grainlab.analysis.band_contacts import BandContacts
     from grainlab.analysis.band_fabric import BandFabric, roc_auc
     from grainlab.analysis.strain import match_ids
 
@@ -235,6 +301,7 @@ def _snapshot_row(reference: Any, snap: Any, labels: NDArray[np.int32] | None,
             grain_contacts=np.asarray(fabric["grain_contacts"])[grains], rotation=rotation,
         )
         row.update(bf.summary())
+        row.update(BandContacts().compute(lam, counts, member[0][grains]).summary())
     return row
 
 

@@ -441,7 +441,7 @@ def write_outputs(plan: ReproductionPlan, out_dir: str | os.PathLike[str], *, wo
         from grainlab.reproduction.figures import draw_figures
         from grainlab.reproduction.html import write_html
 
-        drawn = draw_figures(plan, results, out / "figures")
+        drawn = draw_figures(plan, results, out / "figures", runs_root=out)
         files += [p for p in drawn.values()]
         files.append(write_html(out / HTML_FILE, plan, document, drawn))
     return Outputs(out, document, files, time.perf_counter() - started)

@@ -24,6 +24,14 @@ Variants (:func:`parse_variant`):
     the paper variant's reads the paper variant's runs.
 ``set:<key>=<value>[,<key>=<value>...]``
     ``paper`` with any biaxial configuration keys changed.
+``lambda:<key>=<value>[,...]``
+    Analysis only: the paper variant's runs, lambda read another way (Eqs. 9-11):
+    ``slots`` (angular, list, nearest), ``anchor`` (min, mean), ``deviation`` (sum,
+    per_contact), e.g. ``lambda:slots=nearest,deviation=per_contact``.
+``band:displacement``, ``band:lambda``, ``band:final``
+    Analysis only: the paper variant's runs, the band's grains read from the
+    displacement map (Fig. 11), from the zone of lambda > 0.5 (Fig. 12), or the
+    final band carried back to every snapshot.
 ``lambda_raw``, ``lambda_raw:<variant>``
     Analysis only: the paper variant's (or the given biaxial variant's) runs,
     lambda counting every membrane disk a grain touches as a contact (instead
@@ -86,6 +94,20 @@ QUICK_BIAXIAL: dict[str, Any] = {"shear.final_strain": 0.05, "shear.strain_rate"
 QUICK_STUDY: dict[str, Any] = {"width": 0.03, "height": 0.06}
 
 Kind = Literal["biaxial", "study", "analysis"]
+
+#: The readings of Eqs. 9-11 an analysis variant ``lambda:<key>=<value>,...`` may choose
+#: (:class:`~grainlab.analysis.StabilityIndex`'s options; the first of each is the default).
+LAMBDA_READINGS: dict[str, tuple[str, ...]] = {
+    "slots": ("angular", "list", "nearest"),
+    "anchor": ("min", "mean"),
+    "deviation": ("sum", "per_contact"),
+}
+_BAND_TEXT = {
+    "displacement": "the zone separating the two moving blocks of the displacement map (Fig. 11), "
+                    "the best two-block split whether or not it passes the acceptance test",
+    "lambda": "the zone of lambda > 0.5 (Fig. 12)",
+    "final": "the band accepted last (10 %) carried back by id",
+}
 
 
 def snapshot_strains(final_strain: float) -> list[float]:
@@ -183,6 +205,28 @@ def parse_variant(text: str) -> Variant:
             analysis={"boundary_contacts": "raw"}, source=source.name,
             description=f"{source.name}'s runs; lambda with every membrane disk a grain touches counted",
         )
+    if name.startswith("lambda:"):
+        pairs = _assignments(name, name[len("lambda:"):])
+        analysis = {}
+        for key, value in pairs:
+            if key not in LAMBDA_READINGS:
+                raise ValueError(f"--variants: {name!r}: unknown lambda option {key!r}; known: "
+                                 + ", ".join(LAMBDA_READINGS))
+            if value not in LAMBDA_READINGS[key]:
+                raise ValueError(f"--variants: {name!r}: {key} must be one of "
+                                 f"{', '.join(LAMBDA_READINGS[key])}, got {value!r}")
+            analysis[f"lambda_{key}"] = value
+        what = ", ".join(f"{k} = {v}" for k, v in pairs)
+        return Variant(name, "analysis", analysis=analysis, source="paper",
+                       description=f"paper's runs; lambda read with {what} (Eqs. 9-11)")
+    if name.startswith("band:"):
+        from grainlab.reproduction.measures import BAND_READINGS
+
+        reading = name[len("band:"):].strip()
+        if reading not in BAND_READINGS or reading == "strain":
+            raise ValueError(f"--variants: {name!r}: expected band:displacement, band:lambda or band:final")
+        return Variant(name, "analysis", analysis={"band": reading}, source="paper",
+                       description=f"paper's runs; the band's grains from {_BAND_TEXT[reading]}")
     if name.startswith("rate="):
         rate = _biaxial_value(name, "shear.strain_rate", name[len("rate="):])
         if rate == "auto":
@@ -204,7 +248,8 @@ def parse_variant(text: str) -> Variant:
                        description="the Sec. 7 packing study" + (f" with {what}" if what else " (Tables 2-3)"))
     raise ValueError(
         f"--variants: unknown variant {name!r}; known: paper, boundary_b, lambda_raw, rate=<rate> "
-        "(e.g. rate=1%/min), set:<key>=<value>, study, study:<field>=<value>"
+        "(e.g. rate=1%/min), set:<key>=<value>, lambda:<key>=<value>, band:<reading>, study, "
+        "study:<field>=<value>"
     )
 
 
