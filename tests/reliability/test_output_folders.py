@@ -126,3 +126,27 @@ def test_outputs_get_the_mode_the_umask_asks_for(tmp_path, umask):
         assert stat.S_IMODE(path.stat().st_mode) == expected, (path.name, oct(path.stat().st_mode))
     assert json.loads((tmp_path / "summary.json").read_text()) == {"a": 1}
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+
+
+@pytest.mark.parametrize("case", ["negative radius", "truncated HDF5"])
+def test_analyze_of_refused_input_leaves_no_folder(tmp_path, capsys, case):
+    if case == "negative radius":
+        source = tmp_path / "p.csv"
+        source.write_text("id,x,y,radius\n1,0,0,-1\n2,1,0,0.5\n")
+        needle = "column 'radius': -1 is not > 0"
+    else:
+        source = tmp_path / "run.h5"
+        source.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(92))  # an HDF5 signature, cut short
+        needle = "cannot be read as HDF5"
+    out = tmp_path / "new" / "analysis"
+    assert main(["analyze", str(source), "--out", str(out)]) == 2
+    _one_line(capsys, "grainlab analyze: error:", needle)
+    assert not (tmp_path / "new").exists()  # nothing created before the input was accepted
+    assert sorted(p.name for p in tmp_path.iterdir()) == [source.name]
+
+
+def test_analyze_refuses_an_out_it_cannot_create_before_reading(tmp_path, capsys):
+    source = tmp_path / "p.csv"
+    source.write_text("id,x,y,radius\n1,0,0,-1\n")  # would be refused too, but --out is checked first
+    assert main(["analyze", str(source), "--out", "/proc/grainlab-analysis/out"]) == 2
+    _one_line(capsys, "grainlab analyze: error: --out:", "cannot create the folder")

@@ -168,7 +168,7 @@ def run(args: argparse.Namespace) -> int:
         list_timesteps,
         read_snapshot,
     )
-    from grainlab.io.results import ensure_output_folder
+    from grainlab.io.results import check_output_folder, ensure_output_folder
     from grainlab.postprocess import write_analysis
 
     if not 2 <= args.bins <= MAX_BINS:
@@ -178,7 +178,7 @@ def run(args: argparse.Namespace) -> int:
     columns = parse_columns(args.contact_columns)
     particle_columns = parse_columns(getattr(args, "columns", None), "--columns")
     boundary_types = parse_types(args.boundary_types)
-    ensure_output_folder(args.out)  # a bad --out is refused before the input is read
+    check_output_folder(args.out)  # a bad --out is refused before the input is read, and nothing is created
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", MissingKindWarning)
         snapshot = read_snapshot(
@@ -237,6 +237,7 @@ def run(args: argparse.Namespace) -> int:
         lambda_anchor=getattr(args, "lambda_anchor", "min"),
         lambda_deviation=getattr(args, "lambda_deviation", "sum"),
     )
+    ensure_output_folder(args.out)  # the input is accepted: the folder may now be made
     write_analysis(result, Path(args.out), figures=not args.no_figures)
     s = result.summary()
 

@@ -43,6 +43,7 @@ __all__ = [
     "CHECKPOINT_FILE",
     "RESULTS_FILE",
     "atomic_path",
+    "check_output_folder",
     "FolderBusyError",
     "ensure_output_folder",
     "fsync_directory",
@@ -257,6 +258,40 @@ def ensure_output_folder(path: str | os.PathLike[str], *, option: str = "--out",
         raise ValueError(f"{option}: cannot write in {folder} ({_reason(error)})") from None
     with contextlib.suppress(OSError):
         probe.unlink()
+    return folder
+
+
+def check_output_folder(path: str | os.PathLike[str], *, option: str = "--out") -> Path:
+    """``path`` checked as :func:`ensure_output_folder` checks it, but created by no one:
+    an existing folder must be writable, a missing one must lie under a writable folder
+    (its nearest existing ancestor). A command calls this before reading its input and
+    :func:`ensure_output_folder` once the input is accepted, so that input it refuses
+    leaves no empty folder behind. Raises ``ValueError`` naming ``option``.
+
+    >>> import tempfile, pathlib
+    >>> base = pathlib.Path(tempfile.mkdtemp())
+    >>> check_output_folder(base / "runs" / "a") == base / "runs" / "a", (base / "runs").exists()
+    (True, False)
+    """
+    import tempfile
+
+    folder = Path(path)
+    for parent in (folder, *folder.parents):
+        if parent.exists() or parent.is_symlink():
+            if not parent.is_dir():
+                where = f"{folder}" if parent == folder else f"{folder}: {parent}"
+                raise ValueError(f"{option}: {where} is a file, not a folder")
+            try:  # a probe that is removed at once: it tells permissions, read-only and pseudo file systems
+                if parent == folder:
+                    probe = _create_temporary(folder, "write-test")
+                    with contextlib.suppress(OSError):
+                        probe.unlink()
+                else:
+                    os.rmdir(tempfile.mkdtemp(prefix=".grainlab-", dir=parent))
+            except OSError as error:
+                what = f"write in {folder}" if parent == folder else f"create the folder {folder}"
+                raise ValueError(f"{option}: cannot {what} ({_reason(error)})") from None
+            break
     return folder
 
 
