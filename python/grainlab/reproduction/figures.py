@@ -383,7 +383,7 @@ def draw_figures(plan: ReproductionPlan, results: Mapping[tuple[str, str, str], 
     if runs_root is not None and any(v.name.startswith("band:") for v in plan.variants):
         first = plan.biaxial_folder(runs_root, plan.variant("paper"), plan.seeds[0])
         if (first / "run.h5").exists():
-            drawn["band_readings"] = _save(
+            drawn["bandreadings_paper"] = _save(
                 band_readings_figure(first, f"paper, seed {plan.seeds[0]}: the readings of the band"),
                 out / "band_readings.png")
     family = rate_family(plan)

@@ -38,6 +38,13 @@ _FIGURE_CAPTIONS = {
             "how well lambda alone ranks band grains above the others (0.5: not at all).",
     "study": "The packing study's mean lambda against Z, porosity and anisotropy for every seed.",
     "rates": "Peak and end-window stress ratios against the strain rate (mean and 95 % interval over seeds).",
+    "strata": "At the peak: mean lambda of the band's grains and of the rest among grains with the same number "
+              "of contacts (mean over seeds, 95 % interval), and what tells band grains from the rest: lambda, "
+              "lambda within contact numbers, the contact number alone and with lambda (out-of-sample ROC AUCs; "
+              "0.5: nothing).",
+    "bandreadings": "The readings of the band over the first seed's displacement map, near the peak and at the "
+                    "end: the two-block split of the displacements (the paper's Fig. 11), the band accepted in "
+                    "the local strain and the zone of lambda > 0.5 (Fig. 12) where one is accepted.",
 }
 
 
