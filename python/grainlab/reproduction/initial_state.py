@@ -731,6 +731,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--explore", action="store_true",
                         help="prepare the settings Table 1 leaves open, seeds 1-3, one thread")
     parser.add_argument("--output", default=str(EXPLORE_FILE), help="the exploration's JSON file")
+    parser.add_argument("--save", metavar="FILE", help="also write the runs' table (one row per run) as JSON")
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     parser.add_argument("--settings", nargs="+", metavar="NAME",
                         help="explore only these settings (names of EXPLORE_SETTINGS)")
@@ -747,6 +748,12 @@ def main(argv: Sequence[str] | None = None) -> int:
               f"a_n {PAPER_A_N}")
         print(format_table(rows))
         print(noise_floor_check([r for _, r in rows]))
+        if args.save:
+            from grainlab.io.results import write_json_atomic
+
+            write_json_atomic(args.save, {"description": "The state at 0 % axial strain of finished biaxial runs "
+                                          "(python -m grainlab.reproduction.initial_state RUNS --save FILE).",
+                                          "runs": [{"run": label, **row} for label, row in rows]})
     if args.explore:
         chosen = EXPLORE_SETTINGS
         if args.settings:
