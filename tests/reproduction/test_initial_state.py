@@ -246,3 +246,31 @@ def test_mean_interval() -> None:
     assert mean == 2.0
     assert half == pytest.approx(4.302652729911275 / math.sqrt(3))
     assert math.isnan(mean_interval([1.0])[1])
+
+
+def test_the_numbers_docs_quote_come_from_the_stored_runs():
+    """docs/reproduction.md's initial-state section quotes paper_scale/initial_state_runs.json."""
+    import json
+    from pathlib import Path
+
+    import numpy as np
+    from scipy import stats
+
+    root = Path(__file__).resolve().parents[2]
+    runs = json.loads((root / "python/grainlab/reproduction/paper_scale/initial_state_runs.json").read_text())["runs"]
+    page = (root / "docs" / "reproduction.md").read_text(encoding="utf-8")
+    assert len(runs) == 20
+
+    def mean_ci(key, digits):
+        v = np.array([r[key] for r in runs], dtype=float)
+        half = stats.t.ppf(0.975, v.size - 1) * v.std(ddof=1) / np.sqrt(v.size)
+        return f"{v.mean():.{digits}f} ± {half:.{digits}f}"
+
+    assert f"Z = {mean_ci('coordination_number', 3)}" in page
+    assert f"Z_m = {mean_ci('mechanical_coordination_number', 3)}" in page
+    assert f"a = {mean_ci('anisotropy', 4)}" in page
+    assert f"a = {mean_ci('anisotropy_interior', 4)}" in page
+    assert f"E[a] = {np.mean([r['noise_mean'] for r in runs]):.4f}" in page
+    assert f"P = {np.mean([r['noise_p_paper'] for r in runs]):.3f}" in page
+    assert f"**{np.mean([r['circle_porosity_mean'] for r in runs]):.4f}** nominal" in page
+    assert f"against {np.mean([r['porosity'] for r in runs]):.4f} for the whole sample" in page
