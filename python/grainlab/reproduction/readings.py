@@ -16,7 +16,12 @@ import math
 
 import numpy as np
 
-from grainlab.analysis.stability import LAMBDA_ANCHORS, LAMBDA_DEVIATIONS, LAMBDA_SLOTS, stability_index
+from grainlab.analysis.stability import (
+    LAMBDA_ANCHORS,
+    LAMBDA_DEVIATIONS,
+    LAMBDA_SLOTS,
+    stability_index,
+)
 
 __all__ = ["PAPER_LAMBDA_MAX", "lambda_max_table"]
 
