@@ -38,7 +38,7 @@ def test_a_sensitivity_table_has_a_column_per_variant_and_marks_partial_counts(t
     row = {"id": "band_lambda_above_rest", "mean": 0.012, "n": 3, "verdict": "reproduced"}
     partial = {"id": "band_lambda_above_rest", "mean": -0.5, "n": 2, "verdict": "not reproduced"}
     docs = [{"variants": [block("paper", [row]), {"variant": "rates", "kind": "rate", "claims": []}]},
-            {"variants": [block("band:final", [partial])]}]
+            {"variants": [block("paper", [partial]), block("band:final", [partial])]}]
     text = sensitivity_markdown(docs, ["band_lambda_above_rest", "z_initial"])
     lines = text.splitlines()
     assert lines[0] == "| claim | `paper` (3) | `band:final` (3) |"
@@ -77,3 +77,30 @@ def test_the_default_run_quoted_in_biaxial_md_is_the_campaign_seed_1():
     peak_strain = rows["peak_near_1.5"]["per_seed"][seed_1]
     assert f"| coordination number, initial | {z0:.2f} |" in page
     assert f"at {100 * peak_strain:.2f} % axial strain |" in page
+
+
+#: The numbers the page's short verdict quotes: (variant, claim id), as "mean [low, high]".
+QUOTED = [
+    ("paper", "band_lambda_above_rest_all"), ("paper", "band_lambda_above_rest"), ("paper", "lambda_locates_band"),
+    ("paper", "band_lambda_above_rest_at_equal_contacts"), ("paper", "band_lambda_above_rest_n2"),
+    ("paper", "band_lambda_above_rest_n3"), ("paper", "band_lambda_above_rest_n4"),
+    ("paper", "band_lambda_above_rest_n5plus"), ("paper", "lambda_adds_to_contacts"),
+    ("paper", "contacts_locate_band"), ("paper", "z_initial_mechanical"), ("paper", "lambda_tracks_coordination"),
+    ("lambda:deviation=per_contact", "lambda_tracks_coordination"), ("band:displacement", "band_lambda_above_rest_all"),
+    ("band:final", "band_lambda_above_rest_all"),
+]
+
+
+def test_the_short_verdict_quotes_the_stored_ensemble():
+    document = json.loads((ROOT / "python/grainlab/reproduction/paper_scale/main.json").read_text(encoding="utf-8"))
+    page = (ROOT / "docs" / "reproduction.md").read_text(encoding="utf-8")
+    short = page[page.index("## The verdict, in short"):page.index("### Verdict sensitivity")]
+    blocks = {b["variant"]: {r["id"]: r for r in b["claims"]} for b in document["variants"]}
+    for variant, claim in QUOTED:
+        row = blocks[variant][claim]
+        low, high = row["ci95"]
+        assert f"{row['mean']:+.3f} [{low:.3f}, {high:.3f}]" in short, (variant, claim)
+    # the events: a two-block split accepted at the peak in 1 of 20 seeds, the lambda > 0.5 zone in none
+    assert round(20 * blocks["band:displacement"]["band_at_peak"]["mean"]) == 1 and "in 1 of 20" in short
+    assert blocks["band:lambda"]["band_at_peak"]["mean"] == 0.0 and "0 of 20 seeds" in short
+    assert len(document["seeds"]) == 20 and "**20 seeds**" in short

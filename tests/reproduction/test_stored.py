@@ -18,9 +18,9 @@ def test_verdicts_by_claim_from_a_document():
 
 
 def test_an_unknown_campaign_is_refused():
-    with pytest.raises(ValueError, match="name: expected one of main, rates, rate1, study"):
+    with pytest.raises(ValueError, match="name: expected one of main, readings, rates, rate1, study"):
         stored_claims("nope")
-    assert set(CAMPAIGNS) == {"main", "rates", "rate1", "study"}
+    assert set(CAMPAIGNS) == {"main", "readings", "rates", "rate1", "study"}
 
 
 def test_the_shipped_campaign_judges_every_biaxial_claim():
@@ -28,7 +28,14 @@ def test_the_shipped_campaign_judges_every_biaxial_claim():
 
     verdicts = paper_scale_verdicts()
     assert {c.id for c in BIAXIAL_CLAIMS} <= set(verdicts)
-    assert all(v["seeds"] == 5 for v in verdicts.values())
+    assert all(v["seeds"] == 20 for v in verdicts.values())  # the ensemble size fixed in advance
+    main = stored_claims("main")
+    # every analysis variant of the sensitivity table judges the same 20 runs
+    assert {b["variant"] for b in main["variants"]} >= {
+        "paper", "lambda_raw", "band:displacement", "band:lambda", "band:final", "lambda:deviation=per_contact"}
+    assert all(b["seeds"] == main["seeds"] for b in main["variants"])
+    readings = stored_claims("readings")
+    assert readings["seeds"] == main["seeds"]
     assert verdicts["band_lambda_above_rest"]["verdict"] in ("reproduced", "not reproduced", "inconclusive")
     rates = stored_claims("rate1")
     assert {e["rate"] for e in rates["rate_convergence"]} == {"2%/min", "4%/min", "8%/min"}

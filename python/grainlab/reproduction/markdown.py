@@ -174,10 +174,14 @@ SENSITIVITY_CLAIMS: tuple[str, ...] = (
 
 def sensitivity_markdown(documents: Sequence[dict[str, Any]], claims: Sequence[str] = SENSITIVITY_CLAIMS) -> str:
     """The verdict-sensitivity table: one row per claim of ``claims``, one column per
-    variant block (rate families left out) of each document in turn; each cell the
+    variant block (rate families left out) of each document in turn, a variant that an
+    earlier document has already shown left out; each cell the
     verdict (yes / **no** / ?) and the seed mean, with n when it is not the block's
     seed count; empty where the variant has no such claim."""
-    blocks = [b for d in documents for b in d.get("variants", []) if b.get("kind") != "rate"]
+    blocks: list[dict[str, Any]] = []
+    for d in documents:  # a variant shown by an earlier document (its reference, re-run there) once
+        blocks += [b for b in d.get("variants", []) if b.get("kind") != "rate"
+                   and b["variant"] not in {x["variant"] for x in blocks}]
     header = ["claim"] + [f"`{b['variant']}` ({len(b.get('seeds', []))})" for b in blocks]
     by = [{r["id"]: r for r in b["claims"]} for b in blocks]
     rows = []
