@@ -124,8 +124,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from grainlab.analysis._util import Computable
-from grainlab.analysis.shear_band import _best, _clip_line
+from grainlab.analysis.shear_band import SlabBand, _best
 
 __all__ = ["MIN_GRAINS", "SHARE_HIGH", "SHARE_LOW", "DisplacementBand"]
 
@@ -373,7 +372,7 @@ class _DisplacementBandResults:
     displacement: NDArray[np.float64]
 
 
-class DisplacementBand(Computable[_DisplacementBandResults]):
+class DisplacementBand(SlabBand[_DisplacementBandResults]):
     r"""The shear band as the zone between two blocks that move differently (Fig. 11).
 
     See the module docstring for the method, the acceptance tests and how
@@ -658,67 +657,6 @@ class DisplacementBand(Computable[_DisplacementBandResults]):
         return []
 
     @property
-    def found(self) -> bool:
-        """Whether the band passed the acceptance tests (module docstring)."""
-        return self._computed("found").found
-
-    @property
-    def reason(self) -> str:
-        """Why the band was not accepted ("" when :attr:`found`)."""
-        return self._computed("reason").reason
-
-    @property
-    def angle(self) -> float:
-        """Band direction, rad in [0, pi), CCW from +x."""
-        return self._computed("angle").angle
-
-    @property
-    def angle_degrees(self) -> float:
-        """Band direction in degrees, [0, 180), CCW from +x."""
-        return float(np.degrees(self.angle))
-
-    @property
-    def inclination(self) -> float:
-        """Acute angle between the band and the x axis, rad in [0, pi/2]."""
-        return float(min(self.angle, np.pi - self.angle))
-
-    @property
-    def inclination_degrees(self) -> float:
-        """Acute angle between the band and the x axis (the horizontal sigma_3
-        direction of a biaxial test loaded along y), degrees in [0, 90]."""
-        return float(np.degrees(self.inclination))
-
-    @property
-    def thickness(self) -> float:
-        """Band thickness (between the 0.1 and 0.9 crossings of the profile), m."""
-        return self._computed("thickness").thickness
-
-    @property
-    def thickness_diameters(self) -> float:
-        """Band thickness in mean grain diameters."""
-        return self._computed("thickness_diameters").thickness_diameters
-
-    @property
-    def mean_diameter(self) -> float:
-        """Mean diameter of the grains considered, m."""
-        return self._computed("mean_diameter").mean_diameter
-
-    @property
-    def center(self) -> NDArray[np.float64]:
-        """(2,) a point on the band's centre line (the nearest to the grains' centroid), m."""
-        return self._computed("center").center
-
-    @property
-    def normal(self) -> NDArray[np.float64]:
-        """(2,) unit normal of the band, pointing from block A into block B."""
-        return self._computed("normal").normal
-
-    @property
-    def members(self) -> NDArray[np.bool_]:
-        """(N,) grains whose centre lies inside the band."""
-        return self._computed("members").members
-
-    @property
     def residual_reduction(self) -> float:
         """Share of the residual of one affine motion of the whole sample that the
         two blocks' motions remove, 1 - S_2/S_1, in [0, 1]."""
@@ -780,22 +718,6 @@ class DisplacementBand(Computable[_DisplacementBandResults]):
             "slip_m": num(self.slip),
             "opening_m": num(self.opening),
         }
-
-    def outline(self, extent: ArrayLike | None = None) -> list[NDArray[np.float64]]:
-        """The two band edges as (2, 2) segments clipped to ``extent`` ``[[x0, x1], [y0, y1]]``
-        (default: the grains' bounding box), as :meth:`ShearBand.outline
-        <grainlab.analysis.ShearBand.outline>` gives them."""
-        if extent is None:
-            pos = self._computed("positions").positions
-            extent = np.array([[pos[:, 0].min(), pos[:, 0].max()], [pos[:, 1].min(), pos[:, 1].max()]])
-        ext = np.asarray(extent, dtype=np.float64)
-        t = np.array([np.cos(self.angle), np.sin(self.angle)])
-        edges = []
-        for side in (-0.5, 0.5):
-            seg = _clip_line(self.center + side * self.thickness * self.normal, t, ext)
-            if seg is not None:
-                edges.append(seg)
-        return edges
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Grain map coloured by displacement magnitude (Fig. 11) with the band

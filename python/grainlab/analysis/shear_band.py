@@ -96,7 +96,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -105,7 +105,7 @@ from scipy.ndimage import uniform_filter1d
 from grainlab.analysis._util import Computable, finite_mean
 from grainlab.snapshot import Snapshot
 
-__all__ = ["ShearBand"]
+__all__ = ["ShearBand", "SlabBand"]
 
 #: The second band's direction differs from the first's by at least this much (rad).
 _SECOND_SEPARATION = np.radians(20.0)
@@ -334,7 +334,123 @@ class _ShearBandResults:
     shear_strain: NDArray[np.float64]
 
 
-class ShearBand(Computable[_ShearBandResults]):
+class _SlabRecord(Protocol):
+    """What a straight-slab band's results record holds (both readings' records do)."""
+
+    @property
+    def found(self) -> bool: ...
+    @property
+    def reason(self) -> str: ...
+    @property
+    def angle(self) -> float: ...
+    @property
+    def thickness(self) -> float: ...
+    @property
+    def thickness_diameters(self) -> float: ...
+    @property
+    def mean_diameter(self) -> float: ...
+    @property
+    def center(self) -> NDArray[np.float64]: ...
+    @property
+    def normal(self) -> NDArray[np.float64]: ...
+    @property
+    def members(self) -> NDArray[np.bool_]: ...
+    @property
+    def positions(self) -> NDArray[np.float64]: ...
+
+
+S = TypeVar("S", bound=_SlabRecord)
+
+
+class SlabBand(Computable[S]):
+    """A band modelled as a straight slab (a centre line, a thickness): the results
+    and the outline that every reading of the band shares (:class:`ShearBand`,
+    :class:`~grainlab.analysis.band_readings.DisplacementBand`). How the slab is
+    found and accepted, and so what its thickness measures, is the subclass's."""
+
+    @property
+    def found(self) -> bool:
+        """Whether the band passed the acceptance tests (the class docstring)."""
+        return self._computed("found").found
+
+    @property
+    def reason(self) -> str:
+        """Why the band was not accepted ("" when :attr:`found`)."""
+        return self._computed("reason").reason
+
+    @property
+    def angle(self) -> float:
+        """Band direction, rad in [0, pi), CCW from +x."""
+        return self._computed("angle").angle
+
+    @property
+    def angle_degrees(self) -> float:
+        """Band direction in degrees, [0, 180), CCW from +x."""
+        return float(np.degrees(self.angle))
+
+    @property
+    def inclination(self) -> float:
+        """Acute angle between the band and the x axis, rad in [0, pi/2]."""
+        return float(min(self.angle, np.pi - self.angle))
+
+    @property
+    def inclination_degrees(self) -> float:
+        """Acute angle between the band and the x axis (the horizontal sigma_3
+        direction of a biaxial test loaded along y), degrees in [0, 90]."""
+        return float(np.degrees(self.inclination))
+
+    @property
+    def thickness(self) -> float:
+        """Band thickness, m (the class docstring says what it measures)."""
+        return self._computed("thickness").thickness
+
+    @property
+    def thickness_diameters(self) -> float:
+        """Band thickness in mean particle diameters."""
+        return self._computed("thickness_diameters").thickness_diameters
+
+    @property
+    def mean_diameter(self) -> float:
+        """Mean diameter of the particles considered, m."""
+        return self._computed("mean_diameter").mean_diameter
+
+    @property
+    def center(self) -> NDArray[np.float64]:
+        """(2,) a point on the centre line, m."""
+        return self._computed("center").center
+
+    @property
+    def normal(self) -> NDArray[np.float64]:
+        """(2,) unit normal of the band."""
+        return self._computed("normal").normal
+
+    @property
+    def members(self) -> NDArray[np.bool_]:
+        """(N,) particles inside the band."""
+        return self._computed("members").members
+
+    def outline(self, extent: ArrayLike | None = None) -> list[NDArray[np.float64]]:
+        """The two band edges as (2, 2) segments clipped to ``extent`` ``[[x0, x1], [y0, y1]]``.
+
+        ``extent`` defaults to the bounding box of the particles.
+        """
+        if extent is None:
+            pos = self._computed("positions").positions
+            extent = np.array(
+                [[pos[:, 0].min(), pos[:, 0].max()], [pos[:, 1].min(), pos[:, 1].max()]]
+            )
+        ext = np.asarray(extent, dtype=np.float64)
+        t = np.array([np.cos(self.angle), np.sin(self.angle)])
+        edges = []
+        for side in (-0.5, 0.5):
+            p0 = self.center + side * self.thickness * self.normal
+            seg = _clip_line(p0, t, ext)
+            if seg is not None:
+                edges.append(seg)
+        return edges
+
+
+class ShearBand(SlabBand[_ShearBandResults]):
     r"""Locate the dominant shear band (and a second one) in a per-particle strain field.
 
     See the module docstring for the method and for how to read the angle.
@@ -628,67 +744,6 @@ class ShearBand(Computable[_ShearBandResults]):
         return p[pick], g[pick]
 
     @property
-    def found(self) -> bool:
-        """Whether the band passed the acceptance tests (thickness, prominence)."""
-        return self._computed("found").found
-
-    @property
-    def reason(self) -> str:
-        """Why the band was not accepted ("" when :attr:`found`)."""
-        return self._computed("reason").reason
-
-    @property
-    def angle(self) -> float:
-        """Band direction, rad in [0, pi), CCW from +x."""
-        return self._computed("angle").angle
-
-    @property
-    def angle_degrees(self) -> float:
-        """Band direction in degrees, [0, 180), CCW from +x."""
-        return float(np.degrees(self.angle))
-
-    @property
-    def inclination(self) -> float:
-        """Acute angle between the band and the x axis, rad in [0, pi/2]."""
-        return float(min(self.angle, np.pi - self.angle))
-
-    @property
-    def inclination_degrees(self) -> float:
-        """Acute angle between the band and the x axis (the horizontal sigma_3
-        direction of a biaxial test loaded along y), degrees in [0, 90]."""
-        return float(np.degrees(self.inclination))
-
-    @property
-    def thickness(self) -> float:
-        """Band thickness, m."""
-        return self._computed("thickness").thickness
-
-    @property
-    def thickness_diameters(self) -> float:
-        """Band thickness in mean particle diameters."""
-        return self._computed("thickness_diameters").thickness_diameters
-
-    @property
-    def mean_diameter(self) -> float:
-        """Mean diameter of the particles considered, m."""
-        return self._computed("mean_diameter").mean_diameter
-
-    @property
-    def center(self) -> NDArray[np.float64]:
-        """(2,) a point on the centre line, m."""
-        return self._computed("center").center
-
-    @property
-    def normal(self) -> NDArray[np.float64]:
-        """(2,) unit normal of the band."""
-        return self._computed("normal").normal
-
-    @property
-    def members(self) -> NDArray[np.bool_]:
-        """(N,) particles inside the band."""
-        return self._computed("members").members
-
-    @property
     def mean_lambda_inside(self) -> float:
         """Mean stability index of the band's particles."""
         return self._computed("mean_lambda_inside").mean_lambda_inside
@@ -763,26 +818,6 @@ class ShearBand(Computable[_ShearBandResults]):
             "mean_lambda_outside": num(self.mean_lambda_outside),
             "second": second.summary() if second is not None else None,
         }
-
-    def outline(self, extent: ArrayLike | None = None) -> list[NDArray[np.float64]]:
-        """The two band edges as (2, 2) segments clipped to ``extent`` ``[[x0, x1], [y0, y1]]``.
-
-        ``extent`` defaults to the bounding box of the particles.
-        """
-        if extent is None:
-            pos = self._computed("positions").positions
-            extent = np.array(
-                [[pos[:, 0].min(), pos[:, 0].max()], [pos[:, 1].min(), pos[:, 1].max()]]
-            )
-        ext = np.asarray(extent, dtype=np.float64)
-        t = np.array([np.cos(self.angle), np.sin(self.angle)])
-        edges = []
-        for side in (-0.5, 0.5):
-            p0 = self.center + side * self.thickness * self.normal
-            seg = _clip_line(p0, t, ext)
-            if seg is not None:
-                edges.append(seg)
-        return edges
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Particle map coloured by shear strain with the band outlined; returns the axes."""
