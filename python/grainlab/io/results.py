@@ -218,6 +218,18 @@ def write_json_atomic(path: str | os.PathLike[str], value: Any, *, indent: int |
 # ---- output folders ------------------------------------------------------------
 
 
+def _nearest_existing(folder: Path, option: str) -> Path | None:
+    """``folder`` or its nearest ancestor that exists (None when none does); ``ValueError``
+    naming ``option`` when that is a file rather than a folder."""
+    for parent in (folder, *folder.parents):
+        if parent.exists() or parent.is_symlink():
+            if not parent.is_dir():
+                where = f"{folder}" if parent == folder else f"{folder}: {parent}"
+                raise ValueError(f"{option}: {where} is a file, not a folder")
+            return parent
+    return None
+
+
 def ensure_output_folder(path: str | os.PathLike[str], *, option: str = "--out", create: bool = True) -> Path:
     """The folder ``path``, made if needed (``create``), checked to be a folder
     this process can write into; returns it.
@@ -239,12 +251,7 @@ def ensure_output_folder(path: str | os.PathLike[str], *, option: str = "--out",
     ValueError: --out: .../notes.txt is a file, not a folder
     """
     folder = Path(path)
-    for parent in (folder, *folder.parents):
-        if parent.exists() or parent.is_symlink():
-            if not parent.is_dir():
-                where = f"{folder}" if parent == folder else f"{folder}: {parent}"
-                raise ValueError(f"{option}: {where} is a file, not a folder")
-            break
+    _nearest_existing(folder, option)
     if not folder.is_dir():
         if not create:
             raise ValueError(f"{option}: {folder} does not exist")
@@ -276,22 +283,19 @@ def check_output_folder(path: str | os.PathLike[str], *, option: str = "--out") 
     import tempfile
 
     folder = Path(path)
-    for parent in (folder, *folder.parents):
-        if parent.exists() or parent.is_symlink():
-            if not parent.is_dir():
-                where = f"{folder}" if parent == folder else f"{folder}: {parent}"
-                raise ValueError(f"{option}: {where} is a file, not a folder")
-            try:  # a probe that is removed at once: it tells permissions, read-only and pseudo file systems
-                if parent == folder:
-                    probe = _create_temporary(folder, "write-test")
-                    with contextlib.suppress(OSError):
-                        probe.unlink()
-                else:
-                    os.rmdir(tempfile.mkdtemp(prefix=".grainlab-", dir=parent))
-            except OSError as error:
-                what = f"write in {folder}" if parent == folder else f"create the folder {folder}"
-                raise ValueError(f"{option}: cannot {what} ({_reason(error)})") from None
-            break
+    parent = _nearest_existing(folder, option)
+    if parent is None:
+        return folder
+    try:  # a probe that is removed at once: it tells permissions, read-only and pseudo file systems
+        if parent == folder:
+            probe = _create_temporary(folder, "write-test")
+            with contextlib.suppress(OSError):
+                probe.unlink()
+        else:
+            os.rmdir(tempfile.mkdtemp(prefix=".grainlab-", dir=parent))
+    except OSError as error:
+        what = f"write in {folder}" if parent == folder else f"create the folder {folder}"
+        raise ValueError(f"{option}: cannot {what} ({_reason(error)})") from None
     return folder
 
 
