@@ -76,7 +76,9 @@ from grainlab.analysis import (
     StabilityIndex,
     anisotropy_fourier,
 )
+from grainlab.analysis._util import finite_mean
 from grainlab.io.hdf5 import read_results
+from grainlab.reproduction.verdicts import t_interval
 from grainlab.samples import measurement_circle_porosity
 from grainlab.snapshot import Snapshot
 
@@ -336,11 +338,6 @@ def gap_for_coordination_number(
     return float(max(gap[needed - 1], 0.0))
 
 
-def _finite_mean(values: NDArray[np.float64], mask: NDArray[np.bool_]) -> float:
-    chosen = values[mask & np.isfinite(values)]
-    return float(chosen.mean()) if chosen.size else math.nan
-
-
 def snapshot_initial_state(
     snapshot: Snapshot,
     *,
@@ -454,7 +451,7 @@ def snapshot_initial_state(
         sample_height_m=height,
         porosity=porosity,
         mean_lambda=lam.mean,
-        mean_lambda_active=_finite_mean(np.asarray(lam.stability_index), sample & ~rattler),
+        mean_lambda_active=finite_mean(np.asarray(lam.stability_index), sample & ~rattler),
         share_lambda_grains=float(lam_grains.sum() / n_grains) if n_grains else math.nan,
         share_active_grains=float((sample & ~rattler).sum() / n_grains) if n_grains else math.nan,
         gap_for_paper_z_m=gap,
@@ -567,8 +564,8 @@ def mean_interval(values: Sequence[float], confidence: float = 0.95) -> tuple[fl
         return math.nan, math.nan
     if x.size == 1:
         return float(x[0]), math.nan
-    half = float(stats.t.ppf(0.5 + confidence / 2.0, x.size - 1) * x.std(ddof=1) / math.sqrt(x.size))
-    return float(x.mean()), half
+    low, high = t_interval(x, confidence)
+    return float(x.mean()), 0.5 * (high - low)
 
 
 def format_table(rows: Sequence[tuple[str, Mapping[str, Any]]], *, interval: bool = True) -> str:
