@@ -100,8 +100,9 @@ def fake_fabric_figures(run_dir, *args, **kwargs):
     return SimpleNamespace(numbers=SimpleNamespace(summary=lambda: numbers))
 
 
-def assert_same_run(reference: Path, other: Path) -> None:
-    """``other`` is finished, with the reference's records, snapshots and summary, bit for bit."""
+def assert_same_run(reference: Path, other: Path, also_differing: set[str] | frozenset[str] = frozenset()) -> None:
+    """``other`` is finished, with the reference's records, snapshots and summary, bit for bit
+    (the summary but its wall times and the keys ``also_differing``)."""
     from grainlab.io.hdf5 import read_results
 
     a, b = read_results(reference), read_results(other)
@@ -114,6 +115,6 @@ def assert_same_run(reference: Path, other: Path) -> None:
         np.testing.assert_array_equal(a.snapshot(name).positions, b.snapshot(name).positions)
     assert (reference / "timeseries.csv").read_text() == (other / "timeseries.csv").read_text()
     sa, sb = (json.loads((p / "summary.json").read_text()) for p in (reference, other))
-    timing = {"wall_time_s", "wall_time_by_phase_s"}
+    timing = {"wall_time_s", "wall_time_by_phase_s", *also_differing}
     assert {k: v for k, v in sa.items() if k not in timing} == {k: v for k, v in sb.items() if k not in timing}
     assert not (other / "checkpoint.h5").exists() and not (other / "run.h5.partial").exists()

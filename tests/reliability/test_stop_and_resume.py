@@ -138,6 +138,22 @@ def test_resume_names_the_keys_whose_values_differ(tmp_path, monkeypatch, fast_f
     assert "sample." not in message  # only the keys that differ
 
 
+@pytest.mark.parametrize("where", ["shearing", "finalized"])
+def test_a_run_resumes_on_another_thread_count_with_the_same_bits(tmp_path, monkeypatch, fast_figures,
+                                                                   tiny_reference, where):
+    """The thread count and the checkpoint interval change no bit: a run started on
+    one thread finishes on two (as a campaign with fewer workers resumes it)."""
+    out = tmp_path / "run"
+    with monkeypatch.context() as patch:
+        _stop_at(patch, where)
+        with pytest.raises(Stop):
+            biaxial.run_biaxial(tiny_config(), out, progress=False)
+    other = tiny_config("run.threads=2", "run.checkpoint_interval=1e-9")
+    result = biaxial.run_biaxial(other, out, resume=True, progress=False)
+    assert result.summary["threads"] == (2 if where == "shearing" else 1)  # a finished engine is not rerun
+    assert_same_run(tiny_reference, out, also_differing={"threads"})
+
+
 def test_a_checkpoint_without_the_results_image_resumes_from_the_partial_file(
     tmp_path, monkeypatch, fast_figures, tiny_reference
 ):

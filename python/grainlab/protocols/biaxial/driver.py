@@ -60,17 +60,21 @@ def _saved_config(saved: Any) -> dict[str, Any] | None:
         return None
 
 
+#: Keys that set how a run is executed, not one bit of what it computes (the
+#: engine gives the same bits on any thread count): a run resumes under other values.
+EXECUTION_KEYS = frozenset({"run.threads", "run.checkpoint_interval"})
+
+
 def _config_difference(saved: Any, config: BiaxialConfig) -> str | None:
-    """The keys on which a run's saved configuration and ``config`` differ, with
-    both values; None when they agree."""
+    """The keys other than :data:`EXECUTION_KEYS` on which a run's saved
+    configuration and ``config`` differ, with both values; None when they agree."""
     resolved = _saved_config(saved)
     if resolved is None:
         return "the run's saved configuration cannot be read by this grainlab"
-    current = config.to_dict()
-    if resolved == current:
+    old, new = flatten_keys(resolved), flatten_keys(config.to_dict())
+    keys = [k for k in dict.fromkeys([*old, *new]) if old.get(k) != new.get(k) and k not in EXECUTION_KEYS]
+    if not keys:
         return None
-    old, new = flatten_keys(resolved), flatten_keys(current)
-    keys = [k for k in dict.fromkeys([*old, *new]) if old.get(k) != new.get(k)]
     return "; ".join(f"{k} = {old.get(k)!r} in the run, {new.get(k)!r} now" for k in keys)
 
 
@@ -208,6 +212,7 @@ def _run_locked(config: BiaxialConfig, out: Path, *, resume: bool, progress: boo
             saved = dict(checkpoint.protocol_state)
             _refuse_differing(out, saved.get("config"), config)
             sim = Simulation.from_bytes(checkpoint.engine_state)
+            sim.threads = threads  # the bits do not depend on it: a resumed run takes the count asked now
             run = _Run(**{k: v for k, v in saved.items() if k != "config" and k != "elapsed_s"})
             elapsed_before = float(saved.get("elapsed_s", 0.0))
             writer = _reopen_results(out, run, checkpoint)
@@ -252,7 +257,7 @@ def _run_locked(config: BiaxialConfig, out: Path, *, resume: bool, progress: boo
                 save()
             total = elapsed_before + time.perf_counter() - started
             summary = _summary(run, config, writer.read_timeseries(), total)
-            summary["threads"] = sim.threads  # the count the run used (a resumed run keeps its own): reruns bitwise
+            summary["threads"] = sim.threads  # the count the run ended with (any count reruns it bitwise)
             writer.write_summary(summary)
             writer.write_phases(run.wall_time)
             writer.finalize()
