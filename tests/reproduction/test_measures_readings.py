@@ -44,3 +44,33 @@ def test_every_reading_on_one_run(quick_biaxial_run):
         assert inside == pytest.approx(bearing, abs=1e-6)
         assert 0.0 <= peak["auc_contacts"] <= 1.0 and math.isfinite(peak["auc_gain_lambda"])
     assert np.isfinite([r["mean_lambda"] for r in nearest["snapshots"]]).all()
+
+
+def test_a_packing_study_is_measured_again_under_a_reading_on_its_stored_packings(tmp_path):
+    from grainlab.analysis import StabilityIndex
+    from grainlab.reproduction.measures import measure_study, read_study_rows
+    from grainlab.study import make_run, run_campaign
+    from grainlab.study.packing import read_packing
+
+    small = {"width": 0.02, "height": 0.04}
+    runs = [make_run(f"{kind}_{porosity}", "packing", {**small, "kind": kind, "porosity": porosity}, 3, {"kind": kind})
+            for kind, porosity in (("hexagonal", 0.12), ("irregular", 0.18))]
+    run_campaign(runs, tmp_path, workers=1, progress=False)
+    folder = tmp_path / "runs"
+    default = read_study_rows(folder)
+    assert read_study_rows(folder, {}) == default
+    per_contact = read_study_rows(folder, {"lambda_deviation": "per_contact"})
+    for d, p in zip(default, per_contact, strict=True):
+        snap = read_packing(folder / d["name"])
+        expected = StabilityIndex(deviation="per_contact").compute(snap)
+        assert p["mean_stability_index"] == expected.mean and p["mean_stability_index_all"] == expected.mean_all
+        # D / (n - 1) <= D grain by grain; nothing but lambda changes
+        assert p["mean_stability_index"] <= d["mean_stability_index"] + 1e-12
+        assert {k: v for k, v in p.items() if "stability" not in k} == {
+            k: v for k, v in d.items() if "stability" not in k}
+    irregular = next(p for p, d in zip(per_contact, default, strict=True) if d["kind"] == "irregular")
+    assert irregular["mean_stability_index"] < next(d for d in default if d["kind"] == "irregular")[
+        "mean_stability_index"]  # grains with 3+ contacts exist
+    assert measure_study(per_contact)["n_rows"] == 2
+    with pytest.raises(ValueError, match="only under a reading of lambda"):
+        read_study_rows(folder, {"band": "final"})

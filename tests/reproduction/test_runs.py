@@ -43,6 +43,14 @@ def test_variants_by_name():
     reading = parse_variant("lambda:slots=nearest,deviation=per_contact")
     assert reading.kind == "analysis" and reading.source == "paper"
     assert reading.analysis == {"lambda_slots": "nearest", "lambda_deviation": "per_contact"}
+    on_study = parse_variant("lambda: deviation=per_contact :study:generation_friction=0")
+    assert on_study.name == "lambda:deviation=per_contact:study:generation_friction=0"
+    assert on_study.source == "study:generation_friction=0" and on_study.analysis == {"lambda_deviation": "per_contact"}
+    assert parse_variant("lambda:anchor=mean:rate=1 %/min").source == "rate=1%/min"
+    studied = ReproductionPlan.build(2, [on_study.name])
+    assert [v.name for v in studied.variants] == ["study:generation_friction=0", on_study.name]
+    assert [studied.reads(v) for v in studied.variants] == ["study", "study"]
+    assert len(studied.runs()) == 2 * 19  # the study's packings, measured again: nothing of its own
     band = parse_variant("band:displacement")
     assert band.kind == "analysis" and band.source == "paper" and band.analysis == {"band": "displacement"}
     plan = ReproductionPlan.build(2, ["band:final", "lambda:anchor=mean"])
@@ -62,6 +70,8 @@ def test_variants_by_name():
         ("lambda_raw:study", "reads a biaxial variant"),
         ("lambda:slots=sideways", "slots must be one of angular, list, nearest"),
         ("lambda:colour=red", "unknown lambda option 'colour'"),
+        ("lambda:anchor=mean:lambda_raw", "lambda reads a biaxial or study variant's runs"),
+        ("lambda:anchor=mean:nonsense", "unknown variant 'nonsense'"),
         ("band:strain", "band:displacement, band:lambda or band:final"),
         ("band:eyeballed", "band:displacement, band:lambda or band:final"),
     ],

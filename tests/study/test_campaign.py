@@ -80,6 +80,21 @@ def test_single_run_alone_repeats_the_campaign_numbers(tmp_path):
     assert saved["run"]["seed"] == derive_seed(7, "packing", runs[1].params)
 
 
+def test_each_packing_keeps_the_snapshot_it_was_measured_on(tmp_path):
+    from grainlab.analysis import fabric_summary
+    from grainlab.study.packing import read_packing
+
+    campaign = run_campaign(_runs(seed=7), tmp_path, workers=1, progress=False)
+    for row in campaign.rows:
+        snap = read_packing(tmp_path / "runs" / row["name"])
+        again = fabric_summary(snap)
+        for key in ("coordination_number", "mean_stability_index", "mean_stability_index_all", "anisotropy"):
+            assert again[key] == row[key], (row["name"], key)
+        assert snap.n_particles == row["n_particles"]
+    with pytest.raises(ValueError, match="no stored packing"):
+        read_packing(tmp_path / "runs")
+
+
 def test_duplicate_names_rejected(tmp_path):
     run = make_run("x", "packing", {"porosity": 0.12}, 0)
     with pytest.raises(ValueError, match="duplicate"):

@@ -366,7 +366,7 @@ def draw_figures(plan: ReproductionPlan, results: Mapping[tuple[str, str, str], 
     out = Path(folder)
     drawn: dict[str, Path] = {}
     for v in plan.variants:
-        kind = "study" if v.kind == "study" else "biaxial"
+        kind = plan.reads(v)
         found = [results.get((v.name, str(s), kind)) for s in plan.seeds]
         runs = [m for m in found if m is not None]
         if not runs:

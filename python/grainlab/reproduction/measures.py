@@ -360,12 +360,26 @@ def measure_study(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def read_study_rows(folder: str | Path) -> list[dict[str, Any]]:
-    """The rows of the packings finished in ``folder`` (``*/result.json``)."""
+def read_study_rows(folder: str | Path, options: Mapping[str, Any] | None = None) -> list[dict[str, Any]]:
+    """The rows of the packings finished in ``folder`` (``*/result.json``). With lambda
+    ``options`` (``lambda_slots``, ``lambda_anchor``, ``lambda_deviation``: a reading of
+    Eqs. 9-11), each row's mean lambda is measured again under that reading on the
+    packing the row was measured on (``ValueError`` for a packing stored without it)."""
+    from grainlab.analysis import StabilityIndex
+    from grainlab.study.packing import read_packing
+
+    reading = {k[len("lambda_"):]: v for k, v in (options or {}).items()}
+    unknown = set(reading) - {"slots", "anchor", "deviation"}
+    if unknown:
+        raise ValueError(f"a packing study is measured again only under a reading of lambda, not {sorted(unknown)}")
     rows = []
     for path in sorted(Path(folder).glob("*/result.json")):
         try:
-            rows.append(json.loads(path.read_text())["row"])
+            row = json.loads(path.read_text())["row"]
         except (OSError, json.JSONDecodeError, KeyError):
             continue
+        if reading and row.get("status") != "failed":
+            stability = StabilityIndex(**reading).compute(read_packing(path.parent))
+            row = {**row, "mean_stability_index": stability.mean, "mean_stability_index_all": stability.mean_all}
+        rows.append(row)
     return rows

@@ -66,7 +66,7 @@ def _measure_task(kind: str, path: str, options: list[dict[str, Any]]) -> tuple[
     try:
         if kind == "biaxial":
             return list(measure_biaxial_each(path, options)), ""
-        return [measure_study(read_study_rows(path))], ""
+        return [measure_study(read_study_rows(path, o)) for o in options], ""
     except Exception as error:  # noqa: BLE001 - one unreadable run must not stop the claims
         return [None] * len(options), f"{path}: {type(error).__name__}: {error}"
 
@@ -82,10 +82,10 @@ def _tasks(plan: ReproductionPlan, out: Path) -> dict[TaskKey, Task]:
     for v in plan.variants:
         source = plan.variant(v.runs_variant)
         for seed in plan.seeds:
-            if v.kind == "study":
+            if plan.reads(v) == "study":
                 folder = plan.study_folder(out, source, seed)
                 if any(folder.glob("*/result.json")):
-                    tasks[(v.name, str(seed), "study")] = ("study", str(folder), {})
+                    tasks[(v.name, str(seed), "study")] = ("study", str(folder), dict(v.analysis))
             else:
                 folder = plan.biaxial_folder(out, source, seed)
                 if (folder / "run.h5").exists():
@@ -137,11 +137,12 @@ def _compute(
 
 def _block(variant: Variant, plan: ReproductionPlan, measures: list[dict[str, Any] | None], out: Path
            ) -> dict[str, Any]:
-    claims = BIAXIAL_CLAIMS if variant.kind in ("biaxial", "analysis") else STUDY_CLAIMS
+    study = plan.reads(variant) == "study"
+    claims = STUDY_CLAIMS if study else BIAXIAL_CLAIMS
     rows = evaluate(claims, measures, plan.seeds, variant.name)
     source = plan.variant(variant.runs_variant)
-    walls = [m.get("wall_time_s") if m else None for m in measures] if variant.kind != "study" else []
-    if variant.kind == "study":
+    walls = [] if study else [m.get("wall_time_s") if m else None for m in measures]
+    if study:
         runs = [str(plan.study_folder(out, source, s).relative_to(out)) for s in plan.seeds]
         walls = [_study_wall_time(plan.study_folder(out, source, s)) for s in plan.seeds]
     else:
@@ -394,8 +395,7 @@ def write_outputs(plan: ReproductionPlan, out_dir: str | os.PathLike[str], *, wo
     results, notes = _compute(tasks, workers, progress)
 
     def per_seed(v: Variant) -> list[dict[str, Any] | None]:
-        kind = "study" if v.kind == "study" else "biaxial"
-        return [results.get((v.name, str(s), kind)) for s in plan.seeds]
+        return [results.get((v.name, str(s), plan.reads(v))) for s in plan.seeds]
 
     blocks = [_block(v, plan, per_seed(v), out) for v in plan.variants]
     family = rate_family(plan)

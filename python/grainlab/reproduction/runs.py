@@ -24,10 +24,12 @@ Variants (:func:`parse_variant`):
     the paper variant's reads the paper variant's runs.
 ``set:<key>=<value>[,<key>=<value>...]``
     ``paper`` with any biaxial configuration keys changed.
-``lambda:<key>=<value>[,...]``
-    Analysis only: the paper variant's runs, lambda read another way (Eqs. 9-11):
-    ``slots`` (angular, list, nearest), ``anchor`` (min, mean), ``deviation`` (sum,
-    per_contact), e.g. ``lambda:slots=nearest,deviation=per_contact``.
+``lambda:<key>=<value>[,...]``, ``lambda:<key>=<value>[,...]:<variant>``
+    Analysis only: the paper variant's runs (or the given variant's: a biaxial
+    variant's runs, or a study variant's stored packings), lambda read another way
+    (Eqs. 9-11): ``slots`` (angular, list, nearest), ``anchor`` (min, mean),
+    ``deviation`` (sum, per_contact), e.g. ``lambda:slots=nearest,deviation=per_contact``
+    or ``lambda:deviation=per_contact:study:generation_friction=0``.
 ``band:displacement``, ``band:lambda``, ``band:final``
     Analysis only: the paper variant's runs, the band's grains read from the
     displacement map (Fig. 11), from the zone of lambda > 0.5 (Fig. 12), or the
@@ -206,7 +208,12 @@ def parse_variant(text: str) -> Variant:
             description=f"{source.name}'s runs; lambda with every membrane disk a grain touches counted",
         )
     if name.startswith("lambda:"):
-        pairs = _assignments(name, name[len("lambda:"):])
+        readings, _, source_name = name[len("lambda:"):].partition(":")
+        source = parse_variant(source_name) if source_name else parse_variant("paper")
+        if source.kind == "analysis":
+            raise ValueError(f"--variants: {name!r}: lambda reads a biaxial or study variant's runs, "
+                             f"not {source.name!r}")
+        pairs = _assignments(name, readings)
         analysis = {}
         for key, value in pairs:
             if key not in LAMBDA_READINGS:
@@ -217,8 +224,12 @@ def parse_variant(text: str) -> Variant:
                                  f"{', '.join(LAMBDA_READINGS[key])}, got {value!r}")
             analysis[f"lambda_{key}"] = value
         what = ", ".join(f"{k} = {v}" for k, v in pairs)
-        return Variant(name, "analysis", analysis=analysis, source="paper",
-                       description=f"paper's runs; lambda read with {what} (Eqs. 9-11)")
+        canonical = f"lambda:{','.join(f'{k}={v}' for k, v in pairs)}"
+        if source.name != "paper":
+            canonical += f":{source.name}"
+        runs = "stored packings" if source.kind == "study" else "runs"
+        return Variant(canonical, "analysis", analysis=analysis, source=source.name,
+                       description=f"{source.name}'s {runs}; lambda read with {what} (Eqs. 9-11)")
     if name.startswith("band:"):
         from grainlab.reproduction.measures import BAND_READINGS
 
@@ -318,6 +329,10 @@ class ReproductionPlan:
                     first[key] = v.name
             out.append(v)
         return ReproductionPlan(self.seeds, tuple(out), self.quick)
+
+    def reads(self, variant: Variant) -> Literal["biaxial", "study"]:
+        """The kind of runs ``variant`` measures: biaxial runs or a packing study's."""
+        return "study" if self.variant(variant.runs_variant).kind == "study" else "biaxial"
 
     def variant(self, name: str) -> Variant:
         for v in self.variants:

@@ -99,7 +99,7 @@ def _packing_task(run: Run, run_dir: Path, threads: int) -> dict[str, Any]:
 
     params = {"threads": threads, **run.params}
     params.setdefault("seed", run.seed)
-    return run_packing(params)
+    return run_packing(params, run_dir)
 
 
 def _biaxial_task(run: Run, run_dir: Path, threads: int) -> dict[str, Any]:

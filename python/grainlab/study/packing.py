@@ -24,21 +24,31 @@ Two kinds (Tables 2 and 3):
   ``kn * overlap``.
 
 :func:`run_packing` returns a flat dict of measures (:data:`MEASURES`) plus
-``status`` and ``note``.
+``status`` and ``note``; given a folder, it also stores the measured packing
+there (:data:`PACKING_FILE`, a results file of kind ``packing`` with one
+snapshot), so that the packing can be measured again another way
+(:func:`read_packing`) without being made again.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
+from pathlib import Path
 from typing import Any, TypedDict
 
 import numpy as np
 
 from grainlab.analysis import fabric_summary
 from grainlab.snapshot import Snapshot
+
+#: The results file a packing's folder holds: its measured snapshot and its measures.
+PACKING_FILE = "run.h5"
+#: The name of that snapshot.
+PACKING_SNAPSHOT = "packing"
 
 #: The measured columns of one packing, in table order.
 MEASURES: tuple[str, ...] = (
@@ -220,7 +230,7 @@ class _ExpansionOptions(TypedDict, total=False):
     density_scaling: bool
 
 
-def _irregular(p: PackingParams) -> dict[str, Any]:
+def _irregular(p: PackingParams) -> tuple[dict[str, Any], Snapshot]:
     from grainlab.samples import (
         ExpansionError,
         UniformByNumber,
@@ -314,10 +324,10 @@ def _irregular(p: PackingParams) -> dict[str, Any]:
         generation_expansions=expansions,
     )
     return {**result, "status": status, "note": "; ".join(notes),
-            "friction_search": search.trials_json() if search is not None else ""}
+            "friction_search": search.trials_json() if search is not None else ""}, snap
 
 
-def _hexagonal(p: PackingParams) -> dict[str, Any]:
+def _hexagonal(p: PackingParams) -> tuple[dict[str, Any], Snapshot]:
     from grainlab.samples import hexagonal_lattice
 
     lattice = hexagonal_lattice(
@@ -369,16 +379,51 @@ def _hexagonal(p: PackingParams) -> dict[str, Any]:
     note = lattice.note
     if not overlap.any():
         note += "; the lattice at contact carries no load, so the force anisotropy is undefined (NaN)"
-    return {**result, "status": "ok", "note": note, "friction_search": ""}
+    return {**result, "status": "ok", "note": note, "friction_search": ""}, snap
 
 
-def run_packing(params: PackingParams | Mapping[str, Any]) -> dict[str, Any]:
+def run_packing(params: PackingParams | Mapping[str, Any],
+                out_dir: str | os.PathLike[str] | None = None) -> dict[str, Any]:
     """Makes and measures one packing; returns :data:`MEASURES` + ``status``, ``note``,
-    ``friction_search`` (the search's trials as JSON, or ``""``), ``seed``, ``wall_time_s``."""
+    ``friction_search`` (the search's trials as JSON, or ``""``), ``seed``, ``wall_time_s``.
+    With ``out_dir``, the measured snapshot and the parameters are stored in
+    ``out_dir/run.h5`` (:data:`PACKING_FILE`, replacing one an earlier attempt left)."""
     p = params if isinstance(params, PackingParams) else PackingParams.from_mapping(params)
     p.validate()
     started = time.perf_counter()
-    result = _irregular(p) if p.kind == "irregular" else _hexagonal(p)
+    result, snap = _irregular(p) if p.kind == "irregular" else _hexagonal(p)
     result["seed"] = p.seed
     result["wall_time_s"] = time.perf_counter() - started
+    if out_dir is not None:
+        _store(Path(out_dir), p, result, snap)
     return result
+
+
+def _store(folder: Path, p: PackingParams, result: Mapping[str, Any], snap: Snapshot) -> Path:
+    from grainlab.io.hdf5 import ResultsWriter
+
+    folder.mkdir(parents=True, exist_ok=True)
+    writer = ResultsWriter(folder / PACKING_FILE, kind="packing", overwrite=True, buffered=True)
+    try:
+        writer.write_config(asdict(p))
+        writer.write_snapshot(PACKING_SNAPSHOT, snap)
+        writer.write_summary(result)
+    except BaseException:
+        writer.close()
+        raise
+    return writer.finalize()
+
+
+def read_packing(folder: str | os.PathLike[str]) -> Snapshot:
+    """The packing :func:`run_packing` stored in ``folder``; ``ValueError`` naming the
+    folder when it holds none (a packing measured before grainlab stored them)."""
+    from grainlab.io.hdf5 import read_results
+
+    path = Path(folder) / PACKING_FILE
+    if not path.exists():
+        raise ValueError(f"{folder}: no stored packing ({PACKING_FILE} not found): the packing was measured "
+                         "without being stored; run it again to measure it another way")
+    results = read_results(path)
+    if results.kind != "packing":
+        raise ValueError(f"{path}: a results file of kind {results.kind!r}, not a packing")
+    return results.snapshot(PACKING_SNAPSHOT)
