@@ -38,12 +38,12 @@ import time
 from pathlib import Path
 
 from grainlab.protocols.biaxial.phases import (
-    _check_shear_plan,
-    _consolidate,
-    _generate,
-    _install_boundary,
-    _start_shear,
-    _threads,
+    check_shear_plan,
+    consolidate,
+    engine_threads,
+    generate,
+    install_boundary,
+    start_shear,
 )
 from grainlab.protocols.config import resolve
 from grainlab.simulation import Simulation
@@ -52,11 +52,11 @@ from grainlab.simulation import Simulation
 def build_state(path: Path, quick: bool) -> None:
     """Runs the biaxial protocol to the start of shear and writes the engine state."""
     config = resolve(quick=quick)
-    sim, run = _generate(config, _threads(config), progress=False)
-    _consolidate(sim, run, config, progress=False)
-    _install_boundary(sim, run, config, progress=False)
-    _start_shear(sim, run, config)
-    _check_shear_plan(sim, run, config)
+    sim, run = generate(config, engine_threads(config), progress=False)
+    consolidate(sim, run, config, progress=False)
+    install_boundary(sim, run, config, progress=False)
+    start_shear(sim, run, config)
+    check_shear_plan(sim, run, config)
     path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.NamedTemporaryFile(dir=path.parent, delete=False) as f:
         f.write(sim.to_bytes())

@@ -20,7 +20,7 @@ import json
 import sys
 import time
 
-from grainlab.protocols.biaxial.phases import _consolidate, _generate, _threads
+from grainlab.protocols.biaxial.phases import consolidate, engine_threads, generate
 from grainlab.protocols.config import resolve
 from grainlab.protocols.consolidate import BoxState
 
@@ -28,7 +28,7 @@ from grainlab.protocols.consolidate import BoxState
 def main(argv: list[str] | None = None) -> int:
     overrides = sys.argv[1:] if argv is None else argv
     config = resolve(overrides=overrides)
-    sim, run = _generate(config, _threads(config), progress=False)
+    sim, run = generate(config, engine_threads(config), progress=False)
     target = config["consolidation.pressure"]
     tolerance = config["consolidation.tolerance"]
     first_within: list[int] = []
@@ -41,7 +41,7 @@ def main(argv: list[str] | None = None) -> int:
               f"kPa, unbalanced force ratio {sim.unbalanced_force_ratio:.2e}", flush=True)
 
     start = time.perf_counter()
-    _consolidate(sim, run, config, progress=False, on_chunk=show)
+    consolidate(sim, run, config, progress=False, on_chunk=show)
     seconds = time.perf_counter() - start
     c = run.consolidation
     result = {

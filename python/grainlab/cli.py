@@ -82,9 +82,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as error:
         # imported only on failure: every command would otherwise pay for the protocol's imports
         from grainlab import SimulationUnstableError
-        from grainlab.protocols.biaxial import BiaxialError
+        from grainlab.protocols.runner import ProtocolError
 
-        if not isinstance(error, SimulationUnstableError | BiaxialError):
+        if not isinstance(error, SimulationUnstableError | ProtocolError):
             raise  # a bug: its traceback is the useful report
         print(f"grainlab {args.command}: run stopped: {error}", file=sys.stderr)  # the physics failed mid-run
         return 1

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import grainlab.protocols.biaxial as biaxial
-import grainlab.protocols.biaxial.driver as driver
 import grainlab.protocols.biaxial.phases as phases
+import grainlab.protocols.biaxial.protocol as protocol
 from grainlab.analysis import StabilityIndex
 from grainlab.cli import main
 from grainlab.io.hdf5 import read_results
@@ -179,7 +179,7 @@ def test_a_run_stopped_before_its_first_checkpoint_starts_over(tmp_path, monkeyp
     def generate(*args, **kwargs):
         raise RuntimeError("generation reached")
 
-    monkeypatch.setattr(driver, "_generate", generate)
+    monkeypatch.setattr(protocol, "generate", generate)
     with pytest.raises(RuntimeError, match="generation reached"):
         biaxial.run_biaxial(resolve(quick=True), tmp_path, progress=False)
     with pytest.raises(ValueError, match="nothing to resume"):
@@ -191,8 +191,8 @@ def test_a_checkpoint_from_before_new_keys_resumes_with_their_defaults():
     old = config.to_dict()
     del old["material"]["limiting_contact_pressure"]  # keys added since
     del old["sample"]["sieve_sizes"], old["sample"]["percent_passing"]
-    assert driver._saved_config(old) == config.to_dict()
-    assert driver._saved_config({"sample": {"porosity": 2.0}}) is None  # not a valid configuration
+    assert protocol.BiaxialProtocol(config).resolve_saved(old) == config.to_dict()
+    assert protocol.BiaxialProtocol(config).resolve_saved({"sample": {"porosity": 2.0}}) is None  # not a valid configuration
 
 
 @pytest.mark.slow
@@ -220,7 +220,7 @@ def test_snapshot_arrays_are_stored_compressed(quick_run):
         stored = raw = 0
         for name in ("positions", "radii", "contact_i", "contact_j", "normal_force", "shear_force"):
             ds = group[name]
-            assert ds.compression == driver.RESULTS_COMPRESSION and ds.shuffle, name
+            assert ds.compression == protocol.BiaxialProtocol.compression and ds.shuffle, name
             stored += ds.id.get_storage_size()
             raw += ds.size * ds.dtype.itemsize
         assert stored < 0.8 * raw  # the pair indices and radii shrink most

@@ -15,8 +15,8 @@ import pytest
 from reliability_factories import TINY_TOML, assert_same_run, tiny_config
 
 import grainlab.protocols.biaxial as biaxial
-import grainlab.protocols.biaxial.driver as driver
 import grainlab.protocols.biaxial.outputs as outputs
+import grainlab.protocols.runner as runner
 from grainlab.cli import main
 from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, read_results
 from grainlab.io.results import is_disk_full
@@ -43,7 +43,7 @@ def _full_at(function, n):
     [
         ("a record", (ResultsWriter, "append_timeseries"), 3),
         ("a snapshot", (ResultsWriter, "write_snapshot"), 2),
-        ("the final checkpoint", (driver, "write_checkpoint"), 4),
+        ("the final checkpoint", (runner, "write_checkpoint"), 4),
         ("the figures", (outputs, "_figures"), 1),
     ],
 )

@@ -17,9 +17,10 @@ from reliability_factories import TINY_TOML, assert_same_run, tiny_config
 
 import grainlab.postprocess.figures as figures
 import grainlab.protocols.biaxial as biaxial
-import grainlab.protocols.biaxial.driver as driver
 import grainlab.protocols.biaxial.outputs as outputs
 import grainlab.protocols.biaxial.phases as phases
+import grainlab.protocols.biaxial.protocol as protocol
+import grainlab.protocols.runner as runner
 from grainlab.cli import main
 from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, read_results, write_checkpoint
 
@@ -57,9 +58,9 @@ def _before(function, n=1):
 
 def _stop_at(monkeypatch, where: str) -> None:
     if where == "generation":
-        monkeypatch.setattr(driver, "_generate", _after(driver._generate))
+        monkeypatch.setattr(protocol, "generate", _after(protocol.generate))
     elif where.startswith("checkpoint "):  # 1 generated, 2 consolidated, 3 boundary installed, 4 sheared
-        monkeypatch.setattr(driver, "write_checkpoint", _after(write_checkpoint, int(where.split()[1])))
+        monkeypatch.setattr(runner, "write_checkpoint", _after(write_checkpoint, int(where.split()[1])))
     elif where == "shearing":
         monkeypatch.setattr(phases, "_measure", _before(phases._measure, 3))
     elif where == "summary":

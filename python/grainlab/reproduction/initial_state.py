@@ -492,7 +492,7 @@ def prepared_state(
     stress and porosities, the consolidation's steps, its porosities and
     unbalanced force ratio, and the wall time.
     """
-    from grainlab.protocols.biaxial.phases import _consolidate, _generate
+    from grainlab.protocols.biaxial.phases import consolidate, generate
     from grainlab.protocols.config import resolve
 
     values = dict(overrides or {})
@@ -501,8 +501,8 @@ def prepared_state(
     config = resolve(overrides=values)
     start = time.perf_counter()
     with _kernels.kernel_threads(int(threads)):
-        sim, run = _generate(config, int(threads), progress=False)
-        _consolidate(sim, run, config, progress=False)
+        sim, run = generate(config, int(threads), progress=False)
+        consolidate(sim, run, config, progress=False)
     seconds = time.perf_counter() - start
     c = run.consolidation
     state = snapshot_initial_state(sim.snapshot(), area=float(c["width_m"] * c["height_m"]))

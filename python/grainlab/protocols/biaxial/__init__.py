@@ -1,6 +1,8 @@
 """The paper's biaxial test, end to end (Sec. 6, Table 1).
 
-Phases, each run by the engine in blocks of steps:
+The stages of :class:`BiaxialProtocol`, run in order by the protocol runner
+(:mod:`grainlab.protocols.runner`), each by the engine in blocks of steps
+(generation makes the sample when the run starts):
 
 1. **generate**: random placement at half radii inside four rigid walls and
    radius expansion to the target nominal porosity (:mod:`grainlab.samples`).
@@ -21,15 +23,20 @@ Everything lands in one results folder: ``run.h5`` (config, time series,
 snapshots, summary, phase times), ``timeseries.csv``, ``summary.json`` and the
 figures. A ``checkpoint.h5`` is written after each phase and during shearing;
 ``run_biaxial(..., resume=True)`` continues a killed run and ends with the same
-results as an uninterrupted one (same config, same thread count).
+results as an uninterrupted one (same configuration, on any thread count).
 
 Sign conventions: stresses and strains compression positive; axial strain
 ``(H0 - H) / H0``, volumetric (area) strain ``(A0 - A) / A0`` from the
 membrane polygon, both from the start of shearing.
 """
 
-from grainlab.protocols.biaxial.driver import OUTPUT_FILES, RUN_FILES, run_biaxial
 from grainlab.protocols.biaxial.outputs import PAPER_VALUES, BiaxialResult
+from grainlab.protocols.biaxial.protocol import (
+    OUTPUT_FILES,
+    RUN_FILES,
+    BiaxialProtocol,
+    run_biaxial,
+)
 from grainlab.protocols.biaxial.rates import (
     DENSITY_SCALING_LIMIT,
     MAX_PLATEN_TRAVEL_PER_STEP,
@@ -54,6 +61,7 @@ __all__ = [
     "RUN_FILES",
     "TIMESERIES_UNITS",
     "BiaxialError",
+    "BiaxialProtocol",
     "BiaxialResult",
     "DensityScalingWarning",
     "check_density_scaling",

@@ -18,6 +18,7 @@ from grainlab.io.results import RESULTS_FILE, write_json_atomic, write_text_atom
 from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
 from grainlab.protocols.biaxial.state import _Run
 from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.runner import RunResult
 
 #: The paper's reported values, for the summary and the docs.
 PAPER_VALUES = {
@@ -28,11 +29,8 @@ PAPER_VALUES = {
 
 
 @dataclass(frozen=True)
-class BiaxialResult:
+class BiaxialResult(RunResult):
     """What ``grainlab biaxial`` reports: the summary and where the files are."""
-
-    out_dir: Path
-    summary: dict[str, Any]
 
     def one_line(self) -> str:
         s = self.summary

@@ -1,6 +1,7 @@
 """The biaxial test's phases: generate, consolidate, install the boundary,
-start and run the shearing. Each takes the simulation and the run state and
-leaves the run in its next phase."""
+start and run the shearing. Each takes the simulation, the run state and the
+configuration; :mod:`grainlab.protocols.biaxial.protocol` lists them as the
+protocol's stages, and the runner moves the run from one to the next."""
 
 from __future__ import annotations
 
@@ -40,6 +41,7 @@ from grainlab.protocols.boundary import (
 )
 from grainlab.protocols.config import BiaxialConfig
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
+from grainlab.protocols.triggers import At, Every, WallClock, schedule_steps
 from grainlab.samples import (
     PAPER_GRADING,
     GradingCurve,
@@ -68,7 +70,7 @@ def _grading(config: BiaxialConfig) -> UniformByNumber | UniformByMass | Grading
     return PAPER_GRADING
 
 
-def _threads(config: BiaxialConfig) -> int:
+def engine_threads(config: BiaxialConfig) -> int:
     threads = config["run.threads"]
     return available_cores() if threads == "auto" else int(threads)
 
@@ -85,7 +87,7 @@ def _platen_model(config: BiaxialConfig) -> ContactModel:
     )
 
 
-def _generate(config: BiaxialConfig, threads: int, progress: bool) -> tuple[Simulation, _Run]:
+def generate(config: BiaxialConfig, threads: int, progress: bool) -> tuple[Simulation, _Run]:
     start = time.perf_counter()
     box = (0.0, 0.0, config["sample.width"], config["sample.height"])
     sample = expand_to_porosity(
@@ -120,7 +122,7 @@ def _generate(config: BiaxialConfig, threads: int, progress: bool) -> tuple[Simu
     return sim, run
 
 
-def _consolidate(
+def consolidate(
     sim: Simulation,
     run: _Run,
     config: BiaxialConfig,
@@ -184,10 +186,9 @@ def _consolidate(
         "time_step_s": sim.time_step,
     }
     run.wall_time["consolidate"] = time.perf_counter() - start
-    run.phase = "boundary"
 
 
-def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
+def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
     start = time.perf_counter()
     walls = run.walls
     left_x = float(sim.wall(walls["left"]).points[0, 0])
@@ -279,10 +280,9 @@ def _install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progres
         run.membrane = grains.to_dict()
     run.consolidation["boundary_steps"] = steps
     run.wall_time["boundary"] = time.perf_counter() - start
-    run.phase = "shear"
 
 
-def _start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
+def start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     boundary = _boundary(run)
     grains = np.arange(run.n_grains)
     radii = sim.radii[grains]
@@ -303,9 +303,8 @@ def _start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     steps_per_strain = 1.0 / (rate * dt)
     final = config["shear.final_strain"]
     interval = config["shear.record_interval"]
-    targets = {round(k * interval * steps_per_strain) for k in range(1, int(round(final / interval)) + 1)}
     snaps = [s for s in config["shear.snapshot_strains"] if s <= final + 1e-12]
-    targets |= {round(s * steps_per_strain) for s in snaps if s > 0}
+    record_steps = schedule_steps([Every(interval), At(snaps)], final=final, steps_per_unit=steps_per_strain)
     root = math.sqrt(config["material.density"] / config["consolidation.pressure"])
     run.shear = {
         "strain_rate": rate,
@@ -313,7 +312,7 @@ def _start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
         "height0": height0,
         "area0": area0,
         "start_step": sim.step_count,
-        "record_steps": sorted(targets),
+        "record_steps": record_steps,
         "snapshot_steps": {str(round(s * steps_per_strain)): s for s in snaps},
         "next": 0,
         "inertial_number": inertial_number(config, rate, max_d),
@@ -325,7 +324,7 @@ def _start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     }
 
 
-def _shear(
+def shear(
     sim: Simulation,
     run: _Run,
     config: BiaxialConfig,
@@ -334,16 +333,16 @@ def _shear(
     progress: bool,
 ) -> None:
     start = time.perf_counter() - run.wall_time.get("shear", 0.0)
-    shear = run.shear_plan()
-    steps = shear["record_steps"]
-    snap_steps = shear["snapshot_steps"]
+    plan = run.shear_plan()
+    steps = plan["record_steps"]
+    snap_steps = plan["snapshot_steps"]
     final = config["shear.final_strain"]
-    if shear["next"] == 0 and "0" in snap_steps and writer.n_rows == 0:
+    if plan["next"] == 0 and "0" in snap_steps and writer.n_rows == 0:
         record = _measure(sim, run, config)
         writer.append_timeseries(record, units=TIMESERIES_UNITS)
         writer.write_snapshot(snapshot_name(0.0), _snapshot(sim, run, 0.0), step=sim.step_count,
                               walls=_walls(sim, run))
-    last_checkpoint = time.perf_counter()
+    checkpoint_due = WallClock(config["run.checkpoint_interval"])
     done_strain = 0.0
     bar = progress_bar(
         round(100 * final, 3),
@@ -352,12 +351,12 @@ def _shear(
         unit="% strain",
         bar_format="{l_bar}{bar}| {n:.2f}/{total:.1f} % [{elapsed}<{remaining}{postfix}]",
     )
-    while shear["next"] < len(steps):
-        target = shear["start_step"] + steps[shear["next"]]
+    while plan["next"] < len(steps):
+        target = plan["start_step"] + steps[plan["next"]]
         sim.run(target - sim.step_count)
         record = _measure(sim, run, config)
         writer.append_timeseries(record, units=TIMESERIES_UNITS)
-        key = str(steps[shear["next"]])
+        key = str(steps[plan["next"]])
         if key in snap_steps:
             strain = snap_steps[key]
             writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record["axial_strain"]),
@@ -380,21 +379,19 @@ def _shear(
                 raise BiaxialError(
                     f"shearing stopped at {100 * record['axial_strain']:.2f} % axial strain: {breach}"
                 )
-        shear["next"] += 1
+        plan["next"] += 1
         raise_if_interrupted()
         bar.update(100 * record["axial_strain"] - done_strain)
         done_strain = 100 * record["axial_strain"]
         bar.set_postfix_str(f"ratio {record['stress_ratio']:.2f}")
-        if time.perf_counter() - last_checkpoint > config["run.checkpoint_interval"]:
+        if checkpoint_due():
             run.wall_time["shear"] = time.perf_counter() - start
             save()
-            last_checkpoint = time.perf_counter()
     bar.close()
     run.wall_time["shear"] = time.perf_counter() - start
-    run.phase = "done"
 
 
-def _check_shear_plan(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
+def check_shear_plan(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     """The shearing phase's records and snapshots fall on distinct time steps,
     checked with the run's own time step before the first record."""
     shear = run.shear_plan()

@@ -7,12 +7,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from grainlab.protocols.boundary import GrainBoundary, Membrane
+from grainlab.protocols.runner import ProtocolError
 
 #: Steps per engine call while a phase waits for a condition.
 CHUNK_STEPS = 2000
 
 
-class BiaxialError(RuntimeError):
+class BiaxialError(ProtocolError):
     """The test could not proceed (e.g. consolidation did not converge)."""
 
 
@@ -47,8 +48,6 @@ class _Run:
         if self.shear is None:
             raise BiaxialError(f"the run has no shearing plan yet (phase {self.phase!r})")
         return self.shear
-
-
 
 
 def _boundary(run: _Run) -> Membrane | GrainBoundary:

@@ -1,0 +1,109 @@
+"""The biaxial test as a protocol of the runner (:mod:`grainlab.protocols.runner`):
+its stages in order, its configuration, its summary and its outputs; and
+:func:`run_biaxial`, which runs it into a results folder."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, ClassVar
+
+from grainlab.protocols.biaxial.outputs import BiaxialResult, _summary, _write_outputs
+from grainlab.protocols.biaxial.phases import (
+    check_shear_plan,
+    consolidate,
+    engine_threads,
+    generate,
+    install_boundary,
+    shear,
+    start_shear,
+)
+from grainlab.protocols.biaxial.rates import check_density_scaling, check_strain_rate
+from grainlab.protocols.biaxial.state import _Run
+from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.runner import RUN_FILES, Protocol, Stage, StageContext, run_protocol
+from grainlab.simulation import Simulation
+
+__all__ = ["OUTPUT_FILES", "RUN_FILES", "BiaxialProtocol", "run_biaxial"]
+
+#: The run's outputs besides run.h5 (``report.html`` is ``grainlab biaxial``'s): a new run
+#: refuses a folder that already holds one, which another run or the user wrote.
+OUTPUT_FILES = ("timeseries.csv", "summary.json", "report.html", "fig[0-9][0-9]_*.png", "fig[0-9][0-9]_*.svg")
+
+Context = StageContext[BiaxialConfig, _Run]
+
+
+def _consolidate(context: Context) -> None:
+    consolidate(context.sim, context.state, context.config, context.progress)
+
+
+def _boundary(context: Context) -> None:
+    sim, run, config = context.sim, context.state, context.config
+    install_boundary(sim, run, config, context.progress)
+    start_shear(sim, run, config)
+    check_shear_plan(sim, run, config)
+
+
+def _shear(context: Context) -> None:
+    shear(context.sim, context.state, context.config, context.writer, context.save, context.progress)
+
+
+class BiaxialProtocol(Protocol[BiaxialConfig, _Run, BiaxialResult]):
+    """The paper's biaxial test (Sec. 6, Table 1); the sample is generated when the run starts."""
+
+    name = "biaxial"
+    stages: ClassVar[tuple[Stage[Any, Any], ...]] = (
+        Stage("consolidate", _consolidate, "the four walls servo-controlled to sigma_0 until equilibrium"),
+        Stage("boundary", _boundary, "the side walls replaced by the membrane (or the outer grains) under "
+                                     "sigma_0, the sample re-equilibrated, the shearing planned"),
+        Stage("shear", _shear, "the platens at a constant axial strain rate to the final strain; records "
+                               "and snapshots on their triggers, checkpoints on the wall clock"),
+    )
+    output_files = OUTPUT_FILES
+
+    def check(self) -> None:
+        check_strain_rate(self.config)  # a rate refused needs no warning about its inertia
+        check_density_scaling(self.config)
+
+    def threads(self) -> int:
+        return engine_threads(self.config)
+
+    def config_dict(self) -> dict[str, Any]:
+        return self.config.to_dict()
+
+    def resolve_saved(self, saved: Any) -> dict[str, Any] | None:
+        try:
+            return BiaxialConfig.from_dict(saved).to_dict()
+        except (ValueError, TypeError, AttributeError):
+            return None
+
+    def start(self, threads: int, progress: bool) -> tuple[Simulation, _Run]:
+        return generate(self.config, threads, progress)
+
+    def state_from_dict(self, saved: Any) -> _Run:
+        return _Run(**{k: v for k, v in saved.items() if k not in ("config", "elapsed_s")})
+
+    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
+        return _summary(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
+
+    def write_outputs(self, out: Path) -> dict[str, Any]:
+        return _write_outputs(out)
+
+    def result(self, out: Path, summary: dict[str, Any]) -> BiaxialResult:
+        return BiaxialResult(out, summary)
+
+
+def run_biaxial(
+    config: BiaxialConfig,
+    out_dir: str | os.PathLike[str],
+    *,
+    resume: bool = False,
+    progress: bool = False,
+) -> BiaxialResult:
+    """Runs (or, with ``resume``, continues) the biaxial test into ``out_dir``
+    (:func:`grainlab.protocols.runner.run_protocol`: resume from any stop point, a
+    folder holding another run refused, a full disk stopped with the last checkpoint
+    kept). ``progress`` shows each stage's progress on stderr (off by default; see
+    :func:`grainlab._progress.progress_bar`)."""
+    return run_protocol(BiaxialProtocol(config), out_dir, resume=resume, progress=progress)
+
