@@ -6,9 +6,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from grainlab.reproduction.markdown import (
     claims_markdown,
     generated_blocks,
+    named_sensitivity_markdown,
     sensitivity_blocks,
     sensitivity_markdown,
     update_generated_blocks,
@@ -26,9 +29,11 @@ def test_generated_blocks_match_their_stored_claims():
 
 
 def test_sensitivity_tables_match_their_stored_claims():
-    for paths, body in sensitivity_blocks((ROOT / "docs" / "reproduction.md").read_text(encoding="utf-8")):
+    blocks = sensitivity_blocks((ROOT / "docs" / "reproduction.md").read_text(encoding="utf-8"))
+    assert {claim_set for _, claim_set, _ in blocks} == {"", "study"}
+    for paths, claim_set, body in blocks:
         documents = [json.loads((ROOT / p).read_text(encoding="utf-8")) for p in paths]
-        assert body == sensitivity_markdown(documents), "rerun python -m grainlab.reproduction.markdown"
+        assert body == named_sensitivity_markdown(documents, claim_set), "rerun python -m grainlab.reproduction.markdown"
 
 
 def test_a_sensitivity_table_has_a_column_per_variant_and_marks_partial_counts(tmp_path):
@@ -44,6 +49,11 @@ def test_a_sensitivity_table_has_a_column_per_variant_and_marks_partial_counts(t
     assert lines[0] == "| claim | `paper` (3) | `band:final` (3) |"
     assert lines[2] == "| `band_lambda_above_rest` | yes 0.012 | **no** -0.5 (n 2) |"
     assert lines[3] == "| `z_initial` |  |  |"
+    by_variant = sensitivity_markdown(docs, ["band_lambda_above_rest"], rows_are_variants=True).splitlines()
+    assert by_variant[0] == "| variant | `band_lambda_above_rest` |"
+    assert by_variant[2:] == ["| `paper` (3) | yes 0.012 |", "| `band:final` (3) | **no** -0.5 (n 2) |"]
+    with pytest.raises(ValueError, match="claim set"):
+        named_sensitivity_markdown(docs, "nope")
     (tmp_path / "a.json").write_text(json.dumps(docs[0]))
     (tmp_path / "b.json").write_text(json.dumps(docs[1]))
     page = tmp_path / "page.md"

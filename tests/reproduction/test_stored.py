@@ -18,9 +18,9 @@ def test_verdicts_by_claim_from_a_document():
 
 
 def test_an_unknown_campaign_is_refused():
-    with pytest.raises(ValueError, match="name: expected one of main, readings, rates, rate1, study"):
+    with pytest.raises(ValueError, match="name: expected one of main, readings, rates, rate1, study, study_readings"):
         stored_claims("nope")
-    assert set(CAMPAIGNS) == {"main", "readings", "rates", "rate1", "study"}
+    assert set(CAMPAIGNS) == {"main", "readings", "rates", "rate1", "study", "study_readings"}
 
 
 def test_the_shipped_campaign_judges_every_biaxial_claim():
@@ -47,4 +47,12 @@ def test_the_shipped_packing_study_judges_every_study_claim():
     study = stored_claims("study")
     assert study is not None and study["variant"] == "study:generation_friction=0"
     for block in study["variants"]:
+        assert {c.id for c in STUDY_CLAIMS} <= {row["id"] for row in block["claims"]}
+    readings = stored_claims("study_readings")
+    # the readings measure the same packings again: the default reading is the study's own block
+    own = next(b for b in readings["variants"] if b["variant"] == "study:generation_friction=0")
+    assert own["claims"] == study["variants"][0]["claims"]
+    lambdas = [b for b in readings["variants"] if b["variant"].startswith("lambda:")]
+    assert len(lambdas) == 8 and all(b["runs_of"] == "study:generation_friction=0" for b in lambdas)
+    for block in lambdas:
         assert {c.id for c in STUDY_CLAIMS} <= {row["id"] for row in block["claims"]}

@@ -16,8 +16,8 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SENSITIVITY_CLAIMS", "claims_markdown", "generated_blocks", "sensitivity_blocks",
-           "sensitivity_markdown", "update_generated_blocks"]
+__all__ = ["CLAIM_SETS", "SENSITIVITY_CLAIMS", "claims_markdown", "generated_blocks", "named_sensitivity_markdown",
+           "sensitivity_blocks", "sensitivity_markdown", "update_generated_blocks"]
 
 #: Rate-convergence and comparison quantities, as the tables name them.
 QUANTITY_LABELS = {
@@ -172,44 +172,68 @@ SENSITIVITY_CLAIMS: tuple[str, ...] = (
 )
 
 
-def sensitivity_markdown(documents: Sequence[dict[str, Any]], claims: Sequence[str] = SENSITIVITY_CLAIMS) -> str:
+def _study_claims() -> tuple[str, ...]:
+    from grainlab.reproduction.claims import STUDY_CLAIMS
+
+    return tuple(c.id for c in STUDY_CLAIMS)
+
+
+#: The claim sets a sensitivity block may name: ``sensitivity_markdown()`` the band and
+#: lambda claims (a row per claim), ``sensitivity_markdown(study)`` the packing study's (a
+#: row per variant: the readings of lambda on one study's packings).
+CLAIM_SETS: dict[str, Any] = {"": lambda: SENSITIVITY_CLAIMS, "study": _study_claims}
+
+
+def sensitivity_markdown(documents: Sequence[dict[str, Any]], claims: Sequence[str] = SENSITIVITY_CLAIMS,
+                         *, rows_are_variants: bool = False) -> str:
     """The verdict-sensitivity table: one row per claim of ``claims``, one column per
     variant block (rate families left out) of each document in turn, a variant that an
-    earlier document has already shown left out; each cell the
+    earlier document has already shown left out (``rows_are_variants``: a row per
+    variant, a column per claim); each cell the
     verdict (yes / **no** / ?) and the seed mean, with n when it is not the block's
     seed count; empty where the variant has no such claim."""
     blocks: list[dict[str, Any]] = []
     for d in documents:  # a variant shown by an earlier document (its reference, re-run there) once
         blocks += [b for b in d.get("variants", []) if b.get("kind") != "rate"
                    and b["variant"] not in {x["variant"] for x in blocks}]
-    header = ["claim"] + [f"`{b['variant']}` ({len(b.get('seeds', []))})" for b in blocks]
     by = [{r["id"]: r for r in b["claims"]} for b in blocks]
-    rows = []
-    for claim in claims:
-        cells = [f"`{claim}`"]
-        for b, rows_of in zip(blocks, by, strict=True):
-            r = rows_of.get(claim)
-            if r is None:
-                cells.append("")
-                continue
-            n = "" if r["n"] == len(b.get("seeds", [])) else f" (n {r['n']})"
-            cells.append(f"{SHORT.get(r['verdict'], r['verdict'])} {_num(r['mean'])}{n}")
-        rows.append(cells)
+
+    def cell(b: dict[str, Any], rows_of: dict[str, Any], claim: str) -> str:
+        r = rows_of.get(claim)
+        if r is None:
+            return ""
+        n = "" if r["n"] == len(b.get("seeds", [])) else f" (n {r['n']})"
+        return f"{SHORT.get(r['verdict'], r['verdict'])} {_num(r['mean'])}{n}"
+
+    if rows_are_variants:
+        header = ["variant"] + [f"`{c}`" for c in claims]
+        rows = [[f"`{b['variant']}` ({len(b.get('seeds', []))})"] + [cell(b, rows_of, c) for c in claims]
+                for b, rows_of in zip(blocks, by, strict=True)]
+    else:
+        header = ["claim"] + [f"`{b['variant']}` ({len(b.get('seeds', []))})" for b in blocks]
+        rows = [[f"`{c}`"] + [cell(b, rows_of, c) for b, rows_of in zip(blocks, by, strict=True)] for c in claims]
     return "\n".join(_table(header, rows)) + "\n"
+
+
+def named_sensitivity_markdown(documents: Sequence[dict[str, Any]], claim_set: str = "") -> str:
+    """The table a sensitivity block names by its claim set (:data:`CLAIM_SETS`)."""
+    if claim_set not in CLAIM_SETS:
+        raise ValueError(f"claim set: expected one of {sorted(CLAIM_SETS)}, got {claim_set!r}")
+    return sensitivity_markdown(documents, CLAIM_SETS[claim_set](), rows_are_variants=bool(claim_set))
 
 
 #: A verdict-sensitivity table generated from stored ``claims.json`` documents (paths
 #: relative to the repository root, separated by spaces).
 SENSITIVITY_BLOCK = re.compile(
-    r"(<!-- generated from (?P<paths>[^>]+?) by sensitivity_markdown\(\) -->\n)(?P<body>.*?)"
-    r"(<!-- end of generated block -->)",
+    r"(?P<head><!-- generated from (?P<paths>[^>]+?) by sensitivity_markdown\((?P<set>\w*)\) -->\n)(?P<body>.*?)"
+    r"(?P<end><!-- end of generated block -->)",
     re.S,
 )
 
 
-def sensitivity_blocks(text: str) -> list[tuple[list[str], str]]:
-    """(paths, body) of every verdict-sensitivity block of ``text``."""
-    return [(m["paths"].split(), m["body"]) for m in SENSITIVITY_BLOCK.finditer(text)]
+def sensitivity_blocks(text: str) -> list[tuple[list[str], str, str]]:
+    """(paths, claim set, body) of every verdict-sensitivity block of ``text``."""
+    return [(m["paths"].split(), m["set"], m["body"]) for m in SENSITIVITY_BLOCK.finditer(text)]
 
 
 def generated_blocks(text: str) -> list[tuple[str, int, str]]:
@@ -229,7 +253,7 @@ def update_generated_blocks(page: str | Path, root: str | Path) -> int:
 
     def table(m: re.Match[str]) -> str:
         documents = [json.loads((Path(root) / p).read_text(encoding="utf-8")) for p in m["paths"].split()]
-        return m.group(1) + sensitivity_markdown(documents) + m.group(4)
+        return m["head"] + named_sensitivity_markdown(documents, m["set"]) + m["end"]
 
     new, count = GENERATED_BLOCK.subn(body, text)
     new, tables = SENSITIVITY_BLOCK.subn(table, new)

@@ -6,7 +6,8 @@ folder: ``main.json``, the 2 %/min ensemble of 20 seeds with its analysis varian
 ``readings.json``, the same runs under the readings of Eqs. 9-11 that the paper's
 lambda_max admits; ``rates.json``, the faster rates,
 boundary B and the time-step check; ``rate1.json``, 1 %/min; ``study.json``, the
-packing study generated with friction 0 and 0.9). docs/reproduction.md
+packing study generated with friction 0 and 0.9; ``study_readings.json``, its
+frictionless packings under the readings of Eqs. 9-11). docs/reproduction.md
 quotes their tables (a test keeps them equal) and ``report.html`` shows, beside
 a run's own value of each claim, the verdict of the ensemble.
 """
@@ -21,7 +22,7 @@ from typing import Any
 __all__ = ["CAMPAIGNS", "paper_scale_verdicts", "stored_claims"]
 
 #: The stored campaign documents, by name.
-CAMPAIGNS = ("main", "readings", "rates", "rate1", "study")
+CAMPAIGNS = ("main", "readings", "rates", "rate1", "study", "study_readings")
 
 
 @cache
