@@ -37,7 +37,7 @@ def dense_periodic():
         pos = np.column_stack([(a.ravel() + 0.5) * s, (b.ravel() + 0.5) * s]) + g.uniform(-0.03, 0.03, (n_side**2, 2)) * s
         rad = g.uniform(0.48, 0.56, n_side**2) * s
         sim = grainlab.Simulation(
-            pos, rad, contact_model=grainlab.ContactModel(friction=friction), threads=threads
+            pos, rad, density=2.0e8, contact_model=grainlab.ContactModel(friction=friction), threads=threads
         )
         sim.set_periodic_cell((0.0, 0.0), (n_side * s, n_side * s))
         return sim

@@ -10,7 +10,7 @@ Example
 -------
 >>> import numpy as np
 >>> from grainlab import Simulation
->>> sim = Simulation(positions=[[0.0, 0.0], [1.9e-3, 0.0]], radii=[1e-3, 1e-3])
+>>> sim = Simulation(positions=[[0.0, 0.0], [1.9e-3, 0.0]], radii=[1e-3, 1e-3], density=2650.0)
 >>> sim.velocities = [[0.01, 0.0], [-0.01, 0.0]]
 >>> sim.run(10_000)
 >>> bool(sim.velocities[0, 0] < 0)  # the disks bounced apart
@@ -37,6 +37,11 @@ TABLE1_STIFFNESS_N_PER_M = paper.NORMAL_STIFFNESS_N_PER_M
 TABLE1_FRICTION = paper.FRICTION
 TABLE1_DENSITY_KG_PER_M3 = paper.DENSITY_KG_PER_M3
 TABLE1_LOCAL_DAMPING = paper.LOCAL_DAMPING
+
+#: The time step as a fraction of the critical one when none is given: PFC's 0.8. The one
+#: default of every time step grainlab picks (a :class:`Simulation`, the radius expansion,
+#: the biaxial test's ``run.time_step_safety``).
+DEFAULT_TIME_STEP_SAFETY = 0.8
 
 #: Bits of :attr:`Simulation.fixity`.
 FIX_X, FIX_Y, FIX_ROTATION = 1, 2, 4
@@ -471,11 +476,12 @@ class Simulation:
     ----------
     positions : (N, 2) array, m
     radii : (N,) array, m, all > 0
-    density : scalar or (N,) array, kg/m^3 (Table 1: 2e8, a scaled density)
+    density : scalar or (N,) array, kg/m^3; required (the paper's Table 1 has the scaled
+        density :data:`TABLE1_DENSITY_KG_PER_M3`, 2e8, which no real grain has)
     contact_model : model used between every pair of groups until
         :meth:`set_contact_model` says otherwise
-    time_step : s; ``None`` picks ``time_step_safety`` times the critical step
-        (:meth:`critical_time_step`)
+    time_step : s; ``None`` picks ``time_step_safety`` (default
+        :data:`DEFAULT_TIME_STEP_SAFETY`) times the critical step (:meth:`critical_time_step`)
     threads : worker threads (default: all cores); results are bitwise the
         same for every count (the work partition depends on the system only)
     local_damping : alpha of paper Eq. 5, in [0, 1)
@@ -486,15 +492,20 @@ class Simulation:
         self,
         positions: ArrayLike,
         radii: ArrayLike,
-        density: ArrayLike = TABLE1_DENSITY_KG_PER_M3,
+        density: ArrayLike | None = None,
         *,
         contact_model: ContactModel | None = None,
         time_step: float | None = None,
-        time_step_safety: float = 0.5,
+        time_step_safety: float = DEFAULT_TIME_STEP_SAFETY,
         threads: int | None = None,
         local_damping: float = 0.0,
         gravity: ArrayLike = (0.0, 0.0),
     ) -> None:
+        if density is None:
+            raise ValueError(
+                "density: give the grains' density in kg/m^3 (the paper's Table 1 uses the scaled "
+                f"density grainlab.simulation.TABLE1_DENSITY_KG_PER_M3 = {TABLE1_DENSITY_KG_PER_M3:g})"
+            )
         positions = _points("positions", positions)
         n = len(positions)
         radii = _values("radii", radii, n)
@@ -559,7 +570,7 @@ class Simulation:
             raise ValueError(f"steps: must be >= 0, got {steps}")
         self._engine.run(steps)
 
-    def critical_time_step(self, safety: float = 0.5) -> float:
+    def critical_time_step(self, safety: float = DEFAULT_TIME_STEP_SAFETY) -> float:
         """``safety * min_i min(sqrt(m_i / k_n,i), sqrt(I_i / (k_s,i r_i^2)))`` with the
         stiffnesses of each particle's current contacts summed (one contact of its
         stiffest model when it has none)."""

@@ -20,7 +20,7 @@ def sheared_packing(n_side: int = 14, seed: int = 1, **model) -> Simulation:
     a, b = np.meshgrid(np.arange(n_side), np.arange(n_side), indexing="ij")
     pos = np.column_stack([(a.ravel() + 0.5) * s, (b.ravel() + 0.5) * s]) + g.uniform(-0.03, 0.03, (n_side**2, 2)) * s
     rad = g.uniform(0.48, 0.56, n_side**2) * s
-    sim = Simulation(pos, rad, contact_model=ContactModel(KN, KN, MU, **model), threads=1, local_damping=0.2)
+    sim = Simulation(pos, rad, density=2.0e8, contact_model=ContactModel(KN, KN, MU, **model), threads=1, local_damping=0.2)
     sim.set_periodic_cell((0.0, 0.0), (n_side * s, n_side * s))
     sim.set_velocity_gradient([[-2.0, 0.0], [0.0, 2.0]])
     sim.velocities = g.normal(0.0, 0.01, (n_side**2, 2))
@@ -34,7 +34,7 @@ def walled_packing(n_side: int = 12, seed: int = 2) -> Simulation:
     a, b = np.meshgrid(np.arange(n_side), np.arange(n_side), indexing="ij")
     pos = np.column_stack([(a.ravel() + 0.5) * s, (b.ravel() + 0.5) * s]) + g.uniform(-0.03, 0.03, (n_side**2, 2)) * s
     rad = g.uniform(0.48, 0.56, n_side**2) * s
-    sim = Simulation(pos, rad, contact_model=ContactModel(KN, KN, MU), threads=1, local_damping=0.2)
+    sim = Simulation(pos, rad, density=2.0e8, contact_model=ContactModel(KN, KN, MU), threads=1, local_damping=0.2)
     side = n_side * s
     corners = [(0, 0), (side, 0), (side, side), (0, side)]
     walls = [sim.add_segment_wall(corners[k], corners[(k + 1) % 4]) for k in range(4)]

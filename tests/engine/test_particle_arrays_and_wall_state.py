@@ -33,7 +33,7 @@ ARRAYS = {
 
 
 def three_disks() -> Simulation:
-    return Simulation([[0.0, 0.0], [5e-3, 0.0], [0.0, 5e-3]], [1e-3, 1e-3, 1e-3])
+    return Simulation([[0.0, 0.0], [5e-3, 0.0], [0.0, 5e-3]], [1e-3, 1e-3, 1e-3], density=2.0e8)
 
 
 @pytest.mark.parametrize("name", ARRAYS)
@@ -93,7 +93,7 @@ def test_help_shows_every_array_with_its_doc():
 def test_wall_state_reads_the_force_of_a_pressed_disk():
     # a disk overlapping a floor by half its radius: the wall carries kn * overlap
     # along -inward normal, and its stress over L is kn * overlap / L
-    sim = Simulation([[0.0, 0.5e-3]], [1e-3], time_step=1e-7)
+    sim = Simulation([[0.0, 0.5e-3]], [1e-3], density=2.0e8, time_step=1e-7)
     floor = sim.add_line_wall((0.0, 0.0), (0.0, 1.0))
     segment = sim.add_segment_wall((1.0, 1.0), (2.0, 1.0))
     sim.run(1)
@@ -114,7 +114,7 @@ def test_wall_state_reads_the_force_of_a_pressed_disk():
 
 
 def test_wall_state_is_a_frozen_snapshot_of_the_wall():
-    sim = Simulation([[0.0, 5e-3]], [1e-3], time_step=1e-7)
+    sim = Simulation([[0.0, 5e-3]], [1e-3], density=2.0e8, time_step=1e-7)
     wall = sim.add_segment_wall((-1e-2, 0.0), (1e-2, 0.0))
     before = wall.state
     with pytest.raises(dataclasses.FrozenInstanceError):

@@ -11,7 +11,7 @@ from grainlab import ContactModel, Simulation
 
 
 def two_disks(**kwargs) -> Simulation:
-    return Simulation([[0.0, 0.0], [2.5e-3, 0.0]], [1e-3, 1e-3], **kwargs)
+    return Simulation([[0.0, 0.0], [2.5e-3, 0.0]], [1e-3, 1e-3], **({"density": 2.0e8} | kwargs))
 
 
 @pytest.mark.parametrize(
@@ -23,6 +23,7 @@ def two_disks(**kwargs) -> Simulation:
         ({"positions": [[0, 0], [1, 0]], "radii": [1e-3, 1e-3, 1e-3]}, "radii"),
         ({"positions": [[0, 0, 0]], "radii": [1e-3]}, "positions"),
         ({"positions": [[0, 0]], "radii": [1e-3], "density": -1.0}, "density[0]"),
+        ({"positions": [[0, 0]], "radii": [1e-3], "density": None}, "density: give the grains' density"),
         ({"positions": [[0, 0]], "radii": [1e-3], "contact_model": ContactModel(normal_stiffness=0.0)}, "normal_stiffness"),
         ({"positions": [[0, 0]], "radii": [1e-3], "contact_model": ContactModel(shear_stiffness=-5.0)}, "shear_stiffness"),
         ({"positions": [[0, 0]], "radii": [1e-3], "local_damping": 1.0}, "local_damping"),
@@ -31,7 +32,7 @@ def two_disks(**kwargs) -> Simulation:
 )
 def test_bad_input_names_the_field(kwargs, field):
     with pytest.raises(ValueError, match=field.replace("[", r"\[").replace("]", r"\]")):
-        Simulation(**kwargs)
+        Simulation(**({"density": 2.0e8} | kwargs))
 
 
 def test_bad_input_after_construction_names_the_field():
@@ -71,7 +72,7 @@ def test_masses_are_those_of_unit_thickness_disks():
 
 def test_free_fall_is_exact_from_full_step_velocities():
     # constant force: leapfrog started with a half kick gives x = x0 + v0 t + g t^2 / 2 exactly
-    sim = Simulation([[0.0, 0.0]], [1e-3], time_step=1e-4, gravity=(0.0, -9.81))
+    sim = Simulation([[0.0, 0.0]], [1e-3], density=2.0e8, time_step=1e-4, gravity=(0.0, -9.81))
     sim.velocities = [[0.5, 1.0]]
     sim.run(1000)
     t = sim.time
@@ -111,7 +112,7 @@ def test_resultants_are_the_sums_of_contact_forces(dense_periodic):
 
 def test_bond_carries_tension():
     # two bonded disks pulled apart by +-F settle at extension F / kn_bond
-    sim = Simulation([[0.0, 0.0], [2e-3, 0.0]], [1e-3, 1e-3], local_damping=0.7, time_step=1e-5, threads=1)
+    sim = Simulation([[0.0, 0.0], [2e-3, 0.0]], [1e-3, 1e-3], density=2.0e8, local_damping=0.7, time_step=1e-5, threads=1)
     sim.add_bond(0, 1, normal_stiffness=1e6, shear_stiffness=1e6)
     force = 50.0
     sim.external_forces = [[-force, 0.0], [force, 0.0]]
@@ -124,7 +125,7 @@ def test_bond_carries_tension():
 
 
 def test_prescribed_velocity_ignores_forces():
-    sim = Simulation([[0.0, 0.0], [1.8e-3, 0.0]], [1e-3, 1e-3], time_step=1e-5)
+    sim = Simulation([[0.0, 0.0], [1.8e-3, 0.0]], [1e-3, 1e-3], density=2.0e8, time_step=1e-5)
     sim.fixity = [grainlab.FIX_X | grainlab.FIX_Y | grainlab.FIX_ROTATION, 0]
     sim.velocities = [[0.01, 0.0], [0.0, 0.0]]
     sim.run(100)
@@ -134,7 +135,7 @@ def test_prescribed_velocity_ignores_forces():
 
 def test_homogeneous_deformation_maps_a_particle_affinely():
     # a lone disk with no fluctuation follows x_n = (I + dt L)^n x_0 about the cell origin
-    sim = Simulation([[0.02, 0.03]], [1e-3], time_step=1e-3)
+    sim = Simulation([[0.02, 0.03]], [1e-3], density=2.0e8, time_step=1e-3)
     sim.set_periodic_cell((0.0, 0.0), (0.05, 0.05))
     grad = np.array([[-0.2, 0.1], [0.0, 0.2]])
     sim.set_velocity_gradient(grad)
@@ -147,7 +148,7 @@ def test_homogeneous_deformation_maps_a_particle_affinely():
 
 
 def test_periodic_images_interact_across_the_boundary():
-    sim = Simulation([[0.0005, 0.01], [0.0195, 0.01]], [1e-3, 1e-3], time_step=1e-5)
+    sim = Simulation([[0.0005, 0.01], [0.0195, 0.01]], [1e-3, 1e-3], density=2.0e8, time_step=1e-5)
     sim.set_periodic_cell((0.0, 0.0), (0.02, 0.02))
     c = sim.contacts()
     assert len(c) == 1
@@ -205,7 +206,7 @@ def test_snapshot_carries_the_contacts_with_the_analysis_conventions(dense_perio
 
 
 def test_snapshot_wall_contacts_point_to_the_wall():
-    sim = Simulation([[0.0, 0.9e-3]], [1e-3], time_step=1e-6)
+    sim = Simulation([[0.0, 0.9e-3]], [1e-3], density=2.0e8, time_step=1e-6)
     sim.add_line_wall((0.0, 0.0), (0.0, 1.0))
     snap = sim.snapshot()
     assert snap.contact_j.tolist() == [-1]
@@ -222,7 +223,7 @@ def test_pressure_chain_pushes_with_pressure_times_span():
     # pressure against a wall on their right: the wall carries p * H at equilibrium
     r, height, pressure = 1e-3, 20e-3, 1e5
     y = r + 2 * r * np.arange(10)
-    sim = Simulation(np.column_stack([np.zeros(10), y]), np.full(10, r), local_damping=0.7, threads=1)
+    sim = Simulation(np.column_stack([np.zeros(10), y]), np.full(10, r), density=2.0e8, local_damping=0.7, threads=1)
     sim.set_contact_model(0, 1, ContactModel(friction=0.0))
     floor = sim.add_line_wall((0, 0), (0, 1))
     ceiling = sim.add_line_wall((0, height), (0, -1))
@@ -239,7 +240,7 @@ def test_pressure_chain_pushes_with_pressure_times_span():
 
 
 def test_inactive_wall_lets_particles_through():
-    sim = Simulation([[0.0, 0.5e-3]], [1e-3], time_step=1e-6)
+    sim = Simulation([[0.0, 0.5e-3]], [1e-3], density=2.0e8, time_step=1e-6)
     floor = sim.add_line_wall((0, 0), (0, 1))
     sim.run(1)
     assert floor.contact_count == 1
@@ -263,7 +264,7 @@ def test_added_particles_join_and_old_contacts_keep_their_history(dense_periodic
 
 
 def test_groups_that_do_not_interact_pass_through_each_other():
-    sim = Simulation([[0.0, 0.0], [1.5e-3, 0.0]], [1e-3, 1e-3], time_step=1e-5, threads=1)
+    sim = Simulation([[0.0, 0.0], [1.5e-3, 0.0]], [1e-3, 1e-3], density=2.0e8, time_step=1e-5, threads=1)
     sim.groups = [0, 2]
     sim.set_contact_model(0, 2, ContactModel(enabled=False))
     sim.velocities = [[0.1, 0.0], [-0.1, 0.0]]

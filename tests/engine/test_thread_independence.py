@@ -21,7 +21,8 @@ def sheared_box(threads: int, n_side: int = 60) -> Simulation:
     a, b = np.meshgrid(np.arange(n_side), np.arange(n_side), indexing="ij")
     pos = np.column_stack([(a.ravel() + 0.5) * s, (b.ravel() + 0.5) * s]) + g.uniform(-0.03, 0.03, (n_side**2, 2)) * s
     rad = g.uniform(0.48, 0.56, n_side**2) * s
-    sim = Simulation(pos, rad, contact_model=ContactModel(KN, KN, 0.5), threads=threads, local_damping=0.3)
+    sim = Simulation(pos, rad, density=2.0e8, contact_model=ContactModel(KN, KN, 0.5), threads=threads, local_damping=0.3,
+                     time_step_safety=0.5)
     side = n_side * s
     bottom = sim.add_segment_wall((0, 0), (side, 0))
     sim.add_segment_wall((side, 0), (side, side))

@@ -13,7 +13,7 @@ from grainlab.snapshot import Snapshot
 
 
 def _sim_with_walls() -> grainlab.Simulation:
-    sim = grainlab.Simulation([[0.005, 0.002], [0.007, 0.002]], [1e-3, 1e-3])
+    sim = grainlab.Simulation([[0.005, 0.002], [0.007, 0.002]], [1e-3, 1e-3], density=2.0e8)
     sim.add_segment_wall((0.0, 0.0), (0.02, 0.0))  # bottom platen, particles above
     sim.add_segment_wall((0.02, 0.01), (0.0, 0.01))  # top platen
     side = sim.add_line_wall((0.0, 0.0), (1.0, 0.0))  # left, infinite

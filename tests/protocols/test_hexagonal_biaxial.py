@@ -32,7 +32,7 @@ def test_frictionless_hexagonal_array_fails_at_stress_ratio_three():
     positions, width, height = hexagonal_box(10, 12, r)
     sim = Simulation(
         positions,
-        np.full(len(positions), r),
+        np.full(len(positions), r), density=2.0e8,
         contact_model=ContactModel(8.45e7, 8.45e7, 0.0),
         local_damping=0.7,
         threads=1,

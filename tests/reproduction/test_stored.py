@@ -18,9 +18,9 @@ def test_verdicts_by_claim_from_a_document():
 
 
 def test_an_unknown_campaign_is_refused():
-    with pytest.raises(ValueError, match="name: expected one of main, readings, rates, rate1, study, study_readings"):
+    with pytest.raises(ValueError, match="name: expected one of main, readings, rates, rate1, rate05, study, study_readings"):
         stored_claims("nope")
-    assert set(CAMPAIGNS) == {"main", "readings", "rates", "rate1", "study", "study_readings"}
+    assert set(CAMPAIGNS) == {"main", "readings", "rates", "rate1", "rate05", "study", "study_readings"}
 
 
 def test_the_shipped_campaign_judges_every_biaxial_claim():
@@ -39,6 +39,17 @@ def test_the_shipped_campaign_judges_every_biaxial_claim():
     assert verdicts["band_lambda_above_rest"]["verdict"] in ("reproduced", "not reproduced", "inconclusive")
     rates = stored_claims("rate1")
     assert {e["rate"] for e in rates["rate_convergence"]} == {"2%/min", "4%/min", "8%/min"}
+    slowest = stored_claims("rate05")
+    (pair,) = slowest["rate_convergence"]
+    assert (pair["rate"], pair["half_rate"]) == ("1%/min", "0.5%/min")
+    # the macro response converged, the band's lambda (near 0 at both rates) did not by the rule
+    assert [q["within"] for q in pair["quantities"].values()] == [True, True, True, False]
+    assert not pair["converged"]
+    one = next(b for b in slowest["variants"] if b["variant"] == "rate=1%/min")
+    earlier = next(b for b in rates["variants"] if b["variant"] == "rate=1%/min")
+    now, then = ({r["id"]: r for r in b["claims"]} for b in (one, earlier))
+    for claim in ("peak_near_1.5", "z_initial", "band_lambda_above_rest"):
+        assert now[claim]["per_seed"] == then[claim]["per_seed"], claim  # the same runs, bit for bit
 
 
 def test_the_shipped_packing_study_judges_every_study_claim():

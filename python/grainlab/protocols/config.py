@@ -22,6 +22,7 @@ from typing import Any, TypedDict
 
 from grainlab import paper
 from grainlab._mapping import flatten_keys
+from grainlab.simulation import DEFAULT_TIME_STEP_SAFETY
 
 
 class ConfigError(ValueError):
@@ -167,7 +168,8 @@ FIELDS: dict[str, Field] = {
     ),
     "run.threads": Field("integer", "auto", "engine threads (auto: all cores)", minimum=1, allow_auto=True),
     "run.time_step_safety": Field(
-        "number", 0.8, "time step = this x the critical time step (0.8, as PFC)", minimum=0.0, maximum=1.0,
+        "number", DEFAULT_TIME_STEP_SAFETY, "time step = this x the critical time step (0.8, as PFC)", minimum=0.0,
+        maximum=1.0,
         exclusive_minimum=True,
     ),
     "run.checkpoint_interval": Field("time", 30.0, "wall-clock time between checkpoints", **_POSITIVE),

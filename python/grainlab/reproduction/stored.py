@@ -5,7 +5,8 @@ documents are kept in ``grainlab/reproduction/paper_scale/`` (one per campaign
 folder: ``main.json``, the 2 %/min ensemble of 20 seeds with its analysis variants;
 ``readings.json``, the same runs under the readings of Eqs. 9-11 that the paper's
 lambda_max admits; ``rates.json``, the faster rates,
-boundary B and the time-step check; ``rate1.json``, 1 %/min; ``study.json``, the
+boundary B and the time-step check; ``rate1.json``, 1 %/min; ``rate05.json``, 0.5
+against 1 %/min; ``study.json``, the
 packing study generated with friction 0 and 0.9; ``study_readings.json``, its
 frictionless packings under the readings of Eqs. 9-11). docs/reproduction.md
 quotes their tables (a test keeps them equal) and ``report.html`` shows, beside
@@ -22,7 +23,7 @@ from typing import Any
 __all__ = ["CAMPAIGNS", "paper_scale_verdicts", "stored_claims"]
 
 #: The stored campaign documents, by name.
-CAMPAIGNS = ("main", "readings", "rates", "rate1", "study", "study_readings")
+CAMPAIGNS = ("main", "readings", "rates", "rate1", "rate05", "study", "study_readings")
 
 
 @cache

@@ -63,6 +63,7 @@ from grainlab.samples.porosity import (
     overlap_corrected_porosity,
     particle_count,
 )
+from grainlab.simulation import DEFAULT_TIME_STEP_SAFETY
 
 __all__ = ["WALL_NAMES", "ExpansionError", "Sample", "expand_to_porosity"]
 
@@ -289,7 +290,7 @@ def expand_to_porosity(
     stress_free_overlap: float = 1.0e-5,
     max_equilibrium_steps: int = 300_000,
     max_stress_pa: float = MAX_STRESS_PA,
-    time_step_safety: float = 0.8,
+    time_step_safety: float = DEFAULT_TIME_STEP_SAFETY,
     density_scaling: bool = True,
     threads: int = 1,
     progress: bool = False,
