@@ -43,5 +43,10 @@ def run_digest(run_h5) -> str:
 
 @pytest.mark.parametrize("threads", [1, 2])
 def test_the_tiny_biaxial_run_keeps_its_bits(tmp_path, fast_figures, threads):
-    biaxial.run_biaxial(tiny_config(f"run.threads={threads}"), tmp_path / "run", progress=False)
+    result = biaxial.run_biaxial(tiny_config(f"run.threads={threads}"), tmp_path / "run", progress=False)
     assert run_digest(tmp_path / "run" / "run.h5") == GOLDEN_DIGEST
+    # the summary's peak is the records' largest stress ratio (the one rule, grainlab.analysis.peak)
+    series = read_results(tmp_path / "run" / "run.h5").timeseries
+    k = int(np.argmax(series["stress_ratio"]))
+    assert result.summary["peak_stress_ratio"] == series["stress_ratio"][k]
+    assert result.summary["axial_strain_at_peak"] == series["axial_strain"][k]

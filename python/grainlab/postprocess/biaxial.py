@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
+from grainlab.analysis.peak import nearest_snapshot, peak_is_interior, peak_record
 from grainlab.analysis.stability import StabilityIndex
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.io.results import json_safe
@@ -340,11 +341,7 @@ def _select_peak(
                 f"peak_snapshot: index {k} out of range for {len(names)} snapshots {names}"
             )
         return k % len(names)
-    candidates = [k for k in range(1 if len(names) > 1 else 0, len(names))]
-    known = [k for k in candidates if math.isfinite(strains[k])]
-    if not known or not math.isfinite(eps_peak):
-        return candidates[-1]
-    return min(known, key=lambda k: (abs(strains[k] - eps_peak), k))
+    return nearest_snapshot(strains, eps_peak)
 
 
 def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> RunAnalysis:
@@ -368,8 +365,8 @@ def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> 
             f"{results.path}: no record has both a finite axial_strain and a finite stress_ratio"
         )
     rows = np.flatnonzero(finite)
-    k_peak = int(rows[np.argmax(q[rows])])
-    interior = rows[0] < k_peak < rows[-1]
+    k_peak = peak_record(eps, q)
+    interior = peak_is_interior(eps, q)
     eps_peak = float(eps[k_peak])
     if not interior:
         where = "last" if k_peak == rows[-1] else "first"

@@ -22,6 +22,7 @@ import numpy as np
 
 import grainlab
 from grainlab._mapping import flatten_keys
+from grainlab.analysis.peak import peak_record
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.paper import BIAXIAL_CLAIMS, STRAIN_RATE_PER_S, TABLE1
 from grainlab.postprocess.band import BandNumbers
@@ -329,11 +330,7 @@ def check_biaxial_folder(folder: Path) -> Results:
 
 
 def _peak_row(ts: dict[str, np.ndarray]) -> int:
-    eps, q = ts["axial_strain"], ts["stress_ratio"]
-    rows = np.flatnonzero(np.isfinite(eps) & np.isfinite(q))
-    if rows.size == 0:
-        raise ValueError("no record has a finite axial strain and stress ratio")
-    return int(rows[np.argmax(q[rows])])
+    return peak_record(ts["axial_strain"], ts["stress_ratio"])
 
 
 def _file_figure(path: Path, key: str, title: str, caption: str) -> EmbeddedFigure | None:

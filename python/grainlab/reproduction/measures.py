@@ -25,6 +25,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from grainlab.analysis.peak import nearest_snapshot, peak_is_interior, peak_record
+
 if TYPE_CHECKING:
     from grainlab.analysis.stability import StabilityIndex
 
@@ -90,7 +92,7 @@ def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
     ev = np.asarray(ts["volumetric_strain"], dtype=np.float64)
     ok = np.isfinite(eps) & np.isfinite(q)
     rows = np.flatnonzero(ok)
-    k = int(rows[np.argmax(q[rows])])
+    k = peak_record(eps, q)
     final = float(eps[rows[-1]])
     window = ok & (eps >= max(float(eps[k]), (1.0 - END_WINDOW) * final))
     linear = ok & (eps <= LINEAR_TO + 1e-9)
@@ -100,7 +102,7 @@ def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
         "peak_row": k,
         "peak_axial_strain": float(eps[k]),
         "peak_stress_ratio": float(q[k]),
-        "peak_in_interior": bool(rows[0] < k < rows[-1]),
+        "peak_in_interior": peak_is_interior(eps, q),
         "linear_r2": _r2(eps[linear], q[linear]),
         "residual_stress_ratio": float(np.mean(q[window])) if window.any() else math.nan,
         "residual_relative_slope": relative_slope(eps[window], q[window]),
@@ -164,8 +166,7 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
     strains = [_snapshot_strain(info) for info in infos]
     order = sorted(range(len(infos)), key=lambda k: strains[k])
     snaps = [results.snapshot(infos[k].name) for k in order]
-    peak_pos = (1 + int(np.argmin([abs(strains[k] - macro["peak_axial_strain"]) for k in order[1:]]))
-                if len(order) > 1 else 0)
+    peak_pos = nearest_snapshot([strains[k] for k in order], macro["peak_axial_strain"])
     readings: dict[str, tuple[list[NDArray[np.int32] | None], list[tuple[NDArray[np.bool_], int] | None]]] = {}
 
     def bands(reading: str) -> tuple[list[NDArray[np.int32] | None], list[tuple[NDArray[np.bool_], int] | None]]:

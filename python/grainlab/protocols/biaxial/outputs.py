@@ -14,6 +14,7 @@ import numpy as np
 
 import grainlab
 from grainlab._interrupt import raise_if_interrupted
+from grainlab.analysis.peak import peak_record
 from grainlab.io.results import RESULTS_FILE, write_json_atomic, write_text_atomic
 from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
 from grainlab.protocols.biaxial.state import _Run
@@ -46,7 +47,9 @@ def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray]
     shear = run.shear_plan()
     first = {k: float(v[0]) for k, v in timeseries.items()}
     last = {k: float(v[-1]) for k, v in timeseries.items()}
-    peak = run.peak or {}
+    k = peak_record(timeseries["axial_strain"], timeseries["stress_ratio"])
+    peak = {name: float(timeseries[name][k])
+            for name in ("stress_ratio", "axial_strain", "coordination_number", "volumetric_strain")}
     return {
         "n_particles": run.n_grains,
         "n_membrane_disks": run.consolidation.get("membrane_disks", 0),
@@ -57,11 +60,11 @@ def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray]
         "porosity_generated_overlap_corrected": run.sample.get("porosity_overlap_corrected"),
         "generation_stress_pa": run.sample.get("mean_wall_stress_pa"),
         "coordination_number_initial": first["coordination_number"],
-        "coordination_number_at_peak": peak.get("coordination_number"),
+        "coordination_number_at_peak": peak["coordination_number"],
         "coordination_number_final": last["coordination_number"],
-        "peak_stress_ratio": peak.get("stress_ratio"),
-        "axial_strain_at_peak": peak.get("axial_strain"),
-        "volumetric_strain_at_peak": peak.get("volumetric_strain"),
+        "peak_stress_ratio": peak["stress_ratio"],
+        "axial_strain_at_peak": peak["axial_strain"],
+        "volumetric_strain_at_peak": peak["volumetric_strain"],
         "final_stress_ratio": last["stress_ratio"],
         "final_volumetric_strain": last["volumetric_strain"],
         "max_contraction": float(np.max(timeseries["volumetric_strain"])),

@@ -361,14 +361,6 @@ def shear(
             strain = snap_steps[key]
             writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record["axial_strain"]),
                                   step=sim.step_count, walls=_walls(sim, run))
-        peak = run.peak or {"stress_ratio": -math.inf}
-        if record["stress_ratio"] > peak["stress_ratio"]:
-            run.peak = {
-                "stress_ratio": record["stress_ratio"],
-                "axial_strain": record["axial_strain"],
-                "coordination_number": record["coordination_number"],
-                "volumetric_strain": record["volumetric_strain"],
-            }
         boundary = _boundary(run)
         if isinstance(boundary, GrainBoundary):
             run.membrane = boundary.identify(sim).to_dict()

@@ -32,7 +32,6 @@ class _Run:
     shear: dict[str, Any] | None = None
     rows: int = 0
     snapshots: list[str] | None = None
-    peak: dict[str, float] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return dict(self.__dict__)
