@@ -112,3 +112,30 @@ def test_sieve_table_grading_sets_the_size_range():
 def test_bad_sieve_tables_are_refused_before_any_work(overrides, message):
     with pytest.raises(ConfigError, match=re.escape(message)):
         resolve(overrides=overrides)
+
+
+def test_a_protocol_declares_its_keys_on_the_shared_ones(monkeypatch):
+    from grainlab.protocols.config import (
+        RUN_FIELDS,
+        SCHEMAS,
+        SHARED_FIELDS,
+        Config,
+        ConfigSchema,
+        Field,
+        check_sample,
+    )
+
+    own = {"load.pressure": Field("stress", 1e5, "the final vertical stress", minimum=0.0, exclusive_minimum=True)}
+    toy = ConfigSchema("toy", {**SHARED_FIELDS, **own, **RUN_FIELDS}, {"sample.width": 0.03}, check_sample)
+    monkeypatch.setitem(SCHEMAS, "toy", toy)
+    config = toy.resolve(overrides=["load.pressure=400 kPa", "material.friction=0.5"], quick=True)
+    assert config["load.pressure"] == 4e5 and config["material.friction"] == 0.5
+    assert config["sample.width"] == 0.03 and config.schema == "toy"
+    assert "shear.final_strain" not in config.values  # the biaxial test's own keys are not the toy's
+    assert Config.from_dict(config.to_dict(), "toy") == config
+    with pytest.raises(ConfigError, match="unknown configuration key 'shear.final_strain'"):
+        toy.resolve(overrides=["shear.final_strain=0.05"])
+    with pytest.raises(ConfigError, match="load.pressure: -1 is out of range"):
+        toy.resolve(overrides=["load.pressure=-1"])
+    with pytest.raises(ConfigError, match="sample.d_min: 0.004 m exceeds sample.d_max"):
+        toy.resolve(overrides=["sample.d_min=4mm"])  # the shared checks come with the shared keys

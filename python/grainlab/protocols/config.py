@@ -1,5 +1,10 @@
-"""Configuration of the biaxial test: defaults from the paper's Table 1, TOML
+"""Configuration of the protocols: defaults from the paper's Table 1, TOML
 files, ``key=value`` overrides, units at the edge, validation before any work.
+
+Each protocol declares its keys as a :class:`ConfigSchema` (in :data:`SCHEMAS`):
+the shared keys of a sample, its material and its consolidation
+(:data:`SHARED_FIELDS`), its own (the biaxial test's :data:`BIAXIAL_FIELDS`) and
+the runner's (:data:`RUN_FIELDS`); :func:`resolve` is the biaxial test's.
 
 A configuration is a flat mapping of dotted keys (``sample.porosity``,
 ``shear.strain_rate``, ...) to values in SI units. Files and overrides may give
@@ -14,7 +19,7 @@ from __future__ import annotations
 import math
 import re
 import tomllib
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from pathlib import Path
@@ -81,7 +86,9 @@ class _Range(TypedDict, total=False):
 _POSITIVE: _Range = {"minimum": 0.0, "exclusive_minimum": True}
 
 #: Every key, with the paper's Table 1 values as defaults.
-FIELDS: dict[str, Field] = {
+#: The keys of every test that makes a sample and consolidates it: the sample, its
+#: material (Table 1) and the consolidation.
+SHARED_FIELDS: dict[str, Field] = {
     "sample.width": Field("length", paper.WIDTH_M, "sample width (Table 1: 75 mm)", **_POSITIVE),
     "sample.height": Field("length", paper.HEIGHT_M, "sample height (Table 1: 150 mm)", **_POSITIVE),
     "sample.porosity": Field(
@@ -132,6 +139,10 @@ FIELDS: dict[str, Field] = {
         "number", 1.0e-3, "equilibrium: mean unbalanced force ratio below this", **_POSITIVE
     ),
     "consolidation.max_steps": Field("integer", 2_000_000, "give up consolidating after this many steps", minimum=1),
+}
+
+#: The biaxial test's own keys: the lateral boundary and the shearing.
+BIAXIAL_FIELDS: dict[str, Field] = {
     "boundary.kind": Field(
         "choice", "membrane",
         "flexible lateral boundary (docs/boundary.md): a bonded membrane (A) or the outermost grains (B)",
@@ -166,6 +177,10 @@ FIELDS: dict[str, Field] = {
         "bound on the inertial number (and Eq. 16 factor) for the auto strain rate: its value at the rate study's "
         "fastest converged rate, 2 %/min with Table 1", **_POSITIVE
     ),
+}
+
+#: How a run executes (the runner's keys, in every test's configuration).
+RUN_FIELDS: dict[str, Field] = {
     "run.threads": Field("integer", "auto", "engine threads (auto: all cores)", minimum=1, allow_auto=True),
     "run.time_step_safety": Field(
         "number", DEFAULT_TIME_STEP_SAFETY, "time step = this x the critical time step (0.8, as PFC)", minimum=0.0,
@@ -174,6 +189,9 @@ FIELDS: dict[str, Field] = {
     ),
     "run.checkpoint_interval": Field("time", 30.0, "wall-clock time between checkpoints", **_POSITIVE),
 }
+
+#: Every key of the biaxial test, in the order files and tables list them.
+FIELDS: dict[str, Field] = {**SHARED_FIELDS, **BIAXIAL_FIELDS, **RUN_FIELDS}
 
 #: Item kind and range of each list kind.
 _LIST_ITEMS: dict[str, tuple[str, Field]] = {
@@ -219,13 +237,13 @@ def _check_range(key: str, field: Field, number: float) -> float:
     return number
 
 
-def coerce(key: str, value: Any) -> Any:
-    """Converts ``value`` for ``key`` to SI and checks its range."""
-    if key not in FIELDS:
-        close = [k for k in FIELDS if k.split(".")[-1] == key.split(".")[-1]]
+def coerce_field(fields: Mapping[str, Field], key: str, value: Any) -> Any:
+    """Converts ``value`` for ``key`` of ``fields`` to SI and checks its range."""
+    if key not in fields:
+        close = [k for k in fields if k.split(".")[-1] == key.split(".")[-1]]
         hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise ConfigError(f"unknown configuration key {key!r}{hint}; known keys: {', '.join(sorted(FIELDS))}")
-    field = FIELDS[key]
+        raise ConfigError(f"unknown configuration key {key!r}{hint}; known keys: {', '.join(sorted(fields))}")
+    field = fields[key]
     if field.allow_auto and value == "auto":
         return "auto"
     if field.kind == "choice":
@@ -263,10 +281,12 @@ def _parse_override(text: str) -> tuple[str, Any]:
 
 
 @dataclass(frozen=True)
-class BiaxialConfig:
-    """A resolved, validated configuration: ``values`` maps every key to SI values."""
+class Config:
+    """A resolved, validated configuration: ``values`` maps every key of its schema
+    (``schema``, a name of :data:`SCHEMAS`) to SI values."""
 
     values: dict[str, Any]
+    schema: str = "biaxial"
 
     def __getitem__(self, key: str) -> Any:
         return self.values[key]
@@ -280,8 +300,80 @@ class BiaxialConfig:
         return nested
 
     @classmethod
-    def from_dict(cls, nested: Mapping[str, Any]) -> BiaxialConfig:
-        return resolve(overrides=flatten_keys(nested))
+    def from_dict(cls, nested: Mapping[str, Any], schema: str = "biaxial") -> Config:
+        """A stored configuration resolved again (keys added since take their defaults)."""
+        return SCHEMAS[schema].resolve(overrides=flatten_keys(nested))
+
+
+#: The biaxial test's configuration (a :class:`Config` of the ``biaxial`` schema).
+BiaxialConfig = Config
+
+
+@dataclass(frozen=True)
+class ConfigSchema:
+    """The configuration keys of one protocol: its fields (usually :data:`SHARED_FIELDS`,
+    its own and :data:`RUN_FIELDS`), the overrides of ``--quick``, and the checks that
+    span several keys (``check(values, given_keys)``, raising :class:`ConfigError`)."""
+
+    name: str
+    fields: Mapping[str, Field]
+    quick: Mapping[str, Any]
+    check: Callable[[dict[str, Any], AbstractSet[str]], None]
+
+    def coerce(self, key: str, value: Any) -> Any:
+        return coerce_field(self.fields, key, value)
+
+    def resolve(
+        self,
+        config_file: str | Path | None = None,
+        overrides: Mapping[str, Any] | Iterable[str] | None = None,
+        *,
+        quick: bool = False,
+    ) -> Config:
+        """Defaults, then ``--quick``, then the TOML file, then overrides (a mapping,
+        or ``key=value`` strings), all validated before anything runs."""
+        values = {key: field.default for key, field in self.fields.items()}
+        layers: list[dict[str, Any]] = []
+        if quick:
+            layers.append(dict(self.quick))
+        if config_file is not None:
+            path = Path(config_file)
+            file_layer = flatten_keys(_read_toml(path))
+            for key, value in file_layer.items():  # checked even where an override replaces it
+                try:
+                    self.coerce(key, value)
+                except ConfigError as error:
+                    raise ConfigError(f"{path}: {error}") from None
+            layers.append(file_layer)
+        if overrides is not None:
+            if isinstance(overrides, Mapping):
+                layers.append(dict(overrides))
+            else:
+                layers.append(dict(_parse_override(text) for text in overrides))
+        for layer in layers:
+            for key, value in layer.items():
+                values[key] = value
+        resolved = {key: self.coerce(key, value) for key, value in values.items()}
+        self.check(resolved, {key for layer in layers for key in layer})
+        return Config(resolved, self.name)
+
+
+def _read_toml(path: Path) -> dict[str, Any]:
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: configuration file not found") from None
+    except IsADirectoryError:
+        raise ConfigError(f"{path}: is a folder, not a configuration file") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise ConfigError(f"{path}: cannot be read as a TOML configuration file ({error})") from None
+    except tomllib.TOMLDecodeError as error:
+        raise ConfigError(f"{path}: not valid TOML ({error})") from None
+
+
+def coerce(key: str, value: Any) -> Any:
+    """Converts ``value`` for the biaxial key ``key`` to SI and checks its range."""
+    return coerce_field(FIELDS, key, value)
 
 
 def resolve(
@@ -289,43 +381,11 @@ def resolve(
     overrides: Mapping[str, Any] | Iterable[str] | None = None,
     *,
     quick: bool = False,
-) -> BiaxialConfig:
-    """Defaults (Table 1), then ``--quick``, then the TOML file, then overrides
-    (a mapping, or ``key=value`` strings), all validated before anything runs."""
-    values = {key: field.default for key, field in FIELDS.items()}
-    layers: list[dict[str, Any]] = []
-    if quick:
-        layers.append(dict(QUICK))
-    if config_file is not None:
-        path = Path(config_file)
-        try:
-            table = tomllib.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise ConfigError(f"{path}: configuration file not found") from None
-        except IsADirectoryError:
-            raise ConfigError(f"{path}: is a folder, not a configuration file") from None
-        except (OSError, UnicodeDecodeError) as error:
-            raise ConfigError(f"{path}: cannot be read as a TOML configuration file ({error})") from None
-        except tomllib.TOMLDecodeError as error:
-            raise ConfigError(f"{path}: not valid TOML ({error})") from None
-        file_layer = flatten_keys(table)
-        for key, value in file_layer.items():  # checked even where an override replaces it
-            try:
-                coerce(key, value)
-            except ConfigError as error:
-                raise ConfigError(f"{path}: {error}") from None
-        layers.append(file_layer)
-    if overrides is not None:
-        if isinstance(overrides, Mapping):
-            layers.append(dict(overrides))
-        else:
-            layers.append(dict(_parse_override(text) for text in overrides))
-    for layer in layers:
-        for key, value in layer.items():
-            values[key] = value
-    resolved = {key: coerce(key, value) for key, value in values.items()}
-    _check_consistency(resolved, given={key for layer in layers for key in layer})
-    return BiaxialConfig(resolved)
+) -> Config:
+    """The biaxial test's configuration: defaults (Table 1), then ``--quick``, then the
+    TOML file, then overrides (a mapping, or ``key=value`` strings), all validated
+    before anything runs (:meth:`ConfigSchema.resolve` of :data:`BIAXIAL`)."""
+    return SCHEMAS["biaxial"].resolve(config_file, overrides, quick=quick)
 
 
 def _grading_curve(v: dict[str, Any], given: AbstractSet[str]) -> None:
@@ -359,7 +419,9 @@ def _grading_curve(v: dict[str, Any], given: AbstractSet[str]) -> None:
     v["sample.d_min"], v["sample.d_max"] = sizes[0], sizes[-1]
 
 
-def _check_consistency(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
+def check_sample(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
+    """The checks of :data:`SHARED_FIELDS` that span several keys (the grading, the
+    sample's size against its grains); a 'curve' grading sets ``sample.d_min/d_max``."""
     _grading_curve(v, given)
     if v["sample.d_min"] > v["sample.d_max"]:
         raise ConfigError(
@@ -370,6 +432,10 @@ def _check_consistency(v: dict[str, Any], given: AbstractSet[str] = frozenset())
             f"sample.width/height: the sample must be at least 10 largest diameters wide "
             f"({10 * v['sample.d_max']:g} m), got {v['sample.width']:g} x {v['sample.height']:g} m"
         )
+
+
+def _check_consistency(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
+    check_sample(v, given)
     if 0.0 not in v["shear.snapshot_strains"]:
         raise ConfigError(
             "shear.snapshot_strains: must include 0, the state at the start of shearing that "
@@ -386,3 +452,9 @@ def _check_consistency(v: dict[str, Any], given: AbstractSet[str] = frozenset())
             f"shear.final_strain: {v['shear.final_strain']:g} is below one record interval "
             f"({v['shear.record_interval']:g})"
         )
+
+
+#: The configuration schemas of the protocols, by name (a protocol registers its own).
+SCHEMAS: dict[str, ConfigSchema] = {
+    "biaxial": ConfigSchema("biaxial", FIELDS, QUICK, _check_consistency),
+}
