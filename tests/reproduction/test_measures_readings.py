@@ -28,6 +28,15 @@ def test_every_reading_on_one_run(quick_biaxial_run):
         assert n["mean_lambda"] <= d["mean_lambda"] + 1e-12
         # readings of lambda leave the band and the contact counts alone
         assert p["band_found"] == d["band_found"] and p["coordination_number"] == d["coordination_number"]
+        assert math.isnan(d["band_overlap_with_strain"])  # the strain reading against itself: none
+    # each band reading's overlap with the strain band is a Jaccard index; the final band carried
+    # back is the strain band itself where that band was accepted
+    for reading in (displacement, final, in_lambda):
+        overlaps = np.array([r["band_overlap_with_strain"] for r in reading["snapshots"]], dtype=float)
+        assert np.all((overlaps[np.isfinite(overlaps)] >= 0) & (overlaps[np.isfinite(overlaps)] <= 1))
+    last = final["snapshots"][-1]
+    if default["snapshots"][-1]["band_found"]:
+        assert last["band_overlap_with_strain"] == 1.0
     # the displacement map always has a two-block split after the first snapshot: its grains are known
     assert all(r["band_members_known"] for r in displacement["snapshots"])
     # the final band carried back: the same grains at every snapshot where the band is known

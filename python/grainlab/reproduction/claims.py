@@ -305,6 +305,14 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
           "peak", "Sec. 6, Figs. 11a-d", None,
           "share of the grains inside the band at the peak minus at 0.5 %, paired per seed (seeds with a band "
           "at both)", SideRule(-1), lambda m: _band_share(_peak(m)) - _band_share(_at(m, 0.005))),
+    Claim("band_readings_agree", "the band of the displacement map (Fig. 11) and of lambda > 0.5 (Fig. 12) is the "
+          "band of the strain field: the figures show one band", "Sec. 6, Figs. 11-12", None,
+          "Jaccard overlap |A & B| / |A | B| of the reading's band grains with the local-strain band's at the "
+          "peak snapshot (a band: reading's variant; none for the strain reading itself); most shared: above 0.5",
+          SideRule(+1, 0.5), lambda m: _num(_peak(m).get("band_overlap_with_strain"))),
+    Claim("band_readings_agree_at_end", "the same at the end of the test (10 %)", "Sec. 6, Figs. 11-12", None,
+          "the same overlap at the last snapshot", SideRule(+1, 0.5),
+          lambda m: _num(_final(m).get("band_overlap_with_strain"))),
     Claim("band_lambda_above_rest", "mean lambda in the shear zone at the peak (0.34) above the rest (0.31)",
           "Sec. 6, Fig. 13", 0.03, f"band minus rest at the peak snapshot, paired per seed; {_LAMBDA_BAND}",
           SideRule(+1), lambda m: band_measure(_peak(m), "inside_mean_lambda") - band_measure(_peak(m), "outside_mean_lambda")),

@@ -164,6 +164,8 @@ SENSITIVITY_CLAIMS: tuple[str, ...] = (
     "lambda_locates_band",
     "lambda_field_locates_band",
     "band_at_peak",
+    "band_readings_agree",
+    "band_readings_agree_at_end",
     "band_z_below_rest",
     "lambda_tracks_coordination",
     "z_initial",

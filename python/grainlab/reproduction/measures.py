@@ -205,16 +205,28 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
         peak_members = members[peak_pos]
         if peak_members is not None:
             peak_ids = np.asarray(snaps[peak_pos].ids)[peak_members[0]]
+        strain_members = bands("strain")[1] if opts["band"] != "strain" else None
         rows = []
-        for k, snap, band, member in zip(order, snaps, labels, members, strict=True):
+        for i, (k, snap, band, member) in enumerate(zip(order, snaps, labels, members, strict=True)):
             row = {"name": infos[k].name, "axial_strain": strains[k],
                    "stress_ratio": float(np.interp(strains[k], eps_ts[finite], q_ts[finite]))}
             row.update(_snapshot_row(snaps[0], snap, band, member, peak_ids, opts))
             if member is not None:
                 row["band_from_strain"] = strains[order[member[1]]]
+            row["band_overlap_with_strain"] = (
+                math.nan if strain_members is None else _overlap(member, strain_members[i]))
             rows.append(row)
         out.append({**common, "analysis": opts, "snapshots": rows})
     return out
+
+
+def _overlap(a: tuple[NDArray[np.bool_], int] | None, b: tuple[NDArray[np.bool_], int] | None) -> float:
+    """The Jaccard overlap |A & B| / |A | B| of two band grain sets of one snapshot
+    (:func:`_band_members`); NaN when either reading has no band there."""
+    if a is None or b is None:
+        return math.nan
+    union = int(np.count_nonzero(a[0] | b[0]))
+    return int(np.count_nonzero(a[0] & b[0])) / union if union else math.nan
 
 
 def _band_members(snaps: Sequence[Any], labels: Sequence[NDArray[np.int32] | None]
