@@ -224,3 +224,18 @@ def test_snapshot_arrays_are_stored_compressed(quick_run):
             stored += ds.id.get_storage_size()
             raw += ds.size * ds.dtype.itemsize
         assert stored < 0.8 * raw  # the pair indices and radii shrink most
+
+
+def test_the_shear_plan_is_typed_and_keeps_the_checkpoints_layout():
+    from grainlab.protocols.biaxial.state import ShearPlan, _Run
+
+    saved = {"strain_rate": 3.3e-4, "platen_speed_m_per_s": 1.2e-5, "height0": 0.15, "area0": 0.011,
+             "start_step": 1234, "record_steps": [10, 20, 30], "snapshot_steps": {"0": 0.0, "20": 0.001},
+             "next": 2, "inertial_number": 1e-4, "inertial_number_mean_diameter": 5e-5,
+             "density_scaling_factor": 1e-4, "porosity_initial": 0.146}
+    plan = ShearPlan.from_dict(saved)  # as a checkpoint (of this or an earlier grainlab) stores it
+    assert plan.next_record == 2 and plan.record_steps == [10, 20, 30]
+    assert plan.to_dict() == saved
+    run = _Run.from_dict({"phase": "shear", "n_grains": 3, "grain_density": 2e8, "walls": {}, "wall_time": {},
+                          "sample": {}, "consolidation": {}, "shear": saved})
+    assert run.shear_plan() == plan and run.to_dict()["shear"] == saved

@@ -30,7 +30,7 @@ from grainlab.protocols.biaxial.records import (
     _snapshot,
     _walls,
 )
-from grainlab.protocols.biaxial.state import CHUNK_STEPS, BiaxialError, _boundary, _Run
+from grainlab.protocols.biaxial.state import CHUNK_STEPS, BiaxialError, ShearPlan, _boundary, _Run
 from grainlab.protocols.boundary import (
     GrainBoundary,
     Membrane,
@@ -306,22 +306,21 @@ def start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     snaps = [s for s in config["shear.snapshot_strains"] if s <= final + 1e-12]
     record_steps = schedule_steps([Every(interval), At(snaps)], final=final, steps_per_unit=steps_per_strain)
     root = math.sqrt(config["material.density"] / config["consolidation.pressure"])
-    run.shear = {
-        "strain_rate": rate,
-        "platen_speed_m_per_s": speed,
-        "height0": height0,
-        "area0": area0,
-        "start_step": sim.step_count,
-        "record_steps": record_steps,
-        "snapshot_steps": {str(round(s * steps_per_strain)): s for s in snaps},
-        "next": 0,
-        "inertial_number": inertial_number(config, rate, max_d),
-        "inertial_number_mean_diameter": rate * float(2 * radii.mean()) * root,
-        "density_scaling_factor": grainlab.density_scaling_factor(
+    run.shear = ShearPlan(
+        strain_rate=rate,
+        platen_speed_m_per_s=speed,
+        height0=height0,
+        area0=area0,
+        start_step=sim.step_count,
+        record_steps=record_steps,
+        snapshot_steps={str(round(s * steps_per_strain)): s for s in snaps},
+        inertial_number=inertial_number(config, rate, max_d),
+        inertial_number_mean_diameter=rate * float(2 * radii.mean()) * root,
+        density_scaling_factor=grainlab.density_scaling_factor(
             rate, config["material.density"], float(radii.min()), config["material.limiting_contact_pressure"]
         ),
-        "porosity_initial": 1.0 - float(np.pi * np.sum(radii**2)) / area0,
-    }
+        porosity_initial=1.0 - float(np.pi * np.sum(radii**2)) / area0,
+    )
 
 
 def shear(
@@ -334,10 +333,10 @@ def shear(
 ) -> None:
     start = time.perf_counter() - run.wall_time.get("shear", 0.0)
     plan = run.shear_plan()
-    steps = plan["record_steps"]
-    snap_steps = plan["snapshot_steps"]
+    steps = plan.record_steps
+    snap_steps = plan.snapshot_steps
     final = config["shear.final_strain"]
-    if plan["next"] == 0 and "0" in snap_steps and writer.n_rows == 0:
+    if plan.next_record == 0 and "0" in snap_steps and writer.n_rows == 0:
         record = _measure(sim, run, config)
         writer.append_timeseries(record, units=TIMESERIES_UNITS)
         writer.write_snapshot(snapshot_name(0.0), _snapshot(sim, run, 0.0), step=sim.step_count,
@@ -351,12 +350,12 @@ def shear(
         unit="% strain",
         bar_format="{l_bar}{bar}| {n:.2f}/{total:.1f} % [{elapsed}<{remaining}{postfix}]",
     )
-    while plan["next"] < len(steps):
-        target = plan["start_step"] + steps[plan["next"]]
+    while plan.next_record < len(steps):
+        target = plan.start_step + steps[plan.next_record]
         sim.run(target - sim.step_count)
         record = _measure(sim, run, config)
         writer.append_timeseries(record, units=TIMESERIES_UNITS)
-        key = str(steps[plan["next"]])
+        key = str(steps[plan.next_record])
         if key in snap_steps:
             strain = snap_steps[key]
             writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record["axial_strain"]),
@@ -371,7 +370,7 @@ def shear(
                 raise BiaxialError(
                     f"shearing stopped at {100 * record['axial_strain']:.2f} % axial strain: {breach}"
                 )
-        plan["next"] += 1
+        plan.next_record += 1
         raise_if_interrupted()
         bar.update(100 * record["axial_strain"] - done_strain)
         done_strain = 100 * record["axial_strain"]
@@ -388,13 +387,13 @@ def check_shear_plan(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     checked with the run's own time step before the first record."""
     shear = run.shear_plan()
     problem = strain_rate_problem(
-        shear["strain_rate"], sim.time_step, shear["height0"], float(sim.radii.min()), config["shear.record_interval"]
+        shear.strain_rate, sim.time_step, shear.height0, float(sim.radii.min()), config["shear.record_interval"]
     )
     if problem is not None:
         raise BiaxialError(f"shear.strain_rate: {problem}; start again with a slower rate in another folder")
     wanted = [s for s in config["shear.snapshot_strains"] if s <= config["shear.final_strain"] + 1e-12]
-    if len(shear["snapshot_steps"]) < len(wanted):
+    if len(shear.snapshot_steps) < len(wanted):
         raise BiaxialError(
             f"shear.snapshot_strains: two of {wanted} fall on the same time step "
-            f"({sim.time_step:.3g} s at {shear['strain_rate']:.3g} 1/s); keep them further apart"
+            f"({sim.time_step:.3g} s at {shear.strain_rate:.3g} 1/s); keep them further apart"
         )

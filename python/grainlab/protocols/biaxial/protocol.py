@@ -83,7 +83,7 @@ class BiaxialProtocol(Protocol[BiaxialConfig, _Run, BiaxialResult]):
     def state_from_dict(self, saved: Any) -> _Run:
         # "peak": the peak so far, which checkpoints of earlier grainlab versions carry; the
         # summary takes it from the records (grainlab.analysis.peak)
-        return _Run(**{k: v for k, v in saved.items() if k not in ("config", "elapsed_s", "peak")})
+        return _Run.from_dict({k: v for k, v in saved.items() if k not in ("config", "elapsed_s", "peak")})
 
     def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
         return _summary(context.state, self.config, context.writer.read_timeseries(), wall_time_s)

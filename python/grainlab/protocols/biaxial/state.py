@@ -3,7 +3,7 @@ its boundary, and the error a run stops with."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any
 
 from grainlab.protocols.boundary import GrainBoundary, Membrane
@@ -18,6 +18,40 @@ class BiaxialError(ProtocolError):
 
 
 @dataclass
+class ShearPlan:
+    """The shearing's plan and progress, set when shearing starts: the rate and the
+    platens' speed, the reference height and area of the strains, the engine steps
+    (counted from ``start_step``) of the records and of the snapshots (``snapshot_steps``:
+    step, as text, to the snapshot's strain), the next record to take, and the rate's
+    inertial numbers and Eq. 16 factor. Checkpoints store it as a dict with these keys
+    (``next_record`` as ``next``)."""
+
+    strain_rate: float
+    platen_speed_m_per_s: float
+    height0: float
+    area0: float
+    start_step: int
+    record_steps: list[int]
+    snapshot_steps: dict[str, float]
+    inertial_number: float
+    inertial_number_mean_diameter: float
+    density_scaling_factor: float
+    porosity_initial: float
+    next_record: int = 0
+
+    def to_dict(self) -> dict[str, Any]:
+        saved = asdict(self)
+        saved["next"] = saved.pop("next_record")
+        return saved
+
+    @classmethod
+    def from_dict(cls, saved: dict[str, Any]) -> ShearPlan:
+        values = dict(saved)
+        values["next_record"] = values.pop("next", 0)
+        return cls(**values)
+
+
+@dataclass
 class _Run:
     """What a run carries from phase to phase, saved in every checkpoint."""
 
@@ -29,12 +63,21 @@ class _Run:
     sample: dict[str, Any]
     consolidation: dict[str, Any]
     membrane: dict[str, Any] | None = None
-    shear: dict[str, Any] | None = None
+    shear: ShearPlan | None = None
     rows: int = 0
     snapshots: list[str] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return dict(self.__dict__)
+        saved = dict(self.__dict__)
+        saved["shear"] = None if self.shear is None else self.shear.to_dict()
+        return saved
+
+    @classmethod
+    def from_dict(cls, saved: dict[str, Any]) -> _Run:
+        values = dict(saved)
+        if values.get("shear") is not None:
+            values["shear"] = ShearPlan.from_dict(values["shear"])
+        return cls(**values)
 
     def boundary_state(self) -> dict[str, Any]:
         """The lateral boundary's record (:attr:`membrane`), set by the boundary phase."""
@@ -42,7 +85,7 @@ class _Run:
             raise BiaxialError(f"the run has no lateral boundary yet (phase {self.phase!r})")
         return self.membrane
 
-    def shear_plan(self) -> dict[str, Any]:
+    def shear_plan(self) -> ShearPlan:
         """The shearing phase's plan and progress (:attr:`shear`), set when shearing starts."""
         if self.shear is None:
             raise BiaxialError(f"the run has no shearing plan yet (phase {self.phase!r})")
