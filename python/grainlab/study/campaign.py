@@ -3,7 +3,7 @@ processes (:class:`concurrent.futures.ProcessPoolExecutor`) or on a Dask
 distributed cluster, resumable and failure-isolated.
 
 - A run is ``(name, kind, params)``; ``kind`` names a task in :data:`TASKS`
-  (``"packing"``, ``"biaxial"``). Its folder is ``OUT/runs/NAME``.
+  (``"packing"``) or a protocol of :mod:`grainlab.protocols.registry` (``"biaxial"``). Its folder is ``OUT/runs/NAME``.
 - **Finished** means ``OUT/runs/NAME/result.json`` exists (written atomically
   at the very end of the run). A rerun of the same campaign skips finished
   runs and reruns the others, including failed ones (a failure may be
@@ -85,8 +85,7 @@ class Run:
 def make_run(name: str, kind: str, params: Mapping[str, Any], campaign_seed: int,
              labels: Mapping[str, Any] | None = None) -> Run:
     """A :class:`Run` with its seed derived from ``campaign_seed`` and ``params``."""
-    if kind not in TASKS:
-        raise ValueError(f"kind: unknown run kind {kind!r}; known: {', '.join(TASKS)}")
+    task_of(kind)  # an unknown kind is refused here, before any run
     params = dict(params)
     return Run(name, kind, params, derive_seed(campaign_seed, kind, params), dict(labels or {}))
 
@@ -102,34 +101,46 @@ def _packing_task(run: Run, run_dir: Path, threads: int) -> dict[str, Any]:
     return run_packing(params, run_dir)
 
 
-def _biaxial_task(run: Run, run_dir: Path, threads: int) -> dict[str, Any]:
-    from grainlab.protocols.biaxial import run_biaxial
-    from grainlab.protocols.config import resolve
+def _protocol_task(run: Run, run_dir: Path, threads: int) -> dict[str, Any]:
+    """A run of the registered protocol ``run.kind`` (:mod:`grainlab.protocols.registry`)
+    in ``run_dir/<kind>``, resumed from its checkpoint when a stop left one."""
+    from grainlab.protocols.registry import resolve_config, run_named
 
     params = dict(run.params)
     config_file = params.pop("config_file", None)
     quick = bool(params.pop("quick", False))
     params.setdefault("sample.seed", run.seed)
     params.setdefault("run.threads", threads)
-    config = resolve(config_file, params, quick=quick)
-    out = run_dir / "biaxial"
+    config = resolve_config(run.kind, config_file, params, quick=quick)
+    out = run_dir / run.kind
     resume = (out / "checkpoint.h5").exists()
     if not resume and out.exists():
         # a run killed before its first checkpoint, or after its last: start it again
         import shutil
 
         shutil.rmtree(out)
-    result = run_biaxial(config, out, resume=resume, progress=False)
+    result = run_named(run.kind, config, out, resume=resume, progress=False)
     row = {k: v for k, v in result.summary.items() if isinstance(v, int | float | str | bool) or v is None}
     row["status"] = "ok"
     return row
 
 
-#: Run kinds: ``task(run, run_dir, threads) -> dict`` of scalar results.
+#: Run kinds besides the protocols: ``task(run, run_dir, threads) -> dict`` of scalar results.
 TASKS: dict[str, Callable[[Run, Path, int], dict[str, Any]]] = {
     "packing": _packing_task,
-    "biaxial": _biaxial_task,
 }
+
+
+def task_of(kind: str) -> Callable[[Run, Path, int], dict[str, Any]]:
+    """The task of run kind ``kind``: one of :data:`TASKS`, or a protocol of
+    :data:`grainlab.protocols.registry.PROTOCOLS` (run by its name)."""
+    if kind in TASKS:
+        return TASKS[kind]
+    from grainlab.protocols.registry import PROTOCOLS
+
+    if kind in PROTOCOLS:
+        return _protocol_task
+    raise ValueError(f"kind: unknown run kind {kind!r}; known: {', '.join([*TASKS, *sorted(PROTOCOLS)])}")
 
 
 def execute_run(run: Run | Mapping[str, Any], out_dir: str | os.PathLike[str], threads: int = 1) -> dict[str, Any]:
@@ -145,7 +156,7 @@ def execute_run(run: Run | Mapping[str, Any], out_dir: str | os.PathLike[str], t
     started = time.perf_counter()
     base = {"name": run.name, "kind": run.kind, "seed": run.seed, **run.labels}
     try:
-        result = TASKS[run.kind](run, run_dir, threads)
+        result = task_of(run.kind)(run, run_dir, threads)
     except Exception as error:  # noqa: BLE001 - one failing run must not stop the others
         message = f"{type(error).__name__}: {error}"
         write_text_atomic(run_dir / "error.txt", traceback.format_exc())

@@ -1,0 +1,43 @@
+"""The protocols grainlab runs, in one place: their names, their classes and
+their configuration schemas. The campaigns (``grainlab study``, ``sweep``,
+``reproduce``, Dask) run a protocol by its name from here; a new protocol
+registers here and in :data:`grainlab.protocols.config.SCHEMAS`.
+
+>>> sorted(PROTOCOLS)
+['biaxial']
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+from grainlab.protocols.biaxial.protocol import BiaxialProtocol
+from grainlab.protocols.config import SCHEMAS, Config
+from grainlab.protocols.runner import Protocol, RunResult, run_protocol
+
+__all__ = ["PROTOCOLS", "resolve_config", "run_named"]
+
+#: Protocol name -> its class (the name is also the results file's ``kind``).
+PROTOCOLS: dict[str, type[Protocol[Any, Any, Any]]] = {
+    BiaxialProtocol.name: BiaxialProtocol,
+}
+
+
+def resolve_config(name: str, config_file: str | Path | None = None,
+                   overrides: Mapping[str, Any] | Iterable[str] | None = None, *, quick: bool = False) -> Config:
+    """The configuration of protocol ``name`` (its schema's ``resolve``)."""
+    if name not in PROTOCOLS or name not in SCHEMAS:
+        raise ValueError(f"protocol: unknown protocol {name!r}; known: {', '.join(sorted(PROTOCOLS))}")
+    return SCHEMAS[name].resolve(config_file, overrides, quick=quick)
+
+
+def run_named(name: str, config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
+              progress: bool = False) -> RunResult:
+    """Runs (or resumes) protocol ``name`` with ``config`` into ``out_dir``."""
+    if name not in PROTOCOLS:
+        raise ValueError(f"protocol: unknown protocol {name!r}; known: {', '.join(sorted(PROTOCOLS))}")
+    result: RunResult = run_protocol(PROTOCOLS[name](config), out_dir, resume=resume, progress=progress)
+    return result
