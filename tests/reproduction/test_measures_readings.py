@@ -81,5 +81,8 @@ def test_a_packing_study_is_measured_again_under_a_reading_on_its_stored_packing
     assert irregular["mean_stability_index"] < next(d for d in default if d["kind"] == "irregular")[
         "mean_stability_index"]  # grains with 3+ contacts exist
     assert measure_study(per_contact)["n_rows"] == 2
+    from grainlab.reproduction.measures import read_study_rows_each
+
+    assert read_study_rows_each(folder, [{}, {"lambda_deviation": "per_contact"}]) == [default, per_contact]
     with pytest.raises(ValueError, match="only under a reading of lambda"):
         read_study_rows(folder, {"band": "final"})

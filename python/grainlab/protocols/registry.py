@@ -26,18 +26,21 @@ PROTOCOLS: dict[str, type[Protocol[Any, Any, Any]]] = {
 }
 
 
+def _check_name(name: str) -> None:
+    if name not in PROTOCOLS or name not in SCHEMAS:
+        raise ValueError(f"protocol: unknown protocol {name!r}; known: {', '.join(sorted(PROTOCOLS))}")
+
+
 def resolve_config(name: str, config_file: str | Path | None = None,
                    overrides: Mapping[str, Any] | Iterable[str] | None = None, *, quick: bool = False) -> Config:
     """The configuration of protocol ``name`` (its schema's ``resolve``)."""
-    if name not in PROTOCOLS or name not in SCHEMAS:
-        raise ValueError(f"protocol: unknown protocol {name!r}; known: {', '.join(sorted(PROTOCOLS))}")
+    _check_name(name)
     return SCHEMAS[name].resolve(config_file, overrides, quick=quick)
 
 
 def run_named(name: str, config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
               progress: bool = False) -> RunResult:
     """Runs (or resumes) protocol ``name`` with ``config`` into ``out_dir``."""
-    if name not in PROTOCOLS:
-        raise ValueError(f"protocol: unknown protocol {name!r}; known: {', '.join(sorted(PROTOCOLS))}")
+    _check_name(name)
     result: RunResult = run_protocol(PROTOCOLS[name](config), out_dir, resume=resume, progress=progress)
     return result

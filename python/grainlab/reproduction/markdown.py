@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -183,7 +183,7 @@ def _study_claims() -> tuple[str, ...]:
 #: The claim sets a sensitivity block may name: ``sensitivity_markdown()`` the band and
 #: lambda claims (a row per claim), ``sensitivity_markdown(study)`` the packing study's (a
 #: row per variant: the readings of lambda on one study's packings).
-CLAIM_SETS: dict[str, Any] = {"": lambda: SENSITIVITY_CLAIMS, "study": _study_claims}
+CLAIM_SETS: dict[str, Callable[[], tuple[str, ...]]] = {"": lambda: SENSITIVITY_CLAIMS, "study": _study_claims}
 
 
 def sensitivity_markdown(documents: Sequence[dict[str, Any]], claims: Sequence[str] = SENSITIVITY_CLAIMS,

@@ -373,26 +373,39 @@ def measure_study(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     return out
 
 
+#: The analysis options a packing study is measured again under: a reading of Eqs. 9-11.
+STUDY_OPTIONS = frozenset({"lambda_slots", "lambda_anchor", "lambda_deviation"})
+
+
 def read_study_rows(folder: str | Path, options: Mapping[str, Any] | None = None) -> list[dict[str, Any]]:
     """The rows of the packings finished in ``folder`` (``*/result.json``). With lambda
-    ``options`` (``lambda_slots``, ``lambda_anchor``, ``lambda_deviation``: a reading of
-    Eqs. 9-11), each row's mean lambda is measured again under that reading on the
-    packing the row was measured on (``ValueError`` for a packing stored without it)."""
-    from grainlab.analysis import StabilityIndex
+    ``options`` (:data:`STUDY_OPTIONS`: a reading of Eqs. 9-11), each row's mean lambda
+    is measured again under that reading on the packing the row was measured on
+    (``ValueError`` for a packing stored without it)."""
+    return read_study_rows_each(folder, [options or {}])[0]
+
+
+def read_study_rows_each(folder: str | Path, options: Sequence[Mapping[str, Any]]) -> list[list[dict[str, Any]]]:
+    """:func:`read_study_rows` under each of ``options``, each packing read once."""
     from grainlab.study.packing import read_packing
 
-    reading = {k[len("lambda_"):]: v for k, v in (options or {}).items()}
-    unknown = set(reading) - {"slots", "anchor", "deviation"}
-    if unknown:
-        raise ValueError(f"a packing study is measured again only under a reading of lambda, not {sorted(unknown)}")
-    rows = []
+    for given in options:
+        unknown = set(given) - STUDY_OPTIONS
+        if unknown:
+            raise ValueError(f"a packing study is measured again only under a reading of lambda, not {sorted(unknown)}")
+    out: list[list[dict[str, Any]]] = [[] for _ in options]
     for path in sorted(Path(folder).glob("*/result.json")):
         try:
             row = json.loads(path.read_text())["row"]
         except (OSError, json.JSONDecodeError, KeyError):
             continue
-        if reading and row.get("status") != "failed":
-            stability = StabilityIndex(**reading).compute(read_packing(path.parent))
-            row = {**row, "mean_stability_index": stability.mean, "mean_stability_index_all": stability.mean_all}
-        rows.append(row)
-    return rows
+        measured = row.get("status") != "failed" and any(options)
+        snap = read_packing(path.parent) if measured else None
+        for rows, given in zip(out, options, strict=True):
+            if given and snap is not None:
+                stability = _stability(given).compute(snap)
+                rows.append({**row, "mean_stability_index": stability.mean,
+                             "mean_stability_index_all": stability.mean_all})
+            else:
+                rows.append(row)
+    return out

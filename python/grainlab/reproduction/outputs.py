@@ -40,7 +40,12 @@ import grainlab
 from grainlab.io.results import write_json_atomic, write_text_atomic
 from grainlab.reproduction.claims import BIAXIAL_CLAIMS, RATE_CLAIMS, STUDY_CLAIMS, evaluate
 from grainlab.reproduction.markdown import claims_markdown
-from grainlab.reproduction.measures import measure_biaxial_each, measure_study, read_study_rows
+from grainlab.reproduction.measures import (
+    measure_biaxial_each,
+    measure_study,
+    read_study_rows,
+    read_study_rows_each,
+)
 from grainlab.reproduction.runs import ReproductionPlan, Variant
 from grainlab.reproduction.verdicts import VERDICTS, t_interval
 
@@ -66,7 +71,7 @@ def _measure_task(kind: str, path: str, options: list[dict[str, Any]]) -> tuple[
     try:
         if kind == "biaxial":
             return list(measure_biaxial_each(path, options)), ""
-        return [measure_study(read_study_rows(path, o)) for o in options], ""
+        return [measure_study(rows) for rows in read_study_rows_each(path, options)], ""
     except Exception as error:  # noqa: BLE001 - one unreadable run must not stop the claims
         return [None] * len(options), f"{path}: {type(error).__name__}: {error}"
 

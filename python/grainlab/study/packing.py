@@ -403,15 +403,11 @@ def _store(folder: Path, p: PackingParams, result: Mapping[str, Any], snap: Snap
     from grainlab.io.hdf5 import ResultsWriter
 
     folder.mkdir(parents=True, exist_ok=True)
-    writer = ResultsWriter(folder / PACKING_FILE, kind="packing", overwrite=True, buffered=True)
-    try:
-        writer.write_config(asdict(p))
+    with ResultsWriter(folder / PACKING_FILE, kind="packing", overwrite=True, buffered=True) as writer:
+        writer.write_config(asdict(p))  # finalized on leaving the block, closed on an error
         writer.write_snapshot(PACKING_SNAPSHOT, snap)
         writer.write_summary(result)
-    except BaseException:
-        writer.close()
-        raise
-    return writer.finalize()
+    return folder / PACKING_FILE
 
 
 def read_packing(folder: str | os.PathLike[str]) -> Snapshot:
