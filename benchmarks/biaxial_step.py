@@ -37,22 +37,17 @@ import tempfile
 import time
 from pathlib import Path
 
-from grainlab.protocols.biaxial.phases import (
-    check_shear_plan,
-    consolidate,
-    engine_threads,
-    generate,
-    install_boundary,
-    start_shear,
-)
+from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary, start_shear
+from grainlab.protocols.biaxial.state import _Run
 from grainlab.protocols.config import resolve
+from grainlab.protocols.specimen import consolidate, engine_threads, generate
 from grainlab.simulation import Simulation
 
 
 def build_state(path: Path, quick: bool) -> None:
     """Runs the biaxial protocol to the start of shear and writes the engine state."""
     config = resolve(quick=quick)
-    sim, run = generate(config, engine_threads(config), progress=False)
+    sim, run = generate(config, engine_threads(config), False, _Run, "consolidate")
     consolidate(sim, run, config, progress=False)
     install_boundary(sim, run, config, progress=False)
     start_shear(sim, run, config)

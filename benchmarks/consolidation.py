@@ -20,15 +20,15 @@ import json
 import sys
 import time
 
-from grainlab.protocols.biaxial.phases import consolidate, engine_threads, generate
 from grainlab.protocols.config import resolve
 from grainlab.protocols.consolidate import BoxState
+from grainlab.protocols.specimen import SpecimenRun, consolidate, engine_threads, generate
 
 
 def main(argv: list[str] | None = None) -> int:
     overrides = sys.argv[1:] if argv is None else argv
     config = resolve(overrides=overrides)
-    sim, run = generate(config, engine_threads(config), progress=False)
+    sim, run = generate(config, engine_threads(config), False, SpecimenRun, "consolidate")
     target = config["consolidation.pressure"]
     tolerance = config["consolidation.tolerance"]
     first_within: list[int] = []

@@ -484,7 +484,7 @@ def prepared_state(
     threads: int = 1,
 ) -> tuple[InitialState, dict[str, float]]:
     """Generate and consolidate a biaxial sample only (as ``grainlab biaxial`` does,
-    ``protocols/biaxial/phases.py``), and measure the consolidated state.
+    ``protocols/specimen.py``), and measure the consolidated state.
 
     ``overrides`` are configuration keys (``{"consolidation.friction": 0.9}``);
     ``seed`` sets ``sample.seed``. Returns the measures (whole-sample porosity in
@@ -492,8 +492,8 @@ def prepared_state(
     stress and porosities, the consolidation's steps, its porosities and
     unbalanced force ratio, and the wall time.
     """
-    from grainlab.protocols.biaxial.phases import consolidate, generate
     from grainlab.protocols.config import resolve
+    from grainlab.protocols.specimen import SpecimenRun, consolidate, generate
 
     values = dict(overrides or {})
     values["sample.seed"] = int(seed)
@@ -501,7 +501,7 @@ def prepared_state(
     config = resolve(overrides=values)
     start = time.perf_counter()
     with _kernels.kernel_threads(int(threads)):
-        sim, run = generate(config, int(threads), progress=False)
+        sim, run = generate(config, int(threads), False, SpecimenRun, "consolidate")
         consolidate(sim, run, config, progress=False)
     seconds = time.perf_counter() - start
     c = run.consolidation

@@ -1,7 +1,8 @@
-"""The biaxial test's phases: generate, consolidate, install the boundary,
-start and run the shearing. Each takes the simulation, the run state and the
-configuration; :mod:`grainlab.protocols.biaxial.protocol` lists them as the
-protocol's stages, and the runner moves the run from one to the next."""
+"""The biaxial test's own phases: install the boundary, start and run the
+shearing (the sample's generation and consolidation are every test's,
+:mod:`grainlab.protocols.specimen`). Each takes the simulation, the run state
+and the configuration; :mod:`grainlab.protocols.biaxial.protocol` lists them as
+the protocol's stages, and the runner moves the run from one to the next."""
 
 from __future__ import annotations
 
@@ -13,7 +14,6 @@ from collections.abc import Callable
 import numpy as np
 
 import grainlab
-from grainlab._cores import available_cores
 from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
 from grainlab.io.hdf5 import ResultsWriter, snapshot_name
@@ -40,152 +40,9 @@ from grainlab.protocols.boundary import (
     set_platen_velocity,
 )
 from grainlab.protocols.config import BiaxialConfig
-from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
+from grainlab.protocols.specimen import grain_model, platen_model
 from grainlab.protocols.triggers import At, Every, WallClock, schedule_steps
-from grainlab.samples import (
-    PAPER_GRADING,
-    GradingCurve,
-    UniformByMass,
-    UniformByNumber,
-    expand_to_porosity,
-    overlap_corrected_porosity,
-)
-from grainlab.simulation import ContactModel, Simulation
-
-
-def _grading(config: BiaxialConfig) -> UniformByNumber | UniformByMass | GradingCurve:
-    kind = config["sample.grading"]
-    d_min, d_max = config["sample.d_min"], config["sample.d_max"]
-    if kind == "uniform_by_number":
-        return UniformByNumber(d_min, d_max)
-    if kind == "uniform_by_mass":
-        return UniformByMass(d_min, d_max)
-    if kind == "curve":
-        return GradingCurve(config["sample.sieve_sizes"], config["sample.percent_passing"])
-    if (d_min, d_max) != (PAPER_GRADING.d_min, PAPER_GRADING.d_max):
-        raise ValueError(
-            "sample.grading: 'paper' is the 0.5-3 mm curve; with other sample.d_min/d_max "
-            "choose 'uniform_by_number' or 'uniform_by_mass'"
-        )
-    return PAPER_GRADING
-
-
-def engine_threads(config: BiaxialConfig) -> int:
-    threads = config["run.threads"]
-    return available_cores() if threads == "auto" else int(threads)
-
-
-def _grain_model(config: BiaxialConfig) -> ContactModel:
-    return ContactModel(
-        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.friction"]
-    )
-
-
-def _platen_model(config: BiaxialConfig) -> ContactModel:
-    return ContactModel(
-        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.platen_friction"]
-    )
-
-
-def generate(config: BiaxialConfig, threads: int, progress: bool) -> tuple[Simulation, _Run]:
-    start = time.perf_counter()
-    box = (0.0, 0.0, config["sample.width"], config["sample.height"])
-    sample = expand_to_porosity(
-        box,
-        config["sample.porosity"],
-        _grading(config),
-        seed=config["sample.seed"],
-        friction=config["sample.generation_friction"],
-        wall_friction=config["material.platen_friction"],
-        normal_stiffness=config["material.normal_stiffness"],
-        shear_stiffness=config["material.shear_stiffness"],
-        density=config["material.density"],
-        local_damping=config["material.local_damping"],
-        max_stress_pa=config["sample.max_generation_stress"],
-        threads=threads,
-        progress=progress,
-        keep_simulation=True,
-    )
-    sim = sample.simulation
-    n = sim.n_particles
-    sim.densities = np.full(n, config["material.density"])  # generation may scale densities
-    info = {k: v for k, v in sample.to_dict().items() if isinstance(v, int | float | str | bool) or v is None}
-    run = _Run(
-        phase="consolidate",
-        n_grains=n,
-        grain_density=config["material.density"],
-        walls={"bottom": 0, "right": 1, "top": 2, "left": 3},
-        wall_time={"generate": time.perf_counter() - start},
-        sample=info,
-        consolidation={},
-    )
-    return sim, run
-
-
-def consolidate(
-    sim: Simulation,
-    run: _Run,
-    config: BiaxialConfig,
-    progress: bool,
-    on_chunk: Callable[[BoxState, int], None] | None = None,
-) -> None:
-    """Servo-controls the box to the confining pressure until equilibrium;
-    ``on_chunk(state, steps)`` after every chunk (``benchmarks/consolidation.py``)."""
-    start = time.perf_counter()
-    consolidation_model = ContactModel(
-        config["material.normal_stiffness"], config["material.shear_stiffness"], config["consolidation.friction"]
-    )
-    sim.set_contact_model(0, 0, consolidation_model)
-    sim.set_contact_model(0, 1, _platen_model(config))
-    sim.local_damping = config["material.local_damping"]
-    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
-    target = config["consolidation.pressure"]
-    tolerance = config["consolidation.tolerance"]
-    limit = config["consolidation.unbalanced_force_ratio"]
-    max_steps = config["consolidation.max_steps"]
-    speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
-    bar = progress_bar(max_steps, "consolidating", enabled=progress, unit="step")
-
-    def show(state: BoxState, steps: int) -> None:
-        bar.update(CHUNK_STEPS)
-        bar.set_postfix_str(f"sxx {state.stress_xx_pa / 1e3:.1f} kPa, syy {state.stress_yy_pa / 1e3:.1f} kPa, "
-                            f"unbalanced {sim.unbalanced_force_ratio:.1e}")
-        if on_chunk is not None:
-            on_chunk(state, steps)
-
-    walls = {name: sim.wall(run.walls[name]) for name in BOX_WALLS}
-    state, steps, converged = servo_box(
-        sim, walls, target, tolerance=tolerance, unbalanced_force_limit=limit, max_steps=max_steps,
-        max_speed_m_per_s=speed, chunk_steps=CHUNK_STEPS, after_chunk=show,
-    )
-    if not converged:
-        bar.close()
-        raise BiaxialError(
-            f"consolidation did not converge in {steps} steps: wall stresses {state.stress_xx_pa / 1e3:.1f} / "
-            f"{state.stress_yy_pa / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa +- {tolerance:.0%}), unbalanced "
-            f"force ratio {sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise consolidation.max_steps"
-        )
-    sxx, syy, width, height = state.stress_xx_pa, state.stress_yy_pa, state.width_m, state.height_m
-    bar.close()
-    grains = np.arange(run.n_grains)
-    radii = sim.radii[grains]
-    area = width * height
-    box = (float(sim.wall(run.walls["left"]).points[0, 0]), float(sim.wall(run.walls["bottom"]).points[0, 1]))
-    run.consolidation = {
-        "steps": steps,
-        "stress_xx_pa": sxx,
-        "stress_yy_pa": syy,
-        "width_m": width,
-        "height_m": height,
-        "porosity": 1.0 - float(np.pi * np.sum(radii**2)) / area,
-        "porosity_overlap_corrected": overlap_corrected_porosity(
-            sim.positions[grains], radii, (box[0], box[1], box[0] + width, box[1] + height)
-        ),
-        "coordination_number": sim.coordination_number,
-        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
-        "time_step_s": sim.time_step,
-    }
-    run.wall_time["consolidate"] = time.perf_counter() - start
+from grainlab.simulation import Simulation
 
 
 def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
@@ -203,8 +60,8 @@ def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress
     bottom = sim.add_segment_wall((reach[0], y_bottom), (reach[1], y_bottom))  # sample on the left
     top = sim.add_segment_wall((reach[1], y_top), (reach[0], y_top))
     walls["bottom"], walls["top"] = bottom.id, top.id
-    sim.set_contact_model(0, 0, _grain_model(config))  # Table 1 friction from here on
-    sim.set_contact_model(0, 1, _platen_model(config))
+    sim.set_contact_model(0, 0, grain_model(config))  # Table 1 friction from here on
+    sim.set_contact_model(0, 1, platen_model(config))
     limit = config["consolidation.unbalanced_force_ratio"]
     steps = 0
     if config["boundary.kind"] == "membrane":
@@ -218,7 +75,7 @@ def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress
             overlap=config["boundary.membrane_overlap"],
             bond_stiffness=config["boundary.membrane_stiffness"],
             friction=config["boundary.membrane_friction"],
-            grain_model=_grain_model(config),
+            grain_model=grain_model(config),
             density=config["material.density"],
             pressure=config["consolidation.pressure"],
         )

@@ -9,19 +9,12 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from grainlab.protocols.biaxial.outputs import BiaxialResult, _summary, _write_outputs
-from grainlab.protocols.biaxial.phases import (
-    check_shear_plan,
-    consolidate,
-    engine_threads,
-    generate,
-    install_boundary,
-    shear,
-    start_shear,
-)
+from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary, shear, start_shear
 from grainlab.protocols.biaxial.rates import check_density_scaling, check_strain_rate
 from grainlab.protocols.biaxial.state import _Run
 from grainlab.protocols.config import BiaxialConfig
 from grainlab.protocols.runner import RUN_FILES, Protocol, Stage, StageContext, run_protocol
+from grainlab.protocols.specimen import consolidate, engine_threads, generate
 from grainlab.simulation import Simulation
 
 __all__ = ["OUTPUT_FILES", "RUN_FILES", "BiaxialProtocol", "run_biaxial"]
@@ -78,7 +71,7 @@ class BiaxialProtocol(Protocol[BiaxialConfig, _Run, BiaxialResult]):
             return None
 
     def start(self, threads: int, progress: bool) -> tuple[Simulation, _Run]:
-        return generate(self.config, threads, progress)
+        return generate(self.config, threads, progress, _Run, "consolidate")
 
     def state_from_dict(self, saved: Any) -> _Run:
         # "peak": the peak so far, which checkpoints of earlier grainlab versions carry; the

@@ -7,14 +7,13 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from grainlab.protocols.boundary import GrainBoundary, Membrane
-from grainlab.protocols.runner import ProtocolError
+from grainlab.protocols.specimen import CHUNK_STEPS, SpecimenError, SpecimenRun
 
-#: Steps per engine call while a phase waits for a condition.
-CHUNK_STEPS = 2000
+__all__ = ["CHUNK_STEPS", "BiaxialError", "ShearPlan"]
 
 
-class BiaxialError(ProtocolError):
-    """The test could not proceed (e.g. consolidation did not converge)."""
+class BiaxialError(SpecimenError):
+    """The biaxial test could not proceed (e.g. the membrane was breached)."""
 
 
 @dataclass
@@ -52,16 +51,10 @@ class ShearPlan:
 
 
 @dataclass
-class _Run:
-    """What a run carries from phase to phase, saved in every checkpoint."""
+class _Run(SpecimenRun):
+    """What a biaxial run carries from phase to phase, saved in every checkpoint:
+    :class:`SpecimenRun`'s fields, the lateral boundary, the shearing's plan."""
 
-    phase: str
-    n_grains: int
-    grain_density: float
-    walls: dict[str, int]
-    wall_time: dict[str, float]
-    sample: dict[str, Any]
-    consolidation: dict[str, Any]
     membrane: dict[str, Any] | None = None
     shear: ShearPlan | None = None
     rows: int = 0

@@ -1,0 +1,197 @@
+"""What every test that makes a sample and consolidates it shares: the run
+state's common part (:class:`SpecimenRun`), the sample's generation by radius
+expansion (:func:`generate`, the ``sample.*`` keys) and the isotropic
+consolidation in four servo-controlled walls (:func:`consolidate`, the
+``consolidation.*`` keys). The biaxial test and the oedometer start with them."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, TypeVar
+
+import numpy as np
+
+from grainlab._cores import available_cores
+from grainlab._progress import progress_bar
+from grainlab.protocols.config import Config
+from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
+from grainlab.protocols.runner import ProtocolError
+from grainlab.samples import (
+    PAPER_GRADING,
+    GradingCurve,
+    UniformByMass,
+    UniformByNumber,
+    expand_to_porosity,
+    overlap_corrected_porosity,
+)
+from grainlab.simulation import ContactModel, Simulation
+
+__all__ = ["CHUNK_STEPS", "SpecimenError", "SpecimenRun", "consolidate", "engine_threads", "generate",
+           "grain_model", "platen_model"]
+
+#: Steps per engine call while a phase waits for a condition.
+CHUNK_STEPS = 2000
+
+
+class SpecimenError(ProtocolError):
+    """The sample could not be made or consolidated (e.g. consolidation did not converge)."""
+
+
+@dataclass
+class SpecimenRun:
+    """What every test's run state starts with (saved in every checkpoint): the
+    phase, the grain count and density, the walls by name (engine ids), the wall
+    time of each stage, the generated sample's numbers and the consolidation's."""
+
+    phase: str
+    n_grains: int
+    grain_density: float
+    walls: dict[str, int]
+    wall_time: dict[str, float]
+    sample: dict[str, Any]
+    consolidation: dict[str, Any]
+
+
+R = TypeVar("R", bound=SpecimenRun)
+
+
+def grading(config: Config) -> UniformByNumber | UniformByMass | GradingCurve:
+    kind = config["sample.grading"]
+    d_min, d_max = config["sample.d_min"], config["sample.d_max"]
+    if kind == "uniform_by_number":
+        return UniformByNumber(d_min, d_max)
+    if kind == "uniform_by_mass":
+        return UniformByMass(d_min, d_max)
+    if kind == "curve":
+        return GradingCurve(config["sample.sieve_sizes"], config["sample.percent_passing"])
+    if (d_min, d_max) != (PAPER_GRADING.d_min, PAPER_GRADING.d_max):
+        raise ValueError(
+            "sample.grading: 'paper' is the 0.5-3 mm curve; with other sample.d_min/d_max "
+            "choose 'uniform_by_number' or 'uniform_by_mass'"
+        )
+    return PAPER_GRADING
+
+
+def engine_threads(config: Config) -> int:
+    threads = config["run.threads"]
+    return available_cores() if threads == "auto" else int(threads)
+
+
+def grain_model(config: Config) -> ContactModel:
+    return ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.friction"]
+    )
+
+
+def platen_model(config: Config) -> ContactModel:
+    return ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.platen_friction"]
+    )
+
+
+def generate(config: Config, threads: int, progress: bool, state: type[R], phase: str,
+             **fields: Any) -> tuple[Simulation, R]:
+    """The sample of ``config`` made by radius expansion in four rigid walls (bottom,
+    right, top, left), and a new run state of type ``state`` in ``phase`` (its own
+    ``fields`` besides :class:`SpecimenRun`'s)."""
+    start = time.perf_counter()
+    box = (0.0, 0.0, config["sample.width"], config["sample.height"])
+    sample = expand_to_porosity(
+        box,
+        config["sample.porosity"],
+        grading(config),
+        seed=config["sample.seed"],
+        friction=config["sample.generation_friction"],
+        wall_friction=config["material.platen_friction"],
+        normal_stiffness=config["material.normal_stiffness"],
+        shear_stiffness=config["material.shear_stiffness"],
+        density=config["material.density"],
+        local_damping=config["material.local_damping"],
+        max_stress_pa=config["sample.max_generation_stress"],
+        threads=threads,
+        progress=progress,
+        keep_simulation=True,
+    )
+    sim = sample.simulation
+    n = sim.n_particles
+    sim.densities = np.full(n, config["material.density"])  # generation may scale densities
+    info = {k: v for k, v in sample.to_dict().items() if isinstance(v, int | float | str | bool) or v is None}
+    run = state(
+        phase=phase,
+        n_grains=n,
+        grain_density=config["material.density"],
+        walls={"bottom": 0, "right": 1, "top": 2, "left": 3},
+        wall_time={"generate": time.perf_counter() - start},
+        sample=info,
+        consolidation={},
+        **fields,
+    )
+    return sim, run
+
+
+def consolidate(
+    sim: Simulation,
+    run: SpecimenRun,
+    config: Config,
+    progress: bool,
+    on_chunk: Callable[[BoxState, int], None] | None = None,
+) -> None:
+    """Servo-controls the box to the confining pressure until equilibrium;
+    ``on_chunk(state, steps)`` after every chunk (``benchmarks/consolidation.py``)."""
+    start = time.perf_counter()
+    consolidation_model = ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["consolidation.friction"]
+    )
+    sim.set_contact_model(0, 0, consolidation_model)
+    sim.set_contact_model(0, 1, platen_model(config))
+    sim.local_damping = config["material.local_damping"]
+    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+    target = config["consolidation.pressure"]
+    tolerance = config["consolidation.tolerance"]
+    limit = config["consolidation.unbalanced_force_ratio"]
+    max_steps = config["consolidation.max_steps"]
+    speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
+    bar = progress_bar(max_steps, "consolidating", enabled=progress, unit="step")
+
+    def show(state: BoxState, steps: int) -> None:
+        bar.update(CHUNK_STEPS)
+        bar.set_postfix_str(f"sxx {state.stress_xx_pa / 1e3:.1f} kPa, syy {state.stress_yy_pa / 1e3:.1f} kPa, "
+                            f"unbalanced {sim.unbalanced_force_ratio:.1e}")
+        if on_chunk is not None:
+            on_chunk(state, steps)
+
+    walls = {name: sim.wall(run.walls[name]) for name in BOX_WALLS}
+    state, steps, converged = servo_box(
+        sim, walls, target, tolerance=tolerance, unbalanced_force_limit=limit, max_steps=max_steps,
+        max_speed_m_per_s=speed, chunk_steps=CHUNK_STEPS, after_chunk=show,
+    )
+    if not converged:
+        bar.close()
+        raise SpecimenError(
+            f"consolidation did not converge in {steps} steps: wall stresses {state.stress_xx_pa / 1e3:.1f} / "
+            f"{state.stress_yy_pa / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa +- {tolerance:.0%}), unbalanced "
+            f"force ratio {sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise consolidation.max_steps"
+        )
+    sxx, syy, width, height = state.stress_xx_pa, state.stress_yy_pa, state.width_m, state.height_m
+    bar.close()
+    grains = np.arange(run.n_grains)
+    radii = sim.radii[grains]
+    area = width * height
+    box = (float(sim.wall(run.walls["left"]).points[0, 0]), float(sim.wall(run.walls["bottom"]).points[0, 1]))
+    run.consolidation = {
+        "steps": steps,
+        "stress_xx_pa": sxx,
+        "stress_yy_pa": syy,
+        "width_m": width,
+        "height_m": height,
+        "porosity": 1.0 - float(np.pi * np.sum(radii**2)) / area,
+        "porosity_overlap_corrected": overlap_corrected_porosity(
+            sim.positions[grains], radii, (box[0], box[1], box[0] + width, box[1] + height)
+        ),
+        "coordination_number": sim.coordination_number,
+        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
+        "time_step_s": sim.time_step,
+    }
+    run.wall_time["consolidate"] = time.perf_counter() - start
