@@ -4,7 +4,9 @@ Every module of ``python/grainlab`` belongs to one layer; a module may import
 (at module level or inside a function) only modules of its own layer or of a
 layer below. io, besides, imports no analysis or plotting: it reads and
 writes, and computes nothing. The test walks the syntax tree of every module,
-so a lazy import inside a function counts too. It is run by ``make lint``.
+so a lazy import inside a function counts too. No two files, and no two of
+the package's subpackages, import each other, directly or round a circle
+(:func:`import_cycles`). It is run by ``make lint``.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ LAYERS: dict[str, int] = {
     "grainlab._progress": 0,
     "grainlab._repr": 0,
     "grainlab._child": 0,
+    "grainlab._html": 0,
     "grainlab.paper": 0,
     # 1: the engine API and the snapshot data model
     "grainlab": 1,
@@ -151,6 +154,112 @@ def test_every_import_follows_the_layer_rule():
     problems, met = layer_violations(PACKAGE.parent)
     assert problems == []
     assert met == EXCEPTIONS, "an exception no longer needed: remove it from EXCEPTIONS"
+
+
+def import_graph(root: Path) -> dict[str, set[str]]:
+    """Module -> the grainlab modules it imports (at module level or lazily), each
+    import resolved to the module file it reaches (``from grainlab.x import name``
+    reaches ``grainlab.x``); the compiled engine counts as a module."""
+    files = {module_name(root, path): path for path in sorted((root / "grainlab").rglob("*.py"))}
+    known = set(files) | {m for m in LAYERS if (root / m.replace(".", "/")).with_suffix(".pyi").exists()}
+
+    def reached(target: str) -> str:
+        while target not in known and "." in target:
+            target = target.rpartition(".")[0]
+        return target
+
+    graph: dict[str, set[str]] = {}
+    for module, path in files.items():
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+        targets: set[str] = set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                targets |= {reached(alias.name) for alias in node.names}
+            elif isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                    source = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    source = node.module or ""
+                targets |= {reached(f"{source}.{alias.name}") for alias in node.names}
+        graph[module] = {t for t in targets if _under(t, "grainlab")} - {module}
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one node (Tarjan), each sorted."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+
+    def visit(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for other in sorted(graph.get(node, ())):
+            if other not in index:
+                visit(other)
+                low[node] = min(low[node], low[other])
+            elif other in on_stack:
+                low[node] = min(low[node], index[other])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                component.append(member)
+                if member == node:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    for node in sorted(graph):
+        if node not in index:
+            visit(node)
+    return sorted(found)
+
+
+def _subpackage(module: str) -> str:
+    """``grainlab.x`` of ``grainlab.x.y.z`` (the package itself for ``grainlab``)."""
+    return ".".join(module.split(".")[:2])
+
+
+def import_cycles(root: Path) -> tuple[list[list[str]], list[list[str]]]:
+    """The import circles of the package under ``root``: between files, and between
+    its subpackages (``grainlab.report`` and ``grainlab.reproduction``, say)."""
+    graph = import_graph(root)
+    packages: dict[str, set[str]] = {}
+    for module, targets in graph.items():
+        mine = _subpackage(module)
+        packages.setdefault(mine, set()).update(_subpackage(t) for t in targets if _subpackage(t) != mine)
+    return _cycles(graph), _cycles(packages)
+
+
+def test_no_import_cycle_between_files_or_packages():
+    files, packages = import_cycles(PACKAGE.parent)
+    assert files == [], "files that import each other (move what both need into a module of its own)"
+    assert packages == [], "subpackages that import each other (one of them must not know the other)"
+
+
+def test_an_import_cycle_is_caught_even_lazily(tmp_path):
+    root = _synthetic_package(
+        tmp_path,
+        {
+            "grainlab.__init__": "",
+            "grainlab.report.__init__": "",
+            "grainlab.report.page": "def f():\n    from grainlab.reproduction.claims import rows\n",
+            "grainlab.reproduction.__init__": "",
+            "grainlab.reproduction.claims": "from grainlab.report import page\n",
+            "grainlab.plot.__init__": "from grainlab.plot.workers import pool\n",
+            "grainlab.plot.workers": "def g():\n    from grainlab.plot import save\n",
+        },
+    )
+    files, packages = import_cycles(root)
+    assert files == [["grainlab.plot", "grainlab.plot.workers"], ["grainlab.report.page", "grainlab.reproduction.claims"]]
+    assert packages == [["grainlab.report", "grainlab.reproduction"]]
 
 
 def _synthetic_package(root: Path, modules: dict[str, str]) -> Path:

@@ -94,7 +94,7 @@ def test_page_copies_made_with_the_figures_are_the_copies_made_here(tmp_path, wo
         files = pool.draw(curve_tasks(_timeseries(90)), tmp_path).result()
     for png, _ in files.values():
         data = png.read_bytes()
-        kept = plot._page_copies.get(plot._png_digest(data))
+        kept = plot.files._page_copies.get(plot.files._png_digest(data))
         assert kept is not None
         assert kept == compact_png(data, dpi=PAGE_DPI) == page_png(data)
 

@@ -14,13 +14,13 @@ import pytest
 from report_factories import BAND_DEG, DILATION_SLOPE, PEAK_RATIO, PEAK_STRAIN, PHASES, THREADS
 from report_helpers import check_self_contained, parse
 
+from grainlab._html import fmt
 from grainlab.cli import build_parser, main
 from grainlab.io.hdf5 import read_results
 from grainlab.postprocess import FIGURES
 from grainlab.protocols.config import resolve
 from grainlab.report import write_report
 from grainlab.report.biaxial import CURVE_FIGURES, gather_biaxial
-from grainlab.report.html import fmt
 
 #: Figures of a biaxial report: the folder's ten and the report's grading and macro curves.
 N_FIGURES = len(FIGURES) + len(CURVE_FIGURES) + 2

@@ -7,8 +7,7 @@ import re
 
 from matplotlib.figure import Figure
 
-from grainlab.report.figures import png_bytes
-from grainlab.report.html import (
+from grainlab._html import (
     DISPLAY_ZOOM,
     EmbeddedFigure,
     Markup,
@@ -18,6 +17,7 @@ from grainlab.report.html import (
     section,
     table,
 )
+from grainlab.report.figures import png_bytes
 
 
 def test_text_from_the_data_is_escaped_and_markup_is_not():

@@ -13,9 +13,9 @@ from report_factories import STUDY_OVERRIDES, STUDY_TARGETS
 from report_helpers import check_self_contained
 
 import grainlab.commands.study as study_command
+from grainlab._html import fmt
 from grainlab.cli import main
 from grainlab.report import write_report
-from grainlab.report.html import fmt
 from grainlab.report.study import STUDY_FIGURES, gather_study
 from grainlab.study import read_table, run_study
 

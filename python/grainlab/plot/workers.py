@@ -77,7 +77,7 @@ _Drawn = tuple[list[Path], tuple[bytes, bytes] | None]
 
 
 def _draw_and_save(task: FigureTask, out_dir: Path, page_copy: bool) -> _Drawn:
-    from grainlab.plot import PAGE_DPI, _png_digest, compact_png, save_figure
+    from grainlab.plot.files import PAGE_DPI, _png_digest, compact_png, save_figure
 
     paths = save_figure(task.make(*task.args, **task.kwargs), out_dir / task.name, task.formats)
     png = next((p for p in paths if p.suffix == ".png"), None)
@@ -150,7 +150,7 @@ class PendingFigures:
         self.claimed = True
         files: dict[str, list[Path]] = {}
         failure: BaseException | None = None
-        from grainlab.plot import _keep_page_png
+        from grainlab.plot.files import _keep_page_png
 
         for name, future in self._futures:
             try:

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 import grainlab
+from grainlab._html import EmbeddedFigure, fmt, is_usable_png
 from grainlab._mapping import flatten_keys
 from grainlab.analysis.peak import peak_record
 from grainlab.io.hdf5 import Results, read_results
@@ -36,7 +37,6 @@ from grainlab.report.angles import (
 )
 from grainlab.report.band import band_from_numbers
 from grainlab.report.figures import embedded_png, grading_figure, macro_figure
-from grainlab.report.html import EmbeddedFigure, fmt, is_usable_png
 from grainlab.samples import PAPER_GRADING, UniformByMass, UniformByNumber
 from grainlab.samples.grading import Grading, GradingCurve
 

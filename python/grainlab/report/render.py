@@ -8,9 +8,7 @@ import shlex
 from typing import Any
 
 import grainlab
-from grainlab.report.band import ACCEPTANCE
-from grainlab.report.biaxial import BiaxialReport
-from grainlab.report.html import (
+from grainlab._html import (
     EmbeddedFigure,
     Markup,
     code_block,
@@ -24,6 +22,8 @@ from grainlab.report.html import (
     section,
     table,
 )
+from grainlab.report.band import ACCEPTANCE
+from grainlab.report.biaxial import BiaxialReport
 from grainlab.report.study import StudyReport, param_unit
 
 __all__ = ["render_biaxial", "render_study"]

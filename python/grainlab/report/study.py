@@ -19,9 +19,9 @@ from typing import Any
 
 import numpy as np
 
+from grainlab._html import EmbeddedFigure, fmt, is_usable_png
 from grainlab.paper import STUDY_CLAIMS
 from grainlab.report.figures import embedded_png
-from grainlab.report.html import EmbeddedFigure, fmt, is_usable_png
 from grainlab.study.packing import PackingParams
 from grainlab.study.paper import (
     HEXAGONAL_POROSITIES,

@@ -23,7 +23,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from grainlab import plot
-from grainlab.reproduction.runs import ReproductionPlan, variant_folder
+from grainlab.reproduction.runs import ReproductionPlan, rate_family, variant_folder
 from grainlab.reproduction.verdicts import t_interval
 
 __all__ = ["DPI", "draw_figures"]
@@ -361,7 +361,6 @@ def draw_figures(plan: ReproductionPlan, results: Mapping[tuple[str, str, str], 
     """Draws every figure of the reproduction into ``folder``; returns name -> PNG path.
     ``runs_root`` (the reproduction folder): with a ``band:`` variant, the band readings
     over the first seed's displacement map (:func:`band_readings_figure`)."""
-    from grainlab.reproduction.outputs import rate_family
 
     out = Path(folder)
     drawn: dict[str, Path] = {}

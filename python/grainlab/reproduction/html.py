@@ -1,5 +1,5 @@
 """``reproduction.html``: the verdict on every claim, one self-contained page
-(the report's building blocks, :mod:`grainlab.report.html`: figures as PNG
+(the report's building blocks, :mod:`grainlab._html`: figures as PNG
 ``data:`` URIs, no scripts, no network)."""
 
 from __future__ import annotations
@@ -9,8 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import grainlab
-from grainlab.io.results import write_text_atomic
-from grainlab.report.html import (
+from grainlab._html import (
     EmbeddedFigure,
     Markup,
     code_block,
@@ -23,6 +22,7 @@ from grainlab.report.html import (
     section,
     table,
 )
+from grainlab.io.results import write_text_atomic
 from grainlab.reproduction.runs import ReproductionPlan, variant_folder
 from grainlab.reproduction.verdicts import VERDICTS
 

@@ -46,11 +46,11 @@ from grainlab.reproduction.measures import (
     read_study_rows,
     read_study_rows_each,
 )
-from grainlab.reproduction.runs import ReproductionPlan, Variant
+from grainlab.reproduction.runs import ReproductionPlan, Variant, main_variant, rate_family
 from grainlab.reproduction.verdicts import VERDICTS, t_interval
 
 __all__ = ["CLAIMS_CSV", "CLAIMS_JSON", "CLAIMS_MD", "MEASURES_JSON", "Outputs", "comparison_pairs", "rate_convergence",
-           "fastest_converged_rate", "rate_family", "variant_comparison", "write_outputs"]
+           "fastest_converged_rate", "variant_comparison", "write_outputs"]
 
 CLAIMS_JSON = "claims.json"
 CLAIMS_CSV = "claims.csv"
@@ -181,28 +181,6 @@ def _counts(rows: Sequence[dict[str, Any]]) -> dict[str, int]:
 
 
 # ----------------------------------------------------------------------------- rates
-def rate_family(plan: ReproductionPlan) -> list[tuple[float, Variant]]:
-    """Biaxial variants that differ from the main one only in the strain rate, by rate."""
-    base = _main(plan, "biaxial")
-    if base is None:
-        return []
-
-    def without_rate(v: Variant) -> tuple[str, float]:
-        config = plan.biaxial_config(plan.variant(v.runs_variant), plan.seeds[0]).to_dict()
-        rate = config["shear"].pop("strain_rate")
-        return json.dumps(config, sort_keys=True), float(rate)
-
-    key, _ = without_rate(base)
-    family: dict[float, Variant] = {}
-    for v in plan.variants:
-        if v.kind != "biaxial":
-            continue
-        k, rate = without_rate(v)
-        if k == key:
-            family.setdefault(rate, v)
-    return sorted(family.items())
-
-
 def _band_difference(m: dict[str, Any] | None) -> float:
     """Band minus rest mean lambda (grains with >= 2 contacts) at the peak snapshot,
     the band's grains as the claims take them (:func:`~grainlab.reproduction.claims.band_measure`)."""
@@ -289,7 +267,7 @@ def comparison_pairs(plan: ReproductionPlan) -> list[tuple[Variant, Variant, lis
     """Each biaxial variant that runs its own configuration, other than the main one,
     with its reference: the biaxial variant whose configuration differs from it in the
     fewest keys (the main variant on a tie), and those keys."""
-    main = _main(plan, "biaxial")
+    main = main_variant(plan, "biaxial")
     own = [v for v in plan.variants if v.kind == "biaxial" and not v.source]
     if main is None or len(own) < 2:
         return []
@@ -337,15 +315,6 @@ def variant_comparison(measures: Sequence[dict[str, Any] | None], reference: Seq
 
 
 # ----------------------------------------------------------------------------- writing
-def _main(plan: ReproductionPlan, kind: str) -> Variant | None:
-    preferred = "paper" if kind == "biaxial" else "study"
-    kinds = ("biaxial",) if kind == "biaxial" else ("study",)
-    for v in plan.variants:
-        if v.name == preferred:
-            return v
-    return next((v for v in plan.variants if v.kind in kinds), None)
-
-
 def _csv_text(blocks: Sequence[dict[str, Any]]) -> str:
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
@@ -420,7 +389,7 @@ def write_outputs(plan: ReproductionPlan, out_dir: str | os.PathLike[str], *, wo
                     **variant_comparison(per_seed(v), per_seed(ref))}
                    for v, ref, keys in comparison_pairs(plan)]
 
-    main_biaxial, main_study = _main(plan, "biaxial"), _main(plan, "study")
+    main_biaxial, main_study = main_variant(plan, "biaxial"), main_variant(plan, "study")
     top = [b for b in blocks if b["variant"] in {v.name for v in (main_biaxial, main_study) if v}]
     top_claims = [row for b in top for row in b["claims"]]
     document = {

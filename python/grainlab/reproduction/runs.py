@@ -70,7 +70,9 @@ __all__ = [
     "RUNS_TABLE",
     "ReproductionPlan",
     "Variant",
+    "main_variant",
     "parse_variant",
+    "rate_family",
     "snapshot_strains",
 ]
 
@@ -470,3 +472,36 @@ def plan_from_args(seeds: int | None, variants: Sequence[str] | None, quick: boo
     if seeds is None:
         seeds = QUICK_SEEDS if quick else DEFAULT_SEEDS
     return ReproductionPlan.build(seeds, variants or (QUICK_VARIANTS if quick else DEFAULT_VARIANTS), quick)
+
+
+def main_variant(plan: ReproductionPlan, kind: str) -> Variant | None:
+    """The variant a kind's figures and tables lead with: the paper's (biaxial) or the
+    study's by name, else the first of its kind."""
+    preferred = "paper" if kind == "biaxial" else "study"
+    kinds = ("biaxial",) if kind == "biaxial" else ("study",)
+    for v in plan.variants:
+        if v.name == preferred:
+            return v
+    return next((v for v in plan.variants if v.kind in kinds), None)
+
+
+def rate_family(plan: ReproductionPlan) -> list[tuple[float, Variant]]:
+    """Biaxial variants that differ from the main one only in the strain rate, by rate."""
+    base = main_variant(plan, "biaxial")
+    if base is None:
+        return []
+
+    def without_rate(v: Variant) -> tuple[str, float]:
+        config = plan.biaxial_config(plan.variant(v.runs_variant), plan.seeds[0]).to_dict()
+        rate = config["shear"].pop("strain_rate")
+        return json.dumps(config, sort_keys=True), float(rate)
+
+    key, _ = without_rate(base)
+    family: dict[float, Variant] = {}
+    for v in plan.variants:
+        if v.kind != "biaxial":
+            continue
+        k, rate = without_rate(v)
+        if k == key:
+            family.setdefault(rate, v)
+    return sorted(family.items())
