@@ -32,6 +32,7 @@ LAYERS: dict[str, int] = {
     "grainlab._repr": 0,
     "grainlab._child": 0,
     "grainlab._html": 0,
+    "grainlab.columns": 0,
     "grainlab.paper": 0,
     # 1: the engine API and the snapshot data model
     "grainlab": 1,

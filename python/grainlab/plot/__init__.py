@@ -31,6 +31,7 @@ from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
 from grainlab._notebook import new_figure, prepare_notebook
+from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 from grainlab.plot.files import (
     FIGURE_DPI,
     PAGE_DPI,
@@ -364,12 +365,12 @@ def curve_tasks(timeseries: dict[str, Any]) -> list[FigureTask]:
     """The figures of :func:`biaxial_curves` as tasks for a :class:`~grainlab.plot.workers.FigurePool`."""
     from grainlab.plot.workers import FigureTask
 
-    eps = np.asarray(timeseries["axial_strain"], dtype=np.float64)
+    eps = np.asarray(timeseries[AXIAL_STRAIN], dtype=np.float64)
     figures = (
-        ("fig08_stress_ratio", "stress_ratio", r"stress ratio $\sigma_1/\sigma_3$", False, 1.0),
+        ("fig08_stress_ratio", STRESS_RATIO, r"stress ratio $\sigma_1/\sigma_3$", False, 1.0),
         (
             "fig10_volumetric_strain",
-            "volumetric_strain",
+            VOLUMETRIC_STRAIN,
             r"volumetric strain $\varepsilon_v$ (%, compression positive)",
             True,
             0.0,

@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
 from grainlab.analysis.peak import nearest_snapshot, peak_is_interior, peak_record
 from grainlab.analysis.stability import StabilityIndex
+from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.io.results import json_safe
 from grainlab.postprocess.band import BandNumbers, BandSearch, find_band
@@ -55,8 +56,8 @@ __all__ = [
 
 #: Time-series columns needed, and what for.
 REQUIRED_COLUMNS: dict[str, str] = {
-    "axial_strain": "the strain axis of Figs. 9 and 14",
-    "stress_ratio": "locating the peak",
+    AXIAL_STRAIN: "the strain axis of Figs. 9 and 14",
+    STRESS_RATIO: "locating the peak",
     "anisotropy": "a in Fig. 9",
     "force_anisotropy": "a_n in Fig. 9",
     "mean_stability_index": "Fig. 14",
@@ -275,7 +276,7 @@ def _timeseries(results: Results) -> dict[str, NDArray[np.float64]]:
                 f"{results.path}: the time series has no column {column!r} (needed for "
                 f"{purpose}); its columns are {sorted(ts)}"
             )
-    if len(ts["axial_strain"]) == 0:
+    if len(ts[AXIAL_STRAIN]) == 0:
         raise ValueError(f"{results.path}: the time series is empty")
     return ts
 
@@ -357,8 +358,8 @@ def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> 
     if not names:
         raise ValueError(f"{results.path}: the run has no snapshots")
     notes: list[str] = []
-    eps = np.asarray(ts["axial_strain"], dtype=np.float64)
-    q = np.asarray(ts["stress_ratio"], dtype=np.float64)
+    eps = np.asarray(ts[AXIAL_STRAIN], dtype=np.float64)
+    q = np.asarray(ts[STRESS_RATIO], dtype=np.float64)
     finite = np.isfinite(eps) & np.isfinite(q)
     if not finite.any():
         raise ValueError(

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from grainlab.columns import AXIAL_STRAIN
 from grainlab.plot.biaxial import (
     COUNT_CAP,
     BandOutline,
@@ -136,7 +137,7 @@ def _contact_counts(st: RunState) -> NDArray[np.float64]:
 
 def _series(analysis: RunAnalysis, which: str) -> FigureTask:
     ts = analysis.results.timeseries
-    eps, peak = ts["axial_strain"], analysis.numbers.peak_axial_strain
+    eps, peak = ts[AXIAL_STRAIN], analysis.numbers.peak_axial_strain
     if which == "anisotropy":
         return FigureTask("fig09_anisotropy", anisotropy_figure, (eps, ts["anisotropy"], ts["force_anisotropy"], peak))
     return FigureTask(

@@ -24,6 +24,7 @@ import grainlab
 from grainlab._html import EmbeddedFigure, fmt, is_usable_png
 from grainlab._mapping import flatten_keys
 from grainlab.analysis.peak import peak_record
+from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.paper import BIAXIAL_CLAIMS, STRAIN_RATE_PER_S, TABLE1
 from grainlab.postprocess.band import BandNumbers
@@ -52,7 +53,7 @@ __all__ = [
 ]
 
 #: Time-series columns without which there is no report.
-REQUIRED_COLUMNS: tuple[str, ...] = ("axial_strain", "stress_ratio", "volumetric_strain")
+REQUIRED_COLUMNS: tuple[str, ...] = (AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN)
 
 #: The macro-curve figures of the folder (drawn by :func:`grainlab.plot.biaxial_curves`).
 CURVE_FIGURES: tuple[str, ...] = ("fig08_stress_ratio", "fig10_volumetric_strain", "fig18_coordination_number")
@@ -322,7 +323,7 @@ def check_biaxial_folder(folder: Path) -> Results:
         raise ValueError(
             f"{results.path}: the time series lacks {missing} (needed for the macro curves and the angles)"
         )
-    if len(results.timeseries["axial_strain"]) == 0:
+    if len(results.timeseries[AXIAL_STRAIN]) == 0:
         raise ValueError(f"{results.path}: the time series is empty")
     if not results.snapshot_names:
         raise ValueError(f"{results.path}: the run has no snapshots")
@@ -330,7 +331,7 @@ def check_biaxial_folder(folder: Path) -> Results:
 
 
 def _peak_row(ts: dict[str, np.ndarray]) -> int:
-    return peak_record(ts["axial_strain"], ts["stress_ratio"])
+    return peak_record(ts[AXIAL_STRAIN], ts[STRESS_RATIO])
 
 
 def _file_figure(path: Path, key: str, title: str, caption: str) -> EmbeddedFigure | None:
@@ -386,7 +387,7 @@ def _paper_rows(r: BiaxialReport) -> list[tuple[str, str, str, str]]:
     )
     run["a_initial"] = fmt(_num(_val(states, "initial", "a")), 3)
     run["a_n_initial"] = fmt(_num(_val(states, "initial", "a_n")), 3)
-    eps = ts["axial_strain"]
+    eps = ts[AXIAL_STRAIN]
     if "anisotropy" in ts and np.nanmax(eps) >= 0.005:
         run["a_at_0.5"] = fmt(float(np.interp(0.005, eps, ts["anisotropy"])), 3)
     else:
@@ -395,7 +396,7 @@ def _paper_rows(r: BiaxialReport) -> list[tuple[str, str, str, str]]:
     run["z_peak"] = fmt(_num(s.get("coordination_number_at_peak")), 3)
     run["strain_at_peak"] = fmt(r.peak_strain, percent=True)
     run["peak_ratio"] = fmt(r.peak_ratio, 3)
-    ev = ts["volumetric_strain"]
+    ev = ts[VOLUMETRIC_STRAIN]
     run["volumetric"] = (
         f"largest contraction {fmt(float(np.nanmax(ev)), percent=True)}, "
         f"{fmt(float(ev[-1]), percent=True)} at {fmt(float(eps[-1]), percent=True)} "
@@ -550,7 +551,7 @@ def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float
 
     # the macro numbers and the angles
     k = _peak_row(ts)
-    eps, q, ev = ts["axial_strain"], ts["stress_ratio"], ts["volumetric_strain"]
+    eps, q, ev = ts[AXIAL_STRAIN], ts[STRESS_RATIO], ts[VOLUMETRIC_STRAIN]
     phi = mobilised_friction_angle(float(q[k]))
     dilation = fit_dilation(eps, ev, k, dilation_window)
     if dilation.reason:

@@ -22,6 +22,7 @@ from grainlab._html import (
     section,
     table,
 )
+from grainlab.columns import AXIAL_STRAIN
 from grainlab.report.band import ACCEPTANCE
 from grainlab.report.biaxial import BiaxialReport
 from grainlab.report.study import StudyReport, param_unit
@@ -164,7 +165,7 @@ def _fabric_states(r: BiaxialReport) -> Markup:
             (
                 role,
                 s.get("snapshot", ""),
-                fmt(_num(s.get("axial_strain")), percent=True),
+                fmt(_num(s.get(AXIAL_STRAIN)), percent=True),
                 fmt(_num(s.get("a")), 3),
                 fmt(_num(s.get("theta_a_deg")), 3),
                 fmt(_num(s.get("a_n")), 3),
@@ -278,7 +279,7 @@ def render_biaxial(r: BiaxialReport) -> str:
          f"{fmt(_num(s.get('inertial_number')), 3)} / {fmt(_num(s.get('inertial_number_mean_diameter')), 3)}"),
         ("density scaling factor I (Eq. 16 with p_y)", fmt(_num(s.get("density_scaling_factor")), 3)),
         ("time step", fmt(_num(s.get("time_step_s")), 4, unit="s")),
-        ("records", fmt(len(ts["axial_strain"]))),
+        ("records", fmt(len(ts[AXIAL_STRAIN]))),
         ("snapshots", ", ".join(res.snapshot_names)),
     ]
     grading_fig = EmbeddedFigure(

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from grainlab import paper
+from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
 from grainlab.reproduction.measures import END_WINDOW, relative_slope
 from grainlab.reproduction.verdicts import ProportionRule, SideRule, ValueRule
 
@@ -151,8 +152,8 @@ def _peak(m: Measures) -> Mapping[str, Any]:
 def _at(m: Measures, strain: float, tolerance: float = 0.001) -> Mapping[str, Any]:
     """The snapshot within ``tolerance`` of ``strain`` (KeyError when there is none)."""
     rows = _snaps(m)
-    best = min(rows, key=lambda r: abs(_num(r["axial_strain"]) - strain))
-    if abs(_num(best["axial_strain"]) - strain) > tolerance:
+    best = min(rows, key=lambda r: abs(_num(r[AXIAL_STRAIN]) - strain))
+    if abs(_num(best[AXIAL_STRAIN]) - strain) > tolerance:
         raise KeyError(f"no snapshot at {strain}")
     return best
 
@@ -175,12 +176,12 @@ def _band_share(row: Mapping[str, Any]) -> float:
 
 def _series(m: Measures, key: str) -> tuple[np.ndarray, np.ndarray]:
     rows = _snaps(m)
-    return (np.array([_num(r["axial_strain"]) for r in rows]), np.array([_num(r.get(key)) for r in rows]))
+    return (np.array([_num(r[AXIAL_STRAIN]) for r in rows]), np.array([_num(r.get(key)) for r in rows]))
 
 
 def _end_slope(m: Measures, key: str) -> float:
     eps, y = _series(m, key)
-    start = max(_num(_peak(m)["axial_strain"]), (1.0 - END_WINDOW) * float(np.nanmax(eps)))
+    start = max(_num(_peak(m)[AXIAL_STRAIN]), (1.0 - END_WINDOW) * float(np.nanmax(eps)))
     use = eps >= start - 1e-9
     return relative_slope(eps[use], y[use]) if use.sum() >= 2 else math.nan
 
@@ -400,7 +401,7 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
           ValueRule(-0.02, 0.02), lambda m: _end_slope(m, "mean_lambda")),
     Claim("lambda_tracks_stress_ratio", "the trend of mean lambda agrees with that of the stress ratio",
           "Sec. 6, Figs. 8, 14", None, "Pearson r of mean lambda and the stress ratio over the snapshots",
-          SideRule(+1), lambda m: _correlation(m, "mean_lambda", "stress_ratio")),
+          SideRule(+1), lambda m: _correlation(m, "mean_lambda", STRESS_RATIO)),
     Claim("lambda_tracks_anisotropy", "and with that of the fabric anisotropy", "Sec. 6, Figs. 9, 14; Sec. 7",
           None, "Pearson r of mean lambda and a over the snapshots", SideRule(+1),
           lambda m: _correlation(m, "mean_lambda", "a")),

@@ -23,6 +23,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from grainlab import plot
+from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 from grainlab.reproduction.runs import ReproductionPlan, rate_family, variant_folder
 from grainlab.reproduction.verdicts import t_interval
 
@@ -50,7 +51,7 @@ def _ensemble(runs: Sequence[Measures], key: Callable[[Mapping[str, Any]], float
         xs, ys = [], []
         for row in m["snapshots"]:
             value = key(row)
-            x = round(float(row["axial_strain"]), 4)
+            x = round(float(row[AXIAL_STRAIN]), 4)
             xs.append(x)
             ys.append(value)
             if math.isfinite(value):
@@ -116,15 +117,15 @@ def _macro_figure(runs: Sequence[Measures], title: str) -> Figure:
     with plot.paper_style():
         fig = Figure(figsize=(8.0, 3.2), layout="constrained")
         axes = fig.subplots(1, 2)
-        for key, ax, ylabel in (("stress_ratio", axes[0], r"$\sigma_1/\sigma_3$"),
-                                ("volumetric_strain", axes[1], "volumetric strain (%), compression +")):
-            scale = 100.0 if key == "volumetric_strain" else 1.0
-            grids = [np.asarray(m["macro"]["records"]["axial_strain"]) for m in runs]
+        for key, ax, ylabel in ((STRESS_RATIO, axes[0], r"$\sigma_1/\sigma_3$"),
+                                (VOLUMETRIC_STRAIN, axes[1], "volumetric strain (%), compression +")):
+            scale = 100.0 if key == VOLUMETRIC_STRAIN else 1.0
+            grids = [np.asarray(m["macro"]["records"][AXIAL_STRAIN]) for m in runs]
             grid = grids[int(np.argmin([g[-1] for g in grids]))]
             stack = []
             for m in runs:
                 rec = m["macro"]["records"]
-                eps, y = np.asarray(rec["axial_strain"]), np.asarray(rec[key], dtype=np.float64)
+                eps, y = np.asarray(rec[AXIAL_STRAIN]), np.asarray(rec[key], dtype=np.float64)
                 ax.plot(100 * eps, scale * y, color="0.6", linewidth=0.6)
                 stack.append(np.interp(grid, eps, y))
             values = np.array(stack)

@@ -77,6 +77,7 @@ from grainlab.analysis import (
     anisotropy_fourier,
 )
 from grainlab.analysis._util import finite_mean
+from grainlab.columns import AXIAL_STRAIN
 from grainlab.io.hdf5 import read_results
 from grainlab.reproduction.verdicts import t_interval
 from grainlab.samples import measurement_circle_porosity
@@ -472,8 +473,8 @@ def initial_state(run_dir: str | os.PathLike[str]) -> InitialState:
     snapshot = results.snapshot(first.name)
     area = None
     ts = results.timeseries
-    if "area_m2" in ts and "axial_strain" in ts and len(ts["area_m2"]):
-        area = float(ts["area_m2"][int(np.argmin(np.abs(ts["axial_strain"])))])
+    if "area_m2" in ts and AXIAL_STRAIN in ts and len(ts["area_m2"]):
+        area = float(ts["area_m2"][int(np.argmin(np.abs(ts[AXIAL_STRAIN])))])
     return snapshot_initial_state(snapshot, area=area)
 
 

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.analysis.peak import nearest_snapshot, peak_is_interior, peak_record
+from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 
 if TYPE_CHECKING:
     from grainlab.analysis.stability import StabilityIndex
@@ -87,9 +88,9 @@ def _r2(x: NDArray[np.float64], y: NDArray[np.float64]) -> float:
 
 def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
     """The macro numbers of a biaxial time series (compression positive)."""
-    eps = np.asarray(ts["axial_strain"], dtype=np.float64)
-    q = np.asarray(ts["stress_ratio"], dtype=np.float64)
-    ev = np.asarray(ts["volumetric_strain"], dtype=np.float64)
+    eps = np.asarray(ts[AXIAL_STRAIN], dtype=np.float64)
+    q = np.asarray(ts[STRESS_RATIO], dtype=np.float64)
+    ev = np.asarray(ts[VOLUMETRIC_STRAIN], dtype=np.float64)
     ok = np.isfinite(eps) & np.isfinite(q)
     rows = np.flatnonzero(ok)
     k = peak_record(eps, q)
@@ -110,8 +111,8 @@ def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
         "max_contraction": float(ev[contraction_row]),
         "axial_strain_at_max_contraction": float(eps[contraction_row]),
         "final_volumetric_strain": float(ev[rows[-1]]),
-        "records": {"axial_strain": eps[rows].tolist(), "stress_ratio": q[rows].tolist(),
-                    "volumetric_strain": ev[rows].tolist()},
+        "records": {AXIAL_STRAIN: eps[rows].tolist(), STRESS_RATIO: q[rows].tolist(),
+                    VOLUMETRIC_STRAIN: ev[rows].tolist()},
     }
 
 
@@ -185,8 +186,8 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
             readings[reading] = (labels, members)
         return readings[reading]
 
-    eps_ts = np.asarray(ts["axial_strain"], dtype=np.float64)
-    q_ts = np.asarray(ts["stress_ratio"], dtype=np.float64)
+    eps_ts = np.asarray(ts[AXIAL_STRAIN], dtype=np.float64)
+    q_ts = np.asarray(ts[STRESS_RATIO], dtype=np.float64)
     finite = np.isfinite(q_ts) & np.isfinite(eps_ts)
     common = {
         "run": str(Path(results.path)),
@@ -208,8 +209,8 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
         strain_members = bands("strain")[1] if opts["band"] != "strain" else None
         rows = []
         for i, (k, snap, band, member) in enumerate(zip(order, snaps, labels, members, strict=True)):
-            row = {"name": infos[k].name, "axial_strain": strains[k],
-                   "stress_ratio": float(np.interp(strains[k], eps_ts[finite], q_ts[finite]))}
+            row = {"name": infos[k].name, AXIAL_STRAIN: strains[k],
+                   STRESS_RATIO: float(np.interp(strains[k], eps_ts[finite], q_ts[finite]))}
             row.update(_snapshot_row(snaps[0], snap, band, member, peak_ids, opts))
             if member is not None:
                 row["band_from_strain"] = strains[order[member[1]]]

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.analysis import StabilityIndex, match_ids
+from grainlab.columns import AXIAL_STRAIN, AXIAL_STRESS_PA, STRESS_RATIO
 from grainlab.io.hdf5 import read_results
 from grainlab.io.vtk import contact_lines
 from grainlab.postprocess.band import find_band
@@ -35,7 +36,7 @@ from grainlab.postprocess.vtk import snapshot_arrays
 __all__ = ["CURVE_COLUMNS", "encode", "viewer_data"]
 
 #: Time series columns drawn as the stress–strain curve (x, y), the first pair the file has.
-CURVE_COLUMNS = (("axial_strain", "stress_ratio"), ("axial_strain", "axial_stress_pa"))
+CURVE_COLUMNS = ((AXIAL_STRAIN, STRESS_RATIO), (AXIAL_STRAIN, AXIAL_STRESS_PA))
 
 
 def encode(values: NDArray[Any], dtype: str) -> str:

@@ -15,6 +15,7 @@ import numpy as np
 import grainlab
 from grainlab._interrupt import raise_if_interrupted
 from grainlab.analysis.peak import peak_record
+from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 from grainlab.io.results import RESULTS_FILE, write_json_atomic, write_text_atomic
 from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
 from grainlab.protocols.biaxial.state import _Run
@@ -47,9 +48,9 @@ def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray]
     shear = run.shear_plan()
     first = {k: float(v[0]) for k, v in timeseries.items()}
     last = {k: float(v[-1]) for k, v in timeseries.items()}
-    k = peak_record(timeseries["axial_strain"], timeseries["stress_ratio"])
+    k = peak_record(timeseries[AXIAL_STRAIN], timeseries[STRESS_RATIO])
     peak = {name: float(timeseries[name][k])
-            for name in ("stress_ratio", "axial_strain", "coordination_number", "volumetric_strain")}
+            for name in (STRESS_RATIO, AXIAL_STRAIN, "coordination_number", VOLUMETRIC_STRAIN)}
     return {
         "n_particles": run.n_grains,
         "n_membrane_disks": run.consolidation.get("membrane_disks", 0),
@@ -62,18 +63,18 @@ def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray]
         "coordination_number_initial": first["coordination_number"],
         "coordination_number_at_peak": peak["coordination_number"],
         "coordination_number_final": last["coordination_number"],
-        "peak_stress_ratio": peak["stress_ratio"],
-        "axial_strain_at_peak": peak["axial_strain"],
-        "volumetric_strain_at_peak": peak["volumetric_strain"],
-        "final_stress_ratio": last["stress_ratio"],
-        "final_volumetric_strain": last["volumetric_strain"],
-        "max_contraction": float(np.max(timeseries["volumetric_strain"])),
+        "peak_stress_ratio": peak[STRESS_RATIO],
+        "axial_strain_at_peak": peak[AXIAL_STRAIN],
+        "volumetric_strain_at_peak": peak[VOLUMETRIC_STRAIN],
+        "final_stress_ratio": last[STRESS_RATIO],
+        "final_volumetric_strain": last[VOLUMETRIC_STRAIN],
+        "max_contraction": float(np.max(timeseries[VOLUMETRIC_STRAIN])),
         "strain_rate": shear.strain_rate,
         "inertial_number": shear.inertial_number,
         "inertial_number_mean_diameter": shear.inertial_number_mean_diameter,
         "density_scaling_factor": shear.density_scaling_factor,
         "time_step_s": run.consolidation["time_step_s"],
-        "records": len(timeseries["axial_strain"]),
+        "records": len(timeseries[AXIAL_STRAIN]),
         "wall_time_s": total_s,
         "wall_time_by_phase_s": dict(run.wall_time),
         "paper": PAPER_VALUES,

@@ -16,6 +16,7 @@ import numpy as np
 import grainlab
 from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
+from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
 from grainlab.io.hdf5 import ResultsWriter, snapshot_name
 from grainlab.protocols.biaxial.rates import (
     default_strain_rate,
@@ -215,7 +216,7 @@ def shear(
         key = str(steps[plan.next_record])
         if key in snap_steps:
             strain = snap_steps[key]
-            writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record["axial_strain"]),
+            writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record[AXIAL_STRAIN]),
                                   step=sim.step_count, walls=_walls(sim, run))
         boundary = _boundary(run)
         if isinstance(boundary, GrainBoundary):
@@ -225,13 +226,13 @@ def shear(
             if breach is not None:
                 bar.close()
                 raise BiaxialError(
-                    f"shearing stopped at {100 * record['axial_strain']:.2f} % axial strain: {breach}"
+                    f"shearing stopped at {100 * record[AXIAL_STRAIN]:.2f} % axial strain: {breach}"
                 )
         plan.next_record += 1
         raise_if_interrupted()
-        bar.update(100 * record["axial_strain"] - done_strain)
-        done_strain = 100 * record["axial_strain"]
-        bar.set_postfix_str(f"ratio {record['stress_ratio']:.2f}")
+        bar.update(100 * record[AXIAL_STRAIN] - done_strain)
+        done_strain = 100 * record[AXIAL_STRAIN]
+        bar.set_postfix_str(f"ratio {record[STRESS_RATIO]:.2f}")
         if checkpoint_due():
             run.wall_time["shear"] = time.perf_counter() - start
             save()

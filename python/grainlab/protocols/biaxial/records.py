@@ -9,6 +9,7 @@ import numpy as np
 
 from grainlab.analysis import fabric_summary
 from grainlab.analysis.stress import love_weber_stress
+from grainlab.columns import BIAXIAL
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols.biaxial.state import _boundary, _Run
 from grainlab.protocols.boundary import GrainBoundary, Membrane, sample_area
@@ -16,39 +17,8 @@ from grainlab.protocols.config import BiaxialConfig
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind, Snapshot
 
-TIMESERIES_UNITS = {
-    "anisotropy": "1",
-    "anisotropy_direction_rad": "rad",
-    "anisotropy_binned": "1",
-    "anisotropy_fourier": "1",
-    "force_anisotropy": "1",
-    "force_anisotropy_binned": "1",
-    "mean_stability_index": "1",
-    "mean_stability_index_all": "1",
-    "mechanical_coordination_number": "1",
-    "step": "1",
-    "time_s": "s",
-    "axial_strain": "1",
-    "axial_stress_pa": "Pa",
-    "confining_pressure_pa": "Pa",
-    "confining_stress_felt_pa": "Pa",
-    "stress_ratio": "1",
-    "stress_ratio_mobilised": "1",
-    "volumetric_strain": "1",
-    "area_m2": "m^2",
-    "height_m": "m",
-    "love_weber_xx_pa": "Pa",
-    "love_weber_yy_pa": "Pa",
-    "love_weber_xy_pa": "Pa",
-    "coordination_number": "1",
-    "unbalanced_force_ratio": "1",
-    "kinetic_energy_j": "J",
-    "elastic_energy_j": "J",
-    "friction_dissipated_j": "J",
-    "damping_dissipated_j": "J",
-    "boundary_work_j": "J",
-    "wall_work_j": "J",
-}
+#: Column -> unit of the shearing's records (:data:`grainlab.columns.BIAXIAL`).
+TIMESERIES_UNITS = BIAXIAL.units()
 
 
 

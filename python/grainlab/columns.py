@@ -1,0 +1,197 @@
+"""The time-series columns the protocols record, in one place: each column's
+name, unit and meaning (:class:`Column`), and the columns of each test
+(:class:`Columns`: :data:`BIAXIAL`, :data:`OEDOMETER`).
+
+A :class:`Column` *is* its name (a ``str``), so ``timeseries[AXIAL_STRAIN]``
+reads the column from a results file, a CSV or a record, while
+``AXIAL_STRAIN.unit`` and ``AXIAL_STRAIN.meaning`` say what it holds. The
+protocols record with these names, and postprocess, the report, the viewer
+and the reproduction read with them; ``docs/file-formats.md``'s table of the
+columns is made from this module (``python -m grainlab.columns
+docs/file-formats.md`` writes it; ``tests/test_columns.py`` keeps it so).
+
+>>> AXIAL_STRAIN, AXIAL_STRAIN.unit
+('axial_strain', '1')
+>>> BIAXIAL.units()[AXIAL_STRESS_PA]
+'Pa'
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+__all__ = [
+    "AXIAL_STRAIN",
+    "AXIAL_STRESS_PA",
+    "BIAXIAL",
+    "COORDINATION_NUMBER",
+    "Column",
+    "Columns",
+    "FABRIC",
+    "HORIZONTAL_STRESS_PA",
+    "LATERAL_STRESS_RATIO",
+    "OEDOMETER",
+    "OVERCONSOLIDATION_RATIO",
+    "STRESS_RATIO",
+    "VERTICAL_STRESS_PA",
+    "VOLUMETRIC_STRAIN",
+]
+
+
+class Column(str):
+    """One time-series column: the string is its name; ``unit`` is its unit (``"1"``
+    for strains, ratios and counts) and ``meaning`` what it holds, in a line."""
+
+    unit: str
+    meaning: str
+
+    def __new__(cls, name: str, unit: str, meaning: str) -> Column:
+        column = super().__new__(cls, name)
+        column.unit = unit
+        column.meaning = meaning
+        return column
+
+    def __reduce__(self) -> tuple[type[Column], tuple[str, str, str]]:
+        return (Column, (str(self), self.unit, self.meaning))
+
+
+class Columns:
+    """The columns one test records, in the order a file lists them."""
+
+    def __init__(self, kind: str, *groups: tuple[Column, ...]) -> None:
+        self.kind = kind
+        self.columns: tuple[Column, ...] = tuple(c for group in groups for c in group)
+        names = [str(c) for c in self.columns]
+        if len(set(names)) != len(names):
+            raise ValueError(f"{kind}: a column is listed twice in {names}")
+        self._by_name = dict(zip(names, self.columns, strict=True))
+
+    def __iter__(self) -> Iterator[Column]:
+        return iter(self.columns)
+
+    def __len__(self) -> int:
+        return len(self.columns)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._by_name
+
+    def __getitem__(self, name: str) -> Column:
+        return self._by_name[name]
+
+    def units(self) -> dict[str, str]:
+        """Column name -> unit, as a results file stores them."""
+        return {str(c): c.unit for c in self.columns}
+
+    def markdown_table(self) -> str:
+        """The columns as a Markdown table (name, unit, meaning)."""
+        rows = ["| column | unit | meaning |", "| --- | --- | --- |"]
+        rows += [f"| `{c}` | {c.unit} | {c.meaning} |" for c in self.columns]
+        return "\n".join(rows)
+
+
+# ---- every test's ------------------------------------------------------------------
+STEP = Column("step", "1", "engine step count (int64)")
+TIME_S = Column("time_s", "s", "simulated time")
+AXIAL_STRAIN = Column("axial_strain", "1", "axial strain eps_1 = (H0 - H) / H0, compression positive")
+VOLUMETRIC_STRAIN = Column("volumetric_strain", "1", "volumetric strain (A0 - A) / A0, compression positive")
+AXIAL_STRESS_PA = Column("axial_stress_pa", "Pa", "axial stress sigma_1 on the platens")
+AREA_M2 = Column("area_m2", "m^2", "sample area")
+HEIGHT_M = Column("height_m", "m", "sample height between the platens")
+LOVE_WEBER = (
+    Column("love_weber_xx_pa", "Pa", "Love-Weber stress of the grains, xx"),
+    Column("love_weber_yy_pa", "Pa", "Love-Weber stress of the grains, yy"),
+    Column("love_weber_xy_pa", "Pa", "Love-Weber stress of the grains, xy"),
+)
+COORDINATION_NUMBER = Column("coordination_number", "1", "Z = 2 x grain-grain contacts / grains")
+UNBALANCED_FORCE_RATIO = Column("unbalanced_force_ratio", "1", "mean unbalanced force over mean contact force")
+#: The engine's energy ledger (J per m of thickness; docs/contact-law.md, "Energy bookkeeping").
+ENERGY = (
+    Column("kinetic_energy_j", "J", "kinetic energy of the particles"),
+    Column("elastic_energy_j", "J", "energy stored in the contact and bond springs"),
+    Column("friction_dissipated_j", "J", "dissipated by frictional slip since step 0"),
+    Column("damping_dissipated_j", "J", "dissipated by local damping since step 0"),
+    Column("boundary_work_j", "J", "work of the follower loads (the membrane's pressure) since step 0"),
+    Column("wall_work_j", "J", "work of the walls on the particles since step 0"),
+)
+#: The fabric of every record (grainlab.analysis.fabric_summary, in its order, but its Z: a
+#: record's own counts grain-grain contacts only).
+FABRIC = (
+    Column("mechanical_coordination_number", "1", "Z of the grains with >= 2 contacts (rattlers out)"),
+    Column("mean_stability_index", "1", "mean lambda of the grains with >= 2 contacts (paper Sec. 5)"),
+    Column("mean_stability_index_all", "1", "mean lambda of every grain (0 and 1 contact at lambda = 1)"),
+    Column("anisotropy", "1", "contact-normal anisotropy a (exact estimate, paper Eq. 7)"),
+    Column("anisotropy_direction_rad", "rad", "principal direction of the contact normals"),
+    Column("anisotropy_binned", "1", "contact-normal anisotropy, Eq. 7 on 18 bins"),
+    Column("anisotropy_fourier", "1", "the exact estimate under its earlier name"),
+    Column("force_anisotropy", "1", "normal-force anisotropy a_n (exact estimate, Eq. 8)"),
+    Column("force_anisotropy_binned", "1", "normal-force anisotropy, Eq. 8 on 18 bins"),
+)
+
+# ---- the biaxial test's ------------------------------------------------------------
+CONFINING_PRESSURE_PA = Column("confining_pressure_pa", "Pa", "confining pressure sigma_3 applied")
+CONFINING_STRESS_FELT_PA = Column("confining_stress_felt_pa", "Pa", "lateral stress the grains feel")
+STRESS_RATIO = Column("stress_ratio", "1", "principal stress ratio sigma_1 / sigma_3")
+STRESS_RATIO_MOBILISED = Column("stress_ratio_mobilised", "1", "(sigma_1 - sigma_3) / (sigma_1 + sigma_3)")
+
+#: The biaxial test's records (grainlab.protocols.biaxial.records).
+BIAXIAL = Columns(
+    "biaxial",
+    (STEP, TIME_S, AXIAL_STRAIN, AXIAL_STRESS_PA, CONFINING_PRESSURE_PA, CONFINING_STRESS_FELT_PA,
+     STRESS_RATIO, STRESS_RATIO_MOBILISED, VOLUMETRIC_STRAIN, AREA_M2, HEIGHT_M),
+    LOVE_WEBER,
+    (COORDINATION_NUMBER, UNBALANCED_FORCE_RATIO),
+    ENERGY,
+    FABRIC,
+)
+
+# ---- the oedometer's ---------------------------------------------------------------
+VERTICAL_STRESS_PA = Column("vertical_stress_pa", "Pa", "vertical stress sigma_v on the platens")
+HORIZONTAL_STRESS_PA = Column("horizontal_stress_pa", "Pa", "horizontal stress sigma_h on the fixed side walls")
+LATERAL_STRESS_RATIO = Column("lateral_stress_ratio", "1", "K = sigma_h / sigma_v (K0 on first loading)")
+TARGET_VERTICAL_STRESS_PA = Column("target_vertical_stress_pa", "Pa", "the load step's vertical stress")
+MAX_VERTICAL_STRESS_PA = Column("max_vertical_stress_pa", "Pa", "largest vertical stress reached so far")
+OVERCONSOLIDATION_RATIO = Column("overconsolidation_ratio", "1", "OCR = max sigma_v so far / sigma_v")
+POROSITY = Column("porosity", "1", "porosity of the grains in the box")
+VOID_RATIO = Column("void_ratio", "1", "void ratio e = n / (1 - n)")
+
+#: The oedometer's records, one per load step at equilibrium (grainlab.protocols.oedometer).
+OEDOMETER = Columns(
+    "oedometer",
+    (STEP, TIME_S, TARGET_VERTICAL_STRESS_PA, VERTICAL_STRESS_PA, HORIZONTAL_STRESS_PA, LATERAL_STRESS_RATIO,
+     MAX_VERTICAL_STRESS_PA, OVERCONSOLIDATION_RATIO, AXIAL_STRAIN, VOLUMETRIC_STRAIN, POROSITY, VOID_RATIO,
+     HEIGHT_M, AREA_M2),
+    LOVE_WEBER,
+    (COORDINATION_NUMBER, UNBALANCED_FORCE_RATIO),
+    ENERGY,
+    FABRIC,
+)
+
+#: Every test's columns, by the results file's ``kind``.
+BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER}
+
+
+_BLOCK = re.compile(
+    r"(<!-- generated from python/grainlab/columns.py: (\w+) -->\n)(.*?)(<!-- end of generated block -->)", re.S
+)
+
+
+def update_markdown(text: str) -> str:
+    """``text`` with each block ``<!-- generated from python/grainlab/columns.py: KIND -->``
+    ... ``<!-- end of generated block -->`` made again from :data:`BY_KIND`'s table of KIND."""
+
+    def table(match: re.Match[str]) -> str:
+        kind = match.group(2)
+        if kind not in BY_KIND:
+            raise ValueError(f"a generated block names the test {kind!r}; known: {', '.join(sorted(BY_KIND))}")
+        return match.group(1) + BY_KIND[kind].markdown_table() + "\n" + match.group(4)
+
+    return _BLOCK.sub(table, text)
+
+
+if __name__ == "__main__":  # python -m grainlab.columns docs/file-formats.md
+    for name in sys.argv[1:]:
+        page = Path(name)
+        page.write_text(update_markdown(page.read_text(encoding="utf-8")), encoding="utf-8")
