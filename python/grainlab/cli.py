@@ -18,6 +18,7 @@ import grainlab
 #: Subcommand modules, in the order ``grainlab --help`` lists them.
 COMMAND_MODULES: tuple[str, ...] = (
     "grainlab.commands.biaxial",
+    "grainlab.commands.run",
     "grainlab.commands.analyze",
     "grainlab.commands.demo",
     "grainlab.commands.study",

@@ -27,8 +27,10 @@ Example
 from __future__ import annotations
 
 import contextlib
+import csv
 import errno
 import fcntl
+import io
 import json
 import math
 import os
@@ -40,6 +42,7 @@ from typing import Any
 import numpy as np
 
 __all__ = [
+    "timeseries_csv",
     "CHECKPOINT_FILE",
     "RESULTS_FILE",
     "atomic_path",
@@ -154,6 +157,19 @@ def write_text_atomic(path: str | os.PathLike[str], text: str, *, encoding: str 
     """
     data = text.encode(encoding)
     return _write_atomic(path, lambda tmp: tmp.write_bytes(data))
+
+
+def timeseries_csv(timeseries: Mapping[str, Any]) -> str:
+    """A time series (column -> 1-D array, all of one length) as CSV text: a header of
+    the column names, then one row per record, each value as Python's ``repr`` of
+    the float (exact: it reads back to the same bits)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer)
+    names = list(timeseries)
+    writer.writerow(names)
+    for row in zip(*(timeseries[k] for k in names), strict=True):
+        writer.writerow([repr(float(v)) for v in row])
+    return buffer.getvalue()
 
 
 def json_safe(value: Any, *, nan: str = "null", where: str = "value") -> Any:

@@ -43,6 +43,7 @@ _UNITS: dict[str, dict[str, float]] = {
     "density": {"kg/m^3": 1.0, "kg/m3": 1.0},
     "number": {"": 1.0},
     "time": {"s": 1.0, "min": 60.0, "h": 3600.0},
+    "angle": {"rad": 1.0, "deg": math.pi / 180.0},
 }
 
 
@@ -198,6 +199,7 @@ _LIST_ITEMS: dict[str, tuple[str, Field]] = {
     "strain_list": ("strains", Field("strain", 0.0, "", minimum=0.0, maximum=0.5)),
     "length_list": ("lengths", Field("length", 0.0, "", minimum=0.0, exclusive_minimum=True)),
     "percent_list": ("percentages", Field("number", 0.0, "", minimum=0.0, maximum=100.0)),
+    "stress_list": ("stresses", Field("stress", 0.0, "", minimum=0.0, exclusive_minimum=True)),
 }
 
 #: Overrides of ``--quick``: a small sample of a few hundred disks, for demos and CI.
@@ -302,6 +304,9 @@ class Config:
     @classmethod
     def from_dict(cls, nested: Mapping[str, Any], schema: str = "biaxial") -> Config:
         """A stored configuration resolved again (keys added since take their defaults)."""
+        if schema not in SCHEMAS:
+            raise ConfigError(f"no configuration schema {schema!r} (import grainlab.protocols.registry); "
+                              f"known: {', '.join(sorted(SCHEMAS))}")
         return SCHEMAS[schema].resolve(overrides=flatten_keys(nested))
 
 
@@ -454,7 +459,17 @@ def _check_consistency(v: dict[str, Any], given: AbstractSet[str] = frozenset())
         )
 
 
-#: The configuration schemas of the protocols, by name (a protocol registers its own).
+#: The configuration schemas of the protocols, by name (a protocol registers its own
+#: with :func:`register_schema`; :mod:`grainlab.protocols.registry` imports every protocol).
 SCHEMAS: dict[str, ConfigSchema] = {
     "biaxial": ConfigSchema("biaxial", FIELDS, QUICK, _check_consistency),
 }
+
+
+def register_schema(schema: ConfigSchema) -> ConfigSchema:
+    """Adds ``schema`` to :data:`SCHEMAS` under its name (a protocol's own module does,
+    when it is imported); returns it."""
+    known = SCHEMAS.setdefault(schema.name, schema)
+    if known is not schema:
+        raise ValueError(f"protocol configuration {schema.name!r} is registered already")
+    return schema

@@ -4,7 +4,7 @@ their configuration schemas. The campaigns (``grainlab study``, ``sweep``,
 registers here and in :data:`grainlab.protocols.config.SCHEMAS`.
 
 >>> sorted(PROTOCOLS)
-['biaxial']
+['biaxial', 'oedometer']
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from typing import Any
 
 from grainlab.protocols.biaxial.protocol import BiaxialProtocol
 from grainlab.protocols.config import SCHEMAS, Config
+from grainlab.protocols.oedometer.protocol import OedometerProtocol
 from grainlab.protocols.runner import Protocol, RunResult, run_protocol
 
 __all__ = ["PROTOCOLS", "resolve_config", "run_named"]
@@ -23,6 +24,7 @@ __all__ = ["PROTOCOLS", "resolve_config", "run_named"]
 #: Protocol name -> its class (the name is also the results file's ``kind``).
 PROTOCOLS: dict[str, type[Protocol[Any, Any, Any]]] = {
     BiaxialProtocol.name: BiaxialProtocol,
+    OedometerProtocol.name: OedometerProtocol,
 }
 
 

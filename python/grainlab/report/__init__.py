@@ -49,7 +49,8 @@ __all__ = [
 #: Name of the report in a results folder.
 REPORT_FILE = "report.html"
 
-Kind = Literal["biaxial", "study"]
+#: What a results folder holds: a run of a protocol (its results file's ``kind``) or a study.
+Kind = Literal["biaxial", "oedometer", "study"]
 
 
 class ReportError(ValueError):
@@ -57,11 +58,12 @@ class ReportError(ValueError):
 
 
 def detect_kind(folder: str | os.PathLike[str]) -> tuple[Path, Kind]:
-    """``(folder, "biaxial" | "study")`` of a results folder, or :class:`ReportError`.
+    """``(folder, kind)`` of a results folder, or :class:`ReportError`.
 
-    A biaxial folder holds a finished ``run.h5``; a study folder holds
+    A run's folder holds a finished ``run.h5``, whose ``kind`` attribute names
+    its test (``"biaxial"``, ``"oedometer"``); a study folder holds
     ``study.csv``. A path to either file stands for its folder. Nothing is
-    read beyond the folder listing, so this fails before any work.
+    read beyond the folder listing and that attribute, so this fails before any work.
     """
     path = Path(folder)
     if path.is_file() and path.name in ("run.h5", "study.csv"):
@@ -71,11 +73,17 @@ def detect_kind(folder: str | os.PathLike[str]) -> tuple[Path, Kind]:
     if not path.is_dir():
         raise ReportError(f"{path}: not a folder (give a biaxial results folder or a study folder)")
     if (path / "run.h5").exists():
-        return path, "biaxial"
+        from grainlab.io.hdf5 import results_kind
+
+        kind = results_kind(path / "run.h5") or "biaxial"
+        if kind not in ("biaxial", "oedometer"):
+            raise ReportError(f"{path}: a run of kind {kind!r}, which grainlab report does not cover "
+                              "(it covers biaxial and oedometer runs and the packing study)")
+        return path, "biaxial" if kind == "biaxial" else "oedometer"
     if (path / "run.h5.partial").exists():
         raise ReportError(
             f"{path}: the run has not finished (only run.h5.partial); continue it with "
-            f"grainlab biaxial --out {path} --resume, then make the report"
+            f"grainlab run KIND --out {path} --resume (grainlab biaxial for a biaxial run), then make the report"
         )
     if (path / "study.csv").exists():
         return path, "study"
@@ -98,7 +106,7 @@ def write_report(
     redraw: bool = False,
     out: str | os.PathLike[str] | None = None,
 ) -> Path:
-    """Writes ``report.html`` for the biaxial run or study in ``folder``; returns its path.
+    """Writes ``report.html`` for the run (biaxial, oedometer) or study in ``folder``; returns its path.
 
     Figures missing from the folder are drawn into it first (all of them
     with ``redraw``); ``out`` writes the page elsewhere than
@@ -112,6 +120,10 @@ def write_report(
         from grainlab.report.render import render_biaxial
 
         text = render_biaxial(gather_biaxial(path, redraw=redraw))
+    elif kind == "oedometer":
+        from grainlab.report.oedometer import gather_oedometer, render_oedometer
+
+        text = render_oedometer(gather_oedometer(path, redraw=redraw))
     else:
         from grainlab.report.render import render_study
         from grainlab.report.study import gather_study

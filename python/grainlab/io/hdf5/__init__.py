@@ -82,7 +82,7 @@ from grainlab.io.hdf5.errors import (
     ResultsFileError,
     UnsupportedVersionError,
 )
-from grainlab.io.hdf5.reader import Results, read_hdf5_snapshot, read_results
+from grainlab.io.hdf5.reader import Results, read_hdf5_snapshot, read_results, results_kind
 from grainlab.io.hdf5.snapshot import SnapshotInfo, snapshot_name
 from grainlab.io.hdf5.writer import ResultsWriter
 
@@ -105,6 +105,7 @@ __all__ = [
     "read_checkpoint",
     "read_hdf5_snapshot",
     "read_results",
+    "results_kind",
     "snapshot_name",
     "write_checkpoint",
 ]

@@ -231,6 +231,14 @@ def read_results(path: str | os.PathLike[str], *, allow_incomplete: bool = False
         return reader.read_results(f, Path(f.filename), allow_incomplete)
 
 
+def results_kind(path: str | os.PathLike[str]) -> str:
+    """The ``kind`` of a results file (the protocol that wrote it: ``"biaxial"``,
+    ``"oedometer"``, ...), read from its attributes alone; the reader's errors as
+    :func:`read_results` raises them, but for an unfinished run, whose kind is read too."""
+    with _open_results(path, True) as (f, _):
+        return _attr_str(f.attrs, "kind", "")
+
+
 def _select(
     path: Path,
     infos: tuple[SnapshotInfo, ...],

@@ -4,8 +4,6 @@
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -16,7 +14,7 @@ import grainlab
 from grainlab._interrupt import raise_if_interrupted
 from grainlab.analysis.peak import peak_record
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
-from grainlab.io.results import RESULTS_FILE, write_json_atomic, write_text_atomic
+from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
 from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
 from grainlab.protocols.biaxial.state import _Run
 from grainlab.protocols.config import BiaxialConfig
@@ -82,16 +80,6 @@ def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray]
     }
 
 
-def _csv(timeseries: dict[str, np.ndarray]) -> str:
-    buffer = io.StringIO()
-    writer = csv.writer(buffer)
-    names = list(timeseries)
-    writer.writerow(names)
-    for row in zip(*(timeseries[k] for k in names), strict=True):
-        writer.writerow([repr(float(v)) for v in row])
-    return buffer.getvalue()
-
-
 def _figures(timeseries: dict[str, np.ndarray], out: Path) -> None:
     """Starts the macro curves (Figs. 8, 10, 18) in the current figure pool: they are
     drawn while the snapshots are measured, and finished when the pool closes."""
@@ -116,7 +104,7 @@ def _write_outputs(out: Path) -> dict[str, Any]:
     results = read_results(out / RESULTS_FILE)
     raise_if_interrupted()  # a Ctrl-C that h5py's clean-up swallowed stops the run here
     summary = dict(results.summary)
-    write_text_atomic(out / "timeseries.csv", _csv(results.timeseries))
+    write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
     with figure_pool(tasks=3 + len(figures.FIGURES), page_copies=True):
         _figures(results.timeseries, out)
         # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers

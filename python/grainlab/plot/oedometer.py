@@ -1,0 +1,63 @@
+"""The oedometer's figures, from plain data (a time series as column -> array):
+the lateral stress ratio K along the load path, and the compression curve."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
+
+from grainlab.columns import LATERAL_STRESS_RATIO, VERTICAL_STRESS_PA, VOID_RATIO
+from grainlab.plot.files import paper_style
+
+__all__ = ["compression_figure", "lateral_stress_ratio_figure"]
+
+
+def _branches(timeseries: Mapping[str, ArrayLike], loading: ArrayLike, y: str) -> list[tuple[str, str, np.ndarray,
+                                                                                                np.ndarray]]:
+    sigma_v = np.asarray(timeseries[VERTICAL_STRESS_PA], dtype=np.float64) / 1e3
+    values = np.asarray(timeseries[y], dtype=np.float64)
+    first = np.zeros(len(sigma_v), dtype=bool)
+    first[np.asarray(loading, dtype=np.int64)] = True
+    later = np.flatnonzero(~first)
+    if len(later) and later[0] > 0:  # the unloading line starts where the loading turned
+        later = np.r_[later[0] - 1, later]
+    return [("loading", "o-", sigma_v[first], values[first]),
+            ("unloading", "s--", sigma_v[later], values[later])]
+
+
+def lateral_stress_ratio_figure(timeseries: Mapping[str, ArrayLike], loading: ArrayLike, k0_jaky: float | None,
+                                friction_angle_deg: float | None) -> Figure:
+    """K = sigma_h / sigma_v against sigma_v (log axis), loading and unloading, with
+    Jaky's 1 - sin phi' as a line when a friction angle is given."""
+    with paper_style():
+        fig = Figure(figsize=(3.5, 3.0), layout="constrained")
+        ax = fig.add_subplot()
+        for label, style, x, y in _branches(timeseries, loading, LATERAL_STRESS_RATIO):
+            if len(x):
+                ax.plot(x, y, style, markersize=3, label=label)
+        if k0_jaky is not None:
+            ax.axhline(k0_jaky, color="0.4", linewidth=0.8, linestyle=":",
+                       label=f"Jaky, phi' = {friction_angle_deg:.1f} deg")
+        ax.set_xscale("log")
+        ax.set_xlabel(r"vertical stress $\sigma_v$ (kPa)")
+        ax.set_ylabel(r"$K = \sigma_h / \sigma_v$")
+        ax.legend(frameon=False)
+    return fig
+
+
+def compression_figure(timeseries: Mapping[str, ArrayLike], loading: ArrayLike) -> Figure:
+    """Void ratio against sigma_v (log axis): the compression and swelling lines."""
+    with paper_style():
+        fig = Figure(figsize=(3.5, 3.0), layout="constrained")
+        ax = fig.add_subplot()
+        for label, style, x, y in _branches(timeseries, loading, VOID_RATIO):
+            if len(x):
+                ax.plot(x, y, style, markersize=3, label=label)
+        ax.set_xscale("log")
+        ax.set_xlabel(r"vertical stress $\sigma_v$ (kPa)")
+        ax.set_ylabel("void ratio e")
+        ax.legend(frameon=False)
+    return fig

@@ -1,0 +1,134 @@
+"""A finished oedometer run's outputs: the summary (K0 on first loading by the
+rule below, K against the overconsolidation ratio on unloading, Jaky's and
+Mayne-Kulhawy's values when a friction angle is given), ``timeseries.csv``,
+``summary.json`` and the figures, all from ``run.h5``.
+
+K0 on first loading is the slope of sigma_h against sigma_v, fitted by least
+squares over the first-loading records whose sigma_v is at least
+:data:`K0_FROM_STRESS_RATIO` times the consolidation stress (the records
+nearer the isotropic start still carry its K = 1); with fewer than two such
+records, over every first-loading record but the start. The rule was fixed
+before any run was seen.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import grainlab
+from grainlab._interrupt import raise_if_interrupted
+from grainlab.columns import (
+    HORIZONTAL_STRESS_PA,
+    LATERAL_STRESS_RATIO,
+    OVERCONSOLIDATION_RATIO,
+    VERTICAL_STRESS_PA,
+)
+from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
+from grainlab.protocols.config import Config
+from grainlab.protocols.oedometer.state import OedometerRun
+from grainlab.protocols.runner import RunResult
+
+__all__ = ["K0_FROM_STRESS_RATIO", "OedometerResult", "first_loading", "k0_loading", "summarise", "write_outputs"]
+
+#: The first-loading records that K0 is fitted on start at this many times sigma_0.
+K0_FROM_STRESS_RATIO = 4.0
+
+
+@dataclass(frozen=True)
+class OedometerResult(RunResult):
+    """What ``grainlab run oedometer`` reports: the summary and where the files are."""
+
+    def one_line(self) -> str:
+        s = self.summary
+        jaky = "" if s["k0_jaky"] is None else f" (Jaky {s['k0_jaky']:.3f})"
+        return (
+            f"grainlab oedometer: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}; K0 "
+            f"{s['k0_loading']:.3f}{jaky} on loading to {s['max_vertical_stress_pa'] / 1e3:.0f} kPa; "
+            f"K {s['lateral_stress_ratio_final']:.3f} at OCR {s['overconsolidation_ratio_final']:.2f}; "
+            f"{s['wall_time_s']:.1f} s -> {self.out_dir}"
+        )
+
+
+def first_loading(timeseries: dict[str, np.ndarray]) -> np.ndarray:
+    """Indices of the first-loading records: each at a vertical stress above every earlier one's."""
+    sigma_v = np.asarray(timeseries[VERTICAL_STRESS_PA], dtype=np.float64)
+    previous = np.maximum.accumulate(np.r_[-np.inf, sigma_v[:-1]])
+    return np.flatnonzero(sigma_v > previous)
+
+
+def k0_loading(timeseries: dict[str, np.ndarray], consolidation_pressure_pa: float) -> float:
+    """K0 on first loading by the module's rule (NaN with fewer than two records to fit)."""
+    rows = first_loading(timeseries)
+    sigma_v = np.asarray(timeseries[VERTICAL_STRESS_PA], dtype=np.float64)[rows]
+    sigma_h = np.asarray(timeseries[HORIZONTAL_STRESS_PA], dtype=np.float64)[rows]
+    far = sigma_v >= K0_FROM_STRESS_RATIO * consolidation_pressure_pa * (1.0 - 1e-9)
+    if np.count_nonzero(far) < 2:
+        far = np.arange(len(rows)) > 0
+    if np.count_nonzero(far) < 2:
+        return math.nan
+    slope, _ = np.polyfit(sigma_v[far], sigma_h[far], 1)
+    return float(slope)
+
+
+def summarise(run: OedometerRun, config: Config, timeseries: dict[str, np.ndarray],
+              total_s: float) -> dict[str, Any]:
+    """The run's summary, as ``run.h5`` and ``summary.json`` store it."""
+    k = np.asarray(timeseries[LATERAL_STRESS_RATIO], dtype=np.float64)
+    ocr = np.asarray(timeseries[OVERCONSOLIDATION_RATIO], dtype=np.float64)
+    loading = set(first_loading(timeseries).tolist())
+    phi = config["oedometer.friction_angle"]
+    jaky = None if phi == "auto" else 1.0 - math.sin(phi)
+    unloading = [
+        {"overconsolidation_ratio": float(ocr[r]), "lateral_stress_ratio": float(k[r]),
+         "mayne_kulhawy": None if jaky is None else jaky * float(ocr[r]) ** math.sin(phi)}
+        for r in range(len(k)) if r not in loading
+    ]
+    return {
+        "n_particles": run.n_grains,
+        "porosity_initial": float(timeseries["porosity"][0]),
+        "void_ratio_initial": float(timeseries["void_ratio"][0]),
+        "porosity_after_consolidation": run.consolidation["porosity"],
+        "coordination_number_initial": float(timeseries["coordination_number"][0]),
+        "k0_loading": k0_loading(timeseries, config["consolidation.pressure"]),
+        "k0_rule": f"slope of sigma_h on sigma_v over first loading at sigma_v >= {K0_FROM_STRESS_RATIO:g} sigma_0",
+        "max_vertical_stress_pa": run.max_vertical_stress_pa,
+        "void_ratio_at_max_stress": float(timeseries["void_ratio"][int(np.argmax(timeseries[VERTICAL_STRESS_PA]))]),
+        "lateral_stress_ratio_final": float(k[-1]),
+        "overconsolidation_ratio_final": float(ocr[-1]),
+        "unloading": unloading,
+        "friction_angle_deg": None if jaky is None else math.degrees(phi),
+        "k0_jaky": jaky,
+        "time_step_s": run.consolidation["time_step_s"],
+        "records": len(k),
+        "wall_time_s": total_s,
+        "wall_time_by_phase_s": dict(run.wall_time),
+        "grainlab_version": grainlab.__version__,
+    }
+
+
+def write_outputs(out: Path) -> dict[str, Any]:
+    """``timeseries.csv``, the figures and ``summary.json`` from the finished ``run.h5``."""
+    from grainlab.io.hdf5 import read_results
+    from grainlab.plot import oedometer
+    from grainlab.plot.workers import FigureTask, figure_pool
+
+    results = read_results(out / RESULTS_FILE)
+    raise_if_interrupted()
+    summary = dict(results.summary)
+    write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
+    series = {name: np.asarray(values) for name, values in results.timeseries.items()}
+    loading = first_loading(series)
+    with figure_pool(tasks=2, page_copies=True) as pool:
+        pool.draw([
+            FigureTask("fig01_lateral_stress_ratio", oedometer.lateral_stress_ratio_figure,
+                       (series, loading, summary["k0_jaky"], summary["friction_angle_deg"])),
+            FigureTask("fig02_compression", oedometer.compression_figure, (series, loading)),
+        ], out).result()  # drawn before the summary says the outputs are complete
+    raise_if_interrupted()
+    write_json_atomic(out / "summary.json", summary)
+    return summary

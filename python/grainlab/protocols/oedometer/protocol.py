@@ -1,0 +1,191 @@
+"""The oedometer (K0) test as a protocol of the runner: the sample made and
+consolidated as every test's (:mod:`grainlab.protocols.specimen`), then loaded
+vertically between fixed side walls to each stress of a list, a record and a
+snapshot at each equilibrium; :func:`run_oedometer` runs it into a folder."""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from grainlab._interrupt import raise_if_interrupted
+from grainlab._progress import progress_bar
+from grainlab.analysis import fabric_summary
+from grainlab.analysis.stress import love_weber_stress
+from grainlab.columns import OEDOMETER
+from grainlab.io.walls import WallGeometry
+from grainlab.protocols.config import Config
+from grainlab.protocols.consolidate import BOX_WALLS, box_state
+from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA
+from grainlab.protocols.oedometer.outputs import OedometerResult, summarise, write_outputs
+from grainlab.protocols.oedometer.state import OedometerRun
+from grainlab.protocols.runner import Protocol, Stage, StageContext, run_protocol
+from grainlab.protocols.specimen import (
+    CHUNK_STEPS,
+    SpecimenError,
+    consolidate,
+    engine_threads,
+    generate,
+    grain_model,
+    platen_model,
+)
+from grainlab.simulation import Simulation
+from grainlab.snapshot import ParticleKind
+
+__all__ = ["OUTPUT_FILES", "OedometerProtocol", "OedometerRun", "run_oedometer"]
+
+#: The run's outputs besides run.h5.
+OUTPUT_FILES = ("timeseries.csv", "summary.json", "report.html", "fig[0-9][0-9]_*.png", "fig[0-9][0-9]_*.svg")
+
+
+Context = StageContext[Config, OedometerRun]
+
+
+def load_path(config: Config) -> list[float]:
+    """The vertical stresses of the load steps: sigma_0 first (the state with
+    friction on, from which strains count), then the configured ones."""
+    return [config["consolidation.pressure"], *config["oedometer.vertical_stresses"]]
+
+
+def _consolidate(context: Context) -> None:
+    consolidate(context.sim, context.state, context.config, context.progress)
+
+
+def _confine(context: Context) -> None:
+    sim, run, config = context.sim, context.state, context.config
+    sim.set_contact_model(0, 0, grain_model(config))  # Table 1 friction from here on
+    sim.set_contact_model(0, 1, platen_model(config))
+    for name in BOX_WALLS:
+        sim.wall(run.walls[name]).velocity = (0.0, 0.0)  # rigid and fixed; the top is servo-loaded
+    run.max_vertical_stress_pa = config["consolidation.pressure"]
+
+
+def _load(context: Context) -> None:
+    sim, run, config = context.sim, context.state, context.config
+    start = time.perf_counter() - run.wall_time.get("load", 0.0)
+    walls = {name: sim.wall(run.walls[name]) for name in BOX_WALLS}
+    stresses = load_path(config)
+    bar = progress_bar(len(stresses), "loading", enabled=context.progress, unit="step", initial=run.next_load)
+    speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
+    tolerance, limit = config["oedometer.tolerance"], config["consolidation.unbalanced_force_ratio"]
+    while run.next_load < len(stresses):
+        target = stresses[run.next_load]
+        steps = 0
+        while True:
+            box = box_state(walls)
+            walls["top"].servo(target, box.width_m, relaxation=0.5, max_speed_m_per_s=speed)
+            sim.run(CHUNK_STEPS)
+            steps += CHUNK_STEPS
+            box = box_state(walls)
+            if abs(box.stress_yy_pa / target - 1.0) < tolerance and sim.unbalanced_force_ratio < limit:
+                break
+            if steps >= config["oedometer.max_steps"]:
+                bar.close()
+                raise SpecimenError(
+                    f"load step {run.next_load} ({target / 1e3:.1f} kPa) did not reach equilibrium in {steps} "
+                    f"steps: sigma_v {box.stress_yy_pa / 1e3:.1f} kPa, unbalanced force ratio "
+                    f"{sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise oedometer.max_steps"
+                )
+            raise_if_interrupted()
+        walls["top"].velocity = (0.0, 0.0)
+        if run.next_load == 0:  # sigma_0 with friction on: strains count from here
+            run.height0, run.area0 = box.height_m, box.width_m * box.height_m
+        run.max_vertical_stress_pa = max(run.max_vertical_stress_pa, box.stress_yy_pa)
+        context.writer.append_timeseries(_record(sim, run, target), units=OEDOMETER.units())
+        context.writer.write_snapshot(f"load_{run.next_load:02d}", _snapshot(sim, run), step=sim.step_count,
+                                      walls=WallGeometry.from_simulation(sim, names={i: n for n, i in run.walls.items()}))
+        run.next_load += 1
+        bar.update(1)
+        bar.set_postfix_str(f"sigma_v {box.stress_yy_pa / 1e3:.0f} kPa, K {box.stress_xx_pa / box.stress_yy_pa:.3f}")
+        run.wall_time["load"] = time.perf_counter() - start
+        context.save()  # a checkpoint at every equilibrium: a stop loses at most one load step
+    bar.close()
+
+
+def _snapshot(sim: Simulation, run: OedometerRun) -> Any:
+    kind = np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8)
+    box = box_state({name: sim.wall(run.walls[name]) for name in BOX_WALLS})
+    return sim.snapshot(kind=kind, axial_strain=(run.height0 - box.height_m) / run.height0, step=sim.step_count)
+
+
+def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, float]:
+    """One record at a load step's equilibrium, in :data:`grainlab.columns.OEDOMETER`'s order."""
+    box = box_state({name: sim.wall(run.walls[name]) for name in BOX_WALLS})
+    area = box.width_m * box.height_m
+    n = run.n_grains
+    porosity = 1.0 - float(np.pi * np.sum(sim.radii[:n] ** 2)) / area
+    c, w = sim.contacts(), sim.wall_contacts()
+    lw = love_weber_stress(sim.positions, c.i, c.j, c.point, -c.force_on_i, area, np.ones(sim.n_particles, bool),
+                           wall_particle=w.particle, wall_point=w.point, wall_force_on_particle=w.force_on_particle)
+    fabric = fabric_summary(_snapshot(sim, run))
+    fabric.pop("coordination_number")
+    energy = sim.energy
+    values = {
+        "step": float(sim.step_count), "time_s": sim.time, "target_vertical_stress_pa": target,
+        "vertical_stress_pa": box.stress_yy_pa, "horizontal_stress_pa": box.stress_xx_pa,
+        "lateral_stress_ratio": box.stress_xx_pa / box.stress_yy_pa,
+        "max_vertical_stress_pa": run.max_vertical_stress_pa,
+        "overconsolidation_ratio": run.max_vertical_stress_pa / box.stress_yy_pa,
+        "axial_strain": (run.height0 - box.height_m) / run.height0,
+        "volumetric_strain": (run.area0 - area) / run.area0,
+        "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "height_m": box.height_m, "area_m2": area,
+        "love_weber_xx_pa": float(lw[0, 0]), "love_weber_yy_pa": float(lw[1, 1]), "love_weber_xy_pa": float(lw[0, 1]),
+        "coordination_number": 2.0 * int(np.count_nonzero((c.i < n) & (c.j < n))) / n,
+        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
+        "kinetic_energy_j": energy.kinetic, "elastic_energy_j": energy.elastic,
+        "friction_dissipated_j": energy.friction_dissipated, "damping_dissipated_j": energy.damping_dissipated,
+        "boundary_work_j": energy.boundary_work, "wall_work_j": energy.wall_work,
+        **fabric,
+    }
+    return {name: values[name] for name in OEDOMETER}
+
+
+class OedometerProtocol(Protocol[Config, OedometerRun, OedometerResult]):
+    """Confined (K0) compression: side walls fixed, the top platen servo-loaded to each vertical stress."""
+
+    name = "oedometer"
+    stages: ClassVar[tuple[Stage[Any, Any], ...]] = (
+        Stage("consolidate", _consolidate, "the four walls servo-controlled to sigma_0 until equilibrium"),
+        Stage("confine", _confine, "Table 1 friction on; the four walls fixed"),
+        Stage("load", _load, "the top platen servo-controlled to sigma_0 (strains count from there), then to "
+                             "each vertical stress in turn; a record, a snapshot and a checkpoint at each equilibrium"),
+    )
+    output_files = OUTPUT_FILES
+
+    def threads(self) -> int:
+        return engine_threads(self.config)
+
+    def config_dict(self) -> dict[str, Any]:
+        return self.config.to_dict()
+
+    def resolve_saved(self, saved: Any) -> dict[str, Any] | None:
+        try:
+            return Config.from_dict(saved, OEDOMETER_SCHEMA.name).to_dict()
+        except (ValueError, TypeError, AttributeError):
+            return None
+
+    def start(self, threads: int, progress: bool) -> tuple[Simulation, OedometerRun]:
+        return generate(self.config, threads, progress, OedometerRun, "consolidate")
+
+    def state_from_dict(self, saved: Any) -> OedometerRun:
+        return OedometerRun(**{k: v for k, v in saved.items() if k not in ("config", "elapsed_s", "rows", "snapshots")})
+
+    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
+        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
+
+    def write_outputs(self, out: Path) -> dict[str, Any]:
+        return write_outputs(out)
+
+    def result(self, out: Path, summary: dict[str, Any]) -> OedometerResult:
+        return OedometerResult(out, summary)
+
+
+def run_oedometer(config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
+                  progress: bool = False) -> OedometerResult:
+    """Runs (or, with ``resume``, continues) the oedometer test into ``out_dir``
+    (:func:`grainlab.protocols.runner.run_protocol`)."""
+    return run_protocol(OedometerProtocol(config), out_dir, resume=resume, progress=progress)

@@ -1,0 +1,136 @@
+"""The oedometer's report page: K0 on first loading beside Jaky's 1 - sin phi',
+K against the overconsolidation ratio on unloading beside Mayne and
+Kulhawy's K0 OCR^sin phi' (when the run names phi'), the load path's records,
+the figures, the configuration and how to rerun."""
+
+from __future__ import annotations
+
+import datetime
+import shlex
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import grainlab
+from grainlab._html import (
+    EmbeddedFigure,
+    code_block,
+    definition_table,
+    figures,
+    fmt,
+    page,
+    paragraph,
+    section,
+    table,
+)
+from grainlab._mapping import flatten_keys
+from grainlab.columns import (
+    COORDINATION_NUMBER,
+    HORIZONTAL_STRESS_PA,
+    LATERAL_STRESS_RATIO,
+    OVERCONSOLIDATION_RATIO,
+    TARGET_VERTICAL_STRESS_PA,
+    VERTICAL_STRESS_PA,
+    VOID_RATIO,
+)
+from grainlab.io.hdf5 import Results, read_results
+from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA
+from grainlab.report.figures import embedded_png
+
+__all__ = ["FIGURES", "OedometerReport", "gather_oedometer", "render_oedometer"]
+
+#: The run's figures: file stem -> (title, caption).
+FIGURES = {
+    "fig01_lateral_stress_ratio": ("K along the load path", "K = sigma_h / sigma_v at each load step's equilibrium; "
+                                   "the dotted line is Jaky's 1 - sin phi' when the run names phi'."),
+    "fig02_compression": ("Compression curve", "Void ratio against the vertical stress, loading and unloading."),
+}
+
+
+@dataclass
+class OedometerReport:
+    """What the oedometer page shows."""
+
+    folder: Path
+    results: Results
+    summary: dict[str, Any]
+    figures: list[EmbeddedFigure]
+    generated: str
+
+
+def gather_oedometer(folder: str | Path, *, redraw: bool = False) -> OedometerReport:
+    """Collects the report of the oedometer run in ``folder``; figures missing from it
+    (all of them with ``redraw``) are drawn into it first."""
+    folder = Path(folder)
+    results = read_results(folder / "run.h5")
+    if redraw or any(not (folder / f"{stem}.png").exists() for stem in FIGURES):
+        from grainlab.protocols.oedometer.outputs import write_outputs  # draws them from run.h5
+
+        write_outputs(folder)
+    shown = [EmbeddedFigure(stem, title, caption, embedded_png((folder / f"{stem}.png").read_bytes()), f"{stem}.png")
+             for stem, (title, caption) in FIGURES.items()]
+    generated = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    return OedometerReport(folder, results, dict(results.summary), shown, generated)
+
+
+def _toml(value: Any) -> str:
+    """A configuration value as ``--set`` reads it back (TOML, or a bare word)."""
+    if isinstance(value, list):
+        return "[" + ", ".join(repr(float(v)) for v in value) + "]"
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def _kpa(x: float) -> str:
+    return fmt(x / 1e3, 4, unit="kPa")
+
+
+def render_oedometer(r: OedometerReport) -> str:
+    """The oedometer report page."""
+    s, ts = r.summary, r.results.timeseries
+    phi = s.get("friction_angle_deg")
+    jaky = s.get("k0_jaky")
+    glance = definition_table([
+        ("grains", fmt(s["n_particles"])),
+        ("porosity / void ratio at the start of loading",
+         f"{fmt(s['porosity_initial'], 4)} / {fmt(s['void_ratio_initial'], 4)}"),
+        ("K0 on first loading", f"{fmt(s['k0_loading'], 3)} ({s['k0_rule']})"),
+        ("Jaky's K0 = 1 - sin phi'", "no phi' given (oedometer.friction_angle)" if jaky is None
+         else f"{fmt(jaky, 3)} for phi' = {fmt(phi, 3)} deg"),
+        ("largest vertical stress", _kpa(s["max_vertical_stress_pa"])),
+        ("K at the end", f"{fmt(s['lateral_stress_ratio_final'], 3)} at OCR {fmt(s['overconsolidation_ratio_final'], 3)}"),
+        ("wall time", fmt(s["wall_time_s"], 3, unit="s")),
+    ])
+    columns = (TARGET_VERTICAL_STRESS_PA, VERTICAL_STRESS_PA, HORIZONTAL_STRESS_PA, LATERAL_STRESS_RATIO,
+               OVERCONSOLIDATION_RATIO, VOID_RATIO, COORDINATION_NUMBER, "mean_stability_index", "anisotropy")
+    present = [c for c in columns if c in ts]
+    rows = [[fmt(float(ts[c][k]) / (1e3 if c.endswith("_pa") else 1.0), 4) for c in present]
+            for k in range(len(ts[VERTICAL_STRESS_PA]))]
+    headers = [f"{c[:-3]} (kPa)" if c.endswith("_pa") else str(c) for c in present]
+    unloading = [(fmt(u["overconsolidation_ratio"], 3), fmt(u["lateral_stress_ratio"], 3),
+                  "n/a" if u["mayne_kulhawy"] is None else fmt(u["mayne_kulhawy"], 3)) for u in s["unloading"]]
+    fields = OEDOMETER_SCHEMA.fields
+    overrides = [f"--set {shlex.quote(f'{key}={_toml(value)}')}"
+                 for key, value in flatten_keys(r.results.config).items()
+                 if key in fields and not key.startswith("run.") and value != fields[key].default]
+    command = " ".join(["grainlab run oedometer --out", shlex.quote(str(r.folder)), *overrides])
+    config_rows = [(f"{section_}.{key}", str(value)) for section_, values in r.results.config.items()
+                   for key, value in values.items()]
+    sections = [
+        section("glance", "At a glance", glance),
+        section("path", "The load path", paragraph(
+            "One record per load step, at its equilibrium (the step ends with sigma_v within oedometer.tolerance "
+            "of its target and the unbalanced force ratio below consolidation.unbalanced_force_ratio); the first "
+            "is the consolidated sample with Table 1 friction on, from which strains count.", "note"),
+            table(headers, rows, numeric=range(len(headers))), figures(r.figures)),
+        section("unloading", "Unloading: K against OCR", paragraph(
+            "Mayne and Kulhawy (1982): K0 = (1 - sin phi') OCR^(sin phi'), a comparison for sands, not an oracle "
+            "for disks.", "note"), table(["OCR", "K (this run)", "Mayne-Kulhawy"], unloading, numeric=(0, 1, 2))),
+        section("rerun", "How to rerun", code_block(command),
+                paragraph(f"Rebuild this report: grainlab report {shlex.quote(str(r.folder.resolve()))}", "note")),
+        section("config", "Resolved configuration", table(["key", "value (SI)"], config_rows)),
+    ]
+    header = paragraph(f"grainlab oedometer test: {r.folder.resolve().name}; run by grainlab "
+                       f"{r.results.grainlab_version}, report generated {r.generated}.")
+    return page(f"grainlab oedometer report: {r.folder.resolve().name}", header, sections,
+                f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, "
+                "no network).")

@@ -1,0 +1,153 @@
+"""The oedometer (K0) test: the second protocol on the runner. Its physics (side
+walls that do not move, each load step at its stress, the walls' stresses equal
+to the grains' Love-Weber stress at equilibrium, K below 1 on loading and
+growing with the overconsolidation ratio on unloading), its resume to the same
+bits from any checkpoint, its command line, report and bad input."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import grainlab.protocols.runner as runner
+from grainlab.cli import main
+from grainlab.columns import OEDOMETER
+from grainlab.io.hdf5 import read_results, write_checkpoint
+from grainlab.protocols.config import ConfigError
+from grainlab.protocols.oedometer import K0_FROM_STRESS_RATIO, OedometerProtocol, k0_loading, load_path
+from grainlab.protocols.registry import PROTOCOLS, resolve_config
+from grainlab.report import detect_kind
+
+# three load steps up, two down: a few seconds on the quick sample
+PATH = ["oedometer.vertical_stresses=[200 kPa, 400 kPa, 800 kPa, 400 kPa, 100 kPa]", "run.threads=1"]
+
+
+@pytest.fixture(scope="module")
+def config():
+    return resolve_config("oedometer", overrides=PATH, quick=True)
+
+
+@pytest.fixture(scope="module")
+def straight(tmp_path_factory, config):
+    out = tmp_path_factory.mktemp("oedometer") / "run"
+    runner.run_protocol(OedometerProtocol(config), out)
+    return out
+
+
+def test_the_records_are_the_schemas_columns_one_per_load_step(straight, config):
+    results = read_results(straight / "run.h5")
+    assert results.kind == "oedometer" and list(results.timeseries) == [str(c) for c in OEDOMETER]
+    ts = results.timeseries
+    np.testing.assert_array_equal(ts["target_vertical_stress_pa"], load_path(config))
+    assert results.snapshot_names == [f"load_{k:02d}" for k in range(len(load_path(config)))]
+    # each step ends within the tolerance of its target
+    assert np.all(np.abs(ts["vertical_stress_pa"] / ts["target_vertical_stress_pa"] - 1) < 0.01)
+
+
+def test_the_side_walls_stay_put_and_the_sample_compresses_then_swells(straight):
+    results = read_results(straight / "run.h5")
+    walls = [results.walls(name) for name in results.snapshot_names]
+    for name in ("left", "right", "bottom"):
+        k = walls[0].names.index(name)
+        for w in walls[1:]:
+            np.testing.assert_array_equal(np.r_[w.a[k], w.b[k]], np.r_[walls[0].a[k], walls[0].b[k]], err_msg=name)
+    ts = results.timeseries
+    # width fixed: the area strain is the axial strain
+    np.testing.assert_allclose(ts["volumetric_strain"], ts["axial_strain"], rtol=1e-12, atol=1e-15)
+    strain = ts["axial_strain"]
+    assert strain[0] == 0.0 and np.all(np.diff(strain[:4]) > 0) and np.all(np.diff(strain[3:]) < 0)
+    assert np.all(np.diff(ts["void_ratio"][:4]) < 0)
+
+
+def test_the_walls_stresses_are_the_grains_love_weber_stress_at_equilibrium(straight):
+    ts = read_results(straight / "run.h5").timeseries
+    np.testing.assert_allclose(ts["love_weber_yy_pa"], ts["vertical_stress_pa"], rtol=0.02)
+    np.testing.assert_allclose(ts["love_weber_xx_pa"], ts["horizontal_stress_pa"], rtol=0.02)
+    assert np.all(np.abs(ts["love_weber_xy_pa"]) < 0.02 * ts["vertical_stress_pa"])
+
+
+def test_k_on_loading_and_unloading(straight, config):
+    ts = read_results(straight / "run.h5").timeseries
+    k, ocr = ts["lateral_stress_ratio"], ts["overconsolidation_ratio"]
+    np.testing.assert_allclose(k, ts["horizontal_stress_pa"] / ts["vertical_stress_pa"], rtol=1e-15)
+    assert abs(k[0] - 1.0) < 0.02  # isotropically consolidated, friction just on
+    assert np.all(np.diff(k[:4]) < 0) and 0.1 < k[3] < 1.0  # loading: towards K0
+    assert np.all(ocr[:4] == 1.0) and np.all(np.diff(ocr[3:]) > 0)
+    assert np.all(np.diff(k[3:]) > 0)  # unloading: K grows with the OCR
+    summary = read_results(straight / "run.h5").summary
+    # the module's rule: the slope of sigma_h on sigma_v over 400 and 800 kPa (>= 4 sigma_0)
+    assert K0_FROM_STRESS_RATIO == 4.0
+    expected = np.polyfit(ts["vertical_stress_pa"][2:4], ts["horizontal_stress_pa"][2:4], 1)[0]
+    assert summary["k0_loading"] == pytest.approx(expected, rel=1e-12)
+    assert summary["k0_loading"] == pytest.approx(k0_loading(ts, config["consolidation.pressure"]), rel=1e-15)
+    assert summary["k0_jaky"] is None
+    assert [u["overconsolidation_ratio"] for u in summary["unloading"]] == pytest.approx(list(ocr[4:]))
+
+
+class Stop(KeyboardInterrupt):
+    pass
+
+
+@pytest.mark.parametrize("checkpoints", [2, 3, 6])
+def test_a_stopped_run_resumes_to_the_same_bits(straight, tmp_path, monkeypatch, config, checkpoints):
+    calls = {"n": 0}
+
+    def stopping(*args, **kwargs):
+        write_checkpoint(*args, **kwargs)
+        calls["n"] += 1
+        if calls["n"] == checkpoints:
+            raise Stop
+
+    out = tmp_path / "run"
+    with monkeypatch.context() as patch:
+        patch.setattr(runner, "write_checkpoint", stopping)
+        with pytest.raises(Stop):
+            runner.run_protocol(OedometerProtocol(config), out)
+    runner.run_protocol(OedometerProtocol(config), out, resume=True)
+    a, b = read_results(straight / "run.h5"), read_results(out / "run.h5")
+    for name in a.timeseries:
+        np.testing.assert_array_equal(a.timeseries[name], b.timeseries[name], err_msg=name)
+    assert a.snapshot_names == b.snapshot_names
+    for name in a.snapshot_names:
+        np.testing.assert_array_equal(a.snapshot(name).positions, b.snapshot(name).positions)
+
+
+def test_the_command_line_runs_it_with_its_report(tmp_path, capsys):
+    out = tmp_path / "cli"
+    assert main(["run", "oedometer", "--quick", "--out", str(out), "--no-progress",
+                 "--set", "oedometer.vertical_stresses=[400 kPa, 200 kPa]", "--set", "oedometer.friction_angle=30deg"]) == 0
+    printed = capsys.readouterr().out
+    assert "grainlab oedometer: 563 grains" in printed and "(Jaky 0.500)" in printed
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["k0_jaky"] == pytest.approx(0.5, rel=1e-12) and summary["friction_angle_deg"] == pytest.approx(30)
+    mk = summary["unloading"][0]
+    assert mk["mayne_kulhawy"] == pytest.approx(0.5 * mk["overconsolidation_ratio"] ** 0.5, rel=1e-12)
+    assert detect_kind(out) == (out, "oedometer")
+    page = (out / "report.html").read_text()
+    assert "K0 on first loading" in page and "Mayne" in page and "data:image/png;base64," in page
+    header = (out / "timeseries.csv").read_text().splitlines()[0].split(",")
+    assert header == [str(c) for c in OEDOMETER]
+
+
+@pytest.mark.parametrize(("override", "message"), [
+    ("oedometer.vertical_stresses=[200 kPa, -5 kPa]", "oedometer.vertical_stresses: -5000 is out of range"),
+    ("oedometer.vertical_stresses=[]", "give at least one vertical stress"),
+    ("oedometer.friction_angle=95deg", "oedometer.friction_angle"),
+    ("shear.strain_rate=0.01", "unknown configuration key 'shear.strain_rate'"),
+])
+def test_bad_input_gets_one_line_and_no_folder(tmp_path, capsys, override, message):
+    out = tmp_path / "never"
+    assert main(["run", "oedometer", "--quick", "--out", str(out), "--set", override]) != 0
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_the_load_path_keeps_its_order_and_the_registry_knows_it():
+    config = resolve_config("oedometer", overrides=["oedometer.vertical_stresses=[1 MPa, 200 kPa, 300 kPa]"])
+    assert config["oedometer.vertical_stresses"] == [1e6, 2e5, 3e5]
+    assert set(PROTOCOLS) == {"biaxial", "oedometer"}
+    with pytest.raises(ConfigError, match="unknown configuration key"):
+        resolve_config("oedometer", overrides=["boundary.kind=membrane"])
