@@ -118,8 +118,11 @@ def test_the_options_of_every_command_are_in_cli_md_and_on_every_command():
 
 
 def test_every_configuration_key_is_in_cli_md():
+    from grainlab.protocols.registry import SCHEMAS
+
     text = (DOCS / "cli.md").read_text(encoding="utf-8")
-    missing = [key for key in FIELDS if f"`{key}`" not in text]
+    keys = dict.fromkeys([*FIELDS, *(key for schema in SCHEMAS.values() for key in schema.fields)])
+    missing = [key for key in keys if f"`{key}`" not in text]
     assert not missing, f"configuration keys missing from docs/cli.md: {missing}"
 
 

@@ -12,6 +12,7 @@ import pytest
 import grainlab.protocols.biaxial as biaxial
 import grainlab.protocols.biaxial.phases as phases
 import grainlab.protocols.biaxial.protocol as protocol
+import grainlab.protocols.specimen as specimen
 from grainlab.analysis import StabilityIndex
 from grainlab.cli import main
 from grainlab.io.hdf5 import read_results
@@ -179,7 +180,7 @@ def test_a_run_stopped_before_its_first_checkpoint_starts_over(tmp_path, monkeyp
     def generate(*args, **kwargs):
         raise RuntimeError("generation reached")
 
-    monkeypatch.setattr(protocol, "generate", generate)
+    monkeypatch.setattr(specimen, "generate", generate)
     with pytest.raises(RuntimeError, match="generation reached"):
         biaxial.run_biaxial(resolve(quick=True), tmp_path, progress=False)
     with pytest.raises(ValueError, match="nothing to resume"):

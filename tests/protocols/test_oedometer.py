@@ -7,6 +7,9 @@ bits from any checkpoint, its command line, report and bad input."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,7 +19,12 @@ from grainlab.cli import main
 from grainlab.columns import OEDOMETER
 from grainlab.io.hdf5 import read_results, write_checkpoint
 from grainlab.protocols.config import ConfigError
-from grainlab.protocols.oedometer import K0_FROM_STRESS_RATIO, OedometerProtocol, k0_loading, load_path
+from grainlab.protocols.oedometer import (
+    K0_FROM_STRESS_RATIO,
+    OedometerProtocol,
+    k0_loading,
+    load_path,
+)
 from grainlab.protocols.registry import PROTOCOLS, resolve_config
 from grainlab.report import detect_kind
 
@@ -114,19 +122,22 @@ def test_a_stopped_run_resumes_to_the_same_bits(straight, tmp_path, monkeypatch,
         np.testing.assert_array_equal(a.snapshot(name).positions, b.snapshot(name).positions)
 
 
-def test_the_command_line_runs_it_with_its_report(tmp_path, capsys):
-    out = tmp_path / "cli"
+def test_the_command_line_runs_it_with_its_report_as_cli_md_prints(tmp_path, capsys):
+    out = tmp_path / "oedo"
     assert main(["run", "oedometer", "--quick", "--out", str(out), "--no-progress",
-                 "--set", "oedometer.vertical_stresses=[400 kPa, 200 kPa]", "--set", "oedometer.friction_angle=30deg"]) == 0
-    printed = capsys.readouterr().out
-    assert "grainlab oedometer: 563 grains" in printed and "(Jaky 0.500)" in printed
+                 "--set", "oedometer.friction_angle=30deg"]) == 0
+    printed = capsys.readouterr().out.splitlines()[0]
+    quoted = " ".join((Path(__file__).resolve().parents[2] / "docs" / "cli.md").read_text().split())
+    line = printed.split("; ")  # all but the wall time and folder, as docs/cli.md quotes them
+    assert "; ".join(line[:-1]) in quoted, printed
     summary = json.loads((out / "summary.json").read_text())
     assert summary["k0_jaky"] == pytest.approx(0.5, rel=1e-12) and summary["friction_angle_deg"] == pytest.approx(30)
-    mk = summary["unloading"][0]
-    assert mk["mayne_kulhawy"] == pytest.approx(0.5 * mk["overconsolidation_ratio"] ** 0.5, rel=1e-12)
+    for step in summary["unloading"]:
+        assert step["mayne_kulhawy"] == pytest.approx(0.5 * step["overconsolidation_ratio"] ** 0.5, rel=1e-12)
     assert detect_kind(out) == (out, "oedometer")
     page = (out / "report.html").read_text()
     assert "K0 on first loading" in page and "Mayne" in page and "data:image/png;base64," in page
+    assert f"{summary['k0_loading']:.3g}" in page
     header = (out / "timeseries.csv").read_text().splitlines()[0].split(",")
     assert header == [str(c) for c in OEDOMETER]
 
@@ -151,3 +162,25 @@ def test_the_load_path_keeps_its_order_and_the_registry_knows_it():
     assert set(PROTOCOLS) == {"biaxial", "oedometer"}
     with pytest.raises(ConfigError, match="unknown configuration key"):
         resolve_config("oedometer", overrides=["boundary.kind=membrane"])
+
+
+def test_the_example_prints_k_at_each_step_and_k0_beside_jaky(tmp_path):
+    example = Path(__file__).resolve().parents[2] / "examples" / "09_oedometer.py"
+    printed = subprocess.run([sys.executable, str(example), str(tmp_path / "run")], check=True,
+                             capture_output=True, text=True).stdout
+    lines = printed.splitlines()
+    steps = [line for line in lines if line.startswith("sigma_v")]
+    stresses = [float(line.split()[1]) for line in steps]
+    assert stresses == pytest.approx([100, 200, 400, 800, 400, 200, 100], rel=0.01)
+    assert "(Jaky 0.500)" in lines[-1] and "K0 " in lines[-1]
+
+
+@pytest.mark.slow
+def test_the_default_run_is_the_one_docs_protocols_md_prints(tmp_path, capsys):
+    # the paper-scale sample (3,518 grains): about 30 s
+    assert main(["run", "oedometer", "--out", str(tmp_path / "oedometer"), "--no-progress", "--no-report",
+                 "--set", "oedometer.friction_angle=30.1 deg"]) == 0
+    printed = capsys.readouterr().out.splitlines()[0]
+    docs = Path(__file__).resolve().parents[2] / "docs" / "protocols.md"
+    quoted = next(line for line in docs.read_text().splitlines() if line.startswith("grainlab oedometer: 3518"))
+    assert printed.split("; ")[:-1] == quoted.split("; ")[:-1], (printed, quoted)

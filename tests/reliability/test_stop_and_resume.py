@@ -19,8 +19,8 @@ import grainlab.postprocess.figures as figures
 import grainlab.protocols.biaxial as biaxial
 import grainlab.protocols.biaxial.outputs as outputs
 import grainlab.protocols.biaxial.phases as phases
-import grainlab.protocols.biaxial.protocol as protocol
 import grainlab.protocols.runner as runner
+import grainlab.protocols.specimen as specimen
 from grainlab.cli import main
 from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, read_results, write_checkpoint
 
@@ -58,7 +58,7 @@ def _before(function, n=1):
 
 def _stop_at(monkeypatch, where: str) -> None:
     if where == "generation":
-        monkeypatch.setattr(protocol, "generate", _after(protocol.generate))
+        monkeypatch.setattr(specimen, "generate", _after(specimen.generate))
     elif where.startswith("checkpoint "):  # 1 generated, 2 consolidated, 3 boundary installed, 4 sheared
         monkeypatch.setattr(runner, "write_checkpoint", _after(write_checkpoint, int(where.split()[1])))
     elif where == "shearing":

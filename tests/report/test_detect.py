@@ -51,7 +51,7 @@ def test_sweep_folder_points_to_a_run_that_exists(tmp_path, capsys):
 def test_results_of_another_kind_are_refused(tmp_path, capsys):
     with ResultsWriter(tmp_path / "run.h5", kind="consolidation") as writer:
         writer.append_rows({"axial_strain": [0.0, 0.01]})
-    _refused(capsys, tmp_path, "not a biaxial test")
+    _refused(capsys, tmp_path, "a run of kind 'consolidation', which grainlab report does not cover")
 
 
 def test_a_table_that_is_not_a_study_is_refused(tmp_path, capsys):

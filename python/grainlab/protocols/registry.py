@@ -1,7 +1,8 @@
 """The protocols grainlab runs, in one place: their names, their classes and
 their configuration schemas. The campaigns (``grainlab study``, ``sweep``,
 ``reproduce``, Dask) run a protocol by its name from here; a new protocol
-registers here and in :data:`grainlab.protocols.config.SCHEMAS`.
+registers here, and its schema in :data:`SCHEMAS` (``register_schema`` in its own
+package; importing this module imports every protocol, so :data:`SCHEMAS` holds them all).
 
 >>> sorted(PROTOCOLS)
 ['biaxial', 'oedometer']
@@ -19,7 +20,7 @@ from grainlab.protocols.config import SCHEMAS, Config
 from grainlab.protocols.oedometer.protocol import OedometerProtocol
 from grainlab.protocols.runner import Protocol, RunResult, run_protocol
 
-__all__ = ["PROTOCOLS", "resolve_config", "run_named"]
+__all__ = ["PROTOCOLS", "SCHEMAS", "resolve_config", "run_named"]
 
 #: Protocol name -> its class (the name is also the results file's ``kind``).
 PROTOCOLS: dict[str, type[Protocol[Any, Any, Any]]] = {

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any, TypeVar
+from dataclasses import asdict, dataclass
+from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
@@ -17,7 +17,7 @@ from grainlab._cores import available_cores
 from grainlab._progress import progress_bar
 from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
-from grainlab.protocols.runner import ProtocolError
+from grainlab.protocols.runner import Protocol, ProtocolError, RunResult
 from grainlab.samples import (
     PAPER_GRADING,
     GradingCurve,
@@ -28,11 +28,14 @@ from grainlab.samples import (
 )
 from grainlab.simulation import ContactModel, Simulation
 
-__all__ = ["CHUNK_STEPS", "SpecimenError", "SpecimenRun", "consolidate", "engine_threads", "generate",
-           "grain_model", "platen_model"]
+__all__ = ["CHUNK_STEPS", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
+           "engine_threads", "generate", "grain_model", "platen_model"]
 
 #: Steps per engine call while a phase waits for a condition.
 CHUNK_STEPS = 2000
+#: A test's outputs besides run.h5 (``report.html`` is the command's): a new run refuses a
+#: folder that already holds one, which another run or the user wrote.
+OUTPUT_FILES = ("timeseries.csv", "summary.json", "report.html", "fig[0-9][0-9]_*.png", "fig[0-9][0-9]_*.svg")
 
 
 class SpecimenError(ProtocolError):
@@ -53,8 +56,37 @@ class SpecimenRun:
     sample: dict[str, Any]
     consolidation: dict[str, Any]
 
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
 
 R = TypeVar("R", bound=SpecimenRun)
+Result = TypeVar("Result", bound=RunResult)
+
+
+class SpecimenProtocol(Protocol[Config, R, Result]):
+    """A protocol whose configuration is a :class:`Config` of the schema named as the
+    protocol and whose run starts by making the sample (:func:`generate`) into a state
+    of type :attr:`state_type`, in the first stage's phase; it writes :data:`OUTPUT_FILES`."""
+
+    state_type: ClassVar[type[SpecimenRun]]
+    output_files = OUTPUT_FILES
+
+    def threads(self) -> int:
+        return engine_threads(self.config)
+
+    def config_dict(self) -> dict[str, Any]:
+        return self.config.to_dict()
+
+    def resolve_saved(self, saved: Any) -> dict[str, Any] | None:
+        try:
+            return Config.from_dict(saved, self.name).to_dict()
+        except (ValueError, TypeError, AttributeError):
+            return None
+
+    def start(self, threads: int, progress: bool) -> tuple[Simulation, R]:
+        sim, run = generate(self.config, threads, progress, self.state_type, self.stages[0].name)
+        return sim, run  # type: ignore[return-value]  # state_type is R's class
 
 
 def grading(config: Config) -> UniformByNumber | UniformByMass | GradingCurve:

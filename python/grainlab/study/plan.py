@@ -1,11 +1,11 @@
 """Sweep plans: a TOML file naming a base config and the parameters to vary.
 
 ```toml
-base = "packing"            # or "biaxial"
+base = "packing"            # or a test: "biaxial", "oedometer"
 mode = "grid"               # "grid" (every combination) or "zip" (element-wise)
 seed = 0                    # campaign seed (each run's seed is derived from it)
-# config = "biaxial.toml"   # biaxial only: a config file, relative to the plan
-# quick = true              # biaxial only: the --quick sample
+# config = "biaxial.toml"   # a test only: a config file, relative to the plan
+# quick = true              # a test only: the --quick sample
 
 [fixed]                     # the same for every run
 width = 0.02
@@ -17,8 +17,9 @@ generation_friction = { start = 0.0, stop = 0.4, num = 3 }   # or { start, stop,
 ```
 
 For ``base = "packing"`` the keys are :class:`~grainlab.study.packing.PackingParams`
-fields; for ``"biaxial"`` they are the dotted config keys of
-:mod:`grainlab.protocols.config` (``"sample.porosity"`` or a nested
+fields; for a test (``"biaxial"``, ``"oedometer"``: a protocol of
+:mod:`grainlab.protocols.registry`) they are the dotted config keys of its
+schema (``"sample.porosity"`` or a nested
 ``[vary.sample]`` table) and accept units (``"100 kPa"``). Every value is
 validated before any run starts; errors name the key.
 """
@@ -67,7 +68,7 @@ class Plan:
         for index, combo in enumerate(combos):
             varied = dict(zip(names, combo, strict=True))
             params = {**self.fixed, **varied}
-            if self.base == "biaxial":
+            if self.base != "packing":
                 if self.config is not None:
                     params["config_file"] = self.config
                 if self.quick:
@@ -128,11 +129,12 @@ def _check_values(base: str, params: dict[str, Any], key_prefix: str) -> None:
         except ValueError as error:
             raise PlanError(f"{key_prefix}{error}") from None
     else:
-        from grainlab.protocols.config import ConfigError, coerce
+        from grainlab.protocols.config import ConfigError
+        from grainlab.protocols.registry import SCHEMAS
 
         for key, value in params.items():
             try:
-                coerce(key, value)
+                SCHEMAS[base].coerce(key, value)
             except ConfigError as error:
                 raise PlanError(f"{key_prefix}{error}") from None
 
@@ -146,11 +148,14 @@ def parse_plan(text: str, *, base_dir: str | os.PathLike[str] | None = None, sou
     for key in table:
         if key not in PLAN_KEYS:
             raise PlanError(f"{key}: unknown plan key; known: {', '.join(PLAN_KEYS)}")
+    from grainlab.protocols.registry import PROTOCOLS
+
+    bases = ", ".join(repr(b) for b in ("packing", *sorted(PROTOCOLS)))
     if "base" not in table:
-        raise PlanError("base: missing; expected 'packing' or 'biaxial'")
+        raise PlanError(f"base: missing; expected one of {bases}")
     base = table["base"]
-    if base not in ("packing", "biaxial"):
-        raise PlanError(f"base: expected 'packing' or 'biaxial', got {base!r}")
+    if base != "packing" and base not in PROTOCOLS:
+        raise PlanError(f"base: expected one of {bases}, got {base!r}")
     mode = table.get("mode", "grid")
     if mode not in ("grid", "zip"):
         raise PlanError(f"mode: expected 'grid' or 'zip', got {mode!r}")
@@ -162,7 +167,8 @@ def parse_plan(text: str, *, base_dir: str | os.PathLike[str] | None = None, sou
         raise PlanError(f"quick: expected true or false, got {quick!r}")
     config = table.get("config")
     if base == "packing" and (config is not None or quick):
-        raise PlanError(f"{'config' if config is not None else 'quick'}: only for base = 'biaxial'")
+        tests = ", ".join(repr(b) for b in sorted(PROTOCOLS))
+        raise PlanError(f"{'config' if config is not None else 'quick'}: only for the base of a test ({tests})")
     if config is not None:
         if not isinstance(config, str):
             raise PlanError(f"config: expected a path, got {config!r}")

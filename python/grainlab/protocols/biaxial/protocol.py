@@ -13,15 +13,11 @@ from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary
 from grainlab.protocols.biaxial.rates import check_density_scaling, check_strain_rate
 from grainlab.protocols.biaxial.state import _Run
 from grainlab.protocols.config import BiaxialConfig
-from grainlab.protocols.runner import RUN_FILES, Protocol, Stage, StageContext, run_protocol
-from grainlab.protocols.specimen import consolidate, engine_threads, generate
-from grainlab.simulation import Simulation
+from grainlab.protocols.runner import RUN_FILES, Stage, StageContext, run_protocol
+from grainlab.protocols.specimen import OUTPUT_FILES, SpecimenProtocol, consolidate
 
 __all__ = ["OUTPUT_FILES", "RUN_FILES", "BiaxialProtocol", "run_biaxial"]
 
-#: The run's outputs besides run.h5 (``report.html`` is ``grainlab biaxial``'s): a new run
-#: refuses a folder that already holds one, which another run or the user wrote.
-OUTPUT_FILES = ("timeseries.csv", "summary.json", "report.html", "fig[0-9][0-9]_*.png", "fig[0-9][0-9]_*.svg")
 
 Context = StageContext[BiaxialConfig, _Run]
 
@@ -41,7 +37,7 @@ def _shear(context: Context) -> None:
     shear(context.sim, context.state, context.config, context.writer, context.save, context.progress)
 
 
-class BiaxialProtocol(Protocol[BiaxialConfig, _Run, BiaxialResult]):
+class BiaxialProtocol(SpecimenProtocol[_Run, BiaxialResult]):
     """The paper's biaxial test (Sec. 6, Table 1); the sample is generated when the run starts."""
 
     name = "biaxial"
@@ -52,26 +48,11 @@ class BiaxialProtocol(Protocol[BiaxialConfig, _Run, BiaxialResult]):
         Stage("shear", _shear, "the platens at a constant axial strain rate to the final strain; records "
                                "and snapshots on their triggers, checkpoints on the wall clock"),
     )
-    output_files = OUTPUT_FILES
+    state_type = _Run
 
     def check(self) -> None:
         check_strain_rate(self.config)  # a rate refused needs no warning about its inertia
         check_density_scaling(self.config)
-
-    def threads(self) -> int:
-        return engine_threads(self.config)
-
-    def config_dict(self) -> dict[str, Any]:
-        return self.config.to_dict()
-
-    def resolve_saved(self, saved: Any) -> dict[str, Any] | None:
-        try:
-            return BiaxialConfig.from_dict(saved).to_dict()
-        except (ValueError, TypeError, AttributeError):
-            return None
-
-    def start(self, threads: int, progress: bool) -> tuple[Simulation, _Run]:
-        return generate(self.config, threads, progress, _Run, "consolidate")
 
     def state_from_dict(self, saved: Any) -> _Run:
         # "peak": the peak so far, which checkpoints of earlier grainlab versions carry; the

@@ -20,26 +20,23 @@ from grainlab.columns import OEDOMETER
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import BOX_WALLS, box_state
-from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA
+from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA  # noqa: F401 - registers the schema
 from grainlab.protocols.oedometer.outputs import OedometerResult, summarise, write_outputs
 from grainlab.protocols.oedometer.state import OedometerRun
-from grainlab.protocols.runner import Protocol, Stage, StageContext, run_protocol
+from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import (
     CHUNK_STEPS,
     SpecimenError,
+    SpecimenProtocol,
     consolidate,
-    engine_threads,
-    generate,
     grain_model,
     platen_model,
 )
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind
 
-__all__ = ["OUTPUT_FILES", "OedometerProtocol", "OedometerRun", "run_oedometer"]
+__all__ = ["OedometerProtocol", "OedometerRun", "load_path", "run_oedometer"]
 
-#: The run's outputs besides run.h5.
-OUTPUT_FILES = ("timeseries.csv", "summary.json", "report.html", "fig[0-9][0-9]_*.png", "fig[0-9][0-9]_*.svg")
 
 
 Context = StageContext[Config, OedometerRun]
@@ -144,7 +141,7 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
     return {name: values[name] for name in OEDOMETER}
 
 
-class OedometerProtocol(Protocol[Config, OedometerRun, OedometerResult]):
+class OedometerProtocol(SpecimenProtocol[OedometerRun, OedometerResult]):
     """Confined (K0) compression: side walls fixed, the top platen servo-loaded to each vertical stress."""
 
     name = "oedometer"
@@ -154,22 +151,7 @@ class OedometerProtocol(Protocol[Config, OedometerRun, OedometerResult]):
         Stage("load", _load, "the top platen servo-controlled to sigma_0 (strains count from there), then to "
                              "each vertical stress in turn; a record, a snapshot and a checkpoint at each equilibrium"),
     )
-    output_files = OUTPUT_FILES
-
-    def threads(self) -> int:
-        return engine_threads(self.config)
-
-    def config_dict(self) -> dict[str, Any]:
-        return self.config.to_dict()
-
-    def resolve_saved(self, saved: Any) -> dict[str, Any] | None:
-        try:
-            return Config.from_dict(saved, OEDOMETER_SCHEMA.name).to_dict()
-        except (ValueError, TypeError, AttributeError):
-            return None
-
-    def start(self, threads: int, progress: bool) -> tuple[Simulation, OedometerRun]:
-        return generate(self.config, threads, progress, OedometerRun, "consolidate")
+    state_type = OedometerRun
 
     def state_from_dict(self, saved: Any) -> OedometerRun:
         return OedometerRun(**{k: v for k, v in saved.items() if k not in ("config", "elapsed_s", "rows", "snapshots")})

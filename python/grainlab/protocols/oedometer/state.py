@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
-from typing import Any
+from dataclasses import dataclass
 
 from grainlab.protocols.specimen import SpecimenRun
 
@@ -20,6 +19,3 @@ class OedometerRun(SpecimenRun):
     area0: float = 0.0
     next_load: int = 0
     max_vertical_stress_pa: float = 0.0
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
