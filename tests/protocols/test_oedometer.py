@@ -184,3 +184,11 @@ def test_the_default_run_is_the_one_docs_protocols_md_prints(tmp_path, capsys):
     docs = Path(__file__).resolve().parents[2] / "docs" / "protocols.md"
     quoted = next(line for line in docs.read_text().splitlines() if line.startswith("grainlab oedometer: 3518"))
     assert printed.split("; ")[:-1] == quoted.split("; ")[:-1], (printed, quoted)
+
+
+def test_the_viewer_draws_the_oedometer_curve_of_sigma_v(straight):
+    from grainlab.viewer.data import viewer_data
+
+    data = viewer_data(straight / "run.h5")
+    assert (data["curve"]["x"], data["curve"]["y"]) == ("axial_strain", "vertical_stress_pa")
+    assert data["curve"]["n"] == len(read_results(straight / "run.h5").timeseries["step"])

@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.analysis import StabilityIndex, match_ids
-from grainlab.columns import AXIAL_STRAIN, AXIAL_STRESS_PA, STRESS_RATIO
+from grainlab.columns import AXIAL_STRAIN, AXIAL_STRESS_PA, STRESS_RATIO, VERTICAL_STRESS_PA
 from grainlab.io.hdf5 import read_results
 from grainlab.io.vtk import contact_lines
 from grainlab.postprocess.band import find_band
@@ -35,8 +35,9 @@ from grainlab.postprocess.vtk import snapshot_arrays
 
 __all__ = ["CURVE_COLUMNS", "encode", "viewer_data"]
 
-#: Time series columns drawn as the stress–strain curve (x, y), the first pair the file has.
-CURVE_COLUMNS = ((AXIAL_STRAIN, STRESS_RATIO), (AXIAL_STRAIN, AXIAL_STRESS_PA))
+#: Time series columns drawn as the stress–strain curve (x, y), the first pair the file has
+#: (the biaxial test's stress ratio, or the oedometer's vertical stress).
+CURVE_COLUMNS = ((AXIAL_STRAIN, STRESS_RATIO), (AXIAL_STRAIN, AXIAL_STRESS_PA), (AXIAL_STRAIN, VERTICAL_STRESS_PA))
 
 
 def encode(values: NDArray[Any], dtype: str) -> str:
