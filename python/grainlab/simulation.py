@@ -892,7 +892,8 @@ class Simulation:
         Contacts and wall contacts are in the snapshot's convention already
         (:meth:`contacts`, :meth:`wall_contacts`). ``kind`` gives each
         particle's :class:`~grainlab.snapshot.ParticleKind`; ``metadata`` may set
-        ``time`` and ``axial_strain`` and any other key. The particles'
+        ``time``, ``axial_strain`` and ``scalars`` (the run's control variables,
+        :attr:`Snapshot.scalars`) and any other key. The particles'
         ``velocity`` (m/s, (N, 2)) and ``angular_velocity`` (rad/s, (N,)) travel
         as ``particle_fields``.
         """
@@ -900,6 +901,7 @@ class Simulation:
         w = self.wall_contacts()
         time = metadata.pop("time", self.time)
         axial_strain = metadata.pop("axial_strain", None)
+        scalars = metadata.pop("scalars", None)
         return Snapshot.from_engine_arrays(
             self.positions,
             self.radii,
@@ -923,6 +925,7 @@ class Simulation:
             wall_sliding=w.sliding,
             time=time,
             axial_strain=axial_strain,
+            scalars=scalars,
             kind=kind,
             particle_fields={
                 "velocity": self.velocities,

@@ -195,8 +195,14 @@ class Snapshot:
     periodic : (bool, bool)
         Periodicity in x and y; a periodic direction needs ``box``.
     time : float, s, optional
+    scalars : mapping of str to float, optional
+        The run's control variables at this snapshot, by name, finite: a
+        biaxial test's ``axial_strain`` (eps_11, compression positive), an
+        oedometer's ``vertical_stress_pa``, any other (a name as in
+        :mod:`grainlab.columns`).
     axial_strain : float, optional
-        Axial strain eps_11 of the run at this snapshot, compression positive.
+        Shorthand for ``scalars={"axial_strain": axial_strain}``; read back as
+        :attr:`axial_strain` (None when the snapshot has none).
     metadata : mapping, optional
         Free-form provenance (source file, timestep, code, ...).
 
@@ -230,7 +236,7 @@ class Snapshot:
     box: NDArray[np.float64] | None
     periodic: tuple[bool, bool]
     time: float | None
-    axial_strain: float | None
+    scalars: Mapping[str, float]
     metadata: Mapping[str, Any]
     _cache: dict[str, NDArray[Any]] = field(init=False, repr=False, compare=False)
 
@@ -255,6 +261,7 @@ class Snapshot:
         time: float | None = None,
         axial_strain: float | None = None,
         metadata: Mapping[str, Any] | None = None,
+        scalars: Mapping[str, float] | None = None,
     ) -> None:
         # the inputs are checked and stored as read-only arrays (the dataclass is
         # frozen, so the fields are set through object.__setattr__ once, here)
@@ -376,12 +383,25 @@ class Snapshot:
             raise ValueError("box: a periodic direction needs the box bounds")
         else:
             put("box", None)
-        for name, scalar in (("time", time), ("axial_strain", axial_strain)):
-            if scalar is not None:
-                scalar = float(scalar)
-                if not np.isfinite(scalar):
-                    raise ValueError(f"{name}: must be finite, got {scalar}")
-            put(name, scalar)
+        if time is not None:
+            time = float(time)
+            if not np.isfinite(time):
+                raise ValueError(f"time: must be finite, got {time}")
+        put("time", time)
+        values = dict(scalars or {})
+        if axial_strain is not None:
+            if "axial_strain" in values and values["axial_strain"] != axial_strain:
+                raise ValueError("axial_strain: given twice, as axial_strain and in scalars, with other values")
+            values["axial_strain"] = axial_strain
+        checked: dict[str, float] = {}
+        for name, scalar in values.items():
+            if not isinstance(name, str) or not name:
+                raise ValueError(f"scalars: names must be non-empty strings, got {name!r}")
+            number = float(scalar)
+            if not np.isfinite(number):
+                raise ValueError(f"scalars[{name!r}]: must be finite, got {number}")
+            checked[name] = number
+        put("scalars", checked)
         put("metadata", dict(metadata or {}))
 
     @staticmethod
@@ -780,6 +800,11 @@ class Snapshot:
             key = np.concatenate([keys[keep, 0], keys[pp, 1]])
             owner = owner[boundary_end_groups(owner, key) == np.arange(owner.size)]
         return np.bincount(owner, minlength=self.n_particles)
+
+    @property
+    def axial_strain(self) -> float | None:
+        """The run's axial strain at this snapshot (``scalars["axial_strain"]``), None when it has none."""
+        return self.scalars.get("axial_strain")
 
     def _repr_html_(self) -> str:
         from grainlab._repr import snapshot_html

@@ -192,3 +192,13 @@ def test_the_viewer_draws_the_oedometer_curve_of_sigma_v(straight):
     data = viewer_data(straight / "run.h5")
     assert (data["curve"]["x"], data["curve"]["y"]) == ("axial_strain", "vertical_stress_pa")
     assert data["curve"]["n"] == len(read_results(straight / "run.h5").timeseries["step"])
+
+
+def test_each_snapshot_carries_the_load_steps_stresses_as_its_scalars(straight):
+    results = read_results(straight / "run.h5")
+    ts = results.timeseries
+    for k, info in enumerate(results.snapshots):
+        snap = results.snapshot(info.name)
+        assert snap.scalars["vertical_stress_pa"] == ts["vertical_stress_pa"][k] == info.scalars["vertical_stress_pa"]
+        assert snap.scalars["horizontal_stress_pa"] == ts["horizontal_stress_pa"][k]
+        assert snap.axial_strain == ts["axial_strain"][k] == info.axial_strain

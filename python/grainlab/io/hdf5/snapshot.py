@@ -4,8 +4,10 @@ about it without loading it (:class:`SnapshotInfo`)."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -89,6 +91,20 @@ def _write_array(
         ds.attrs["units"] = units
 
 
+#: Attributes of a snapshot group that a scalar may not be named as.
+_RESERVED_ATTRS = frozenset({"n_particles", "n_contacts", "periodic", "time", "step", "scalars", "index"})
+
+
+def _scalars(attrs: Any) -> dict[str, float]:
+    """A snapshot group's scalars: those its ``scalars`` attribute names, or (files written
+    before snapshots had scalars) its ``axial_strain`` attribute."""
+    if "scalars" in attrs:
+        names = [n.decode() if isinstance(n, bytes) else str(n) for n in np.atleast_1d(attrs["scalars"])]
+    else:
+        names = ["axial_strain"] if "axial_strain" in attrs else []
+    return {name: float(attrs[name]) for name in names}
+
+
 def _write_snapshot_group(
     group: h5py.Group, snapshot: Snapshot, *, compression: str | None, step: int | None
 ) -> None:
@@ -126,8 +142,13 @@ def _write_snapshot_group(
     group.attrs["periodic"] = np.array(snapshot.periodic, dtype=np.int8)
     if snapshot.time is not None:
         group.attrs["time"] = np.float64(snapshot.time)
-    if snapshot.axial_strain is not None:
-        group.attrs["axial_strain"] = np.float64(snapshot.axial_strain)
+    for name, value in snapshot.scalars.items():  # each an attribute of its own name
+        if name in _RESERVED_ATTRS:
+            raise ValueError(f"snapshot.scalars: {name!r} is a name the snapshot group uses already")
+        _check_name("snapshot.scalars", name)
+        group.attrs[name] = np.float64(value)
+    if snapshot.scalars:
+        group.attrs["scalars"] = np.array(list(snapshot.scalars), dtype=h5py.string_dtype())
     if step is not None:
         group.attrs["step"] = np.int64(step)
 
@@ -166,7 +187,7 @@ def _read_snapshot_group_v1(group: h5py.Group, path: Path) -> Snapshot:
             box=get("box"),
             periodic=periodic,  # type: ignore[arg-type]
             time=float(attrs["time"]) if "time" in attrs else None,
-            axial_strain=float(attrs["axial_strain"]) if "axial_strain" in attrs else None,
+            scalars=_scalars(attrs),
             metadata=metadata,
         )
     except KeyError as error:
@@ -193,6 +214,8 @@ class SnapshotInfo:
     n_particles: int
     #: Number of contacts Nc (particle–particle and wall).
     n_contacts: int
+    #: The snapshot's scalars (:attr:`grainlab.snapshot.Snapshot.scalars`), ``axial_strain`` among them.
+    scalars: Mapping[str, float] = dataclasses.field(default_factory=dict)
 
 
 def _snapshot_order(group: h5py.Group) -> list[tuple[str, int]]:
@@ -220,6 +243,7 @@ def _snapshot_infos_v1(f: h5py.File) -> tuple[SnapshotInfo, ...]:
                 step=int(a["step"]) if "step" in a else None,
                 n_particles=int(a.get("n_particles", group[name]["positions"].shape[0])),
                 n_contacts=int(a.get("n_contacts", 0)),
+                scalars=_scalars(a),
             )
         )
     return tuple(infos)

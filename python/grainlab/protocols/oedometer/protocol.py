@@ -106,7 +106,9 @@ def _load(context: Context) -> None:
 def _snapshot(sim: Simulation, run: OedometerRun) -> Any:
     kind = np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8)
     box = box_state({name: sim.wall(run.walls[name]) for name in BOX_WALLS})
-    return sim.snapshot(kind=kind, axial_strain=(run.height0 - box.height_m) / run.height0, step=sim.step_count)
+    scalars = {"axial_strain": (run.height0 - box.height_m) / run.height0, "vertical_stress_pa": box.stress_yy_pa,
+               "horizontal_stress_pa": box.stress_xx_pa}
+    return sim.snapshot(kind=kind, scalars=scalars, step=sim.step_count)
 
 
 def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, float]:
