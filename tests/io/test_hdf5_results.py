@@ -163,7 +163,7 @@ def test_round_trip_is_exact(tmp_path):
         out.write_phases({"generation": 12.5, "consolidation": 3.0, "shearing": 40.25})
     res = read_results(tmp_path / "run.h5")
 
-    assert res.format_version == FORMAT_VERSION == 1
+    assert res.format_version == FORMAT_VERSION == 2
     assert res.kind == "biaxial" and res.status == "complete"
     assert res.grainlab_version and res.created.endswith("+00:00")
     assert same_config(res.config, CONFIG)
@@ -418,7 +418,7 @@ def test_future_version_is_refused_naming_the_version(tmp_path):
     with h5py.File(path, "r+") as f:
         f.attrs["format_version"] = 0
     with pytest.raises(
-        ResultsFileError, match=r"format_version 0 is unknown \(known versions: 1\)"
+        ResultsFileError, match=r"format_version 0 is unknown \(known versions: 1, 2\)"
     ):
         read_results(path)
 

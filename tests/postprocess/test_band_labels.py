@@ -174,7 +174,6 @@ def test_a_field_per_particle_or_per_grain_gives_the_same_band():
 
 def test_the_field_band_runs_the_strain_band_acceptance(sheared, monkeypatch):
     """The strain band is the field band of the excess local strain: one code path."""
-    monkeypatch.setattr(band_module, "_searches", type(band_module._searches)())
     reference, current, _ = sheared
     stability = StabilityIndex().compute(current)
     strain = LocalStrain().compute(grains_only(reference), grains_only(current))

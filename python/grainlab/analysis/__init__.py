@@ -19,7 +19,7 @@ from grainlab.analysis.fabric import (
     fabric_tensor,
     rattlers,
 )
-from grainlab.analysis.shear_band import ShearBand
+from grainlab.analysis.shear_band import ShearBand, Slab
 from grainlab.analysis.stability import StabilityIndex, stability_index, stability_index_of_angles
 from grainlab.analysis.strain import LocalStrain, match_ids, neighbour_pairs
 
@@ -32,6 +32,7 @@ __all__ = [
     "DisplacementBand",
     "LocalStrain",
     "ShearBand",
+    "Slab",
     "StabilityIndex",
     "analyze_snapshot",
     "angular_histogram",

@@ -105,7 +105,7 @@ from scipy.ndimage import uniform_filter1d
 from grainlab.analysis._util import Computable, finite_mean
 from grainlab.snapshot import Snapshot
 
-__all__ = ["ShearBand", "SlabBand"]
+__all__ = ["ShearBand", "Slab", "SlabBand"]
 
 #: The second band's direction differs from the first's by at least this much (rad).
 _SECOND_SEPARATION = np.radians(20.0)
@@ -429,25 +429,95 @@ class SlabBand(Computable[S]):
         """(N,) particles inside the band."""
         return self._computed("members").members
 
+    @property
+    def slab(self) -> Slab:
+        """The band's straight slab alone (no per-particle data): what a results file stores of it."""
+        pos = self._computed("slab").positions
+        extent = (
+            np.array([[pos[:, 0].min(), pos[:, 0].max()], [pos[:, 1].min(), pos[:, 1].max()]])
+            if pos.shape[0]
+            else np.full((2, 2), np.nan)
+        )
+        return Slab(
+            found=self.found,
+            angle=self.angle,
+            center=np.array(self.center, dtype=np.float64),
+            normal=np.array(self.normal, dtype=np.float64),
+            thickness=self.thickness,
+            thickness_diameters=self.thickness_diameters,
+            extent=extent,
+        )
+
     def outline(self, extent: ArrayLike | None = None) -> list[NDArray[np.float64]]:
         """The two band edges as (2, 2) segments clipped to ``extent`` ``[[x0, x1], [y0, y1]]``.
 
         ``extent`` defaults to the bounding box of the particles.
         """
-        if extent is None:
-            pos = self._computed("positions").positions
-            extent = np.array(
-                [[pos[:, 0].min(), pos[:, 0].max()], [pos[:, 1].min(), pos[:, 1].max()]]
-            )
-        ext = np.asarray(extent, dtype=np.float64)
+        return self.slab.outline(extent)
+
+
+@dataclass(frozen=True, eq=False)
+class Slab:
+    """A band as a straight slab: its centre line and thickness, and the box of
+    the particles it was found among (the default extent of :meth:`outline`).
+
+    What :attr:`SlabBand.slab` gives of any reading of the band, and what the
+    results file's analysis group stores (``docs/file-formats.md``)."""
+
+    #: Whether the band passed its reading's acceptance tests.
+    found: bool
+    #: Direction of the centre line, rad in [0, pi), CCW from +x.
+    angle: float
+    #: (2,) a point on the centre line, m.
+    center: NDArray[np.float64]
+    #: (2,) unit normal of the slab.
+    normal: NDArray[np.float64]
+    #: Thickness, m.
+    thickness: float
+    #: Thickness in mean diameters of the particles the band was found among.
+    thickness_diameters: float
+    #: (2, 2) ``[[x0, x1], [y0, y1]]``: the bounding box of those particles.
+    extent: NDArray[np.float64]
+
+    @property
+    def angle_degrees(self) -> float:
+        """Direction in degrees, [0, 180), CCW from +x."""
+        return float(np.degrees(self.angle))
+
+    @property
+    def inclination_degrees(self) -> float:
+        """Acute angle between the slab and the x axis, degrees in [0, 90]."""
+        return float(np.degrees(min(self.angle, np.pi - self.angle)))
+
+    def members(self, positions: ArrayLike) -> NDArray[np.bool_]:
+        """(N,) whether each point of ``positions`` (N, 2) lies inside the slab."""
+        p = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
+        return np.asarray(np.abs((p - self.center) @ self.normal) <= 0.5 * self.thickness)
+
+    def outline(self, extent: ArrayLike | None = None) -> list[NDArray[np.float64]]:
+        """The two edges as (2, 2) segments clipped to ``extent`` ``[[x0, x1], [y0, y1]]``
+        (default :attr:`extent`)."""
+        ext = np.asarray(self.extent if extent is None else extent, dtype=np.float64)
         t = np.array([np.cos(self.angle), np.sin(self.angle)])
         edges = []
         for side in (-0.5, 0.5):
-            p0 = self.center + side * self.thickness * self.normal
-            seg = _clip_line(p0, t, ext)
+            seg = _clip_line(self.center + side * self.thickness * self.normal, t, ext)
             if seg is not None:
                 edges.append(seg)
         return edges
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Slab):
+            return NotImplemented
+        return (
+            (self.found, self.angle, self.thickness, self.thickness_diameters)
+            == (other.found, other.angle, other.thickness, other.thickness_diameters)
+            and np.array_equal(self.center, other.center)
+            and np.array_equal(self.normal, other.normal)
+            and np.array_equal(self.extent, other.extent, equal_nan=True)
+        )
+
+    __hash__ = None  # type: ignore[assignment]
 
 
 class ShearBand(SlabBand[_ShearBandResults]):

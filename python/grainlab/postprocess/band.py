@@ -41,13 +41,9 @@ field (:class:`~grainlab.analysis.DisplacementBand`, with its own acceptance).
 
 from __future__ import annotations
 
-import hashlib
 import math
-from collections import OrderedDict
-from collections.abc import Mapping, Sequence
-from concurrent.futures import Future
-from dataclasses import dataclass, fields, replace
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -55,30 +51,24 @@ from scipy.spatial import cKDTree
 
 from grainlab.analysis._util import finite_mean
 from grainlab.analysis.band_readings import MIN_GRAINS, DisplacementBand
-from grainlab.analysis.shear_band import ShearBand
+from grainlab.analysis.shear_band import ShearBand, Slab
 from grainlab.analysis.stability import StabilityIndex
 from grainlab.analysis.strain import LocalStrain, match_ids
 from grainlab.snapshot import Snapshot
-
-if TYPE_CHECKING:
-    from grainlab.io.hdf5 import Results
-    from grainlab.plot.workers import FigurePool
 
 __all__ = [
     "LAMBDA_LIMIT",
     "READINGS",
     "BandNumbers",
     "BandSearch",
+    "DisplacementZone",
     "band_labels",
     "displacement_band",
+    "displacement_zone",
     "find_band",
     "find_field_band",
     "interior_grains",
-    "keep_searched",
-    "keep_searches",
     "lambda_indicator",
-    "search_ahead",
-    "searched",
     "slab_members",
 ]
 
@@ -136,17 +126,55 @@ class BandNumbers:
     second_prominence: float = math.nan
 
 
-@dataclass
+@dataclass(frozen=True)
 class BandSearch:
-    """What :func:`find_band` found: the numbers and the accepted bands themselves."""
+    """What :func:`find_band` (or :func:`find_field_band`) found: the numbers and the
+    accepted bands' slabs."""
 
     numbers: BandNumbers
     #: The accepted band (None when not found).
-    band: ShearBand | None
-    #: (N,) displacement magnitude of every particle of the snapshot (m), NaN for membrane disks.
+    band: Slab | None
+    #: (N,) displacement magnitude of every particle of the snapshot (m), NaN for membrane
+    #: disks (all NaN for a field band: there is no reference state).
     displacement: NDArray[np.float64]
     #: The accepted second band (None when not found).
-    second: ShearBand | None = None
+    second: Slab | None = None
+
+    def labels(self, snapshot: Snapshot) -> NDArray[np.int32]:
+        """(N,) per particle of ``snapshot`` (the one searched): 1 inside the accepted
+        band, 2 inside the accepted second band and not the first, 0 elsewhere
+        (membrane disks, and every particle when no band was accepted)."""
+        labels = np.zeros(snapshot.n_particles, np.int32)
+        grains = np.flatnonzero(snapshot.is_sample)
+        pos = snapshot.positions[grains]
+        if self.band is not None:
+            labels[grains[self.band.members(pos)]] = 1
+            if self.second is not None:
+                second = grains[self.second.members(pos)]
+                labels[second[labels[second] == 0]] = 2
+        return labels
+
+
+@dataclass(frozen=True)
+class DisplacementZone:
+    """Fig. 11's reading of the band (:func:`displacement_zone`): the best two-block
+    split of the grains' displacements, accepted or not."""
+
+    #: Whether the split passed :class:`~grainlab.analysis.DisplacementBand`'s tests.
+    found: bool
+    #: Why it was not accepted ("" when found).
+    reason: str
+    #: Share of the two-block fit's residual that the transition zone removes.
+    residual_reduction: float
+    #: The transition zone between the two blocks, accepted or not.
+    zone: Slab
+    #: (N,) per particle of the snapshot: 1 for the zone's grains, 0 elsewhere.
+    members: NDArray[np.int32]
+
+    @property
+    def labels(self) -> NDArray[np.int32]:
+        """(N,) :func:`band_labels`' reading: the zone's grains (1) when it was accepted, else 0."""
+        return self.members if self.found else np.zeros_like(self.members)
 
 
 def grains_only(snap: Snapshot) -> Snapshot:
@@ -206,46 +234,6 @@ def _eta2(
     return 1.0 - (1.0 - between / total) * (m - 1) / max(m - n_bins, 1)
 
 
-#: Searches kept by :func:`find_band` (the latest ones), by the digest of what they read.
-_SEARCHES_KEPT = 16
-_searches: OrderedDict[bytes, BandSearch] = OrderedDict()
-
-
-def _feed(digest: Any, value: Any) -> None:
-    if isinstance(value, np.ndarray) and not value.dtype.hasobject:
-        digest.update(f"{value.dtype.str}{value.shape}".encode())
-        digest.update(np.ascontiguousarray(value).view(np.uint8).reshape(-1).data)
-    elif isinstance(value, np.ndarray):
-        _feed(digest, value.tolist())
-    elif isinstance(value, Mapping):
-        digest.update(b"{")
-        for key in sorted(value, key=repr):
-            _feed(digest, key)
-            _feed(digest, value[key])
-        digest.update(b"}")
-    elif isinstance(value, tuple | list):
-        digest.update(b"(")
-        for item in value:
-            _feed(digest, item)
-        digest.update(b")")
-    else:
-        digest.update(f"{type(value).__name__}:{value!r}".encode())
-    digest.update(b"|")
-
-
-def _search_key(reference: Snapshot, current: Snapshot, stability: StabilityIndex) -> bytes:
-    """A digest of everything a band search reads: both snapshots' data (every field,
-    not their caches) and the stability index's per-particle values."""
-    digest = hashlib.blake2b(digest_size=24)
-    for snap in (reference, current):
-        for f in fields(snap):
-            if not f.name.startswith("_"):
-                _feed(digest, getattr(snap, f.name))
-    _feed(digest, np.asarray(stability.stability_index))
-    _feed(digest, np.asarray(stability.n_contacts))
-    return digest.digest()
-
-
 def find_band(
     reference: Snapshot,
     current: Snapshot,
@@ -261,74 +249,13 @@ def find_band(
     means in and out of the band); ``name``, ``reference_name`` and
     ``axial_strain`` label the :class:`BandNumbers`.
 
-    The search (twenty band fits: the band and its permutation test) is kept
-    for the latest few pairs of snapshots: the same snapshots searched again,
-    read again from the file or not (the figures' and the claims' searches of
-    one run), give the kept result, labelled anew, without a second search.
+    The search (twenty band fits: the band and its permutation test) is made
+    anew on every call; a run's searches are stored in its ``run.h5``
+    (:mod:`grainlab.postprocess.products`) and read from there.
     """
-    key = _search_key(reference, current, stability)
-    found = _searches.get(key)
-    if found is None:
-        found = _search(reference, current, stability)
-    _keep(key, found)
+    found = _search(reference, current, stability)
     numbers = replace(found.numbers, snapshot=name, reference=reference_name, axial_strain=axial_strain)
-    return BandSearch(numbers, found.band, found.displacement.copy(), found.second)
-
-
-def _keep(key: bytes, found: BandSearch) -> None:
-    _searches[key] = found
-    _searches.move_to_end(key)
-    while len(_searches) > _SEARCHES_KEPT:
-        _searches.popitem(last=False)
-
-
-def searched() -> list[tuple[bytes, BandSearch]]:
-    """The searches :func:`find_band` keeps, oldest first, by digest: what a worker
-    process sends back for :func:`keep_searched` to keep in the process that asked."""
-    return list(_searches.items())
-
-
-def keep_searched(searches: Sequence[tuple[bytes, BandSearch]]) -> None:
-    """Keeps the searches of :func:`searched` (made in another process) for :func:`find_band`."""
-    for key, found in searches:
-        _keep(key, found)
-
-
-def _pair(results: Results, reference: str, current: str) -> tuple[Snapshot, Snapshot, StabilityIndex]:
-    ref, cur = results.snapshot(reference), results.snapshot(current)
-    return ref, cur, StabilityIndex().compute(cur)
-
-
-def _search_in_file(path: str, reference: str, current: str) -> tuple[bytes, BandSearch]:
-    """A worker's search of two snapshots of ``run.h5`` at ``path`` (the stability
-    index of :func:`band_labels`), with the digest :func:`find_band` keeps it by."""
-    from grainlab.io.hdf5 import read_results
-
-    ref, cur, stability = _pair(read_results(path), reference, current)
-    return _search_key(ref, cur, stability), _search(ref, cur, stability)
-
-
-def search_ahead(results: Results, pairs: Sequence[tuple[str, str]], pool: FigurePool) -> list[Future[Any]]:
-    """Starts in ``pool`` the band searches of :func:`band_labels` for the snapshot
-    pairs ``(reference, current)`` of ``results`` that :func:`find_band` does not
-    keep yet (at most as many as it keeps); :func:`keep_searches` waits for them
-    and keeps them, so that the searches made next find them done."""
-    todo = []
-    for reference, current in pairs[:_SEARCHES_KEPT]:
-        if _search_key(*_pair(results, reference, current)) not in _searches:
-            todo.append(pool.submit(_search_in_file, str(results.path), reference, current))
-    return todo
-
-
-def keep_searches(started: Sequence[Future[Any]]) -> None:
-    """Waits for the searches of :func:`search_ahead` and keeps them for :func:`find_band`.
-    One that failed is left out: the search made next does it again and reports its error."""
-    for future in started:
-        try:
-            key, found = future.result()
-        except Exception:  # noqa: S112, PERF203 - redone (and its error raised) by the search itself
-            continue
-        _keep(key, found)
+    return replace(found, numbers=numbers)
 
 
 def _search(reference: Snapshot, current: Snapshot, stability: StabilityIndex) -> BandSearch:
@@ -439,7 +366,7 @@ def _accepted_band(
             prominence=band.prominence,
         )
     second = band.second
-    accepted_second = None
+    accepted_second: Slab | None = None
     if second is not None:
         second_problems = _band_problems(second, pos, d_mean, side)
         numbers.update(
@@ -457,18 +384,18 @@ def _accepted_band(
             second_contrast=second.contrast,
             second_prominence=second.prominence,
         )
-        accepted_second = None if second_problems else second
+        accepted_second = None if second_problems else second.slab
     return BandSearch(
         BandNumbers(name, reference_name, axial_strain, True, "", **numbers),
-        band,
+        band.slab,
         displacement,
         accepted_second,
     )
 
 
-def slab_members(band: ShearBand, pos: NDArray[np.float64]) -> NDArray[np.bool_]:
+def slab_members(band: ShearBand | Slab, pos: NDArray[np.float64]) -> NDArray[np.bool_]:
     """Grains whose centre lies inside the band's slab (boundary grains included)."""
-    return np.asarray(np.abs((pos - band.center) @ band.normal) <= 0.5 * band.thickness)
+    return (band if isinstance(band, Slab) else band.slab).members(pos)
 
 
 def _band_problems(
@@ -548,8 +475,7 @@ def find_field_band(
     found = _accepted_band(
         snapshot, values.copy(), stability, np.full(snapshot.n_particles, np.nan), _FIELD_WORDS
     )
-    numbers = replace(found.numbers, snapshot=name, axial_strain=axial_strain)
-    return BandSearch(numbers, found.band, found.displacement, found.second)
+    return replace(found, numbers=replace(found.numbers, snapshot=name, axial_strain=axial_strain))
 
 
 def displacement_band(reference: Snapshot, current: Snapshot) -> DisplacementBand | None:
@@ -567,6 +493,17 @@ def displacement_band(reference: Snapshot, current: Snapshot) -> DisplacementBan
     return DisplacementBand().compute(cur.positions, disp, cur.radii)
 
 
+def displacement_zone(reference: Snapshot, current: Snapshot) -> DisplacementZone | None:
+    """:func:`displacement_band` as a :class:`DisplacementZone` of ``current``'s particles
+    (what the results file stores of it); None when it is None."""
+    moved = displacement_band(reference, current)
+    if moved is None:
+        return None
+    members = np.zeros(current.n_particles, np.int32)
+    members[np.flatnonzero(current.is_sample)[np.asarray(moved.members)]] = 1
+    return DisplacementZone(moved.found, moved.reason, float(moved.residual_reduction), moved.slab, members)
+
+
 def band_labels(reference: Snapshot, current: Snapshot, reading: str = "strain") -> NDArray[np.int32]:
     """(N,) per particle of ``current``: 1 inside the accepted shear band, 2
     inside its accepted conjugate band, 0 elsewhere (membrane disks, and every
@@ -582,25 +519,16 @@ def band_labels(reference: Snapshot, current: Snapshot, reading: str = "strain")
     * ``"lambda"``: the band of the grains with lambda > 0.5 in ``current``
       (:func:`find_field_band` on :func:`lambda_indicator`, ``StabilityIndex()``
       defaults; Fig. 12), with its conjugate band as for the strain.
+
+    The labels are found anew; a run's are stored in its ``run.h5``
+    (:class:`grainlab.postprocess.products.RunProducts`).
     """
     if reading not in READINGS:
         raise ValueError(f"reading: must be one of {', '.join(map(repr, READINGS))}, got {reading!r}")
-    labels = np.zeros(current.n_particles, np.int32)
-    grains = np.flatnonzero(current.is_sample)
     if reading == "displacement":
-        moved = displacement_band(reference, current)
-        if moved is not None and moved.found:
-            labels[grains[moved.members]] = 1
-        return labels
+        zone = displacement_zone(reference, current)
+        return np.zeros(current.n_particles, np.int32) if zone is None else zone.labels
     stability = StabilityIndex().compute(current)
     if reading == "lambda":
-        found = find_field_band(current, lambda_indicator(stability), stability)
-    else:
-        found = find_band(reference, current, stability, reference_name="")
-    pos = current.positions[grains]
-    if found.band is not None:
-        labels[grains[slab_members(found.band, pos)]] = 1
-        if found.second is not None:
-            second = grains[slab_members(found.second, pos)]
-            labels[second[labels[second] == 0]] = 2
-    return labels
+        return find_field_band(current, lambda_indicator(stability), stability).labels(current)
+    return find_band(reference, current, stability).labels(current)

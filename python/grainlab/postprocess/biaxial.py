@@ -14,8 +14,9 @@ States
 Shear band
     Found on each pair (initial, peak) and (initial, final) by
     :func:`~grainlab.postprocess.band.find_band` (its acceptance tests are
-    described there); a band that fails them is "not found" and
-    :attr:`BandNumbers.reason` says why.
+    described there), read from the run's stored products when ``run.h5``
+    holds them (:mod:`grainlab.postprocess.products`); a band that fails
+    them is "not found" and :attr:`BandNumbers.reason` says why.
 
 Stability index
     lambda with the library's default: contacts with membrane disks and
@@ -27,7 +28,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -40,7 +41,8 @@ from grainlab.analysis.stability import StabilityIndex
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.io.results import json_safe
-from grainlab.postprocess.band import BandNumbers, BandSearch, find_band
+from grainlab.postprocess.band import BandNumbers, BandSearch
+from grainlab.postprocess.products import RunProducts
 from grainlab.snapshot import Snapshot
 
 __all__ = [
@@ -313,15 +315,12 @@ def _state_numbers(st: RunState) -> StateNumbers:
     )
 
 
-def _band(reference: RunState, current: RunState) -> BandSearch:
-    return find_band(
-        reference.snap,
-        current.snap,
-        current.stability,
-        name=current.name,
-        reference_name=reference.name,
-        axial_strain=current.strain,
-    )
+def _band(products: RunProducts, reference: RunState, current: RunState) -> BandSearch:
+    """The stored band search at ``current`` (made anew when the file holds none), labelled
+    with the states' names and strain."""
+    found = products.band_search(current.name)
+    numbers = replace(found.numbers, snapshot=current.name, reference=reference.name, axial_strain=current.strain)
+    return replace(found, numbers=numbers)
 
 
 def _select_peak(
@@ -357,6 +356,7 @@ def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> 
     names = results.snapshot_names
     if not names:
         raise ValueError(f"{results.path}: the run has no snapshots")
+    products = RunProducts(results)
     notes: list[str] = []
     eps = np.asarray(ts[AXIAL_STRAIN], dtype=np.float64)
     q = np.asarray(ts[STRESS_RATIO], dtype=np.float64)
@@ -408,9 +408,9 @@ def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> 
         notes.append("only one snapshot: no displacements and no shear band")
     else:
         if k_snap != 0:
-            bands["peak"] = _band(states["initial"], states["peak"])
+            bands["peak"] = _band(products, states["initial"], states["peak"])
         if last not in (0, k_snap):
-            bands["final"] = _band(states["initial"], states["final"])
+            bands["final"] = _band(products, states["initial"], states["final"])
     for key, b in bands.items():
         if not b.numbers.found:
             notes.append(

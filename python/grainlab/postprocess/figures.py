@@ -34,7 +34,7 @@ from grainlab.plot.biaxial import (
     shared_map_figure,
 )
 from grainlab.plot.workers import FigureTask, figure_pool
-from grainlab.postprocess.band import BandSearch, keep_searched, searched
+from grainlab.postprocess.band import BandSearch
 from grainlab.postprocess.biaxial import FabricNumbers, RunAnalysis, RunState, analyse_run
 
 __all__ = ["FIGURES", "FabricFigures", "fabric_figures", "figure_tasks"]
@@ -223,17 +223,13 @@ def fabric_figures(
     """
     with figure_pool(workers, tasks=len(FIGURES)) as pool:
         # measured in a worker too: its numerical libraries run on one thread (twice as fast here)
-        numbers, tasks, searches = pool.submit(_planned, Path(run_dir), peak_snapshot).result()
-        keep_searched(searches)
+        numbers, tasks = pool.submit(_planned, Path(run_dir), peak_snapshot).result()
         out = Path(out_dir) if out_dir is not None else numbers.results_path.parent
         drawn = pool.draw(tasks, out).result()
     return FabricFigures(drawn, numbers)
 
 
-def _planned(
-    run_dir: Path, peak_snapshot: str | int | None
-) -> tuple[FabricNumbers, list[FigureTask], list[tuple[bytes, BandSearch]]]:
-    """The run measured and its figures planned (where the pool runs it), with the band
-    searches made there, for :func:`~grainlab.postprocess.band.find_band` to keep here."""
+def _planned(run_dir: Path, peak_snapshot: str | int | None) -> tuple[FabricNumbers, list[FigureTask]]:
+    """The run measured and its figures planned (where the pool runs it)."""
     analysis = analyse_run(run_dir, peak_snapshot)
-    return analysis.numbers, figure_tasks(analysis), searched()
+    return analysis.numbers, figure_tasks(analysis)

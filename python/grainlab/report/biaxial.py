@@ -28,6 +28,7 @@ from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.paper import BIAXIAL_CLAIMS, STRAIN_RATE_PER_S, TABLE1
 from grainlab.postprocess.band import BandNumbers
+from grainlab.postprocess.products import store_run_products
 from grainlab.protocols.config import FIELDS, QUICK
 from grainlab.report.angles import (
     DEFAULT_DILATION_WINDOW,
@@ -483,29 +484,21 @@ def gather_biaxial(
     the fabric figures are drawn here, in which case they are the new ones.
     """
     from grainlab.plot.workers import figure_pool
-    from grainlab.postprocess.band import keep_searches, search_ahead
 
     folder = Path(folder)
     results = check_biaxial_folder(folder)
-    # the claims' band searches (the slow part of the report) run in worker processes
-    # (those of an enclosing figure pool, e.g. grainlab biaxial's) while the figures and
-    # the report's own numbers are made here
+    notes: list[str] = []
+    # the bands and lambda fields that the figures and the claims read: a run of this
+    # grainlab stored them; an older file gets them now, in worker processes
     with figure_pool(tasks=len(results.snapshot_names)) as pool:
-        started = search_ahead(results, _claim_pairs(results), pool)
-        report = _gather(folder, results, redraw, dilation_window)
-        import grainlab.reproduction.claims  # noqa: F401 - imported (scipy.stats: ~1 s) while the workers search
-        keep_searches(started)
+        try:
+            results = store_run_products(results, pool)
+        except OSError as exc:  # a read-only folder: every reader makes them anew
+            notes.append(f"the analysis products could not be stored in run.h5 ({exc}): made anew for this report")
+    report = _gather(folder, results, redraw, dilation_window)
+    report.notes[:0] = notes
     report.claim_rows = _claim_rows(folder, report.notes)
     return report
-
-
-def _claim_pairs(results: Results) -> list[tuple[str, str]]:
-    """The snapshot pairs whose bands the claims measure (:func:`grainlab.reproduction.measures.measure_biaxial`):
-    each snapshot against the first, in the order of their axial strains."""
-    infos = list(results.snapshots)
-    strains = [math.nan if info.axial_strain is None else float(info.axial_strain) for info in infos]
-    order = sorted(range(len(infos)), key=lambda k: strains[k])
-    return [(infos[order[0]].name, infos[k].name) for k in order[1:]]
 
 
 def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float) -> BiaxialReport:

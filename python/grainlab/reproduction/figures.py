@@ -259,44 +259,38 @@ def band_readings_figure(run_dir: str | Path, title: str = "") -> Figure:
     stress-ratio peak and at the last one: grains coloured by their displacement since
     0 %, the displacement map's two-block split (accepted or not, with its share of the
     residual removed), and the bands accepted in the local strain and in lambda > 0.5."""
-    from grainlab.analysis.stability import StabilityIndex
-    from grainlab.io.hdf5 import read_results
-    from grainlab.postprocess.band import (
-        displacement_band,
-        find_band,
-        find_field_band,
-        lambda_indicator,
-    )
+    from grainlab.postprocess.products import RunProducts
     from grainlab.reproduction.measures import macro_measures
 
-    results = read_results(run_dir)
+    products = RunProducts(run_dir)
+    results = products.results
+
     def strain(info: Any) -> float:
         return math.nan if info.axial_strain is None else float(info.axial_strain)
 
-    infos = sorted(results.snapshots, key=strain)
+    by_name = {info.name: info for info in results.snapshots}
+    infos = [by_name[name] for name in products.names_by_strain]
     peak = macro_measures(results.timeseries)["peak_axial_strain"]
     chosen = [min(infos[1:], key=lambda i: abs(strain(i) - peak)), infos[-1]]
-    reference = results.snapshot(infos[0].name)
     with plot.paper_style():
         fig = Figure(figsize=(8.0, 7.0), layout="constrained")
         axes = fig.subplots(1, 2)
         for ax, info in zip(axes, chosen, strict=True):
             snap = results.snapshot(info.name)
-            stability = StabilityIndex().compute(snap)
-            strain_band = find_band(reference, snap, stability)
+            strain_band = products.band_search(info.name)
             grains = np.asarray(snap.is_sample)
             plot.particle_map(snap.positions[grains], snap.radii[grains], 1e3 * strain_band.displacement[grains],
                               ax=ax, cmap="Greys", label="displacement since 0 % (mm)")
-            moved = displacement_band(reference, snap)
+            moved = products.displacement_zone(info.name)
             if moved is not None:
-                for k, seg in enumerate(moved.outline()):
+                for k, seg in enumerate(moved.zone.outline()):
                     verdict = "accepted" if moved.found else "not accepted"
                     ax.plot(seg[:, 0], seg[:, 1], color="C1", linewidth=1.4,
                             label=(f"two-block split ({verdict};\nremoves {moved.residual_reduction:.2f} "
                                    "of the residual)") if k == 0 else None)
             if strain_band.band is not None:
                 plot.outline_shear_band(ax, strain_band.band, color="crimson", linestyle="--")
-            field = find_field_band(snap, lambda_indicator(stability), stability)
+            field = products.lambda_band(info.name)
             if field.band is not None:
                 for k, seg in enumerate(field.band.outline()):
                     ax.plot(seg[:, 0], seg[:, 1], color="C0", linestyle=":", linewidth=1.4,

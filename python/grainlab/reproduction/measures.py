@@ -30,6 +30,7 @@ from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 
 if TYPE_CHECKING:
     from grainlab.analysis.stability import StabilityIndex
+    from grainlab.postprocess.products import RunProducts
 
 #: Analysis options a variant may set, with their defaults: how lambda counts the boundary
 #: ("body" or "raw") and reads Eqs. 9-11 (StabilityIndex's slots, anchor and deviation), and
@@ -157,16 +158,18 @@ def measure_biaxial(run_dir: str | Path, options: Mapping[str, Any] | None = Non
 def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """:func:`measure_biaxial` under each of several analysis options, reading the
     run and finding its bands (which do not depend on the options) once."""
-    from grainlab.io.hdf5 import read_results
-    from grainlab.postprocess.band import band_labels
+    from grainlab.postprocess.products import RunProducts
 
-    results = read_results(run_dir)
+    products = RunProducts(run_dir)
+    results = products.results
     ts = results.timeseries
     macro = macro_measures(ts)
     infos = list(results.snapshots)
     strains = [_snapshot_strain(info) for info in infos]
-    order = sorted(range(len(infos)), key=lambda k: strains[k])
-    snaps = [results.snapshot(infos[k].name) for k in order]
+    position = {info.name: k for k, info in enumerate(infos)}
+    order = [position[name] for name in products.names_by_strain]
+    names = products.names_by_strain
+    snaps = [results.snapshot(name) for name in names]
     peak_pos = nearest_snapshot([strains[k] for k in order], macro["peak_axial_strain"])
     readings: dict[str, tuple[list[NDArray[np.int32] | None], list[tuple[NDArray[np.bool_], int] | None]]] = {}
 
@@ -176,12 +179,12 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
             if reading not in BAND_READINGS:
                 raise ValueError(f"band: expected one of {', '.join(BAND_READINGS)}, got {reading!r}")
             if reading == "displacement":
-                labels, candidates = _displacement_readings(snaps)
+                labels, candidates = _displacement_readings(products, snaps)
                 readings[reading] = (labels, _band_members(snaps, candidates))
                 return readings[reading]
             found = "strain" if reading == "final" else reading
             labels = readings[found][0] if found in readings else (
-                [None] + [band_labels(snaps[0], snap, reading=found) for snap in snaps[1:]])
+                [None] + [products.band_labels(name, reading=found) for name in names[1:]])
             members = _final_band_members(snaps, labels) if reading == "final" else _band_members(snaps, labels)
             readings[reading] = (labels, members)
         return readings[reading]
@@ -248,23 +251,18 @@ def _band_members(snaps: Sequence[Any], labels: Sequence[NDArray[np.int32] | Non
     return out
 
 
-def _displacement_readings(snaps: Sequence[Any]) -> tuple[list[NDArray[np.int32] | None],
-                                                          list[NDArray[np.int32] | None]]:
-    """The displacement map's band at each snapshot since the first: labels of the band
-    accepted (1; zeros when the two-block fit fails the acceptance test), and labels of
-    the best two-block split's transition zone, accepted or not: the paper reads its
-    band off the displacement map (Fig. 11) with no test, so the band's grains are the
-    candidate's, while ``band_found`` counts accepted bands only."""
-    from grainlab.postprocess.band import displacement_band
-
+def _displacement_readings(products: RunProducts, snaps: Sequence[Any]
+                           ) -> tuple[list[NDArray[np.int32] | None], list[NDArray[np.int32] | None]]:
+    """The displacement map's band at each snapshot (in ``products``' strain order) since
+    the first: labels of the band accepted (1; zeros when the two-block fit fails the
+    acceptance test), and labels of the best two-block split's transition zone, accepted
+    or not: the paper reads its band off the displacement map (Fig. 11) with no test, so
+    the band's grains are the candidate's, while ``band_found`` counts accepted bands only."""
     accepted: list[NDArray[np.int32] | None] = [None]
     candidates: list[NDArray[np.int32] | None] = [None]
-    for snap in snaps[1:]:
-        moved = displacement_band(snaps[0], snap)
-        grains = np.flatnonzero(np.asarray(snap.is_sample))
-        zone = np.zeros(snap.n_particles, np.int32)
-        if moved is not None:
-            zone[grains[np.asarray(moved.members)]] = 1
+    for name, snap in zip(products.names_by_strain[1:], snaps[1:], strict=True):
+        moved = products.displacement_zone(name)
+        zone = np.zeros(snap.n_particles, np.int32) if moved is None else moved.members
         accepted.append(zone if moved is not None and moved.found else np.zeros(snap.n_particles, np.int32))
         candidates.append(zone)
     return accepted, candidates

@@ -3,11 +3,12 @@
 :func:`viewer_data` reads every snapshot of a results file and computes, per
 snapshot, the per-grain values the page colours by (the ones the ParaView
 export writes, :func:`grainlab.postprocess.vtk.snapshot_arrays`): the
-stability index lambda (:class:`~grainlab.analysis.StabilityIndex` with its
-defaults, the run's value), the number of contacts, the displacement and
+stability index lambda (the run's stored lambda field,
+:class:`grainlab.postprocess.products.RunProducts`), the number of contacts, the displacement and
 the rotation since the first snapshot, the local shear strain since it and
 the shear band labels; the particle–particle contacts with their normal
-forces; the accepted bands' outlines (:func:`grainlab.postprocess.band.find_band`);
+forces; the accepted bands' outlines (the run's stored band searches, against its
+snapshot of smallest axial strain);
 the walls when the file stores them; and the stress–strain curve of the
 time series.
 
@@ -26,11 +27,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.analysis import StabilityIndex, match_ids
+from grainlab.analysis import match_ids
 from grainlab.columns import AXIAL_STRAIN, AXIAL_STRESS_PA, STRESS_RATIO, VERTICAL_STRESS_PA
 from grainlab.io.hdf5 import read_results
 from grainlab.io.vtk import contact_lines
-from grainlab.postprocess.band import find_band
+from grainlab.postprocess.products import RunProducts
 from grainlab.postprocess.vtk import snapshot_arrays
 
 __all__ = ["CURVE_COLUMNS", "encode", "viewer_data"]
@@ -55,7 +56,7 @@ def _band_outline(band: Any) -> dict[str, Any] | None:
     }
 
 
-def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str) -> dict[str, Any]:
+def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str, products: RunProducts) -> dict[str, Any]:
     arrays = snapshot_arrays(snap, first)
     n = snap.n_particles
     rotation = np.zeros(n)
@@ -67,9 +68,9 @@ def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str) ->
     lines, line_data, _ = contact_lines(snap)
     force = line_data.get("normal_force", np.full(len(lines), np.nan))
     outline: dict[str, Any] = {"first": None, "second": None}
-    if snap is not first:
+    if name != products.reference:
         try:
-            search = find_band(first, snap, StabilityIndex().compute(snap), name=name)
+            search = products.band_search(name)
             outline = {"first": _band_outline(search.band), "second": _band_outline(search.second)}
         except ValueError:  # too few grains with a local strain: no band
             pass
@@ -88,7 +89,7 @@ def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str) ->
             "r": encode(snap.radii, "f4"),
             "id": encode(snap.ids, "u4"),
             "kind": encode(snap.kind, "u1"),
-            "lambda": encode(arrays["stability_index"], "f4"),
+            "lambda": encode(products.stability_index(name).stability_index, "f4"),
             "contacts": encode(np.minimum(arrays["n_contacts"], 255), "u1"),
             "dx": encode(disp[:, 0], "f4"),
             "dy": encode(disp[:, 1], "f4"),
@@ -123,6 +124,7 @@ def viewer_data(run: str | Path) -> dict[str, Any]:
     names = list(results.snapshot_names)
     if not names:
         raise ValueError(f"{h5}: the run has no snapshots to view")
+    products = RunProducts(results)
     snaps = [results.snapshot(name) for name in names]
     largest = max(s.n_particles for s in snaps)
     index_dtype = "u2" if largest < 2**16 else "u4"
@@ -142,7 +144,7 @@ def viewer_data(run: str | Path) -> dict[str, Any]:
         "peak_stress_ratio": _finite(results.summary.get("peak_stress_ratio")),
         "curve": curve,
         "snapshots": [
-            _snapshot(name, snap, snaps[0], results.walls(name), index_dtype)
+            _snapshot(name, snap, snaps[0], results.walls(name), index_dtype, products)
             for name, snap in zip(names, snaps, strict=True)
         ],
     }

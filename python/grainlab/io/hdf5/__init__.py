@@ -3,12 +3,14 @@
 The layouts are specified, group by group and attribute by attribute, in
 ``docs/file-formats.md``; this module is their reference implementation.
 
-Results file (``format = "grainlab-results"``, ``format_version = 1``)
+Results file (``format = "grainlab-results"``, ``format_version = 2``)
     :class:`ResultsWriter` creates it while a run goes on; :func:`read_results`
     loads it as a :class:`Results`. It holds the resolved configuration,
     the time series (one appendable float64 column per measurement), full
     :class:`~grainlab.snapshot.Snapshot` objects, a summary and wall time per
-    phase.
+    phase. Version 2 adds the analysis group (:mod:`grainlab.io.hdf5.analysis`):
+    products of the analysis stored with the run, added to a complete file by
+    :func:`write_analysis`.
 
 Crash safety
     The writer works on ``run.h5.partial`` with root attribute
@@ -75,6 +77,7 @@ from grainlab.io.hdf5._layout import (
     PARTIAL_SUFFIX,
     Status,
 )
+from grainlab.io.hdf5.analysis import ANALYSIS_GROUP, AnalysisItem, write_analysis
 from grainlab.io.hdf5.checkpoint import Checkpoint, read_checkpoint, write_checkpoint
 from grainlab.io.hdf5.errors import (
     CheckpointError,
@@ -87,12 +90,14 @@ from grainlab.io.hdf5.snapshot import SnapshotInfo, snapshot_name
 from grainlab.io.hdf5.writer import ResultsWriter
 
 __all__ = [
+    "ANALYSIS_GROUP",
     "CHECKPOINT_FORMAT",
     "CHECKPOINT_FORMAT_VERSION",
     "FORMAT",
     "FORMAT_VERSION",
     "INTEGER_COLUMNS",
     "PARTIAL_SUFFIX",
+    "AnalysisItem",
     "Checkpoint",
     "CheckpointError",
     "IncompleteResultsError",
@@ -107,5 +112,6 @@ __all__ = [
     "read_results",
     "results_kind",
     "snapshot_name",
+    "write_analysis",
     "write_checkpoint",
 ]

@@ -21,8 +21,8 @@ from grainlab.io.results import RESULTS_FILE, json_safe
 
 #: Root attribute ``format`` of a results file.
 FORMAT = "grainlab-results"
-#: Layout version written by this grainlab.
-FORMAT_VERSION = 1
+#: Layout version written by this grainlab: 2 adds the analysis group to version 1's layout.
+FORMAT_VERSION = 2
 #: Root attribute ``format`` of a checkpoint file.
 CHECKPOINT_FORMAT = "grainlab-checkpoint"
 #: Checkpoint layout version written by this grainlab.
@@ -198,7 +198,8 @@ def _check_format(
             raise UnsupportedVersionError(
                 path,
                 f"format_version {version} is newer than this grainlab "
-                f"({_grainlab_version()}) can read (it reads {expected} version {known}); "
+                f"({_grainlab_version()}) can read (it reads {expected} "
+                f"version{'s' if len(readers) > 1 else ''} {known}); "
                 "upgrade grainlab to read this file",
             )
         raise error(path, f"format_version {version} is unknown (known versions: {known})")

@@ -25,6 +25,7 @@ from grainlab.io.hdf5._layout import (
     _read_json,
     _resolve_results_path,
 )
+from grainlab.io.hdf5.analysis import AnalysisItem, read_analysis_item, read_analysis_versions
 from grainlab.io.hdf5.errors import IncompleteResultsError, ResultsFileError
 from grainlab.io.hdf5.snapshot import SnapshotInfo, _read_snapshot_group_v1, _snapshot_infos_v1
 from grainlab.io.walls import WallGeometry, read_wall_group
@@ -67,6 +68,9 @@ class Results:
     snapshots: tuple[SnapshotInfo, ...]
     #: All root attributes of the file (including ``error`` of a failed run).
     attrs: dict[str, Any] = field(default_factory=dict)
+    #: The analysis products stored in the file, ``product -> version`` (empty in
+    #: version-1 files and before any is stored; :mod:`grainlab.io.hdf5.analysis`).
+    analysis_versions: dict[str, int] = field(default_factory=dict)
     _allow_incomplete: bool = field(default=False, repr=False)
 
     @property
@@ -89,6 +93,26 @@ class Results:
         info = _select(self.path, self.snapshots, name, None)
         with _open_results(self.path, self._allow_incomplete) as (f, reader):
             return reader.read_snapshot(f, info.name, self.path)
+
+    def analysis(self, product: str, item: str) -> AnalysisItem | None:
+        """The stored ``item`` (a snapshot's name) of the analysis ``product``, or None
+        when the file does not hold it (read from the file now, not when loaded)."""
+        if product not in self.analysis_versions:
+            return None
+        with _open_results(self.path, self._allow_incomplete) as (f, _reader):
+            return read_analysis_item(f, product, item)
+
+    @contextlib.contextmanager
+    def analysis_reader(self) -> Iterator[Callable[[str, str], AnalysisItem | None]]:
+        """Reads many stored analysis items with the file opened once: yields
+        ``read(product, item)``, :meth:`analysis` within the block."""
+        with _open_results(self.path, self._allow_incomplete) as (f, _reader):
+            versions = self.analysis_versions
+
+            def read(product: str, item: str) -> AnalysisItem | None:
+                return read_analysis_item(f, product, item) if product in versions else None
+
+            yield read
 
     def walls(self, name: str | int | None = None) -> WallGeometry | None:
         """The walls stored with a snapshot (selected as by :meth:`snapshot`), or None if none were."""
@@ -149,6 +173,7 @@ def _read_results_v1(f: h5py.File, path: Path, allow_incomplete: bool) -> Result
         phases=phases,
         snapshots=_snapshot_infos_v1(f),
         attrs=attrs,
+        analysis_versions=read_analysis_versions(f),
         _allow_incomplete=allow_incomplete,
     )
 
@@ -163,6 +188,8 @@ def _read_snapshot_v1(f: h5py.File, name: str, path: Path) -> Snapshot:
 #: Reader of each results layout version. A new layout adds an entry; old ones stay.
 _READERS_BY_VERSION: dict[int, _LayoutReader] = {
     1: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_v1),
+    # version 2 is version 1 and the analysis group, which version 1 files do not have
+    2: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_v1),
 }
 
 

@@ -100,13 +100,18 @@ def _write_outputs(out: Path) -> dict[str, Any]:
     from grainlab.io.hdf5 import read_results
     from grainlab.plot.workers import figure_pool
     from grainlab.postprocess import figures
+    from grainlab.postprocess.products import store_run_products
 
     results = read_results(out / RESULTS_FILE)
     raise_if_interrupted()  # a Ctrl-C that h5py's clean-up swallowed stops the run here
     summary = dict(results.summary)
     write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
-    with figure_pool(tasks=3 + len(figures.FIGURES), page_copies=True):
+    with figure_pool(tasks=3 + len(figures.FIGURES), page_copies=True) as pool:
         _figures(results.timeseries, out)
+        # the bands and lambda fields of every snapshot, stored in run.h5 for the figures,
+        # the report, the viewer and the claims to read
+        store_run_products(out / RESULTS_FILE, pool)
+        raise_if_interrupted()
         # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
         summary["fabric"] = figures.fabric_figures(out).numbers.summary()
     raise_if_interrupted()
