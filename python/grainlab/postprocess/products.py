@@ -9,9 +9,9 @@ reader of an older file), and kept in the results file's analysis group
 is how every reader gets them: the stored item when the file holds it, made
 anew (and not stored) otherwise, so a read-only file is read all the same.
 
-Every product of a snapshot is taken against the run's *reference*: its snapshot
-of smallest axial strain (the start of shearing), as the paper measures the
-displacements. The products and the rule of each (its version; a changed rule
+Every product of a snapshot is taken against the run's *reference*: its first
+snapshot written (a biaxial run's start of shearing, its smallest axial strain),
+as the paper measures the displacements. The products and the rule of each (its version; a changed rule
 gets a new version, and the stored items of the old one are made again):
 
 ``stability_index`` (version 1)
@@ -223,13 +223,15 @@ class RunProducts:
         if not infos:
             raise ValueError(f"{self.results.path}: the run has no snapshots")
         self._strain = {info.name: snapshot_strain(info) for info in infos}
-        # the smallest strain, the first snapshot on ties or without strains (NaN last)
-        order = sorted(range(len(infos)),
-                       key=lambda k: (math.isnan(self._strain[infos[k].name]), self._strain[infos[k].name], k))
-        #: The snapshot every product is taken against (the smallest axial strain).
-        self.reference = infos[order[0]].name
+        #: The snapshot every product is taken against: the first written (the start of
+        #: shearing, the smallest axial strain of a biaxial run).
+        self.reference = min(infos, key=lambda info: info.index).name
+        # the others by axial strain, the first written on ties or without strains (NaN last)
+        order = sorted((k for k in range(len(infos)) if infos[k].name != self.reference),
+                       key=lambda k: (math.isnan(self._strain[infos[k].name]), self._strain[infos[k].name],
+                                      infos[k].index))
         #: The snapshots in order of their axial strains, the reference first.
-        self.names_by_strain = [infos[k].name for k in order]
+        self.names_by_strain = [self.reference] + [infos[k].name for k in order]
         self._made: dict[tuple[str, str], AnalysisItem] = {}
         self._snapshots: dict[str, Snapshot] = {}
 

@@ -8,7 +8,7 @@ stability index lambda (the run's stored lambda field,
 the rotation since the first snapshot, the local shear strain since it and
 the shear band labels; the particle–particle contacts with their normal
 forces; the accepted bands' outlines (the run's stored band searches, against its
-snapshot of smallest axial strain);
+first snapshot);
 the walls when the file stores them; and the stress–strain curve of the
 time series.
 
