@@ -1,6 +1,6 @@
 """The time-series columns the protocols record, in one place: each column's
 name, unit and meaning (:class:`Column`), and the columns of each test
-(:class:`Columns`: :data:`BIAXIAL`, :data:`OEDOMETER`).
+(:class:`Columns`: :data:`BIAXIAL`, :data:`OEDOMETER`, :data:`CYCLIC`).
 
 A :class:`Column` *is* its name (a ``str``), so ``timeseries[AXIAL_STRAIN]``
 reads the column from a results file, a CSV or a record, while
@@ -28,6 +28,8 @@ __all__ = [
     "AXIAL_STRESS_PA",
     "BIAXIAL",
     "COORDINATION_NUMBER",
+    "CYCLE",
+    "CYCLIC",
     "Column",
     "Columns",
     "FABRIC",
@@ -35,6 +37,7 @@ __all__ = [
     "LATERAL_STRESS_RATIO",
     "OEDOMETER",
     "OVERCONSOLIDATION_RATIO",
+    "STRAIN_PATH",
     "STRESS_RATIO",
     "VERTICAL_STRESS_PA",
     "VOLUMETRIC_STRAIN",
@@ -169,8 +172,15 @@ OEDOMETER = Columns(
     FABRIC,
 )
 
+# ---- the cyclic biaxial test's ------------------------------------------------------
+STRAIN_PATH = Column("strain_path", "1", "axial strain travelled since the start of cycling, whatever its direction")
+CYCLE = Column("cycle", "1", "cycles done: strain_path / (4 x amplitude)")
+
+#: The cyclic biaxial test's records (grainlab.protocols.cyclic): the biaxial test's and the path.
+CYCLIC = Columns("cyclic", BIAXIAL.columns, (STRAIN_PATH, CYCLE))
+
 #: Every test's columns, by the results file's ``kind``.
-BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER}
+BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER, CYCLIC.kind: CYCLIC}
 
 
 _BLOCK = re.compile(

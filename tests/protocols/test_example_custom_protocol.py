@@ -12,9 +12,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from resume_check import assert_same_run, stop_and_resume
 
-import grainlab.protocols.runner as runner
-from grainlab.io.hdf5 import read_results, write_checkpoint
+from grainlab.io.hdf5 import read_results
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "08_custom_protocol.py"
 
@@ -42,34 +42,11 @@ def test_each_higher_pressure_packs_denser_with_more_contacts(straight):
     assert np.all(np.diff(series["coordination_number"]) > 0)
 
 
-class Stop(KeyboardInterrupt):
-    pass
-
-
 @pytest.mark.parametrize("checkpoints", [1, 3, 5])
 def test_a_stopped_run_resumes_to_the_same_bits(straight, tmp_path, monkeypatch, checkpoints):
     example = _example()
-    calls = {"n": 0}
-
-    def stopping(*args, **kwargs):
-        write_checkpoint(*args, **kwargs)
-        calls["n"] += 1
-        if calls["n"] == checkpoints:
-            raise Stop
-
     out = tmp_path / "run"
-    protocol = example.IsotropicCompression(example.CompressionConfig())
-    with monkeypatch.context() as patch:
-        patch.setattr(runner, "write_checkpoint", stopping)
-        with pytest.raises(Stop):
-            runner.run_protocol(protocol, out)
-    with pytest.raises(ValueError, match="use --resume"):
-        runner.run_protocol(protocol, out)
-    runner.run_protocol(protocol, out, resume=True)
-    a, b = read_results(straight / "run.h5"), read_results(out / "run.h5")
-    assert b.kind == "isotropic_compression" and b.status == "complete"
-    for name in a.timeseries:
-        np.testing.assert_array_equal(a.timeseries[name], b.timeseries[name], err_msg=name)
-    assert a.snapshot_names == b.snapshot_names
-    np.testing.assert_array_equal(a.snapshot(-1).positions, b.snapshot(-1).positions)
+    stop_and_resume(example.IsotropicCompression(example.CompressionConfig()), out, checkpoints, monkeypatch)
+    assert_same_run(straight, out, snapshots="last")
+    assert read_results(out / "run.h5").kind == "isotropic_compression"
     assert not (out / "checkpoint.h5").exists()

@@ -13,11 +13,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from resume_check import assert_same_run, stop_and_resume
 
 import grainlab.protocols.runner as runner
 from grainlab.cli import main
 from grainlab.columns import OEDOMETER
-from grainlab.io.hdf5 import read_results, write_checkpoint
+from grainlab.io.hdf5 import read_results
 from grainlab.protocols.config import ConfigError
 from grainlab.protocols.oedometer import (
     K0_FROM_STRESS_RATIO,
@@ -94,32 +95,10 @@ def test_k_on_loading_and_unloading(straight, config):
     assert [u["overconsolidation_ratio"] for u in summary["unloading"]] == pytest.approx(list(ocr[4:]))
 
 
-class Stop(KeyboardInterrupt):
-    pass
-
-
 @pytest.mark.parametrize("checkpoints", [2, 3, 6])
 def test_a_stopped_run_resumes_to_the_same_bits(straight, tmp_path, monkeypatch, config, checkpoints):
-    calls = {"n": 0}
-
-    def stopping(*args, **kwargs):
-        write_checkpoint(*args, **kwargs)
-        calls["n"] += 1
-        if calls["n"] == checkpoints:
-            raise Stop
-
-    out = tmp_path / "run"
-    with monkeypatch.context() as patch:
-        patch.setattr(runner, "write_checkpoint", stopping)
-        with pytest.raises(Stop):
-            runner.run_protocol(OedometerProtocol(config), out)
-    runner.run_protocol(OedometerProtocol(config), out, resume=True)
-    a, b = read_results(straight / "run.h5"), read_results(out / "run.h5")
-    for name in a.timeseries:
-        np.testing.assert_array_equal(a.timeseries[name], b.timeseries[name], err_msg=name)
-    assert a.snapshot_names == b.snapshot_names
-    for name in a.snapshot_names:
-        np.testing.assert_array_equal(a.snapshot(name).positions, b.snapshot(name).positions)
+    stop_and_resume(OedometerProtocol(config), tmp_path / "run", checkpoints, monkeypatch)
+    assert_same_run(straight, tmp_path / "run")
 
 
 def test_the_command_line_runs_it_with_its_report_as_cli_md_prints(tmp_path, capsys):
@@ -159,7 +138,7 @@ def test_bad_input_gets_one_line_and_no_folder(tmp_path, capsys, override, messa
 def test_the_load_path_keeps_its_order_and_the_registry_knows_it():
     config = resolve_config("oedometer", overrides=["oedometer.vertical_stresses=[1 MPa, 200 kPa, 300 kPa]"])
     assert config["oedometer.vertical_stresses"] == [1e6, 2e5, 3e5]
-    assert set(PROTOCOLS) == {"biaxial", "oedometer"}
+    assert set(PROTOCOLS) == {"biaxial", "cyclic", "oedometer"}
     with pytest.raises(ConfigError, match="unknown configuration key"):
         resolve_config("oedometer", overrides=["boundary.kind=membrane"])
 

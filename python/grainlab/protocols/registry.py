@@ -5,7 +5,7 @@ registers here, and its schema in :data:`SCHEMAS` (``register_schema`` in its ow
 package; importing this module imports every protocol, so :data:`SCHEMAS` holds them all).
 
 >>> sorted(PROTOCOLS)
-['biaxial', 'oedometer']
+['biaxial', 'cyclic', 'oedometer']
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from typing import Any
 
 from grainlab.protocols.biaxial.protocol import BiaxialProtocol
 from grainlab.protocols.config import SCHEMAS, Config
+from grainlab.protocols.cyclic.protocol import CyclicProtocol
 from grainlab.protocols.oedometer.protocol import OedometerProtocol
 from grainlab.protocols.runner import Protocol, RunResult, run_protocol
 
@@ -26,6 +27,7 @@ __all__ = ["PROTOCOLS", "SCHEMAS", "resolve_config", "run_named"]
 PROTOCOLS: dict[str, type[Protocol[Any, Any, Any]]] = {
     BiaxialProtocol.name: BiaxialProtocol,
     OedometerProtocol.name: OedometerProtocol,
+    CyclicProtocol.name: CyclicProtocol,
 }
 
 

@@ -2,19 +2,25 @@
 state's common part (:class:`SpecimenRun`), the sample's generation by radius
 expansion (:func:`generate`, the ``sample.*`` keys) and the isotropic
 consolidation in four servo-controlled walls (:func:`consolidate`, the
-``consolidation.*`` keys). The biaxial test and the oedometer start with them."""
+``consolidation.*`` keys), and the outputs written from a finished ``run.h5``
+(:func:`write_run_outputs`). The biaxial test, the oedometer and the cyclic test
+start with them."""
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from typing import Any, ClassVar, TypeVar
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from grainlab._cores import available_cores
+from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
+from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
 from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
 from grainlab.protocols.runner import Protocol, ProtocolError, RunResult
@@ -28,8 +34,11 @@ from grainlab.samples import (
 )
 from grainlab.simulation import ContactModel, Simulation
 
+if TYPE_CHECKING:
+    from grainlab.plot.workers import FigureTask
+
 __all__ = ["CHUNK_STEPS", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
-           "engine_threads", "generate", "grain_model", "platen_model"]
+           "engine_threads", "generate", "grain_model", "platen_model", "write_run_outputs"]
 
 #: Steps per engine call while a phase waits for a condition.
 CHUNK_STEPS = 2000
@@ -227,3 +236,24 @@ def consolidate(
         "time_step_s": sim.time_step,
     }
     run.wall_time["consolidate"] = time.perf_counter() - start
+
+
+def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.float64]], dict[str, Any]],
+                                                          list[FigureTask]]) -> dict[str, Any]:
+    """A finished run's ``timeseries.csv``, figures and ``summary.json``, from its ``run.h5``:
+    the figures of ``figure_tasks(time series, summary)`` drawn in the figure pool before
+    the summary is written (which says the outputs are complete); returns the summary."""
+    from grainlab.io.hdf5 import read_results
+    from grainlab.plot.workers import figure_pool
+
+    results = read_results(out / RESULTS_FILE)
+    raise_if_interrupted()
+    summary = dict(results.summary)
+    write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
+    series = {name: np.asarray(values, dtype=np.float64) for name, values in results.timeseries.items()}
+    tasks = figure_tasks(series, summary)
+    with figure_pool(tasks=len(tasks), page_copies=True) as pool:
+        pool.draw(tasks, out).result()
+    raise_if_interrupted()
+    write_json_atomic(out / "summary.json", summary)
+    return summary

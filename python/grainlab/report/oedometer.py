@@ -5,16 +5,10 @@ the figures, the configuration and how to rerun."""
 
 from __future__ import annotations
 
-import datetime
-import shlex
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import grainlab
 from grainlab._html import (
-    EmbeddedFigure,
-    code_block,
     definition_table,
     figures,
     fmt,
@@ -23,7 +17,6 @@ from grainlab._html import (
     section,
     table,
 )
-from grainlab._mapping import flatten_keys
 from grainlab.columns import (
     COORDINATION_NUMBER,
     HORIZONTAL_STRESS_PA,
@@ -33,9 +26,8 @@ from grainlab.columns import (
     VERTICAL_STRESS_PA,
     VOID_RATIO,
 )
-from grainlab.io.hdf5 import Results, read_results
 from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA
-from grainlab.report.figures import embedded_png
+from grainlab.report.run_page import RunPage, gather_run_page, rerun_sections
 
 __all__ = ["FIGURES", "OedometerReport", "gather_oedometer", "render_oedometer"]
 
@@ -47,44 +39,23 @@ FIGURES = {
 }
 
 
-@dataclass
-class OedometerReport:
-    """What the oedometer page shows."""
-
-    folder: Path
-    results: Results
-    summary: dict[str, Any]
-    figures: list[EmbeddedFigure]
-    generated: str
+#: What the oedometer page shows.
+OedometerReport = RunPage
 
 
-def gather_oedometer(folder: str | Path, *, redraw: bool = False) -> OedometerReport:
+def gather_oedometer(folder: str | Path, *, redraw: bool = False) -> RunPage:
     """Collects the report of the oedometer run in ``folder``; figures missing from it
     (all of them with ``redraw``) are drawn into it first."""
-    folder = Path(folder)
-    results = read_results(folder / "run.h5")
-    if redraw or any(not (folder / f"{stem}.png").exists() for stem in FIGURES):
-        from grainlab.protocols.oedometer.outputs import write_outputs  # draws them from run.h5
+    from grainlab.protocols.oedometer.outputs import write_outputs  # draws them from run.h5
 
-        write_outputs(folder)
-    shown = [EmbeddedFigure(stem, title, caption, embedded_png((folder / f"{stem}.png").read_bytes()), f"{stem}.png")
-             for stem, (title, caption) in FIGURES.items()]
-    generated = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
-    return OedometerReport(folder, results, dict(results.summary), shown, generated)
-
-
-def _toml(value: Any) -> str:
-    """A configuration value as ``--set`` reads it back (TOML, or a bare word)."""
-    if isinstance(value, list):
-        return "[" + ", ".join(repr(float(v)) for v in value) + "]"
-    return repr(value) if isinstance(value, float) else str(value)
+    return gather_run_page(folder, FIGURES, write_outputs, redraw=redraw)
 
 
 def _kpa(x: float) -> str:
     return fmt(x / 1e3, 4, unit="kPa")
 
 
-def render_oedometer(r: OedometerReport) -> str:
+def render_oedometer(r: RunPage) -> str:
     """The oedometer report page."""
     s, ts = r.summary, r.results.timeseries
     phi = s.get("friction_angle_deg")
@@ -108,13 +79,6 @@ def render_oedometer(r: OedometerReport) -> str:
     headers = [f"{c[:-3]} (kPa)" if c.endswith("_pa") else str(c) for c in present]
     unloading = [(fmt(u["overconsolidation_ratio"], 3), fmt(u["lateral_stress_ratio"], 3),
                   "n/a" if u["mayne_kulhawy"] is None else fmt(u["mayne_kulhawy"], 3)) for u in s["unloading"]]
-    fields = OEDOMETER_SCHEMA.fields
-    overrides = [f"--set {shlex.quote(f'{key}={_toml(value)}')}"
-                 for key, value in flatten_keys(r.results.config).items()
-                 if key in fields and not key.startswith("run.") and value != fields[key].default]
-    command = " ".join(["grainlab run oedometer --out", shlex.quote(str(r.folder)), *overrides])
-    config_rows = [(f"{section_}.{key}", str(value)) for section_, values in r.results.config.items()
-                   for key, value in values.items()]
     sections = [
         section("glance", "At a glance", glance),
         section("path", "The load path", paragraph(
@@ -125,9 +89,7 @@ def render_oedometer(r: OedometerReport) -> str:
         section("unloading", "Unloading: K against OCR", paragraph(
             "Mayne and Kulhawy (1982): K0 = (1 - sin phi') OCR^(sin phi'), a comparison for sands, not an oracle "
             "for disks.", "note"), table(["OCR", "K (this run)", "Mayne-Kulhawy"], unloading, numeric=(0, 1, 2))),
-        section("rerun", "How to rerun", code_block(command),
-                paragraph(f"Rebuild this report: grainlab report {shlex.quote(str(r.folder.resolve()))}", "note")),
-        section("config", "Resolved configuration", table(["key", "value (SI)"], config_rows)),
+        *rerun_sections(OEDOMETER_SCHEMA.name, r.folder, r.results),
     ]
     header = paragraph(f"grainlab oedometer test: {r.folder.resolve().name}; run by grainlab "
                        f"{r.results.grainlab_version}, report generated {r.generated}.")

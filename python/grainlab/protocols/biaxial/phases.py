@@ -9,7 +9,8 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -141,6 +142,31 @@ def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress
 
 
 def start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
+    """The platens set moving at the axial strain rate, the shearing planned to
+    ``shear.final_strain`` (records ``Every(shear.record_interval)``, snapshots
+    ``At(shear.snapshot_strains)``)."""
+    final = config["shear.final_strain"]
+    snaps = [s for s in config["shear.snapshot_strains"] if s <= final + 1e-12]
+    start_platens(sim, run, config, final=final, records=[Every(config["shear.record_interval"]), At(snaps)],
+                  snapshots=snaps)
+
+
+def drive_platens(sim: Simulation, boundary: Membrane | GrainBoundary, speed: float) -> None:
+    """Each platen moves towards the other at ``speed`` (m/s; negative: apart)."""
+    if isinstance(boundary, Membrane):
+        set_platen_velocity(sim, boundary, speed)
+    else:
+        sim.wall(boundary.bottom_wall).velocity = (0.0, speed)
+        sim.wall(boundary.top_wall).velocity = (0.0, -speed)
+
+
+def start_platens(sim: Simulation, run: _Run, config: Any, *, final: float, records: Sequence[Any],
+                  snapshots: Sequence[float], turns: Sequence[float] = ()) -> None:
+    """The platens set approaching each other at ``shear.strain_rate`` and the loading
+    planned over ``final`` of *strain path* (the axial strain travelled, whatever its
+    direction): records on the ``records`` triggers, snapshots at the path strains
+    ``snapshots``, the platens' direction reversed at the path strains ``turns``
+    (:class:`ShearPlan`; a monotonic test has none)."""
     boundary = _boundary(run)
     grains = np.arange(run.n_grains)
     radii = sim.radii[grains]
@@ -152,17 +178,10 @@ def start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     height0 = float(top.points[0, 1] - bottom.points[0, 1])
     area0 = _area(sim, boundary)
     speed = 0.5 * rate * height0
-    if isinstance(boundary, Membrane):
-        set_platen_velocity(sim, boundary, speed)
-    else:
-        bottom.velocity = (0.0, speed)
-        top.velocity = (0.0, -speed)
+    drive_platens(sim, boundary, speed)
     dt = sim.time_step
     steps_per_strain = 1.0 / (rate * dt)
-    final = config["shear.final_strain"]
-    interval = config["shear.record_interval"]
-    snaps = [s for s in config["shear.snapshot_strains"] if s <= final + 1e-12]
-    record_steps = schedule_steps([Every(interval), At(snaps)], final=final, steps_per_unit=steps_per_strain)
+    record_steps = schedule_steps(list(records), final=final, steps_per_unit=steps_per_strain)
     root = math.sqrt(config["material.density"] / config["consolidation.pressure"])
     run.shear = ShearPlan(
         strain_rate=rate,
@@ -171,52 +190,75 @@ def start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
         area0=area0,
         start_step=sim.step_count,
         record_steps=record_steps,
-        snapshot_steps={str(round(s * steps_per_strain)): s for s in snaps},
+        snapshot_steps={str(round(s * steps_per_strain)): s for s in snapshots},
         inertial_number=inertial_number(config, rate, max_d),
         inertial_number_mean_diameter=rate * float(2 * radii.mean()) * root,
         density_scaling_factor=grainlab.density_scaling_factor(
             rate, config["material.density"], float(radii.min()), config["material.limiting_contact_pressure"]
         ),
         porosity_initial=1.0 - float(np.pi * np.sum(radii**2)) / area0,
+        turn_steps=[round(t * steps_per_strain) for t in turns],
     )
 
 
 def shear(
     sim: Simulation,
     run: _Run,
-    config: BiaxialConfig,
+    config: Any,
     writer: ResultsWriter,
     save: Callable[[], None],
     progress: bool,
+    *,
+    final: float | None = None,
+    snapshot_name_of: Callable[[float], str] = snapshot_name,
+    extra: Callable[[int], dict[str, float]] | None = None,
+    units: Mapping[str, str] = TIMESERIES_UNITS,
 ) -> None:
+    """Runs the planned loading (:func:`start_platens`) to its end: the platens reversed
+    at the plan's turns, a record (with ``extra(steps since the start)``'s columns, in
+    ``units``) on each record step, a snapshot named ``snapshot_name_of(path strain)``
+    on each snapshot step, a checkpoint on the wall clock; ``final`` (default
+    ``shear.final_strain``) is the path strain the progress counts to."""
     start = time.perf_counter() - run.wall_time.get("shear", 0.0)
     plan = run.shear_plan()
     steps = plan.record_steps
     snap_steps = plan.snapshot_steps
-    final = config["shear.final_strain"]
+    final = config["shear.final_strain"] if final is None else final
+
+    def record() -> dict[str, float]:
+        values = _measure(sim, run, config)
+        if extra is not None:
+            values.update(extra(sim.step_count - plan.start_step))
+        return values
+
     if plan.next_record == 0 and "0" in snap_steps and writer.n_rows == 0:
-        record = _measure(sim, run, config)
-        writer.append_timeseries(record, units=TIMESERIES_UNITS)
-        writer.write_snapshot(snapshot_name(0.0), _snapshot(sim, run, 0.0), step=sim.step_count,
+        first = record()
+        writer.append_timeseries(first, units=units)
+        writer.write_snapshot(snapshot_name_of(0.0), _snapshot(sim, run, 0.0), step=sim.step_count,
                               walls=_walls(sim, run))
     checkpoint_due = WallClock(config["run.checkpoint_interval"])
-    done_strain = 0.0
+    done = 100 * final * steps[plan.next_record - 1] / steps[-1] if plan.next_record and steps[-1] else 0.0
     bar = progress_bar(
         round(100 * final, 3),
         "shearing",
         enabled=progress,
         unit="% strain",
+        initial=done,
         bar_format="{l_bar}{bar}| {n:.2f}/{total:.1f} % [{elapsed}<{remaining}{postfix}]",
     )
     while plan.next_record < len(steps):
         target = plan.start_step + steps[plan.next_record]
+        turn = plan.start_step + plan.turn_steps[plan.next_turn] if plan.next_turn < len(plan.turn_steps) else None
+        if turn is not None and turn < target:
+            sim.run(turn - sim.step_count)
+            _reverse(sim, run, plan)
+            continue
         sim.run(target - sim.step_count)
-        record = _measure(sim, run, config)
-        writer.append_timeseries(record, units=TIMESERIES_UNITS)
+        values = record()
+        writer.append_timeseries(values, units=units)
         key = str(steps[plan.next_record])
         if key in snap_steps:
-            strain = snap_steps[key]
-            writer.write_snapshot(snapshot_name(strain), _snapshot(sim, run, record[AXIAL_STRAIN]),
+            writer.write_snapshot(snapshot_name_of(snap_steps[key]), _snapshot(sim, run, values[AXIAL_STRAIN]),
                                   step=sim.step_count, walls=_walls(sim, run))
         boundary = _boundary(run)
         if isinstance(boundary, GrainBoundary):
@@ -226,13 +268,16 @@ def shear(
             if breach is not None:
                 bar.close()
                 raise BiaxialError(
-                    f"shearing stopped at {100 * record[AXIAL_STRAIN]:.2f} % axial strain: {breach}"
+                    f"shearing stopped at {100 * values[AXIAL_STRAIN]:.2f} % axial strain: {breach}"
                 )
         plan.next_record += 1
+        if turn == target:  # a turning point recorded: reversed after its record
+            _reverse(sim, run, plan)
         raise_if_interrupted()
-        bar.update(100 * record[AXIAL_STRAIN] - done_strain)
-        done_strain = 100 * record[AXIAL_STRAIN]
-        bar.set_postfix_str(f"ratio {record[STRESS_RATIO]:.2f}")
+        path = 100 * final * steps[plan.next_record - 1] / steps[-1]
+        bar.update(path - done)
+        done = path
+        bar.set_postfix_str(f"ratio {values[STRESS_RATIO]:.2f}")
         if checkpoint_due():
             run.wall_time["shear"] = time.perf_counter() - start
             save()
@@ -240,18 +285,29 @@ def shear(
     run.wall_time["shear"] = time.perf_counter() - start
 
 
-def check_shear_plan(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
-    """The shearing phase's records and snapshots fall on distinct time steps,
-    checked with the run's own time step before the first record."""
+def _reverse(sim: Simulation, run: _Run, plan: ShearPlan) -> None:
+    """The platens reversed at the plan's next turn: compression after an even number of
+    turns, extension after an odd one."""
+    plan.next_turn += 1
+    drive_platens(sim, _boundary(run), plan.platen_speed_m_per_s * (-1.0) ** plan.next_turn)
+
+
+def check_shear_plan(sim: Simulation, run: _Run, config: Any, snapshots: Sequence[float] | None = None,
+                     key: str = "shear.snapshot_strains") -> None:
+    """The shearing phase's records and snapshots (path strains ``snapshots``, default
+    ``shear.snapshot_strains`` up to ``shear.final_strain``; ``key`` names them in the
+    error) fall on distinct time steps, checked with the run's own time step before the
+    first record."""
     shear = run.shear_plan()
     problem = strain_rate_problem(
         shear.strain_rate, sim.time_step, shear.height0, float(sim.radii.min()), config["shear.record_interval"]
     )
     if problem is not None:
         raise BiaxialError(f"shear.strain_rate: {problem}; start again with a slower rate in another folder")
-    wanted = [s for s in config["shear.snapshot_strains"] if s <= config["shear.final_strain"] + 1e-12]
+    wanted = ([s for s in config["shear.snapshot_strains"] if s <= config["shear.final_strain"] + 1e-12]
+              if snapshots is None else list(snapshots))
     if len(shear.snapshot_steps) < len(wanted):
         raise BiaxialError(
-            f"shear.snapshot_strains: two of {wanted} fall on the same time step "
+            f"{key}: two of {wanted} fall on the same time step "
             f"({sim.time_step:.3g} s at {shear.strain_rate:.3g} 1/s); keep them further apart"
         )

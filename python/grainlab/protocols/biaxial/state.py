@@ -3,7 +3,7 @@ its boundary, and the error a run stops with."""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from grainlab.protocols.boundary import GrainBoundary, Membrane
@@ -22,8 +22,8 @@ class ShearPlan:
     platens' speed, the reference height and area of the strains, the engine steps
     (counted from ``start_step``) of the records and of the snapshots (``snapshot_steps``:
     step, as text, to the snapshot's strain), the next record to take, and the rate's
-    inertial numbers and Eq. 16 factor. Checkpoints store it as a dict with these keys
-    (``next_record`` as ``next``)."""
+    inertial numbers and Eq. 16 factor, the turning points of a cyclic test. Checkpoints
+    store it as a dict with these keys (``next_record`` as ``next``)."""
 
     strain_rate: float
     platen_speed_m_per_s: float
@@ -37,10 +37,16 @@ class ShearPlan:
     density_scaling_factor: float
     porosity_initial: float
     next_record: int = 0
+    #: Engine steps (counted from ``start_step``) at which the platens reverse (a cyclic test's
+    #: turning points; none in a monotonic test), and the next of them to come.
+    turn_steps: list[int] = field(default_factory=list)
+    next_turn: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         saved = asdict(self)
         saved["next"] = saved.pop("next_record")
+        if not self.turn_steps:  # a monotonic test's checkpoints keep their earlier layout
+            del saved["turn_steps"], saved["next_turn"]
         return saved
 
     @classmethod

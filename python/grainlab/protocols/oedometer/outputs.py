@@ -21,17 +21,16 @@ from typing import Any
 import numpy as np
 
 import grainlab
-from grainlab._interrupt import raise_if_interrupted
 from grainlab.columns import (
     HORIZONTAL_STRESS_PA,
     LATERAL_STRESS_RATIO,
     OVERCONSOLIDATION_RATIO,
     VERTICAL_STRESS_PA,
 )
-from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
 from grainlab.protocols.config import Config
 from grainlab.protocols.oedometer.state import OedometerRun
 from grainlab.protocols.runner import RunResult
+from grainlab.protocols.specimen import write_run_outputs
 
 __all__ = ["K0_FROM_STRESS_RATIO", "OedometerResult", "first_loading", "k0_loading", "summarise", "write_outputs"]
 
@@ -113,22 +112,16 @@ def summarise(run: OedometerRun, config: Config, timeseries: dict[str, np.ndarra
 
 def write_outputs(out: Path) -> dict[str, Any]:
     """``timeseries.csv``, the figures and ``summary.json`` from the finished ``run.h5``."""
-    from grainlab.io.hdf5 import read_results
-    from grainlab.plot import oedometer
-    from grainlab.plot.workers import FigureTask, figure_pool
+    return write_run_outputs(out, _figure_tasks)
 
-    results = read_results(out / RESULTS_FILE)
-    raise_if_interrupted()
-    summary = dict(results.summary)
-    write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
-    series = {name: np.asarray(values) for name, values in results.timeseries.items()}
+
+def _figure_tasks(series: dict[str, np.ndarray], summary: dict[str, Any]) -> list[Any]:
+    from grainlab.plot import oedometer
+    from grainlab.plot.workers import FigureTask
+
     loading = first_loading(series)
-    with figure_pool(tasks=2, page_copies=True) as pool:
-        pool.draw([
-            FigureTask("fig01_lateral_stress_ratio", oedometer.lateral_stress_ratio_figure,
-                       (series, loading, summary["k0_jaky"], summary["friction_angle_deg"])),
-            FigureTask("fig02_compression", oedometer.compression_figure, (series, loading)),
-        ], out).result()  # drawn before the summary says the outputs are complete
-    raise_if_interrupted()
-    write_json_atomic(out / "summary.json", summary)
-    return summary
+    return [
+        FigureTask("fig01_lateral_stress_ratio", oedometer.lateral_stress_ratio_figure,
+                   (series, loading, summary["k0_jaky"], summary["friction_angle_deg"])),
+        FigureTask("fig02_compression", oedometer.compression_figure, (series, loading)),
+    ]
