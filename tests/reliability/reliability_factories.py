@@ -84,7 +84,7 @@ def tiny_config(*extra: str):
     return resolve(overrides=[*TINY, *extra])
 
 
-def fake_curves(timeseries, out):
+def fake_curves(timeseries, out, constant_volume=False):
     """Stands in for the macro-curve figures: one small file per run."""
     path = Path(out) / "fig08_stress_ratio.png"
     path.write_bytes(b"stand-in figure of %d records" % len(timeseries["axial_strain"]))

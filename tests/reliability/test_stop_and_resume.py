@@ -211,7 +211,7 @@ import grainlab.postprocess.figures as figures
 import grainlab.protocols.biaxial.outputs as outputs
 from grainlab.cli import main
 
-def slow_curves(timeseries, out):
+def slow_curves(timeseries, out, constant_volume=False):
     time.sleep(float(os.environ.get("STAND_IN_SECONDS", "0")))
     return stand_ins.fake_curves(timeseries, out)
 

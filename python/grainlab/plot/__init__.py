@@ -63,6 +63,7 @@ __all__ = [
     "polar_distribution",
     "save_figure",
     "scale_colors",
+    "stress_path_figure",
 ]
 
 
@@ -361,8 +362,34 @@ def _strain_figure(
     return fig
 
 
-def curve_tasks(timeseries: dict[str, Any]) -> list[FigureTask]:
-    """The figures of :func:`biaxial_curves` as tasks for a :class:`~grainlab.plot.workers.FigurePool`."""
+def stress_path_figure(axial_strain: ArrayLike, axial_stress_pa: ArrayLike, lateral_stress_pa: ArrayLike,
+                       cell_pressure_pa: float) -> Figure:
+    """A constant-volume biaxial run's stress path: q = (sigma_1' - sigma_3') / 2 against
+    p' = (sigma_1' + sigma_3') / 2 (kPa), and the pore-pressure analogue u = sigma_0 -
+    sigma_3' against the axial strain (%): the drop of the effective lateral stress
+    below the cell pressure it would take to hold the volume with water."""
+    s1 = np.asarray(axial_stress_pa, dtype=np.float64) / 1e3
+    s3 = np.asarray(lateral_stress_pa, dtype=np.float64) / 1e3
+    with paper_style():
+        fig = Figure(figsize=(7.0, 3.0), layout="constrained")
+        left, right = fig.subplots(1, 2)
+        left.plot(0.5 * (s1 + s3), 0.5 * (s1 - s3), color="k", linewidth=1.0)
+        left.set_xlabel(r"$p' = (\sigma_1' + \sigma_3')/2$ (kPa)")
+        left.set_ylabel(r"$q = (\sigma_1' - \sigma_3')/2$ (kPa)")
+        left.set_xlim(left=0.0)
+        left.set_ylim(bottom=min(0.0, float(np.nanmin(0.5 * (s1 - s3)))))
+        right.plot(100 * np.asarray(axial_strain, dtype=np.float64), cell_pressure_pa / 1e3 - s3, color="k",
+                   linewidth=1.0)
+        right.axhline(0.0, color="0.6", linewidth=0.6)
+        right.set_xlabel("axial strain (%)")
+        right.set_ylabel(r"$u = \sigma_0 - \sigma_3'$ (kPa)")
+    return fig
+
+
+def curve_tasks(timeseries: dict[str, Any], *, stress_path: bool = False) -> list[FigureTask]:
+    """The figures of :func:`biaxial_curves` as tasks for a :class:`~grainlab.plot.workers.FigurePool`;
+    with ``stress_path`` (a constant-volume run) also ``fig19_stress_path``
+    (:func:`stress_path_figure`)."""
     from grainlab.plot.workers import FigureTask
 
     eps = np.asarray(timeseries[AXIAL_STRAIN], dtype=np.float64)
@@ -377,21 +404,29 @@ def curve_tasks(timeseries: dict[str, Any]) -> list[FigureTask]:
         ),
         ("fig18_coordination_number", "coordination_number", "coordination number $Z$", False, None),
     )
-    return [
+    tasks = [
         FigureTask(name, _strain_figure, (eps, np.asarray(timeseries[column], dtype=np.float64), label, percent, ref))
         for name, column, label, percent, ref in figures
     ]
+    if stress_path:
+        cell = float(np.asarray(timeseries["confining_pressure_pa"], dtype=np.float64)[0])
+        tasks.append(FigureTask("fig19_stress_path", stress_path_figure,
+                                (eps, np.asarray(timeseries["axial_stress_pa"], dtype=np.float64),
+                                 np.asarray(timeseries["confining_stress_felt_pa"], dtype=np.float64), cell)))
+    return tasks
 
 
-def biaxial_curves(timeseries: dict[str, Any], out_dir: str | Path, *, workers: int | None = None) -> list[Path]:
+def biaxial_curves(timeseries: dict[str, Any], out_dir: str | Path, *, workers: int | None = None,
+                   stress_path: bool = False) -> list[Path]:
     """The macro curves of a biaxial test, PNG and SVG, into ``out_dir``:
     ``stress_ratio`` (Fig. 8), ``volumetric_strain`` (Fig. 10) and
-    ``coordination_number`` (Fig. 18) against axial strain, drawn side by side
-    in up to ``workers`` processes (0: here), or in the pool of an enclosing
-    ``with FigurePool()`` block (:mod:`grainlab.plot.workers`)."""
+    ``coordination_number`` (Fig. 18) against axial strain (and, with
+    ``stress_path``, the constant-volume run's ``fig19_stress_path``), drawn side
+    by side in up to ``workers`` processes (0: here), or in the pool of an
+    enclosing ``with FigurePool()`` block (:mod:`grainlab.plot.workers`)."""
     from grainlab.plot.workers import figure_pool
 
-    tasks = curve_tasks(timeseries)
+    tasks = curve_tasks(timeseries, stress_path=stress_path)
     with figure_pool(workers, tasks=len(tasks)) as pool:
         files = pool.draw(tasks, out_dir).result()
     return [path for paths in files.values() for path in paths]

@@ -412,3 +412,65 @@ def install_grain_boundary(
     right = sim.add_pressure_chain(placeholder, pressure, start_wall=top, end_wall=bottom)
     boundary = GrainBoundary((left, right), bottom.id, top.id, n_grains, bin_height, pressure, [], [])
     return boundary.identify(sim)
+
+
+@dataclass(frozen=True)
+class WallBoundary:
+    """Variant C: the consolidation box's rigid side walls stay as the lateral
+    boundary. Drained, each is servo-controlled to the confining ``pressure``
+    (:meth:`control`, between records); at constant volume they move apart or
+    together so that the box's area stays the area at the start of shearing
+    (the undrained test's constant-volume analogue, as PFC's walled biaxial tests
+    do it), and the stress they feel is the effective lateral stress."""
+
+    left_wall: int
+    right_wall: int
+    bottom_wall: int
+    top_wall: int
+    pressure: float
+    constant_volume: bool
+
+    kind = "walls"
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["kind"] = self.kind
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> WallBoundary:
+        return cls(int(d["left_wall"]), int(d["right_wall"]), int(d["bottom_wall"]), int(d["top_wall"]),
+                   float(d["pressure"]), bool(d["constant_volume"]))
+
+    def size(self, sim: Simulation) -> tuple[float, float]:
+        """The box's width and height now, m."""
+        width = float(sim.wall(self.right_wall).points[0, 0] - sim.wall(self.left_wall).points[0, 0])
+        height = float(sim.wall(self.top_wall).points[0, 1] - sim.wall(self.bottom_wall).points[0, 1])
+        return width, height
+
+    def area(self, sim: Simulation) -> float:
+        width, height = self.size(sim)
+        return width * height
+
+    def lateral_stress(self, sim: Simulation) -> float:
+        """The mean normal stress on the side walls from the last step, Pa (compression positive)."""
+        _, height = self.size(sim)
+        return 0.5 * (sim.wall(self.left_wall).normal_stress(height) + sim.wall(self.right_wall).normal_stress(height))
+
+    def control(self, sim: Simulation, steps: int, area0: float, max_speed_m_per_s: float) -> None:
+        """Sets the side walls' motion for the next ``steps`` steps: at constant volume,
+        the velocity that brings the box to ``area0`` at their end given the platens'
+        velocities (each side wall half the width change); drained, the engine's servo
+        to :attr:`pressure` (at most ``max_speed_m_per_s``)."""
+        left, right = sim.wall(self.left_wall), sim.wall(self.right_wall)
+        width, height = self.size(sim)
+        if not self.constant_volume:
+            for wall in (left, right):
+                wall.servo(self.pressure, height, relaxation=0.5, max_speed_m_per_s=max_speed_m_per_s)
+            return
+        duration = steps * sim.time_step
+        closing = float(sim.wall(self.bottom_wall).velocity[1] - sim.wall(self.top_wall).velocity[1])
+        width_then = area0 / (height - closing * duration)
+        speed = 0.5 * (width_then - width) / duration
+        left.velocity = (-speed, 0.0)
+        right.velocity = (speed, 0.0)

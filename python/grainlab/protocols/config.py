@@ -146,8 +146,9 @@ SHARED_FIELDS: dict[str, Field] = {
 BIAXIAL_FIELDS: dict[str, Field] = {
     "boundary.kind": Field(
         "choice", "membrane",
-        "flexible lateral boundary (docs/boundary.md): a bonded membrane (A) or the outermost grains (B)",
-        choices=("membrane", "outer_particles"),
+        "lateral boundary (docs/boundary.md): a bonded membrane (A), the outermost grains (B), or the "
+        "consolidation box's rigid side walls (C; the one of shear.volume = constant)",
+        choices=("membrane", "outer_particles", "walls"),
     ),
     "boundary.membrane_diameter": Field("length", 0.5e-3, "diameter of the membrane disks", **_POSITIVE),
     "boundary.membrane_overlap": Field(
@@ -163,6 +164,12 @@ BIAXIAL_FIELDS: dict[str, Field] = {
         "axial strain rate (Table 1: 2 %/min); auto = the fastest with the heaviest grain's inertial "
         "number <= shear.inertial_number (2 %/min with Table 1: no faster rate passed the rate study)",
         **_POSITIVE, allow_auto=True,
+    ),
+    "shear.volume": Field(
+        "choice", "free",
+        "free: the confining pressure held (drained); constant: the sample's area held by the rigid side walls, "
+        "the undrained test's analogue (needs boundary.kind = walls, its default then)",
+        choices=("free", "constant"),
     ),
     "shear.final_strain": Field("strain", 0.10, "final axial strain", minimum=0.0, maximum=0.5, exclusive_minimum=True),
     "shear.record_interval": Field(
@@ -439,8 +446,24 @@ def check_sample(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> No
         )
 
 
+def check_boundary(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
+    """A constant-volume test needs the rigid side walls: they are its boundary unless
+    another was asked for, which is refused."""
+    if v["shear.volume"] != "constant":
+        return
+    if "boundary.kind" not in given:
+        v["boundary.kind"] = "walls"
+    elif v["boundary.kind"] != "walls":
+        raise ConfigError(
+            f"shear.volume: 'constant' holds the sample's area with the rigid side walls, not with "
+            f"boundary.kind = {v['boundary.kind']!r} (whose area follows the grains); set boundary.kind = "
+            "'walls' or leave it out"
+        )
+
+
 def _check_consistency(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
     check_sample(v, given)
+    check_boundary(v, given)
     if 0.0 not in v["shear.snapshot_strains"]:
         raise ConfigError(
             "shear.snapshot_strains: must include 0, the state at the start of shearing that "

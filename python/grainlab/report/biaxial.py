@@ -29,6 +29,7 @@ from grainlab.io.hdf5 import Results, read_results
 from grainlab.paper import BIAXIAL_CLAIMS, STRAIN_RATE_PER_S, TABLE1
 from grainlab.postprocess.band import BandNumbers
 from grainlab.postprocess.products import store_run_products
+from grainlab.protocols.biaxial.outputs import is_constant_volume
 from grainlab.protocols.config import FIELDS, QUICK
 from grainlab.report.angles import (
     DEFAULT_DILATION_WINDOW,
@@ -451,6 +452,9 @@ def _figure_specs(fab: dict[str, Any] | None, peak_strain: float) -> list[tuple[
         ("fig10_volumetric_strain", "Fig. 18: volumetric strain",
          "Area strain (A0 - A)/A0 inside the membrane against axial strain, compression positive. The "
          "paper's Fig. 18 (this folder's file is named fig10)."),
+        ("fig19_stress_path", "Stress path at constant volume",
+         "q = (σ₁′ − σ₃′)/2 against p′ = (σ₁′ + σ₃′)/2, and the pore-pressure analogue u = σ₀ − σ₃′ against "
+         "axial strain: the rigid side walls hold the sample's area and measure the effective lateral stress."),
         ("fig06_contact_normals", "Fig. 6: contact normals",
          f"Polar histogram of contact normals (18 bins of 20 deg) with Eq. 6; a = {c['a']}."),
         ("fig07_normal_forces", "Fig. 7: normal forces",
@@ -516,11 +520,12 @@ def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float
     threads = summary.get("threads") if isinstance(summary.get("threads"), int) else None
 
     # figures of the folder: draw the missing ones with the functions that drew them
-    missing_curves = [n for n in CURVE_FIGURES if not is_usable_png(folder / f"{n}.png")]
+    curves = CURVE_FIGURES + (("fig19_stress_path",) if is_constant_volume(results.config) else ())
+    missing_curves = [n for n in curves if not is_usable_png(folder / f"{n}.png")]
     if redraw or missing_curves:
         if "coordination_number" in ts:
-            biaxial_curves(ts, folder)
-            regenerated += list(CURVE_FIGURES)
+            biaxial_curves(ts, folder, stress_path=is_constant_volume(results.config))
+            regenerated += list(curves)
         else:
             notes.append("no coordination_number column: Figs. 8, 10 and 18 could not be drawn")
     expected = [n for n in FIGURES if not (n == "fig11_displacement" and len(results.snapshot_names) < 2)]

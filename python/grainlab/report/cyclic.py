@@ -65,12 +65,21 @@ def render_cyclic(r: RunPage) -> str:
     rows = [[fmt(c["cycle"]), fmt(c["stress_ratio_compression"], 4), fmt(c["stress_ratio_extension"], 4),
              fmt(100 * c[VOLUMETRIC_STRAIN], 4), fmt(c[COORDINATION_NUMBER], 4), fmt(c["mean_stability_index"], 4),
              fmt(c["anisotropy"], 4)] for c in cycles]
+    undrained = s.get("shear_volume") == "constant"
+    if undrained:  # the mean effective stress and the pore-pressure analogue at each cycle's end
+        headers += ["p' at end (kPa)", "u at end (kPa)"]
+        for row, c in zip(rows, cycles, strict=True):
+            row += [fmt(c["mean_effective_stress_pa"] / 1e3, 4), fmt(c["pore_pressure_pa"] / 1e3, 4)]
+    drainage = ("The sample's area is held by the rigid side walls (shear.volume = constant): sigma_3 is the "
+                "effective lateral stress the walls feel, and u = sigma_0 - sigma_3' is the pore pressure water "
+                "held in the sample would carry." if undrained else
+                "The confining pressure is held constant, so the volumetric strain is the drained response.")
     sections = [
         section("glance", "At a glance", glance),
         section("cycles", "The cycles", paragraph(
             "One row per cycle: the stress ratio at its compression (+A) and extension (-A) turning points, and "
-            "the state at its end, where the axial strain is back to 0 (grainlab.protocols.cyclic.outputs). The "
-            "confining pressure is held constant, so the volumetric strain is the drained response.", "note"),
+            "the state at its end, where the axial strain is back to 0 (grainlab.protocols.cyclic.outputs). "
+            + drainage, "note"),
             table(headers, rows, numeric=range(len(headers))), figures(r.figures)),
         *rerun_sections(CYCLIC_SCHEMA.name, r.folder, r.results),
     ]

@@ -312,7 +312,8 @@ def render_biaxial(r: BiaxialReport) -> str:
         r.macro_png,
         "drawn by the report",
     )
-    macro_figs = [macro_fig] + [figs[k] for k in ("fig08_stress_ratio", "fig10_volumetric_strain") if k in figs]
+    macro_figs = [macro_fig] + [figs[k] for k in ("fig08_stress_ratio", "fig10_volumetric_strain", "fig19_stress_path")
+                                if k in figs]
     sections.append(section("macro", "Macro curves", figures(macro_figs)))
 
     fabric_parts: list[Any] = [

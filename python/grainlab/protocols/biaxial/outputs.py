@@ -37,9 +37,17 @@ class BiaxialResult(RunResult):
         return (
             f"grainlab biaxial: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}, "
             f"Z0 {s['coordination_number_initial']:.2f}; peak sigma1/sigma3 {s['peak_stress_ratio']:.2f} "
-            f"at {100 * s['axial_strain_at_peak']:.2f} % axial strain; strain rate {s['strain_rate']:.3g} 1/s; "
-            f"{s['wall_time_s']:.1f} s -> {self.out_dir}"
+            f"at {100 * s['axial_strain_at_peak']:.2f} % axial strain; {self._undrained()}strain rate "
+            f"{s['strain_rate']:.3g} 1/s; {s['wall_time_s']:.1f} s -> {self.out_dir}"
         )
+
+    def _undrained(self) -> str:
+        s = self.summary
+        if s.get("shear_volume") != "constant":
+            return ""
+        return (f"constant volume: u up to {s['pore_pressure_max_pa'] / 1e3:.1f} kPa at "
+                f"{100 * s['axial_strain_at_pore_pressure_max']:.2f} %, {s['pore_pressure_final_pa'] / 1e3:.1f} kPa at "
+                "the end; ")
 
 
 def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
@@ -67,6 +75,8 @@ def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray]
         "final_stress_ratio": last[STRESS_RATIO],
         "final_volumetric_strain": last[VOLUMETRIC_STRAIN],
         "max_contraction": float(np.max(timeseries[VOLUMETRIC_STRAIN])),
+        "shear_volume": config["shear.volume"],
+        **(_undrained(timeseries, config["consolidation.pressure"]) if config["shear.volume"] == "constant" else {}),
         "strain_rate": shear.strain_rate,
         "inertial_number": shear.inertial_number,
         "inertial_number_mean_diameter": shear.inertial_number_mean_diameter,
@@ -80,14 +90,41 @@ def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray]
     }
 
 
-def _figures(timeseries: dict[str, np.ndarray], out: Path) -> None:
-    """Starts the macro curves (Figs. 8, 10, 18) in the current figure pool: they are
-    drawn while the snapshots are measured, and finished when the pool closes."""
+def is_constant_volume(config: dict[str, Any]) -> bool:
+    """Whether a results file's configuration (nested, as ``run.h5`` stores it) is a
+    constant-volume run's."""
+    return bool(config.get("shear", {}).get("volume") == "constant")
+
+
+def _undrained(timeseries: dict[str, np.ndarray], cell_pressure_pa: float) -> dict[str, float]:
+    """A constant-volume run's pore-pressure analogue u = sigma_0 - sigma_3' (the effective
+    lateral stress below the cell pressure): its largest value and the axial strain there
+    (the phase transformation, where contraction turns to dilation), the final one, the
+    smallest mean effective stress p' = (sigma_1' + sigma_3') / 2 and the final p' and q."""
+    s1 = np.asarray(timeseries["axial_stress_pa"], dtype=np.float64)
+    s3 = np.asarray(timeseries["confining_stress_felt_pa"], dtype=np.float64)
+    u = cell_pressure_pa - s3
+    p = 0.5 * (s1 + s3)
+    k = int(np.argmax(u))
+    return {
+        "pore_pressure_max_pa": float(u[k]),
+        "axial_strain_at_pore_pressure_max": float(timeseries[AXIAL_STRAIN][k]),
+        "pore_pressure_final_pa": float(u[-1]),
+        "mean_effective_stress_min_pa": float(p.min()),
+        "mean_effective_stress_final_pa": float(p[-1]),
+        "deviator_stress_final_pa": float(0.5 * (s1[-1] - s3[-1])),
+    }
+
+
+def _figures(timeseries: dict[str, np.ndarray], out: Path, constant_volume: bool) -> None:
+    """Starts the macro curves (Figs. 8, 10, 18; a constant-volume run's stress path) in the
+    current figure pool: they are drawn while the snapshots are measured, and finished when
+    the pool closes."""
     from grainlab.plot import curve_tasks
     from grainlab.plot.workers import figure_pool
 
     with figure_pool(tasks=3) as pool:
-        pool.draw(curve_tasks(timeseries), out)
+        pool.draw(curve_tasks(timeseries, stress_path=constant_volume), out)
 
 
 def _write_outputs(out: Path) -> dict[str, Any]:
@@ -107,7 +144,7 @@ def _write_outputs(out: Path) -> dict[str, Any]:
     summary = dict(results.summary)
     write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
     with figure_pool(tasks=3 + len(figures.FIGURES), page_copies=True) as pool:
-        _figures(results.timeseries, out)
+        _figures(results.timeseries, out, is_constant_volume(results.config))
         # the bands and lambda fields of every snapshot, stored in run.h5 for the figures,
         # the report, the viewer and the claims to read
         store_run_products(out / RESULTS_FILE, pool)

@@ -32,19 +32,31 @@ from grainlab.protocols.biaxial.records import (
     _snapshot,
     _walls,
 )
-from grainlab.protocols.biaxial.state import CHUNK_STEPS, BiaxialError, ShearPlan, _boundary, _Run
+from grainlab.protocols.biaxial.state import (
+    CHUNK_STEPS,
+    BiaxialError,
+    Boundary,
+    ShearPlan,
+    _boundary,
+    _Run,
+)
 from grainlab.protocols.boundary import (
     GrainBoundary,
     Membrane,
+    WallBoundary,
     install_grain_boundary,
     install_membrane,
     membrane_breach,
     set_platen_velocity,
 )
 from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.consolidate import servo_box
 from grainlab.protocols.specimen import grain_model, platen_model
 from grainlab.protocols.triggers import At, Every, WallClock, schedule_steps
-from grainlab.simulation import Simulation
+from grainlab.simulation import Simulation, Wall
+
+#: Steps between two settings of rigid side walls' motion while shearing (variant C).
+WALL_CONTROL_STEPS = 100
 
 
 def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
@@ -66,7 +78,9 @@ def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress
     sim.set_contact_model(0, 1, platen_model(config))
     limit = config["consolidation.unbalanced_force_ratio"]
     steps = 0
-    if config["boundary.kind"] == "membrane":
+    if config["boundary.kind"] == "walls":
+        steps = _install_walls(sim, run, config, left_x, right_x, bottom, top)
+    elif config["boundary.kind"] == "membrane":
         membrane = install_membrane(
             sim,
             left_x=left_x,
@@ -141,6 +155,39 @@ def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress
     run.wall_time["boundary"] = time.perf_counter() - start
 
 
+def _install_walls(sim: Simulation, run: _Run, config: Any, left_x: float, right_x: float, bottom: Wall,
+                   top: Wall) -> int:
+    """Variant C: rigid side walls three sample heights long where the box's were, the
+    four walls servo-controlled to sigma_0 with friction on until equilibrium, then
+    stopped; returns the steps it took."""
+    walls = run.walls
+    y0, y1 = float(bottom.points[0, 1]), float(top.points[0, 1])
+    reach = y0 - (y1 - y0), y1 + (y1 - y0)
+    left = sim.add_segment_wall((left_x, reach[1]), (left_x, reach[0]))  # the sample on its left, as the box's
+    right = sim.add_segment_wall((right_x, reach[0]), (right_x, reach[1]))
+    walls["left"], walls["right"] = left.id, right.id
+    box = {"bottom": bottom, "right": right, "top": top, "left": left}
+    target = config["consolidation.pressure"]
+    state, steps, settled = servo_box(
+        sim, box, target, tolerance=config["consolidation.tolerance"],
+        unbalanced_force_limit=config["consolidation.unbalanced_force_ratio"],
+        max_steps=config["consolidation.max_steps"],
+        max_speed_m_per_s=0.05 * config["sample.d_min"] / (100 * sim.time_step), chunk_steps=CHUNK_STEPS)
+    for wall in box.values():
+        wall.velocity = (0.0, 0.0)
+    if not settled:
+        warnings.warn(
+            f"boundary phase: consolidation.max_steps reached with the walls at {state.stress_xx_pa / 1e3:.1f} and "
+            f"{state.stress_yy_pa / 1e3:.1f} kPa (sigma_0 {target / 1e3:.1f} kPa): shearing starts from there",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+    run.consolidation["platen_stress_pa"] = state.stress_yy_pa
+    run.membrane = WallBoundary(left.id, right.id, bottom.id, top.id, target,
+                                config["shear.volume"] == "constant").to_dict()
+    return steps
+
+
 def start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
     """The platens set moving at the axial strain rate, the shearing planned to
     ``shear.final_strain`` (records ``Every(shear.record_interval)``, snapshots
@@ -151,7 +198,7 @@ def start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
                   snapshots=snaps)
 
 
-def drive_platens(sim: Simulation, boundary: Membrane | GrainBoundary, speed: float) -> None:
+def drive_platens(sim: Simulation, boundary: Boundary, speed: float) -> None:
     """Each platen moves towards the other at ``speed`` (m/s; negative: apart)."""
     if isinstance(boundary, Membrane):
         set_platen_velocity(sim, boundary, speed)
@@ -231,6 +278,20 @@ def shear(
             values.update(extra(sim.step_count - plan.start_step))
         return values
 
+    boundary = _boundary(run)
+    walls = boundary if isinstance(boundary, WallBoundary) else None
+    wall_speed = 0.05 * float(sim.radii[: run.n_grains].min()) / (50 * sim.time_step)
+
+    def advance(to_step: int) -> None:
+        """Runs to ``to_step``; rigid side walls are controlled every WALL_CONTROL_STEPS."""
+        if walls is None:
+            sim.run(to_step - sim.step_count)
+            return
+        while sim.step_count < to_step:
+            n = min(WALL_CONTROL_STEPS, to_step - sim.step_count)
+            walls.control(sim, n, plan.area0, wall_speed)
+            sim.run(n)
+
     if plan.next_record == 0 and "0" in snap_steps and writer.n_rows == 0:
         first = record()
         writer.append_timeseries(first, units=units)
@@ -250,10 +311,10 @@ def shear(
         target = plan.start_step + steps[plan.next_record]
         turn = plan.start_step + plan.turn_steps[plan.next_turn] if plan.next_turn < len(plan.turn_steps) else None
         if turn is not None and turn < target:
-            sim.run(turn - sim.step_count)
+            advance(turn)
             _reverse(sim, run, plan)
             continue
-        sim.run(target - sim.step_count)
+        advance(target)
         values = record()
         writer.append_timeseries(values, units=units)
         key = str(steps[plan.next_record])
@@ -263,7 +324,7 @@ def shear(
         boundary = _boundary(run)
         if isinstance(boundary, GrainBoundary):
             run.membrane = boundary.identify(sim).to_dict()
-        else:
+        elif isinstance(boundary, Membrane):
             breach = membrane_breach(sim, boundary)
             if breach is not None:
                 bar.close()

@@ -11,8 +11,8 @@ from grainlab.analysis import fabric_summary
 from grainlab.analysis.stress import love_weber_stress
 from grainlab.columns import BIAXIAL
 from grainlab.io.walls import WallGeometry
-from grainlab.protocols.biaxial.state import _boundary, _Run
-from grainlab.protocols.boundary import GrainBoundary, Membrane, sample_area
+from grainlab.protocols.biaxial.state import Boundary, _boundary, _Run
+from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, sample_area
 from grainlab.protocols.config import BiaxialConfig
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind, Snapshot
@@ -33,7 +33,7 @@ class _Platens:
     axial_stress_pa: float
 
 
-def _platens(sim: Simulation, boundary: Membrane | GrainBoundary) -> _Platens:
+def _platens(sim: Simulation, boundary: Boundary) -> _Platens:
     bottom, top = sim.wall(boundary.bottom_wall), sim.wall(boundary.top_wall)
     height = float(top.points[0, 1] - bottom.points[0, 1])
     area = _area(sim, boundary)
@@ -48,7 +48,7 @@ def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, flo
     shear = run.shear_plan()
     platens = _platens(sim, boundary)
     height, area, sigma_1 = platens.height_m, platens.area_m2, platens.axial_stress_pa
-    sigma_3 = config["consolidation.pressure"]
+    sigma_3 = config["consolidation.pressure"]  # the confining pressure held (a cell pressure)
 
     c = sim.contacts()
     w = sim.wall_contacts()
@@ -67,9 +67,13 @@ def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, flo
         membrane_particle = np.where(grain_i, c.j, c.i)
         felt_left = -on_membrane[left[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
         felt_right = on_membrane[right[membrane_particle] & (grain_i ^ grain_j), 0].sum() / height
+    elif isinstance(boundary, WallBoundary):
+        felt_left = felt_right = boundary.lateral_stress(sim)
     else:
         # the follower loads act on the grains themselves: the pressure over the full height
         felt_left = felt_right = boundary.pressure
+    # at constant volume the side walls' stress is the effective one, sigma_3'
+    sigma_3_ratio = felt_left if isinstance(boundary, WallBoundary) and boundary.constant_volume else sigma_3
     wall_force = w.force_on_particle
     grains = np.zeros(sim.n_particles, dtype=bool)
     grains[:n] = True
@@ -95,8 +99,8 @@ def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, flo
         "axial_stress_pa": sigma_1,
         "confining_pressure_pa": sigma_3,
         "confining_stress_felt_pa": 0.5 * (felt_left + felt_right),
-        "stress_ratio": sigma_1 / sigma_3,
-        "stress_ratio_mobilised": (sigma_1 - sigma_3) / (sigma_1 + sigma_3),
+        "stress_ratio": sigma_1 / sigma_3_ratio,
+        "stress_ratio_mobilised": (sigma_1 - sigma_3_ratio) / (sigma_1 + sigma_3_ratio),
         "volumetric_strain": (shear.area0 - area) / shear.area0,
         "area_m2": area,
         "height_m": height,
@@ -125,7 +129,7 @@ def _fabric(sim: Simulation, run: _Run) -> dict[str, float]:
     return summary
 
 
-def _area(sim: Simulation, boundary: Membrane | GrainBoundary) -> float:
+def _area(sim: Simulation, boundary: Boundary) -> float:
     return sample_area(sim, boundary) if isinstance(boundary, Membrane) else boundary.area(sim)
 
 
@@ -136,7 +140,7 @@ def _snapshot(sim: Simulation, run: _Run, strain: float) -> Snapshot:
     body = np.full(sim.n_particles, -1, dtype=np.int64)
     if run.membrane is not None and run.membrane.get("kind") == GrainBoundary.kind:
         kind[run.membrane["left"] + run.membrane["right"]] = int(ParticleKind.BOUNDARY)
-    elif run.membrane is not None:
+    elif run.membrane is not None and run.membrane.get("kind") != WallBoundary.kind:
         body[run.membrane["left"]] = 0
         body[run.membrane["right"]] = 1
     snap = sim.snapshot(kind=kind, axial_strain=strain, step=sim.step_count)

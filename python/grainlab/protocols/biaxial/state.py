@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-from grainlab.protocols.boundary import GrainBoundary, Membrane
+from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary
 from grainlab.protocols.specimen import CHUNK_STEPS, SpecimenError, SpecimenRun
 
 __all__ = ["CHUNK_STEPS", "BiaxialError", "ShearPlan"]
@@ -91,9 +91,15 @@ class _Run(SpecimenRun):
         return self.shear
 
 
-def _boundary(run: _Run) -> Membrane | GrainBoundary:
-    """The run's lateral boundary (the membrane, or variant B's grain chains)."""
+#: A biaxial run's lateral boundary.
+Boundary = Membrane | GrainBoundary | WallBoundary
+
+
+def _boundary(run: _Run) -> Boundary:
+    """The run's lateral boundary (the membrane, variant B's grain chains or variant C's walls)."""
     boundary = run.boundary_state()
     if boundary.get("kind") == GrainBoundary.kind:
         return GrainBoundary.from_dict(boundary)
+    if boundary.get("kind") == WallBoundary.kind:
+        return WallBoundary.from_dict(boundary)
     return Membrane.from_dict(boundary)

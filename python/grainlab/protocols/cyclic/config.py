@@ -15,6 +15,7 @@ from grainlab.protocols.config import (
     ConfigError,
     ConfigSchema,
     Field,
+    check_boundary,
     check_sample,
     register_schema,
 )
@@ -35,6 +36,7 @@ _MONOTONIC_ONLY = ("shear.final_strain", "shear.snapshot_strains")
 
 def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
     check_sample(values, given)
+    check_boundary(values, given)
     amplitude, interval = values["cyclic.strain_amplitude"], values["shear.record_interval"]
     if amplitude < 4 * interval:
         raise ConfigError(

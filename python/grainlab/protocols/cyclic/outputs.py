@@ -47,14 +47,24 @@ class CyclicResult(RunResult):
             f"{len(s['cycles'])} cycles of +/-{100 * s['strain_amplitude']:.2f} %: sigma1/sigma3 at +A "
             f"{first['stress_ratio_compression']:.2f} -> {last['stress_ratio_compression']:.2f}, volumetric strain "
             f"{100 * last[VOLUMETRIC_STRAIN]:.3f} %, Z {s['coordination_number_initial']:.2f} -> "
-            f"{last[COORDINATION_NUMBER]:.2f}; {s['wall_time_s']:.1f} s -> {self.out_dir}"
+            f"{last[COORDINATION_NUMBER]:.2f}; {self._undrained()}{s['wall_time_s']:.1f} s -> {self.out_dir}"
         )
 
+    def _undrained(self) -> str:
+        s = self.summary
+        if s.get("shear_volume") != "constant":
+            return ""
+        return (f"constant volume: p' {s['cycles'][0]['mean_effective_stress_pa'] / 1e3:.1f} -> "
+                f"{s['mean_effective_stress_after_cycles_pa'] / 1e3:.1f} kPa at the cycles' ends, u "
+                f"{s['pore_pressure_after_cycles_pa'] / 1e3:.1f} kPa; ")
 
-def cycle_table(timeseries: dict[str, np.ndarray]) -> list[dict[str, float]]:
+
+def cycle_table(timeseries: dict[str, np.ndarray], cell_pressure_pa: float | None = None) -> list[dict[str, float]]:
     """One row per complete cycle (module docstring): ``cycle``, the stress ratio and
     axial strain at its compression and extension turning points, and the end
-    record's :data:`_END_COLUMNS`."""
+    record's :data:`_END_COLUMNS`; at constant volume (``cell_pressure_pa`` given) also
+    the end record's mean effective stress p' = (sigma_1' + sigma_3') / 2 and the
+    pore-pressure analogue u = sigma_0 - sigma_3'."""
     cycle = np.asarray(timeseries[CYCLE], dtype=np.float64)
     eps = np.asarray(timeseries[AXIAL_STRAIN], dtype=np.float64)
     q = np.asarray(timeseries[STRESS_RATIO], dtype=np.float64)
@@ -66,6 +76,10 @@ def cycle_table(timeseries: dict[str, np.ndarray]) -> list[dict[str, float]]:
         row = {"cycle": k, "stress_ratio_compression": float(q[top]), "axial_strain_compression": float(eps[top]),
                "stress_ratio_extension": float(q[bottom]), "axial_strain_extension": float(eps[bottom])}
         row.update({str(c): float(timeseries[c][end]) for c in _END_COLUMNS if c in timeseries})
+        if cell_pressure_pa is not None:
+            s1, s3 = float(timeseries["axial_stress_pa"][end]), float(timeseries["confining_stress_felt_pa"][end])
+            row["mean_effective_stress_pa"] = 0.5 * (s1 + s3)
+            row["pore_pressure_pa"] = cell_pressure_pa - s3
         rows.append(row)
     return rows
 
@@ -73,7 +87,8 @@ def cycle_table(timeseries: dict[str, np.ndarray]) -> list[dict[str, float]]:
 def summarise(run: _Run, config: Config, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
     """The run's summary, as ``run.h5`` and ``summary.json`` store it."""
     plan = run.shear_plan()
-    cycles = cycle_table(timeseries)
+    constant_volume = config["shear.volume"] == "constant"
+    cycles = cycle_table(timeseries, config["consolidation.pressure"] if constant_volume else None)
     last = cycles[-1] if cycles else {}
     return {
         "n_particles": run.n_grains,
@@ -84,6 +99,7 @@ def summarise(run: _Run, config: Config, timeseries: dict[str, np.ndarray], tota
         "mean_stability_index_initial": float(timeseries["mean_stability_index"][0]),
         "anisotropy_initial": float(timeseries["anisotropy"][0]),
         "strain_amplitude": config["cyclic.strain_amplitude"],
+        "shear_volume": config["shear.volume"],
         "strain_rate": plan.strain_rate,
         "inertial_number": plan.inertial_number,
         "cycles": cycles,
@@ -94,6 +110,8 @@ def summarise(run: _Run, config: Config, timeseries: dict[str, np.ndarray], tota
         "coordination_number_after_cycles": last.get(COORDINATION_NUMBER),
         "mean_stability_index_after_cycles": last.get("mean_stability_index"),
         "anisotropy_after_cycles": last.get("anisotropy"),
+        "mean_effective_stress_after_cycles_pa": last.get("mean_effective_stress_pa"),
+        "pore_pressure_after_cycles_pa": last.get("pore_pressure_pa"),
         "time_step_s": run.consolidation["time_step_s"],
         "records": len(timeseries[AXIAL_STRAIN]),
         "wall_time_s": total_s,
