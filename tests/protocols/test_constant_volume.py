@@ -119,3 +119,20 @@ def test_a_membrane_at_constant_volume_is_one_line_and_no_folder(tmp_path, capsy
     err = capsys.readouterr().err
     assert "shear.volume: 'constant' holds the sample's area" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_the_docs_quote_the_default_constant_volume_run():
+    """docs/protocols.md's default constant-volume run is tests/data/constant_volume's summary."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    s = json.loads((root / "tests" / "data" / "constant_volume" / "default_summary.json").read_text())
+    line = next(x for x in (root / "docs" / "protocols.md").read_text().splitlines()
+                if x.startswith("grainlab biaxial: 3518") and "constant volume" in x)
+    assert line.split("; ")[:-2] == [
+        f"grainlab biaxial: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}, "
+        f"Z0 {s['coordination_number_initial']:.2f}",
+        f"peak sigma1/sigma3 {s['peak_stress_ratio']:.2f} at {100 * s['axial_strain_at_peak']:.2f} % axial strain",
+        f"constant volume: u up to {s['pore_pressure_max_pa'] / 1e3:.1f} kPa at "
+        f"{100 * s['axial_strain_at_pore_pressure_max']:.2f} %, {s['pore_pressure_final_pa'] / 1e3:.1f} kPa at the end"]
+    assert s["shear_volume"] == "constant" and s["final_stress_ratio"] == pytest.approx(1.745, abs=5e-4)
