@@ -15,10 +15,11 @@ from matplotlib.collections import EllipseCollection, LineCollection, PolyCollec
 from matplotlib.colors import Normalize
 from numpy.typing import ArrayLike
 
+from grainlab._notebook import new_figure, prepare_notebook
 from grainlab.plot import new_axes
 from grainlab.plot.files import paper_style
 
-__all__ = ["cell_map", "contact_network"]
+__all__ = ["cell_map", "contact_network", "grouped_means"]
 
 
 def _frame(ax: Any, points: np.ndarray) -> None:
@@ -124,3 +125,32 @@ def cell_map(
         mappable = mpl.cm.ScalarMappable(norm=norm, cmap=colormap)
         ax.figure.colorbar(mappable, ax=ax, label=label or "")
     return ax
+
+
+def grouped_means(
+    panels: list[tuple[str, list[str], ArrayLike, ArrayLike, ArrayLike]],
+    *,
+    ylabel: str,
+    reference: float | None = None,
+) -> Any:
+    """One panel per ``(title, labels, means, standard_errors, counts)``: the mean of
+    a quantity in each group with its standard error, the group's count under
+    its label, and a dashed line at ``reference`` (the overall mean); returns the
+    figure."""
+    prepare_notebook()
+    with paper_style():
+        fig = new_figure(figsize=(2.4 * len(panels), 2.8), layout="constrained")
+        axes = fig.subplots(1, len(panels), sharey=True, squeeze=False)[0]
+        for ax, (title, labels, means, errors, counts) in zip(axes, panels, strict=True):
+            m = np.asarray(means, dtype=np.float64)
+            e = np.asarray(errors, dtype=np.float64)
+            x = np.arange(m.size)
+            ax.errorbar(x, m, yerr=e, fmt="o", color="k", ms=4, capsize=2, lw=0.8)
+            n = np.asarray(counts, dtype=np.int64)
+            ax.set_xticks(x, [f"{t}\n({int(c)})" for t, c in zip(labels, n, strict=True)], fontsize=6)
+            ax.set_xlim(-0.5, m.size - 0.5)
+            if reference is not None:
+                ax.axhline(reference, color="0.5", lw=0.6, ls="--")
+            ax.set_title(title, fontsize=8)
+        axes[0].set_ylabel(ylabel)
+    return fig
