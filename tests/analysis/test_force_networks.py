@@ -178,3 +178,13 @@ def test_analyze_reports_the_new_measures(tmp_path):
     written = {p.name for p in write_analysis(result, tmp_path)}
     assert {"force_network.png", "force_chains.png", "map_local_porosity.png",
             "map_loop_size.png", "stress_force_fabric.png"} <= written
+
+
+def test_every_new_measure_draws():
+    from grainlab.analysis import ContactLoops, ForceChains, GrainStress, LocalPorosity
+
+    snap, _ = hex_three_and_one()
+    for measure in (FabricTensor(), GrainStress(), ForceNetworks(), StressForceFabric(),
+                    ForceChains(), LocalPorosity(), ContactLoops()):
+        ax = measure.compute(snap).plot()
+        assert ax.figure is not None
