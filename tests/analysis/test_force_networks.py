@@ -135,6 +135,26 @@ def test_stress_force_fabric_is_exact_for_the_forms_on_even_directions():
     assert rb.stress_ratio == pytest.approx(0.05) and rb.residual == pytest.approx(0.0, abs=1e-12)
 
 
+def test_branch_length_anisotropy():
+    """Equal forces on 360 contacts 1 deg apart whose branch lengths follow
+    l0 [1 + a_l cos 2(theta - 90 deg)]: q/p = a_l / 2, all of it in the branch lengths."""
+    th = np.radians(np.arange(360.0))
+    length = 2e-3 * (1 + 0.2 * np.cos(2 * (th - np.pi / 2)))
+    pos = np.vstack([[0.0, 0.0], length[:, None] * np.c_[np.cos(th), np.sin(th)]])
+    radii = np.r_[0.5e-3, length - 0.5e-3]
+    snap = Snapshot(pos, radii, contact_i=np.zeros(360, np.int64), contact_j=np.arange(1, 361),
+                    normal_force=np.ones(360))
+    rb = StressForceFabric().compute(snap)
+    assert rb.anisotropies.a_l == pytest.approx(0.2)
+    assert rb.anisotropies.theta_l == pytest.approx(np.pi / 2)
+    assert rb.anisotropies.l0 == pytest.approx(2e-3)
+    assert rb.anisotropies.a_n == pytest.approx(0.0, abs=1e-12)
+    assert rb.stress_ratio == pytest.approx(0.1)
+    assert rb.predicted_stress_ratio == pytest.approx(0.0, abs=1e-12)
+    assert rb.residual == pytest.approx(0.1)
+    assert rb.residual_with_branch_length == pytest.approx(0.0, abs=1e-12)
+
+
 def test_uniaxially_loaded_hexagonal_lattice():
     """Contacts at 30, 90, 150 deg, only the vertical ones loaded: a = 0, a_n = 2,
     q/p = 1 measured and predicted (no fourth harmonic)."""
@@ -148,6 +168,8 @@ def test_uniaxially_loaded_hexagonal_lattice():
     assert rb.anisotropies.theta_n == pytest.approx(np.pi / 2)
     assert rb.stress_ratio == pytest.approx(1.0)
     assert rb.residual == pytest.approx(0.0, abs=1e-12)
+    assert rb.anisotropies.a_l == pytest.approx(0.0, abs=1e-12)  # one size of disk
+    assert rb.residual_with_branch_length == pytest.approx(0.0, abs=1e-12)
 
 
 def test_uniaxially_loaded_square_lattice_has_no_a_n():

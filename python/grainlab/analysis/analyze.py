@@ -173,6 +173,9 @@ class AnalysisResult:
         out["rb_stress_ratio"] = num(rb.stress_ratio) if rb else None
         out["rb_predicted_stress_ratio"] = num(rb.predicted_stress_ratio) if rb else None
         out["rb_residual"] = num(rb.residual) if rb else None
+        out["rb_a_l"] = num(rb.anisotropies.a_l) if rb else None
+        out["rb_predicted_with_branch_length"] = num(rb.predicted_with_branch_length) if rb else None
+        out["rb_residual_with_branch_length"] = num(rb.residual_with_branch_length) if rb else None
         ch = self.chains
         out.update(
             {f"chains_{k}": v for k, v in nums(ch.summary()).items()}

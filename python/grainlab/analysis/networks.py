@@ -158,6 +158,7 @@ class ForceNetworks(Computable[_ForceNetworksResults]):
         p_whole = 0.5 * float(np.trace(whole_stress))
         angles = np.asarray(snapshot.contact_angles())
         fs = snapshot.shear_force
+        lengths = np.hypot(*branch_vectors(snapshot).T)
 
         def network(mask: NDArray[np.bool_]) -> Network:
             stress = contact_stress(snapshot, mask, self.area)
@@ -166,7 +167,10 @@ class ForceNetworks(Computable[_ForceNetworksResults]):
             return Network(
                 contacts=mask,
                 anisotropies=force_anisotropies(
-                    angles[mask], fn[mask], None if fs is None else np.asarray(fs)[mask]
+                    angles[mask],
+                    fn[mask],
+                    None if fs is None else np.asarray(fs)[mask],
+                    lengths[mask],
                 ),
                 stress=stress,
                 mean_stress=p,

@@ -42,7 +42,9 @@ Anisotropies of Rothenburg and Bathurst (1989)
     exact whenever the forces follow the forms, whatever the normals; NaN
     when the normals take fewer than three directions modulo 180° (two
     directions cannot separate :math:`f_0` from :math:`a_n`) and :math:`a_t`
-    NaN without shear forces.
+    NaN without shear forces. The branch lengths are fitted the same way,
+    :math:`|l_c| \approx l_0[1 + a_l\cos 2(\theta_c - \theta_l)]` (Ouadfel
+    and Rothenburg's branch-length anisotropy, 0 for disks of one size).
 
 Stress-force-fabric relation
     With the stress of the same contacts (:func:`~grainlab.analysis.stress.contact_stress`),
@@ -61,7 +63,9 @@ Stress-force-fabric relation
     both sides and the residual measured − predicted: the products of
     anisotropies, the fourth and higher harmonics of the normals and of the
     forces, and the branch-length anisotropy of a polydisperse packing,
-    which the relation leaves out. On a hexagonal lattice with forces of
+    which the relation leaves out; the last is also reported, and the
+    prediction and residual with :math:`\tfrac12 a_l\cos 2(\theta_l -
+    \theta_\sigma)` added. On a hexagonal lattice with forces of
     the forms the residual is 0 (its normals have no fourth harmonic); a
     square lattice loaded along one axis has a = 0, q/p = 1, and its
     :math:`a_n` is NaN (two directions).
@@ -90,7 +94,8 @@ __all__ = ["Anisotropies", "FabricTensor", "StressForceFabric", "force_anisotrop
 class Anisotropies:
     """Rothenburg and Bathurst's anisotropies of a set of contacts (module
     docstring): ``a``, ``a_n``, ``a_t`` and their directions (rad, [0, pi)),
-    ``f0`` the fitted mean normal force (N), ``n_contacts``."""
+    ``f0`` the fitted mean normal force (N), ``n_contacts``; ``a_l``,
+    ``theta_l`` and ``l0`` (m) of the branch lengths when they were given."""
 
     n_contacts: int
     a: float
@@ -100,11 +105,14 @@ class Anisotropies:
     a_t: float
     theta_t: float
     f0: float
+    a_l: float = float("nan")
+    theta_l: float = float("nan")
+    l0: float = float("nan")
 
     def as_dict(self, prefix: str = "") -> dict[str, float | int]:
         """The numbers by name, angles in degrees (``theta_a_deg``, ...)."""
         out: dict[str, float | int] = {f"{prefix}n_contacts": self.n_contacts}
-        for name in ("a", "a_n", "a_t"):
+        for name in ("a", "a_n", "a_t", "a_l"):
             out[prefix + name] = getattr(self, name)
             theta = getattr(self, "theta" + (name[1:] if name != "a" else "_a"))
             out[f"{prefix}theta{name[1:] if name != 'a' else '_a'}_deg"] = float(np.degrees(theta))
@@ -116,9 +124,10 @@ def force_anisotropies(
     angles: NDArray[np.float64],
     normal_force: NDArray[np.float64] | None,
     shear_force: NDArray[np.float64] | None,
+    branch_length: NDArray[np.float64] | None = None,
 ) -> Anisotropies:
     """:class:`Anisotropies` of contacts at ``angles`` (rad) with these forces
-    (N; None: the force terms NaN)."""
+    (N; None: the force terms NaN) and branch lengths (m; None: a_l NaN)."""
     th = np.asarray(angles, dtype=np.float64)
     nan = float("nan")
     if th.size == 0:
@@ -140,7 +149,16 @@ def force_anisotropies(
                 )
                 a_t = float(np.hypot(d[0], d[1]) / f0)
                 theta_t = float(axial_direction(np.arctan2(-d[0], d[1])))
-    return Anisotropies(int(th.size), a, theta_a, a_n, theta_n, a_t, theta_t, f0)
+    a_l = theta_l = l0 = nan
+    if branch_length is not None and np.linalg.matrix_rank(design) == 3:
+        b, *_ = np.linalg.lstsq(design, np.asarray(branch_length, dtype=np.float64), rcond=None)
+        if b[0] > 0.0:
+            l0 = float(b[0])
+            a_l = float(np.hypot(b[1], b[2]) / b[0])
+            theta_l = float(axial_direction(np.arctan2(b[2], b[1])))
+    return Anisotropies(
+        int(th.size), a, theta_a, a_n, theta_n, a_t, theta_t, f0, a_l, theta_l, l0
+    )
 
 
 def _normal_products(normals: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -342,7 +360,10 @@ class StressForceFabric(Computable[_StressForceFabricResults]):
         used = grain_contacts(snapshot, self.include_boundary)
         angles = np.asarray(snapshot.contact_angles())[used]
         fs = None if snapshot.shear_force is None else np.asarray(snapshot.shear_force)[used]
-        rb = force_anisotropies(angles, np.asarray(snapshot.normal_force)[used], fs)
+        from grainlab.analysis.stress import branch_vectors
+
+        lengths = np.hypot(*branch_vectors(snapshot)[used].T)
+        rb = force_anisotropies(angles, np.asarray(snapshot.normal_force)[used], fs, lengths)
         stress = contact_stress(snapshot, used)
         s1, s2, direction = principal_stresses(stress)
         ratio = float((s1 - s2) / (s1 + s2)) if s1 + s2 > 0 else float("nan")
@@ -386,6 +407,18 @@ class StressForceFabric(Computable[_StressForceFabricResults]):
     def residual(self) -> float:
         """Measured minus predicted q/p."""
         return self.stress_ratio - self.predicted_stress_ratio
+
+    @property
+    def predicted_with_branch_length(self) -> float:
+        """The predicted q/p plus (1/2) a_l cos 2(theta_l - theta_sigma)."""
+        rb = self.anisotropies
+        extra = 0.5 * rb.a_l * np.cos(2.0 * (rb.theta_l - self.stress_direction))
+        return float(self.predicted_stress_ratio + (extra if np.isfinite(extra) else 0.0))
+
+    @property
+    def residual_with_branch_length(self) -> float:
+        """Measured q/p minus :attr:`predicted_with_branch_length`."""
+        return self.stress_ratio - self.predicted_with_branch_length
 
     @property
     def sigma_ratio(self) -> float:
