@@ -134,6 +134,39 @@ def test_rattler_next_to_a_rigid_core():
     assert z.rattlers.sum() == 1 and z.rattlers[16]
 
 
+def test_thornton_rattlers_need_the_second_round():
+    """Thornton's rule (fewer than 2 contacts), applied until nothing changes: on a square
+    lattice core (grains 0-15), grain 16 touches only grains 17 and 18, which touch
+    nothing else. Round 1 removes 17 and 18 (one contact each), which leaves 16 with
+    none: round 2 removes it. One round would keep 16 (two contacts) and give Z_m =
+    2 (32 + 2) / 17; a wall contact counts as one when boundary contacts are included."""
+    sq = square_lattice(4, 4)
+    d = 1e-3
+    pos = np.vstack([sq.positions, [[-2 * d, 0.0], [-2 * d, d], [-2 * d, -d]]])
+    i = np.r_[sq.contact_i, 16, 16]
+    j = np.r_[sq.contact_j, 17, 18]
+    np.testing.assert_array_equal(rattlers(i, j, 19), [False] * 16 + [True] * 3)
+    snap = Snapshot(pos, np.full(19, 0.5e-3), contact_i=i, contact_j=j)
+    z = CoordinationNumber().compute(snap)
+    np.testing.assert_array_equal(np.flatnonzero(z.rattlers), [16, 17, 18])
+    assert z.mechanical_coordination_number == pytest.approx(4.0)  # 32 contacts, 16 grains
+    # grain 17 also on a wall: 18 goes in round 1, then 16 (left with 17 only), then 17
+    # (left with the wall only); with 16 on the wall too, only 18 is a rattler
+    def walls(*grains):
+        k = len(grains)
+        return Snapshot(pos, np.full(19, 0.5e-3), contact_i=np.r_[i, grains],
+                        contact_j=np.r_[j, [-1] * k],
+                        contact_point=np.vstack([np.zeros((i.size, 2)), pos[list(grains)] - [0.5 * d, 0]]))
+
+    one = CoordinationNumber(include_boundary=True).compute(walls(17))
+    np.testing.assert_array_equal(np.flatnonzero(one.rattlers), [16, 17, 18])
+    two = CoordinationNumber(include_boundary=True).compute(walls(16, 17))
+    np.testing.assert_array_equal(np.flatnonzero(two.rattlers), [18])
+    assert two.mechanical_coordination_number == pytest.approx((2 * 32 + 2 + 2) / 18)
+    # without boundary contacts the walls do not hold them
+    assert np.flatnonzero(CoordinationNumber().compute(walls(16, 17)).rattlers).tolist() == [16, 17, 18]
+
+
 def test_boundary_contacts_excluded_from_z_by_default():
     snap = Snapshot(
         [[0, 0], [1e-3, 0], [2e-3, 0]],

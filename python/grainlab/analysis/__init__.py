@@ -1,4 +1,5 @@
-"""Analysis of snapshots: fabric, stability index, strain fields, shear band.
+"""Analysis of snapshots: fabric, stability index, strain fields, shear band, stresses,
+force networks and chains, power cells, contact loops.
 
 Every measure is a small class in the freud style (parameters in the
 constructor, ``compute(...)`` returns ``self``, results as properties that
@@ -19,21 +20,35 @@ from grainlab.analysis.fabric import (
     fabric_tensor,
     rattlers,
 )
+from grainlab.analysis.force_chains import ForceChains
+from grainlab.analysis.loops import ContactLoops
+from grainlab.analysis.networks import ForceNetworks
 from grainlab.analysis.shear_band import ShearBand, Slab
 from grainlab.analysis.stability import StabilityIndex, stability_index, stability_index_of_angles
 from grainlab.analysis.strain import LocalStrain, match_ids, neighbour_pairs
+from grainlab.analysis.stress import GrainStress, LoveWeberStress
+from grainlab.analysis.stress_fabric import FabricTensor, StressForceFabric
+from grainlab.analysis.tessellation import LocalPorosity, power_cells
 
 __all__ = [
     "EDGE_TOLERANCE_RAD",
     "AnalysisResult",
     "BandContacts",
     "ContactAnisotropy",
+    "ContactLoops",
     "CoordinationNumber",
     "DisplacementBand",
+    "FabricTensor",
+    "ForceChains",
+    "ForceNetworks",
+    "GrainStress",
+    "LocalPorosity",
     "LocalStrain",
+    "LoveWeberStress",
     "ShearBand",
     "Slab",
     "StabilityIndex",
+    "StressForceFabric",
     "analyze_snapshot",
     "angular_histogram",
     "anisotropy_eq7",
@@ -42,6 +57,7 @@ __all__ = [
     "fabric_tensor",
     "match_ids",
     "neighbour_pairs",
+    "power_cells",
     "rattlers",
     "stability_index",
     "stability_index_of_angles",

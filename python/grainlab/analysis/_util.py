@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Generic, TypeVar
+from typing import Any, Generic, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -187,3 +187,51 @@ def finite_mean(values: NDArray[np.float64], mask: NDArray[np.bool_] | None = No
     if mask is not None:
         ok &= mask
     return float(v[ok].mean()) if ok.any() else float("nan")
+
+
+def sample_bounds(snapshot: Snapshot) -> NDArray[np.float64]:
+    """(2, 2) ``[[xlo, xhi], [ylo, yhi]]`` of the region a snapshot's measures
+    refer to, m: the snapshot's box when it has one, else the rectangle
+    bounding every disk (``min(x - r) .. max(x + r)``, all particles)."""
+    if snapshot.box is not None:
+        return np.array(snapshot.box, dtype=np.float64)
+    x = np.asarray(snapshot.positions)
+    r = np.asarray(snapshot.radii)[:, None]
+    if x.shape[0] == 0:
+        raise ValueError("positions: a snapshot without particles has no region")
+    return np.column_stack([(x - r).min(axis=0), (x + r).max(axis=0)])
+
+
+def grain_contacts(snapshot: Snapshot, include_boundary: bool = False) -> NDArray[np.bool_]:
+    """(Nc,) mask of the contacts a network measure uses: contacts between two
+    sample grains (no wall, no membrane particle) by default; with
+    ``include_boundary`` also the sample grains' contacts with walls and
+    membrane particles (a contact between two membrane particles never)."""
+    ci = np.asarray(snapshot.contact_i)
+    cj = np.asarray(snapshot.contact_j)
+    if not include_boundary:
+        return np.asarray(~snapshot.is_boundary_contact, dtype=bool)
+    sample = snapshot.is_sample
+    return np.asarray(sample[ci] | ((cj >= 0) & sample[np.where(cj >= 0, cj, 0)]), dtype=bool)
+
+
+def principal_stresses(
+    stress: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Major and minor principal values and the major direction of symmetric
+    (..., 2, 2) tensors: ``s1 = p + R``, ``s2 = p - R`` with ``p = (sxx + syy)/2``,
+    ``R = sqrt(((sxx - syy)/2)^2 + sxy^2)``, direction
+    ``0.5 atan2(2 sxy, sxx - syy)`` in [0, pi) rad (0 for an isotropic tensor)."""
+    s = np.asarray(stress, dtype=np.float64)
+    sxx, syy, sxy = s[..., 0, 0], s[..., 1, 1], 0.5 * (s[..., 0, 1] + s[..., 1, 0])
+    p = 0.5 * (sxx + syy)
+    radius = np.hypot(0.5 * (sxx - syy), sxy)
+    return p + radius, p - radius, axial_direction(np.arctan2(2.0 * sxy, sxx - syy))
+
+
+def axial_direction(doubled: Any) -> Any:
+    """The direction in [0, pi) rad of an axis whose doubled angle is ``doubled``
+    (rad, any range); within 1e-12 rad of pi it is 0 (round-off of a doubled
+    angle near 2 pi, such as a horizontal axis, would otherwise give pi)."""
+    theta = np.mod(0.5 * np.asarray(doubled, dtype=np.float64), np.pi)
+    return np.where(theta > np.pi - 1e-12, 0.0, theta)

@@ -11,9 +11,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
+from grainlab.analysis.force_chains import ForceChains
+from grainlab.analysis.loops import ContactLoops
+from grainlab.analysis.networks import ForceNetworks
 from grainlab.analysis.shear_band import ShearBand
 from grainlab.analysis.stability import DEFAULT_READING, StabilityIndex
 from grainlab.analysis.strain import LocalStrain
+from grainlab.analysis.stress import GrainStress
+from grainlab.analysis.stress_fabric import FabricTensor, StressForceFabric
+from grainlab.analysis.tessellation import LocalPorosity
 from grainlab.snapshot import Snapshot
 
 __all__ = ["AnalysisResult", "analyze_snapshot", "fabric_summary"]
@@ -32,6 +38,13 @@ class AnalysisResult:
     strain: LocalStrain | None = None
     band: ShearBand | None = None
     notes: list[str] = field(default_factory=list)
+    fabric_tensor: FabricTensor | None = None
+    loops: ContactLoops | None = None
+    porosity: LocalPorosity | None = None
+    networks: ForceNetworks | None = None
+    stress_force_fabric: StressForceFabric | None = None
+    grain_stress: GrainStress | None = None
+    chains: ForceChains | None = None
 
     def summary(self) -> dict[str, Any]:
         """The scalar results, as written to ``fabric.json`` (angles in degrees)."""
@@ -100,6 +113,7 @@ class AnalysisResult:
             "band2_inclination_deg": num(b2.inclination_degrees) if b2 else None,
             "band2_thickness_diameters": num(b2.thickness_diameters) if b2 else None,
             "band2_contrast": num(b2.contrast) if b2 else None,
+            **self.network_summary(),
             "has_reference": self.strain is not None,
             "time": self.snapshot.time,
             "axial_strain": self.snapshot.axial_strain,
@@ -108,6 +122,66 @@ class AnalysisResult:
             "contacts": self.snapshot.metadata.get("contacts"),
             "notes": list(self.notes),
         }
+        return out
+
+    def network_summary(self) -> dict[str, Any]:
+        """The fabric tensor, loops, porosity, force networks, stress-force-fabric
+        and force chains' scalars (``fabric.json``; None where not computed)."""
+
+        def num(x: float | None) -> float | None:
+            return None if x is None or not math.isfinite(x) else float(x)
+
+        def nums(values: dict[str, Any]) -> dict[str, Any]:
+            return {
+                k: num(v) if isinstance(v, float) else v for k, v in values.items()
+            }
+
+        out: dict[str, Any] = {}
+        ft = self.fabric_tensor
+        out["satake_fabric_tensor"] = (
+            ft.tensor.tolist() if ft is not None and np.all(np.isfinite(ft.tensor)) else None
+        )
+        out["fabric_fourth_harmonic"] = num(ft.fourth_harmonic) if ft is not None else None
+        out["satake_strong_part"] = (
+            ft.strong_part.tolist() if ft is not None and ft.strong_part is not None else None
+        )
+        out["satake_weak_part"] = (
+            ft.weak_part.tolist() if ft is not None and ft.weak_part is not None else None
+        )
+        lp = self.loops
+        out.update(
+            nums(lp.summary())
+            if lp is not None
+            else dict.fromkeys(
+                ("cyclomatic_number", "n_loops", "mean_loop_size", "loop_size_distribution")
+            )
+        )
+        po = self.porosity
+        out["porosity_power_cells"] = num(po.porosity) if po is not None else None
+        out["mean_local_porosity"] = (
+            num(float(np.nanmean(po.local_porosity)))
+            if po is not None and np.isfinite(po.local_porosity).any()
+            else None
+        )
+        nets = self.networks
+        if nets is not None:
+            out.update(nums(nets.summary()))
+        rb = self.stress_force_fabric
+        out["rb_a"] = num(rb.anisotropies.a) if rb else None
+        out["rb_a_n"] = num(rb.anisotropies.a_n) if rb else None
+        out["rb_a_t"] = num(rb.anisotropies.a_t) if rb else None
+        out["rb_stress_ratio"] = num(rb.stress_ratio) if rb else None
+        out["rb_predicted_stress_ratio"] = num(rb.predicted_stress_ratio) if rb else None
+        out["rb_residual"] = num(rb.residual) if rb else None
+        out["rb_a_l"] = num(rb.anisotropies.a_l) if rb else None
+        out["rb_predicted_with_branch_length"] = num(rb.predicted_with_branch_length) if rb else None
+        out["rb_residual_with_branch_length"] = num(rb.residual_with_branch_length) if rb else None
+        ch = self.chains
+        out.update(
+            {f"chains_{k}": v for k, v in nums(ch.summary()).items()}
+            if ch is not None
+            else {}
+        )
         return out
 
     @property
@@ -141,6 +215,13 @@ class AnalysisResult:
             cols["volumetric_strain"] = s.volumetric_strain
             cols["d2min"] = s.d2min
         cols["rattler"] = self.coordination.rattlers.astype(np.int64)
+        cols["local_porosity"] = self.porosity.local_porosity if self.porosity else nan
+        cols["major_stress_pa"] = self.grain_stress.major if self.grain_stress else nan
+        cols["in_strong_network"] = (
+            self.networks.in_strong_network.astype(np.int64) if self.networks else nan
+        )
+        cols["force_chain"] = self.chains.chain if self.chains else nan
+        cols["loop_size"] = self.loops.grain_loop_size if self.loops else nan
         return cols
 
 
@@ -241,6 +322,25 @@ def analyze_snapshot(
     else:
         notes.append("no contact forces in the input: a_n not computed")
     stability.compute(snapshot)
+    fabric_tensor = FabricTensor(include_boundary=fabric_include_boundary).compute(snapshot)
+    loops = ContactLoops().compute(snapshot)
+    porosity: LocalPorosity | None = None
+    try:
+        porosity = LocalPorosity().compute(snapshot)
+    except (ValueError, RuntimeError) as error:  # fewer than 3 disks, all in a line (Qhull)
+        notes.append(f"no power cells, local porosity not computed: {str(error).splitlines()[0]}")
+    networks = stress_force_fabric = grains = chains = None
+    if snapshot.normal_force is not None and float(np.sum(snapshot.normal_force)) > 0.0:
+        networks = ForceNetworks(include_boundary=fabric_include_boundary).compute(snapshot)
+        stress_force_fabric = StressForceFabric(include_boundary=fabric_include_boundary).compute(
+            snapshot
+        )
+        grains = GrainStress().compute(snapshot)
+        chains = ForceChains().compute(snapshot, grains)
+    else:
+        notes.append(
+            "no contact forces: force networks, stress-force-fabric and force chains not computed"
+        )
     strain = band = None
     if reference is None:
         notes.append(
@@ -264,5 +364,19 @@ def analyze_snapshot(
         else:
             notes.append("fewer than 10 particles with a local strain: no shear band detected")
     return AnalysisResult(
-        snapshot, coordination, anisotropy, force_anisotropy, stability, strain, band, notes
+        snapshot,
+        coordination,
+        anisotropy,
+        force_anisotropy,
+        stability,
+        strain,
+        band,
+        notes,
+        fabric_tensor=fabric_tensor,
+        loops=loops,
+        porosity=porosity,
+        networks=networks,
+        stress_force_fabric=stress_force_fabric,
+        grain_stress=grains,
+        chains=chains,
     )

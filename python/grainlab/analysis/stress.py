@@ -1,5 +1,6 @@
-"""The average stress tensor of a set of particles from their contact forces
-(Love-Weber), a check on boundary stresses.
+r"""The average stress tensor of a set of particles from their contact forces
+(Love-Weber), a check on boundary stresses; the stress of each grain, of a
+region and of a set of contacts (a force network).
 
 For particles ``p`` in a region of area ``A`` (unit thickness), with contact
 forces ``f_c`` acting on ``p`` at contact points ``x_c``::
@@ -10,12 +11,53 @@ symmetrised, **compression positive** (hence the minus sign). Every contact of a
 selected particle counts, including those with walls and with particles outside
 the selection (the boundary forces), so in static equilibrium the result equals
 the boundary stress.
+
+On a :class:`~grainlab.snapshot.Snapshot` (docs/fabric.md, "Stress"):
+
+* the force on particle i of contact c is
+  :math:`f^i_c = -f_{n,c}\, n_c + f_{s,c}\, t_c`, ``t = rot90(n)``, and
+  :math:`-f^i_c` acts on j (or on the wall); the contact point is the stored
+  one, else :math:`x_i + (r_i - \delta_c/2)\, n_c` with the overlap
+  :math:`\delta_c = r_i + r_j - |l_c|` (a wall contact without a point:
+  :math:`x_i + r_i n_c`);
+* the stress of a set C of contacts (:func:`contact_stress`) is the contact
+  (branch-vector) form
+
+  .. math:: \sigma^C = \frac{1}{A}\sum_{c \in C} \operatorname{sym}(l_c \otimes (-f^i_c)),
+
+  with the branch vector :math:`l_c = x_j - x_i` (minimum image; a wall
+  contact: contact point minus :math:`x_i`); summed over every contact of a
+  region it is the particle sum above, term by term. It is linear in the
+  contacts, so the stresses of disjoint sets of contacts add up to that of
+  their union (the strong and weak networks);
+* the stress of grain p (:func:`grain_stress`, :class:`GrainStress`) is
+  the particle sum over p alone,
+  :math:`\sigma^p = -\frac{1}{V_p}\sum_{c \ni p}\operatorname{sym}((x_c - x_p)\otimes f^p_c)`,
+  with :math:`V_p = \pi r_p^2` (unit thickness) or any area given (a power
+  cell, :class:`~grainlab.analysis.tessellation.LocalPorosity`).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from grainlab.analysis._util import Computable, principal_stresses, sample_bounds
+from grainlab.snapshot import Snapshot
+
+__all__ = [
+    "GrainStress",
+    "LoveWeberStress",
+    "branch_vectors",
+    "contact_forces_on_i",
+    "contact_points",
+    "contact_stress",
+    "grain_stress",
+    "love_weber_stress",
+]
 
 
 def love_weber_stress(
@@ -72,3 +114,278 @@ def love_weber_stress(
         total += arm.T @ np.asarray(wall_force_on_particle, dtype=float).reshape(-1, 2)[keep]
     sym = 0.5 * (total + total.T)
     return -sym / area
+
+
+# ------------------------------------------------------------------ on snapshots
+def contact_forces_on_i(snapshot: Snapshot) -> NDArray[np.float64]:
+    """(Nc, 2) force on particle ``contact_i`` of each contact, N (per m of
+    thickness): ``-f_n n + f_s t`` with ``t = rot90(n) = (-n_y, n_x)``; the
+    shear part is 0 when the snapshot has no shear forces.
+
+    Raises ValueError when the snapshot has no normal forces.
+    """
+    if snapshot.normal_force is None:
+        raise ValueError("normal_force: the snapshot has no contact forces (needed for stresses)")
+    n = np.asarray(snapshot.contact_normals())
+    fn = np.asarray(snapshot.normal_force)
+    fs = np.zeros_like(fn) if snapshot.shear_force is None else np.asarray(snapshot.shear_force)
+    t = np.column_stack([-n[:, 1], n[:, 0]])
+    return np.asarray(-fn[:, None] * n + fs[:, None] * t, dtype=np.float64)
+
+
+def branch_vectors(snapshot: Snapshot) -> NDArray[np.float64]:
+    """(Nc, 2) branch vector of each contact, m: ``x_j - x_i`` (minimum image)
+    for particle contacts, the contact point minus ``x_i`` for wall contacts."""
+    x = np.asarray(snapshot.positions)
+    ci = np.asarray(snapshot.contact_i)
+    cj = np.asarray(snapshot.contact_j)
+    wall = cj < 0
+    d = snapshot.minimum_image(x[np.where(wall, ci, cj)] - x[ci])
+    if wall.any():
+        d[wall] = contact_points(snapshot)[wall] - x[ci[wall]]
+    return np.asarray(d, dtype=np.float64)
+
+
+def contact_points(snapshot: Snapshot) -> NDArray[np.float64]:
+    """(Nc, 2) contact points, m: the stored ones, else ``x_i + (r_i - delta/2) n``
+    with the overlap ``delta = r_i + r_j - |x_j - x_i|`` (a wall contact:
+    ``x_i + r_i n``), so that a point may lie outside a periodic box."""
+    if snapshot.contact_point is not None:
+        return np.asarray(snapshot.contact_point, dtype=np.float64)
+    x = np.asarray(snapshot.positions)
+    r = np.asarray(snapshot.radii)
+    ci = np.asarray(snapshot.contact_i)
+    cj = np.asarray(snapshot.contact_j)
+    n = np.asarray(snapshot.contact_normals())
+    wall = cj < 0
+    cjs = np.where(wall, ci, cj)
+    d = snapshot.minimum_image(x[cjs] - x[ci])
+    overlap = np.where(wall, 0.0, r[ci] + r[cjs] - np.hypot(d[:, 0], d[:, 1]))
+    return np.asarray(x[ci] + (r[ci] - 0.5 * overlap)[:, None] * n, dtype=np.float64)
+
+
+def contact_stress(
+    snapshot: Snapshot, used: ArrayLike | None = None, area: float | None = None
+) -> NDArray[np.float64]:
+    """(2, 2) stress of the contacts ``used`` ((Nc,) mask, default all), Pa,
+    compression positive: ``(1/A) sum_c sym(l_c (x) (-f^i_c))``.
+
+    ``area`` A (m^2 per m of thickness) defaults to the snapshot's region
+    (its box, else the rectangle bounding the disks).
+    """
+    mask = np.ones(snapshot.n_contacts, bool) if used is None else np.asarray(used, dtype=bool)
+    a = float(np.prod(np.diff(sample_bounds(snapshot), axis=1))) if area is None else float(area)
+    if not a > 0:
+        raise ValueError(f"area: must be > 0, got {area}")
+    lever = branch_vectors(snapshot)[mask]
+    force = -contact_forces_on_i(snapshot)[mask]
+    total = lever.T @ force
+    return np.asarray(0.5 * (total + total.T) / a, dtype=np.float64)
+
+
+def grain_stress(snapshot: Snapshot, area: ArrayLike | None = None) -> NDArray[np.float64]:
+    """(N, 2, 2) Love-Weber stress of every particle, Pa, compression positive:
+    ``-(1/V_p) sum_{c of p} sym((x_c - x_p) (x) f^p_c)``.
+
+    ``area`` (N,) the area V_p of each particle, m^2 per m of thickness
+    (default its disk, pi r^2). Every contact of a particle counts (walls,
+    membrane particles); a particle without contacts has zero stress.
+    """
+    x = np.asarray(snapshot.positions)
+    n_p = snapshot.n_particles
+    v = np.pi * np.asarray(snapshot.radii) ** 2 if area is None else np.asarray(area, float)
+    if v.shape != (n_p,) or np.any(~(v > 0)):
+        raise ValueError(f"area: expected ({n_p},) areas > 0")
+    ci = np.asarray(snapshot.contact_i)
+    cj = np.asarray(snapshot.contact_j)
+    f_i = contact_forces_on_i(snapshot)
+    arm_i = snapshot.minimum_image(contact_points(snapshot) - x[ci])
+    pp = cj >= 0
+    arm_j = arm_i[pp] - branch_vectors(snapshot)[pp]  # x_c - x_j
+    owner = np.concatenate([ci, cj[pp]])
+    arm = np.concatenate([arm_i, arm_j])
+    force = np.concatenate([f_i, -f_i[pp]])
+    out = np.zeros((n_p, 2, 2))
+    for a in (0, 1):
+        for b in (0, 1):
+            out[:, a, b] = np.bincount(owner, weights=arm[:, a] * force[:, b], minlength=n_p)
+    out = 0.5 * (out + np.swapaxes(out, 1, 2))
+    return np.asarray(-out / v[:, None, None], dtype=np.float64)
+
+
+@dataclass(frozen=True, eq=False)
+class _GrainStressResults:
+    """The results of :class:`GrainStress` (see its properties)."""
+
+    snapshot: Snapshot
+    stress: NDArray[np.float64]
+    major: NDArray[np.float64]
+    minor: NDArray[np.float64]
+    major_direction: NDArray[np.float64]
+
+
+class GrainStress(Computable[_GrainStressResults]):
+    r"""The Love-Weber stress of each grain and its principal values.
+
+    .. math::
+
+       \sigma^p = -\frac{1}{V_p}\sum_{c \ni p}\operatorname{sym}\big((x_c - x_p)\otimes f^p_c\big),
+       \qquad \sigma_{1,2} = \frac{\sigma_{xx}+\sigma_{yy}}{2} \pm
+       \sqrt{\Big(\frac{\sigma_{xx}-\sigma_{yy}}{2}\Big)^2 + \sigma_{xy}^2},
+
+    compression positive (Pa), :math:`V_p = \pi r_p^2` by default, the
+    major direction :math:`\tfrac12\operatorname{atan2}(2\sigma_{xy},
+    \sigma_{xx}-\sigma_{yy}) \in [0, \pi)`. In equilibrium the area-weighted
+    sum over grains equals the contact stress (:func:`contact_stress`) of
+    their contacts.
+
+    Parameters
+    ----------
+    area : (N,) float, m^2, optional
+        The area each grain's stress is spread over (default its disk).
+
+    Example
+    -------
+    >>> from grainlab.snapshot import Snapshot
+    >>> snap = Snapshot([[0, 0], [2, 0]], [1.0, 1.0], contact_i=[0], contact_j=[1],
+    ...                 normal_force=[1.0])
+    >>> round(float(GrainStress().compute(snap).major[0] * np.pi), 12)  # 1 N on a 1 m lever
+    1.0
+    """
+
+    def __init__(self, area: ArrayLike | None = None) -> None:
+        self.area = None if area is None else np.asarray(area, dtype=np.float64)
+
+    def compute(self, snapshot: Snapshot) -> GrainStress:
+        """Compute every grain's stress in ``snapshot``; returns ``self``."""
+        stress = grain_stress(snapshot, self.area)
+        major, minor, direction = principal_stresses(stress)
+        self._store(_GrainStressResults(snapshot, stress, major, minor, direction))
+        return self
+
+    @property
+    def stress(self) -> NDArray[np.float64]:
+        """(N, 2, 2) stress of each grain, Pa, compression positive."""
+        return self._computed("stress").stress
+
+    @property
+    def major(self) -> NDArray[np.float64]:
+        """(N,) major principal stress sigma_1, Pa."""
+        return self._computed("major").major
+
+    @property
+    def minor(self) -> NDArray[np.float64]:
+        """(N,) minor principal stress sigma_2, Pa."""
+        return self._computed("minor").minor
+
+    @property
+    def major_direction(self) -> NDArray[np.float64]:
+        """(N,) direction of sigma_1, rad in [0, pi) from +x (0 where sigma_1 = sigma_2)."""
+        return self._computed("major_direction").major_direction
+
+    def plot(self, ax: Any = None, **kwargs: Any) -> Any:
+        """Particle map coloured by the major principal stress; returns the axes."""
+        from grainlab import plot
+
+        snap = self._computed("snapshot").snapshot
+        values = np.where(snap.is_sample, self.major, np.nan)
+        return plot.particle_map(
+            snap.positions, snap.radii, values, ax=ax, cmap="magma_r",
+            label=r"major principal stress $\sigma_1$ (Pa)", **kwargs,
+        )
+
+    def __repr__(self) -> str:
+        return f"GrainStress(area={'disks' if self.area is None else 'given'})"
+
+
+@dataclass(frozen=True, eq=False)
+class _LoveWeberResults:
+    """The results of :class:`LoveWeberStress` (see its properties)."""
+
+    stress: NDArray[np.float64]
+    area: float
+    n_particles: int
+
+
+class LoveWeberStress(Computable[_LoveWeberResults]):
+    r"""The average (Love-Weber) stress of a region of a snapshot.
+
+    .. math:: \sigma = -\frac{1}{A}\sum_{p \in R}\sum_{c \ni p}
+              \operatorname{sym}\big((x_c - x_p)\otimes f^p_c\big)
+
+    (:func:`love_weber_stress`), Pa, compression positive, over the
+    particles ``p`` of the region R, every contact of theirs counted (those
+    with walls and with particles outside R: the region's boundary forces).
+
+    Parameters
+    ----------
+    area : float, m^2, optional
+        The region's area. Default: the snapshot's region (its box, else the
+        rectangle bounding the disks) when the region is every particle, else
+        the sum of the region's power cells
+        (:class:`~grainlab.analysis.tessellation.LocalPorosity`).
+
+    Example
+    -------
+    >>> from grainlab.snapshot import Snapshot
+    >>> snap = Snapshot([[0, 0], [2, 0]], [1.0, 1.0], contact_i=[0], contact_j=[1],
+    ...                 normal_force=[1.0], box=[[-1, 3], [-1, 1]])
+    >>> float(LoveWeberStress().compute(snap).stress[0, 0])  # 2 m x 1 N over 8 m^2
+    0.25
+    """
+
+    def __init__(self, area: float | None = None) -> None:
+        if area is not None and not area > 0:
+            raise ValueError(f"area: must be > 0, got {area}")
+        self.area = area
+
+    def compute(self, snapshot: Snapshot, region: ArrayLike | None = None) -> LoveWeberStress:
+        """The stress of the particles where ``region`` ((N,) bool, default all) is
+        true; returns ``self``."""
+        n_p = snapshot.n_particles
+        selected = np.ones(n_p, bool) if region is None else np.asarray(region, dtype=bool)
+        if selected.shape != (n_p,):
+            raise ValueError(f"region: expected shape ({n_p},), got {selected.shape}")
+        area = self.area
+        if area is None:
+            if selected.all():
+                area = float(np.prod(np.diff(sample_bounds(snapshot), axis=1)))
+            else:
+                from grainlab.analysis.tessellation import power_cell_areas
+
+                area = float(power_cell_areas(snapshot)[selected].sum())
+        # the particle sum, each particle's moment sum_c sym((x_c - x_p) (x) f^p_c)
+        moments = grain_stress(snapshot, np.ones(n_p))
+        stress = np.asarray(moments[selected].sum(axis=0) / area, dtype=np.float64)
+        self._store(_LoveWeberResults(stress, area, int(selected.sum())))
+        return self
+
+    @property
+    def stress(self) -> NDArray[np.float64]:
+        """(2, 2) stress of the region, Pa, compression positive."""
+        return self._computed("stress").stress
+
+    @property
+    def region_area(self) -> float:
+        """The region's area used, m^2."""
+        return self._computed("region_area").area
+
+    @property
+    def n_particles(self) -> int:
+        """Particles in the region."""
+        return self._computed("n_particles").n_particles
+
+    @property
+    def mean_stress(self) -> float:
+        """p = (sigma_1 + sigma_2) / 2, Pa."""
+        s = self.stress
+        return float(0.5 * (s[0, 0] + s[1, 1]))
+
+    @property
+    def deviatoric_stress(self) -> float:
+        """q = (sigma_1 - sigma_2) / 2, Pa."""
+        s1, s2, _ = principal_stresses(self.stress)
+        return float(0.5 * (s1 - s2))
+
+    def __repr__(self) -> str:
+        return f"LoveWeberStress(area={self.area!r})"

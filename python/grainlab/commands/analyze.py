@@ -252,6 +252,12 @@ def run(args: argparse.Namespace) -> int:
     )
     if "lambda_reading" in s:  # said only when not the default reading
         line += f" ({s['lambda_reading']})"
+    if s.get("strong_deviatoric_share") is not None:
+        line += (
+            f", strong network's share of q = {f(s['strong_deviatoric_share'], '.2f')}, "
+            f"q/p = {f(s['rb_stress_ratio'])} (R-B {f(s['rb_predicted_stress_ratio'])}), "
+            f"{s['chains_n_chains']} force chains"
+        )
     if s["band_angle_deg"] is not None:
         line += (
             f", band {f(s['band_angle_deg'], '.1f')} deg x "

@@ -44,6 +44,16 @@ def write_analysis(result: AnalysisResult, out_dir: str | Path, *, figures: bool
         band=band,
     )
     written += plot.save_figure(ax, out / "map_contacts")
+    if result.porosity is not None:
+        written += plot.save_figure(result.porosity.plot(), out / "map_local_porosity")
+    if result.loops is not None:
+        written += plot.save_figure(result.loops.plot(), out / "map_loop_size")
+    if result.networks is not None:
+        written += plot.save_figure(result.networks.plot(), out / "force_network")
+    if result.chains is not None:
+        written += plot.save_figure(result.chains.plot(), out / "force_chains")
+    if result.stress_force_fabric is not None:
+        written += plot.save_figure(result.stress_force_fabric.plot(), out / "stress_force_fabric")
     if result.strain is not None:
         written += plot.save_figure(result.strain.plot(band=band), out / "map_displacement")
         written += plot.save_figure(

@@ -1,0 +1,231 @@
+r"""The loops of the contact network (docs/fabric.md, "Loops").
+
+The **contact graph** has the sample grains as vertices and their contacts
+with each other as edges (walls and membrane disks are not part of it); by
+default the rattlers are removed first, iteratively, by Thornton's rule
+(grains with fewer than 2 contacts,
+:func:`~grainlab.analysis.fabric.rattlers`), which also removes every
+dangling branch, as Kruyt and Rothenburg's loop analysis does.
+
+Independent cycles
+    The cyclomatic number :math:`L = E - V + C` (edges, vertices, connected
+    components, isolated grains each a component).
+
+Minimal loops
+    Drawn with straight branches between centres, the contact graph of
+    disks is planar, and its **faces** are the minimal loops (Kruyt and
+    Rothenburg; Tordesillas et al. call them minimal cycles): the smallest
+    closed paths of contacts enclosing a void. Each face is traced through
+    the half-edges: with every grain's contacts sorted counter-clockwise,
+    the half-edge after :math:`u \to v` is :math:`v \to w`, w the contact of
+    v just clockwise from u, which keeps the face on the left. A face's
+    **size** is its number of half-edges (its grains, for a simple loop).
+    Summed along a face, the turns between successive branches give
+    :math:`+2\pi` for a bounded face, :math:`-2\pi` for the outer boundary
+    of a bounded packing and 0 for a face that wraps around a periodic cell;
+    only the bounded faces are loops. In a bounded connected packing the
+    loops number :math:`L` (Euler); in a periodic cell :math:`L - 1`.
+
+A hexagonal lattice has loops of size 3 only, a square lattice of size 4.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.analysis._util import Computable
+from grainlab.analysis.fabric import rattlers
+from grainlab.snapshot import Snapshot
+
+__all__ = ["ContactLoops"]
+
+
+@dataclass(frozen=True, eq=False)
+class _ContactLoopsResults:
+    """The results of :class:`ContactLoops` (see its properties)."""
+
+    snapshot: Snapshot
+    in_graph: NDArray[np.bool_]
+    cyclomatic_number: int
+    loop_sizes: NDArray[np.int64]
+    grain_loop_size: NDArray[np.float64]
+    n_edges: int
+    n_components: int
+
+
+class ContactLoops(Computable[_ContactLoopsResults]):
+    r"""Independent cycles and minimal loops (faces) of the contact graph.
+
+    .. math:: L = E - V + C,
+
+    and the sizes of the bounded faces of the planar contact network
+    (module docstring).
+
+    Parameters
+    ----------
+    remove_rattlers : bool, default True
+        Remove the rattlers (fewer than 2 contacts, iteratively) first.
+
+    Attributes (after :meth:`compute`)
+    ----------------------------------
+    cyclomatic_number : int
+        L = E - V + C of the graph used.
+    loop_sizes : (F,) int
+        Size of each minimal loop.
+    size_distribution : (max + 1,) float
+        Fraction of the loops of each size 0, 1, 2, ... (0, 1, 2 are empty).
+    mean_loop_size : float
+    grain_loop_size : (N,) float
+        Mean size of the loops a grain sits on (NaN for grains on none).
+    in_graph : (N,) bool
+        The grains of the graph.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> from grainlab.snapshot import Snapshot
+    >>> x, y = np.meshgrid(np.arange(4.0), np.arange(4.0))
+    >>> snap = Snapshot.from_geometry(np.c_[x.ravel(), y.ravel()], np.full(16, 0.5), tolerance=1e-9)
+    >>> loops = ContactLoops().compute(snap)  # a 4 x 4 square patch: 9 squares
+    >>> loops.cyclomatic_number, loops.loop_sizes.tolist()
+    (9, [4, 4, 4, 4, 4, 4, 4, 4, 4])
+    """
+
+    def __init__(self, remove_rattlers: bool = True) -> None:
+        self.remove_rattlers = bool(remove_rattlers)
+
+    def compute(self, snapshot: Snapshot) -> ContactLoops:
+        """Trace the loops of ``snapshot``'s contact graph; returns ``self``."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        n = snapshot.n_particles
+        sample = snapshot.is_sample
+        grain_grain = ~snapshot.is_boundary_contact
+        ci = np.asarray(snapshot.contact_i)[grain_grain]
+        cj = np.asarray(snapshot.contact_j)[grain_grain]
+        keep = sample.copy()
+        if self.remove_rattlers:
+            keep &= ~rattlers(ci, cj, n, min_contacts=2, candidates=sample)
+        edge = keep[ci] & keep[cj]
+        ci, cj = ci[edge], cj[edge]
+        d = snapshot.minimum_image(
+            np.asarray(snapshot.positions)[cj] - np.asarray(snapshot.positions)[ci]
+        )
+        n_edges = int(ci.size)
+        graph = coo_matrix((np.ones(n_edges), (ci, cj)), shape=(n, n))
+        labels = connected_components(graph, directed=False)[1]
+        n_components = int(np.unique(labels[keep]).size)
+        cyclomatic = n_edges - int(keep.sum()) + n_components
+        # half-edges: h < E runs i -> j, h + E runs j -> i
+        tail = np.concatenate([ci, cj])
+        head = np.concatenate([cj, ci])
+        direction = np.concatenate([d, -d])
+        phi = np.arctan2(direction[:, 1], direction[:, 0])
+        m = tail.size
+        twin = np.concatenate([np.arange(n_edges, m), np.arange(n_edges)])
+        order = np.lexsort((phi, tail))  # around each grain, counter-clockwise
+        place = np.empty(m, dtype=np.int64)
+        place[order] = np.arange(m)
+        degree = np.bincount(tail, minlength=n)
+        start = np.concatenate([[0], np.cumsum(degree)])[:-1]
+        at = place[twin]  # the reverse half-edge v -> u in v's order
+        v = head
+        before = np.where(at > start[v], at - 1, start[v] + degree[v] - 1)
+        following = order[before]
+        faces = coo_matrix((np.ones(m), (np.arange(m), following)), shape=(m, m))
+        n_faces, face = connected_components(faces, directed=False)
+        turn = np.angle(np.exp(1j * (phi[following] - phi)))
+        turn = np.where(np.isclose(np.abs(turn), np.pi), np.pi, turn)  # a U-turn turns left
+        winding = np.bincount(face, weights=turn, minlength=n_faces)
+        size = np.bincount(face, minlength=n_faces)
+        bounded = winding > np.pi
+        loop_sizes = size[bounded].astype(np.int64)
+        on = bounded[face]
+        total = np.bincount(tail[on], weights=size[face[on]], minlength=n)
+        count = np.bincount(tail[on], minlength=n)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            grain_loop = np.where(count > 0, total / count, np.nan)
+        self._store(
+            _ContactLoopsResults(
+                snapshot, keep, cyclomatic, loop_sizes, grain_loop, n_edges, n_components
+            )
+        )
+        return self
+
+    @property
+    def cyclomatic_number(self) -> int:
+        """L = E - V + C, the independent cycles of the graph used."""
+        return self._computed("cyclomatic_number").cyclomatic_number
+
+    @property
+    def loop_sizes(self) -> NDArray[np.int64]:
+        """(F,) the size of each minimal loop (bounded face)."""
+        return self._computed("loop_sizes").loop_sizes
+
+    @property
+    def n_loops(self) -> int:
+        """Number of minimal loops."""
+        return int(self.loop_sizes.size)
+
+    @property
+    def mean_loop_size(self) -> float:
+        """Mean size of the minimal loops (NaN without loops)."""
+        return float(self.loop_sizes.mean()) if self.loop_sizes.size else float("nan")
+
+    @property
+    def size_distribution(self) -> NDArray[np.float64]:
+        """Fraction of the loops of size 0, 1, 2, ...."""
+        counts = np.bincount(self.loop_sizes).astype(np.float64)
+        return counts / counts.sum() if counts.sum() else counts
+
+    @property
+    def grain_loop_size(self) -> NDArray[np.float64]:
+        """(N,) mean size of the loops each grain sits on, NaN for none."""
+        return self._computed("grain_loop_size").grain_loop_size
+
+    @property
+    def in_graph(self) -> NDArray[np.bool_]:
+        """(N,) the grains of the graph (the sample, less the rattlers by default)."""
+        return self._computed("in_graph").in_graph
+
+    @property
+    def n_edges(self) -> int:
+        """E, the contacts of the graph."""
+        return self._computed("n_edges").n_edges
+
+    @property
+    def n_components(self) -> int:
+        """C, its connected components."""
+        return self._computed("n_components").n_components
+
+    def summary(self) -> dict[str, Any]:
+        """The loops' numbers: L, the loops' count, mean size and size fractions."""
+        return {
+            "cyclomatic_number": self.cyclomatic_number,
+            "n_loops": self.n_loops,
+            "mean_loop_size": self.mean_loop_size,
+            "loop_size_distribution": [float(f) for f in self.size_distribution],
+        }
+
+    def plot(self, ax: Any = None) -> Any:
+        """Particle map coloured by the mean size of each grain's loops; returns the axes."""
+        from grainlab import plot
+
+        snap = self._computed("snapshot").snapshot
+        return plot.particle_map(
+            snap.positions,
+            snap.radii,
+            self.grain_loop_size,
+            ax=ax,
+            cmap="viridis",
+            vmin=3.0,
+            label="mean size of the grain's loops",
+        )
+
+    def __repr__(self) -> str:
+        return f"ContactLoops(remove_rattlers={self.remove_rattlers})"

@@ -1,0 +1,462 @@
+r"""Satake's fabric tensor and the stress-force-fabric relation of Rothenburg
+and Bathurst (docs/fabric.md, "Fabric tensor" and "Stress-force-fabric").
+
+Contacts used: those between sample grains by default (``include_boundary``
+adds the grains' contacts with walls and membrane disks), each once, its
+normal :math:`n_c = (\cos\theta_c, \sin\theta_c)` from i to j.
+
+Satake's fabric tensor (2D, trace 1) and its fourth-order companion
+    .. math::
+
+       \phi_{ij} = \frac{1}{N_c}\sum_c n_i n_j,\qquad
+       \phi_{ijkl} = \frac{1}{N_c}\sum_c n_i n_j n_k n_l ,
+
+    :math:`a = 2(\phi_1 - \phi_2)` and :math:`\theta_a` the major direction
+    (the exact estimate of Eq. 6, :mod:`grainlab.analysis.fabric`). The
+    fourth harmonic :math:`b_4 = |\langle e^{4i\theta}\rangle|` is what
+    :math:`\phi_{ij}` cannot see: a hexagonal lattice has :math:`\phi = I/2`,
+    :math:`\phi_{xxxx} = 3/8` and :math:`b_4 = 0`; a square lattice has
+    :math:`\phi = I/2` too, but :math:`\phi_{xxxx} = 1/2` and
+    :math:`b_4 = 1`. With forces, the **strong and weak parts**
+    :math:`\phi^{s,w}_{ij} = \frac{1}{N_c}\sum_{c \in s,w} n_i n_j`
+    (contacts with :math:`f_n` above / not above the mean, Radjai et al.
+    1998) sum to :math:`\phi`.
+
+Anisotropies of Rothenburg and Bathurst (1989)
+    .. math::
+
+       E(\theta) = \tfrac{1}{2\pi}[1 + a\cos 2(\theta - \theta_a)],\quad
+       \bar f_n(\theta) = f_0[1 + a_n\cos 2(\theta - \theta_n)],\quad
+       \bar f_t(\theta) = f_0\, a_t \sin 2(\theta - \theta_t),
+
+    :math:`a, \theta_a` from the second moment of the normals (as above);
+    :math:`f_0, a_n, \theta_n` the least-squares fit of the contacts'
+    normal forces, :math:`f_{n,c} \approx c_0 + c_1\cos 2\theta_c + c_2\sin
+    2\theta_c`, :math:`f_0 = c_0`, :math:`a_n = \sqrt{c_1^2 + c_2^2}/c_0`,
+    :math:`\theta_n = \frac12\operatorname{atan2}(c_2, c_1)`; :math:`a_t,
+    \theta_t` the fit :math:`f_{t,c} \approx d_1\cos 2\theta_c + d_2\sin
+    2\theta_c`, :math:`a_t = \sqrt{d_1^2+d_2^2}/c_0`, :math:`\theta_t =
+    \frac12\operatorname{atan2}(-d_1, d_2)` (``f_t`` the shear force on i
+    along ``rot90(n)``, so that a positive :math:`a_t` adds to the stress
+    along :math:`\theta_t`). Being fits to the forces themselves, these are
+    exact whenever the forces follow the forms, whatever the normals; NaN
+    when the normals take fewer than three directions modulo 180° (two
+    directions cannot separate :math:`f_0` from :math:`a_n`) and :math:`a_t`
+    NaN without shear forces. The branch lengths are fitted the same way,
+    :math:`|l_c| \approx l_0[1 + a_l\cos 2(\theta_c - \theta_l)]` (Ouadfel
+    and Rothenburg's branch-length anisotropy, 0 for disks of one size).
+
+Stress-force-fabric relation
+    With the stress of the same contacts (:func:`~grainlab.analysis.stress.contact_stress`),
+    principal values :math:`\sigma_1 \ge \sigma_2` and major direction
+    :math:`\theta_\sigma`, Rothenburg and Bathurst's first-order relation is
+
+    .. math::
+
+       \frac{q}{p} = \frac{\sigma_1 - \sigma_2}{\sigma_1 + \sigma_2}
+       \approx \tfrac12\left[a\cos 2(\theta_a - \theta_\sigma)
+       + a_n\cos 2(\theta_n - \theta_\sigma)
+       + a_t\cos 2(\theta_t - \theta_\sigma)\right],
+
+    (coaxial: :math:`\tfrac12(a + a_n + a_t)`), and
+    :math:`\sigma_1/\sigma_2 = (1 + q/p)/(1 - q/p)`. The measure reports
+    both sides and the residual measured − predicted: the products of
+    anisotropies, the fourth and higher harmonics of the normals and of the
+    forces, and the branch-length anisotropy of a polydisperse packing,
+    which the relation leaves out; the last is also reported, and the
+    prediction and residual with :math:`\tfrac12 a_l\cos 2(\theta_l -
+    \theta_\sigma)` added. On a hexagonal lattice with forces of
+    the forms the residual is 0 (its normals have no fourth harmonic); a
+    square lattice loaded along one axis has a = 0, q/p = 1, and its
+    :math:`a_n` is NaN (two directions).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.analysis._util import (
+    Computable,
+    axial_direction,
+    grain_contacts,
+    principal_stresses,
+)
+from grainlab.snapshot import Snapshot
+
+__all__ = ["Anisotropies", "FabricTensor", "StressForceFabric", "force_anisotropies"]
+
+
+@dataclass(frozen=True)
+class Anisotropies:
+    """Rothenburg and Bathurst's anisotropies of a set of contacts (module
+    docstring): ``a``, ``a_n``, ``a_t`` and their directions (rad, [0, pi)),
+    ``f0`` the fitted mean normal force (N), ``n_contacts``; ``a_l``,
+    ``theta_l`` and ``l0`` (m) of the branch lengths when they were given."""
+
+    n_contacts: int
+    a: float
+    theta_a: float
+    a_n: float
+    theta_n: float
+    a_t: float
+    theta_t: float
+    f0: float
+    a_l: float = float("nan")
+    theta_l: float = float("nan")
+    l0: float = float("nan")
+
+    def as_dict(self, prefix: str = "") -> dict[str, float | int]:
+        """The numbers by name, angles in degrees (``theta_a_deg``, ...)."""
+        out: dict[str, float | int] = {f"{prefix}n_contacts": self.n_contacts}
+        for name in ("a", "a_n", "a_t", "a_l"):
+            out[prefix + name] = getattr(self, name)
+            theta = getattr(self, "theta" + (name[1:] if name != "a" else "_a"))
+            out[f"{prefix}theta{name[1:] if name != 'a' else '_a'}_deg"] = float(np.degrees(theta))
+        out[prefix + "f0"] = self.f0
+        return out
+
+
+def force_anisotropies(
+    angles: NDArray[np.float64],
+    normal_force: NDArray[np.float64] | None,
+    shear_force: NDArray[np.float64] | None,
+    branch_length: NDArray[np.float64] | None = None,
+) -> Anisotropies:
+    """:class:`Anisotropies` of contacts at ``angles`` (rad) with these forces
+    (N; None: the force terms NaN) and branch lengths (m; None: a_l NaN)."""
+    th = np.asarray(angles, dtype=np.float64)
+    nan = float("nan")
+    if th.size == 0:
+        return Anisotropies(0, nan, nan, nan, nan, nan, nan, nan)
+    moment = np.mean(np.exp(2j * th))
+    a, theta_a = float(2.0 * abs(moment)), float(axial_direction(np.angle(moment)))
+    a_n = theta_n = a_t = theta_t = f0 = nan
+    c2, s2 = np.cos(2.0 * th), np.sin(2.0 * th)
+    design = np.column_stack([np.ones_like(th), c2, s2])
+    if normal_force is not None and np.linalg.matrix_rank(design) == 3:
+        c, *_ = np.linalg.lstsq(design, np.asarray(normal_force, dtype=np.float64), rcond=None)
+        f0 = float(c[0])
+        if f0 > 0.0:
+            a_n = float(np.hypot(c[1], c[2]) / f0)
+            theta_n = float(axial_direction(np.arctan2(c[2], c[1])))
+            if shear_force is not None:
+                d, *_ = np.linalg.lstsq(
+                    design[:, 1:], np.asarray(shear_force, dtype=np.float64), rcond=None
+                )
+                a_t = float(np.hypot(d[0], d[1]) / f0)
+                theta_t = float(axial_direction(np.arctan2(-d[0], d[1])))
+    a_l = theta_l = l0 = nan
+    if branch_length is not None and np.linalg.matrix_rank(design) == 3:
+        b, *_ = np.linalg.lstsq(design, np.asarray(branch_length, dtype=np.float64), rcond=None)
+        if b[0] > 0.0:
+            l0 = float(b[0])
+            a_l = float(np.hypot(b[1], b[2]) / b[0])
+            theta_l = float(axial_direction(np.arctan2(b[2], b[1])))
+    return Anisotropies(
+        int(th.size), a, theta_a, a_n, theta_n, a_t, theta_t, f0, a_l, theta_l, l0
+    )
+
+
+def _normal_products(normals: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Sums of n (x) n (2, 2) and of n (x) n (x) n (x) n (2, 2, 2, 2) over the normals."""
+    second = np.einsum("ci,cj->ij", normals, normals)
+    fourth = np.einsum("ci,cj,ck,cl->ijkl", normals, normals, normals, normals)
+    return second, fourth
+
+
+@dataclass(frozen=True, eq=False)
+class _FabricTensorResults:
+    """The results of :class:`FabricTensor` (see its properties)."""
+
+    tensor: NDArray[np.float64]
+    fourth_order: NDArray[np.float64]
+    anisotropy: float
+    direction: float
+    fourth_harmonic: float
+    strong_part: NDArray[np.float64] | None
+    weak_part: NDArray[np.float64] | None
+    n_contacts: int
+    angles: NDArray[np.float64]
+
+
+class FabricTensor(Computable[_FabricTensorResults]):
+    r"""Satake's fabric tensor, its fourth-order companion and its strong and weak parts.
+
+    .. math::
+
+       \phi_{ij} = \frac{1}{N_c}\sum_c n_i n_j,\quad
+       \phi_{ijkl} = \frac{1}{N_c}\sum_c n_i n_j n_k n_l,\quad
+       \phi^{s}_{ij} = \frac{1}{N_c}\sum_{f_{n,c} > \langle f_n\rangle} n_i n_j,\quad
+       \phi^{w} = \phi - \phi^{s},
+
+    :math:`a = 2(\phi_1 - \phi_2)`, :math:`b_4 = |\langle e^{4i\theta}\rangle|`
+    (module docstring). 2D prefactors: :math:`\operatorname{tr}\phi = 1`.
+
+    Parameters
+    ----------
+    include_boundary : bool, default False
+        Add the grains' contacts with walls and membrane disks.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> from grainlab.snapshot import Snapshot
+    >>> x, y = np.meshgrid(np.arange(6.0), np.arange(6.0))
+    >>> snap = Snapshot.from_geometry(np.c_[x.ravel(), y.ravel()], np.full(36, 0.5),
+    ...                               box=[[0, 6], [0, 6]], periodic=(True, True), tolerance=1e-9)
+    >>> fabric = FabricTensor().compute(snap)  # a square lattice
+    >>> fabric.tensor.round(12).tolist(), round(float(fabric.fourth_order[0, 0, 0, 0]), 12)
+    ([[0.5, 0.0], [0.0, 0.5]], 0.5)
+    """
+
+    def __init__(self, include_boundary: bool = False) -> None:
+        self.include_boundary = bool(include_boundary)
+
+    def compute(self, snapshot: Snapshot) -> FabricTensor:
+        """Compute the fabric tensors of ``snapshot``; returns ``self``."""
+        used = grain_contacts(snapshot, self.include_boundary)
+        normals = np.asarray(snapshot.contact_normals())[used]
+        n_c = int(normals.shape[0])
+        nan2, nan4 = np.full((2, 2), np.nan), np.full((2, 2, 2, 2), np.nan)
+        second, fourth = _normal_products(normals)
+        tensor = second / n_c if n_c else nan2
+        fourth = fourth / n_c if n_c else nan4
+        angles = np.asarray(snapshot.contact_angles())[used]
+        anisotropy = harmonic = direction = float("nan")
+        if n_c:
+            s1, s2, major = principal_stresses(tensor)
+            anisotropy, direction = float(2.0 * (s1 - s2)), float(major)
+            harmonic = float(abs(np.mean(np.exp(4j * angles))))
+        strong = weak = None
+        if snapshot.normal_force is not None and n_c:
+            fn = np.asarray(snapshot.normal_force)[used]
+            strong_mask = fn > fn.mean()
+            strong = _normal_products(normals[strong_mask])[0] / n_c
+            weak = _normal_products(normals[~strong_mask])[0] / n_c
+        self._store(
+            _FabricTensorResults(
+                tensor, fourth, anisotropy, direction, harmonic, strong, weak, n_c, angles
+            )
+        )
+        return self
+
+    @property
+    def tensor(self) -> NDArray[np.float64]:
+        """(2, 2) phi_ij, trace 1."""
+        return self._computed("tensor").tensor
+
+    @property
+    def fourth_order(self) -> NDArray[np.float64]:
+        """(2, 2, 2, 2) phi_ijkl, its contractions phi_ijkk = phi_ij."""
+        return self._computed("fourth_order").fourth_order
+
+    @property
+    def anisotropy(self) -> float:
+        """a = 2 (phi_1 - phi_2)."""
+        return self._computed("anisotropy").anisotropy
+
+    @property
+    def direction(self) -> float:
+        """theta_a, the major direction of phi, rad in [0, pi)."""
+        return self._computed("direction").direction
+
+    @property
+    def fourth_harmonic(self) -> float:
+        """b_4 = |mean of exp(4 i theta)|: 0 for a hexagonal lattice, 1 for a square one."""
+        return self._computed("fourth_harmonic").fourth_harmonic
+
+    @property
+    def strong_part(self) -> NDArray[np.float64] | None:
+        """(2, 2) phi^s, the strong contacts' share of phi (None without forces)."""
+        return self._computed("strong_part").strong_part
+
+    @property
+    def weak_part(self) -> NDArray[np.float64] | None:
+        """(2, 2) phi^w = phi - phi^s (None without forces)."""
+        return self._computed("weak_part").weak_part
+
+    @property
+    def n_contacts(self) -> int:
+        """N_c, the contacts used."""
+        return self._computed("n_contacts").n_contacts
+
+    def plot(self, ax: Any = None) -> Any:
+        """Rose diagram of the contact normals with the fitted E(theta); returns the axes."""
+        from grainlab import plot
+        from grainlab.analysis.fabric import angular_histogram
+
+        values, _ = angular_histogram(self._computed("angles").angles, 18)
+        return plot.polar_distribution(
+            values, anisotropy=self.anisotropy, direction=self.direction, ax=ax
+        )
+
+    def __repr__(self) -> str:
+        return f"FabricTensor(include_boundary={self.include_boundary})"
+
+
+@dataclass(frozen=True, eq=False)
+class _StressForceFabricResults:
+    """The results of :class:`StressForceFabric` (see its properties)."""
+
+    anisotropies: Anisotropies
+    stress: NDArray[np.float64]
+    stress_direction: float
+    stress_ratio: float
+    predicted_stress_ratio: float
+
+
+class StressForceFabric(Computable[_StressForceFabricResults]):
+    r"""Rothenburg and Bathurst's stress-force-fabric relation, with its residual.
+
+    .. math::
+
+       \frac{q}{p} = \frac{\sigma_1 - \sigma_2}{\sigma_1 + \sigma_2}
+       \quad\text{against}\quad
+       \tfrac12\sum_{k \in \{a, a_n, a_t\}} k\cos 2(\theta_k - \theta_\sigma),
+
+    the stress :math:`\sigma` of the contacts used (their contact form,
+    :func:`~grainlab.analysis.stress.contact_stress`) and the anisotropies
+    fitted to the same contacts (module docstring). :attr:`residual` is
+    measured − predicted; :attr:`sigma_ratio` and
+    :attr:`predicted_sigma_ratio` are :math:`\sigma_1/\sigma_2 = (1 +
+    q/p)/(1 - q/p)` of each. Needs normal forces; shear forces optional
+    (without them :math:`a_t` is NaN and left out of the sum).
+
+    Parameters
+    ----------
+    include_boundary : bool, default False
+        Add the grains' contacts with walls and membrane disks.
+
+    Example
+    -------
+    A hexagonal lattice loaded along y only (a = 0, a_n = 2, q/p = 1):
+
+    >>> import numpy as np
+    >>> from grainlab.snapshot import Snapshot
+    >>> x, y = np.meshgrid(np.arange(4.0), np.arange(4.0) * 3**0.5)
+    >>> pos = np.r_[np.c_[x.ravel(), y.ravel()], np.c_[x.ravel() + 0.5, y.ravel() + 3**0.5 / 2]]
+    >>> snap = Snapshot.from_geometry(pos[:, ::-1], np.full(32, 0.5), tolerance=1e-9,
+    ...     box=[[0, 4 * 3**0.5], [0, 4]], periodic=(True, True))
+    >>> vertical = np.abs(snap.contact_normals()[:, 1]) > 0.99
+    >>> rb = StressForceFabric().compute(snap.with_contacts(
+    ...     snap.contact_i, snap.contact_j, normal_force=np.where(vertical, 1.0, 0.0)))
+    >>> round(rb.stress_ratio, 12), round(rb.anisotropies.a_n, 12), round(rb.residual, 12)
+    (1.0, 2.0, 0.0)
+    """
+
+    def __init__(self, include_boundary: bool = False) -> None:
+        self.include_boundary = bool(include_boundary)
+
+    def compute(self, snapshot: Snapshot) -> StressForceFabric:
+        """Compute both sides of the relation for ``snapshot``; returns ``self``."""
+        from grainlab.analysis.stress import contact_stress
+
+        if snapshot.normal_force is None:
+            raise ValueError("normal_force: the snapshot has no contact forces (needed here)")
+        used = grain_contacts(snapshot, self.include_boundary)
+        angles = np.asarray(snapshot.contact_angles())[used]
+        fs = None if snapshot.shear_force is None else np.asarray(snapshot.shear_force)[used]
+        from grainlab.analysis.stress import branch_vectors
+
+        lengths = np.hypot(*branch_vectors(snapshot)[used].T)
+        rb = force_anisotropies(angles, np.asarray(snapshot.normal_force)[used], fs, lengths)
+        stress = contact_stress(snapshot, used)
+        s1, s2, direction = principal_stresses(stress)
+        ratio = float((s1 - s2) / (s1 + s2)) if s1 + s2 > 0 else float("nan")
+        terms = [
+            k * np.cos(2.0 * (t - direction))
+            for k, t in ((rb.a, rb.theta_a), (rb.a_n, rb.theta_n), (rb.a_t, rb.theta_t))
+            if np.isfinite(k)
+        ]
+        predicted = float(0.5 * np.sum(terms)) if np.isfinite(rb.a_n) else float("nan")
+        self._store(
+            _StressForceFabricResults(rb, stress, float(direction), ratio, predicted)
+        )
+        return self
+
+    @property
+    def anisotropies(self) -> Anisotropies:
+        """a, a_n, a_t, their directions and f0 (:class:`Anisotropies`)."""
+        return self._computed("anisotropies").anisotropies
+
+    @property
+    def stress(self) -> NDArray[np.float64]:
+        """(2, 2) the contacts' stress, Pa (over the snapshot's region)."""
+        return self._computed("stress").stress
+
+    @property
+    def stress_direction(self) -> float:
+        """theta_sigma, the major principal direction of :attr:`stress`, rad."""
+        return self._computed("stress_direction").stress_direction
+
+    @property
+    def stress_ratio(self) -> float:
+        """q/p = (sigma_1 - sigma_2) / (sigma_1 + sigma_2), measured."""
+        return self._computed("stress_ratio").stress_ratio
+
+    @property
+    def predicted_stress_ratio(self) -> float:
+        """(1/2) sum of the anisotropies projected on theta_sigma."""
+        return self._computed("predicted_stress_ratio").predicted_stress_ratio
+
+    @property
+    def residual(self) -> float:
+        """Measured minus predicted q/p."""
+        return self.stress_ratio - self.predicted_stress_ratio
+
+    @property
+    def predicted_with_branch_length(self) -> float:
+        """The predicted q/p plus (1/2) a_l cos 2(theta_l - theta_sigma)."""
+        rb = self.anisotropies
+        extra = 0.5 * rb.a_l * np.cos(2.0 * (rb.theta_l - self.stress_direction))
+        return float(self.predicted_stress_ratio + (extra if np.isfinite(extra) else 0.0))
+
+    @property
+    def residual_with_branch_length(self) -> float:
+        """Measured q/p minus :attr:`predicted_with_branch_length`."""
+        return self.stress_ratio - self.predicted_with_branch_length
+
+    @property
+    def sigma_ratio(self) -> float:
+        """sigma_1 / sigma_2 measured."""
+        x = self.stress_ratio
+        return float((1.0 + x) / (1.0 - x)) if x < 1.0 else float("inf")
+
+    @property
+    def predicted_sigma_ratio(self) -> float:
+        """sigma_1 / sigma_2 from the predicted q/p."""
+        x = self.predicted_stress_ratio
+        return float((1.0 + x) / (1.0 - x)) if x < 1.0 else float("inf")
+
+    def plot(self, ax: Any = None) -> Any:
+        """Bars: each anisotropy's share of q/p and the measured q/p; returns the axes."""
+        from grainlab.plot import new_axes
+        from grainlab.plot.files import paper_style
+
+        rb = self.anisotropies
+        th = self.stress_direction
+        parts = [
+            (name, 0.5 * k * np.cos(2.0 * (t - th)) if np.isfinite(k) else 0.0)
+            for name, k, t in (
+                ("a/2", rb.a, rb.theta_a), ("a_n/2", rb.a_n, rb.theta_n), ("a_t/2", rb.a_t, rb.theta_t)
+            )
+        ]
+        ax = new_axes(ax)
+        with paper_style():
+            bottom = 0.0
+            for k, (name, value) in enumerate(parts):
+                ax.bar(0, value, bottom=bottom, color=f"C{k}", label=name, width=0.6)
+                bottom += value
+            ax.bar(1, self.stress_ratio, color="0.4", width=0.6, label="measured")
+            ax.set_xticks([0, 1], ["predicted", "measured"])
+            ax.set_ylabel("q / p")
+            ax.set_title(f"residual {self.residual:+.3f}")
+            ax.legend(frameon=False, fontsize=7)
+        return ax
+
+    def __repr__(self) -> str:
+        return f"StressForceFabric(include_boundary={self.include_boundary})"
