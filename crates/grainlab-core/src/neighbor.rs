@@ -13,8 +13,8 @@
 //! into stripes of bin columns with balanced counts, as many as
 //! [`stripe_count`] gives for the system (never a function of the thread
 //! count); pairs with both
-//! particles in block `b` are stored contiguously (`block_start[b]..block_start[b+1]`)
-//! and may be evaluated concurrently with other blocks; pairs across blocks
+//! particles in stripe `b` are stored contiguously (`stripe_start[b]..stripe_start[b+1]`)
+//! and may be evaluated concurrently with other stripes; pairs across stripes
 //! come last. Shear history is carried over from the previous list by pair key.
 
 use serde::{Deserialize, Serialize};
@@ -43,9 +43,9 @@ pub struct PairList {
     pub shear: Vec<f64>,
     /// Whether the contact slid in the last step.
     pub sliding: Vec<bool>,
-    /// Pairs interior to block `b` are `block_start[b]..block_start[b + 1]`;
-    /// cross-block pairs follow from `block_start[n_blocks]`.
-    pub block_start: Vec<usize>,
+    /// Pairs interior to stripe `b` are `stripe_start[b]..stripe_start[b + 1]`;
+    /// cross-stripe pairs follow from `stripe_start[n_stripes]`.
+    pub stripe_start: Vec<usize>,
 }
 
 impl PairList {
@@ -111,13 +111,13 @@ pub struct NeighborList {
     pub pairs: PairList,
     /// Particle-wall pairs.
     pub wall_pairs: WallPairList,
-    /// Internal index range of the particles owned by each block.
-    pub block_ranges: Vec<(usize, usize)>,
-    /// For each block, the cross-block pairs that touch its particles, as
+    /// Internal index range of the particles owned by each stripe.
+    pub stripe_ranges: Vec<(usize, usize)>,
+    /// For each stripe, the cross-stripe pairs that touch its particles, as
     /// `(local cross index << 1) | side` (side 0: the pair's `i`, 1: its `j`),
     /// in pair order: CSR offsets in `cross_touch_start`.
     pub cross_touch: Vec<u32>,
-    /// Offsets of each block's entries in `cross_touch` (`n_blocks + 1`).
+    /// Offsets of each stripe's entries in `cross_touch` (`n_stripes + 1`).
     pub cross_touch_start: Vec<usize>,
     /// Number of builds so far.
     pub build_count: u64,
@@ -147,7 +147,7 @@ impl NeighborList {
             skin,
             pairs: PairList::default(),
             wall_pairs: WallPairList::default(),
-            block_ranges: Vec::new(),
+            stripe_ranges: Vec::new(),
             cross_touch: Vec::new(),
             cross_touch_start: Vec::new(),
             build_count: 0,
@@ -203,31 +203,31 @@ impl NeighborList {
         if p.model.iter().any(|&k| k as usize >= n_models) {
             return bad("a pair names a contact model that does not exist");
         }
-        let n_blocks = self.block_ranges.len();
+        let n_stripes = self.stripe_ranges.len();
         if self.valid {
-            if p.block_start.len() != n_blocks + 1
-                || p.block_start.windows(2).any(|w| w[0] > w[1])
-                || p.block_start.last().is_some_and(|&last| last > m)
+            if p.stripe_start.len() != n_stripes + 1
+                || p.stripe_start.windows(2).any(|w| w[0] > w[1])
+                || p.stripe_start.last().is_some_and(|&last| last > m)
             {
-                return bad("block starts");
+                return bad("stripe starts");
             }
             let mut next = 0usize;
-            for &(lo, hi) in &self.block_ranges {
+            for &(lo, hi) in &self.stripe_ranges {
                 if lo != next || hi < lo {
-                    return bad("block ranges");
+                    return bad("stripe ranges");
                 }
                 next = hi;
             }
             if next != n_particles {
-                return bad("block ranges do not cover the particles");
+                return bad("stripe ranges do not cover the particles");
             }
-            let cross = m - p.block_start[n_blocks];
-            if self.cross_touch_start.len() != n_blocks + 1
+            let cross = m - p.stripe_start[n_stripes];
+            if self.cross_touch_start.len() != n_stripes + 1
                 || self.cross_touch_start.windows(2).any(|w| w[0] > w[1])
                 || self.cross_touch_start.last() != Some(&self.cross_touch.len())
                 || self.cross_touch.iter().any(|&e| (e >> 1) as usize >= cross)
             {
-                return bad("cross-block pairs");
+                return bad("cross-stripe pairs");
             }
         }
         let w = &self.wall_pairs;
@@ -302,7 +302,7 @@ impl NeighborList {
     /// lists pairs and wall pairs, and carries over the contact history.
     ///
     /// The particles are also put in *spatial order* (by bin, bins column by
-    /// column): each block is then a contiguous index range, which keeps the
+    /// column): each stripe is then a contiguous index range, which keeps the
     /// threads' writes apart in memory and a pair's two particles close in cache.
     /// `order` maps internal to external (user) indices and is permuted along,
     /// as are the bonds and the old lists' indices. Returns the renumbering
@@ -331,7 +331,7 @@ impl NeighborList {
 
         // 2. bins in fractional coordinates
         let grid = BinGrid::new(&particles.position, cell, cutoff)?;
-        let n_blocks = stripe_count(n, grid.n[0]);
+        let n_stripes = stripe_count(n, grid.n[0]);
         let bins = grid.assign(&particles.position, cell);
         let (bin_start, perm) = counting_sort(&bins, grid.count());
 
@@ -351,25 +351,25 @@ impl NeighborList {
         }
         let bin_members: Vec<u32> = (0..n as u32).collect();
 
-        // 3. blocks: contiguous ranges of bin columns with balanced particle counts
+        // 3. stripes: contiguous ranges of bin columns with balanced particle counts
         let mut column_counts = vec![0usize; grid.n[0]];
         for &b in &bins {
             column_counts[b as usize / grid.n[1]] += 1;
         }
-        let mut block_of_column = vec![0u8; grid.n[0]];
+        let mut stripe_of_column = vec![0u8; grid.n[0]];
         let mut seen = 0usize;
         for (c, count) in column_counts.iter().enumerate() {
-            let block = ((seen * n_blocks) / n.max(1)).min(n_blocks - 1);
-            block_of_column[c] = block as u8;
+            let stripe = ((seen * n_stripes) / n.max(1)).min(n_stripes - 1);
+            stripe_of_column[c] = stripe as u8;
             seen += count;
         }
-        let block_of = |p: usize| block_of_column[bins[p] as usize / grid.n[1]];
-        // blocks are contiguous in the spatial order
-        let mut block_ranges = vec![(0usize, 0usize); n_blocks];
+        let stripe_of = |p: usize| stripe_of_column[bins[p] as usize / grid.n[1]];
+        // stripes are contiguous in the spatial order
+        let mut stripe_ranges = vec![(0usize, 0usize); n_stripes];
         let mut start = 0usize;
-        for (b, range) in block_ranges.iter_mut().enumerate() {
+        for (b, range) in stripe_ranges.iter_mut().enumerate() {
             let mut end = start;
-            while end < n && block_of(end) as usize == b {
+            while end < n && stripe_of(end) as usize == b {
                 end += 1;
             }
             *range = (start, end);
@@ -377,8 +377,8 @@ impl NeighborList {
         }
         debug_assert_eq!(start, n);
 
-        // 4. pairs, in bin order for locality, sorted into blocks
-        let mut per_block: Vec<Vec<(u32, u32, [i8; 2])>> = vec![Vec::new(); n_blocks + 1];
+        // 4. pairs, in bin order for locality, sorted into stripes
+        let mut per_stripe: Vec<Vec<(u32, u32, [i8; 2])>> = vec![Vec::new(); n_stripes + 1];
         let positions = &particles.position;
         let radii = &particles.radius;
         let groups = &particles.group;
@@ -412,9 +412,9 @@ impl NeighborList {
                                     && !bonds.contains(pi, pj)
                                     && materials.interacts(groups[i], groups[j])
                                 {
-                                    let (bi, bj) = (block_of(i), block_of(j));
-                                    let slot = if bi == bj { bi as usize } else { n_blocks };
-                                    per_block[slot].push((pi, pj, shift));
+                                    let (bi, bj) = (stripe_of(i), stripe_of(j));
+                                    let slot = if bi == bj { bi as usize } else { n_stripes };
+                                    per_stripe[slot].push((pi, pj, shift));
                                 }
                             }
                         }
@@ -426,8 +426,8 @@ impl NeighborList {
         // 5. carry the history of touching pairs over, correcting shifts for the wraps
         let history = PairHistory::new(&self.pairs, &wraps, n);
         let mut pairs = PairList::default();
-        for list in &per_block {
-            pairs.block_start.push(pairs.len());
+        for list in &per_stripe {
+            pairs.stripe_start.push(pairs.len());
             for &(i, j, shift) in list {
                 let model =
                     MaterialTable::index(particles.group[i as usize], particles.group[j as usize]);
@@ -473,13 +473,13 @@ impl NeighborList {
 
         self.pairs = pairs;
         self.wall_pairs = wall_pairs;
-        // which block applies each cross pair's force to each of its particles
-        let cross_first = self.pairs.block_start[n_blocks];
-        let mut touches: Vec<Vec<u32>> = vec![Vec::new(); n_blocks];
+        // which stripe applies each cross pair's force to each of its particles
+        let cross_first = self.pairs.stripe_start[n_stripes];
+        let mut touches: Vec<Vec<u32>> = vec![Vec::new(); n_stripes];
         for c in 0..self.pairs.len() - cross_first {
             let k = cross_first + c;
-            touches[block_of(self.pairs.i[k] as usize) as usize].push((c as u32) << 1);
-            touches[block_of(self.pairs.j[k] as usize) as usize].push(((c as u32) << 1) | 1);
+            touches[stripe_of(self.pairs.i[k] as usize) as usize].push((c as u32) << 1);
+            touches[stripe_of(self.pairs.j[k] as usize) as usize].push(((c as u32) << 1) | 1);
         }
         self.cross_touch_start = std::iter::once(0)
             .chain(touches.iter().scan(0usize, |acc, t| {
@@ -488,7 +488,7 @@ impl NeighborList {
             }))
             .collect();
         self.cross_touch = touches.concat();
-        self.block_ranges = block_ranges;
+        self.stripe_ranges = stripe_ranges;
         self.reference = particles.position.clone();
         self.accumulated_map = IDENTITY;
         self.wall_reference = walls.iter().map(|w| w.displacement).collect();
@@ -626,7 +626,7 @@ fn counting_sort(bins: &[u32], n_bins: usize) -> (Vec<usize>, Vec<u32>) {
 /// their image shifts corrected for this rebuild's wraps, grouped by their first
 /// particle `i` (a counting sort: CSR over `i`), for the carry-over. A new pair
 /// finds its history among the few entries of its `i`; the new pairs come in
-/// increasing `i` within each block's list, so the lookups walk the entries
+/// increasing `i` within each stripe's list, so the lookups walk the entries
 /// nearly in order, where a hash map of millions of pairs missed the cache on
 /// every insert and lookup.
 struct PairHistory {

@@ -12,7 +12,7 @@ use crate::state::ParticleMotion;
 use crate::vec2::{add, dot, mat_vec, perp, scale, sub, Mat2, Vec2};
 use crate::wall::Wall;
 
-/// Per-block sums of the contact phase.
+/// Per-stripe sums of the contact phase.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct ContactTally {
     pub(crate) friction: f64,
@@ -189,7 +189,7 @@ impl ForceSink for BufferSink<'_> {
     }
 }
 
-/// The buffered forces of cross-block pairs and, per block, which of them touch it.
+/// The buffered forces of cross-stripe pairs and, per stripe, which of them touch it.
 pub(crate) struct CrossForces<'a> {
     pub(crate) pair_i: &'a [u32],
     pub(crate) pair_j: &'a [u32],
@@ -200,7 +200,7 @@ pub(crate) struct CrossForces<'a> {
 }
 
 impl CrossForces<'_> {
-    /// Adds block `b`'s cross-pair forces to `force`/`torque`, which start at particle `lo`.
+    /// Adds stripe `b`'s cross-pair forces to `force`/`torque`, which start at particle `lo`.
     pub(crate) fn apply(&self, b: usize, lo: usize, force: &mut [Vec2], torque: &mut [f64]) {
         if self.touch_start.len() <= b + 1 {
             return;
@@ -227,7 +227,7 @@ impl CrossForces<'_> {
     }
 }
 
-/// A cross-block pair's force, computed in parallel and applied afterwards.
+/// A cross-stripe pair's force, computed in parallel and applied afterwards.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct PairForce {
     pub(crate) force: Vec2,
@@ -245,15 +245,15 @@ impl PairForce {
     };
 }
 
-/// One block's share of the contact phase.
-pub(crate) struct BlockWork<'a> {
-    pub(crate) block: usize,
+/// One stripe's share of the contact phase.
+pub(crate) struct StripeWork<'a> {
+    pub(crate) stripe: usize,
     pub(crate) shear: &'a mut [f64],
     pub(crate) sliding: &'a mut [bool],
     pub(crate) cross_shear: &'a mut [f64],
     pub(crate) cross_sliding: &'a mut [bool],
     pub(crate) cross_forces: &'a mut [PairForce],
-    /// The block's share of the bonds, and the slots of their forces.
+    /// The stripe's share of the bonds, and the slots of their forces.
     pub(crate) bonds: &'a mut [Bond],
     pub(crate) bond_slots: &'a mut [BondSlot],
 }
@@ -292,7 +292,7 @@ impl ResetKernel<'_> {
                 .copy_from_slice(&self.external_torque[lo..hi]);
             return;
         }
-        // the block's slices, so that the loop keeps its pointers in registers
+        // the stripe's slices, so that the loop keeps its pointers in registers
         let forces = force.range(lo, hi);
         let loads = self.boundary_load.map(|load| &*load.range(lo, hi));
         let (external, mass) = (&self.external_force[lo..hi], &self.mass[lo..hi]);

@@ -7,7 +7,7 @@ use super::pair_kernel::{
     pair_kernel, wall_contact, NullSink, PairForce, PairKernel, PairRecord, RecordSink,
 };
 use crate::bond::{bond_force, Bond, BondForce, BondSlot, Bonds};
-use crate::boundary::{ChainBlocks, PressureChain};
+use crate::boundary::{ChainStripes, PressureChain};
 use crate::cell::{minimum_image, PeriodicCell};
 use crate::contact::{disk_disk, ContactGeometry};
 use crate::diagnostics::{EnergyLedger, Measurements};
@@ -105,12 +105,12 @@ pub struct Simulation {
     /// Follower loads of this step, per internal particle (recomputed every step).
     #[serde(skip)]
     pub(crate) boundary_load: Vec<Vec2>,
-    /// The chains' entries per block of particles, for the loads' reset (kept
+    /// The chains' entries per stripe of particles, for the loads' reset (kept
     /// current by `run` and every rebuild).
     #[serde(skip)]
-    pub(crate) chain_blocks: ChainBlocks,
-    /// The bonds' and wall pairs' entries per block of particles, for adding
-    /// their forces in the integration (kept current like `chain_blocks`).
+    pub(crate) chain_stripes: ChainStripes,
+    /// The bonds' and wall pairs' entries per stripe of particles, for adding
+    /// their forces in the integration (kept current like `chain_stripes`).
     #[serde(skip)]
     pub(crate) deferred_index: DeferredIndex,
     /// The wall contacts' forces of this step, per wall pair, when a team adds
@@ -184,7 +184,7 @@ impl Simulation {
             cross_forces: Vec::new(),
             bond_slots: Vec::new(),
             boundary_load: Vec::new(),
-            chain_blocks: ChainBlocks::default(),
+            chain_stripes: ChainStripes::default(),
             deferred_index: DeferredIndex::default(),
             wall_slots: Vec::new(),
             external_loads: false,
@@ -950,22 +950,22 @@ impl Simulation {
         for chain in self.chains.iter_mut() {
             chain.remap(&new_of_old);
         }
-        self.index_blocks();
+        self.index_stripes();
         for (k, &e) in self.order.iter().enumerate() {
             self.rank[e as usize] = k as u32;
         }
         Ok(())
     }
 
-    /// The per-block indexes of the chains, bonds and wall pairs, for the
-    /// current blocks (at the start of a run call and after every rebuild).
-    pub(crate) fn index_blocks(&mut self) {
-        let blocks = &self.neighbors.block_ranges;
-        self.chain_blocks = ChainBlocks::new(&self.chains, blocks);
+    /// The per-stripe indexes of the chains, bonds and wall pairs, for the
+    /// current stripes (at the start of a run call and after every rebuild).
+    pub(crate) fn index_stripes(&mut self) {
+        let stripes = &self.neighbors.stripe_ranges;
+        self.chain_stripes = ChainStripes::new(&self.chains, stripes);
         self.deferred_index = DeferredIndex::new(
             &self.bonds.list,
             &self.neighbors.wall_pairs.particle,
-            blocks,
+            stripes,
         );
     }
 
