@@ -15,13 +15,16 @@
 //! count); pairs with both
 //! particles in stripe `b` are stored contiguously (`stripe_start[b]..stripe_start[b+1]`)
 //! and may be evaluated concurrently with other stripes; pairs across stripes
-//! come last. Shear history is carried over from the previous list by pair key.
+//! come last. The contact history (one record per pair, whatever the
+//! sub-models' width, [`ContactHistory`]) is carried over from the previous
+//! list by pair key.
 
 use serde::{Deserialize, Serialize};
 
 use crate::bond::Bonds;
 use crate::cell::PeriodicCell;
 use crate::error::{EngineError, Result};
+use crate::law::history::ContactHistory;
 use crate::material::MaterialTable;
 use crate::parallel::stripe_count;
 use crate::state::Particles;
@@ -39,10 +42,9 @@ pub struct PairList {
     pub shift: Vec<[i8; 2]>,
     /// Contact model index in the [`MaterialTable`].
     pub model: Vec<u16>,
-    /// Shear spring force (N): the contact's history, 0 when not in contact.
-    pub shear: Vec<f64>,
-    /// Whether the contact slid in the last step.
-    pub sliding: Vec<bool>,
+    /// Each pair's contact history (the sub-models' records, all zero when
+    /// not in contact, and the sliding flags).
+    pub history: ContactHistory,
     /// Pairs interior to stripe `b` are `stripe_start[b]..stripe_start[b + 1]`;
     /// cross-stripe pairs follow from `stripe_start[n_stripes]`.
     pub stripe_start: Vec<usize>,
@@ -60,8 +62,9 @@ impl PairList {
     }
 
     /// Renumbers particles (`new_of_old[old] = new`), keeping `i < j` by swapping
-    /// the pair and reversing its image shift (the shear spring, a force on `j`
-    /// along `perp(n)`, is unchanged by the swap since both `n` and `perp(n)` flip).
+    /// the pair and reversing its image shift (the history is unchanged by the
+    /// swap: the shear spring, a force on `j` along `perp(n)`, keeps its sign
+    /// since both `n` and `perp(n)` flip).
     pub fn remap(&mut self, new_of_old: &[u32]) {
         for k in 0..self.len() {
             let (i, j) = (
@@ -76,15 +79,6 @@ impl PairList {
             }
         }
     }
-
-    fn push(&mut self, i: u32, j: u32, shift: [i8; 2], model: u16) {
-        self.i.push(i);
-        self.j.push(j);
-        self.shift.push(shift);
-        self.model.push(model);
-        self.shear.push(0.0);
-        self.sliding.push(false);
-    }
 }
 
 /// Particle-wall pairs with their contact history.
@@ -96,10 +90,8 @@ pub struct WallPairList {
     pub particle: Vec<u32>,
     /// Contact model index.
     pub model: Vec<u16>,
-    /// Shear spring force (N).
-    pub shear: Vec<f64>,
-    /// Whether the contact slid in the last step.
-    pub sliding: Vec<bool>,
+    /// Each wall pair's contact history, as [`PairList::history`].
+    pub history: ContactHistory,
 }
 
 /// The Verlet lists and the bookkeeping that says when to rebuild them.
@@ -189,8 +181,8 @@ impl NeighborList {
             p.j.len(),
             p.shift.len(),
             p.model.len(),
-            p.shear.len(),
-            p.sliding.len(),
+            p.history.records.len(),
+            p.history.sliding.len(),
         ]
         .iter()
         .any(|&l| l != m)
@@ -235,8 +227,8 @@ impl NeighborList {
         if [
             w.particle.len(),
             w.model.len(),
-            w.shear.len(),
-            w.sliding.len(),
+            w.history.records.len(),
+            w.history.sliding.len(),
         ]
         .iter()
         .any(|&l| l != k)
@@ -431,24 +423,23 @@ impl NeighborList {
             for &(i, j, shift) in list {
                 let model =
                     MaterialTable::index(particles.group[i as usize], particles.group[j as usize]);
-                pairs.push(i, j, shift, model);
-                if let Some((shear, sliding)) = history.get(i, j, shift) {
-                    let k = pairs.len() - 1;
-                    pairs.shear[k] = shear;
-                    pairs.sliding[k] = sliding;
+                pairs.i.push(i);
+                pairs.j.push(j);
+                pairs.shift.push(shift);
+                pairs.model.push(model);
+                match history.get(i, j, shift) {
+                    Some(old) => pairs.history.push_from(&self.pairs.history, old),
+                    None => pairs.history.push_untouched(),
                 }
             }
         }
 
         // 6. wall pairs
-        let mut wall_history: PairMap<(u32, u32), (f64, bool)> = PairMap::default();
+        let mut wall_history: PairMap<(u32, u32), usize> = PairMap::default();
         let old = &self.wall_pairs;
         for k in 0..old.wall.len() {
-            if old.shear[k] != 0.0 || old.sliding[k] {
-                wall_history.insert(
-                    (old.wall[k], old.particle[k]),
-                    (old.shear[k], old.sliding[k]),
-                );
+            if old.history.touched(k) {
+                wall_history.insert((old.wall[k], old.particle[k]), k);
             }
         }
         let mut wall_pairs = WallPairList::default();
@@ -456,17 +447,15 @@ impl NeighborList {
             for p in 0..n {
                 let g = wall.disk_contact(positions[p], radii[p]);
                 if g.overlap > -skin && materials.interacts(wall.group, particles.group[p]) {
-                    let (shear, sliding) = wall_history
-                        .get(&(w as u32, p as u32))
-                        .copied()
-                        .unwrap_or((0.0, false));
+                    match wall_history.get(&(w as u32, p as u32)) {
+                        Some(&k) => wall_pairs.history.push_from(&old.history, k),
+                        None => wall_pairs.history.push_untouched(),
+                    }
                     wall_pairs.wall.push(w as u32);
                     wall_pairs.particle.push(p as u32);
                     wall_pairs
                         .model
                         .push(MaterialTable::index(wall.group, particles.group[p]));
-                    wall_pairs.shear.push(shear);
-                    wall_pairs.sliding.push(sliding);
                 }
             }
         }
@@ -622,7 +611,7 @@ fn counting_sort(bins: &[u32], n_bins: usize) -> (Vec<usize>, Vec<u32>) {
     (start, members)
 }
 
-/// The old list's touching pairs (a shear spring or sliding), renumbered, with
+/// The old list's touching pairs (any history), renumbered, with
 /// their image shifts corrected for this rebuild's wraps, grouped by their first
 /// particle `i` (a counting sort: CSR over `i`), for the carry-over. A new pair
 /// finds its history among the few entries of its `i`; the new pairs come in
@@ -632,15 +621,15 @@ fn counting_sort(bins: &[u32], n_bins: usize) -> (Vec<usize>, Vec<u32>) {
 struct PairHistory {
     /// Offsets of each particle's entries (`n + 1`).
     start: Vec<u32>,
-    /// `(j, shift, shear, sliding)` per touching pair, grouped by `i`.
-    entries: Vec<(u32, [i8; 2], f64, bool)>,
+    /// `(j, shift, index in the old list)` per touching pair, grouped by `i`.
+    entries: Vec<(u32, [i8; 2], u32)>,
 }
 
 impl PairHistory {
     /// The touching pairs of `old` (renumbered, `i < j`) among `n` particles;
     /// `wraps` are the new indices' wraps of this rebuild.
     fn new(old: &PairList, wraps: &[[i8; 2]], n: usize) -> Self {
-        let touching = |k: usize| old.shear[k] != 0.0 || old.sliding[k];
+        let touching = |k: usize| old.history.touched(k);
         let mut start = vec![0u32; n + 1];
         for k in (0..old.len()).filter(|&k| touching(k)) {
             start[old.i[k] as usize + 1] += 1;
@@ -649,7 +638,7 @@ impl PairHistory {
             start[q + 1] += start[q];
         }
         let mut fill: Vec<u32> = start[..n].to_vec();
-        let mut entries = vec![(0u32, [0i8; 2], 0.0, false); start[n] as usize];
+        let mut entries = vec![(0u32, [0i8; 2], 0u32); start[n] as usize];
         for k in (0..old.len()).filter(|&k| touching(k)) {
             let (i, j) = (old.i[k] as usize, old.j[k] as usize);
             let s = old.shift[k];
@@ -658,19 +647,19 @@ impl PairHistory {
                 s[1] - wraps[j][1] + wraps[i][1],
             ];
             let slot = &mut fill[i];
-            entries[*slot as usize] = (old.j[k], shift, old.shear[k], old.sliding[k]);
+            entries[*slot as usize] = (old.j[k], shift, k as u32);
             *slot += 1;
         }
         PairHistory { start, entries }
     }
 
-    /// The shear spring and sliding flag of pair `(i, j, shift)`, if it touched.
-    fn get(&self, i: u32, j: u32, shift: [i8; 2]) -> Option<(f64, bool)> {
+    /// The old list's index of pair `(i, j, shift)`, if it touched.
+    fn get(&self, i: u32, j: u32, shift: [i8; 2]) -> Option<usize> {
         let (lo, hi) = (self.start[i as usize], self.start[i as usize + 1]);
         self.entries[lo as usize..hi as usize]
             .iter()
             .find(|e| e.0 == j && e.1 == shift)
-            .map(|e| (e.2, e.3))
+            .map(|e| e.2 as usize)
     }
 }
 

@@ -31,7 +31,14 @@ fn fingerprint(sim: &Simulation) -> Vec<u64> {
             .map(f64::to_bits),
         );
     }
-    bits.extend(sim.neighbors().pairs.shear.iter().map(|s| s.to_bits()));
+    bits.extend(
+        sim.neighbors()
+            .pairs
+            .history
+            .shear_springs()
+            .iter()
+            .map(|s| s.to_bits()),
+    );
     bits
 }
 

@@ -186,7 +186,7 @@ mod tests {
             (
                 "pair arrays",
                 Box::new(|s| {
-                    s.neighbors.pairs.shear.pop();
+                    s.neighbors.pairs.history.records.pop();
                 }),
             ),
             (

@@ -14,6 +14,7 @@
 //! change. The particles' force arrays stay in the cache of the worker that
 //! owns their stripe, instead of crossing to the thread that ran the serial pass.
 use crate::bond::{Bond, BondSlot};
+use crate::diagnostics::ContactDissipation;
 use crate::parallel::StripeLists;
 use crate::vec2::{add, sub, Vec2};
 
@@ -24,11 +25,10 @@ use crate::vec2::{add, sub, Vec2};
 pub(crate) struct WallSlot {
     /// Force on the particle (N).
     pub force: Vec2,
-    /// Taken from the particle's torque (N m): its radius times the shear force.
+    /// Torque on the particle (N m), the contact law's.
     pub torque: f64,
-    /// Energy dissipated by sliding and by the dashpots this step (J).
-    pub friction: f64,
-    pub viscous: f64,
+    /// Energy dissipated by the contact's sub-models this step (J).
+    pub dissipation: ContactDissipation,
     /// Elastic energy (J) and force magnitude (N), measured steps only.
     pub elastic: f64,
     pub force_norm: f64,
@@ -118,7 +118,7 @@ impl DeferredForces<'_> {
             if slot.active {
                 let q = self.wall_particles[k as usize] as usize - lo;
                 force[q] = add(force[q], slot.force);
-                torque[q] -= slot.torque;
+                torque[q] += slot.torque;
             }
         }
     }
@@ -196,7 +196,7 @@ mod tests {
         for (&q, s) in wall_particles.iter().zip(&wall_slots) {
             if s.active {
                 force[q as usize] = add(force[q as usize], s.force);
-                torque[q as usize] -= s.torque;
+                torque[q as usize] += s.torque;
             }
         }
         let index = DeferredIndex::new(&bonds, &wall_particles, &stripes);

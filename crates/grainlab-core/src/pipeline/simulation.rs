@@ -25,7 +25,7 @@ use crate::wall::{Wall, WallControl};
 
 /// The first bytes of [`Simulation::to_bytes`]: the layout of the state that
 /// follows (bincode of [`Simulation`]); a new field makes a new tag.
-const STATE_TAG: &[u8; 8] = b"GLSTATE2";
+const STATE_TAG: &[u8; 8] = b"GLSTATE3";
 
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -753,10 +753,8 @@ impl Simulation {
         let p = &self.particles;
         let kernel = pair_kernel!(self, p, pairs, dt);
         // SAFETY: one caller, and the sink writes nothing
-        let tally = unsafe {
-            kernel.run::<false, _>(0, &mut pairs.shear, &mut pairs.sliding, &mut NullSink)
-        };
-        let mut friction = tally.friction;
+        let tally = unsafe { kernel.run::<false, _>(0, pairs.history.run(), &mut NullSink) };
+        let mut dissipation = tally.dissipation;
         let l = self.deforming_gradient();
         for bond in self.bonds.list.iter_mut() {
             let copy = *bond;
@@ -775,15 +773,15 @@ impl Simulation {
             let wall = &self.walls[wp.wall[k] as usize];
             let model = self.materials.by_index(wp.model[k]);
             let q = wp.particle[k] as usize;
-            match wall_contact(wall, model, &motion, q, dt, dt, &mut wp.shear[k]) {
+            match wall_contact(wall, model, &motion, q, dt, dt, &mut wp.history.records[k]) {
                 Some((_, c)) => {
-                    wp.sliding[k] = c.sliding;
-                    friction += c.friction_dissipation;
+                    wp.history.sliding[k] = c.sliding;
+                    dissipation.friction += c.dissipation.friction;
                 }
-                None => wp.sliding[k] = false,
+                None => wp.history.sliding[k] = false,
             }
         }
-        self.ledger.friction_dissipated += friction;
+        self.ledger.friction_dissipated += dissipation.friction;
         self.springs_current = true;
     }
 
@@ -792,25 +790,25 @@ impl Simulation {
     pub(crate) fn preview_pairs(&self) -> Vec<Option<PairRecord>> {
         let increment_time = self.increment_time();
         let pairs = &self.neighbors.pairs;
-        let (mut shear, mut sliding) = (pairs.shear.clone(), pairs.sliding.clone());
+        let mut history = pairs.history.clone();
         let p = &self.particles;
         let kernel = pair_kernel!(self, p, pairs, increment_time);
         let mut sink = RecordSink {
             records: vec![None; pairs.len()],
         };
         // SAFETY: one caller, and the sink writes only its own records
-        unsafe { kernel.run::<false, _>(0, &mut shear, &mut sliding, &mut sink) };
+        unsafe { kernel.run::<false, _>(0, history.run(), &mut sink) };
         sink.records
     }
 
-    /// Every wall pair as the next force evaluation will see it: the geometry,
-    /// the law's forces and the updated spring (in a copy), or `None`.
-    pub(crate) fn preview_wall_pairs(&self) -> Vec<Option<(ContactGeometry, ContactForce, f64)>> {
+    /// Every wall pair as the next force evaluation will see it: the geometry
+    /// and the law's forces (the history updated in a copy), or `None`.
+    pub(crate) fn preview_wall_pairs(&self) -> Vec<Option<(ContactGeometry, ContactForce)>> {
         let (dt, increment_time) = (self.params.time_step, self.increment_time());
         let wp = &self.neighbors.wall_pairs;
         (0..wp.wall.len())
             .map(|k| {
-                let mut spring = wp.shear[k];
+                let mut record = wp.history.records[k];
                 let wall = &self.walls[wp.wall[k] as usize];
                 let model = self.materials.by_index(wp.model[k]);
                 let q = wp.particle[k] as usize;
@@ -821,9 +819,8 @@ impl Simulation {
                     q,
                     dt,
                     increment_time,
-                    &mut spring,
+                    &mut record,
                 )
-                .map(|(g, c)| (g, c, spring))
             })
             .collect()
     }

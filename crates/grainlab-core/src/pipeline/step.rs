@@ -14,7 +14,7 @@ use crate::error::Result;
 use crate::integrate::{
     integrate_stripe, IntegrationInputs, IntegrationStep, IntegrationTally, MotionStripe,
 };
-use crate::law::elastic_energy;
+use crate::law::{elastic_energy, ContactRecord};
 use crate::parallel::{
     even_bounds, map_stripes, split_ranges, DisjointWriter, Team, PARALLEL_MIN_PARTICLES,
 };
@@ -183,8 +183,8 @@ impl Simulation {
         motion: &IntegrationTally,
     ) {
         let ledger = &mut self.ledger;
-        ledger.friction_dissipated += contacts.friction + walls.friction;
-        ledger.viscous_dissipated += contacts.viscous + walls.viscous;
+        // each contact sub-model's dissipation into its own line
+        ledger.book_contacts(&contacts.dissipation.plus(&walls.dissipation));
         ledger.damping_dissipated += motion.damping_dissipated;
         ledger.wall_work += wall_work;
         ledger.external_work += motion.external_work;
@@ -279,10 +279,8 @@ impl Simulation {
         let mut ranges: Vec<(usize, usize)> =
             (0..n_stripes).map(|b| (starts[b], starts[b + 1])).collect();
         ranges.extend(&cross_ranges);
-        let mut shear_parts = split_ranges(&mut pairs.shear, &ranges);
-        let mut sliding_parts = split_ranges(&mut pairs.sliding, &ranges);
-        let cross_shear = shear_parts.split_off(n_stripes);
-        let cross_sliding = sliding_parts.split_off(n_stripes);
+        let mut history_parts = pairs.history.split(&ranges);
+        let cross_history = history_parts.split_off(n_stripes);
         // every slot is rewritten by the kernel (a force or `skip`), so no clearing
         self.cross_forces
             .resize(n_pairs - cross_start, PairForce::NONE);
@@ -325,26 +323,17 @@ impl Simulation {
                 && !self.external_loads
                 && self.params.gravity == [0.0, 0.0],
         };
-        let stripes: Vec<StripeWork<'_>> = shear_parts
+        let stripes: Vec<StripeWork<'_>> = history_parts
             .into_iter()
-            .zip(sliding_parts)
-            .zip(cross_shear.into_iter().zip(cross_sliding))
+            .zip(cross_history)
             .zip(cross_buffers)
             .zip(bond_parts.into_iter().zip(bond_slot_parts))
             .enumerate()
             .map(
-                |(
-                    b,
-                    (
-                        (((shear, sliding), (cross_shear, cross_sliding)), cross_forces),
-                        (bonds, bond_slots),
-                    ),
-                )| StripeWork {
+                |(b, (((history, cross_history), cross_forces), (bonds, bond_slots)))| StripeWork {
                     stripe: b,
-                    shear,
-                    sliding,
-                    cross_shear,
-                    cross_sliding,
+                    history,
+                    cross_history,
                     cross_forces,
                     bonds,
                     bond_slots,
@@ -370,8 +359,8 @@ impl Simulation {
             wall: &wp.wall,
             particle: &wp.particle,
             model: &wp.model,
-            shear: DisjointWriter::new(&mut wp.shear),
-            sliding: DisjointWriter::new(&mut wp.sliding),
+            records: DisjointWriter::new(&mut wp.history.records),
+            sliding: DisjointWriter::new(&mut wp.history.sliding),
             slots: DisjointWriter::new(&mut self.wall_slots),
         };
         let (materials, deferred_index) = (&self.materials, &self.deferred_index);
@@ -398,16 +387,14 @@ impl Simulation {
                     );
                 }
                 reset.apply(lo, hi, &force, &torque);
-                let mut tally =
-                    kernel.run::<MEASURE, _>(ranges[b].0, work.shear, work.sliding, &mut direct);
+                let mut tally = kernel.run::<MEASURE, _>(ranges[b].0, work.history, &mut direct);
                 if buffer_cross {
                     let mut buffered = BufferSink {
                         slots: work.cross_forces,
                     };
                     let cross = kernel.run::<MEASURE, _>(
                         ranges[n_stripes + b].0,
-                        work.cross_shear,
-                        work.cross_sliding,
+                        work.cross_history,
                         &mut buffered,
                     );
                     tally.merge(&cross);
@@ -428,9 +415,9 @@ impl Simulation {
                         let wall = &walls[wall_pairs.wall[k] as usize];
                         let model = materials.by_index(wall_pairs.model[k]);
                         let q = wall_pairs.particle[k] as usize;
-                        let spring = wall_pairs.shear.get(k);
+                        let record = wall_pairs.records.get(k);
                         let contact =
-                            wall_contact(wall, model, &motion, q, dt, increment_time, spring);
+                            wall_contact(wall, model, &motion, q, dt, increment_time, record);
                         let slot = wall_pairs.slots.get(k);
                         let Some((g, c)) = contact else {
                             *wall_pairs.sliding.get(k) = false;
@@ -442,15 +429,14 @@ impl Simulation {
                         let n = g.normal;
                         *slot = WallSlot {
                             force: add(scale(n, c.normal), scale(perp(n), c.shear)),
-                            torque: r * c.shear,
-                            friction: c.friction_dissipation,
-                            viscous: c.viscous_dissipation,
+                            torque: c.torque_j,
+                            dissipation: c.dissipation,
                             overlap_violation: g.overlap > max_overlap_ratio * r,
                             active: true,
                             ..WallSlot::default()
                         };
                         if MEASURE {
-                            slot.elastic = elastic_energy(model, c.elastic_normal, *spring);
+                            slot.elastic = elastic_energy(model, c.elastic_normal, c.shear_spring);
                             slot.force_norm = (c.normal * c.normal + c.shear * c.shear).sqrt();
                         }
                     }
@@ -486,14 +472,8 @@ impl Simulation {
         for (tally, &(lo, hi)) in tallies.iter_mut().zip(&shares) {
             let (lo, hi) = (cross_start + lo, cross_start + hi);
             // SAFETY: one thread; the pairs index particles that exist
-            let cross = unsafe {
-                kernel.run::<MEASURE, _>(
-                    lo,
-                    &mut pairs.shear[lo..hi],
-                    &mut pairs.sliding[lo..hi],
-                    &mut direct,
-                )
-            };
+            let cross =
+                unsafe { kernel.run::<MEASURE, _>(lo, pairs.history.run_of(lo, hi), &mut direct) };
             tally.merge(&cross);
         }
     }
@@ -559,26 +539,25 @@ impl Simulation {
                     q,
                     dt,
                     increment_time,
-                    &mut wp.shear[k],
+                    &mut wp.history.records[k],
                 );
                 let Some((g, c)) = contact else {
-                    wp.sliding[k] = false;
+                    wp.history.sliding[k] = false;
                     continue;
                 };
-                wp.sliding[k] = c.sliding;
+                wp.history.sliding[k] = c.sliding;
                 let p = &mut self.particles;
                 let r = p.radius[q];
                 let n = g.normal;
                 let f = add(scale(n, c.normal), scale(perp(n), c.shear));
                 p.force[q] = add(p.force[q], f);
-                p.torque[q] -= r * c.shear;
+                p.torque[q] += c.torque_j;
                 WallSlot {
                     force: f,
-                    friction: c.friction_dissipation,
-                    viscous: c.viscous_dissipation,
+                    dissipation: c.dissipation,
                     overlap_violation: g.overlap > self.params.max_overlap_ratio * r,
                     elastic: if MEASURE {
-                        elastic_energy(model, c.elastic_normal, wp.shear[k])
+                        elastic_energy(model, c.elastic_normal, c.shear_spring)
                     } else {
                         0.0
                     },
@@ -593,8 +572,7 @@ impl Simulation {
             wall.force = sub(wall.force, slot.force);
             wall.contact_count += 1;
             wall.stiffness_sum += model.normal_stiffness;
-            tally.friction += slot.friction;
-            tally.viscous += slot.viscous;
+            tally.dissipation.add(&slot.dissipation);
             tally.overlap_violation |= slot.overlap_violation;
             if MEASURE {
                 tally.elastic += slot.elastic;
@@ -776,7 +754,7 @@ struct WallPairWork<'a> {
     wall: &'a [u32],
     particle: &'a [u32],
     model: &'a [u16],
-    shear: DisjointWriter<f64>,
+    records: DisjointWriter<ContactRecord>,
     sliding: DisjointWriter<bool>,
     slots: DisjointWriter<WallSlot>,
 }
