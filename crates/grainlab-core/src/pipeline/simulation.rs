@@ -312,10 +312,11 @@ impl Simulation {
             require_positive(&format!("radii[{k}]"), r)?;
         }
         let radius = self.internal_array("radii", radii)?;
-        self.catch_up_shear_springs();
-        self.particles.radius = radius;
-        self.particles.update_mass_properties();
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            s.particles.radius = radius;
+            s.particles.update_mass_properties();
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -344,9 +345,10 @@ impl Simulation {
             ));
         }
         let group = self.internal_array("groups", groups)?;
-        self.catch_up_shear_springs();
-        self.particles.group = group;
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            s.particles.group = group;
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -383,8 +385,7 @@ impl Simulation {
     pub fn set_params(&mut self, params: StepParameters) -> Result<()> {
         params.validate()?;
         // the last step's displacement was made with the old time step
-        self.catch_up_shear_springs();
-        self.params = params;
+        self.modify_motion(|s| s.params = params);
         Ok(())
     }
 
@@ -414,10 +415,12 @@ impl Simulation {
     /// Sets the contact model between groups `a` and `b`.
     pub fn set_contact_model(&mut self, a: usize, b: usize, model: ContactModel) -> Result<()> {
         model.validate("contact_model")?;
-        self.catch_up_shear_springs();
-        self.materials.set(a, b, model)?;
-        self.neighbors.invalidate();
-        Ok(())
+        MaterialTable::check_groups(a, b)?;
+        self.modify_motion(|s| {
+            s.materials.set(a, b, model)?;
+            s.neighbors.invalidate();
+            Ok(())
+        })
     }
 
     /// Sets (or removes) the periodic cell.
@@ -426,9 +429,10 @@ impl Simulation {
             c.validate()?;
         }
         // the last step's displacement was made in the old cell's flow
-        self.catch_up_shear_springs();
-        self.cell = cell;
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            s.cell = cell;
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -450,8 +454,8 @@ impl Simulation {
         })
     }
 
-    /// The wall with id `id`, to change (only after
-    /// [`Simulation::catch_up_shear_springs`] when its motion changes).
+    /// The wall with id `id`, to change (inside [`Simulation::modify_motion`]
+    /// when its motion changes).
     pub(crate) fn wall_mut(&mut self, id: usize) -> Result<&mut Wall> {
         let n = self.walls.len();
         self.walls.get_mut(id).ok_or_else(|| {
@@ -476,12 +480,13 @@ impl Simulation {
     pub fn set_wall_velocity(&mut self, id: usize, velocity: Vec2) -> Result<()> {
         crate::error::require_finite("velocity", velocity[0])?;
         crate::error::require_finite("velocity", velocity[1])?;
-        self.wall_mut(id)?;
-        self.catch_up_shear_springs();
-        let wall = self.wall_mut(id)?;
-        wall.control = WallControl::Velocity;
-        wall.velocity = velocity;
-        Ok(())
+        self.wall(id)?;
+        self.modify_motion(|s| {
+            let wall = s.wall_mut(id)?;
+            wall.control = WallControl::Velocity;
+            wall.velocity = velocity;
+            Ok(())
+        })
     }
 
     /// Moves wall `id` at once by `d` (m), between steps: a jump, not a shear
@@ -489,10 +494,11 @@ impl Simulation {
     pub fn translate_wall(&mut self, id: usize, d: Vec2) -> Result<()> {
         crate::error::require_finite("displacement", d[0])?;
         crate::error::require_finite("displacement", d[1])?;
-        self.wall_mut(id)?;
-        self.catch_up_shear_springs();
-        self.wall_mut(id)?.translate(d);
-        Ok(())
+        self.wall(id)?;
+        self.modify_motion(|s| {
+            s.wall_mut(id)?.translate(d);
+            Ok(())
+        })
     }
 
     /// Bonds particles `i` and `j` with a spring of rest length `rest_length`
@@ -534,16 +540,17 @@ impl Simulation {
             None => norm(self.branch(i, j)),
         };
         // a new bond starts from zero shear: no displacement before it existed counts
-        self.catch_up_shear_springs();
-        self.bonds.push(Bond {
-            i: i as u32,
-            j: j as u32,
-            normal_stiffness,
-            shear_stiffness,
-            rest_length: rest,
-            shear: 0.0,
+        self.modify_motion(|s| {
+            s.bonds.push(Bond {
+                i: i as u32,
+                j: j as u32,
+                normal_stiffness,
+                shear_stiffness,
+                rest_length: rest,
+                shear: 0.0,
+            });
+            s.neighbors.invalidate();
         });
-        self.neighbors.invalidate();
         Ok(())
     }
 
@@ -562,13 +569,14 @@ impl Simulation {
         density: Vec<f64>,
     ) -> Result<()> {
         let added = Particles::new(position, radius, density)?;
-        self.catch_up_shear_springs();
-        let first = self.particles.len() as u32;
-        let count = added.len() as u32;
-        self.particles.extend(added);
-        self.order.extend(first..first + count);
-        self.rank.extend(first..first + count);
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            let first = s.particles.len() as u32;
+            let count = added.len() as u32;
+            s.particles.extend(added);
+            s.order.extend(first..first + count);
+            s.rank.extend(first..first + count);
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -664,19 +672,20 @@ impl Simulation {
 
     /// Switches a wall on or off; an inactive wall has no contacts and stays put.
     pub fn set_wall_active(&mut self, id: usize, active: bool) -> Result<()> {
-        self.wall_mut(id)?;
-        self.catch_up_shear_springs();
-        let wall = self.wall_mut(id)?;
-        wall.active = active;
-        if !active {
-            wall.velocity = [0.0; 2];
-            wall.control = WallControl::Velocity;
-            wall.force = [0.0; 2];
-            wall.contact_count = 0;
-            wall.stiffness_sum = 0.0;
-        }
-        self.neighbors.invalidate();
-        Ok(())
+        self.wall(id)?;
+        self.modify_motion(|s| {
+            let wall = s.wall_mut(id)?;
+            wall.active = active;
+            if !active {
+                wall.velocity = [0.0; 2];
+                wall.control = WallControl::Velocity;
+                wall.force = [0.0; 2];
+                wall.contact_count = 0;
+                wall.stiffness_sum = 0.0;
+            }
+            s.neighbors.invalidate();
+            Ok(())
+        })
     }
 
     /// Marks the neighbour lists stale (after positions or radii changed).
@@ -690,9 +699,10 @@ impl Simulation {
     pub fn set_positions(&mut self, positions: &[Vec2]) -> Result<()> {
         require_finite_points("positions", positions)?;
         let position = self.internal_array("positions", positions)?;
-        self.catch_up_shear_springs();
-        self.particles.position = position;
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            s.particles.position = position;
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -703,9 +713,10 @@ impl Simulation {
     pub fn set_velocities(&mut self, velocities: &[Vec2]) -> Result<()> {
         require_finite_points("velocities", velocities)?;
         let velocity = self.internal_array("velocities", velocities)?;
-        self.catch_up_shear_springs();
-        self.particles.velocity = velocity;
-        self.half_kick_pending = true;
+        self.modify_motion(|s| {
+            s.particles.velocity = velocity;
+            s.half_kick_pending = true;
+        });
         Ok(())
     }
 
@@ -714,9 +725,10 @@ impl Simulation {
     pub fn set_angular_velocities(&mut self, angular_velocities: &[f64]) -> Result<()> {
         require_finite_values("angular_velocities", angular_velocities)?;
         let omega = self.internal_array("angular_velocities", angular_velocities)?;
-        self.catch_up_shear_springs();
-        self.particles.angular_velocity = omega;
-        self.half_kick_pending = true;
+        self.modify_motion(|s| {
+            s.particles.angular_velocity = omega;
+            s.half_kick_pending = true;
+        });
         Ok(())
     }
 
@@ -737,13 +749,27 @@ impl Simulation {
         }
     }
 
+    /// The one way a setter changes what the pending shear increment depends
+    /// on (velocities and spins, positions, radii, groups, the step parameters,
+    /// contact models, the cell, a wall's velocity, translation or activity,
+    /// bonds, particles): the springs first take the last step's increment
+    /// ([`Simulation::catch_up_shear_springs`]), then `change` runs. A setter
+    /// checks its input before, so that a refused change leaves the springs as
+    /// they were; the test below refuses a setter that writes those fields
+    /// outside of it.
+    fn modify_motion<R>(&mut self, change: impl FnOnce(&mut Self) -> R) -> R {
+        self.catch_up_shear_springs();
+        change(self)
+    }
+
     /// Adds to every shear spring (contacts, wall contacts, bonds) the increment
     /// of the displacement made by the last step, `-ks v_t dt` at the current
     /// positions and half-step velocities, capped as the next force evaluation
     /// would; that evaluation then adds none. A no-op when the springs are
     /// current. Every method that changes what the increment would be (velocities,
     /// positions, the time step, contact models, the cell, walls, bonds,
-    /// particles) calls it first. Slip in it is booked as friction dissipation.
+    /// particles) makes its change through [`Simulation::modify_motion`], which
+    /// calls it first. Slip in it is booked as friction dissipation.
     pub fn catch_up_shear_springs(&mut self) {
         if self.springs_current {
             return;
@@ -1013,5 +1039,129 @@ impl Simulation {
         sim.check_consistent()?;
         sim.make_pool()?;
         Ok(sim)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Writes to what the pending shear increment depends on, as this file
+    /// spells them (`self.` in a setter, `s.` in its `modify_motion` closure).
+    const MOTION_WRITES: &[&str] = &[
+        "particles.position =",
+        "particles.velocity =",
+        "particles.angular_velocity =",
+        "particles.radius =",
+        "particles.group =",
+        "particles.extend(",
+        "params =",
+        "cell =",
+        "materials.set(",
+        "bonds.push(",
+        ".translate(",
+        "wall.velocity =",
+        "wall.active =",
+    ];
+
+    /// The methods of this file, each as `(name, text up to the next method)`.
+    fn methods(source: &str) -> Vec<(String, String)> {
+        let starts: Vec<usize> = source
+            .match_indices("\n    ")
+            .map(|(k, _)| k + 5)
+            .filter(|&k| {
+                let line = &source[k..];
+                ["pub fn ", "pub(crate) fn ", "fn "]
+                    .iter()
+                    .any(|p| line.starts_with(p))
+            })
+            .collect();
+        starts
+            .iter()
+            .enumerate()
+            .map(|(n, &k)| {
+                let end = starts.get(n + 1).copied().unwrap_or(source.len());
+                let text = &source[k..end];
+                let name = text
+                    .split("fn ")
+                    .nth(1)
+                    .and_then(|t| t.split(['(', '<']).next())
+                    .unwrap_or("")
+                    .to_string();
+                (name, text.to_string())
+            })
+            .collect()
+    }
+
+    /// The part of a method's text that is code (comments and strings dropped).
+    fn code(text: &str) -> String {
+        text.lines()
+            .map(|l| l.split("//").next().unwrap_or(""))
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
+    /// The offsets of the motion writes in `code`, with the write.
+    fn motion_writes(code: &str) -> Vec<(usize, &'static str)> {
+        let mut found = Vec::new();
+        for &w in MOTION_WRITES {
+            for (k, _) in code.match_indices(w) {
+                // `==` is a comparison, not a write
+                if !code[k + w.len()..].starts_with('=') {
+                    found.push((k, w));
+                }
+            }
+        }
+        found
+    }
+
+    #[test]
+    fn every_setter_of_motion_goes_through_modify_motion() {
+        let source = include_str!("simulation.rs");
+        let source = &source[..source.find("#[cfg(test)]\nmod tests").unwrap()];
+        let mut setters = 0;
+        for (name, text) in methods(source) {
+            let code = code(&text);
+            let writes = motion_writes(&code);
+            if name == "new" || name == "from_bytes" || name == "modify_motion" {
+                continue;
+            }
+            if name != "modify_motion" && name != "catch_up_shear_springs" {
+                assert!(
+                    !code.contains("catch_up_shear_springs()"),
+                    "{name}: catches the springs up itself; change them through modify_motion"
+                );
+            }
+            if writes.is_empty() {
+                continue;
+            }
+            setters += 1;
+            let entry = code.find(".modify_motion(").unwrap_or_else(|| {
+                panic!("{name}: writes {:?} outside of modify_motion", writes[0].1)
+            });
+            for (k, w) in writes {
+                assert!(
+                    k > entry,
+                    "{name}: writes {w:?} before entering modify_motion"
+                );
+            }
+        }
+        // the setters of velocities, spins, positions, radii, groups, the step
+        // parameters, contact models, the cell, walls (velocity, translation,
+        // activity), bonds and particles
+        assert_eq!(setters, 13, "the setters of motion found in this file");
+    }
+
+    #[test]
+    fn a_setter_that_skips_modify_motion_is_found() {
+        let skipping = "\n    pub fn set_spins(&mut self, w: Vec<f64>) {\n        \
+                        self.particles.angular_velocity = w;\n    }\n";
+        let (name, text) = &methods(skipping)[0];
+        assert_eq!(name, "set_spins");
+        let code = code(text);
+        assert!(!motion_writes(&code).is_empty() && !code.contains(".modify_motion("));
+        let late = "\n    pub fn set_spins(&mut self, w: Vec<f64>) {\n        \
+                    self.particles.velocity = w;\n        self.modify_motion(|_| ());\n    }\n";
+        let code = super::tests::code(&methods(late)[0].1);
+        let entry = code.find(".modify_motion(").unwrap();
+        assert!(motion_writes(&code).iter().any(|&(k, _)| k < entry));
     }
 }
