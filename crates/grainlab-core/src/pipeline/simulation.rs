@@ -769,7 +769,8 @@ impl Simulation {
     /// current. Every method that changes what the increment would be (velocities,
     /// positions, the time step, contact models, the cell, walls, bonds,
     /// particles) makes its change through [`Simulation::modify_motion`], which
-    /// calls it first. Slip in it is booked as friction dissipation.
+    /// calls it first. Slip in it is booked in the ledger's lines of the
+    /// sub-models that carry history (friction, rolling).
     pub fn catch_up_shear_springs(&mut self) {
         if self.springs_current {
             return;
@@ -803,11 +804,15 @@ impl Simulation {
                 Some((_, c)) => {
                     wp.history.sliding[k] = c.sliding;
                     dissipation.friction += c.dissipation.friction;
+                    dissipation.rolling += c.dissipation.rolling;
                 }
                 None => wp.history.sliding[k] = false,
             }
         }
+        // the slip of the increments (the springs' history), not the dashpots'
+        // power, which the step books over its own time step
         self.ledger.friction_dissipated += dissipation.friction;
+        self.ledger.rolling_dissipated += dissipation.rolling;
         self.springs_current = true;
     }
 
