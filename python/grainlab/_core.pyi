@@ -117,6 +117,7 @@ class _Energy(TypedDict):
     elastic: float
     friction_dissipated: float
     viscous_dissipated: float
+    rolling_dissipated: float
     damping_dissipated: float
     wall_work: float
     external_work: float

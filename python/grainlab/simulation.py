@@ -153,6 +153,8 @@ class Energy:
     elastic: float
     friction_dissipated: float
     viscous_dissipated: float
+    rolling_dissipated: float
+    """Dissipated by the contact law's rolling sub-model (0: the linear law resists no rolling)."""
     damping_dissipated: float
     wall_work: float
     external_work: float

@@ -13,7 +13,7 @@
 //! the bulging boundary.
 use serde::{Deserialize, Serialize};
 
-use crate::parallel::BlockLists;
+use crate::parallel::StripeLists;
 use crate::vec2::{dot, scale, sub, Vec2};
 use crate::wall::{Wall, WallShape};
 
@@ -93,36 +93,36 @@ impl PressureChain {
 }
 
 /// The entries `(chain, k)` of the pressure chains whose particle lies in each
-/// block of particles, in chain order then `k` order: the order in which
+/// stripe of particles, in chain order then `k` order: the order in which
 /// [`PressureChain::apply`] over the chains in turn adds to each particle, so a
-/// block's loads can be computed apart with the same bits.
+/// stripe's loads can be computed apart with the same bits.
 #[derive(Debug, Clone, Default)]
-pub(crate) struct ChainBlocks {
-    /// `(chain, position in the chain)` per block.
-    lists: BlockLists<(u32, u32)>,
+pub(crate) struct ChainStripes {
+    /// `(chain, position in the chain)` per stripe.
+    lists: StripeLists<(u32, u32)>,
 }
 
-impl ChainBlocks {
-    /// The entries of `chains` per block of `block_ranges` (contiguous, in
-    /// order); none when the blocks do not cover the chains' particles.
-    pub(crate) fn new(chains: &[PressureChain], block_ranges: &[(usize, usize)]) -> Self {
+impl ChainStripes {
+    /// The entries of `chains` per stripe of `stripe_ranges` (contiguous, in
+    /// order); none when the stripes do not cover the chains' particles.
+    pub(crate) fn new(chains: &[PressureChain], stripe_ranges: &[(usize, usize)]) -> Self {
         let items = chains.iter().enumerate().flat_map(|(c, chain)| {
             (chain.particles.iter().enumerate())
                 .map(move |(k, &q)| (q as usize, (c as u32, k as u32)))
         });
-        // blocks of an older list: the rebuild before the next step makes new ones
-        let lists = BlockLists::new(block_ranges, items).unwrap_or_default();
-        ChainBlocks { lists }
+        // stripes of an older list: the rebuild before the next step makes new ones
+        let lists = StripeLists::new(stripe_ranges, items).unwrap_or_default();
+        ChainStripes { lists }
     }
 
-    /// The number of blocks the index serves (0 when never built).
-    pub(crate) fn n_blocks(&self) -> usize {
-        self.lists.n_blocks()
+    /// The number of stripes the index serves (0 when never built).
+    pub(crate) fn n_stripes(&self) -> usize {
+        self.lists.n_stripes()
     }
 
-    /// Sets the loads of block `b`'s particles `lo..hi` (`load` holds them from
+    /// Sets the loads of stripe `b`'s particles `lo..hi` (`load` holds them from
     /// `lo`): zero, plus the follower loads of the chains.
-    pub(crate) fn block_loads(
+    pub(crate) fn stripe_loads(
         &self,
         b: usize,
         lo: usize,
@@ -132,7 +132,7 @@ impl ChainBlocks {
         load: &mut [Vec2],
     ) {
         load.fill([0.0; 2]);
-        for &(c, k) in self.lists.of_block(b) {
+        for &(c, k) in self.lists.of_stripe(b) {
             let chain = &chains[c as usize];
             let (k, ps) = (k as usize, chain.particles.as_slice());
             let q = ps[k] as usize - lo;

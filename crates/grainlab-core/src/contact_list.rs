@@ -142,7 +142,7 @@ impl Simulation {
         let mut out = WallContactList::default();
         let wp = &self.neighbors.wall_pairs;
         for (k, record) in self.preview_wall_pairs().into_iter().enumerate() {
-            if let Some((g, c, spring)) = record {
+            if let Some((g, c)) = record {
                 let q = wp.particle[k] as usize;
                 out.wall.push(wp.wall[k]);
                 out.particle.push(self.external_index(q) as u32);
@@ -155,7 +155,7 @@ impl Simulation {
                 out.normal.push(g.normal);
                 out.overlap.push(g.overlap);
                 out.normal_force.push(c.elastic_normal);
-                out.shear_force.push(spring);
+                out.shear_force.push(c.shear_spring);
                 out.sliding.push(c.sliding);
             }
         }

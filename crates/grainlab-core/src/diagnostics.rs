@@ -5,9 +5,11 @@ use serde::{Deserialize, Serialize};
 /// Energies (J per unit thickness). `kinetic` and `elastic` are the state at the
 /// last measured step (full-step velocities); the rest accumulate from step 0.
 ///
-/// Balance: `kinetic + elastic + friction + viscous + damping - wall_work -
-/// external_work - boundary_work` stays constant, up to the work of prescribed velocities and
-/// of the periodic cell's imposed deformation, which are not counted.
+/// Balance: `kinetic + elastic + friction + viscous + rolling + damping -
+/// wall_work - external_work - boundary_work` stays constant, up to the work
+/// of prescribed velocities and of the periodic cell's imposed deformation,
+/// which are not counted. The contact law's sub-models book their dissipation
+/// in one entry each ([`ContactDissipation`], `docs/contact-law.md`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnergyLedger {
     /// Translational plus rotational kinetic energy.
@@ -18,6 +20,9 @@ pub struct EnergyLedger {
     pub friction_dissipated: f64,
     /// Energy dissipated by the viscous contact dashpots.
     pub viscous_dissipated: f64,
+    /// Energy dissipated by the rolling-resistance sub-model (0 with the
+    /// linear law's sub-models, which resist no rolling).
+    pub rolling_dissipated: f64,
     /// Energy dissipated by local damping.
     pub damping_dissipated: f64,
     /// Work done on the particles by moving walls: for each step's displacement of
@@ -36,10 +41,54 @@ impl EnergyLedger {
             + self.elastic
             + self.friction_dissipated
             + self.viscous_dissipated
+            + self.rolling_dissipated
             + self.damping_dissipated
             - self.wall_work
             - self.external_work
             - self.boundary_work
+    }
+}
+
+/// Energy taken out of the system by the contact law's sub-models (J), one
+/// entry per sub-model that dissipates: what one contact's evaluation returns
+/// ([`crate::law::ContactForce::dissipation`]), what a step's tallies sum, and
+/// what [`EnergyLedger::book_contacts`] adds to the ledger.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ContactDissipation {
+    /// Coulomb slip of the tangential sub-model (its shear spring at the cap).
+    pub friction: f64,
+    /// The damping sub-model's viscous dashpots.
+    pub viscous: f64,
+    /// The rolling sub-model's resistance.
+    pub rolling: f64,
+}
+
+impl ContactDissipation {
+    /// Adds `other`'s entries, entry by entry.
+    #[inline(always)]
+    pub fn add(&mut self, other: &ContactDissipation) {
+        self.friction += other.friction;
+        self.viscous += other.viscous;
+        self.rolling += other.rolling;
+    }
+
+    /// The entry-by-entry sum `self + other`.
+    #[inline(always)]
+    pub fn plus(&self, other: &ContactDissipation) -> ContactDissipation {
+        ContactDissipation {
+            friction: self.friction + other.friction,
+            viscous: self.viscous + other.viscous,
+            rolling: self.rolling + other.rolling,
+        }
+    }
+}
+
+impl EnergyLedger {
+    /// Books the contact sub-models' dissipation: each entry into its own line.
+    pub fn book_contacts(&mut self, d: &ContactDissipation) {
+        self.friction_dissipated += d.friction;
+        self.viscous_dissipated += d.viscous;
+        self.rolling_dissipated += d.rolling;
     }
 }
 

@@ -10,7 +10,7 @@
 use crate::state::{FIX_ROTATION, FIX_X, FIX_Y};
 use crate::vec2::{mat_vec, sub, Mat2, Vec2};
 
-/// Read-only inputs of the integration of one chunk of particles.
+/// Read-only inputs of the integration of one stripe of particles.
 pub struct IntegrationInputs<'a> {
     /// `1/m`.
     pub inv_mass: &'a [f64],
@@ -56,9 +56,9 @@ pub struct IntegrationStep {
     pub vector: bool,
 }
 
-/// The mutable state of one contiguous chunk of particles `lo..lo + len`.
-pub struct MotionChunk<'a> {
-    /// Index of the chunk's first particle.
+/// The mutable state of one contiguous stripe of particles `lo..lo + len`.
+pub struct MotionStripe<'a> {
+    /// Index of the stripe's first particle.
     pub lo: usize,
     /// Positions.
     pub position: &'a mut [Vec2],
@@ -74,7 +74,7 @@ pub struct MotionChunk<'a> {
     pub torque: &'a [f64],
 }
 
-/// What the integration of a chunk adds to the step's diagnostics.
+/// What the integration of a stripe adds to the step's diagnostics.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct IntegrationTally {
     /// Energy dissipated by local damping (J).
@@ -98,7 +98,7 @@ pub struct IntegrationTally {
 }
 
 impl IntegrationTally {
-    /// Folds another chunk's tally into this one.
+    /// Folds another stripe's tally into this one.
     pub fn merge(&mut self, o: &IntegrationTally) {
         self.damping_dissipated += o.damping_dissipated;
         self.external_work += o.external_work;
@@ -153,31 +153,31 @@ pub(crate) fn kick<const DAMPED: bool>(
     (v + kick * (f + fd) * inv_m, fd)
 }
 
-/// Integrates one chunk of particles over one step.
-pub fn integrate_chunk<const MEASURE: bool>(
-    chunk: MotionChunk<'_>,
+/// Integrates one stripe of particles over one step.
+pub fn integrate_stripe<const MEASURE: bool>(
+    stripe: MotionStripe<'_>,
     inputs: &IntegrationInputs<'_>,
     step: &IntegrationStep,
 ) -> IntegrationTally {
     match (step.alpha > 0.0, step.step_map.is_some()) {
-        (false, false) => integrate_kernel::<MEASURE, false, false>(chunk, inputs, step),
-        (false, true) => integrate_kernel::<MEASURE, false, true>(chunk, inputs, step),
-        (true, false) => integrate_kernel::<MEASURE, true, false>(chunk, inputs, step),
-        (true, true) => integrate_kernel::<MEASURE, true, true>(chunk, inputs, step),
+        (false, false) => integrate_kernel::<MEASURE, false, false>(stripe, inputs, step),
+        (false, true) => integrate_kernel::<MEASURE, false, true>(stripe, inputs, step),
+        (true, false) => integrate_kernel::<MEASURE, true, false>(stripe, inputs, step),
+        (true, true) => integrate_kernel::<MEASURE, true, true>(stripe, inputs, step),
     }
 }
 
-/// The loop of [`integrate_chunk`], specialised on local damping and on the
+/// The loop of [`integrate_stripe`], specialised on local damping and on the
 /// periodic cell's deformation so that neither costs anything when absent;
 /// two particles at a time where the step allows it ([`IntegrationStep::vector`]).
 #[inline(always)]
 fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bool>(
-    chunk: MotionChunk<'_>,
+    stripe: MotionStripe<'_>,
     inputs: &IntegrationInputs<'_>,
     step: &IntegrationStep,
 ) -> IntegrationTally {
-    let mut kernel = ChunkKernel::new(chunk, inputs, step);
-    let mut sums = ChunkSums::default();
+    let mut kernel = StripeKernel::new(stripe, inputs, step);
+    let mut sums = StripeSums::default();
     let n = kernel.position.len();
     #[cfg(target_arch = "x86_64")]
     if step.vector {
@@ -191,9 +191,9 @@ fn integrate_kernel<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bo
     sums.finish::<DEFORMING>(step)
 }
 
-/// What the integration of one chunk reads and writes, cut to the chunk, and
+/// What the integration of one stripe reads and writes, cut to the stripe, and
 /// the step's constants.
-pub(crate) struct ChunkKernel<'a> {
+pub(crate) struct StripeKernel<'a> {
     pub(crate) lo: usize,
     pub(crate) force: &'a [Vec2],
     pub(crate) torque: &'a [f64],
@@ -216,9 +216,9 @@ pub(crate) struct ChunkKernel<'a> {
     pub(crate) acc_shift: Vec2,
 }
 
-/// The running sums of one chunk's integration.
+/// The running sums of one stripe's integration.
 #[derive(Default)]
-pub(crate) struct ChunkSums {
+pub(crate) struct StripeSums {
     pub(crate) tally: IntegrationTally,
     pub(crate) damping_work: f64,
     pub(crate) max_fluctuation_sq: f64,
@@ -227,8 +227,8 @@ pub(crate) struct ChunkSums {
     pub(crate) non_finite: bool,
 }
 
-impl ChunkSums {
-    /// The chunk's tally.
+impl StripeSums {
+    /// The stripe's tally.
     fn finish<const DEFORMING: bool>(mut self, step: &IntegrationStep) -> IntegrationTally {
         self.tally.damping_dissipated = -self.damping_work * step.kick;
         self.tally.max_displacement_sq = self.max_displacement_sq;
@@ -242,9 +242,9 @@ impl ChunkSums {
     }
 }
 
-impl<'a> ChunkKernel<'a> {
+impl<'a> StripeKernel<'a> {
     fn new(
-        chunk: MotionChunk<'a>,
+        stripe: MotionStripe<'a>,
         inputs: &'a IntegrationInputs<'a>,
         step: &'a IntegrationStep,
     ) -> Self {
@@ -252,16 +252,16 @@ impl<'a> ChunkKernel<'a> {
             .step_map
             .unwrap_or(([0.0; 2], [[1.0, 0.0], [0.0, 1.0]]));
         let acc = step.accumulated_map;
-        let n = chunk.position.len();
-        let lo = chunk.lo;
-        ChunkKernel {
+        let n = stripe.position.len();
+        let lo = stripe.lo;
+        StripeKernel {
             lo,
-            force: &chunk.force[..n],
-            torque: &chunk.torque[..n],
-            velocity: &mut chunk.velocity[..n],
-            angular_velocity: &mut chunk.angular_velocity[..n],
-            rotation: &mut chunk.rotation[..n],
-            position: &mut chunk.position[..n],
+            force: &stripe.force[..n],
+            torque: &stripe.torque[..n],
+            velocity: &mut stripe.velocity[..n],
+            angular_velocity: &mut stripe.angular_velocity[..n],
+            rotation: &mut stripe.rotation[..n],
+            position: &mut stripe.position[..n],
             mass: &inputs.mass[lo..lo + n],
             inv_mass: &inputs.inv_mass[lo..lo + n],
             inv_inertia: &inputs.inv_inertia[lo..lo + n],
@@ -277,12 +277,12 @@ impl<'a> ChunkKernel<'a> {
         }
     }
 
-    /// Particle `k` of the chunk over the step.
+    /// Particle `k` of the stripe over the step.
     #[inline(always)]
     pub(crate) fn one_particle<const MEASURE: bool, const DAMPED: bool, const DEFORMING: bool>(
         &mut self,
         k: usize,
-        sums: &mut ChunkSums,
+        sums: &mut StripeSums,
     ) {
         let step = self.step;
         let (dt, alpha) = (step.dt, step.alpha);
@@ -342,7 +342,7 @@ impl<'a> ChunkKernel<'a> {
         [v_old, v]: [Vec2; 2],
         [w_old, w]: [f64; 2],
         fd: [f64; 3],
-        sums: &mut ChunkSums,
+        sums: &mut StripeSums,
     ) {
         let step = self.step;
         let inputs = self.inputs;

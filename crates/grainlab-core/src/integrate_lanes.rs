@@ -1,20 +1,20 @@
 //! The integration two free particles at a time, their `[x, y]` vectors side
 //! by side in one 256-bit AVX2 register, with the same bits as one at a time
-//! ([`ChunkKernel::one_particle`]).
+//! ([`StripeKernel::one_particle`]).
 //!
 //! Why the bits are the same: the kick, the drift and the affine map are done
 //! lane by lane with the scalar code's IEEE operations in its order (sums of
 //! two products are commutative, so `m10 x + m11 y` may be formed as
 //! `m11 y + m10 x`), local damping's sign from the same two masked constants;
 //! the energy sums are booked afterwards one particle at a time in particle
-//! order ([`ChunkKernel::book`]); the running maxima are of non-negative
+//! order ([`StripeKernel::book`]); the running maxima are of non-negative
 //! values that ignore NaN, so their order does not matter. A particle with a
-//! fixed degree of freedom, and the last of an odd chunk, go one at a time.
+//! fixed degree of freedom, and the last of an odd stripe, go one at a time.
 #![cfg(target_arch = "x86_64")]
 
 use std::arch::x86_64::*;
 
-use crate::integrate::{kick, running_max, ChunkKernel, ChunkSums};
+use crate::integrate::{kick, running_max, StripeKernel, StripeSums};
 use crate::simd::spill;
 
 /// The two particles' `[a, b]` as `[a, b, a, b]`.
@@ -54,8 +54,8 @@ unsafe fn squared_lengths(d: __m256d) -> __m256d {
     _mm256_hadd_pd(squares, squares)
 }
 
-impl ChunkKernel<'_> {
-    /// The chunk two particles at a time where both are free, else one at a time.
+impl StripeKernel<'_> {
+    /// The stripe two particles at a time where both are free, else one at a time.
     ///
     /// # Safety
     /// The processor has AVX2.
@@ -66,7 +66,7 @@ impl ChunkKernel<'_> {
         const DEFORMING: bool,
     >(
         &mut self,
-        sums: &mut ChunkSums,
+        sums: &mut StripeSums,
     ) {
         let step = self.step;
         let n = self.position.len();

@@ -1,7 +1,7 @@
 //! grainlab-core: a 2D disk discrete element engine (no Python in it).
 //!
 //! The [`pipeline::Simulation`] owns the state and runs whole blocks of steps;
-//! see `pipeline/` for the step order and `law.rs` for the contact law.
+//! see `pipeline/` for the step order and `law/` for the contact law and its sub-models.
 #![warn(missing_docs)]
 
 pub mod analysis;

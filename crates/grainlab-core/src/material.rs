@@ -71,8 +71,8 @@ impl MaterialTable {
         })
     }
 
-    /// Sets the model between groups `a` and `b` (both orders).
-    pub fn set(&mut self, a: usize, b: usize, model: ContactModel) -> Result<()> {
+    /// Checks that `a` and `b` name material groups.
+    pub fn check_groups(a: usize, b: usize) -> Result<()> {
         for (name, g) in [("group_a", a), ("group_b", b)] {
             if g >= MAX_GROUPS {
                 return Err(EngineError::invalid(
@@ -81,6 +81,12 @@ impl MaterialTable {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// Sets the model between groups `a` and `b` (both orders).
+    pub fn set(&mut self, a: usize, b: usize, model: ContactModel) -> Result<()> {
+        Self::check_groups(a, b)?;
         model.validate("contact_model")?;
         self.models[a * MAX_GROUPS + b] = model;
         self.models[b * MAX_GROUPS + a] = model;

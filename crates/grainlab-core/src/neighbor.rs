@@ -13,15 +13,18 @@
 //! into stripes of bin columns with balanced counts, as many as
 //! [`stripe_count`] gives for the system (never a function of the thread
 //! count); pairs with both
-//! particles in block `b` are stored contiguously (`block_start[b]..block_start[b+1]`)
-//! and may be evaluated concurrently with other blocks; pairs across blocks
-//! come last. Shear history is carried over from the previous list by pair key.
+//! particles in stripe `b` are stored contiguously (`stripe_start[b]..stripe_start[b+1]`)
+//! and may be evaluated concurrently with other stripes; pairs across stripes
+//! come last. The contact history (one record per pair, whatever the
+//! sub-models' width, [`ContactHistory`]) is carried over from the previous
+//! list by pair key.
 
 use serde::{Deserialize, Serialize};
 
 use crate::bond::Bonds;
 use crate::cell::PeriodicCell;
 use crate::error::{EngineError, Result};
+use crate::law::history::ContactHistory;
 use crate::material::MaterialTable;
 use crate::parallel::stripe_count;
 use crate::state::Particles;
@@ -39,13 +42,12 @@ pub struct PairList {
     pub shift: Vec<[i8; 2]>,
     /// Contact model index in the [`MaterialTable`].
     pub model: Vec<u16>,
-    /// Shear spring force (N): the contact's history, 0 when not in contact.
-    pub shear: Vec<f64>,
-    /// Whether the contact slid in the last step.
-    pub sliding: Vec<bool>,
-    /// Pairs interior to block `b` are `block_start[b]..block_start[b + 1]`;
-    /// cross-block pairs follow from `block_start[n_blocks]`.
-    pub block_start: Vec<usize>,
+    /// Each pair's contact history (the sub-models' records, all zero when
+    /// not in contact, and the sliding flags).
+    pub history: ContactHistory,
+    /// Pairs interior to stripe `b` are `stripe_start[b]..stripe_start[b + 1]`;
+    /// cross-stripe pairs follow from `stripe_start[n_stripes]`.
+    pub stripe_start: Vec<usize>,
 }
 
 impl PairList {
@@ -60,8 +62,9 @@ impl PairList {
     }
 
     /// Renumbers particles (`new_of_old[old] = new`), keeping `i < j` by swapping
-    /// the pair and reversing its image shift (the shear spring, a force on `j`
-    /// along `perp(n)`, is unchanged by the swap since both `n` and `perp(n)` flip).
+    /// the pair and reversing its image shift (the history is unchanged by the
+    /// swap: the shear spring, a force on `j` along `perp(n)`, keeps its sign
+    /// since both `n` and `perp(n)` flip).
     pub fn remap(&mut self, new_of_old: &[u32]) {
         for k in 0..self.len() {
             let (i, j) = (
@@ -76,15 +79,6 @@ impl PairList {
             }
         }
     }
-
-    fn push(&mut self, i: u32, j: u32, shift: [i8; 2], model: u16) {
-        self.i.push(i);
-        self.j.push(j);
-        self.shift.push(shift);
-        self.model.push(model);
-        self.shear.push(0.0);
-        self.sliding.push(false);
-    }
 }
 
 /// Particle-wall pairs with their contact history.
@@ -96,10 +90,8 @@ pub struct WallPairList {
     pub particle: Vec<u32>,
     /// Contact model index.
     pub model: Vec<u16>,
-    /// Shear spring force (N).
-    pub shear: Vec<f64>,
-    /// Whether the contact slid in the last step.
-    pub sliding: Vec<bool>,
+    /// Each wall pair's contact history, as [`PairList::history`].
+    pub history: ContactHistory,
 }
 
 /// The Verlet lists and the bookkeeping that says when to rebuild them.
@@ -111,13 +103,13 @@ pub struct NeighborList {
     pub pairs: PairList,
     /// Particle-wall pairs.
     pub wall_pairs: WallPairList,
-    /// Internal index range of the particles owned by each block.
-    pub block_ranges: Vec<(usize, usize)>,
-    /// For each block, the cross-block pairs that touch its particles, as
+    /// Internal index range of the particles owned by each stripe.
+    pub stripe_ranges: Vec<(usize, usize)>,
+    /// For each stripe, the cross-stripe pairs that touch its particles, as
     /// `(local cross index << 1) | side` (side 0: the pair's `i`, 1: its `j`),
     /// in pair order: CSR offsets in `cross_touch_start`.
     pub cross_touch: Vec<u32>,
-    /// Offsets of each block's entries in `cross_touch` (`n_blocks + 1`).
+    /// Offsets of each stripe's entries in `cross_touch` (`n_stripes + 1`).
     pub cross_touch_start: Vec<usize>,
     /// Number of builds so far.
     pub build_count: u64,
@@ -147,7 +139,7 @@ impl NeighborList {
             skin,
             pairs: PairList::default(),
             wall_pairs: WallPairList::default(),
-            block_ranges: Vec::new(),
+            stripe_ranges: Vec::new(),
             cross_touch: Vec::new(),
             cross_touch_start: Vec::new(),
             build_count: 0,
@@ -189,8 +181,8 @@ impl NeighborList {
             p.j.len(),
             p.shift.len(),
             p.model.len(),
-            p.shear.len(),
-            p.sliding.len(),
+            p.history.records.len(),
+            p.history.sliding.len(),
         ]
         .iter()
         .any(|&l| l != m)
@@ -203,31 +195,31 @@ impl NeighborList {
         if p.model.iter().any(|&k| k as usize >= n_models) {
             return bad("a pair names a contact model that does not exist");
         }
-        let n_blocks = self.block_ranges.len();
+        let n_stripes = self.stripe_ranges.len();
         if self.valid {
-            if p.block_start.len() != n_blocks + 1
-                || p.block_start.windows(2).any(|w| w[0] > w[1])
-                || p.block_start.last().is_some_and(|&last| last > m)
+            if p.stripe_start.len() != n_stripes + 1
+                || p.stripe_start.windows(2).any(|w| w[0] > w[1])
+                || p.stripe_start.last().is_some_and(|&last| last > m)
             {
-                return bad("block starts");
+                return bad("stripe starts");
             }
             let mut next = 0usize;
-            for &(lo, hi) in &self.block_ranges {
+            for &(lo, hi) in &self.stripe_ranges {
                 if lo != next || hi < lo {
-                    return bad("block ranges");
+                    return bad("stripe ranges");
                 }
                 next = hi;
             }
             if next != n_particles {
-                return bad("block ranges do not cover the particles");
+                return bad("stripe ranges do not cover the particles");
             }
-            let cross = m - p.block_start[n_blocks];
-            if self.cross_touch_start.len() != n_blocks + 1
+            let cross = m - p.stripe_start[n_stripes];
+            if self.cross_touch_start.len() != n_stripes + 1
                 || self.cross_touch_start.windows(2).any(|w| w[0] > w[1])
                 || self.cross_touch_start.last() != Some(&self.cross_touch.len())
                 || self.cross_touch.iter().any(|&e| (e >> 1) as usize >= cross)
             {
-                return bad("cross-block pairs");
+                return bad("cross-stripe pairs");
             }
         }
         let w = &self.wall_pairs;
@@ -235,8 +227,8 @@ impl NeighborList {
         if [
             w.particle.len(),
             w.model.len(),
-            w.shear.len(),
-            w.sliding.len(),
+            w.history.records.len(),
+            w.history.sliding.len(),
         ]
         .iter()
         .any(|&l| l != k)
@@ -302,7 +294,7 @@ impl NeighborList {
     /// lists pairs and wall pairs, and carries over the contact history.
     ///
     /// The particles are also put in *spatial order* (by bin, bins column by
-    /// column): each block is then a contiguous index range, which keeps the
+    /// column): each stripe is then a contiguous index range, which keeps the
     /// threads' writes apart in memory and a pair's two particles close in cache.
     /// `order` maps internal to external (user) indices and is permuted along,
     /// as are the bonds and the old lists' indices. Returns the renumbering
@@ -331,7 +323,7 @@ impl NeighborList {
 
         // 2. bins in fractional coordinates
         let grid = BinGrid::new(&particles.position, cell, cutoff)?;
-        let n_blocks = stripe_count(n, grid.n[0]);
+        let n_stripes = stripe_count(n, grid.n[0]);
         let bins = grid.assign(&particles.position, cell);
         let (bin_start, perm) = counting_sort(&bins, grid.count());
 
@@ -351,25 +343,25 @@ impl NeighborList {
         }
         let bin_members: Vec<u32> = (0..n as u32).collect();
 
-        // 3. blocks: contiguous ranges of bin columns with balanced particle counts
+        // 3. stripes: contiguous ranges of bin columns with balanced particle counts
         let mut column_counts = vec![0usize; grid.n[0]];
         for &b in &bins {
             column_counts[b as usize / grid.n[1]] += 1;
         }
-        let mut block_of_column = vec![0u8; grid.n[0]];
+        let mut stripe_of_column = vec![0u8; grid.n[0]];
         let mut seen = 0usize;
         for (c, count) in column_counts.iter().enumerate() {
-            let block = ((seen * n_blocks) / n.max(1)).min(n_blocks - 1);
-            block_of_column[c] = block as u8;
+            let stripe = ((seen * n_stripes) / n.max(1)).min(n_stripes - 1);
+            stripe_of_column[c] = stripe as u8;
             seen += count;
         }
-        let block_of = |p: usize| block_of_column[bins[p] as usize / grid.n[1]];
-        // blocks are contiguous in the spatial order
-        let mut block_ranges = vec![(0usize, 0usize); n_blocks];
+        let stripe_of = |p: usize| stripe_of_column[bins[p] as usize / grid.n[1]];
+        // stripes are contiguous in the spatial order
+        let mut stripe_ranges = vec![(0usize, 0usize); n_stripes];
         let mut start = 0usize;
-        for (b, range) in block_ranges.iter_mut().enumerate() {
+        for (b, range) in stripe_ranges.iter_mut().enumerate() {
             let mut end = start;
-            while end < n && block_of(end) as usize == b {
+            while end < n && stripe_of(end) as usize == b {
                 end += 1;
             }
             *range = (start, end);
@@ -377,8 +369,8 @@ impl NeighborList {
         }
         debug_assert_eq!(start, n);
 
-        // 4. pairs, in bin order for locality, sorted into blocks
-        let mut per_block: Vec<Vec<(u32, u32, [i8; 2])>> = vec![Vec::new(); n_blocks + 1];
+        // 4. pairs, in bin order for locality, sorted into stripes
+        let mut per_stripe: Vec<Vec<(u32, u32, [i8; 2])>> = vec![Vec::new(); n_stripes + 1];
         let positions = &particles.position;
         let radii = &particles.radius;
         let groups = &particles.group;
@@ -412,9 +404,9 @@ impl NeighborList {
                                     && !bonds.contains(pi, pj)
                                     && materials.interacts(groups[i], groups[j])
                                 {
-                                    let (bi, bj) = (block_of(i), block_of(j));
-                                    let slot = if bi == bj { bi as usize } else { n_blocks };
-                                    per_block[slot].push((pi, pj, shift));
+                                    let (bi, bj) = (stripe_of(i), stripe_of(j));
+                                    let slot = if bi == bj { bi as usize } else { n_stripes };
+                                    per_stripe[slot].push((pi, pj, shift));
                                 }
                             }
                         }
@@ -426,29 +418,28 @@ impl NeighborList {
         // 5. carry the history of touching pairs over, correcting shifts for the wraps
         let history = PairHistory::new(&self.pairs, &wraps, n);
         let mut pairs = PairList::default();
-        for list in &per_block {
-            pairs.block_start.push(pairs.len());
+        for list in &per_stripe {
+            pairs.stripe_start.push(pairs.len());
             for &(i, j, shift) in list {
                 let model =
                     MaterialTable::index(particles.group[i as usize], particles.group[j as usize]);
-                pairs.push(i, j, shift, model);
-                if let Some((shear, sliding)) = history.get(i, j, shift) {
-                    let k = pairs.len() - 1;
-                    pairs.shear[k] = shear;
-                    pairs.sliding[k] = sliding;
+                pairs.i.push(i);
+                pairs.j.push(j);
+                pairs.shift.push(shift);
+                pairs.model.push(model);
+                match history.get(i, j, shift) {
+                    Some(old) => pairs.history.push_from(&self.pairs.history, old),
+                    None => pairs.history.push_untouched(),
                 }
             }
         }
 
         // 6. wall pairs
-        let mut wall_history: PairMap<(u32, u32), (f64, bool)> = PairMap::default();
+        let mut wall_history: PairMap<(u32, u32), usize> = PairMap::default();
         let old = &self.wall_pairs;
         for k in 0..old.wall.len() {
-            if old.shear[k] != 0.0 || old.sliding[k] {
-                wall_history.insert(
-                    (old.wall[k], old.particle[k]),
-                    (old.shear[k], old.sliding[k]),
-                );
+            if old.history.touched(k) {
+                wall_history.insert((old.wall[k], old.particle[k]), k);
             }
         }
         let mut wall_pairs = WallPairList::default();
@@ -456,30 +447,28 @@ impl NeighborList {
             for p in 0..n {
                 let g = wall.disk_contact(positions[p], radii[p]);
                 if g.overlap > -skin && materials.interacts(wall.group, particles.group[p]) {
-                    let (shear, sliding) = wall_history
-                        .get(&(w as u32, p as u32))
-                        .copied()
-                        .unwrap_or((0.0, false));
+                    match wall_history.get(&(w as u32, p as u32)) {
+                        Some(&k) => wall_pairs.history.push_from(&old.history, k),
+                        None => wall_pairs.history.push_untouched(),
+                    }
                     wall_pairs.wall.push(w as u32);
                     wall_pairs.particle.push(p as u32);
                     wall_pairs
                         .model
                         .push(MaterialTable::index(wall.group, particles.group[p]));
-                    wall_pairs.shear.push(shear);
-                    wall_pairs.sliding.push(sliding);
                 }
             }
         }
 
         self.pairs = pairs;
         self.wall_pairs = wall_pairs;
-        // which block applies each cross pair's force to each of its particles
-        let cross_first = self.pairs.block_start[n_blocks];
-        let mut touches: Vec<Vec<u32>> = vec![Vec::new(); n_blocks];
+        // which stripe applies each cross pair's force to each of its particles
+        let cross_first = self.pairs.stripe_start[n_stripes];
+        let mut touches: Vec<Vec<u32>> = vec![Vec::new(); n_stripes];
         for c in 0..self.pairs.len() - cross_first {
             let k = cross_first + c;
-            touches[block_of(self.pairs.i[k] as usize) as usize].push((c as u32) << 1);
-            touches[block_of(self.pairs.j[k] as usize) as usize].push(((c as u32) << 1) | 1);
+            touches[stripe_of(self.pairs.i[k] as usize) as usize].push((c as u32) << 1);
+            touches[stripe_of(self.pairs.j[k] as usize) as usize].push(((c as u32) << 1) | 1);
         }
         self.cross_touch_start = std::iter::once(0)
             .chain(touches.iter().scan(0usize, |acc, t| {
@@ -488,7 +477,7 @@ impl NeighborList {
             }))
             .collect();
         self.cross_touch = touches.concat();
-        self.block_ranges = block_ranges;
+        self.stripe_ranges = stripe_ranges;
         self.reference = particles.position.clone();
         self.accumulated_map = IDENTITY;
         self.wall_reference = walls.iter().map(|w| w.displacement).collect();
@@ -622,25 +611,25 @@ fn counting_sort(bins: &[u32], n_bins: usize) -> (Vec<usize>, Vec<u32>) {
     (start, members)
 }
 
-/// The old list's touching pairs (a shear spring or sliding), renumbered, with
+/// The old list's touching pairs (any history), renumbered, with
 /// their image shifts corrected for this rebuild's wraps, grouped by their first
 /// particle `i` (a counting sort: CSR over `i`), for the carry-over. A new pair
 /// finds its history among the few entries of its `i`; the new pairs come in
-/// increasing `i` within each block's list, so the lookups walk the entries
+/// increasing `i` within each stripe's list, so the lookups walk the entries
 /// nearly in order, where a hash map of millions of pairs missed the cache on
 /// every insert and lookup.
 struct PairHistory {
     /// Offsets of each particle's entries (`n + 1`).
     start: Vec<u32>,
-    /// `(j, shift, shear, sliding)` per touching pair, grouped by `i`.
-    entries: Vec<(u32, [i8; 2], f64, bool)>,
+    /// `(j, shift, index in the old list)` per touching pair, grouped by `i`.
+    entries: Vec<(u32, [i8; 2], u32)>,
 }
 
 impl PairHistory {
     /// The touching pairs of `old` (renumbered, `i < j`) among `n` particles;
     /// `wraps` are the new indices' wraps of this rebuild.
     fn new(old: &PairList, wraps: &[[i8; 2]], n: usize) -> Self {
-        let touching = |k: usize| old.shear[k] != 0.0 || old.sliding[k];
+        let touching = |k: usize| old.history.touched(k);
         let mut start = vec![0u32; n + 1];
         for k in (0..old.len()).filter(|&k| touching(k)) {
             start[old.i[k] as usize + 1] += 1;
@@ -649,7 +638,7 @@ impl PairHistory {
             start[q + 1] += start[q];
         }
         let mut fill: Vec<u32> = start[..n].to_vec();
-        let mut entries = vec![(0u32, [0i8; 2], 0.0, false); start[n] as usize];
+        let mut entries = vec![(0u32, [0i8; 2], 0u32); start[n] as usize];
         for k in (0..old.len()).filter(|&k| touching(k)) {
             let (i, j) = (old.i[k] as usize, old.j[k] as usize);
             let s = old.shift[k];
@@ -658,19 +647,19 @@ impl PairHistory {
                 s[1] - wraps[j][1] + wraps[i][1],
             ];
             let slot = &mut fill[i];
-            entries[*slot as usize] = (old.j[k], shift, old.shear[k], old.sliding[k]);
+            entries[*slot as usize] = (old.j[k], shift, k as u32);
             *slot += 1;
         }
         PairHistory { start, entries }
     }
 
-    /// The shear spring and sliding flag of pair `(i, j, shift)`, if it touched.
-    fn get(&self, i: u32, j: u32, shift: [i8; 2]) -> Option<(f64, bool)> {
+    /// The old list's index of pair `(i, j, shift)`, if it touched.
+    fn get(&self, i: u32, j: u32, shift: [i8; 2]) -> Option<usize> {
         let (lo, hi) = (self.start[i as usize], self.start[i as usize + 1]);
         self.entries[lo as usize..hi as usize]
             .iter()
             .find(|e| e.0 == j && e.1 == shift)
-            .map(|e| (e.2, e.3))
+            .map(|e| e.2 as usize)
     }
 }
 

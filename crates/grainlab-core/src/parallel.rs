@@ -1,13 +1,13 @@
 //! The little parallel machinery the step needs.
 //!
-//! A DEM step has two short parallel phases (contact forces per block,
-//! integration per chunk) separated by short sequential work, thousands of
+//! A DEM step has two short parallel phases (contact forces per stripe,
+//! integration per stripe) separated by short sequential work, thousands of
 //! times per second. Handing each phase to a thread pool costs a wake-up per
 //! phase, as long as the phase itself on a 2-core machine. So `Simulation::run`
 //! enters its rayon pool *once* per call with a broadcast: worker 0 runs the
 //! step loop, the other workers wait for phases in a [`Team`], spinning, and
 //! each phase is handed to them with one atomic store. Results of a phase come
-//! back in block order, so every reduction is deterministic.
+//! back in stripe order, so every reduction is deterministic.
 //!
 //! On a shared machine a worker may not be running when a phase starts. A
 //! phase therefore never waits for a worker that has not joined it: worker 0
@@ -78,7 +78,7 @@ impl Team {
     /// Runs `job(k)` on worker 0 (the caller) and on every worker `k` that
     /// joins before worker 0's own `job(0)` returns, and waits for those. The
     /// job must hand out its work so that `job(0)` returns only once all of it
-    /// is taken ([`map_blocks`] does): a worker that is not running is then
+    /// is taken ([`map_stripes`] does): a worker that is not running is then
     /// neither needed nor waited for.
     pub fn run<'a>(&self, job: &'a (dyn Fn(usize) + Sync + 'a)) {
         self.leader.get_or_init(std::thread::current);
@@ -290,7 +290,7 @@ impl Pacer {
 /// hold the step up). Without a team the items run in order on this thread.
 /// Results come back in item order either way, so every reduction over them is
 /// deterministic whichever worker ran what.
-pub fn map_blocks<T, R, F>(team: Option<&Team>, items: Vec<T>, f: F) -> Vec<R>
+pub fn map_stripes<T, R, F>(team: Option<&Team>, items: Vec<T>, f: F) -> Vec<R>
 where
     T: Send,
     R: Send,
@@ -378,7 +378,7 @@ struct ClaimSlot<T, R> {
     result: UnsafeCell<Option<R>>,
 }
 
-// SAFETY: a slot is touched by one worker at a time (see `map_blocks`).
+// SAFETY: a slot is touched by one worker at a time (see `map_stripes`).
 unsafe impl<T: Send, R: Send> Sync for ClaimSlot<T, R> {}
 
 impl<T, R> ClaimSlot<T, R> {
@@ -430,7 +430,7 @@ pub fn stripe_count(particles: usize, columns: usize) -> usize {
         .clamp(1, MAX_STRIPES)
 }
 /// A raw pointer that may be shared between threads that write *disjoint*
-/// elements: each particle belongs to exactly one block, and a block's task
+/// elements: each particle belongs to exactly one stripe, and a stripe's task
 /// only writes forces of its own particles.
 #[derive(Clone, Copy)]
 pub struct DisjointWriter<T>(*mut T);
@@ -467,67 +467,67 @@ impl<T> DisjointWriter<T> {
     }
 }
 
-/// Items grouped by the block of particles each belongs to, in their given
-/// order within a block (CSR: block `b`'s are `entries[start[b]..start[b + 1]]`),
-/// so that each block can work through its own items in the order a pass over
+/// Items grouped by the stripe of particles each belongs to, in their given
+/// order within a stripe (CSR: stripe `b`'s are `entries[start[b]..start[b + 1]]`),
+/// so that each stripe can work through its own items in the order a pass over
 /// all of them would.
 #[derive(Debug, Clone)]
-pub(crate) struct BlockLists<T> {
+pub(crate) struct StripeLists<T> {
     entries: Vec<T>,
     start: Vec<usize>,
 }
 
-impl<T> Default for BlockLists<T> {
+impl<T> Default for StripeLists<T> {
     fn default() -> Self {
-        BlockLists {
+        StripeLists {
             entries: Vec::new(),
             start: Vec::new(),
         }
     }
 }
 
-impl<T: Clone> BlockLists<T> {
-    /// `(particle, item)` pairs, in order, grouped by the block of `block_ranges`
+impl<T: Clone> StripeLists<T> {
+    /// `(particle, item)` pairs, in order, grouped by the stripe of `stripe_ranges`
     /// (contiguous, in order) that holds the particle; `None` when a particle
-    /// lies outside them (blocks of an older list).
+    /// lies outside them (stripes of an older list).
     pub(crate) fn new(
-        block_ranges: &[(usize, usize)],
+        stripe_ranges: &[(usize, usize)],
         items: impl Iterator<Item = (usize, T)>,
     ) -> Option<Self> {
-        let mut per_block: Vec<Vec<T>> = vec![Vec::new(); block_ranges.len()];
+        let mut per_stripe: Vec<Vec<T>> = vec![Vec::new(); stripe_ranges.len()];
         for (q, item) in items {
-            let b = block_ranges.partition_point(|&(_, hi)| hi <= q);
-            if b >= block_ranges.len() || q < block_ranges[b].0 {
+            let b = stripe_ranges.partition_point(|&(_, hi)| hi <= q);
+            if b >= stripe_ranges.len() || q < stripe_ranges[b].0 {
                 return None;
             }
-            per_block[b].push(item);
+            per_stripe[b].push(item);
         }
-        let mut start = Vec::with_capacity(block_ranges.len() + 1);
+        let mut start = Vec::with_capacity(stripe_ranges.len() + 1);
         start.push(0);
         let mut entries = Vec::new();
-        for list in per_block {
+        for list in per_stripe {
             entries.extend(list);
             start.push(entries.len());
         }
-        Some(BlockLists { entries, start })
+        Some(StripeLists { entries, start })
     }
 }
 
-impl<T> BlockLists<T> {
-    /// Block `b`'s items (none when the lists were never built).
-    pub(crate) fn of_block(&self, b: usize) -> &[T] {
+impl<T> StripeLists<T> {
+    /// Stripe `b`'s items (none when the lists were never built).
+    pub(crate) fn of_stripe(&self, b: usize) -> &[T] {
         match (self.start.get(b), self.start.get(b + 1)) {
             (Some(&lo), Some(&hi)) => &self.entries[lo..hi],
             _ => &[],
         }
     }
 
-    /// The number of blocks the lists were built for (0 when never built).
-    pub(crate) fn n_blocks(&self) -> usize {
+    /// The number of stripes the lists were built for (0 when never built).
+    pub(crate) fn n_stripes(&self) -> usize {
         self.start.len().saturating_sub(1)
     }
 
-    /// The number of items over every block.
+    /// The number of items over every stripe.
     pub(crate) fn len(&self) -> usize {
         self.entries.len()
     }
@@ -599,7 +599,7 @@ mod tests {
     }
 
     #[test]
-    fn map_blocks_returns_results_in_item_order_with_a_team() {
+    fn map_stripes_returns_results_in_item_order_with_a_team() {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
             .build()
@@ -607,7 +607,7 @@ mod tests {
         let team = Team::new(2);
         let out = pool.broadcast(|ctx| {
             if ctx.index() == 0 {
-                let r = map_blocks(Some(&team), (0..37u64).collect(), |k| k * k);
+                let r = map_stripes(Some(&team), (0..37u64).collect(), |k| k * k);
                 team.dismiss();
                 Some(r)
             } else {

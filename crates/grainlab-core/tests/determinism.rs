@@ -31,7 +31,14 @@ fn fingerprint(sim: &Simulation) -> Vec<u64> {
             .map(f64::to_bits),
         );
     }
-    bits.extend(sim.neighbors().pairs.shear.iter().map(|s| s.to_bits()));
+    bits.extend(
+        sim.neighbors()
+            .pairs
+            .history
+            .shear_springs()
+            .iter()
+            .map(|s| s.to_bits()),
+    );
     bits
 }
 
@@ -119,7 +126,7 @@ fn results_do_not_depend_on_the_thread_count() {
     for threads in [1, 2, 3, 4] {
         let mut walled = sheared_box(threads);
         walled.run(400).unwrap();
-        assert!(walled.neighbors().build_count > 1 && walled.neighbors().block_ranges.len() > 1);
+        assert!(walled.neighbors().build_count > 1 && walled.neighbors().stripe_ranges.len() > 1);
         assert!(walled.measurements().wall_contact_count > 50);
         let mut periodic = sheared(threads);
         periodic.run(400).unwrap();

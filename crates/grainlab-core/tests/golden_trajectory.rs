@@ -54,7 +54,7 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
     let ext = |k: u32| sim.external_index(k as usize) as u64;
     let pairs = &sim.neighbors().pairs;
     let mut springs: Vec<(u64, u64, i8, i8, u64)> = (0..pairs.len())
-        .filter(|&k| pairs.shear[k] != 0.0)
+        .filter(|&k| pairs.history.shear_spring(k) != 0.0)
         .map(|k| {
             let (a, b) = (ext(pairs.i[k]), ext(pairs.j[k]));
             let s = pairs.shift[k];
@@ -64,7 +64,7 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
             } else {
                 (b, a, [-s[0], -s[1]])
             };
-            (a, b, s[0], s[1], pairs.shear[k].to_bits())
+            (a, b, s[0], s[1], pairs.history.shear_spring(k).to_bits())
         })
         .collect();
     springs.sort_unstable();
@@ -78,8 +78,14 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
     }
     let wp = &sim.neighbors().wall_pairs;
     let mut wall_springs: Vec<(u32, u64, u64)> = (0..wp.wall.len())
-        .filter(|&k| wp.shear[k] != 0.0)
-        .map(|k| (wp.wall[k], ext(wp.particle[k]), wp.shear[k].to_bits()))
+        .filter(|&k| wp.history.shear_spring(k) != 0.0)
+        .map(|k| {
+            (
+                wp.wall[k],
+                ext(wp.particle[k]),
+                wp.history.shear_spring(k).to_bits(),
+            )
+        })
         .collect();
     wall_springs.sort_unstable();
     h.word(wall_springs.len() as u64);

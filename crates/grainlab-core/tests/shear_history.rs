@@ -7,8 +7,8 @@ use grainlab_core::Simulation;
 
 /// Every spring of the simulation: contacts, wall contacts, bonds (internal order).
 fn springs(sim: &Simulation) -> Vec<f64> {
-    let mut all = sim.neighbors().pairs.shear.clone();
-    all.extend(&sim.neighbors().wall_pairs.shear);
+    let mut all = sim.neighbors().pairs.history.shear_springs();
+    all.extend(sim.neighbors().wall_pairs.history.shear_springs());
     all.extend(sim.bonds().list.iter().map(|b| b.shear));
     all
 }
@@ -27,8 +27,8 @@ fn the_first_step_from_full_step_velocities_adds_no_shear() {
     assert!(sim.shear_increment_pending());
     sim.run(1).unwrap();
     let nonzero = |v: &[f64]| v.iter().filter(|&&s| s != 0.0).count();
-    assert!(nonzero(&sim.neighbors().pairs.shear) > 150);
-    assert!(nonzero(&sim.neighbors().wall_pairs.shear) > 20);
+    assert!(nonzero(&sim.neighbors().pairs.history.shear_springs()) > 150);
+    assert!(nonzero(&sim.neighbors().wall_pairs.history.shear_springs()) > 20);
     assert_eq!(
         nonzero(&sim.bonds().list.iter().map(|b| b.shear).collect::<Vec<_>>()),
         15
@@ -102,13 +102,16 @@ fn positions_set_between_steps_are_a_jump_not_a_displacement() {
 fn by_pair(sim: &Simulation) -> std::collections::HashMap<(usize, usize), (f64, bool)> {
     let p = &sim.neighbors().pairs;
     (0..p.len())
-        .filter(|&k| p.shear[k] != 0.0)
+        .filter(|&k| p.history.shear_spring(k) != 0.0)
         .map(|k| {
             let (i, j) = (
                 sim.external_index(p.i[k] as usize),
                 sim.external_index(p.j[k] as usize),
             );
-            ((i.min(j), i.max(j)), (p.shear[k], p.sliding[k]))
+            (
+                (i.min(j), i.max(j)),
+                (p.history.shear_spring(k), p.history.sliding[k]),
+            )
         })
         .collect()
 }

@@ -628,6 +628,7 @@ impl Engine {
         d.set_item("elastic", e.elastic)?;
         d.set_item("friction_dissipated", e.friction_dissipated)?;
         d.set_item("viscous_dissipated", e.viscous_dissipated)?;
+        d.set_item("rolling_dissipated", e.rolling_dissipated)?;
         d.set_item("damping_dissipated", e.damping_dissipated)?;
         d.set_item("wall_work", e.wall_work)?;
         d.set_item("external_work", e.external_work)?;

@@ -186,7 +186,7 @@ mod tests {
             (
                 "pair arrays",
                 Box::new(|s| {
-                    s.neighbors.pairs.shear.pop();
+                    s.neighbors.pairs.history.records.pop();
                 }),
             ),
             (
@@ -194,8 +194,8 @@ mod tests {
                 Box::new(|s| s.neighbors.pairs.model[0] = u16::MAX),
             ),
             (
-                "block ranges",
-                Box::new(|s| s.neighbors.block_ranges[0].1 += 1),
+                "stripe ranges",
+                Box::new(|s| s.neighbors.stripe_ranges[0].1 += 1),
             ),
             (
                 "particle arrays",

@@ -1,34 +1,34 @@
 //! The bonds' and the walls' forces of a step, added to the particles by each
-//! block's integration instead of by one thread between the two parallel phases.
+//! stripe's integration instead of by one thread between the two parallel phases.
 //!
-//! On one thread the forces reach a particle in this order: its block's
+//! On one thread the forces reach a particle in this order: its stripe's
 //! interior pairs, the bonds in bond order, the wall contacts in wall-pair
-//! order, then the pairs across blocks. With a team the bonds and the wall
-//! contacts are evaluated in the contact phase (each block its share of the
+//! order, then the pairs across stripes. With a team the bonds and the wall
+//! contacts are evaluated in the contact phase (each stripe its share of the
 //! bonds and the wall pairs of its own particles) and wait in slots; the walls'
 //! forces and the tally are then summed over the slots in wall-pair order, and
-//! each block's integration adds, to its own particles,
+//! each stripe's integration adds, to its own particles,
 //! first the bond slots that touch them in bond order, then their wall slots in
 //! wall-pair order, then the cross pairs, so every particle receives the same
 //! additions in the same order on any number of threads, and the bits do not
 //! change. The particles' force arrays stay in the cache of the worker that
-//! owns their block, instead of crossing to the thread that ran the serial pass.
+//! owns their stripe, instead of crossing to the thread that ran the serial pass.
 use crate::bond::{Bond, BondSlot};
-use crate::parallel::BlockLists;
+use crate::diagnostics::ContactDissipation;
+use crate::parallel::StripeLists;
 use crate::vec2::{add, sub, Vec2};
 
 /// A wall contact's force on its particle this step, and its terms of the
-/// step's tally (evaluated by the block that owns the particle, in the contact
+/// step's tally (evaluated by the stripe that owns the particle, in the contact
 /// phase; summed onto the walls and the tally in wall-pair order afterwards).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct WallSlot {
     /// Force on the particle (N).
     pub force: Vec2,
-    /// Taken from the particle's torque (N m): its radius times the shear force.
+    /// Torque on the particle (N m), the contact law's.
     pub torque: f64,
-    /// Energy dissipated by sliding and by the dashpots this step (J).
-    pub friction: f64,
-    pub viscous: f64,
+    /// Energy dissipated by the contact's sub-models this step (J).
+    pub dissipation: ContactDissipation,
     /// Elastic energy (J) and force magnitude (N), measured steps only.
     pub elastic: f64,
     pub force_norm: f64,
@@ -38,24 +38,24 @@ pub(crate) struct WallSlot {
     pub active: bool,
 }
 
-/// The bond and wall touches of the current blocks (kept current by `run` and
-/// every rebuild, like the chains' block index).
+/// The bond and wall touches of the current stripes (kept current by `run` and
+/// every rebuild, like the chains' stripe index).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct DeferredIndex {
     /// `(bond << 1) | side` (side 0: the bond's `i`, 1: its `j`).
-    bonds: BlockLists<u32>,
+    bonds: StripeLists<u32>,
     /// Wall-pair indices.
-    walls: BlockLists<u32>,
+    walls: StripeLists<u32>,
 }
 
 impl DeferredIndex {
     /// The index of `bonds` and of the wall pairs' particles `wall_particles`
-    /// over `block_ranges`; empty, so that it fits no blocks (the forces are then
+    /// over `stripe_ranges`; empty, so that it fits no stripes (the forces are then
     /// added on one thread), when a particle lies outside them.
     pub(crate) fn new(
         bonds: &[Bond],
         wall_particles: &[u32],
-        block_ranges: &[(usize, usize)],
+        stripe_ranges: &[(usize, usize)],
     ) -> Self {
         let bond_items = bonds.iter().enumerate().flat_map(|(k, b)| {
             let k = k as u32;
@@ -66,27 +66,28 @@ impl DeferredIndex {
             .enumerate()
             .map(|(k, &q)| (q as usize, k as u32));
         match (
-            BlockLists::new(block_ranges, bond_items),
-            BlockLists::new(block_ranges, wall_items),
+            StripeLists::new(stripe_ranges, bond_items),
+            StripeLists::new(stripe_ranges, wall_items),
         ) {
             (Some(bonds), Some(walls)) => DeferredIndex { bonds, walls },
             _ => DeferredIndex::default(),
         }
     }
 
-    /// The wall pairs whose particle lies in block `b`, in wall-pair order.
-    pub(crate) fn walls_of_block(&self, b: usize) -> &[u32] {
-        self.walls.of_block(b)
+    /// The wall pairs whose particle lies in stripe `b`, in wall-pair order.
+    pub(crate) fn walls_of_stripe(&self, b: usize) -> &[u32] {
+        self.walls.of_stripe(b)
     }
 
-    /// Whether the index serves `n_blocks` blocks, `n_bonds` bonds and `n_wall_pairs` wall pairs.
-    pub(crate) fn fits(&self, n_blocks: usize, n_bonds: usize, n_wall_pairs: usize) -> bool {
-        let covers = |lists: &BlockLists<u32>, n| lists.n_blocks() == n_blocks && lists.len() == n;
+    /// Whether the index serves `n_stripes` stripes, `n_bonds` bonds and `n_wall_pairs` wall pairs.
+    pub(crate) fn fits(&self, n_stripes: usize, n_bonds: usize, n_wall_pairs: usize) -> bool {
+        let covers =
+            |lists: &StripeLists<u32>, n| lists.n_stripes() == n_stripes && lists.len() == n;
         covers(&self.bonds, 2 * n_bonds) && covers(&self.walls, n_wall_pairs)
     }
 }
 
-/// The slots of one step, ready to be added block by block.
+/// The slots of one step, ready to be added stripe by stripe.
 pub(crate) struct DeferredForces<'a> {
     pub(crate) index: &'a DeferredIndex,
     pub(crate) bonds: &'a [Bond],
@@ -96,10 +97,10 @@ pub(crate) struct DeferredForces<'a> {
 }
 
 impl DeferredForces<'_> {
-    /// Adds the bond and wall forces on block `b`'s particles to `force` /
+    /// Adds the bond and wall forces on stripe `b`'s particles to `force` /
     /// `torque` (which start at particle `lo`), as the serial passes add them.
     pub(crate) fn apply(&self, b: usize, lo: usize, force: &mut [Vec2], torque: &mut [f64]) {
-        for &entry in self.index.bonds.of_block(b) {
+        for &entry in self.index.bonds.of_stripe(b) {
             let k = (entry >> 1) as usize;
             let (bond, slot) = (&self.bonds[k], &self.bond_slots[k]);
             if entry & 1 == 1 {
@@ -112,12 +113,12 @@ impl DeferredForces<'_> {
                 torque[q] -= slot.torque_i;
             }
         }
-        for &k in self.index.walls.of_block(b) {
+        for &k in self.index.walls.of_stripe(b) {
             let slot = &self.wall_slots[k as usize];
             if slot.active {
                 let q = self.wall_particles[k as usize] as usize - lo;
                 force[q] = add(force[q], slot.force);
-                torque[q] -= slot.torque;
+                torque[q] += slot.torque;
             }
         }
     }
@@ -139,30 +140,30 @@ mod tests {
     }
 
     #[test]
-    fn every_bond_end_and_wall_pair_lands_in_its_block_in_list_order() {
-        let blocks = [(0, 3), (3, 5), (5, 8)];
+    fn every_bond_end_and_wall_pair_lands_in_its_stripe_in_list_order() {
+        let stripes = [(0, 3), (3, 5), (5, 8)];
         let bonds = [bond(0, 4), bond(6, 1), bond(3, 4)];
-        let index = DeferredIndex::new(&bonds, &[7, 2, 5], &blocks);
+        let index = DeferredIndex::new(&bonds, &[7, 2, 5], &stripes);
         assert!(index.fits(3, 3, 3));
         assert!(!index.fits(3, 4, 3));
-        assert_eq!(index.bonds.of_block(0), &[0 << 1, (1 << 1) | 1]);
-        assert_eq!(index.bonds.of_block(1), &[1, 2 << 1, (2 << 1) | 1]);
-        assert_eq!(index.bonds.of_block(2), &[1 << 1]);
-        assert_eq!(index.walls.of_block(0), &[1]);
-        assert!(index.walls.of_block(1).is_empty());
-        assert_eq!(index.walls.of_block(2), &[0, 2]);
+        assert_eq!(index.bonds.of_stripe(0), &[0 << 1, (1 << 1) | 1]);
+        assert_eq!(index.bonds.of_stripe(1), &[1, 2 << 1, (2 << 1) | 1]);
+        assert_eq!(index.bonds.of_stripe(2), &[1 << 1]);
+        assert_eq!(index.walls.of_stripe(0), &[1]);
+        assert!(index.walls.of_stripe(1).is_empty());
+        assert_eq!(index.walls.of_stripe(2), &[0, 2]);
     }
 
     #[test]
-    fn a_particle_outside_the_blocks_leaves_the_index_invalid() {
+    fn a_particle_outside_the_stripes_leaves_the_index_invalid() {
         let index = DeferredIndex::new(&[bond(0, 9)], &[], &[(0, 3), (3, 5)]);
         assert!(!index.fits(2, 1, 0));
     }
 
     #[test]
-    fn block_by_block_adds_what_the_serial_passes_add_bit_for_bit() {
+    fn stripe_by_stripe_adds_what_the_serial_passes_add_bit_for_bit() {
         // awkward magnitudes, so that any change of the addition order shows
-        let blocks = [(0, 2), (2, 4)];
+        let stripes = [(0, 2), (2, 4)];
         let bonds = [bond(0, 3), bond(2, 0), bond(1, 2)];
         let bond_slots: Vec<BondSlot> = (0..3)
             .map(|k| BondSlot {
@@ -195,10 +196,10 @@ mod tests {
         for (&q, s) in wall_particles.iter().zip(&wall_slots) {
             if s.active {
                 force[q as usize] = add(force[q as usize], s.force);
-                torque[q as usize] -= s.torque;
+                torque[q as usize] += s.torque;
             }
         }
-        let index = DeferredIndex::new(&bonds, &wall_particles, &blocks);
+        let index = DeferredIndex::new(&bonds, &wall_particles, &stripes);
         let deferred = DeferredForces {
             index: &index,
             bonds: &bonds,
@@ -206,22 +207,22 @@ mod tests {
             wall_particles: &wall_particles,
             wall_slots: &wall_slots,
         };
-        let (mut blocked_force, mut blocked_torque) = (start_force, start_torque);
-        for (b, &(lo, hi)) in blocks.iter().enumerate() {
+        let (mut by_stripe_force, mut by_stripe_torque) = (start_force, start_torque);
+        for (b, &(lo, hi)) in stripes.iter().enumerate() {
             deferred.apply(
                 b,
                 lo,
-                &mut blocked_force[lo..hi],
-                &mut blocked_torque[lo..hi],
+                &mut by_stripe_force[lo..hi],
+                &mut by_stripe_torque[lo..hi],
             );
         }
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(
-            bits(&blocked_force.concat()),
+            bits(&by_stripe_force.concat()),
             bits(&force.concat()),
             "forces"
         );
-        assert_eq!(bits(&blocked_torque), bits(&torque), "torques");
+        assert_eq!(bits(&by_stripe_torque), bits(&torque), "torques");
         assert_ne!(force[0], [1.0, 1e17], "the case adds something");
     }
 }

@@ -3,17 +3,17 @@
 //! 1. **Neighbours**: rebuild the Verlet lists if a contact could otherwise be
 //!    missed (wraps particles into the periodic cell, carries contact history over).
 //! 2. **Reset**: follower loads of the pressure chains at the current positions;
-//!    resultant = external force + gravity + follower load, per block of particles.
+//!    resultant = external force + gravity + follower load, per stripe of particles.
 //! 3. **Particle contacts**: linear law with shear history and Coulomb cap,
-//!    blocks in parallel, then the cross-block pairs. The shear increment is the
+//!    stripes in parallel, then the cross-stripe pairs. The shear increment is the
 //!    displacement since the last force evaluation: none on a step that starts
 //!    from full-step velocities (see [`Simulation::catch_up_shear_springs`]).
 //! 4. **Bonds**: linear normal and shear springs that carry tension.
 //! 5. **Wall contacts**: the same law against walls; walls sum their force.
-//!    With a team the forces of 4 and 5 wait in slots, and each block's
+//!    With a team the forces of 4 and 5 wait in slots, and each stripe's
 //!    integration (7) adds its own particles' in the same order (`deferred.rs`).
 //! 6. **Servo**: servo-controlled walls set their velocity from this step's force.
-//! 7. **Integrate**: leapfrog with local damping, in parallel chunks; the
+//! 7. **Integrate**: leapfrog with local damping, stripe by stripe in parallel; the
 //!    periodic cell's affine map is applied to positions; displacements since
 //!    the last build are tracked.
 //! 8. **Move and book**: walls translate, the cell deforms, the largest
@@ -30,7 +30,7 @@
 //! `pair_kernel.rs` the contact law over the pair lists, the reset and the
 //! particle-wall contact; `pair_lanes.rs` its undamped loop four pairs at a
 //! time (AVX2, the same bits); `deferred.rs` the bond and wall forces added
-//! block by block; `checks.rs` the consistency checks and the errors
+//! stripe by stripe; `checks.rs` the consistency checks and the errors
 //! of an unstable run. The bond law is in [`crate::bond`], the nearest image
 //! in [`crate::cell`].
 mod checks;

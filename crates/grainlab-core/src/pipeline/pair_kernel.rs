@@ -5,18 +5,22 @@
 use crate::bond::{Bond, BondSlot};
 use crate::cell::PeriodicCell;
 use crate::contact::ContactGeometry;
-use crate::law::{elastic_energy, linear_coulomb, linear_coulomb_with, ContactForce};
+use crate::diagnostics::ContactDissipation;
+use crate::law::history::{forget, HistoryRun};
+use crate::law::{
+    contact_law, elastic_energy, ContactForce, ContactKinematics, ContactRecord, HISTORY_WIDTH,
+};
 use crate::material::{ContactModel, MaterialTable};
 use crate::parallel::DisjointWriter;
 use crate::state::ParticleMotion;
 use crate::vec2::{add, dot, mat_vec, perp, scale, sub, Mat2, Vec2};
 use crate::wall::Wall;
 
-/// Per-block sums of the contact phase.
+/// Per-stripe sums of the contact phase.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct ContactTally {
-    pub(crate) friction: f64,
-    pub(crate) viscous: f64,
+    /// What the sub-models dissipated.
+    pub(crate) dissipation: ContactDissipation,
     pub(crate) elastic: f64,
     pub(crate) force_sum: f64,
     pub(crate) contacts: usize,
@@ -26,8 +30,7 @@ pub(crate) struct ContactTally {
 impl ContactTally {
     /// Adds another tally's sums (merged in stripe order, for the same bits).
     pub(crate) fn merge(&mut self, o: &ContactTally) {
-        self.friction += o.friction;
-        self.viscous += o.viscous;
+        self.dissipation.add(&o.dissipation);
         self.elastic += o.elastic;
         self.force_sum += o.force_sum;
         self.contacts += o.contacts;
@@ -36,9 +39,10 @@ impl ContactTally {
 }
 
 /// Particle `q` against `wall` at the current state: the geometry and the
-/// contact law's forces on the particle, updating `spring` (the pair's shear
-/// spring, or a copy for a query) over `increment_time`; `None`, with the
-/// spring zeroed, when they do not touch.
+/// contact law's forces and torque on the particle (body `j`; the wall, body
+/// `i`, has no lever arm), updating `record` (the pair's history, or a copy
+/// for a query) over `increment_time`; `None`, with the record zeroed, when
+/// they do not touch.
 #[inline]
 pub(crate) fn wall_contact(
     wall: &Wall,
@@ -47,12 +51,12 @@ pub(crate) fn wall_contact(
     q: usize,
     dt: f64,
     increment_time: f64,
-    spring: &mut f64,
+    record: &mut ContactRecord,
 ) -> Option<(ContactGeometry, ContactForce)> {
     let r = p.radius[q];
     let g = wall.disk_contact(p.position[q], r);
     if g.overlap <= 0.0 {
-        *spring = 0.0;
+        *record = [0.0; HISTORY_WIDTH];
         return None;
     }
     let n = g.normal;
@@ -60,16 +64,15 @@ pub(crate) fn wall_contact(
     let dv = sub(p.velocity[q], wall.velocity);
     let vn = dot(dv, n);
     let vt = dot(dv, t) - p.angular_velocity[q] * r;
-    let c = linear_coulomb(
-        model,
-        g.overlap,
-        vn,
-        vt,
-        dt,
-        increment_time,
-        p.mass[q],
-        spring,
-    );
+    let kinematics = ContactKinematics {
+        overlap: g.overlap,
+        normal_velocity: vn,
+        tangential_velocity: vt,
+        radius_i: 0.0,
+        radius_j: r,
+        reduced_mass: p.mass[q],
+    };
+    let c = contact_law::<true>(model, &kinematics, dt, increment_time, record);
     Some((g, c))
 }
 
@@ -82,10 +85,10 @@ pub(crate) trait ForceSink {
     unsafe fn add(&mut self, k: usize, i: usize, j: usize, f: Vec2, torque_i: f64, torque_j: f64);
     /// Local pair `k` is not in contact.
     fn skip(&mut self, k: usize);
-    /// Local pair `k` is in contact with `overlap`, unit normal `n`, forces `c` and
-    /// (updated) shear spring `spring`; only the contact list keeps it.
+    /// Local pair `k` is in contact with `overlap`, unit normal `n` and the
+    /// law's result `c`; only the contact list keeps it.
     #[inline(always)]
-    fn record(&mut self, _k: usize, _overlap: f64, _n: Vec2, _c: &ContactForce, _spring: f64) {}
+    fn record(&mut self, _k: usize, _overlap: f64, _n: Vec2, _c: &ContactForce) {}
 }
 
 /// Throws the forces away (the springs' catch-up).
@@ -123,12 +126,12 @@ impl ForceSink for RecordSink {
     unsafe fn add(&mut self, _: usize, _: usize, _: usize, _: Vec2, _: f64, _: f64) {}
     #[inline(always)]
     fn skip(&mut self, _k: usize) {}
-    fn record(&mut self, k: usize, overlap: f64, n: Vec2, c: &ContactForce, spring: f64) {
+    fn record(&mut self, k: usize, overlap: f64, n: Vec2, c: &ContactForce) {
         self.records[k] = Some(PairRecord {
             overlap,
             normal: n,
             elastic_normal: c.elastic_normal,
-            shear_spring: spring,
+            shear_spring: c.shear_spring,
             sliding: c.sliding,
         });
     }
@@ -189,7 +192,7 @@ impl ForceSink for BufferSink<'_> {
     }
 }
 
-/// The buffered forces of cross-block pairs and, per block, which of them touch it.
+/// The buffered forces of cross-stripe pairs and, per stripe, which of them touch it.
 pub(crate) struct CrossForces<'a> {
     pub(crate) pair_i: &'a [u32],
     pub(crate) pair_j: &'a [u32],
@@ -200,7 +203,7 @@ pub(crate) struct CrossForces<'a> {
 }
 
 impl CrossForces<'_> {
-    /// Adds block `b`'s cross-pair forces to `force`/`torque`, which start at particle `lo`.
+    /// Adds stripe `b`'s cross-pair forces to `force`/`torque`, which start at particle `lo`.
     pub(crate) fn apply(&self, b: usize, lo: usize, force: &mut [Vec2], torque: &mut [f64]) {
         if self.touch_start.len() <= b + 1 {
             return;
@@ -227,7 +230,7 @@ impl CrossForces<'_> {
     }
 }
 
-/// A cross-block pair's force, computed in parallel and applied afterwards.
+/// A cross-stripe pair's force, computed in parallel and applied afterwards.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct PairForce {
     pub(crate) force: Vec2,
@@ -245,15 +248,15 @@ impl PairForce {
     };
 }
 
-/// One block's share of the contact phase.
-pub(crate) struct BlockWork<'a> {
-    pub(crate) block: usize,
-    pub(crate) shear: &'a mut [f64],
-    pub(crate) sliding: &'a mut [bool],
-    pub(crate) cross_shear: &'a mut [f64],
-    pub(crate) cross_sliding: &'a mut [bool],
+/// One stripe's share of the contact phase.
+pub(crate) struct StripeWork<'a> {
+    pub(crate) stripe: usize,
+    /// The history of the stripe's interior pairs.
+    pub(crate) history: HistoryRun<'a>,
+    /// The history of the stripe's share of the cross-stripe pairs.
+    pub(crate) cross_history: HistoryRun<'a>,
     pub(crate) cross_forces: &'a mut [PairForce],
-    /// The block's share of the bonds, and the slots of their forces.
+    /// The stripe's share of the bonds, and the slots of their forces.
     pub(crate) bonds: &'a mut [Bond],
     pub(crate) bond_slots: &'a mut [BondSlot],
 }
@@ -292,7 +295,7 @@ impl ResetKernel<'_> {
                 .copy_from_slice(&self.external_torque[lo..hi]);
             return;
         }
-        // the block's slices, so that the loop keeps its pointers in registers
+        // the stripe's slices, so that the loop keeps its pointers in registers
         let forces = force.range(lo, hi);
         let loads = self.boundary_load.map(|load| &*load.range(lo, hi));
         let (external, mass) = (&self.external_force[lo..hi], &self.mass[lo..hi]);
@@ -369,7 +372,8 @@ pub(crate) struct PairKernel<'a> {
 }
 
 impl PairKernel<'_> {
-    /// Evaluates pairs `first..first + shear.len()`, adding forces to both particles.
+    /// Evaluates pairs `first..first + history.len()`, updating their
+    /// `history` and adding their forces to both particles through `sink`.
     ///
     /// # Safety
     /// Concurrent callers must touch disjoint particles.
@@ -377,10 +381,10 @@ impl PairKernel<'_> {
     pub(crate) unsafe fn run<const MEASURE: bool, S: ForceSink>(
         &self,
         first: usize,
-        shear: &mut [f64],
-        sliding: &mut [bool],
+        history: HistoryRun<'_>,
         sink: &mut S,
     ) -> ContactTally {
+        let (records, sliding) = (history.records, history.sliding);
         // the loop specialised on what is fixed for the whole call: the same
         // arithmetic in every variant, minus the tests whose outcome is known
         match (
@@ -389,22 +393,22 @@ impl PairKernel<'_> {
             self.undamped,
         ) {
             (false, false, false) => {
-                self.pairs::<MEASURE, false, false, true, S>(first, shear, sliding, sink)
+                self.pairs::<MEASURE, false, false, true, S>(first, records, sliding, sink)
             }
             (false, false, true) => {
-                self.pairs::<MEASURE, false, false, false, S>(first, shear, sliding, sink)
+                self.pairs::<MEASURE, false, false, false, S>(first, records, sliding, sink)
             }
             (false, true, _) => {
-                self.pairs::<MEASURE, false, true, false, S>(first, shear, sliding, sink)
+                self.pairs::<MEASURE, false, true, false, S>(first, records, sliding, sink)
             }
             (true, false, false) => {
-                self.pairs::<MEASURE, true, false, true, S>(first, shear, sliding, sink)
+                self.pairs::<MEASURE, true, false, true, S>(first, records, sliding, sink)
             }
             (true, false, true) => {
-                self.pairs::<MEASURE, true, false, false, S>(first, shear, sliding, sink)
+                self.pairs::<MEASURE, true, false, false, S>(first, records, sliding, sink)
             }
             (true, true, _) => {
-                self.pairs::<MEASURE, true, true, false, S>(first, shear, sliding, sink)
+                self.pairs::<MEASURE, true, true, false, S>(first, records, sliding, sink)
             }
         }
     }
@@ -428,22 +432,22 @@ impl PairKernel<'_> {
     >(
         &self,
         first: usize,
-        shear: &mut [f64],
+        records: &mut [ContactRecord],
         sliding: &mut [bool],
         sink: &mut S,
     ) -> ContactTally {
         // (`vector` is never set where the four-pair loop does not exist)
-        if !DASHPOTS && self.vector {
+        if !DASHPOTS && self.vector && crate::law::LANES {
             #[cfg(target_arch = "x86_64")]
             return self
-                .pairs_by_four::<MEASURE, DEFORMING, SINGLE, S>(first, shear, sliding, sink);
+                .pairs_by_four::<MEASURE, DEFORMING, SINGLE, S>(first, records, sliding, sink);
         }
         let mut tally = ContactTally::default();
         let fixed = self.loop_constants();
-        let columns = self.columns(first, shear.len().min(sliding.len()));
+        let columns = self.columns(first, records.len().min(sliding.len()));
         let all = 0..columns.len();
         self.pairs_one_at_a_time::<MEASURE, DEFORMING, SINGLE, DASHPOTS, S>(
-            &fixed, &columns, all, shear, sliding, sink, &mut tally,
+            &fixed, &columns, all, records, sliding, sink, &mut tally,
         );
         tally
     }
@@ -465,7 +469,7 @@ impl PairKernel<'_> {
         fixed: &LoopConstants,
         columns: &PairColumns<'_>,
         range: std::ops::Range<usize>,
-        shear: &mut [f64],
+        records: &mut [ContactRecord],
         sliding: &mut [bool],
         sink: &mut S,
         tally: &mut ContactTally,
@@ -475,7 +479,7 @@ impl PairKernel<'_> {
                 fixed,
                 columns,
                 k,
-                &mut shear[k],
+                &mut records[k],
                 &mut sliding[k],
                 sink,
                 tally,
@@ -537,7 +541,7 @@ impl PairKernel<'_> {
         fixed: &LoopConstants,
         columns: &PairColumns<'_>,
         k: usize,
-        spring: &mut f64,
+        record: &mut ContactRecord,
         slide: &mut bool,
         sink: &mut S,
         tally: &mut ContactTally,
@@ -561,7 +565,7 @@ impl PairKernel<'_> {
         let reach = ri + rj;
         let dist_sq = dot(d, d);
         if dist_sq >= reach * reach {
-            no_contact(sink, k, spring, slide);
+            no_contact(sink, k, record, slide);
             return;
         }
         let dist = dist_sq.sqrt();
@@ -587,29 +591,19 @@ impl PairKernel<'_> {
             } else {
                 0.0
             };
+        let kinematics = ContactKinematics {
+            overlap,
+            normal_velocity: vn,
+            tangential_velocity: vt,
+            radius_i: ri,
+            radius_j: rj,
+            reduced_mass,
+        };
         let (dt, increment_time) = (self.dt, self.increment_time);
         let c = if !DASHPOTS {
-            linear_coulomb_with::<false>(
-                model,
-                overlap,
-                vn,
-                vt,
-                dt,
-                increment_time,
-                reduced_mass,
-                spring,
-            )
+            contact_law::<false>(model, &kinematics, dt, increment_time, record)
         } else {
-            linear_coulomb(
-                model,
-                overlap,
-                vn,
-                vt,
-                dt,
-                increment_time,
-                reduced_mass,
-                spring,
-            )
+            contact_law::<true>(model, &kinematics, dt, increment_time, record)
         };
         let f = [
             c.normal * n[0] + c.shear * t[0],
@@ -625,7 +619,7 @@ impl PairKernel<'_> {
             normal: n,
             force: f,
         };
-        self.finish_contact::<MEASURE, S>(&contact, &c, model, *spring, slide, sink, tally);
+        self.finish_contact::<MEASURE, S>(&contact, &c, model, slide, sink, tally);
     }
 
     /// A touching pair's bookkeeping after the law: its sliding flag, the record,
@@ -640,18 +634,17 @@ impl PairKernel<'_> {
         p: &PairContact,
         c: &ContactForce,
         model: &ContactModel,
-        spring: f64,
         slide: &mut bool,
         sink: &mut S,
         tally: &mut ContactTally,
     ) {
         *slide = c.sliding;
-        sink.record(p.k, p.overlap, p.normal, c, spring);
-        sink.add(p.k, p.i, p.j, p.force, -p.ri * c.shear, -p.rj * c.shear);
-        tally.friction += c.friction_dissipation;
-        tally.viscous += c.viscous_dissipation;
+        sink.record(p.k, p.overlap, p.normal, c);
+        sink.add(p.k, p.i, p.j, p.force, c.torque_i, c.torque_j);
+        tally.dissipation.add(&c.dissipation);
         tally.overlap_violation |= p.overlap > self.max_overlap_ratio * p.ri.min(p.rj);
         if MEASURE {
+            let spring = c.shear_spring;
             tally.elastic += elastic_energy(model, model.normal_stiffness * p.overlap, spring);
             tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
             tally.contacts += 1;
@@ -659,14 +652,16 @@ impl PairKernel<'_> {
     }
 }
 
-/// A pair that is not in contact: its history is cleared (written only when
-/// set, so that a spring of -0 stays as it is) and its sink slot skipped.
+/// A pair that is not in contact: its history is cleared
+/// ([`forget`]) and its sink slot skipped.
 #[inline(always)]
-pub(super) fn no_contact<S: ForceSink>(sink: &mut S, k: usize, spring: &mut f64, slide: &mut bool) {
-    if *spring != 0.0 || *slide {
-        *spring = 0.0;
-        *slide = false;
-    }
+pub(super) fn no_contact<S: ForceSink>(
+    sink: &mut S,
+    k: usize,
+    record: &mut ContactRecord,
+    slide: &mut bool,
+) {
+    forget(record, slide);
     sink.skip(k);
 }
 

@@ -1,6 +1,12 @@
 //! The undamped pair loop four pairs at a time, in the 256-bit registers of
 //! AVX2, with the same bits as the scalar loop of `pair_kernel.rs`.
 //!
+//! The law of four pairs is [`law_by_four`]: the sub-models of
+//! [`crate::law::contact_law`] without dashpots (normal spring, shear spring
+//! with its cap, no rolling), lane by lane; its test gives both the same
+//! random contacts and requires the same bits. The loop runs only while every
+//! sub-model of the law has lanes ([`crate::law::LANES`]).
+//!
 //! Why the bits are the same: every pair's law is computed lane by lane with
 //! the operations of the scalar code in its order (IEEE additions,
 //! multiplications, one division and one square root per pair, all correctly
@@ -21,7 +27,9 @@
 use std::arch::x86_64::*;
 
 use super::pair_kernel::{no_contact, ContactTally, ForceSink, PairKernel};
-use crate::law::{elastic_energy, ContactForce};
+use crate::diagnostics::ContactDissipation;
+use crate::law::tangential::ShearSpring;
+use crate::law::{elastic_energy, ContactForce, ContactRecord};
 use crate::simd::spill;
 
 /// `_mm256_permute4x64_pd`'s selector that swaps lanes 1 and 2: pairs in
@@ -83,13 +91,13 @@ impl PairKernel<'_> {
     >(
         &self,
         first: usize,
-        shear: &mut [f64],
+        records: &mut [ContactRecord],
         sliding: &mut [bool],
         sink: &mut S,
     ) -> ContactTally {
         let mut tally = ContactTally::default();
         let fixed = self.loop_constants();
-        let columns = self.columns(first, shear.len().min(sliding.len()));
+        let columns = self.columns(first, records.len().min(sliding.len()));
         let n = columns.len();
         let g = fixed.gradient;
         let (g00, g01, g10, g11) = (
@@ -101,7 +109,6 @@ impl PairKernel<'_> {
         let increment_time = _mm256_set1_pd(self.increment_time);
         let sign_bit = _mm256_set1_pd(-0.0);
         let one = _mm256_set1_pd(1.0);
-        let zero = _mm256_setzero_pd();
         let max_overlap_ratio = _mm256_set1_pd(self.max_overlap_ratio);
         let position = self.position.as_ptr() as *const f64;
         let velocity = self.velocity.as_ptr() as *const f64;
@@ -150,7 +157,7 @@ impl PairKernel<'_> {
                     no_contact(
                         sink,
                         k,
-                        shear.get_unchecked_mut(k),
+                        records.get_unchecked_mut(k),
                         sliding.get_unchecked_mut(k),
                     );
                 }
@@ -206,37 +213,37 @@ impl PairKernel<'_> {
                 }
                 (lanes(kn), lanes(ks), lanes(mu))
             };
-            // the law (`law::shear_spring_update`, `linear_coulomb_with::<false>`)
-            let elastic_normal = _mm256_mul_pd(kn, overlap);
-            let spring_ptr = shear.as_mut_ptr().add(k0);
+            // the law, lane by lane ([`law_by_four`]); the records are the
+            // shear springs alone (`law::LANES`), contiguous
+            let spring_ptr = records.as_mut_ptr().add(k0) as *mut f64;
             let spring = _mm256_permute4x64_pd::<SWAP_MIDDLE>(_mm256_loadu_pd(spring_ptr));
-            let trial = _mm256_sub_pd(spring, _mm256_mul_pd(_mm256_mul_pd(ks, vt), increment_time));
-            let cap = _mm256_mul_pd(mu, elastic_normal);
-            let slides = _mm256_and_pd(
-                touching,
-                _mm256_cmp_pd::<_CMP_GE_OQ>(_mm256_andnot_pd(sign_bit, trial), cap),
-            );
-            // cap.copysign(trial)
-            let capped = _mm256_or_pd(
-                _mm256_andnot_pd(sign_bit, cap),
-                _mm256_and_pd(sign_bit, trial),
-            );
-            let law_spring = _mm256_blendv_pd(trial, capped, slides);
-            // a pair out of contact keeps a spring of +-0 unless it slid, else gets +0
             let slid_before = slid_lanes(sliding.as_ptr().add(k0));
-            let keeps = _mm256_andnot_pd(slid_before, _mm256_cmp_pd::<_CMP_EQ_OQ>(spring, zero));
-            let idle_spring = _mm256_and_pd(keeps, spring);
-            let new_spring = _mm256_blendv_pd(idle_spring, law_spring, touching);
+            let law = law_by_four(
+                FourContacts {
+                    kn,
+                    ks,
+                    mu,
+                    overlap,
+                    tangential_velocity: vt,
+                    radius_i: r_i,
+                    radius_j: r_j,
+                    spring,
+                    touching,
+                    slid_before,
+                },
+                increment_time,
+            );
+            let new_spring = law.spring;
+            let slides = law.slides;
             let fx = _mm256_add_pd(
-                _mm256_mul_pd(elastic_normal, nx),
+                _mm256_mul_pd(law.elastic_normal, nx),
                 _mm256_mul_pd(new_spring, tx),
             );
             let fy = _mm256_add_pd(
-                _mm256_mul_pd(elastic_normal, ny),
+                _mm256_mul_pd(law.elastic_normal, ny),
                 _mm256_mul_pd(new_spring, ty),
             );
-            let torque_i = _mm256_mul_pd(_mm256_xor_pd(r_i, sign_bit), new_spring);
-            let torque_j = _mm256_mul_pd(_mm256_xor_pd(r_j, sign_bit), new_spring);
+            let (torque_i, torque_j) = (law.torque_i, law.torque_j);
             let too_deep = _mm256_and_pd(
                 touching,
                 _mm256_cmp_pd::<_CMP_GT_OQ>(
@@ -262,7 +269,7 @@ impl PairKernel<'_> {
             let (fx, fy) = (in_order(fx), in_order(fy));
             let (torque_i, torque_j) = (in_order(torque_i), in_order(torque_j));
             let (overlap, new_spring) = (in_order(overlap), in_order(new_spring));
-            let (trial, capped) = (in_order(trial), in_order(capped));
+            let (trial, capped) = (in_order(law.trial), in_order(law.capped));
             let (nx, ny) = (in_order(nx), in_order(ny));
             // the bookkeeping, one touching pair at a time in pair order
             let mut touched = touching_bits;
@@ -278,17 +285,19 @@ impl PairKernel<'_> {
                     normal: elastic_normal,
                     elastic_normal,
                     shear: new_spring[l],
+                    shear_spring: new_spring[l],
                     sliding: slid,
-                    friction_dissipation: 0.0, // (not read by the record)
-                    viscous_dissipation: 0.0,
+                    torque_i: torque_i[l],
+                    torque_j: torque_j[l],
+                    dissipation: ContactDissipation::default(), // (not read by the record)
                 };
-                sink.record(k, overlap[l], [nx[l], ny[l]], &c, new_spring[l]);
+                sink.record(k, overlap[l], [nx[l], ny[l]], &c);
                 sink.add(k, i, j, [fx[l], fy[l]], torque_i[l], torque_j[l]);
                 if slid {
-                    // the slip's work (`law::shear_spring_update`); a sticking
+                    // the slip's work (the tangential sub-model's); a sticking
                     // contact adds +0, which leaves the sum (never -0) as it is
-                    tally.friction += 0.5 * (spring_before[l] + capped[l]) * (trial[l] - capped[l])
-                        / model.shear_stiffness;
+                    tally.dissipation.friction +=
+                        ShearSpring::slip_work(model, spring_before[l], trial[l], capped[l]);
                 }
                 if MEASURE {
                     let (en, fs) = (elastic_normal, new_spring[l]);
@@ -303,11 +312,249 @@ impl PairKernel<'_> {
             &fixed,
             &columns,
             k0..n,
-            shear,
+            records,
             sliding,
             sink,
             &mut tally,
         );
         tally
+    }
+}
+
+/// Four pairs of a run, in register order, as [`law_by_four`] reads them.
+#[derive(Clone, Copy)]
+pub(super) struct FourContacts {
+    /// Normal and shear stiffness, friction coefficient.
+    pub(super) kn: __m256d,
+    pub(super) ks: __m256d,
+    pub(super) mu: __m256d,
+    /// Overlap (m).
+    pub(super) overlap: __m256d,
+    /// `(v_j - v_i) . t - (omega_i r_i + omega_j r_j)` (m/s).
+    pub(super) tangential_velocity: __m256d,
+    /// The lever arms.
+    pub(super) radius_i: __m256d,
+    pub(super) radius_j: __m256d,
+    /// The shear springs before the update.
+    pub(super) spring: __m256d,
+    /// All-ones lanes: the pair touches; the pair slid in its last evaluation.
+    pub(super) touching: __m256d,
+    pub(super) slid_before: __m256d,
+}
+
+/// What [`law_by_four`] gives, in register order.
+#[derive(Clone, Copy)]
+pub(super) struct FourLaws {
+    /// `kn * overlap` (N).
+    pub(super) elastic_normal: __m256d,
+    /// The springs plus the increment, before the cap.
+    pub(super) trial: __m256d,
+    /// The cap with the trial's sign.
+    pub(super) capped: __m256d,
+    /// All-ones lanes: the touching pairs whose spring ends at the cap.
+    pub(super) slides: __m256d,
+    /// The springs after the update (a pair that does not touch: its record
+    /// as [`crate::law::history::forget`] leaves it).
+    pub(super) spring: __m256d,
+    /// Torques on `i` and `j`, `-r Fs`.
+    pub(super) torque_i: __m256d,
+    pub(super) torque_j: __m256d,
+}
+
+/// The undamped contact law of four pairs, lane by lane with the scalar
+/// operations of [`crate::law::contact_law`] in their order: the normal
+/// spring, the shear spring's increment and Coulomb cap (branches as selects
+/// of the value the branch keeps), the torques; and, for a pair that does not
+/// touch, the record [`crate::law::history::forget`] leaves. Every operation is
+/// a correctly rounded IEEE one (no fused multiply-add), so each lane has the
+/// scalar law's bits (the test below checks it on random contacts).
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn law_by_four(c: FourContacts, increment_time: __m256d) -> FourLaws {
+    let sign_bit = _mm256_set1_pd(-0.0);
+    let zero = _mm256_setzero_pd();
+    // normal: the linear spring
+    let elastic_normal = _mm256_mul_pd(c.kn, c.overlap);
+    // tangential: the shear spring's increment, then its cap
+    let trial = _mm256_sub_pd(
+        c.spring,
+        _mm256_mul_pd(_mm256_mul_pd(c.ks, c.tangential_velocity), increment_time),
+    );
+    let cap = _mm256_mul_pd(c.mu, elastic_normal);
+    let slides = _mm256_and_pd(
+        c.touching,
+        _mm256_cmp_pd::<_CMP_GE_OQ>(_mm256_andnot_pd(sign_bit, trial), cap),
+    );
+    // cap.copysign(trial)
+    let capped = _mm256_or_pd(
+        _mm256_andnot_pd(sign_bit, cap),
+        _mm256_and_pd(sign_bit, trial),
+    );
+    let law_spring = _mm256_blendv_pd(trial, capped, slides);
+    // a pair out of contact keeps a spring of +-0 unless it slid, else gets +0
+    let keeps = _mm256_andnot_pd(c.slid_before, _mm256_cmp_pd::<_CMP_EQ_OQ>(c.spring, zero));
+    let idle_spring = _mm256_and_pd(keeps, c.spring);
+    let spring = _mm256_blendv_pd(idle_spring, law_spring, c.touching);
+    // (no dashpot, no rolling resistance:) the torques of the shear force
+    let torque_i = _mm256_mul_pd(_mm256_xor_pd(c.radius_i, sign_bit), spring);
+    let torque_j = _mm256_mul_pd(_mm256_xor_pd(c.radius_j, sign_bit), spring);
+    FourLaws {
+        elastic_normal,
+        trial,
+        capped,
+        slides,
+        spring,
+        torque_i,
+        torque_j,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::law::history::forget;
+    use crate::law::{contact_law, ContactKinematics, HISTORY_WIDTH, TANGENTIAL_HISTORY};
+    use crate::material::ContactModel;
+
+    /// A small deterministic generator (xorshift64*), for reproducible random contacts.
+    struct Random(u64);
+
+    impl Random {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+        }
+        /// Uniform in [0, 1).
+        fn unit(&mut self) -> f64 {
+            (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        }
+        /// `10^e` times a unit, `e` uniform in `lo..hi`, with a random sign if `signed`.
+        fn magnitude(&mut self, lo: f64, hi: f64, signed: bool) -> f64 {
+            let v = 10f64.powf(lo + (hi - lo) * self.unit()) * (0.5 + self.unit());
+            if signed && self.next() & 1 == 1 {
+                -v
+            } else {
+                v
+            }
+        }
+    }
+
+    /// One random contact: a model, its kinematics, the spring before and
+    /// whether it slid; some springs sit exactly at the cap, at +0, at -0.
+    fn random_contact(rng: &mut Random) -> (ContactModel, ContactKinematics, f64, bool) {
+        let mu = match rng.next() % 5 {
+            0 => 0.0,
+            _ => rng.unit(),
+        };
+        let model = ContactModel::linear(
+            rng.magnitude(4.0, 9.0, false),
+            rng.magnitude(4.0, 9.0, false),
+            mu,
+        );
+        let kinematics = ContactKinematics {
+            overlap: rng.magnitude(-9.0, -4.0, false),
+            normal_velocity: rng.magnitude(-4.0, 1.0, true),
+            tangential_velocity: match rng.next() % 6 {
+                0 => 0.0,
+                _ => rng.magnitude(-6.0, 1.0, true),
+            },
+            radius_i: rng.magnitude(-4.0, -2.0, false),
+            radius_j: rng.magnitude(-4.0, -2.0, false),
+            reduced_mass: 0.0,
+        };
+        let cap = model.friction * model.normal_stiffness * kinematics.overlap;
+        let spring = match rng.next() % 6 {
+            0 => 0.0,
+            1 => -0.0,
+            2 => cap,
+            3 => -cap,
+            _ => (2.0 * rng.unit() - 1.0) * 1.5 * cap,
+        };
+        (model, kinematics, spring, rng.next() % 3 == 0)
+    }
+
+    #[test]
+    fn four_lanes_give_the_contact_laws_bits_on_random_contacts() {
+        if !crate::simd::available() {
+            eprintln!("no AVX2 on this processor: the four-pair loop never runs");
+            return;
+        }
+        let mut rng = Random(0x9e37_79b9_7f4a_7c15);
+        let dt = 1.0e-6;
+        let (mut sliding_seen, mut sticking_seen, mut apart_seen) = (0, 0, 0);
+        for round in 0..20_000 {
+            let increment_time = if round % 4 == 0 { 0.0 } else { dt };
+            let contacts: Vec<_> = (0..4).map(|_| random_contact(&mut rng)).collect();
+            let touching: [bool; 4] = std::array::from_fn(|_| rng.next() % 8 != 0);
+            let pick = |f: &dyn Fn(&(ContactModel, ContactKinematics, f64, bool)) -> f64| {
+                let v: [f64; 4] = std::array::from_fn(|l| f(&contacts[l]));
+                // SAFETY: AVX2 checked above
+                unsafe { lanes(v) }
+            };
+            let mask = |m: [bool; 4]| {
+                let v: [f64; 4] = m.map(|b| if b { f64::from_bits(u64::MAX) } else { 0.0 });
+                unsafe { lanes(v) }
+            };
+            let four = FourContacts {
+                kn: pick(&|c| c.0.normal_stiffness),
+                ks: pick(&|c| c.0.shear_stiffness),
+                mu: pick(&|c| c.0.friction),
+                overlap: pick(&|c| c.1.overlap),
+                tangential_velocity: pick(&|c| c.1.tangential_velocity),
+                radius_i: pick(&|c| c.1.radius_i),
+                radius_j: pick(&|c| c.1.radius_j),
+                spring: pick(&|c| c.2),
+                touching: mask(touching),
+                slid_before: mask(std::array::from_fn(|l| contacts[l].3)),
+            };
+            // SAFETY: AVX2 checked above
+            let law = unsafe { law_by_four(four, _mm256_set1_pd(increment_time)) };
+            let slides = pair_order(unsafe { _mm256_movemask_pd(law.slides) });
+            let out = |v: __m256d| unsafe { in_order(v) };
+            let (spring, torque_i, torque_j) =
+                (out(law.spring), out(law.torque_i), out(law.torque_j));
+            let (normal, trial, capped) =
+                (out(law.elastic_normal), out(law.trial), out(law.capped));
+            for (l, (model, kinematics, before, slid)) in contacts.iter().enumerate() {
+                let mut record = [0.0; HISTORY_WIDTH];
+                record[TANGENTIAL_HISTORY.start] = *before;
+                let mut flag = *slid;
+                if !touching[l] {
+                    forget(&mut record, &mut flag);
+                    assert_eq!(spring[l].to_bits(), record[0].to_bits(), "apart, lane {l}");
+                    assert_eq!(slides & (1 << l), 0);
+                    apart_seen += 1;
+                    continue;
+                }
+                let c = contact_law::<false>(model, kinematics, dt, increment_time, &mut record);
+                let lane_sliding = slides & (1 << l) != 0;
+                let what = format!("round {round}, lane {l}: {model:?} {kinematics:?} {before}");
+                assert_eq!(lane_sliding, c.sliding, "{what}");
+                assert_eq!(spring[l].to_bits(), record[0].to_bits(), "{what}");
+                assert_eq!(spring[l].to_bits(), c.shear.to_bits(), "{what}");
+                assert_eq!(normal[l].to_bits(), c.normal.to_bits(), "{what}");
+                assert_eq!(torque_i[l].to_bits(), c.torque_i.to_bits(), "{what}");
+                assert_eq!(torque_j[l].to_bits(), c.torque_j.to_bits(), "{what}");
+                // the slip's work as the loop books it, into a sum that starts at +0
+                let work = if lane_sliding {
+                    ShearSpring::slip_work(model, *before, trial[l], capped[l])
+                } else {
+                    0.0
+                };
+                assert_eq!(
+                    (0.0 + work).to_bits(),
+                    (0.0 + c.dissipation.friction).to_bits()
+                );
+                if c.sliding {
+                    sliding_seen += 1;
+                } else {
+                    sticking_seen += 1;
+                }
+            }
+        }
+        // the random contacts cover every branch of the law
+        assert!(sliding_seen > 10_000 && sticking_seen > 10_000 && apart_seen > 5_000);
     }
 }

@@ -7,7 +7,7 @@ use super::pair_kernel::{
     pair_kernel, wall_contact, NullSink, PairForce, PairKernel, PairRecord, RecordSink,
 };
 use crate::bond::{bond_force, Bond, BondForce, BondSlot, Bonds};
-use crate::boundary::{ChainBlocks, PressureChain};
+use crate::boundary::{ChainStripes, PressureChain};
 use crate::cell::{minimum_image, PeriodicCell};
 use crate::contact::{disk_disk, ContactGeometry};
 use crate::diagnostics::{EnergyLedger, Measurements};
@@ -25,7 +25,7 @@ use crate::wall::{Wall, WallControl};
 
 /// The first bytes of [`Simulation::to_bytes`]: the layout of the state that
 /// follows (bincode of [`Simulation`]); a new field makes a new tag.
-const STATE_TAG: &[u8; 8] = b"GLSTATE2";
+const STATE_TAG: &[u8; 8] = b"GLSTATE3";
 
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -105,12 +105,12 @@ pub struct Simulation {
     /// Follower loads of this step, per internal particle (recomputed every step).
     #[serde(skip)]
     pub(crate) boundary_load: Vec<Vec2>,
-    /// The chains' entries per block of particles, for the loads' reset (kept
+    /// The chains' entries per stripe of particles, for the loads' reset (kept
     /// current by `run` and every rebuild).
     #[serde(skip)]
-    pub(crate) chain_blocks: ChainBlocks,
-    /// The bonds' and wall pairs' entries per block of particles, for adding
-    /// their forces in the integration (kept current like `chain_blocks`).
+    pub(crate) chain_stripes: ChainStripes,
+    /// The bonds' and wall pairs' entries per stripe of particles, for adding
+    /// their forces in the integration (kept current like `chain_stripes`).
     #[serde(skip)]
     pub(crate) deferred_index: DeferredIndex,
     /// The wall contacts' forces of this step, per wall pair, when a team adds
@@ -184,7 +184,7 @@ impl Simulation {
             cross_forces: Vec::new(),
             bond_slots: Vec::new(),
             boundary_load: Vec::new(),
-            chain_blocks: ChainBlocks::default(),
+            chain_stripes: ChainStripes::default(),
             deferred_index: DeferredIndex::default(),
             wall_slots: Vec::new(),
             external_loads: false,
@@ -312,10 +312,11 @@ impl Simulation {
             require_positive(&format!("radii[{k}]"), r)?;
         }
         let radius = self.internal_array("radii", radii)?;
-        self.catch_up_shear_springs();
-        self.particles.radius = radius;
-        self.particles.update_mass_properties();
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            s.particles.radius = radius;
+            s.particles.update_mass_properties();
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -344,9 +345,10 @@ impl Simulation {
             ));
         }
         let group = self.internal_array("groups", groups)?;
-        self.catch_up_shear_springs();
-        self.particles.group = group;
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            s.particles.group = group;
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -383,8 +385,7 @@ impl Simulation {
     pub fn set_params(&mut self, params: StepParameters) -> Result<()> {
         params.validate()?;
         // the last step's displacement was made with the old time step
-        self.catch_up_shear_springs();
-        self.params = params;
+        self.modify_motion(|s| s.params = params);
         Ok(())
     }
 
@@ -414,10 +415,12 @@ impl Simulation {
     /// Sets the contact model between groups `a` and `b`.
     pub fn set_contact_model(&mut self, a: usize, b: usize, model: ContactModel) -> Result<()> {
         model.validate("contact_model")?;
-        self.catch_up_shear_springs();
-        self.materials.set(a, b, model)?;
-        self.neighbors.invalidate();
-        Ok(())
+        MaterialTable::check_groups(a, b)?;
+        self.modify_motion(|s| {
+            s.materials.set(a, b, model)?;
+            s.neighbors.invalidate();
+            Ok(())
+        })
     }
 
     /// Sets (or removes) the periodic cell.
@@ -426,9 +429,10 @@ impl Simulation {
             c.validate()?;
         }
         // the last step's displacement was made in the old cell's flow
-        self.catch_up_shear_springs();
-        self.cell = cell;
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            s.cell = cell;
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -450,8 +454,8 @@ impl Simulation {
         })
     }
 
-    /// The wall with id `id`, to change (only after
-    /// [`Simulation::catch_up_shear_springs`] when its motion changes).
+    /// The wall with id `id`, to change (inside [`Simulation::modify_motion`]
+    /// when its motion changes).
     pub(crate) fn wall_mut(&mut self, id: usize) -> Result<&mut Wall> {
         let n = self.walls.len();
         self.walls.get_mut(id).ok_or_else(|| {
@@ -476,12 +480,13 @@ impl Simulation {
     pub fn set_wall_velocity(&mut self, id: usize, velocity: Vec2) -> Result<()> {
         crate::error::require_finite("velocity", velocity[0])?;
         crate::error::require_finite("velocity", velocity[1])?;
-        self.wall_mut(id)?;
-        self.catch_up_shear_springs();
-        let wall = self.wall_mut(id)?;
-        wall.control = WallControl::Velocity;
-        wall.velocity = velocity;
-        Ok(())
+        self.wall(id)?;
+        self.modify_motion(|s| {
+            let wall = s.wall_mut(id)?;
+            wall.control = WallControl::Velocity;
+            wall.velocity = velocity;
+            Ok(())
+        })
     }
 
     /// Moves wall `id` at once by `d` (m), between steps: a jump, not a shear
@@ -489,10 +494,11 @@ impl Simulation {
     pub fn translate_wall(&mut self, id: usize, d: Vec2) -> Result<()> {
         crate::error::require_finite("displacement", d[0])?;
         crate::error::require_finite("displacement", d[1])?;
-        self.wall_mut(id)?;
-        self.catch_up_shear_springs();
-        self.wall_mut(id)?.translate(d);
-        Ok(())
+        self.wall(id)?;
+        self.modify_motion(|s| {
+            s.wall_mut(id)?.translate(d);
+            Ok(())
+        })
     }
 
     /// Bonds particles `i` and `j` with a spring of rest length `rest_length`
@@ -534,16 +540,17 @@ impl Simulation {
             None => norm(self.branch(i, j)),
         };
         // a new bond starts from zero shear: no displacement before it existed counts
-        self.catch_up_shear_springs();
-        self.bonds.push(Bond {
-            i: i as u32,
-            j: j as u32,
-            normal_stiffness,
-            shear_stiffness,
-            rest_length: rest,
-            shear: 0.0,
+        self.modify_motion(|s| {
+            s.bonds.push(Bond {
+                i: i as u32,
+                j: j as u32,
+                normal_stiffness,
+                shear_stiffness,
+                rest_length: rest,
+                shear: 0.0,
+            });
+            s.neighbors.invalidate();
         });
-        self.neighbors.invalidate();
         Ok(())
     }
 
@@ -562,13 +569,14 @@ impl Simulation {
         density: Vec<f64>,
     ) -> Result<()> {
         let added = Particles::new(position, radius, density)?;
-        self.catch_up_shear_springs();
-        let first = self.particles.len() as u32;
-        let count = added.len() as u32;
-        self.particles.extend(added);
-        self.order.extend(first..first + count);
-        self.rank.extend(first..first + count);
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            let first = s.particles.len() as u32;
+            let count = added.len() as u32;
+            s.particles.extend(added);
+            s.order.extend(first..first + count);
+            s.rank.extend(first..first + count);
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -664,19 +672,20 @@ impl Simulation {
 
     /// Switches a wall on or off; an inactive wall has no contacts and stays put.
     pub fn set_wall_active(&mut self, id: usize, active: bool) -> Result<()> {
-        self.wall_mut(id)?;
-        self.catch_up_shear_springs();
-        let wall = self.wall_mut(id)?;
-        wall.active = active;
-        if !active {
-            wall.velocity = [0.0; 2];
-            wall.control = WallControl::Velocity;
-            wall.force = [0.0; 2];
-            wall.contact_count = 0;
-            wall.stiffness_sum = 0.0;
-        }
-        self.neighbors.invalidate();
-        Ok(())
+        self.wall(id)?;
+        self.modify_motion(|s| {
+            let wall = s.wall_mut(id)?;
+            wall.active = active;
+            if !active {
+                wall.velocity = [0.0; 2];
+                wall.control = WallControl::Velocity;
+                wall.force = [0.0; 2];
+                wall.contact_count = 0;
+                wall.stiffness_sum = 0.0;
+            }
+            s.neighbors.invalidate();
+            Ok(())
+        })
     }
 
     /// Marks the neighbour lists stale (after positions or radii changed).
@@ -690,9 +699,10 @@ impl Simulation {
     pub fn set_positions(&mut self, positions: &[Vec2]) -> Result<()> {
         require_finite_points("positions", positions)?;
         let position = self.internal_array("positions", positions)?;
-        self.catch_up_shear_springs();
-        self.particles.position = position;
-        self.neighbors.invalidate();
+        self.modify_motion(|s| {
+            s.particles.position = position;
+            s.neighbors.invalidate();
+        });
         Ok(())
     }
 
@@ -703,9 +713,10 @@ impl Simulation {
     pub fn set_velocities(&mut self, velocities: &[Vec2]) -> Result<()> {
         require_finite_points("velocities", velocities)?;
         let velocity = self.internal_array("velocities", velocities)?;
-        self.catch_up_shear_springs();
-        self.particles.velocity = velocity;
-        self.half_kick_pending = true;
+        self.modify_motion(|s| {
+            s.particles.velocity = velocity;
+            s.half_kick_pending = true;
+        });
         Ok(())
     }
 
@@ -714,9 +725,10 @@ impl Simulation {
     pub fn set_angular_velocities(&mut self, angular_velocities: &[f64]) -> Result<()> {
         require_finite_values("angular_velocities", angular_velocities)?;
         let omega = self.internal_array("angular_velocities", angular_velocities)?;
-        self.catch_up_shear_springs();
-        self.particles.angular_velocity = omega;
-        self.half_kick_pending = true;
+        self.modify_motion(|s| {
+            s.particles.angular_velocity = omega;
+            s.half_kick_pending = true;
+        });
         Ok(())
     }
 
@@ -737,13 +749,28 @@ impl Simulation {
         }
     }
 
+    /// The one way a setter changes what the pending shear increment depends
+    /// on (velocities and spins, positions, radii, groups, the step parameters,
+    /// contact models, the cell, a wall's velocity, translation or activity,
+    /// bonds, particles): the springs first take the last step's increment
+    /// ([`Simulation::catch_up_shear_springs`]), then `change` runs. A setter
+    /// checks its input before, so that a refused change leaves the springs as
+    /// they were; the test below refuses a setter that writes those fields
+    /// outside of it.
+    fn modify_motion<R>(&mut self, change: impl FnOnce(&mut Self) -> R) -> R {
+        self.catch_up_shear_springs();
+        change(self)
+    }
+
     /// Adds to every shear spring (contacts, wall contacts, bonds) the increment
     /// of the displacement made by the last step, `-ks v_t dt` at the current
     /// positions and half-step velocities, capped as the next force evaluation
     /// would; that evaluation then adds none. A no-op when the springs are
     /// current. Every method that changes what the increment would be (velocities,
     /// positions, the time step, contact models, the cell, walls, bonds,
-    /// particles) calls it first. Slip in it is booked as friction dissipation.
+    /// particles) makes its change through [`Simulation::modify_motion`], which
+    /// calls it first. Slip in it is booked in the ledger's lines of the
+    /// sub-models that carry history (friction, rolling).
     pub fn catch_up_shear_springs(&mut self) {
         if self.springs_current {
             return;
@@ -753,10 +780,8 @@ impl Simulation {
         let p = &self.particles;
         let kernel = pair_kernel!(self, p, pairs, dt);
         // SAFETY: one caller, and the sink writes nothing
-        let tally = unsafe {
-            kernel.run::<false, _>(0, &mut pairs.shear, &mut pairs.sliding, &mut NullSink)
-        };
-        let mut friction = tally.friction;
+        let tally = unsafe { kernel.run::<false, _>(0, pairs.history.run(), &mut NullSink) };
+        let mut dissipation = tally.dissipation;
         let l = self.deforming_gradient();
         for bond in self.bonds.list.iter_mut() {
             let copy = *bond;
@@ -775,15 +800,19 @@ impl Simulation {
             let wall = &self.walls[wp.wall[k] as usize];
             let model = self.materials.by_index(wp.model[k]);
             let q = wp.particle[k] as usize;
-            match wall_contact(wall, model, &motion, q, dt, dt, &mut wp.shear[k]) {
+            match wall_contact(wall, model, &motion, q, dt, dt, &mut wp.history.records[k]) {
                 Some((_, c)) => {
-                    wp.sliding[k] = c.sliding;
-                    friction += c.friction_dissipation;
+                    wp.history.sliding[k] = c.sliding;
+                    dissipation.friction += c.dissipation.friction;
+                    dissipation.rolling += c.dissipation.rolling;
                 }
-                None => wp.sliding[k] = false,
+                None => wp.history.sliding[k] = false,
             }
         }
-        self.ledger.friction_dissipated += friction;
+        // the slip of the increments (the springs' history), not the dashpots'
+        // power, which the step books over its own time step
+        self.ledger.friction_dissipated += dissipation.friction;
+        self.ledger.rolling_dissipated += dissipation.rolling;
         self.springs_current = true;
     }
 
@@ -792,25 +821,25 @@ impl Simulation {
     pub(crate) fn preview_pairs(&self) -> Vec<Option<PairRecord>> {
         let increment_time = self.increment_time();
         let pairs = &self.neighbors.pairs;
-        let (mut shear, mut sliding) = (pairs.shear.clone(), pairs.sliding.clone());
+        let mut history = pairs.history.clone();
         let p = &self.particles;
         let kernel = pair_kernel!(self, p, pairs, increment_time);
         let mut sink = RecordSink {
             records: vec![None; pairs.len()],
         };
         // SAFETY: one caller, and the sink writes only its own records
-        unsafe { kernel.run::<false, _>(0, &mut shear, &mut sliding, &mut sink) };
+        unsafe { kernel.run::<false, _>(0, history.run(), &mut sink) };
         sink.records
     }
 
-    /// Every wall pair as the next force evaluation will see it: the geometry,
-    /// the law's forces and the updated spring (in a copy), or `None`.
-    pub(crate) fn preview_wall_pairs(&self) -> Vec<Option<(ContactGeometry, ContactForce, f64)>> {
+    /// Every wall pair as the next force evaluation will see it: the geometry
+    /// and the law's forces (the history updated in a copy), or `None`.
+    pub(crate) fn preview_wall_pairs(&self) -> Vec<Option<(ContactGeometry, ContactForce)>> {
         let (dt, increment_time) = (self.params.time_step, self.increment_time());
         let wp = &self.neighbors.wall_pairs;
         (0..wp.wall.len())
             .map(|k| {
-                let mut spring = wp.shear[k];
+                let mut record = wp.history.records[k];
                 let wall = &self.walls[wp.wall[k] as usize];
                 let model = self.materials.by_index(wp.model[k]);
                 let q = wp.particle[k] as usize;
@@ -821,9 +850,8 @@ impl Simulation {
                     q,
                     dt,
                     increment_time,
-                    &mut spring,
+                    &mut record,
                 )
-                .map(|(g, c)| (g, c, spring))
             })
             .collect()
     }
@@ -950,22 +978,22 @@ impl Simulation {
         for chain in self.chains.iter_mut() {
             chain.remap(&new_of_old);
         }
-        self.index_blocks();
+        self.index_stripes();
         for (k, &e) in self.order.iter().enumerate() {
             self.rank[e as usize] = k as u32;
         }
         Ok(())
     }
 
-    /// The per-block indexes of the chains, bonds and wall pairs, for the
-    /// current blocks (at the start of a run call and after every rebuild).
-    pub(crate) fn index_blocks(&mut self) {
-        let blocks = &self.neighbors.block_ranges;
-        self.chain_blocks = ChainBlocks::new(&self.chains, blocks);
+    /// The per-stripe indexes of the chains, bonds and wall pairs, for the
+    /// current stripes (at the start of a run call and after every rebuild).
+    pub(crate) fn index_stripes(&mut self) {
+        let stripes = &self.neighbors.stripe_ranges;
+        self.chain_stripes = ChainStripes::new(&self.chains, stripes);
         self.deferred_index = DeferredIndex::new(
             &self.bonds.list,
             &self.neighbors.wall_pairs.particle,
-            blocks,
+            stripes,
         );
     }
 
@@ -1016,5 +1044,129 @@ impl Simulation {
         sim.check_consistent()?;
         sim.make_pool()?;
         Ok(sim)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Writes to what the pending shear increment depends on, as this file
+    /// spells them (`self.` in a setter, `s.` in its `modify_motion` closure).
+    const MOTION_WRITES: &[&str] = &[
+        "particles.position =",
+        "particles.velocity =",
+        "particles.angular_velocity =",
+        "particles.radius =",
+        "particles.group =",
+        "particles.extend(",
+        "params =",
+        "cell =",
+        "materials.set(",
+        "bonds.push(",
+        ".translate(",
+        "wall.velocity =",
+        "wall.active =",
+    ];
+
+    /// The methods of this file, each as `(name, text up to the next method)`.
+    fn methods(source: &str) -> Vec<(String, String)> {
+        let starts: Vec<usize> = source
+            .match_indices("\n    ")
+            .map(|(k, _)| k + 5)
+            .filter(|&k| {
+                let line = &source[k..];
+                ["pub fn ", "pub(crate) fn ", "fn "]
+                    .iter()
+                    .any(|p| line.starts_with(p))
+            })
+            .collect();
+        starts
+            .iter()
+            .enumerate()
+            .map(|(n, &k)| {
+                let end = starts.get(n + 1).copied().unwrap_or(source.len());
+                let text = &source[k..end];
+                let name = text
+                    .split("fn ")
+                    .nth(1)
+                    .and_then(|t| t.split(['(', '<']).next())
+                    .unwrap_or("")
+                    .to_string();
+                (name, text.to_string())
+            })
+            .collect()
+    }
+
+    /// The part of a method's text that is code (comments and strings dropped).
+    fn code(text: &str) -> String {
+        text.lines()
+            .map(|l| l.split("//").next().unwrap_or(""))
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
+    /// The offsets of the motion writes in `code`, with the write.
+    fn motion_writes(code: &str) -> Vec<(usize, &'static str)> {
+        let mut found = Vec::new();
+        for &w in MOTION_WRITES {
+            for (k, _) in code.match_indices(w) {
+                // `==` is a comparison, not a write
+                if !code[k + w.len()..].starts_with('=') {
+                    found.push((k, w));
+                }
+            }
+        }
+        found
+    }
+
+    #[test]
+    fn every_setter_of_motion_goes_through_modify_motion() {
+        let source = include_str!("simulation.rs");
+        let source = &source[..source.find("#[cfg(test)]\nmod tests").unwrap()];
+        let mut setters = 0;
+        for (name, text) in methods(source) {
+            let code = code(&text);
+            let writes = motion_writes(&code);
+            if name == "new" || name == "from_bytes" || name == "modify_motion" {
+                continue;
+            }
+            if name != "modify_motion" && name != "catch_up_shear_springs" {
+                assert!(
+                    !code.contains("catch_up_shear_springs()"),
+                    "{name}: catches the springs up itself; change them through modify_motion"
+                );
+            }
+            if writes.is_empty() {
+                continue;
+            }
+            setters += 1;
+            let entry = code.find(".modify_motion(").unwrap_or_else(|| {
+                panic!("{name}: writes {:?} outside of modify_motion", writes[0].1)
+            });
+            for (k, w) in writes {
+                assert!(
+                    k > entry,
+                    "{name}: writes {w:?} before entering modify_motion"
+                );
+            }
+        }
+        // the setters of velocities, spins, positions, radii, groups, the step
+        // parameters, contact models, the cell, walls (velocity, translation,
+        // activity), bonds and particles
+        assert_eq!(setters, 13, "the setters of motion found in this file");
+    }
+
+    #[test]
+    fn a_setter_that_skips_modify_motion_is_found() {
+        let skipping = "\n    pub fn set_spins(&mut self, w: Vec<f64>) {\n        \
+                        self.particles.angular_velocity = w;\n    }\n";
+        let (name, text) = &methods(skipping)[0];
+        assert_eq!(name, "set_spins");
+        let code = code(text);
+        assert!(!motion_writes(&code).is_empty() && !code.contains(".modify_motion("));
+        let late = "\n    pub fn set_spins(&mut self, w: Vec<f64>) {\n        \
+                    self.particles.velocity = w;\n        self.modify_motion(|_| ());\n    }\n";
+        let code = super::tests::code(&methods(late)[0].1);
+        let entry = code.find(".modify_motion(").unwrap();
+        assert!(motion_writes(&code).iter().any(|&(k, _)| k < entry));
     }
 }

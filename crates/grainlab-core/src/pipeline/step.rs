@@ -4,19 +4,19 @@ use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 
 use super::deferred::{DeferredForces, WallSlot};
 use super::pair_kernel::{
-    pair_kernel, wall_contact, BlockWork, BufferSink, ContactTally, CrossForces, DirectSink,
-    PairForce, PairKernel, ResetKernel,
+    pair_kernel, wall_contact, BufferSink, ContactTally, CrossForces, DirectSink, PairForce,
+    PairKernel, ResetKernel, StripeWork,
 };
 use super::Simulation;
 use crate::bond::{bond_slot, BondSlot};
 use crate::diagnostics::Measurements;
 use crate::error::Result;
 use crate::integrate::{
-    integrate_chunk, IntegrationInputs, IntegrationStep, IntegrationTally, MotionChunk,
+    integrate_stripe, IntegrationInputs, IntegrationStep, IntegrationTally, MotionStripe,
 };
-use crate::law::elastic_energy;
+use crate::law::{elastic_energy, ContactRecord};
 use crate::parallel::{
-    even_bounds, map_blocks, split_ranges, DisjointWriter, Team, PARALLEL_MIN_PARTICLES,
+    even_bounds, map_stripes, split_ranges, DisjointWriter, Team, PARALLEL_MIN_PARTICLES,
 };
 use crate::state::ParticleMotion;
 use crate::vec2::{add, dot, perp, scale, sub, Mat2, Vec2};
@@ -48,7 +48,7 @@ impl Simulation {
         self.check_consistent()?;
         // the chains and bonds cannot change during a run call (a rebuild maps
         // them along and indexes them again)
-        self.index_blocks();
+        self.index_stripes();
         // external loads cannot change during a run call: scan them once, not every step
         let p = &self.particles;
         self.external_loads = p.external_force.iter().any(|f| *f != [0.0, 0.0])
@@ -80,7 +80,7 @@ impl Simulation {
         let results = pool.broadcast(|ctx| {
             if ctx.index() == 0 {
                 // SAFETY: only worker 0 touches the simulation outside of team
-                // phases, and the phases obey the block ownership rules.
+                // phases, and the phases obey the stripe ownership rules.
                 let sim = unsafe { &mut *this.get() };
                 let out = catch_unwind(AssertUnwindSafe(|| steps(sim, Some(&team))));
                 team.dismiss();
@@ -103,11 +103,11 @@ impl Simulation {
     /// energy, contact counts and the unbalanced force ratio.
     fn step<const MEASURE: bool>(&mut self, team: Option<&Team>) -> Result<()> {
         self.ensure_neighbors()?;
-        // with a team, the blocks evaluate their particles' wall contacts in the
-        // contact phase, and each block's integration adds the bonds' and walls' forces
+        // with a team, the stripes evaluate their particles' wall contacts in the
+        // contact phase, and each stripe's integration adds the bonds' and walls' forces
         let defer = team.is_some()
             && self.deferred_index.fits(
-                self.neighbors.block_ranges.len(),
+                self.neighbors.stripe_ranges.len(),
                 self.bonds.list.len(),
                 self.neighbors.wall_pairs.wall.len(),
             );
@@ -183,8 +183,8 @@ impl Simulation {
         motion: &IntegrationTally,
     ) {
         let ledger = &mut self.ledger;
-        ledger.friction_dissipated += contacts.friction + walls.friction;
-        ledger.viscous_dissipated += contacts.viscous + walls.viscous;
+        // each contact sub-model's dissipation into its own line
+        ledger.book_contacts(&contacts.dissipation.plus(&walls.dissipation));
         ledger.damping_dissipated += motion.damping_dissipated;
         ledger.wall_work += wall_work;
         ledger.external_work += motion.external_work;
@@ -266,23 +266,21 @@ impl Simulation {
     ) -> Vec<ContactTally> {
         let increment_time = self.increment_time();
         let buffer_cross = team.is_some();
-        let n_blocks = self.neighbors.block_ranges.len();
+        let n_stripes = self.neighbors.stripe_ranges.len();
         let pairs = &mut self.neighbors.pairs;
-        let starts = &pairs.block_start;
-        // interior pairs of each block, then the cross-block pairs shared out evenly
-        let cross_start = starts[n_blocks];
+        let starts = &pairs.stripe_start;
+        // interior pairs of each stripe, then the cross-stripe pairs shared out evenly
+        let cross_start = starts[n_stripes];
         let n_pairs = pairs.len();
-        let cross_ranges: Vec<(usize, usize)> = even_bounds(n_pairs - cross_start, n_blocks)
+        let cross_ranges: Vec<(usize, usize)> = even_bounds(n_pairs - cross_start, n_stripes)
             .into_iter()
             .map(|(lo, hi)| (cross_start + lo, cross_start + hi))
             .collect();
         let mut ranges: Vec<(usize, usize)> =
-            (0..n_blocks).map(|b| (starts[b], starts[b + 1])).collect();
+            (0..n_stripes).map(|b| (starts[b], starts[b + 1])).collect();
         ranges.extend(&cross_ranges);
-        let mut shear_parts = split_ranges(&mut pairs.shear, &ranges);
-        let mut sliding_parts = split_ranges(&mut pairs.sliding, &ranges);
-        let cross_shear = shear_parts.split_off(n_blocks);
-        let cross_sliding = sliding_parts.split_off(n_blocks);
+        let mut history_parts = pairs.history.split(&ranges);
+        let cross_history = history_parts.split_off(n_stripes);
         // every slot is rewritten by the kernel (a force or `skip`), so no clearing
         self.cross_forces
             .resize(n_pairs - cross_start, PairForce::NONE);
@@ -293,7 +291,7 @@ impl Simulation {
         let cross_buffers = split_ranges(&mut self.cross_forces, &local);
         // the bonds shared out evenly too; their forces wait in slots
         let n_bonds = self.bonds.list.len();
-        let bond_ranges = even_bounds(n_bonds, n_blocks);
+        let bond_ranges = even_bounds(n_bonds, n_stripes);
         self.bond_slots.resize(n_bonds, BondSlot::default());
         let bond_parts = split_ranges(&mut self.bonds.list, &bond_ranges);
         let bond_slot_parts = split_ranges(&mut self.bond_slots, &bond_ranges);
@@ -303,14 +301,14 @@ impl Simulation {
             .filter(|c| c.is_deforming())
             .map(|c| c.velocity_gradient);
 
-        // the chains' follower loads, each block its own particles' (step 2a)
+        // the chains' follower loads, each stripe its own particles' (step 2a)
         let has_chains = !self.chains.is_empty();
         if has_chains {
             self.boundary_load.resize(self.particles.len(), [0.0; 2]);
         }
         let boundary_load = DisjointWriter::new(&mut self.boundary_load);
-        debug_assert!(!has_chains || self.chain_blocks.n_blocks() == n_blocks);
-        let (chains, chain_blocks, walls) = (&self.chains, &self.chain_blocks, &self.walls);
+        debug_assert!(!has_chains || self.chain_stripes.n_stripes() == n_stripes);
+        let (chains, chain_stripes, walls) = (&self.chains, &self.chain_stripes, &self.walls);
         let p = &mut self.particles;
         let force = DisjointWriter::new(&mut p.force);
         let torque = DisjointWriter::new(&mut p.torque);
@@ -325,33 +323,24 @@ impl Simulation {
                 && !self.external_loads
                 && self.params.gravity == [0.0, 0.0],
         };
-        let blocks: Vec<BlockWork<'_>> = shear_parts
+        let stripes: Vec<StripeWork<'_>> = history_parts
             .into_iter()
-            .zip(sliding_parts)
-            .zip(cross_shear.into_iter().zip(cross_sliding))
+            .zip(cross_history)
             .zip(cross_buffers)
             .zip(bond_parts.into_iter().zip(bond_slot_parts))
             .enumerate()
             .map(
-                |(
-                    b,
-                    (
-                        (((shear, sliding), (cross_shear, cross_sliding)), cross_forces),
-                        (bonds, bond_slots),
-                    ),
-                )| BlockWork {
-                    block: b,
-                    shear,
-                    sliding,
-                    cross_shear,
-                    cross_sliding,
+                |(b, (((history, cross_history), cross_forces), (bonds, bond_slots)))| StripeWork {
+                    stripe: b,
+                    history,
+                    cross_history,
                     cross_forces,
                     bonds,
                     bond_slots,
                 },
             )
             .collect();
-        // what the bond and wall laws read (not the resultants the blocks write)
+        // what the bond and wall laws read (not the resultants the stripes write)
         let motion = ParticleMotion {
             position: &p.position,
             velocity: &p.velocity,
@@ -360,8 +349,8 @@ impl Simulation {
             mass: &p.mass,
         };
         let cell = self.cell.as_ref();
-        let block_ranges = &self.neighbors.block_ranges;
-        // the wall pairs, each evaluated by the block of its particle (`defer`)
+        let stripe_ranges = &self.neighbors.stripe_ranges;
+        // the wall pairs, each evaluated by the stripe of its particle (`defer`)
         let wp = &mut self.neighbors.wall_pairs;
         if defer {
             self.wall_slots.resize(wp.wall.len(), WallSlot::default());
@@ -370,25 +359,25 @@ impl Simulation {
             wall: &wp.wall,
             particle: &wp.particle,
             model: &wp.model,
-            shear: DisjointWriter::new(&mut wp.shear),
-            sliding: DisjointWriter::new(&mut wp.sliding),
+            records: DisjointWriter::new(&mut wp.history.records),
+            sliding: DisjointWriter::new(&mut wp.history.sliding),
             slots: DisjointWriter::new(&mut self.wall_slots),
         };
         let (materials, deferred_index) = (&self.materials, &self.deferred_index);
         let (dt, max_overlap_ratio) = (self.params.time_step, self.params.max_overlap_ratio);
-        let tallies = map_blocks(team, blocks, |work| {
-            let b = work.block;
+        let tallies = map_stripes(team, stripes, |work| {
+            let b = work.stripe;
             let mut direct = DirectSink {
                 force: &force,
                 torque: &torque,
             };
-            // SAFETY: block b resets and writes only the forces of its own particles
-            // (interior pairs have both particles in block b); cross pairs only
+            // SAFETY: stripe b resets and writes only the forces of its own particles
+            // (interior pairs have both particles in stripe b); cross pairs only
             // write their own slots of the buffer.
             unsafe {
-                let (lo, hi) = block_ranges[b];
+                let (lo, hi) = stripe_ranges[b];
                 if has_chains {
-                    chain_blocks.block_loads(
+                    chain_stripes.stripe_loads(
                         b,
                         lo,
                         chains,
@@ -398,16 +387,14 @@ impl Simulation {
                     );
                 }
                 reset.apply(lo, hi, &force, &torque);
-                let mut tally =
-                    kernel.run::<MEASURE, _>(ranges[b].0, work.shear, work.sliding, &mut direct);
+                let mut tally = kernel.run::<MEASURE, _>(ranges[b].0, work.history, &mut direct);
                 if buffer_cross {
                     let mut buffered = BufferSink {
                         slots: work.cross_forces,
                     };
                     let cross = kernel.run::<MEASURE, _>(
-                        ranges[n_blocks + b].0,
-                        work.cross_shear,
-                        work.cross_sliding,
+                        ranges[n_stripes + b].0,
+                        work.cross_history,
                         &mut buffered,
                     );
                     tally.merge(&cross);
@@ -422,15 +409,15 @@ impl Simulation {
                     );
                 }
                 if defer {
-                    // SAFETY: each wall pair is in the list of one block only
-                    for &k in deferred_index.walls_of_block(b) {
+                    // SAFETY: each wall pair is in the list of one stripe only
+                    for &k in deferred_index.walls_of_stripe(b) {
                         let k = k as usize;
                         let wall = &walls[wall_pairs.wall[k] as usize];
                         let model = materials.by_index(wall_pairs.model[k]);
                         let q = wall_pairs.particle[k] as usize;
-                        let spring = wall_pairs.shear.get(k);
+                        let record = wall_pairs.records.get(k);
                         let contact =
-                            wall_contact(wall, model, &motion, q, dt, increment_time, spring);
+                            wall_contact(wall, model, &motion, q, dt, increment_time, record);
                         let slot = wall_pairs.slots.get(k);
                         let Some((g, c)) = contact else {
                             *wall_pairs.sliding.get(k) = false;
@@ -442,15 +429,14 @@ impl Simulation {
                         let n = g.normal;
                         *slot = WallSlot {
                             force: add(scale(n, c.normal), scale(perp(n), c.shear)),
-                            torque: r * c.shear,
-                            friction: c.friction_dissipation,
-                            viscous: c.viscous_dissipation,
+                            torque: c.torque_j,
+                            dissipation: c.dissipation,
                             overlap_violation: g.overlap > max_overlap_ratio * r,
                             active: true,
                             ..WallSlot::default()
                         };
                         if MEASURE {
-                            slot.elastic = elastic_energy(model, c.elastic_normal, *spring);
+                            slot.elastic = elastic_energy(model, c.elastic_normal, c.shear_spring);
                             slot.force_norm = (c.normal * c.normal + c.shear * c.shear).sqrt();
                         }
                     }
@@ -458,23 +444,23 @@ impl Simulation {
                 tally
             }
         });
-        // with a buffer the cross-block forces are applied by each block's
+        // with a buffer the cross-stripe forces are applied by each stripe's
         // integration (step 7)
         tallies
     }
 
     /// Step 5b, on one thread: the pairs across stripes, after bonds and walls,
-    /// in pair order and in the same chunks as a team would evaluate them, adding
+    /// in pair order and in the same shares as a team would evaluate them, adding
     /// their forces straight onto the particles. Each particle then receives the
     /// same additions in the same order as from the buffer (which a stripe's
     /// integration applies after the bonds and walls, in pair order), and each
     /// stripe's tally the same merges: the same bits without the buffer.
     fn cross_pairs_in_order<const MEASURE: bool>(&mut self, tallies: &mut [ContactTally]) {
         let increment_time = self.increment_time();
-        let n_blocks = self.neighbors.block_ranges.len();
+        let n_stripes = self.neighbors.stripe_ranges.len();
         let pairs = &mut self.neighbors.pairs;
-        let cross_start = pairs.block_start[n_blocks];
-        let chunks = even_bounds(pairs.len() - cross_start, n_blocks);
+        let cross_start = pairs.stripe_start[n_stripes];
+        let shares = even_bounds(pairs.len() - cross_start, n_stripes);
         let p = &mut self.particles;
         let force = DisjointWriter::new(&mut p.force);
         let torque = DisjointWriter::new(&mut p.torque);
@@ -483,24 +469,18 @@ impl Simulation {
             force: &force,
             torque: &torque,
         };
-        for (tally, &(lo, hi)) in tallies.iter_mut().zip(&chunks) {
+        for (tally, &(lo, hi)) in tallies.iter_mut().zip(&shares) {
             let (lo, hi) = (cross_start + lo, cross_start + hi);
             // SAFETY: one thread; the pairs index particles that exist
-            let cross = unsafe {
-                kernel.run::<MEASURE, _>(
-                    lo,
-                    &mut pairs.shear[lo..hi],
-                    &mut pairs.sliding[lo..hi],
-                    &mut direct,
-                )
-            };
+            let cross =
+                unsafe { kernel.run::<MEASURE, _>(lo, pairs.history.run_of(lo, hi), &mut direct) };
             tally.merge(&cross);
         }
     }
 
     /// Step 4: the bonds' forces, computed with the contact phase
     /// ([`Simulation::particle_contacts`]), added to the particles in bond order
-    /// (`apply`; else each block's integration adds them, `pipeline::deferred`),
+    /// (`apply`; else each stripe's integration adds them, `pipeline::deferred`),
     /// and their tally.
     fn apply_bond_forces<const MEASURE: bool>(&mut self, apply: bool) -> ContactTally {
         let mut tally = ContactTally::default();
@@ -527,8 +507,8 @@ impl Simulation {
     }
 
     /// Step 5: particle-wall contacts, their forces added to the particles (or,
-    /// `defer`, evaluated by the blocks in the contact phase and kept in slots for
-    /// each block's integration to add: here only summed onto the walls and the
+    /// `defer`, evaluated by the stripes in the contact phase and kept in slots for
+    /// each stripe's integration to add: here only summed onto the walls and the
     /// tally, in wall-pair order); returns the tally and the walls' work over
     /// their last step's displacement.
     fn wall_forces<const MEASURE: bool>(&mut self, defer: bool) -> (ContactTally, f64) {
@@ -559,26 +539,25 @@ impl Simulation {
                     q,
                     dt,
                     increment_time,
-                    &mut wp.shear[k],
+                    &mut wp.history.records[k],
                 );
                 let Some((g, c)) = contact else {
-                    wp.sliding[k] = false;
+                    wp.history.sliding[k] = false;
                     continue;
                 };
-                wp.sliding[k] = c.sliding;
+                wp.history.sliding[k] = c.sliding;
                 let p = &mut self.particles;
                 let r = p.radius[q];
                 let n = g.normal;
                 let f = add(scale(n, c.normal), scale(perp(n), c.shear));
                 p.force[q] = add(p.force[q], f);
-                p.torque[q] -= r * c.shear;
+                p.torque[q] += c.torque_j;
                 WallSlot {
                     force: f,
-                    friction: c.friction_dissipation,
-                    viscous: c.viscous_dissipation,
+                    dissipation: c.dissipation,
                     overlap_violation: g.overlap > self.params.max_overlap_ratio * r,
                     elastic: if MEASURE {
-                        elastic_energy(model, c.elastic_normal, wp.shear[k])
+                        elastic_energy(model, c.elastic_normal, c.shear_spring)
                     } else {
                         0.0
                     },
@@ -593,8 +572,7 @@ impl Simulation {
             wall.force = sub(wall.force, slot.force);
             wall.contact_count += 1;
             wall.stiffness_sum += model.normal_stiffness;
-            tally.friction += slot.friction;
-            tally.viscous += slot.viscous;
+            tally.dissipation.add(&slot.dissipation);
             tally.overlap_violation |= slot.overlap_violation;
             if MEASURE {
                 tally.elastic += slot.elastic;
@@ -614,15 +592,15 @@ impl Simulation {
         (tally, work)
     }
 
-    /// Step 7: leapfrog with local damping in parallel chunks; with a team each
-    /// chunk first adds its particles' deferred bond and wall forces (`defer`),
-    /// then their cross-block pairs.
+    /// Step 7: leapfrog with local damping stripe by stripe in parallel; with a team each
+    /// stripe first adds its particles' deferred bond and wall forces (`defer`),
+    /// then their cross-stripe pairs.
     fn integrate<const MEASURE: bool>(
         &mut self,
         team: Option<&Team>,
         defer: bool,
     ) -> IntegrationTally {
-        // with a team the cross-block forces wait in the buffer (else they are applied)
+        // with a team the cross-stripe forces wait in the buffer (else they are applied)
         let buffered = team.is_some();
         let dt = self.params.time_step;
         let step_map = self
@@ -660,14 +638,14 @@ impl Simulation {
         };
         // the stripes of the contact phase: a worker integrates (first) the
         // stripes whose contacts it just computed
-        let bounds = self.neighbors.block_ranges.clone();
+        let bounds = self.neighbors.stripe_ranges.clone();
         let cross = CrossForces {
             pair_i: &self.neighbors.pairs.i,
             pair_j: &self.neighbors.pairs.j,
             first: self
                 .neighbors
                 .pairs
-                .block_start
+                .stripe_start
                 .last()
                 .copied()
                 .unwrap_or(0),
@@ -692,7 +670,7 @@ impl Simulation {
             &'w mut [Vec2],
             &'w mut [f64],
         );
-        let chunks: Vec<Work<'_>> = split_ranges(&mut p.position, &bounds)
+        let stripes: Vec<Work<'_>> = split_ranges(&mut p.position, &bounds)
             .into_iter()
             .zip(split_ranges(&mut p.velocity, &bounds))
             .zip(split_ranges(&mut p.rotation, &bounds))
@@ -722,20 +700,20 @@ impl Simulation {
                 },
             )
             .collect();
-        let tallies = map_blocks(
+        let tallies = map_stripes(
             team,
-            chunks,
+            stripes,
             |(b, lo, position, velocity, rotation, angular_velocity, force, torque)| {
                 if defer {
                     // the bonds, then the wall contacts, as their serial passes add them
                     deferred.apply(b, lo, force, torque);
                 }
                 if buffered {
-                    // the cross-block pairs touching this block, in pair order, as a
+                    // the cross-stripe pairs touching this stripe, in pair order, as a
                     // sequential pass over all of them adds them
                     cross.apply(b, lo, force, torque);
                 }
-                let chunk = MotionChunk {
+                let stripe = MotionStripe {
                     lo,
                     position,
                     velocity,
@@ -744,7 +722,7 @@ impl Simulation {
                     force,
                     torque,
                 };
-                integrate_chunk::<MEASURE>(chunk, &inputs, &step)
+                integrate_stripe::<MEASURE>(stripe, &inputs, &step)
             },
         );
         let mut total = IntegrationTally::default();
@@ -769,14 +747,14 @@ impl SimPtr {
     }
 }
 
-/// The wall pairs as the contact phase's blocks evaluate them: each block its
-/// own particles' pairs (`DeferredIndex::walls_of_block`), writing only their
+/// The wall pairs as the contact phase's stripes evaluate them: each stripe its
+/// own particles' pairs (`DeferredIndex::walls_of_stripe`), writing only their
 /// springs, flags and slots.
 struct WallPairWork<'a> {
     wall: &'a [u32],
     particle: &'a [u32],
     model: &'a [u16],
-    shear: DisjointWriter<f64>,
+    records: DisjointWriter<ContactRecord>,
     sliding: DisjointWriter<bool>,
     slots: DisjointWriter<WallSlot>,
 }
