@@ -17,6 +17,7 @@ import pytest
 from test_figures import write_run
 
 import grainlab.postprocess.products as products_module
+from grainlab.analysis import ForceChains, LocalPorosity
 from grainlab.analysis.shear_band import ShearBand
 from grainlab.analysis.stability import StabilityIndex
 from grainlab.io.hdf5 import ResultsFileError, read_results, write_analysis
@@ -92,6 +93,8 @@ def test_stored_products_are_the_products_made_anew(fresh_run, counted):
         assert (zone.found, zone.reason, zone.residual_reduction, zone.zone) == (
             again.found, again.reason, again.residual_reduction, again.zone)
         np.testing.assert_array_equal(zone.members, again.members)
+        np.testing.assert_array_equal(products.local_porosity(name), LocalPorosity().compute(cur).local_porosity)
+        np.testing.assert_array_equal(products.force_chains(name), ForceChains().compute(cur).chain)
         field = products.stability_index(name)
         np.testing.assert_array_equal(field.stability_index, stability.stability_index)
         np.testing.assert_array_equal(field.n_contacts, stability.n_contacts)

@@ -28,6 +28,13 @@ gets a new version, and the stored items of the old one are made again):
 ``band_displacement`` (version 1)
     :func:`~grainlab.postprocess.band.displacement_zone` of the snapshot
     against the reference (Fig. 11's two-block split, accepted or not).
+``local_porosity`` (version 1)
+    :class:`~grainlab.analysis.LocalPorosity` with its defaults: array
+    ``local_porosity`` per particle (NaN for membrane disks).
+``force_chains`` (version 1)
+    :class:`~grainlab.analysis.ForceChains` with its defaults: array ``chain``
+    per particle (the chain's index, -1 outside every chain); a snapshot without
+    contact forces has none (all -1).
 """
 
 from __future__ import annotations
@@ -41,8 +48,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from grainlab.analysis.force_chains import ForceChains
 from grainlab.analysis.shear_band import Slab
 from grainlab.analysis.stability import StabilityIndex
+from grainlab.analysis.tessellation import LocalPorosity
 from grainlab.io.hdf5 import AnalysisItem, Results, read_results, write_analysis
 from grainlab.postprocess.band import (
     BandNumbers,
@@ -66,7 +75,12 @@ PRODUCTS: dict[str, int] = {
     "band_strain": 1,
     "band_lambda": 1,
     "band_displacement": 1,
+    "local_porosity": 1,
+    "force_chains": 1,
 }
+
+#: The products of every snapshot, the reference included (the others are against it).
+_OF_EVERY_SNAPSHOT = ("stability_index", "local_porosity", "force_chains")
 
 _NUMBER_FIELDS = tuple(f.name for f in dataclasses.fields(BandNumbers))
 _SLAB_SCALARS = ("found", "angle", "thickness", "thickness_diameters")
@@ -184,6 +198,13 @@ def _make_items(reference: Snapshot, current: Snapshot, reference_name: str, nam
     stability = StabilityIndex().compute(current)
     if "stability_index" in wanted:
         items["stability_index"] = _lambda_item(stability)
+    if "local_porosity" in wanted:
+        porosity = LocalPorosity().compute(current).local_porosity
+        items["local_porosity"] = AnalysisItem({}, {"local_porosity": np.asarray(porosity, np.float64)})
+    if "force_chains" in wanted:
+        chain = (ForceChains().compute(current).chain if current.normal_force is not None
+                 else np.full(current.n_particles, -1))
+        items["force_chains"] = AnalysisItem({}, {"chain": np.asarray(chain, np.int32)})
     if name == reference_name:
         return items  # no displacement against itself: no band products
     if "band_strain" in wanted:
@@ -270,6 +291,14 @@ class RunProducts:
         """The snapshot's lambda field (``stability_index``)."""
         return _lambda_of(self._item("stability_index", name))
 
+    def local_porosity(self, name: str) -> NDArray[np.float64]:
+        """(N,) the snapshot's local porosity of each particle (``local_porosity``)."""
+        return np.asarray(self._item("local_porosity", name).arrays["local_porosity"], np.float64)
+
+    def force_chains(self, name: str) -> NDArray[np.int32]:
+        """(N,) the force chain of each particle of the snapshot, -1 outside them (``force_chains``)."""
+        return np.asarray(self._item("force_chains", name).arrays["chain"], np.int32)
+
     def band_search(self, name: str) -> BandSearch:
         """The shear band of the local strain at snapshot ``name`` since the reference (``band_strain``)."""
         return _search_of(self._item("band_strain", name))
@@ -302,7 +331,7 @@ class RunProducts:
         with self.results.analysis_reader() as stored:
             for name in self.names_by_strain:
                 for product, version in PRODUCTS.items():
-                    if name == self.reference and product != "stability_index":
+                    if name == self.reference and product not in _OF_EVERY_SNAPSHOT:
                         continue
                     item = stored(product, name) if versions.get(product) == version else None
                     if item is None or item.attrs.get("reference", self.reference) != self.reference:

@@ -54,6 +54,8 @@ _BODY = """<!DOCTYPE html>
       <option value="displacement">displacement</option>
       <option value="rotation">rotation</option>
       <option value="strain">local shear strain</option>
+      <option value="porosity">local porosity</option>
+      <option value="chains">force chains</option>
     </select>
   </label>
   <label><input type="checkbox" id="show-contacts"> contact network</label>
@@ -70,7 +72,8 @@ _BODY = """<!DOCTYPE html>
   <div>
     <canvas id="curve" width="420" height="300" aria-label="stress-strain curve"></canvas>
     <p class="note">Displacement, rotation and local shear strain are measured since the first
-    snapshot. Membrane disks are grey. Dashed: the outlines of the accepted shear band (red) and
+    snapshot; the local porosity is each grain's power cell's, and a force chain is Peters et
+    al.'s (docs/fabric.md). Membrane disks are grey. Dashed: the outlines of the accepted shear band (red) and
     its conjugate (orange). Hover a grain for its values; click the curve to go to a snapshot.</p>
   </div>
 </div>

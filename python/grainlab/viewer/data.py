@@ -3,8 +3,8 @@
 :func:`viewer_data` reads every snapshot of a results file and computes, per
 snapshot, the per-grain values the page colours by (the ones the ParaView
 export writes, :func:`grainlab.postprocess.vtk.snapshot_arrays`): the
-stability index lambda (the run's stored lambda field,
-:class:`grainlab.postprocess.products.RunProducts`), the number of contacts, the displacement and
+stability index lambda, the local porosity and the force chains (the run's
+stored products, :class:`grainlab.postprocess.products.RunProducts`), the number of contacts, the displacement and
 the rotation since the first snapshot, the local shear strain since it and
 the shear band labels; the particle–particle contacts with their normal
 forces; the accepted bands' outlines (the run's stored band searches, against its
@@ -90,6 +90,8 @@ def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str, pr
             "id": encode(snap.ids, "u4"),
             "kind": encode(snap.kind, "u1"),
             "lambda": encode(products.stability_index(name).stability_index, "f4"),
+            "porosity": encode(products.local_porosity(name), "f4"),
+            "chain": encode(products.force_chains(name) >= 0, "u1"),
             "contacts": encode(np.minimum(arrays["n_contacts"], 255), "u1"),
             "dx": encode(disp[:, 0], "f4"),
             "dy": encode(disp[:, 1], "f4"),

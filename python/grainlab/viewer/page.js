@@ -7,6 +7,7 @@
   const FIELDS = {
     x: "f4", y: "f4", r: "f4", id: "u4", kind: "u1", lambda: "f4", contacts: "u1", dx: "f4",
     dy: "f4", rotation: "f4", strain: "f4", in_band: "u1", ci: D.index_dtype, cj: D.index_dtype, fn: "f4",
+    porosity: "f4", chain: "u1",
   };
   const MEMBRANE = 1;
 
@@ -62,6 +63,9 @@
     rotation: { label: "rotation (rad)", key: "rotation", lo: -percentile("rotation", 0.98, true),
                 hi: percentile("rotation", 0.98, true), stops: DIV },
     strain: { label: "local shear strain", key: "strain", lo: 0, hi: percentile("strain", 0.98), stops: SEQ },
+    porosity: { label: "local porosity (power cell)", key: "porosity", lo: 0, hi: percentile("porosity", 0.98),
+                stops: SEQ },
+    chains: { label: "in a force chain (0 no, 1 yes)", key: "chain", lo: 0, hi: 1, stops: [[200, 200, 210], [150, 20, 30]] },
   };
 
   // ---------------------------------------------------------------- elements
@@ -304,6 +308,8 @@
       ["rotation (rad)", isFinite(a.rotation[i]) ? a.rotation[i].toExponential(3) : "n/a"],
       ["local shear strain", isFinite(a.strain[i]) ? a.strain[i].toFixed(4) : "n/a"],
       ["in shear band", ["no", "yes", "conjugate"][a.in_band[i]] || "no"],
+      ["local porosity", isFinite(a.porosity[i]) ? a.porosity[i].toFixed(4) : "n/a"],
+      ["in a force chain", a.chain[i] ? "yes" : "no"],
     ];
     return rows.map(function (r) {
       return "<tr><th>" + r[0] + "</th><td data-key=\"" + r[0] + "\">" + r[1] + "</td></tr>";
