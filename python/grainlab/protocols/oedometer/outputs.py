@@ -104,6 +104,7 @@ def summarise(run: OedometerRun, config: Config, timeseries: dict[str, np.ndarra
         "k0_jaky": jaky,
         "time_step_s": run.consolidation["time_step_s"],
         "records": len(k),
+        "load_steps": int(timeseries["step"][-1]) - run.load_start_step,
         "wall_time_s": total_s,
         "wall_time_by_phase_s": dict(run.wall_time),
         "grainlab_version": grainlab.__version__,

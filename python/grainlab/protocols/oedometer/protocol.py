@@ -59,6 +59,7 @@ def _confine(context: Context) -> None:
     for name in BOX_WALLS:
         sim.wall(run.walls[name]).velocity = (0.0, 0.0)  # rigid and fixed; the top is servo-loaded
     run.max_vertical_stress_pa = config["consolidation.pressure"]
+    run.load_start_step = sim.step_count
 
 
 def _load(context: Context) -> None:

@@ -13,9 +13,11 @@ __all__ = ["OedometerRun"]
 class OedometerRun(SpecimenRun):
     """What an oedometer run carries from stage to stage (saved in every checkpoint):
     :class:`SpecimenRun`'s fields, the box at sigma_0 with friction on (the strains' reference), the next load
-    step and the largest vertical stress reached so far."""
+    step, the largest vertical stress reached so far and the step the loading started at."""
 
     height0: float = 0.0
     area0: float = 0.0
     next_load: int = 0
     max_vertical_stress_pa: float = 0.0
+    #: The engine step at which the loading started (after the confinement).
+    load_start_step: int = 0
