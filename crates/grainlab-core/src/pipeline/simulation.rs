@@ -25,7 +25,7 @@ use crate::wall::{Wall, WallControl};
 
 /// The first bytes of [`Simulation::to_bytes`]: the layout of the state that
 /// follows (bincode of [`Simulation`]); a new field makes a new tag.
-const STATE_TAG: &[u8; 8] = b"GLSTATE3";
+const STATE_TAG: &[u8; 8] = b"GLSTATE4";
 
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
