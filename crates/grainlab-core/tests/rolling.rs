@@ -247,3 +247,17 @@ fn rolling_resistance_gives_the_same_bits_on_one_and_two_threads_and_without_lan
     assert_eq!(run(2, true), reference, "2 threads");
     assert_eq!(run(1, false), reference, "scalar loop");
 }
+
+/// The critical time step counts the rolling spring in the rotational
+/// stiffness: `sqrt(I / (k_s r^2 + k_r))` for a disk on a wall.
+#[test]
+fn the_critical_time_step_counts_the_rolling_stiffness() {
+    let mut m = model(0.5, 0.1);
+    let plain = disk_on_floor(m, [0.0, -G]).critical_time_step(1.0).unwrap();
+    let k_r = 10.0 * KN * R * R;
+    m.rolling_stiffness = k_r;
+    let dt = disk_on_floor(m, [0.0, -G]).critical_time_step(1.0).unwrap();
+    let expected = (inertia() / (KN * R * R + k_r)).sqrt();
+    assert!((dt / expected - 1.0).abs() < 1e-12, "{dt} vs {expected}");
+    assert!(dt < plain);
+}
