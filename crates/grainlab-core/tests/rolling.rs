@@ -232,6 +232,10 @@ fn rolling_resistance_gives_the_same_bits_on_one_and_two_threads_and_without_lan
         sim.set_simd(simd);
         sim.set_wall_velocity(2, [0.02, -0.002]).unwrap();
         sim.run(400).unwrap();
+        assert!(
+            sim.neighbors().build_count > 1,
+            "the rebuild carried the records"
+        );
         let p = sim.particles();
         let mut bits: Vec<u64> = p.angular_velocity.iter().map(|w| w.to_bits()).collect();
         bits.extend(p.position.iter().flat_map(|x| x.map(f64::to_bits)));
@@ -260,4 +264,28 @@ fn the_critical_time_step_counts_the_rolling_stiffness() {
     let expected = (inertia() / (KN * R * R + k_r)).sqrt();
     assert!((dt / expected - 1.0).abs() < 1e-12, "{dt} vs {expected}");
     assert!(dt < plain);
+}
+
+/// The springs' catch-up (which every change of the motion goes through)
+/// gives the rolling spring the last step's increment `-k_r omega dt` as the
+/// next force evaluation would, and that evaluation then adds none.
+#[test]
+fn the_catch_up_gives_the_rolling_spring_its_increment() {
+    let mu_r = 0.5; // a high cap: the spring stays elastic
+    let mut sim = disk_on_floor(model(0.5, mu_r), [0.0, -G]);
+    sim.set_velocities(&[[0.01, 0.0]]).unwrap();
+    sim.set_angular_velocities(&[-0.01 / R]).unwrap();
+    sim.run(20).unwrap();
+    let before = sim.neighbors().wall_pairs.history.records[0][1];
+    let w = sim.particles().angular_velocity[0];
+    let dt = sim.params().time_step;
+    assert!(before > 0.0 && w < 0.0, "{before} {w}");
+    sim.catch_up_shear_springs();
+    let after = sim.neighbors().wall_pairs.history.records[0][1];
+    let k_r = grainlab_core::law::rolling::RollingSpring::stiffness(sim.materials().get(0, 1), R);
+    assert_eq!(after, before - k_r * w * dt);
+    // a change of the motion now (the springs current) adds no second increment
+    let v = sim.particles().velocity.clone();
+    sim.set_velocities(&v).unwrap();
+    assert_eq!(sim.neighbors().wall_pairs.history.records[0][1], after);
 }
