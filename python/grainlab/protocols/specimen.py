@@ -8,7 +8,6 @@ start with them."""
 
 from __future__ import annotations
 
-
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
