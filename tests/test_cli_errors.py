@@ -94,3 +94,18 @@ def test_an_unreachable_scheduler_is_one_line_after_a_short_wait(tmp_path, capsy
                      "--no-progress"])
     assert code == 2 and time.monotonic() - started < 20
     _one_line(capsys, "--scheduler: cannot reach a Dask scheduler at tcp://127.0.0.1:9 within 1 s")
+
+
+@pytest.mark.parametrize(
+    ("setting", "message"),
+    [
+        ("material.rolling_friction=-0.1", "material.rolling_friction: -0.1 is out of range"),
+        ("material.rolling_stiffness=0", "material.rolling_stiffness: 0"),
+        ("material.rolling_damping=-1", "material.rolling_damping: -1"),
+    ],
+)
+def test_a_bad_rolling_resistance_is_one_line_before_any_folder(tmp_path, capsys, setting, message):
+    out = tmp_path / "run"
+    assert cli.main(["biaxial", "--quick", "--set", setting, "--out", str(out)]) == 2
+    _one_line(capsys, message)
+    assert not out.exists()

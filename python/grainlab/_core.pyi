@@ -50,6 +50,9 @@ class _ContactModel(TypedDict):
     friction: float
     normal_damping_ratio: float
     shear_damping_ratio: float
+    rolling_friction: float
+    rolling_stiffness: float
+    rolling_damping_ratio: float
     enabled: bool
 
 class _Cell(TypedDict):
@@ -180,6 +183,9 @@ class Engine:
         friction: float,
         normal_damping_ratio: float,
         shear_damping_ratio: float,
+        rolling_friction: float = 0.0,
+        rolling_stiffness: float = 0.0,
+        rolling_damping_ratio: float = 0.0,
         enabled: bool = True,
     ) -> None: ...
     def contact_model(self, group_a: int, group_b: int) -> _ContactModel: ...

@@ -63,6 +63,13 @@ class ContactModel:
     (N/m): ``Fn = kn * overlap``, ``dFs = -ks * ds`` (paper Eq. 2-4). The damping
     ratios are fractions of critical damping of optional viscous dashpots
     (``2 sqrt(m* k)``); they are independent of local damping.
+
+    Rolling resistance (docs/contact-law.md, "Rolling resistance"), off by
+    default: ``rolling_friction`` mu_r caps the rolling moment at
+    ``mu_r R* Fn`` (``R* = r_i r_j / (r_i + r_j)``, the radius against a wall);
+    ``rolling_stiffness`` k_r (N m/rad), 0 for the rule
+    ``2.25 kn mu_r^2 R*^2``; ``rolling_damping_ratio`` a fraction of
+    ``2 sqrt(I_r k_r)`` acting below the cap.
     """
 
     normal_stiffness: float = TABLE1_STIFFNESS_N_PER_M
@@ -70,6 +77,9 @@ class ContactModel:
     friction: float = TABLE1_FRICTION
     normal_damping_ratio: float = 0.0
     shear_damping_ratio: float = 0.0
+    rolling_friction: float = 0.0
+    rolling_stiffness: float = 0.0
+    rolling_damping_ratio: float = 0.0
     enabled: bool = True
     """False: the two groups do not interact at all (they pass through each other)."""
 
@@ -527,7 +537,8 @@ class Simulation:
             provisional,
             threads,
         )
-        if model.normal_damping_ratio or model.shear_damping_ratio:
+        if model != ContactModel(model.normal_stiffness, model.shear_stiffness, model.friction):
+            # dashpots, rolling resistance: the fields the engine's constructor does not take
             for a in range(MAX_GROUPS):
                 for b in range(a, MAX_GROUPS):
                     self.set_contact_model(a, b, model)
@@ -718,6 +729,9 @@ class Simulation:
             float(model.friction),
             float(model.normal_damping_ratio),
             float(model.shear_damping_ratio),
+            float(model.rolling_friction),
+            float(model.rolling_stiffness),
+            float(model.rolling_damping_ratio),
             bool(model.enabled),
         )
 

@@ -26,6 +26,9 @@ def two_disks(**kwargs) -> Simulation:
         ({"positions": [[0, 0]], "radii": [1e-3], "density": None}, "density: give the grains' density"),
         ({"positions": [[0, 0]], "radii": [1e-3], "contact_model": ContactModel(normal_stiffness=0.0)}, "normal_stiffness"),
         ({"positions": [[0, 0]], "radii": [1e-3], "contact_model": ContactModel(shear_stiffness=-5.0)}, "shear_stiffness"),
+        ({"positions": [[0, 0]], "radii": [1e-3], "contact_model": ContactModel(rolling_friction=-0.1)}, "rolling_friction"),
+        ({"positions": [[0, 0]], "radii": [1e-3], "contact_model": ContactModel(rolling_stiffness=-1.0)}, "rolling_stiffness"),
+        ({"positions": [[0, 0]], "radii": [1e-3], "contact_model": ContactModel(rolling_damping_ratio=np.nan)}, "rolling_damping_ratio"),
         ({"positions": [[0, 0]], "radii": [1e-3], "local_damping": 1.0}, "local_damping"),
         ({"positions": [[0, 0]], "radii": [1e-3], "time_step": 0.0}, "time_step"),
     ],
@@ -47,6 +50,8 @@ def test_bad_input_after_construction_names_the_field():
         sim.groups = [0, 16]
     with pytest.raises(ValueError, match="normal_stiffness"):
         sim.set_contact_model(0, 1, ContactModel(normal_stiffness=-1.0))
+    with pytest.raises(ValueError, match=r"^contact_model\.rolling_friction: must be finite and >= 0, got -0\.2$"):
+        sim.set_contact_model(0, 1, ContactModel(rolling_friction=-0.2))
     wall = sim.add_segment_wall((0, -1e-3), (1e-2, -1e-3))
     with pytest.raises(ValueError, match="relaxation"):
         wall.servo(1e5, 1e-2, relaxation=2.0)

@@ -139,3 +139,19 @@ def test_a_protocol_declares_its_keys_on_the_shared_ones(monkeypatch):
         toy.resolve(overrides=["load.pressure=-1"])
     with pytest.raises(ConfigError, match="sample.d_min: 0.004 m exceeds sample.d_max"):
         toy.resolve(overrides=["sample.d_min=4mm"])  # the shared checks come with the shared keys
+
+
+def test_the_rolling_resistance_keys_reach_the_grain_and_platen_models() -> None:
+    from grainlab import ContactModel
+    from grainlab.protocols.specimen import grain_model, platen_model
+
+    # off by default: the paper's law, the engine's defaults
+    default = resolve()
+    assert (default["material.rolling_friction"], default["material.rolling_stiffness"]) == (0.0, "auto")
+    assert grain_model(default) == ContactModel(default["material.normal_stiffness"],
+                                                default["material.shear_stiffness"], default["material.friction"])
+    config = resolve(overrides=["material.rolling_friction=0.1", "material.rolling_damping=0.3"])
+    for model in (grain_model(config), platen_model(config)):
+        assert (model.rolling_friction, model.rolling_stiffness, model.rolling_damping_ratio) == (0.1, 0.0, 0.3)
+    config = resolve(overrides=["material.rolling_friction=0.1", "material.rolling_stiffness=25"])
+    assert grain_model(config).rolling_stiffness == 25.0

@@ -21,6 +21,15 @@ pub struct ContactModel {
     pub normal_damping_ratio: f64,
     /// Shear viscous damping, fraction of critical `2 sqrt(m* ks)`.
     pub shear_damping_ratio: f64,
+    /// Rolling friction coefficient mu_r: the rolling moment is capped at
+    /// `mu_r R* F_n` (0, the default, disables rolling resistance).
+    pub rolling_friction: f64,
+    /// Rolling stiffness k_r (N m/rad); 0 (the default) for the rule
+    /// `2.25 k_n mu_r^2 R*^2` (Iwashita and Oda; Ai et al. 2011).
+    pub rolling_stiffness: f64,
+    /// Rolling viscous damping, fraction of critical `2 sqrt(I_r k_r)`,
+    /// acting while the rolling spring is below its cap.
+    pub rolling_damping_ratio: f64,
     /// Whether the two groups interact at all; `false` lets them pass through
     /// each other (e.g. the disks of a membrane chain, held together by bonds).
     pub enabled: bool,
@@ -35,6 +44,9 @@ impl ContactModel {
             friction,
             normal_damping_ratio: 0.0,
             shear_damping_ratio: 0.0,
+            rolling_friction: 0.0,
+            rolling_stiffness: 0.0,
+            rolling_damping_ratio: 0.0,
             enabled: true,
         }
     }
@@ -51,6 +63,15 @@ impl ContactModel {
         require_non_negative(
             &format!("{field}.shear_damping_ratio"),
             self.shear_damping_ratio,
+        )?;
+        require_non_negative(&format!("{field}.rolling_friction"), self.rolling_friction)?;
+        require_non_negative(
+            &format!("{field}.rolling_stiffness"),
+            self.rolling_stiffness,
+        )?;
+        require_non_negative(
+            &format!("{field}.rolling_damping_ratio"),
+            self.rolling_damping_ratio,
         )?;
         Ok(())
     }
@@ -139,6 +160,12 @@ impl MaterialTable {
         self.models
             .iter()
             .all(|m| m.normal_damping_ratio == 0.0 && m.shear_damping_ratio == 0.0)
+    }
+
+    /// Whether any model of the table has rolling resistance (`rolling_friction`
+    /// above 0): the four-pair lanes, which have none, then do not run.
+    pub fn rolling(&self) -> bool {
+        self.models.iter().any(|m| m.rolling_friction != 0.0)
     }
 
     /// Largest normal or shear stiffness of any model involving group `g`.

@@ -219,6 +219,7 @@ pub(crate) struct ParticleMotion<'a> {
     pub angular_velocity: &'a [f64],
     pub radius: &'a [f64],
     pub mass: &'a [f64],
+    pub inertia: &'a [f64],
 }
 
 impl<'a> ParticleMotion<'a> {
@@ -230,6 +231,7 @@ impl<'a> ParticleMotion<'a> {
             angular_velocity: &p.angular_velocity,
             radius: &p.radius,
             mass: &p.mass,
+            inertia: &p.inertia,
         }
     }
 }

@@ -171,7 +171,7 @@ impl Engine {
         self.sim.set_skin(skin).map_err(to_py_err)
     }
 
-    #[pyo3(signature = (group_a, group_b, normal_stiffness, shear_stiffness, friction, normal_damping_ratio, shear_damping_ratio, enabled=true))]
+    #[pyo3(signature = (group_a, group_b, normal_stiffness, shear_stiffness, friction, normal_damping_ratio, shear_damping_ratio, rolling_friction=0.0, rolling_stiffness=0.0, rolling_damping_ratio=0.0, enabled=true))]
     #[allow(clippy::too_many_arguments)]
     fn set_contact_model(
         &mut self,
@@ -182,6 +182,9 @@ impl Engine {
         friction: f64,
         normal_damping_ratio: f64,
         shear_damping_ratio: f64,
+        rolling_friction: f64,
+        rolling_stiffness: f64,
+        rolling_damping_ratio: f64,
         enabled: bool,
     ) -> PyResult<()> {
         let model = ContactModel {
@@ -190,6 +193,9 @@ impl Engine {
             friction,
             normal_damping_ratio,
             shear_damping_ratio,
+            rolling_friction,
+            rolling_stiffness,
+            rolling_damping_ratio,
             enabled,
         };
         self.sim
@@ -218,6 +224,9 @@ impl Engine {
         d.set_item("friction", m.friction)?;
         d.set_item("normal_damping_ratio", m.normal_damping_ratio)?;
         d.set_item("shear_damping_ratio", m.shear_damping_ratio)?;
+        d.set_item("rolling_friction", m.rolling_friction)?;
+        d.set_item("rolling_stiffness", m.rolling_stiffness)?;
+        d.set_item("rolling_damping_ratio", m.rolling_damping_ratio)?;
         d.set_item("enabled", m.enabled)?;
         Ok(d)
     }

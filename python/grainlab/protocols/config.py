@@ -120,6 +120,16 @@ SHARED_FIELDS: dict[str, Field] = {
     "material.shear_stiffness": Field("stiffness", paper.SHEAR_STIFFNESS_N_PER_M, "contact ks (Table 1)", **_POSITIVE),
     "material.friction": Field("number", paper.FRICTION, "particle friction (Table 1: 0.9)", minimum=0.0),
     "material.platen_friction": Field("number", paper.PLATEN_FRICTION, "particle-platen friction (Table 1: 0)", minimum=0.0),
+    "material.rolling_friction": Field(
+        "number", 0.0, "rolling friction mu_r between grains and at the platens (0: none, the paper's law)", minimum=0.0
+    ),
+    "material.rolling_stiffness": Field(
+        "number", "auto", "rolling stiffness k_r in N m/rad (auto: 2.25 kn mu_r^2 R*^2)",
+        **_POSITIVE, allow_auto=True,
+    ),
+    "material.rolling_damping": Field(
+        "number", 0.0, "rolling dashpot, fraction of critical 2 sqrt(I_r k_r), below the cap", minimum=0.0
+    ),
     "material.density": Field("density", paper.DENSITY_KG_PER_M3, "scaled particle density (Table 1: 2e8 kg/m^3)", **_POSITIVE),
     "material.limiting_contact_pressure": Field(
         "stress", paper.LIMITING_CONTACT_PRESSURE_PA, "p_y of the density scaling factor, paper Eq. 16 (Table 1: 150 MPa)", **_POSITIVE

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
@@ -120,16 +120,28 @@ def engine_threads(config: Config) -> int:
     return available_cores() if threads == "auto" else int(threads)
 
 
-def grain_model(config: Config) -> ContactModel:
-    return ContactModel(
-        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.friction"]
+def _with_rolling(config: Config, model: ContactModel) -> ContactModel:
+    """``model`` with the rolling resistance of ``config`` (off by default; a
+    stiffness of 0 is the engine's rule, ``auto``)."""
+    stiffness = config["material.rolling_stiffness"]
+    return replace(
+        model,
+        rolling_friction=float(config["material.rolling_friction"]),
+        rolling_stiffness=0.0 if stiffness == "auto" else float(stiffness),
+        rolling_damping_ratio=float(config["material.rolling_damping"]),
     )
+
+
+def grain_model(config: Config) -> ContactModel:
+    return _with_rolling(config, ContactModel(
+        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.friction"]
+    ))
 
 
 def platen_model(config: Config) -> ContactModel:
-    return ContactModel(
+    return _with_rolling(config, ContactModel(
         config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.platen_friction"]
-    )
+    ))
 
 
 def generate(config: Config, threads: int, progress: bool, state: type[R], phase: str,

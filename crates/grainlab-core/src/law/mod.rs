@@ -2,8 +2,8 @@
 //! **normal** ([`normal::LinearSpring`]: `kn * overlap`), **damping**
 //! ([`damping::ViscousDashpots`]: the optional normal and shear dashpots),
 //! **tangential** ([`tangential::ShearSpring`]: the incremental shear spring
-//! with its Coulomb cap, paper Eq. 2-4) and **rolling** ([`rolling::NoRolling`]:
-//! none yet). [`contact_law`] runs them in that order for one contact and
+//! with its Coulomb cap, paper Eq. 2-4) and **rolling** ([`rolling::RollingSpring`]:
+//! the elastic-plastic rolling spring, off unless a model has `rolling_friction`). [`contact_law`] runs them in that order for one contact and
 //! returns its forces, its torques on both bodies and each sub-model's
 //! dissipation; the pair kernel, its AVX2 lanes (checked against it bit for
 //! bit), the wall contacts, the springs' catch-up and the contact queries all
@@ -22,7 +22,10 @@
 //! - `tangential_velocity = (v_j - v_i) . t - (omega_i r_i + omega_j r_j)`,
 //!   the sliding speed of `j`'s surface relative to `i`'s (Eq. 2);
 //! - the force on `j` is `fn n + fs t` and on `i` its opposite; the torque on
-//!   both is `-r fs` with `r` the body's radius (lever arm to the contact).
+//!   both is `-r fs` with `r` the body's radius (lever arm to the contact);
+//! - `rolling_velocity = omega_j - omega_i` (counter-clockwise positive; a
+//!   wall, body `i`, does not turn), and the rolling moment `M_r` acts on `j`
+//!   and `-M_r` on `i` (a couple: the torques sum to zero).
 //!
 //! In 2D the shear spring is one scalar along the current tangent, so carrying
 //! it from step to step *is* the PFC rotation of the shear force with the contact.
@@ -129,7 +132,7 @@ pub type Damping = damping::ViscousDashpots;
 /// The tangential sub-model of the law.
 pub type Tangential = tangential::ShearSpring;
 /// The rolling sub-model of the law.
-pub type Rolling = rolling::NoRolling;
+pub type Rolling = rolling::RollingSpring;
 
 /// Values of history per contact: the sub-models' declared [`SubModel::HISTORY`], summed.
 pub const HISTORY_WIDTH: usize =
@@ -147,12 +150,13 @@ pub const ROLLING_HISTORY: Range<usize> =
     TANGENTIAL_HISTORY.end..TANGENTIAL_HISTORY.end + Rolling::HISTORY;
 
 /// Whether the four-pair AVX2 loop evaluates this law (every sub-model has
-/// lanes, and the record is the tangential spring alone, which the lanes load).
+/// lanes, and the record starts with the tangential spring, which the lanes
+/// load). The lanes have no rolling resistance: the kernel runs them only for
+/// a table without it ([`crate::material::MaterialTable::rolling`]).
 pub const LANES: bool = Normal::LANES
     && Damping::LANES
     && Tangential::LANES
     && Rolling::LANES
-    && HISTORY_WIDTH == 1
     && TANGENTIAL_HISTORY.start == 0;
 
 /// One contact's history: every sub-model's values, in its slot; all zero for
@@ -175,6 +179,12 @@ pub struct ContactKinematics {
     /// `m_i m_j / (m_i + m_j)`, or the particle's mass against a wall (kg);
     /// read only by the dashpots (0 when no model has one).
     pub reduced_mass: f64,
+    /// `omega_j - omega_i` (rad/s), the relative rolling velocity.
+    pub rolling_velocity: f64,
+    /// The equivalent rotational inertia about the contact (kg m^2),
+    /// `[1/(I_i + m_i r_i^2) + 1/(I_j + m_j r_j^2)]^-1`, `I + m r^2` against a
+    /// wall; read only by the rolling dashpot (0 when the model has none).
+    pub rolling_inertia: f64,
 }
 
 /// What the contact law returns for one contact in one step.
@@ -190,10 +200,16 @@ pub struct ContactForce {
     pub shear_spring: f64,
     /// Whether the shear spring is at the Coulomb cap, `|Fs| = mu kn overlap`.
     pub sliding: bool,
-    /// Torque on body `i` (N m): `-r_i Fs`, plus any rolling resistance.
+    /// Torque on body `i` (N m): `-r_i Fs - M_r`.
     pub torque_i: f64,
-    /// Torque on body `j` (N m): `-r_j Fs`, plus any rolling resistance.
+    /// Torque on body `j` (N m): `-r_j Fs + M_r`.
     pub torque_j: f64,
+    /// The rolling sub-model's spring `M_r^k` after the update (N m; 0 when off).
+    pub rolling_spring: f64,
+    /// The rolling moment on `j` (N m), spring plus dashpot (0 when off).
+    pub rolling_moment: f64,
+    /// The rolling spring's elastic energy `M_r^2 / (2 k_r)` (J; 0 when off).
+    pub rolling_energy: f64,
     /// Energy each dissipating sub-model took out of the system this step (J).
     pub dissipation: ContactDissipation,
 }
@@ -246,6 +262,9 @@ pub fn contact_law<const DASHPOTS: bool>(
         sliding: state.sliding,
         torque_i: -kinematics.radius_i * shear,
         torque_j: -kinematics.radius_j * shear,
+        rolling_spring: 0.0,
+        rolling_moment: 0.0,
+        rolling_energy: 0.0,
         dissipation,
     };
     Rolling::apply(
@@ -263,6 +282,21 @@ pub fn contact_law<const DASHPOTS: bool>(
 #[inline(always)]
 pub fn elastic_energy(model: &ContactModel, normal: f64, shear: f64) -> f64 {
     0.5 * normal * normal / model.normal_stiffness + 0.5 * shear * shear / model.shear_stiffness
+}
+
+impl ContactForce {
+    /// Elastic energy stored in the contact (J): [`elastic_energy`] plus the
+    /// rolling spring's, added only when there is one (so that a contact
+    /// without rolling resistance keeps its bits).
+    #[inline(always)]
+    pub fn stored_energy(&self, model: &ContactModel) -> f64 {
+        let e = elastic_energy(model, self.elastic_normal, self.shear_spring);
+        if self.rolling_energy != 0.0 {
+            e + self.rolling_energy
+        } else {
+            e
+        }
+    }
 }
 
 #[cfg(test)]
@@ -292,8 +326,11 @@ mod tests {
             radius_i: 1.0,
             radius_j: 1.0,
             reduced_mass: mass,
+            rolling_velocity: 0.0,
+            rolling_inertia: 0.0,
         };
-        let mut record = [*s];
+        let mut record = [0.0; HISTORY_WIDTH];
+        record[TANGENTIAL_HISTORY.start] = *s;
         let f = contact_law::<true>(m, &kinematics, dt, increment_time, &mut record);
         *s = record[TANGENTIAL_HISTORY.start];
         f
@@ -301,10 +338,10 @@ mod tests {
 
     #[test]
     fn the_record_holds_each_sub_models_declared_history() {
-        assert_eq!(HISTORY_WIDTH, 1);
+        assert_eq!(HISTORY_WIDTH, 2);
         assert_eq!(TANGENTIAL_HISTORY, 0..1);
         assert!(NORMAL_HISTORY.is_empty() && DAMPING_HISTORY.is_empty());
-        assert!(ROLLING_HISTORY.is_empty());
+        assert_eq!(ROLLING_HISTORY, 1..2);
         assert!(LANES);
     }
 
@@ -327,6 +364,8 @@ mod tests {
             radius_i: 0.25,
             radius_j: 3.0,
             reduced_mass: 1.0,
+            rolling_velocity: 0.0,
+            rolling_inertia: 0.0,
         };
         let mut record = [0.0; HISTORY_WIDTH];
         let f = contact_law::<true>(&m, &kinematics, 1e-6, 1e-6, &mut record);
@@ -441,5 +480,134 @@ mod tests {
         let f = law(&m, 2.0e-6, 0.0, vt, dt, dt, mass, &mut s);
         assert!(f.sliding);
         assert_eq!((f.shear, f.dissipation.viscous), (-1.0, 0.0));
+    }
+
+    /// Two disks of radii 1 and 3 (R* = 0.75) in contact at 2e-6 overlap with
+    /// kn = 1e6 (F_n = 2 N), rolling resistance mu_r and stiffness k_r.
+    fn rolling_contact(
+        mu_r: f64,
+        k_r: f64,
+        rolling_velocity: f64,
+    ) -> (ContactModel, ContactKinematics) {
+        let mut m = model(0.5);
+        m.rolling_friction = mu_r;
+        m.rolling_stiffness = k_r;
+        let kinematics = ContactKinematics {
+            overlap: 2.0e-6,
+            normal_velocity: 0.0,
+            tangential_velocity: 0.0,
+            radius_i: 1.0,
+            radius_j: 3.0,
+            reduced_mass: 1.0,
+            rolling_velocity,
+            rolling_inertia: 2.0,
+        };
+        (m, kinematics)
+    }
+
+    /// Oracle (two disks, a prescribed relative rotation): after rotating `j`
+    /// against `i` by `dtheta = (omega_j - omega_i) dt` in one increment the
+    /// rolling spring is exactly `-k_r dtheta` while below the cap
+    /// `mu_r R* F_n`, and the moment acts on `j` and its opposite on `i` (a
+    /// couple: the two torques, with no shear force, sum to zero). Rotated on,
+    /// the spring stops at the cap and the plastic rotation's work is booked
+    /// in `rolling`, as a slip's is in `friction`.
+    #[test]
+    fn the_rolling_spring_is_minus_k_r_times_the_rotation_then_its_cap() {
+        // cap = mu_r R* F_n = 0.1 * 0.75 * 2 = 0.15 N m; k_r = 100 N m/rad
+        let (m, k) = rolling_contact(0.1, 100.0, 1.0);
+        let dt = 1.0e-3; // dtheta = 1e-3 rad: M_r = -0.1 N m, elastic
+        let mut record = [0.0; HISTORY_WIDTH];
+        let f = contact_law::<true>(&m, &k, dt, dt, &mut record);
+        assert_eq!(f.rolling_spring, -100.0 * 1.0e-3);
+        assert_eq!(record[ROLLING_HISTORY.start], f.rolling_spring);
+        assert_eq!((f.torque_i, f.torque_j), (0.1, -0.1));
+        assert_eq!(f.torque_i + f.torque_j, 0.0);
+        assert_eq!(f.dissipation.rolling, 0.0);
+        assert!((f.rolling_energy - 0.5 * 0.01 / 100.0).abs() < 1e-18);
+        // another 1e-3 rad: the trial -0.2 N m passes the cap, the spring stays at -0.15
+        let cap = 0.1 * 0.75 * f.elastic_normal;
+        let f = contact_law::<true>(&m, &k, dt, dt, &mut record);
+        assert_eq!(f.rolling_spring, -cap);
+        assert!((cap - 0.15).abs() < 1e-15);
+        assert_eq!((f.torque_i, f.torque_j), (cap, -cap));
+        // dissipated: the mean moment (-0.1 - 0.15)/2 times the plastic rotation (-0.05/k_r)
+        let work = 0.5 * (-0.1 - 0.15) * (-0.2 + 0.15) / 100.0;
+        assert!((f.dissipation.rolling - work).abs() < 1e-16);
+        // at the cap, turning on: the moment stays, each increment k_r dtheta dissipated at the cap
+        let f = contact_law::<true>(&m, &k, dt, dt, &mut record);
+        assert_eq!(f.rolling_spring, -cap);
+        assert!((f.dissipation.rolling - 0.15 * 1.0e-3).abs() < 1e-15);
+        // turning back unloads elastically: -0.15 + 100 * 1e-3 = -0.05
+        let (_, back) = rolling_contact(0.1, 100.0, -1.0);
+        let f = contact_law::<true>(&m, &back, dt, dt, &mut record);
+        assert!((f.rolling_spring + 0.05).abs() < 1e-15);
+        assert_eq!(f.dissipation.rolling, 0.0);
+        // no increment time (a step from full-step velocities): the spring is left as it is
+        let f = contact_law::<true>(&m, &back, dt, 0.0, &mut record);
+        assert!((f.rolling_spring + 0.05).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_rolling_stiffness_rule_is_2_25_kn_mu_r_squared_r_star_squared() {
+        let (m, k) = rolling_contact(0.2, 0.0, 1.0);
+        let r_star = rolling::RollingSpring::effective_radius(&k);
+        assert_eq!(r_star, 0.75);
+        let k_r = 2.25 * 1.0e6 * 0.2 * 0.2 * 0.75 * 0.75;
+        assert_eq!(rolling::RollingSpring::stiffness(&m, r_star), k_r);
+        let mut record = [0.0; HISTORY_WIDTH];
+        let dt = 1.0e-7; // k_r dtheta = 5.06e-3 N m, below the cap 0.3 N m
+        let f = contact_law::<true>(&m, &k, dt, dt, &mut record);
+        assert_eq!(f.rolling_spring, -(k_r * 1.0 * dt));
+        // against a wall (r_i = 0), R* is the particle's radius
+        let wall = ContactKinematics { radius_i: 0.0, ..k };
+        assert_eq!(rolling::RollingSpring::effective_radius(&wall), 3.0);
+    }
+
+    /// The rolling dashpot `-eta_r 2 sqrt(I_r k_r) (omega_j - omega_i)` acts on
+    /// top of the spring while it is below the cap, is not stored, and takes
+    /// `c_r w^2 dt` out; at the cap it is off.
+    #[test]
+    fn the_rolling_dashpot_acts_only_below_the_cap() {
+        let (mut m, k) = rolling_contact(0.1, 100.0, 0.5);
+        m.rolling_damping_ratio = 0.3;
+        let c_r = 2.0 * 0.3 * (2.0f64 * 100.0).sqrt();
+        let dt = 1.0e-3;
+        let mut record = [0.0; HISTORY_WIDTH];
+        let f = contact_law::<true>(&m, &k, dt, dt, &mut record);
+        assert_eq!(f.rolling_spring, -0.05);
+        assert_eq!(record[ROLLING_HISTORY.start], -0.05);
+        assert_eq!(f.rolling_moment, -0.05 - c_r * 0.5);
+        assert_eq!(
+            (f.torque_i, f.torque_j),
+            (-f.rolling_moment, f.rolling_moment)
+        );
+        assert_eq!(f.dissipation.rolling, c_r * 0.5 * 0.5 * dt);
+        let cap = 0.1 * 0.75 * f.elastic_normal;
+        record[ROLLING_HISTORY.start] = -cap;
+        let f = contact_law::<true>(&m, &k, dt, dt, &mut record);
+        assert_eq!((f.rolling_spring, f.rolling_moment), (-cap, -cap));
+        assert!((f.dissipation.rolling - 0.15 * 0.5e-3).abs() < 1e-15);
+    }
+
+    /// With `rolling_friction` 0 (the default) the rolling sub-model does
+    /// nothing: the law's bits, torques and record are today's.
+    #[test]
+    fn without_rolling_friction_the_rolling_slot_is_left_and_no_moment_acts() {
+        let (mut m, k) = rolling_contact(0.0, 100.0, 3.0);
+        m.rolling_damping_ratio = 0.5;
+        let k = ContactKinematics {
+            tangential_velocity: 1.0,
+            ..k
+        };
+        let mut record = [0.0; HISTORY_WIDTH];
+        let f = contact_law::<true>(&m, &k, 1e-6, 1e-6, &mut record);
+        assert_eq!(record[ROLLING_HISTORY.start].to_bits(), 0.0f64.to_bits());
+        assert_eq!(
+            (f.rolling_spring, f.rolling_moment, f.rolling_energy),
+            (0.0, 0.0, 0.0)
+        );
+        assert_eq!((f.torque_i, f.torque_j), (-f.shear, -3.0 * f.shear));
+        assert_eq!(f.dissipation.rolling, 0.0);
     }
 }

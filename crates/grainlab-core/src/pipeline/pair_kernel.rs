@@ -71,6 +71,8 @@ pub(crate) fn wall_contact(
         radius_i: 0.0,
         radius_j: r,
         reduced_mass: p.mass[q],
+        rolling_velocity: p.angular_velocity[q],
+        rolling_inertia: p.inertia[q] + p.mass[q] * r * r,
     };
     let c = contact_law::<true>(model, &kinematics, dt, increment_time, record);
     Some((g, c))
@@ -323,6 +325,7 @@ macro_rules! pair_kernel {
             angular_velocity: &$p.angular_velocity,
             radius: &$p.radius,
             mass: &$p.mass,
+            inertia: &$p.inertia,
             pair_i: &$pairs.i,
             pair_j: &$pairs.j,
             shift: &$pairs.shift,
@@ -339,6 +342,7 @@ macro_rules! pair_kernel {
             max_overlap_ratio: $sim.params.max_overlap_ratio,
             single_model: $sim.materials.single_undamped_model(),
             undamped: $sim.materials.undamped(),
+            rolling: $sim.materials.rolling(),
             vector: $sim.simd,
         }
     };
@@ -353,6 +357,7 @@ pub(crate) struct PairKernel<'a> {
     pub(crate) angular_velocity: &'a [f64],
     pub(crate) radius: &'a [f64],
     pub(crate) mass: &'a [f64],
+    pub(crate) inertia: &'a [f64],
     pub(crate) pair_i: &'a [u32],
     pub(crate) pair_j: &'a [u32],
     pub(crate) shift: &'a [[i8; 2]],
@@ -367,6 +372,8 @@ pub(crate) struct PairKernel<'a> {
     pub(crate) single_model: Option<ContactModel>,
     /// No model has a dashpot.
     pub(crate) undamped: bool,
+    /// Some model has rolling resistance (which the four-pair loop lacks).
+    pub(crate) rolling: bool,
     /// Whether undamped pairs run four at a time ([`crate::Simulation::set_simd`]).
     pub(crate) vector: bool,
 }
@@ -437,7 +444,7 @@ impl PairKernel<'_> {
         sink: &mut S,
     ) -> ContactTally {
         // (`vector` is never set where the four-pair loop does not exist)
-        if !DASHPOTS && self.vector && crate::law::LANES {
+        if !DASHPOTS && self.vector && !self.rolling && crate::law::LANES {
             #[cfg(target_arch = "x86_64")]
             return self
                 .pairs_by_four::<MEASURE, DEFORMING, SINGLE, S>(first, records, sliding, sink);
@@ -580,9 +587,11 @@ impl PairKernel<'_> {
             dv = add(dv, mat_vec(&fixed.gradient, d));
         }
         let vn = dot(dv, n);
-        let vt = dot(dv, t)
-            - (*self.angular_velocity.get_unchecked(i) * ri
-                + *self.angular_velocity.get_unchecked(j) * rj);
+        let (wi, wj) = (
+            *self.angular_velocity.get_unchecked(i),
+            *self.angular_velocity.get_unchecked(j),
+        );
+        let vt = dot(dv, t) - (wi * ri + wj * rj);
         let model = self.model_of::<SINGLE>(fixed, columns, k);
         let reduced_mass =
             if DASHPOTS && (model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0) {
@@ -598,6 +607,14 @@ impl PairKernel<'_> {
             radius_i: ri,
             radius_j: rj,
             reduced_mass,
+            rolling_velocity: wj - wi,
+            rolling_inertia: if model.rolling_damping_ratio > 0.0 {
+                let ii = self.inertia[i] + self.mass[i] * ri * ri;
+                let ij = self.inertia[j] + self.mass[j] * rj * rj;
+                ii * ij / (ii + ij)
+            } else {
+                0.0
+            },
         };
         let (dt, increment_time) = (self.dt, self.increment_time);
         let c = if !DASHPOTS {
@@ -646,6 +663,9 @@ impl PairKernel<'_> {
         if MEASURE {
             let spring = c.shear_spring;
             tally.elastic += elastic_energy(model, model.normal_stiffness * p.overlap, spring);
+            if c.rolling_energy != 0.0 {
+                tally.elastic += c.rolling_energy;
+            }
             tally.force_sum += (c.normal * c.normal + c.shear * c.shear).sqrt();
             tally.contacts += 1;
         }

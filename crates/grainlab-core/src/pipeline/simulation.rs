@@ -15,6 +15,7 @@ use crate::error::{
     require_finite_points, require_finite_values, require_non_negative, require_positive,
     EngineError, Result,
 };
+use crate::law::rolling::RollingSpring;
 use crate::law::ContactForce;
 use crate::material::{ContactModel, MaterialTable};
 use crate::neighbor::NeighborList;
@@ -25,7 +26,7 @@ use crate::wall::{Wall, WallControl};
 
 /// The first bytes of [`Simulation::to_bytes`]: the layout of the state that
 /// follows (bincode of [`Simulation`]); a new field makes a new tag.
-const STATE_TAG: &[u8; 8] = b"GLSTATE3";
+const STATE_TAG: &[u8; 8] = b"GLSTATE4";
 
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -889,15 +890,18 @@ impl Simulation {
         self.ledger
     }
 
-    /// A time step estimate: `safety * min_i min(sqrt(m_i / k_n,i), sqrt(I_i / (k_s,i r_i^2)))`
-    /// where `k_n,i` and `k_s,i` sum the stiffnesses of particle `i`'s current
-    /// contacts and bonds (one contact of its stiffest model when it has none).
+    /// A time step estimate: `safety * min_i min(sqrt(m_i / k_n,i), sqrt(I_i / (k_s,i r_i^2 + k_r,i)))`
+    /// where `k_n,i`, `k_s,i` and `k_r,i` sum the normal, shear and rolling
+    /// stiffnesses of particle `i`'s current contacts and bonds (one contact of
+    /// its stiffest model when it has none; rolling only where a model has
+    /// rolling resistance).
     pub fn critical_time_step(&mut self, safety: f64) -> Result<f64> {
         require_positive("safety", safety)?;
         self.ensure_neighbors()?;
         let n = self.particles.len();
         let mut kn = vec![0.0; n];
         let mut ks = vec![0.0; n];
+        let mut kr = vec![0.0; n];
         let p = &self.particles;
         let pairs = &self.neighbors.pairs;
         for k in 0..pairs.len() {
@@ -912,6 +916,12 @@ impl Simulation {
                     kn[q] += m.normal_stiffness;
                     ks[q] += m.shear_stiffness;
                 }
+                if m.rolling_friction > 0.0 {
+                    let (ri, rj) = (p.radius[i], p.radius[j]);
+                    let k_r = RollingSpring::stiffness(m, ri * rj / (ri + rj));
+                    kr[i] += k_r;
+                    kr[j] += k_r;
+                }
             }
         }
         let wp = &self.neighbors.wall_pairs;
@@ -925,6 +935,9 @@ impl Simulation {
                 let m = self.materials.by_index(wp.model[k]);
                 kn[q] += m.normal_stiffness;
                 ks[q] += m.shear_stiffness;
+                if m.rolling_friction > 0.0 {
+                    kr[q] += RollingSpring::stiffness(m, p.radius[q]);
+                }
             }
         }
         for b in &self.bonds.list {
@@ -939,9 +952,14 @@ impl Simulation {
             let kn_q = if kn[q] > 0.0 { kn[q] } else { fallback };
             let ks_q = if ks[q] > 0.0 { ks[q] } else { fallback };
             let r = p.radius[q];
+            let rotation = if kr[q] > 0.0 {
+                ks_q * r * r + kr[q]
+            } else {
+                ks_q * r * r
+            };
             dt = dt
                 .min((p.mass[q] / kn_q).sqrt())
-                .min((p.inertia[q] / (ks_q * r * r)).sqrt());
+                .min((p.inertia[q] / rotation).sqrt());
         }
         Ok(safety * dt)
     }

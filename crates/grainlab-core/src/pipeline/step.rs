@@ -14,7 +14,7 @@ use crate::error::Result;
 use crate::integrate::{
     integrate_stripe, IntegrationInputs, IntegrationStep, IntegrationTally, MotionStripe,
 };
-use crate::law::{elastic_energy, ContactRecord};
+use crate::law::ContactRecord;
 use crate::parallel::{
     even_bounds, map_stripes, split_ranges, DisjointWriter, Team, PARALLEL_MIN_PARTICLES,
 };
@@ -347,6 +347,7 @@ impl Simulation {
             angular_velocity: &p.angular_velocity,
             radius: &p.radius,
             mass: &p.mass,
+            inertia: &p.inertia,
         };
         let cell = self.cell.as_ref();
         let stripe_ranges = &self.neighbors.stripe_ranges;
@@ -436,7 +437,7 @@ impl Simulation {
                             ..WallSlot::default()
                         };
                         if MEASURE {
-                            slot.elastic = elastic_energy(model, c.elastic_normal, c.shear_spring);
+                            slot.elastic = c.stored_energy(model);
                             slot.force_norm = (c.normal * c.normal + c.shear * c.shear).sqrt();
                         }
                     }
@@ -556,11 +557,7 @@ impl Simulation {
                     force: f,
                     dissipation: c.dissipation,
                     overlap_violation: g.overlap > self.params.max_overlap_ratio * r,
-                    elastic: if MEASURE {
-                        elastic_energy(model, c.elastic_normal, c.shear_spring)
-                    } else {
-                        0.0
-                    },
+                    elastic: if MEASURE { c.stored_energy(model) } else { 0.0 },
                     force_norm: if MEASURE {
                         (c.normal * c.normal + c.shear * c.shear).sqrt()
                     } else {
