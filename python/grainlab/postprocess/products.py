@@ -195,7 +195,8 @@ def _make_items(reference: Snapshot, current: Snapshot, reference_name: str, nam
                 wanted: Sequence[str]) -> dict[str, AnalysisItem]:
     """The items ``wanted`` of one snapshot against the reference, made anew."""
     items: dict[str, AnalysisItem] = {}
-    stability = StabilityIndex().compute(current)
+    needs_lambda = {"stability_index", "band_strain", "band_lambda"} & set(wanted)
+    stability = StabilityIndex().compute(current) if needs_lambda else StabilityIndex()
     if "stability_index" in wanted:
         items["stability_index"] = _lambda_item(stability)
     if "local_porosity" in wanted:
