@@ -1,6 +1,7 @@
 """The time-series columns the protocols record, in one place: each column's
 name, unit and meaning (:class:`Column`), and the columns of each test
-(:class:`Columns`: :data:`BIAXIAL`, :data:`OEDOMETER`, :data:`CYCLIC`).
+(:class:`Columns`: :data:`BIAXIAL`, :data:`OEDOMETER`, :data:`CYCLIC`,
+:data:`SIMPLE_SHEAR`).
 
 A :class:`Column` *is* its name (a ``str``), so ``timeseries[AXIAL_STRAIN]``
 reads the column from a results file, a CSV or a record, while
@@ -33,10 +34,16 @@ __all__ = [
     "Column",
     "Columns",
     "FABRIC",
+    "FRICTION_COEFFICIENT",
     "HORIZONTAL_STRESS_PA",
+    "INERTIAL_NUMBER",
     "LATERAL_STRESS_RATIO",
     "OEDOMETER",
+    "NORMAL_STRESS_PA",
     "OVERCONSOLIDATION_RATIO",
+    "SHEAR_STRAIN",
+    "SHEAR_STRESS_PA",
+    "SIMPLE_SHEAR",
     "STRAIN_PATH",
     "STRESS_RATIO",
     "VERTICAL_STRESS_PA",
@@ -179,8 +186,34 @@ CYCLE = Column("cycle", "1", "cycles done: strain_path / (4 x amplitude)")
 #: The cyclic biaxial test's records (grainlab.protocols.cyclic): the biaxial test's and the path.
 CYCLIC = Columns("cyclic", BIAXIAL.columns, (STRAIN_PATH, CYCLE))
 
+# ---- the periodic simple-shear test's ------------------------------------------------
+SHEAR_STRAIN = Column("shear_strain", "1", "shear strain gamma, the imposed shear rate integrated over time")
+SHEAR_STRESS_PA = Column("shear_stress_pa", "Pa", "shear stress tau = -sigma_xy of the cell (contacts and kinetic)")
+NORMAL_STRESS_PA = Column("normal_stress_pa", "Pa", "normal stress sigma_n = sigma_yy of the cell")
+LATERAL_NORMAL_STRESS_PA = Column("lateral_stress_pa", "Pa", "sigma_xx of the cell")
+FRICTION_COEFFICIENT = Column("friction_coefficient", "1", "effective friction mu = tau / sigma_n")
+INERTIAL_NUMBER = Column("inertial_number", "1", "I = gamma_dot d / sqrt(sigma_n / rho), d the mean diameter")
+CELL_TILT = Column("cell_tilt", "1", "the cell's tilt along x over its width, within [-1/2, 1/2] (remapped)")
+KINETIC_STRESS_RATIO = Column("kinetic_stress_share", "1", "kinetic part of sigma_yy over sigma_yy")
+RB_STRESS_RATIO = Column("rb_stress_ratio", "1", "q/p = (s1 - s2) / (s1 + s2) of the contact stress")
+RB_PREDICTED = Column("rb_predicted_stress_ratio", "1", "Rothenburg-Bathurst: (a + a_n + a_t) projected, / 2")
+RB_RESIDUAL = Column("rb_residual", "1", "rb_stress_ratio - rb_predicted_stress_ratio")
+
+#: The periodic simple-shear test's records (grainlab.protocols.simple_shear).
+SIMPLE_SHEAR = Columns(
+    "simple_shear",
+    (STEP, TIME_S, SHEAR_STRAIN, SHEAR_STRESS_PA, NORMAL_STRESS_PA, LATERAL_NORMAL_STRESS_PA, FRICTION_COEFFICIENT,
+     INERTIAL_NUMBER, VOLUMETRIC_STRAIN, POROSITY, VOID_RATIO, AREA_M2, HEIGHT_M, CELL_TILT, KINETIC_STRESS_RATIO),
+    LOVE_WEBER,
+    (COORDINATION_NUMBER, UNBALANCED_FORCE_RATIO),
+    ENERGY,
+    FABRIC,
+    (RB_STRESS_RATIO, RB_PREDICTED, RB_RESIDUAL),
+)
+
 #: Every test's columns, by the results file's ``kind``.
-BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER, CYCLIC.kind: CYCLIC}
+BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER, CYCLIC.kind: CYCLIC,
+                               SIMPLE_SHEAR.kind: SIMPLE_SHEAR}
 
 
 _BLOCK = re.compile(

@@ -745,9 +745,18 @@ class Simulation:
         lower: ArrayLike,
         upper: ArrayLike,
         periodic: tuple[bool, bool] = (True, True),
+        *,
+        tilt: float = 0.0,
     ) -> None:
-        """An axis-aligned periodic cell ``[lower, upper)``; each side at least 3 x
-        (largest diameter + skin) wide along its periodic directions."""
+        """A periodic cell ``[lower, upper)``; each side at least 3 x (largest
+        diameter + skin) wide along its periodic directions.
+
+        ``tilt`` (m) leans it into a parallelogram: the top edge is offset by
+        ``tilt`` along x (LAMMPS's ``xy``), the cell vectors are ``a = (w, 0)``,
+        ``b = (tilt, h)``. A cell sheared along x keeps ``|tilt| <= w / 2``: at
+        each neighbour build the engine takes a whole ``a`` off ``b`` when it
+        leans further (the same lattice of images; docs/engine.md, "Periodic
+        cell")."""
         lo = _vector("lower", lower)
         hi = _vector("upper", upper)
         if not (hi[0] > lo[0] and hi[1] > lo[1]):
@@ -755,7 +764,10 @@ class Simulation:
         flags = tuple(bool(p) for p in periodic)
         if len(flags) != 2:
             raise ValueError(f"periodic: expected two flags (x, y), got {periodic!r}")
-        self._engine.set_cell(list(lo), [hi[0] - lo[0], 0.0], [0.0, hi[1] - lo[1]], (flags[0], flags[1]))
+        lean = float(tilt)
+        if not np.isfinite(lean):
+            raise ValueError(f"tilt: must be finite, got {tilt!r}")
+        self._engine.set_cell(list(lo), [hi[0] - lo[0], 0.0], [lean, hi[1] - lo[1]], (flags[0], flags[1]))
 
     def set_velocity_gradient(self, gradient: ArrayLike) -> None:
         """Imposes a homogeneous deformation of the periodic cell: ``L[i][j] = dv_i/dx_j``

@@ -6,10 +6,17 @@
 //! particle moves by `dt * v` and is then mapped with the cell by
 //! `x <- origin + M (x - origin)`, `M = I + dt L`. The relative velocity of two
 //! particles in contact includes the affine part `L d` of their branch vector `d`.
+//!
+//! A cell sheared without end (simple shear to large strain) would grow ever
+//! thinner across its tilted vector; at each neighbour build the engine takes
+//! the whole number of `a` off `b` that brings `b`'s tilt along `a` back within
+//! half a cell (Lees-Edwards' remap, LAMMPS's box flip). The lattice of images,
+//! hence every pair's geometry and force, is the same; only the image shifts
+//! of the listed pairs are renamed.
 use serde::{Deserialize, Serialize};
 
 use crate::error::{require_finite, EngineError, Result};
-use crate::vec2::{add, mat_mul, mat_vec, scale, sub, Mat2, Vec2, IDENTITY};
+use crate::vec2::{add, dot, mat_mul, mat_vec, scale, sub, Mat2, Vec2, IDENTITY};
 
 /// A parallelogram cell spanned by `a` and `b` from `origin`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -130,6 +137,29 @@ impl PeriodicCell {
     #[inline(always)]
     pub fn map_point(&self, m: &Mat2, x: Vec2) -> Vec2 {
         add(self.origin, mat_vec(m, sub(x, self.origin)))
+    }
+
+    /// The whole number `k` of `a` to take off `b` so that `b`'s tilt along
+    /// `a`, `t = (a . b) / (a . a)`, comes back within half a cell: 0 while
+    /// `|t| <= 1/2`, or when the cell does not repeat along `a` (then `b - k a`
+    /// would not span the same lattice).
+    pub fn tilt_reduction(&self) -> i8 {
+        if !self.periodic[0] {
+            return 0;
+        }
+        let t = dot(self.a, self.b) / dot(self.a, self.a);
+        if t.abs() <= 0.5 {
+            0
+        } else {
+            t.round() as i8
+        }
+    }
+
+    /// Replaces `b` by `b - k a`: the same lattice of images, a cell that is
+    /// less tilted. An image shift `(s0, s1)` of the old cell is
+    /// `(s0 + k s1, s1)` of the new one.
+    pub fn reduce_tilt(&mut self, k: i8) {
+        self.b = sub(self.b, scale(self.a, k as f64));
     }
 
     /// Brings `x` into the cell along periodic directions; returns the integer

@@ -153,6 +153,14 @@ impl NeighborList {
         }
     }
 
+    /// Renames the listed pairs' image shifts after the cell's `b` became
+    /// `b - k a` (`PeriodicCell::reduce_tilt`): `s0 a + s1 b = (s0 + k s1) a + s1 (b - k a)`.
+    pub fn rename_shifts_for_tilt(&mut self, k: i8) {
+        for s in self.pairs.shift.iter_mut() {
+            s[0] += k * s[1];
+        }
+    }
+
     /// Forces a rebuild at the next step (after radii, positions or walls changed).
     pub fn invalidate(&mut self) {
         self.valid = false;

@@ -135,12 +135,24 @@ def contact_forces_on_i(snapshot: Snapshot) -> NDArray[np.float64]:
 
 def branch_vectors(snapshot: Snapshot) -> NDArray[np.float64]:
     """(Nc, 2) branch vector of each contact, m: ``x_j - x_i`` (minimum image)
-    for particle contacts, the contact point minus ``x_i`` for wall contacts."""
+    for particle contacts, the contact point minus ``x_i`` for wall contacts.
+
+    When the snapshot stores the contact normals and overlaps (an engine's
+    snapshot does), a particle contact's branch is ``(r_i + r_j - delta) n``:
+    the same vector for disks, and the only one at hand in a sheared periodic
+    cell, whose images the snapshot's rectangular box cannot describe."""
     x = np.asarray(snapshot.positions)
     ci = np.asarray(snapshot.contact_i)
     cj = np.asarray(snapshot.contact_j)
     wall = cj < 0
-    d = snapshot.minimum_image(x[np.where(wall, ci, cj)] - x[ci])
+    overlap = snapshot.contact_fields.get("overlap")
+    if snapshot.contact_normal is not None and overlap is not None:
+        r = np.asarray(snapshot.radii)
+        n = np.asarray(snapshot.contact_normal)
+        length = r[ci] + r[np.where(wall, ci, cj)] - np.asarray(overlap, dtype=np.float64)
+        d = length[:, None] * n
+    else:
+        d = snapshot.minimum_image(x[np.where(wall, ci, cj)] - x[ci])
     if wall.any():
         d[wall] = contact_points(snapshot)[wall] - x[ci[wall]]
     return np.asarray(d, dtype=np.float64)

@@ -214,6 +214,7 @@ FIELDS: dict[str, Field] = {**SHARED_FIELDS, **BIAXIAL_FIELDS, **RUN_FIELDS}
 #: Item kind and range of each list kind.
 _LIST_ITEMS: dict[str, tuple[str, Field]] = {
     "strain_list": ("strains", Field("strain", 0.0, "", minimum=0.0, maximum=0.5)),
+    "shear_strain_list": ("shear strains", Field("strain", 0.0, "", minimum=0.0, maximum=100.0)),
     "length_list": ("lengths", Field("length", 0.0, "", minimum=0.0, exclusive_minimum=True)),
     "percent_list": ("percentages", Field("number", 0.0, "", minimum=0.0, maximum=100.0)),
     "stress_list": ("stresses", Field("stress", 0.0, "", minimum=0.0, exclusive_minimum=True)),
@@ -284,7 +285,7 @@ def coerce_field(fields: Mapping[str, Field], key: str, value: Any) -> Any:
             raise ConfigError(f"{key}: expected a list of {what}, got {value!r}")
         numbers = [_check_range(key, item, _parse_quantity(key, item, v)) for v in items]
         # snapshot strains are a set of times; sieve data keep their given order
-        return sorted(numbers) if field.kind == "strain_list" else numbers
+        return sorted(numbers) if field.kind in ("strain_list", "shear_strain_list") else numbers
     return _check_range(key, field, _parse_quantity(key, field, value))
 
 

@@ -5,7 +5,7 @@ registers here, and its schema in :data:`SCHEMAS` (``register_schema`` in its ow
 package; importing this module imports every protocol, so :data:`SCHEMAS` holds them all).
 
 >>> sorted(PROTOCOLS)
-['biaxial', 'cyclic', 'oedometer']
+['biaxial', 'cyclic', 'oedometer', 'simple_shear']
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from grainlab.protocols.config import SCHEMAS, Config
 from grainlab.protocols.cyclic.protocol import CyclicProtocol
 from grainlab.protocols.oedometer.protocol import OedometerProtocol
 from grainlab.protocols.runner import Protocol, RunResult, run_protocol
+from grainlab.protocols.simple_shear.protocol import SimpleShearProtocol
 
 __all__ = ["PROTOCOLS", "SCHEMAS", "resolve_config", "run_named"]
 
@@ -28,6 +29,7 @@ PROTOCOLS: dict[str, type[Protocol[Any, Any, Any]]] = {
     BiaxialProtocol.name: BiaxialProtocol,
     OedometerProtocol.name: OedometerProtocol,
     CyclicProtocol.name: CyclicProtocol,
+    SimpleShearProtocol.name: SimpleShearProtocol,
 }
 
 

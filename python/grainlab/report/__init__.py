@@ -50,7 +50,7 @@ __all__ = [
 REPORT_FILE = "report.html"
 
 #: What a results folder holds: a run of a protocol (its results file's ``kind``) or a study.
-Kind = Literal["biaxial", "oedometer", "cyclic", "study"]
+Kind = Literal["biaxial", "oedometer", "cyclic", "simple_shear", "study"]
 
 
 class ReportError(ValueError):
@@ -61,7 +61,7 @@ def detect_kind(folder: str | os.PathLike[str]) -> tuple[Path, Kind]:
     """``(folder, kind)`` of a results folder, or :class:`ReportError`.
 
     A run's folder holds a finished ``run.h5``, whose ``kind`` attribute names
-    its test (``"biaxial"``, ``"oedometer"``, ``"cyclic"``); a study folder holds
+    its test (``"biaxial"``, ``"oedometer"``, ``"cyclic"``, ``"simple_shear"``); a study folder holds
     ``study.csv``. A path to either file stands for its folder. Nothing is
     read beyond the folder listing and that attribute, so this fails before any work.
     """
@@ -82,8 +82,10 @@ def detect_kind(folder: str | os.PathLike[str]) -> tuple[Path, Kind]:
             return path, "oedometer"
         if kind == "cyclic":
             return path, "cyclic"
+        if kind == "simple_shear":
+            return path, "simple_shear"
         raise ReportError(f"{path}: a run of kind {kind!r}, which grainlab report does not cover "
-                          "(it covers biaxial, oedometer and cyclic runs and the packing study)")
+                          "(it covers biaxial, oedometer, cyclic and simple-shear runs and the packing study)")
     if (path / "run.h5.partial").exists():
         raise ReportError(
             f"{path}: the run has not finished (only run.h5.partial); continue it with "
@@ -110,7 +112,8 @@ def write_report(
     redraw: bool = False,
     out: str | os.PathLike[str] | None = None,
 ) -> Path:
-    """Writes ``report.html`` for the run (biaxial, oedometer, cyclic) or study in ``folder``; returns its path.
+    """Writes ``report.html`` for the run (biaxial, oedometer, cyclic, simple shear) or study in ``folder``;
+    returns its path.
 
     Figures missing from the folder are drawn into it first (all of them
     with ``redraw``); ``out`` writes the page elsewhere than
@@ -132,6 +135,10 @@ def write_report(
         from grainlab.report.cyclic import gather_cyclic, render_cyclic
 
         text = render_cyclic(gather_cyclic(path, redraw=redraw))
+    elif kind == "simple_shear":
+        from grainlab.report.simple_shear import gather_simple_shear, render_simple_shear
+
+        text = render_simple_shear(gather_simple_shear(path, redraw=redraw))
     else:
         from grainlab.report.render import render_study
         from grainlab.report.study import gather_study

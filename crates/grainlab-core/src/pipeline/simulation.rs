@@ -976,7 +976,8 @@ impl Simulation {
     /// Rebuilds the neighbour lists if a contact could otherwise be missed. Safe to
     /// call at any time: it rebuilds exactly when the next step would.
     pub fn ensure_neighbors(&mut self) -> Result<()> {
-        if self.neighbors.needs_rebuild(&self.walls) {
+        let tilt_due = self.cell.as_ref().is_some_and(|c| c.tilt_reduction() != 0);
+        if tilt_due || self.neighbors.needs_rebuild(&self.walls) {
             self.rebuild()?;
         }
         Ok(())
@@ -985,6 +986,13 @@ impl Simulation {
     /// Rebuilds the neighbour lists: wraps and renumbers the particles in
     /// spatial order, and maps the chains and the user's order along.
     pub(crate) fn rebuild(&mut self) -> Result<()> {
+        if let Some(cell) = &mut self.cell {
+            let k = cell.tilt_reduction();
+            if k != 0 {
+                cell.reduce_tilt(k);
+                self.neighbors.rename_shifts_for_tilt(k);
+            }
+        }
         let new_of_old = self.neighbors.build(
             &mut self.particles,
             &mut self.order,

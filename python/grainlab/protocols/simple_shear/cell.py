@@ -1,0 +1,82 @@
+"""The periodic cell as a test's boundary: the cell's stress, measured from
+the contacts and the grains' fluctuating motion, and its stress control, the
+periodic counterpart of the servo-controlled walls (docs/boundary.md,
+"A stress-controlled cell").
+
+The stress of the cell (compression positive) is
+
+    sigma = (1/A) [ sum_c l_c (x) f_c + sum_p m_p v_p (x) v_p ],
+
+``l_c = (r_i + r_j - delta) n`` the branch vector of contact c from i to j,
+``f_c`` the contact force on j, ``v_p`` each grain's velocity about the
+imposed flow and ``A`` the cell's area. The control sets the rate of the
+cell's side k, ``L_kk``, once every :data:`CONTROL_STEPS` steps so that half
+the gap between the measured and the wanted stress closes over the next
+interval at the packing's stiffness, estimated from above by the affine
+(Voigt) sum ``E_kk = (1/A) sum_c k_n |l_c|^2 n_k^4``; the rate is capped as
+the walls' speed is (a twentieth of the smallest diameter per 100 steps).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.simulation import Simulation
+
+__all__ = ["CONTROL_STEPS", "RELAXATION", "CellStress", "cell_stress", "servo_rate"]
+
+#: Steps between two settings of the cell's rate.
+CONTROL_STEPS = 100
+#: Fraction of the stress gap closed per control interval at the estimated stiffness.
+RELAXATION = 0.5
+
+
+@dataclass(frozen=True)
+class CellStress:
+    """The cell's stress (Pa, compression positive, symmetric 2 x 2): the
+    contacts' part and the kinetic part; the affine stiffness of each side
+    (Pa per unit strain) and the cell's area (m^2)."""
+
+    contact: NDArray[np.float64]
+    kinetic: NDArray[np.float64]
+    stiffness_pa: tuple[float, float]
+    area_m2: float
+
+    @property
+    def total(self) -> NDArray[np.float64]:
+        return np.asarray(self.contact + self.kinetic, dtype=np.float64)
+
+
+def cell_stress(sim: Simulation, normal_stiffness: float) -> CellStress:
+    """The stress of the periodic cell of ``sim`` (:class:`CellStress`)."""
+    cell = sim.cell
+    if cell is None:
+        raise ValueError("cell_stress: the simulation has no periodic cell")
+    area = float(cell.area)
+    c = sim.contacts()
+    radii = sim.radii
+    length = radii[c.i] + radii[c.j] - c.overlap
+    branch = length[:, None] * c.normal
+    on_j = -c.force_on_i
+    contact = branch.T @ on_j / area
+    contact = 0.5 * (contact + contact.T)
+    v = sim.velocities
+    masses = sim.masses
+    kinetic = (masses[:, None] * v).T @ v / area
+    n4 = c.normal**4
+    stiffness = normal_stiffness * (length**2) @ n4 / area
+    return CellStress(contact, kinetic, (float(stiffness[0]), float(stiffness[1])), area)
+
+
+def servo_rate(stress_pa: float, target_pa: float, stiffness_pa: float, interval_s: float, max_rate: float) -> float:
+    """The rate ``L_kk`` (1/s; positive stretches the cell) that closes
+    :data:`RELAXATION` of the gap ``stress - target`` over ``interval_s`` at
+    ``stiffness_pa``, within ``+- max_rate``; 0 for a cell without stiffness
+    yet (no contacts) when it is not above its target, ``-max_rate`` when it is below."""
+    if stiffness_pa <= 0.0:
+        return 0.0 if stress_pa >= target_pa else -max_rate
+    rate = RELAXATION * (stress_pa - target_pa) / (stiffness_pa * interval_s)
+    return float(np.clip(rate, -max_rate, max_rate))

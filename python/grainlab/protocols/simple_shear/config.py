@@ -1,0 +1,89 @@
+"""The periodic simple-shear test's configuration: the shared sample,
+material and consolidation keys, its own (``simple_shear.*``) and the runner's.
+
+The sample is made as every test's (radius expansion in four walls, the
+``sample.*`` keys); its walls then give way to a periodic cell of the same
+box, in which it is consolidated and sheared (docs/protocols.md, "Periodic
+simple shear")."""
+
+from __future__ import annotations
+
+from collections.abc import Set as AbstractSet
+from dataclasses import replace
+from typing import Any
+
+from grainlab.protocols.config import (
+    RUN_FIELDS,
+    SHARED_FIELDS,
+    ConfigError,
+    ConfigSchema,
+    Field,
+    check_sample,
+    register_schema,
+)
+
+__all__ = ["SIMPLE_SHEAR_FIELDS", "SIMPLE_SHEAR_QUICK", "SIMPLE_SHEAR_SCHEMA"]
+
+#: The simple-shear test's own keys.
+SIMPLE_SHEAR_FIELDS: dict[str, Field] = {
+    "simple_shear.volume": Field(
+        "choice", "free",
+        "free: the cell's height is servo-controlled to hold the normal stress sigma_yy (constant normal "
+        "stress); constant: the cell's area is held (constant volume)",
+        choices=("free", "constant"),
+    ),
+    "simple_shear.normal_stress": Field(
+        "stress", "auto", "normal stress sigma_yy held at free volume (auto: consolidation.pressure)",
+        minimum=0.0, exclusive_minimum=True, allow_auto=True,
+    ),
+    "simple_shear.inertial_number": Field(
+        "number", 1e-3,
+        "inertial number I = gamma_dot d / sqrt(sigma_n / rho) that sets the shear rate gamma_dot (d the mean "
+        "grain diameter, sigma_n the normal stress at the start of shearing, rho material.density)",
+        minimum=0.0, maximum=1.0, exclusive_minimum=True,
+    ),
+    "simple_shear.final_strain": Field(
+        "strain", 1.0, "shear strain gamma at which shearing stops (1 = 100 %)", minimum=0.0, maximum=100.0,
+        exclusive_minimum=True,
+    ),
+    "simple_shear.record_interval": Field(
+        "strain", 0.01, "shear strain between records", minimum=0.0, exclusive_minimum=True,
+    ),
+    "simple_shear.snapshot_strains": Field(
+        "shear_strain_list", [0.0, 0.1, 0.25, 0.5, 1.0], "shear strains at which a snapshot is stored",
+    ),
+}
+
+#: ``--quick``: a square cell of a few hundred disks sheared to 100 %.
+SIMPLE_SHEAR_QUICK: dict[str, Any] = {"sample.width": 0.03, "sample.height": 0.03}
+
+
+def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
+    check_sample(values, given)
+    final, interval = values["simple_shear.final_strain"], values["simple_shear.record_interval"]
+    if interval > final:
+        raise ConfigError(
+            f"simple_shear.record_interval: {interval:g} exceeds simple_shear.final_strain {final:g}: no record "
+            "would be made"
+        )
+    if values["simple_shear.volume"] == "constant" and "simple_shear.normal_stress" in given:
+        raise ConfigError(
+            "simple_shear.normal_stress: a constant-volume run holds the cell's area, not a normal stress; "
+            "leave it out or set simple_shear.volume = 'free'"
+        )
+    beyond = [s for s in values["simple_shear.snapshot_strains"] if not 0.0 <= s <= final]
+    if beyond:
+        raise ConfigError(
+            f"simple_shear.snapshot_strains: {beyond[0]:g} lies outside 0 .. simple_shear.final_strain ({final:g})"
+        )
+
+
+#: A square cell by default: Table 1's width, 75 mm, on both sides (about 1,700 grains).
+_SQUARE = {"sample.height": replace(SHARED_FIELDS["sample.height"], default=SHARED_FIELDS["sample.width"].default,
+                                    help="sample height (a square cell: Table 1's width, 75 mm)")}
+
+#: The simple-shear test's configuration schema (registered as ``"simple_shear"``).
+SIMPLE_SHEAR_SCHEMA = register_schema(
+    ConfigSchema("simple_shear", {**SHARED_FIELDS, **_SQUARE, **SIMPLE_SHEAR_FIELDS, **RUN_FIELDS},
+                 SIMPLE_SHEAR_QUICK, _check)
+)

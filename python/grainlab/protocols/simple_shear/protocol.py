@@ -1,0 +1,299 @@
+"""Periodic simple shear as a protocol of the runner: the sample made as
+every test's (:mod:`grainlab.protocols.specimen`), its four walls then
+replaced by a periodic cell of the same box, consolidated there by the
+stress-controlled cell (:mod:`grainlab.protocols.simple_shear.cell`), and
+sheared at a constant rate ``L = [[0, gamma_dot], [0, L_yy]]`` to large
+strain, the cell remapped whenever it leans past half its width. At free
+volume ``L_yy`` holds the normal stress; at constant volume it is 0.
+:func:`run_simple_shear` runs it into a folder."""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from grainlab._interrupt import raise_if_interrupted
+from grainlab._progress import progress_bar
+from grainlab.analysis import StressForceFabric, fabric_summary
+from grainlab.columns import SIMPLE_SHEAR
+from grainlab.io.hdf5.snapshot import snapshot_name
+from grainlab.protocols.config import Config
+from grainlab.protocols.runner import Stage, StageContext, run_protocol
+from grainlab.protocols.simple_shear.cell import CONTROL_STEPS, cell_stress, servo_rate
+from grainlab.protocols.simple_shear.config import SIMPLE_SHEAR_SCHEMA  # noqa: F401 - registers the schema
+from grainlab.protocols.simple_shear.outputs import SimpleShearResult, summarise, write_outputs
+from grainlab.protocols.simple_shear.state import SimpleShearRun
+from grainlab.protocols.specimen import CHUNK_STEPS, SpecimenError, SpecimenProtocol, grain_model
+from grainlab.protocols.triggers import At, Every, WallClock, schedule_steps
+from grainlab.simulation import ContactModel, Simulation
+from grainlab.snapshot import ParticleKind
+
+__all__ = ["SimpleShearProtocol", "SimpleShearRun", "record_steps", "run_simple_shear", "snapshot_name_of"]
+
+Context = StageContext[Config, SimpleShearRun]
+
+
+def snapshot_name_of(shear_strain: float) -> str:
+    """The snapshot's name in run.h5 at ``shear_strain``: ``gamma_0.2500``."""
+    return snapshot_name(shear_strain, prefix="gamma")
+
+
+def record_steps(config: Config, steps_per_unit: float) -> tuple[list[int], dict[int, float]]:
+    """The steps after the start of shearing that carry a record, and those that
+    also carry a snapshot (step -> its shear strain)."""
+    final = config["simple_shear.final_strain"]
+    strains = [s for s in config["simple_shear.snapshot_strains"] if s > 0]
+    steps = schedule_steps([Every(config["simple_shear.record_interval"]), At(strains)], final=final,
+                           steps_per_unit=steps_per_unit)
+    snaps = {round(s * steps_per_unit): s for s in strains}
+    return steps, snaps
+
+
+def _max_rate(sim: Simulation, run: SimpleShearRun, config: Config) -> float:
+    """The cap on the cell's rate: a twentieth of the smallest diameter per 100 steps over the cell's height."""
+    cell = sim.cell
+    assert cell is not None
+    return float(0.05 * config["sample.d_min"] / (100 * sim.time_step * cell.b[1]))
+
+
+def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int, targets: tuple[float | None, float | None],
+             shear_rate: float) -> None:
+    """Runs to ``to_step``, the cell's side rates set every CONTROL_STEPS steps (counted from
+    ``run.start_step``) to hold ``targets`` (sigma_xx, sigma_yy; None: that side's rate 0)."""
+    kn = config["material.normal_stiffness"]
+    while sim.step_count < to_step:
+        into = (sim.step_count - run.start_step) % CONTROL_STEPS
+        if into == 0:
+            rates = [0.0, 0.0]
+            if targets != (None, None):
+                stress = cell_stress(sim, kn)
+                total = stress.total
+                interval = CONTROL_STEPS * sim.time_step
+                cap = _max_rate(sim, run, config)
+                for k, target in enumerate(targets):
+                    if target is not None:
+                        rates[k] = servo_rate(float(total[k, k]), target, stress.stiffness_pa[k], interval, cap)
+            sim.set_velocity_gradient([[rates[0], shear_rate], [0.0, rates[1]]])
+        sim.run(min(CONTROL_STEPS - into, to_step - sim.step_count))
+
+
+def _to_periodic(context: Context) -> None:
+    """The walls give way to a periodic cell of their box; the gradient is set to 0."""
+    sim, run = context.sim, context.state
+    left = float(sim.wall(run.walls["left"]).points[0, 0])
+    right = float(sim.wall(run.walls["right"]).points[0, 0])
+    bottom = float(sim.wall(run.walls["bottom"]).points[0, 1])
+    top = float(sim.wall(run.walls["top"]).points[0, 1])
+    for wall_id in run.walls.values():
+        sim.wall(wall_id).active = False
+    sim.set_periodic_cell((left, bottom), (right, top))
+    sim.set_velocity_gradient(np.zeros((2, 2)))
+
+
+def _equilibrate(sim: Simulation, run: SimpleShearRun, config: Config, progress: bool, label: str) -> int:
+    """Servo-controls both sides of the cell to sigma_0 until equilibrium; returns the steps taken."""
+    target = config["consolidation.pressure"]
+    tolerance = config["consolidation.tolerance"]
+    limit = config["consolidation.unbalanced_force_ratio"]
+    max_steps = config["consolidation.max_steps"]
+    bar = progress_bar(max_steps, label, enabled=progress, unit="step")
+    steps = 0
+    run.start_step = sim.step_count  # the control's step count starts here
+    while True:
+        _advance(sim, run, config, sim.step_count + CHUNK_STEPS, (target, target), 0.0)
+        steps += CHUNK_STEPS
+        stress = cell_stress(sim, config["material.normal_stiffness"]).total
+        bar.update(CHUNK_STEPS)
+        bar.set_postfix_str(f"sxx {stress[0, 0] / 1e3:.1f} kPa, syy {stress[1, 1] / 1e3:.1f} kPa, "
+                            f"unbalanced {sim.unbalanced_force_ratio:.1e}")
+        settled = max(abs(stress[0, 0] / target - 1.0), abs(stress[1, 1] / target - 1.0)) < tolerance
+        if settled and sim.unbalanced_force_ratio < limit:
+            break
+        if steps >= max_steps:
+            bar.close()
+            raise SpecimenError(
+                f"{label} in the periodic cell did not converge in {steps} steps: sigma_xx {stress[0, 0] / 1e3:.1f}, "
+                f"sigma_yy {stress[1, 1] / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa +- {tolerance:.0%}), "
+                f"unbalanced force ratio {sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise "
+                "consolidation.max_steps"
+            )
+        raise_if_interrupted()
+    bar.close()
+    sim.set_velocity_gradient(np.zeros((2, 2)))
+    return steps
+
+
+def _consolidate(context: Context) -> None:
+    sim, run, config = context.sim, context.state, context.config
+    start = time.perf_counter()
+    _to_periodic(context)
+    sim.set_contact_model(0, 0, ContactModel(config["material.normal_stiffness"], config["material.shear_stiffness"],
+                                             config["consolidation.friction"]))
+    sim.local_damping = config["material.local_damping"]
+    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+    steps = _equilibrate(sim, run, config, context.progress, "consolidating")
+    cell = sim.cell
+    assert cell is not None
+    stress = cell_stress(sim, config["material.normal_stiffness"]).total
+    radii = sim.radii[: run.n_grains]
+    run.consolidation = {
+        "steps": steps, "stress_xx_pa": float(stress[0, 0]), "stress_yy_pa": float(stress[1, 1]),
+        "width_m": float(cell.a[0]), "height_m": float(cell.b[1]),
+        "porosity": 1.0 - float(np.pi * np.sum(radii**2)) / cell.area,
+        "coordination_number": sim.coordination_number, "unbalanced_force_ratio": sim.unbalanced_force_ratio,
+        "time_step_s": sim.time_step,
+    }
+    run.wall_time["consolidate"] = time.perf_counter() - start
+
+
+def _settle(context: Context) -> None:
+    """Table 1 friction on, the cell held at sigma_0 until equilibrium again; the shearing's plan."""
+    sim, run, config = context.sim, context.state, context.config
+    start = time.perf_counter()
+    sim.set_contact_model(0, 0, grain_model(config))
+    _equilibrate(sim, run, config, context.progress, "settling with friction")
+    cell = sim.cell
+    assert cell is not None
+    stress = cell_stress(sim, config["material.normal_stiffness"]).total
+    held = config["simple_shear.normal_stress"]
+    run.normal_stress_pa = float(stress[1, 1]) if config["simple_shear.volume"] == "constant" or held == "auto" \
+        else float(held)
+    if config["simple_shear.volume"] == "free" and held == "auto":
+        run.normal_stress_pa = float(config["consolidation.pressure"])
+    run.mean_diameter_m = float(2.0 * np.mean(sim.radii[: run.n_grains]))
+    density = config["material.density"]
+    run.shear_rate_per_s = config["simple_shear.inertial_number"] * math.sqrt(run.normal_stress_pa / density) \
+        / run.mean_diameter_m
+    run.start_step = sim.step_count
+    run.area0, run.height0 = float(cell.area), float(cell.b[1])
+    run.wall_time["settle"] = time.perf_counter() - start
+
+
+def _shear(context: Context) -> None:
+    sim, run, config, writer = context.sim, context.state, context.config, context.writer
+    start = time.perf_counter() - run.wall_time.get("shear", 0.0)
+    rate = run.shear_rate_per_s
+    steps_per_unit = 1.0 / (rate * sim.time_step)
+    steps, snaps = record_steps(config, steps_per_unit)
+    targets = (None, run.normal_stress_pa) if config["simple_shear.volume"] == "free" else (None, None)
+    final = config["simple_shear.final_strain"]
+    if run.next_record == 0 and writer.n_rows == 0:
+        sim.set_velocity_gradient([[0.0, rate], [0.0, 0.0]])
+        values = _record(sim, run, config)
+        writer.append_timeseries(values, units=SIMPLE_SHEAR.units())
+        if 0.0 in config["simple_shear.snapshot_strains"]:
+            writer.write_snapshot(snapshot_name_of(0.0), _snapshot(sim, run, values), step=sim.step_count)
+    checkpoint_due = WallClock(config["run.checkpoint_interval"])
+    done = 100 * steps[run.next_record - 1] / steps_per_unit if run.next_record else 0.0
+    bar = progress_bar(round(100 * final, 3), "shearing", enabled=context.progress, unit="% strain", initial=done,
+                       bar_format="{l_bar}{bar}| {n:.1f}/{total:.0f} % [{elapsed}<{remaining}{postfix}]")
+    while run.next_record < len(steps):
+        _advance(sim, run, config, run.start_step + steps[run.next_record], targets, rate)
+        values = _record(sim, run, config)
+        writer.append_timeseries(values, units=SIMPLE_SHEAR.units())
+        if steps[run.next_record] in snaps:
+            writer.write_snapshot(snapshot_name_of(snaps[steps[run.next_record]]), _snapshot(sim, run, values),
+                                  step=sim.step_count)
+        run.next_record += 1
+        raise_if_interrupted()
+        reached = 100 * steps[run.next_record - 1] / steps_per_unit
+        bar.update(reached - done)
+        done = reached
+        bar.set_postfix_str(f"mu {values['friction_coefficient']:.3f}, Z {values['coordination_number']:.2f}")
+        if checkpoint_due():
+            run.wall_time["shear"] = time.perf_counter() - start
+            context.save()
+    bar.close()
+    run.wall_time["shear"] = time.perf_counter() - start
+
+
+def _snapshot(sim: Simulation, run: SimpleShearRun, values: dict[str, float]) -> Any:
+    kind = np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8)
+    scalars = {name: values[name] for name in ("shear_strain", "shear_stress_pa", "normal_stress_pa",
+                                                "friction_coefficient", "volumetric_strain", "cell_tilt")}
+    cell = sim.cell
+    assert cell is not None
+    return sim.snapshot(kind=kind, scalars=scalars, step=sim.step_count,
+                        cell_a_m=list(cell.a), cell_b_m=list(cell.b), cell_origin_m=list(cell.origin))
+
+
+def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, float]:
+    """One record, in :data:`grainlab.columns.SIMPLE_SHEAR`'s order."""
+    cell = sim.cell
+    assert cell is not None
+    stress = cell_stress(sim, config["material.normal_stiffness"])
+    total = stress.total
+    n = run.n_grains
+    area = float(cell.area)
+    porosity = 1.0 - float(np.pi * np.sum(sim.radii[:n] ** 2)) / area
+    normal = float(total[1, 1])
+    tau = -float(total[0, 1])
+    snap = sim.snapshot(kind=np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8))
+    fabric = fabric_summary(snap)
+    z = fabric.pop("coordination_number")
+    rb = StressForceFabric().compute(snap)
+    energy = sim.energy
+    strain = (sim.step_count - run.start_step) * sim.time_step * run.shear_rate_per_s
+    values = {
+        "step": float(sim.step_count), "time_s": sim.time, "shear_strain": strain,
+        "shear_stress_pa": tau, "normal_stress_pa": normal, "lateral_stress_pa": float(total[0, 0]),
+        "friction_coefficient": tau / normal if normal > 0 else math.nan,
+        "inertial_number": run.shear_rate_per_s * run.mean_diameter_m / math.sqrt(normal / config["material.density"])
+        if normal > 0 else math.nan,
+        "volumetric_strain": (run.area0 - area) / run.area0 if run.area0 else 0.0,
+        "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "area_m2": area,
+        "height_m": float(cell.b[1]), "cell_tilt": float(cell.b[0] / cell.a[0]),
+        "kinetic_stress_share": float(stress.kinetic[1, 1]) / normal if normal > 0 else math.nan,
+        "love_weber_xx_pa": float(stress.contact[0, 0]), "love_weber_yy_pa": float(stress.contact[1, 1]),
+        "love_weber_xy_pa": float(stress.contact[0, 1]),
+        "coordination_number": z,
+        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
+        "kinetic_energy_j": energy.kinetic, "elastic_energy_j": energy.elastic,
+        "friction_dissipated_j": energy.friction_dissipated, "damping_dissipated_j": energy.damping_dissipated,
+        "boundary_work_j": energy.boundary_work, "wall_work_j": energy.wall_work,
+        **fabric,
+        "rb_stress_ratio": rb.stress_ratio, "rb_predicted_stress_ratio": rb.predicted_stress_ratio,
+        "rb_residual": rb.residual,
+    }
+    return {name: values[name] for name in SIMPLE_SHEAR}
+
+
+class SimpleShearProtocol(SpecimenProtocol[SimpleShearRun, SimpleShearResult]):
+    """Periodic simple shear at constant normal stress or constant volume, to large strain."""
+
+    name = "simple_shear"
+    stages: ClassVar[tuple[Stage[Any, Any], ...]] = (
+        Stage("consolidate", _consolidate, "the walls replaced by a periodic cell of their box, the cell "
+                                           "servo-controlled to sigma_0 (consolidation friction) until equilibrium"),
+        Stage("settle", _settle, "Table 1 friction on, the cell held at sigma_0 until equilibrium; the shear rate "
+                                 "from the inertial number"),
+        Stage("shear", _shear, "simple shear L = [[0, gamma_dot], [0, L_yy]] to the final strain (L_yy holds "
+                               "sigma_n, or 0 at constant volume); a record on each interval, snapshots, "
+                               "checkpoints on the wall clock"),
+    )
+    state_type = SimpleShearRun
+
+    def state_from_dict(self, saved: Any) -> SimpleShearRun:
+        return SimpleShearRun(**{k: v for k, v in saved.items()
+                                 if k not in ("config", "elapsed_s", "rows", "snapshots")})
+
+    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
+        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
+
+    def write_outputs(self, out: Path) -> dict[str, Any]:
+        return write_outputs(out)
+
+    def result(self, out: Path, summary: dict[str, Any]) -> SimpleShearResult:
+        return SimpleShearResult(out, summary)
+
+
+def run_simple_shear(config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
+                     progress: bool = False) -> SimpleShearResult:
+    """Runs (or, with ``resume``, continues) the periodic simple-shear test into ``out_dir``
+    (:func:`grainlab.protocols.runner.run_protocol`)."""
+    return run_protocol(SimpleShearProtocol(config), out_dir, resume=resume, progress=progress)
