@@ -9,12 +9,21 @@ The stress of the cell (compression positive) is
 
 ``l_c = (r_i + r_j - delta) n`` the branch vector of contact c from i to j,
 ``f_c`` the contact force on j, ``v_p`` each grain's velocity about the
-imposed flow and ``A`` the cell's area. The control sets the rate of the
-cell's side k, ``L_kk``, once every :data:`CONTROL_STEPS` steps so that half
-the gap between the measured and the wanted stress closes over the next
-interval at the packing's stiffness, estimated from above by the affine
-(Voigt) sum ``E_kk = (1/A) sum_c k_n |l_c|^2 n_k^4``; the rate is capped as
-the walls' speed is (a twentieth of the smallest diameter per 100 steps).
+imposed flow and ``A`` the cell's area.
+
+The control sets the rate of the cell's side k, ``L_kk``, once every
+:data:`CONTROL_STEPS` steps, proportional and integral in the stress gap
+``e = sigma_kk - target``: ``L_kk = K e + J``, ``J <- J + INTEGRAL_SHARE K e``.
+The proportional part alone would close :data:`RELAXATION` of the gap over
+one interval at the packing's stiffness, estimated from above by the affine
+(Voigt) sum ``E_kk = (1/A) sum_c k_n |l_c|^2 n_k^4``, so ``K = RELAXATION /
+(E_kk dt_interval)``; the integral part ``J`` learns the steady rate that
+shearing asks for (a dilating sample's), which a proportional control alone
+would only give at a standing stress error. With the true stiffness any
+fraction ``r <= 1`` of the estimate, the loop is stable for an integral share
+below 1 (its gain matrix has determinant ``1 - RELAXATION r (1 - share)``).
+The rate and ``J`` are capped as the walls' speed is (a twentieth of the
+smallest diameter per 100 steps) plus the shear rate.
 """
 
 from __future__ import annotations
@@ -26,12 +35,14 @@ from numpy.typing import NDArray
 
 from grainlab.simulation import Simulation
 
-__all__ = ["CONTROL_STEPS", "RELAXATION", "CellStress", "cell_stress", "servo_rate"]
+__all__ = ["CONTROL_STEPS", "INTEGRAL_SHARE", "RELAXATION", "CellStress", "cell_stress", "servo_rate"]
 
 #: Steps between two settings of the cell's rate.
 CONTROL_STEPS = 100
-#: Fraction of the stress gap closed per control interval at the estimated stiffness.
+#: Fraction of the stress gap the proportional part closes per control interval at the estimated stiffness.
 RELAXATION = 0.5
+#: The integral part's gain over the proportional part's, per interval.
+INTEGRAL_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -71,12 +82,16 @@ def cell_stress(sim: Simulation, normal_stiffness: float) -> CellStress:
     return CellStress(contact, kinetic, (float(stiffness[0]), float(stiffness[1])), area)
 
 
-def servo_rate(stress_pa: float, target_pa: float, stiffness_pa: float, interval_s: float, max_rate: float) -> float:
-    """The rate ``L_kk`` (1/s; positive stretches the cell) that closes
-    :data:`RELAXATION` of the gap ``stress - target`` over ``interval_s`` at
-    ``stiffness_pa``, within ``+- max_rate``; 0 for a cell without stiffness
-    yet (no contacts) when it is not above its target, ``-max_rate`` when it is below."""
+def servo_rate(stress_pa: float, target_pa: float, stiffness_pa: float, interval_s: float, max_rate: float,
+               integral: float) -> tuple[float, float]:
+    """``(L_kk, J)``: the rate (1/s; positive stretches the cell) of the module's
+    control for the gap ``stress - target`` at ``stiffness_pa`` over
+    ``interval_s``, and the integral part ``J`` updated from ``integral``, both
+    within ``+- max_rate``. A cell without stiffness yet (no contacts) keeps
+    ``J`` and shrinks at ``max_rate`` when below its target, else stays."""
     if stiffness_pa <= 0.0:
-        return 0.0 if stress_pa >= target_pa else -max_rate
-    rate = RELAXATION * (stress_pa - target_pa) / (stiffness_pa * interval_s)
-    return float(np.clip(rate, -max_rate, max_rate))
+        return (0.0 if stress_pa >= target_pa else -max_rate), integral
+    gain = RELAXATION / (stiffness_pa * interval_s)
+    gap = stress_pa - target_pa
+    integral = float(np.clip(integral + INTEGRAL_SHARE * gain * gap, -max_rate, max_rate))
+    return float(np.clip(gain * gap + integral, -max_rate, max_rate)), integral

@@ -54,11 +54,12 @@ def record_steps(config: Config, steps_per_unit: float) -> tuple[list[int], dict
     return steps, snaps
 
 
-def _max_rate(sim: Simulation, run: SimpleShearRun, config: Config) -> float:
-    """The cap on the cell's rate: a twentieth of the smallest diameter per 100 steps over the cell's height."""
+def _max_rate(sim: Simulation, config: Config, shear_rate: float) -> float:
+    """The cap on the cell's rate: a twentieth of the smallest diameter per 100 steps over the
+    cell's height, plus the shear rate."""
     cell = sim.cell
     assert cell is not None
-    return float(0.05 * config["sample.d_min"] / (100 * sim.time_step * cell.b[1]))
+    return float(0.05 * config["sample.d_min"] / (100 * sim.time_step * cell.b[1]) + abs(shear_rate))
 
 
 def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int, targets: tuple[float | None, float | None],
@@ -74,10 +75,12 @@ def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int,
                 stress = cell_stress(sim, kn)
                 total = stress.total
                 interval = CONTROL_STEPS * sim.time_step
-                cap = _max_rate(sim, run, config)
+                cap = _max_rate(sim, config, shear_rate)
                 for k, target in enumerate(targets):
                     if target is not None:
-                        rates[k] = servo_rate(float(total[k, k]), target, stress.stiffness_pa[k], interval, cap)
+                        rates[k], run.cell_rate_integral[k] = servo_rate(
+                            float(total[k, k]), target, stress.stiffness_pa[k], interval, cap,
+                            run.cell_rate_integral[k])
             sim.set_velocity_gradient([[rates[0], shear_rate], [0.0, rates[1]]])
         sim.run(min(CONTROL_STEPS - into, to_step - sim.step_count))
 
@@ -104,6 +107,7 @@ def _equilibrate(sim: Simulation, run: SimpleShearRun, config: Config, progress:
     bar = progress_bar(max_steps, label, enabled=progress, unit="step")
     steps = 0
     run.start_step = sim.step_count  # the control's step count starts here
+    run.cell_rate_integral = [0.0, 0.0]
     while True:
         _advance(sim, run, config, sim.step_count + CHUNK_STEPS, (target, target), 0.0)
         steps += CHUNK_STEPS
@@ -170,6 +174,7 @@ def _settle(context: Context) -> None:
     run.shear_rate_per_s = config["simple_shear.inertial_number"] * math.sqrt(run.normal_stress_pa / density) \
         / run.mean_diameter_m
     run.start_step = sim.step_count
+    run.cell_rate_integral = [0.0, 0.0]
     run.area0, run.height0 = float(cell.area), float(cell.b[1])
     run.wall_time["settle"] = time.perf_counter() - start
 

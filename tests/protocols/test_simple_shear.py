@@ -1,0 +1,162 @@
+"""Periodic simple shear (docs/protocols.md, "Periodic simple shear"): the
+stress-controlled cell holds sigma_n, the constant-volume cell its area, the
+leaning cell is remapped past half its width, the imposed shear's work is the
+energy the grains dissipate and store (a check of the cell's stress and of
+tau's sign), the Rothenburg-Bathurst relation holds on every record, and a
+stopped run resumes to the same bits."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from resume_check import assert_same_run, stop_and_resume
+
+import grainlab.protocols.runner as runner
+from grainlab.cli import main
+from grainlab.columns import SIMPLE_SHEAR
+from grainlab.io.hdf5 import read_results
+from grainlab.protocols.registry import resolve_config
+from grainlab.protocols.simple_shear import SimpleShearProtocol, snapshot_name_of
+from grainlab.report import detect_kind
+
+# the quick cell (about 280 grains) to 60 % strain at I = 0.01: past one remap, a few seconds
+SMALL = ["simple_shear.final_strain=0.6", "simple_shear.record_interval=0.02", "simple_shear.inertial_number=0.01",
+         "simple_shear.snapshot_strains=[0, 0.3, 0.6]", "run.threads=1"]
+
+
+def _config(*extra: str):  # type: ignore[no-untyped-def]
+    return resolve_config("simple_shear", overrides=[*SMALL, *extra], quick=True)
+
+
+@pytest.fixture(scope="module")
+def free(tmp_path_factory):
+    out = tmp_path_factory.mktemp("simple_shear") / "free"
+    runner.run_protocol(SimpleShearProtocol(_config()), out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def constant(tmp_path_factory):
+    out = tmp_path_factory.mktemp("simple_shear") / "constant"
+    runner.run_protocol(SimpleShearProtocol(_config("simple_shear.volume=constant")), out)
+    return out
+
+
+def _series(out: Path) -> dict[str, np.ndarray]:
+    return {k: np.asarray(v, dtype=np.float64) for k, v in read_results(out / "run.h5").timeseries.items()}
+
+
+def test_the_records_have_the_columns_and_the_strain_is_the_rate_times_the_time(free):
+    ts = _series(free)
+    assert list(ts) == [str(c) for c in SIMPLE_SHEAR]
+    summary = json.loads((free / "summary.json").read_text())
+    elapsed = ts["time_s"] - ts["time_s"][0]
+    np.testing.assert_allclose(ts["shear_strain"], summary["shear_rate_per_s"] * elapsed, rtol=1e-9, atol=1e-12)
+    assert ts["shear_strain"][-1] == pytest.approx(0.6, rel=1e-3)
+    names = read_results(free / "run.h5").snapshot_names
+    assert names == [snapshot_name_of(g) for g in (0.0, 0.3, 0.6)]
+
+
+def test_the_cell_leans_no_further_than_half_its_width_and_is_remapped(free):
+    tilt = _series(free)["cell_tilt"]
+    assert np.all(np.abs(tilt) <= 0.5)
+    assert np.count_nonzero(np.diff(tilt) < -0.5) == 1  # 60 % of strain: one remap
+
+
+def test_the_free_cell_holds_the_normal_stress(free):
+    ts = _series(free)
+    sigma_n = ts["normal_stress_pa"][1:]
+    assert np.median(np.abs(sigma_n / 1e5 - 1.0)) < 0.05
+    assert np.mean(sigma_n) == pytest.approx(1e5, rel=0.03)
+    assert ts["inertial_number"][1:].mean() == pytest.approx(0.01, rel=0.05)
+
+
+def test_the_constant_volume_cell_holds_its_area(constant):
+    ts = _series(constant)
+    np.testing.assert_allclose(ts["area_m2"], ts["area_m2"][0], rtol=1e-12)
+    assert np.all(ts["volumetric_strain"] == pytest.approx(0.0, abs=1e-12))
+    # a dense sample wants to dilate: held at constant volume, its normal stress rises
+    assert ts["normal_stress_pa"][1:].max() > 1.2 * ts["normal_stress_pa"][0]
+
+
+def test_the_shear_work_is_what_the_grains_dissipate_and_store(constant):
+    """At constant volume the cell does work only through the shear, A tau dgamma; the
+    ledger (which leaves that work out) must account for it as friction and damping
+    losses and stored elastic and kinetic energy. A wrong sign or scale of tau, or a
+    stress that misses the branch vectors across the remapped side, breaks this."""
+    ts = _series(constant)
+    work = np.sum(0.5 * (ts["area_m2"][1:] * ts["shear_stress_pa"][1:] + ts["area_m2"][:-1] * ts["shear_stress_pa"][:-1])
+                  * np.diff(ts["shear_strain"]))
+    ledger = sum(ts[name][-1] - ts[name][0] for name in ("friction_dissipated_j", "damping_dissipated_j",
+                                                          "elastic_energy_j", "kinetic_energy_j"))
+    assert work > 0
+    assert ledger == pytest.approx(work, rel=0.05)
+
+
+def test_the_stress_force_fabric_relation_holds_on_every_record(free, constant):
+    for out in (free, constant):
+        ts = _series(out)
+        assert np.all(np.isfinite(ts["rb_residual"]))
+        # the relation is of second order in the anisotropies and leaves out the branch
+        # lengths' (a_l): it explains q/p to within a few hundredths, not exactly; a wrong
+        # stress, sign or anisotropy misses by a share of q/p itself
+        assert np.mean(np.abs(ts["rb_residual"][1:])) < 0.25 * np.mean(ts["rb_stress_ratio"][1:])
+        np.testing.assert_allclose(ts["rb_stress_ratio"] - ts["rb_predicted_stress_ratio"], ts["rb_residual"],
+                                   atol=1e-12)
+
+
+@pytest.mark.parametrize("checkpoints", [2, 12])
+def test_a_stopped_run_resumes_to_the_same_bits(free, tmp_path, monkeypatch, checkpoints):
+    """Stopped after consolidation, and mid-shear (past the remap)."""
+    config = _config("run.checkpoint_interval=1e-6")
+    stop_and_resume(SimpleShearProtocol(config), tmp_path / "run", checkpoints, monkeypatch)
+    assert_same_run(free, tmp_path / "run")
+
+
+def test_the_command_line_writes_the_report(tmp_path, capsys):
+    out = tmp_path / "ss"
+    assert main(["run", "simple_shear", "--quick", "--out", str(out), "--no-progress", *sum(
+        (["--set", s] for s in SMALL), [])]) == 0
+    printed = capsys.readouterr().out
+    assert printed.startswith("grainlab simple_shear (free volume): ")
+    assert detect_kind(out) == (out, "simple_shear")
+    page = (out / "report.html").read_text()
+    assert "Stress-force-fabric relation" in page and "data:image/png;base64," in page
+    assert "grainlab run simple_shear --out" in page
+
+
+@pytest.mark.parametrize(("override", "message"), [
+    ("simple_shear.record_interval=2", "simple_shear.record_interval: 2 exceeds simple_shear.final_strain"),
+    ("simple_shear.volume=constant", "a constant-volume run holds the cell's area"),
+    ("simple_shear.snapshot_strains=[0.5, 2]", "simple_shear.snapshot_strains: 2 lies outside"),
+    ("simple_shear.inertial_number=0", "simple_shear.inertial_number: 0 is out of range"),
+])
+def test_bad_input_gets_one_line_and_no_folder(tmp_path, capsys, override, message):
+    out = tmp_path / "never"
+    extra = ["--set", "simple_shear.normal_stress=100 kPa"] if "volume" in override else []
+    assert main(["run", "simple_shear", "--quick", "--out", str(out), *extra, "--set", override]) != 0
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1, err
+    assert not out.exists()
+
+
+def test_the_inertial_number_sets_the_rate(free):
+    s = json.loads((free / "summary.json").read_text())
+    density = resolve_config("simple_shear")["material.density"]
+    assert s["shear_rate_per_s"] == pytest.approx(0.01 * math.sqrt(1e5 / density) / s["mean_diameter_m"], rel=1e-12)
+
+
+@pytest.mark.slow
+def test_the_example_prints_both_cells(tmp_path):
+    example = Path(__file__).resolve().parents[2] / "examples" / "11_simple_shear.py"
+    printed = subprocess.run([sys.executable, str(example), str(tmp_path / "run")], check=True,
+                             capture_output=True, text=True).stdout
+    lines = printed.splitlines()
+    assert [line.split(":")[0] for line in lines] == ["free volume", "constant volume"]
+    assert "dilation" in lines[0] and "sigma_n 100.0 ->" in lines[1]
