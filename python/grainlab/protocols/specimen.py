@@ -121,11 +121,14 @@ def engine_threads(config: Config) -> int:
 
 
 def _with_rolling(config: Config, model: ContactModel) -> ContactModel:
-    """``model`` with the rolling resistance of ``config`` (off by default; a
-    stiffness of 0 is the engine's rule, ``auto``)."""
+    """``model`` with the rolling resistance and the contact dashpots of ``config``
+    (both off by default; a rolling stiffness of 0 is the engine's rule, ``auto``)."""
     stiffness = config["material.rolling_stiffness"]
+    damping = float(config["material.contact_damping"])
     return replace(
         model,
+        normal_damping_ratio=damping,
+        shear_damping_ratio=damping,
         rolling_friction=float(config["material.rolling_friction"]),
         rolling_stiffness=0.0 if stiffness == "auto" else float(stiffness),
         rolling_damping_ratio=float(config["material.rolling_damping"]),
