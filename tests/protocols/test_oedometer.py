@@ -30,7 +30,8 @@ from grainlab.protocols.registry import PROTOCOLS, resolve_config
 from grainlab.report import detect_kind
 
 # three load steps up, two down: a few seconds on the quick sample
-PATH = ["oedometer.vertical_stresses=[200 kPa, 400 kPa, 800 kPa, 400 kPa, 100 kPa]", "run.threads=1"]
+PATH = ["oedometer.vertical_stresses=[200 kPa, 400 kPa, 800 kPa, 400 kPa, 100 kPa]", "run.threads=1",
+        "run.checkpoint_interval=1e-6"]  # a checkpoint at every load step
 
 
 @pytest.fixture(scope="module")
@@ -138,7 +139,7 @@ def test_bad_input_gets_one_line_and_no_folder(tmp_path, capsys, override, messa
 def test_the_load_path_keeps_its_order_and_the_registry_knows_it():
     config = resolve_config("oedometer", overrides=["oedometer.vertical_stresses=[1 MPa, 200 kPa, 300 kPa]"])
     assert config["oedometer.vertical_stresses"] == [1e6, 2e5, 3e5]
-    assert set(PROTOCOLS) == {"biaxial", "cyclic", "oedometer"}
+    assert set(PROTOCOLS) == {"biaxial", "cyclic", "oedometer", "simple_shear"}
     with pytest.raises(ConfigError, match="unknown configuration key"):
         resolve_config("oedometer", overrides=["boundary.kind=membrane"])
 

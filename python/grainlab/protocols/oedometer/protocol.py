@@ -32,6 +32,7 @@ from grainlab.protocols.specimen import (
     grain_model,
     platen_model,
 )
+from grainlab.protocols.triggers import WallClock
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind
 
@@ -70,6 +71,7 @@ def _load(context: Context) -> None:
     bar = progress_bar(len(stresses), "loading", enabled=context.progress, unit="step", initial=run.next_load)
     speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
     tolerance, limit = config["oedometer.tolerance"], config["consolidation.unbalanced_force_ratio"]
+    checkpoint_due = WallClock(config["run.checkpoint_interval"])
     while run.next_load < len(stresses):
         target = stresses[run.next_load]
         steps = 0
@@ -100,7 +102,8 @@ def _load(context: Context) -> None:
         bar.update(1)
         bar.set_postfix_str(f"sigma_v {box.stress_yy_pa / 1e3:.0f} kPa, K {box.stress_xx_pa / box.stress_yy_pa:.3f}")
         run.wall_time["load"] = time.perf_counter() - start
-        context.save()  # a checkpoint at every equilibrium: a stop loses at most one load step
+        if checkpoint_due():  # a stop loses at most run.checkpoint_interval of work
+            context.save()
     bar.close()
 
 
@@ -152,7 +155,8 @@ class OedometerProtocol(SpecimenProtocol[OedometerRun, OedometerResult]):
         Stage("consolidate", _consolidate, "the four walls servo-controlled to sigma_0 until equilibrium"),
         Stage("confine", _confine, "Table 1 friction on; the four walls fixed"),
         Stage("load", _load, "the top platen servo-controlled to sigma_0 (strains count from there), then to "
-                             "each vertical stress in turn; a record, a snapshot and a checkpoint at each equilibrium"),
+                             "each vertical stress in turn; a record and a snapshot at each equilibrium, a checkpoint there "
+                             "once run.checkpoint_interval has passed"),
     )
     state_type = OedometerRun
 
