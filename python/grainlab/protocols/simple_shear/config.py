@@ -42,6 +42,12 @@ SIMPLE_SHEAR_FIELDS: dict[str, Field] = {
         "grain diameter, sigma_n the normal stress at the start of shearing, rho material.density)",
         minimum=0.0, maximum=1.0, exclusive_minimum=True,
     ),
+    "simple_shear.local_damping": Field(
+        "number", "auto",
+        "local damping alpha while shearing (auto: material.local_damping, which makes and consolidates the "
+        "sample); 0 leaves the grains' inertia undamped, as a rate sweep needs", minimum=0.0, maximum=1.0,
+        exclusive_maximum=True, allow_auto=True,
+    ),
     "simple_shear.final_strain": Field(
         "strain", 1.0, "shear strain gamma at which shearing stops (1 = 100 %)", minimum=0.0, maximum=100.0,
         exclusive_minimum=True,

@@ -173,6 +173,8 @@ def _settle(context: Context) -> None:
     density = config["material.density"]
     run.shear_rate_per_s = config["simple_shear.inertial_number"] * math.sqrt(run.normal_stress_pa / density) \
         / run.mean_diameter_m
+    damping = config["simple_shear.local_damping"]
+    sim.local_damping = config["material.local_damping"] if damping == "auto" else float(damping)
     run.start_step = sim.step_count
     run.cell_rate_integral = [0.0, 0.0]
     run.area0, run.height0 = float(cell.area), float(cell.b[1])
@@ -276,7 +278,7 @@ class SimpleShearProtocol(SpecimenProtocol[SimpleShearRun, SimpleShearResult]):
         Stage("consolidate", _consolidate, "the walls replaced by a periodic cell of their box, the cell "
                                            "servo-controlled to sigma_0 (consolidation friction) until equilibrium"),
         Stage("settle", _settle, "Table 1 friction on, the cell held at sigma_0 until equilibrium; the shear rate "
-                                 "from the inertial number"),
+                                 "from the inertial number, the shearing's local damping"),
         Stage("shear", _shear, "simple shear L = [[0, gamma_dot], [0, L_yy]] to the final strain (L_yy holds "
                                "sigma_n, or 0 at constant volume); a record on each interval, snapshots, "
                                "checkpoints on the wall clock"),
