@@ -480,6 +480,21 @@ class Wall:
         return f"Wall(id={self.id}, kind={state.kind!r}, control={state.control!r})"
 
 
+def _cell_of_snapshot(cell: PeriodicCell | None) -> dict[str, Any]:
+    """A snapshot's ``box``, ``periodic`` and ``tilt`` of a periodic cell whose first
+    vector lies along x; nothing for no cell or another one."""
+    if cell is None or cell.a[1] != 0.0 or not any(cell.periodic):
+        return {}
+    (x0, y0), width, (lean, height) = cell.origin, cell.a[0], cell.b
+    if not cell.periodic[1] and lean != 0.0:
+        return {}
+    return {
+        "box": [[x0, x0 + width], [y0, y0 + height]],
+        "periodic": cell.periodic,
+        "tilt": lean,
+    }
+
+
 class Simulation:
     """A 2D disk DEM simulation (linear contacts with shear history and Coulomb
     friction, PFC local damping, leapfrog integration) run by the Rust engine.
@@ -923,7 +938,10 @@ class Simulation:
         ``time``, ``axial_strain`` and ``scalars`` (the run's control variables,
         :attr:`Snapshot.scalars`) and any other key. The particles'
         ``velocity`` (m/s, (N, 2)) and ``angular_velocity`` (rad/s, (N,)) travel
-        as ``particle_fields``.
+        as ``particle_fields``. A periodic cell whose first vector lies along x
+        (an axis-aligned cell, or one leaned by simple shear along x) gives the
+        snapshot its ``box``, ``periodic`` and ``tilt`` (the x of the second
+        vector), so that branch vectors take the nearest image.
         """
         c = self.contacts()
         w = self.wall_contacts()
@@ -955,6 +973,7 @@ class Simulation:
             axial_strain=axial_strain,
             scalars=scalars,
             kind=kind,
+            **_cell_of_snapshot(self.cell),
             particle_fields={
                 "velocity": self.velocities,
                 "angular_velocity": self.angular_velocities,

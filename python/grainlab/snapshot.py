@@ -194,6 +194,12 @@ class Snapshot:
         ``[[xlo, xhi], [ylo, yhi]]`` of the simulation box.
     periodic : (bool, bool)
         Periodicity in x and y; a periodic direction needs ``box``.
+    tilt : float, m
+        A cell leaned by simple shear along x (LAMMPS's ``xy``): the images
+        along y are shifted by ``(tilt, yhi - ylo)``, the cell vectors are
+        ``a = (xhi - xlo, 0)`` and ``b = (tilt, yhi - ylo)``, its area is
+        still ``(xhi - xlo) (yhi - ylo)``. Default 0 (a rectangle); a
+        non-zero tilt needs y periodic.
     time : float, s, optional
     scalars : mapping of str to float, optional
         The run's control variables at this snapshot, by name, finite: a
@@ -235,6 +241,7 @@ class Snapshot:
     particle_fields: Mapping[str, NDArray[Any]]
     box: NDArray[np.float64] | None
     periodic: tuple[bool, bool]
+    tilt: float
     time: float | None
     scalars: Mapping[str, float]
     metadata: Mapping[str, Any]
@@ -262,6 +269,7 @@ class Snapshot:
         axial_strain: float | None = None,
         metadata: Mapping[str, Any] | None = None,
         scalars: Mapping[str, float] | None = None,
+        tilt: float = 0.0,
     ) -> None:
         # the inputs are checked and stored as read-only arrays (the dataclass is
         # frozen, so the fields are set through object.__setattr__ once, here)
@@ -383,6 +391,12 @@ class Snapshot:
             raise ValueError("box: a periodic direction needs the box bounds")
         else:
             put("box", None)
+        lean = float(tilt)
+        if not np.isfinite(lean):
+            raise ValueError(f"tilt: must be finite, got {tilt!r}")
+        if lean != 0.0 and not flags[1]:
+            raise ValueError(f"tilt: a leaning cell ({lean!r} m) needs y periodic")
+        put("tilt", lean)
         if time is not None:
             time = float(time)
             if not np.isfinite(time):
@@ -439,6 +453,7 @@ class Snapshot:
             tolerance=tolerance,
             box=kwargs.get("box"),
             periodic=kwargs.get("periodic", (False, False)),
+            tilt=kwargs.get("tilt", 0.0),
         )
         metadata = dict(kwargs.pop("metadata", {}) or {})
         metadata.setdefault("contacts", f"detected from geometry (tolerance {tolerance:g} m)")
@@ -705,16 +720,13 @@ class Snapshot:
         return self._cache["id_order"]
 
     def minimum_image(self, d: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Apply the minimum-image convention to separation vectors ``d`` (..., 2)."""
+        """Apply the minimum-image convention to separation vectors ``d`` (..., 2):
+        in a leaning cell (:attr:`tilt`) along y first, by whole ``(tilt, Ly)``,
+        then along x, as LAMMPS does for a triclinic box."""
         if not any(self.periodic):
             return d
-        d = np.array(d, dtype=np.float64, copy=True)
         assert self.box is not None  # the constructor refuses a periodic direction without it
-        lengths = self.box[:, 1] - self.box[:, 0]
-        for axis in (0, 1):
-            if self.periodic[axis]:
-                d[..., axis] -= lengths[axis] * np.round(d[..., axis] / lengths[axis])
-        return d
+        return _minimum_image(d, self.box[:, 1] - self.box[:, 0], self.periodic, self.tilt)
 
     def contact_normals(self) -> NDArray[np.float64]:
         """(Nc, 2) unit normals from particle i towards j (or towards the wall).
@@ -728,7 +740,7 @@ class Snapshot:
             return self._cache["normals"]
         ci = self.contact_i
         cj = self.contact_j
-        if _kernels.compiled() and not (cj.size and cj.min() < 0):
+        if _kernels.compiled() and not (cj.size and cj.min() < 0) and self.tilt == 0.0:
             lengths: list[float | None] = [None, None]
             if any(self.periodic):
                 assert self.box is not None  # the constructor refuses periodic without it
@@ -841,6 +853,49 @@ def boundary_end_groups(owner: ArrayLike, key: ArrayLike) -> NDArray[np.int64]:
     return groups
 
 
+def _minimum_image(
+    d: ArrayLike, lengths: NDArray[np.float64], periodic: tuple[bool, bool], tilt: float
+) -> NDArray[np.float64]:
+    """``d`` (..., 2) brought to its nearest image: along y first (by whole
+    ``(tilt, Ly)``), then along x (by whole ``Lx``)."""
+    d = np.array(d, dtype=np.float64, copy=True)
+    if periodic[1]:
+        k = np.round(d[..., 1] / lengths[1])
+        d[..., 0] -= k * tilt
+        d[..., 1] -= k * lengths[1]
+    if periodic[0]:
+        d[..., 0] -= lengths[0] * np.round(d[..., 0] / lengths[0])
+    return d
+
+
+def _detect_in_leaning_cell(
+    pos: NDArray[np.float64],
+    rad: NDArray[np.float64],
+    tolerance: float,
+    box: ArrayLike | None,
+    periodic: tuple[bool, bool],
+    tilt: float,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """:func:`detect_contacts` in a leaning cell: the cell sheared back to its
+    rectangle (``x - tilt (y - ylo) / Ly``), where the same lattice of images is
+    a rectangular one, the search made there with the tolerance widened by the
+    map's largest stretch, and the candidates kept by their true distance."""
+    if box is None:
+        raise ValueError("box: a periodic direction needs the box bounds")
+    b = _as_float("box", box, (2, 2))
+    lengths = b[:, 1] - b[:, 0]
+    shear = tilt / lengths[1]
+    back = pos.copy()
+    back[:, 0] -= shear * (pos[:, 1] - b[1, 0])
+    # |S^-1 v| <= stretch |v| for the back-shear S^-1 = [[1, -shear], [0, 1]]
+    stretch = 0.5 * (abs(shear) + np.sqrt(shear * shear + 4.0))
+    wide = (stretch - 1.0) * 2.0 * float(rad.max()) + stretch * tolerance
+    i, j = detect_contacts(back, rad, tolerance=wide, box=b, periodic=periodic)
+    d = _minimum_image(pos[j, :2] - pos[i, :2], lengths, periodic, tilt)
+    touching = np.hypot(d[:, 0], d[:, 1]) < rad[i] + rad[j] + tolerance
+    return i[touching], j[touching]
+
+
 def detect_contacts(
     positions: ArrayLike,
     radii: ArrayLike,
@@ -848,6 +903,7 @@ def detect_contacts(
     tolerance: float = 0.0,
     box: ArrayLike | None = None,
     periodic: tuple[bool, bool] = (False, False),
+    tilt: float = 0.0,
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Pairs of disks in contact: centre distance ``< r_i + r_j + tolerance``.
 
@@ -859,9 +915,10 @@ def detect_contacts(
     radii : (N,) float, m
     tolerance : float, m, >= 0
         Touching tolerance added to the radius sum.
-    box, periodic
+    box, periodic, tilt
         As in :class:`Snapshot` (x and y); periodic directions use the
-        minimum image.
+        minimum image (a leaning cell: sheared back to its rectangle for the
+        search, which finds the same pairs).
 
     Returns
     -------
@@ -886,6 +943,10 @@ def detect_contacts(
     rad = np.asarray(radii, dtype=np.float64)
     if tolerance < 0 or not np.isfinite(tolerance):
         raise ValueError(f"tolerance: must be a finite value >= 0, got {tolerance}")
+    if tilt != 0.0 and pos.ndim == 2 and pos.shape[0] >= 2:
+        if not periodic[1]:
+            raise ValueError(f"tilt: a leaning cell ({tilt!r} m) needs y periodic")
+        return _detect_in_leaning_cell(pos, rad, float(tolerance), box, periodic, float(tilt))
     if not _kernels.compiled():
         return _detect_contacts_numpy(pos, rad, tolerance=tolerance, box=box, periodic=periodic)
     if pos.shape[0] < 2:

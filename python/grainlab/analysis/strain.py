@@ -67,6 +67,10 @@ def neighbour_pairs(
     """Unordered pairs ``i < j`` of particles with centre distance < ``cutoff`` (m)."""
     if not np.isfinite(cutoff) or cutoff <= 0:
         raise ValueError(f"cutoff: must be a positive length in m, got {cutoff!r}")
+    if snapshot.tilt != 0.0:
+        raise ValueError(
+            f"tilt: neighbour pairs in a leaning periodic cell (tilt {snapshot.tilt!r} m) are not supported"
+        )
     pos = np.asarray(snapshot.positions, dtype=np.float64)
     boxsize = None
     if any(snapshot.periodic):

@@ -120,6 +120,10 @@ def power_cells(snapshot: Snapshot) -> PowerCells:
     ``snapshot`` over its region (module docstring)."""
     from scipy.spatial import ConvexHull
 
+    if snapshot.tilt != 0.0:
+        raise ValueError(
+            f"tilt: power cells of a leaning periodic cell (tilt {snapshot.tilt!r} m) are not supported"
+        )
     n = snapshot.n_particles
     bounds = _region(snapshot)
     span = bounds[:, 1] - bounds[:, 0]

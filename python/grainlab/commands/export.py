@@ -1,6 +1,8 @@
-"""``grainlab export``: convert a run folder for other tools (``--vtk``: ParaView).
+"""``grainlab export``: convert a run folder for other tools (``--vtk``: ParaView;
+``--lammps``: a LAMMPS data file and input deck of a periodic simple shear).
 
-A thin wrapper around :func:`grainlab.postprocess.export_vtk`, which scripts can call directly.
+Thin wrappers around :func:`grainlab.postprocess.export_vtk` and
+:func:`grainlab.io.lammps_input.write_lammps_shear`, which scripts can call directly.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ def register(subparsers: Any) -> None:
     """Add the ``export`` subcommand."""
     p = subparsers.add_parser(
         "export",
-        help="export a run folder for other tools (--vtk: ParaView time series)",
+        help="export a run folder for other tools (--vtk: ParaView time series; --lammps: a LAMMPS run)",
         description=(
             "Export the snapshots of a run folder DIR/run.h5. With --vtk: one VTK XML "
             "PolyData file per snapshot (snapshot_0000.vtp, ...) and a run.pvd time series, "
@@ -30,12 +32,38 @@ def register(subparsers: Any) -> None:
             "periodic boundary have no line. In ParaView: open run.pvd, add a Glyph "
             "filter (2D Glyph, Circle, filled; Scale Array radius, Scale Factor 2; "
             "Glyph Mode All Points) and colour by stability_index; see "
-            "docs/file-formats.md, section ParaView."
+            "docs/file-formats.md, section ParaView. "
+            "With --lammps: DIR is an engine state in a periodic cell (a file written by "
+            "Simulation.save, a checkpoint.h5, or a run folder holding one); writes data.grainlab, "
+            "in.grainlab (periodic simple shear at --shear-rate to --shear-strain, dumps of atoms "
+            "and contacts) and export.json into --out (default: DIR/lammps, or STATE.lammps next to "
+            "a state file). Run it with 'mpirun -np 2 lmp -in in.grainlab' there; "
+            "grainlab.io.lammps_input.read_lammps_run reads the dumps back as snapshots. "
+            "See docs/lammps.md."
         ),
     )
-    p.add_argument("dir", metavar="DIR", help="run folder holding run.h5 (or the run.h5 itself)")
+    p.add_argument(
+        "dir", metavar="DIR", help="run folder holding run.h5 (or the run.h5 itself); with --lammps: a state"
+    )
     p.add_argument("--vtk", action="store_true", help="write .vtp files and a .pvd for ParaView")
-    p.add_argument("--out", metavar="FOLDER", help="output folder (default: DIR/vtk)")
+    p.add_argument(
+        "--lammps", action="store_true", help="write a LAMMPS data file and input deck (periodic simple shear)"
+    )
+    p.add_argument(
+        "--shear-rate", type=float, metavar="PER_S", help="--lammps: shear rate gamma-dot, 1/s (required)"
+    )
+    p.add_argument(
+        "--shear-strain", type=float, metavar="GAMMA", help="--lammps: shear strain at the end (required)"
+    )
+    p.add_argument(
+        "--dump-every", type=int, default=0, metavar="STEPS",
+        help="--lammps: steps between dumps (default: about 50 dumps over the run)",
+    )  # fmt: skip
+    p.add_argument(
+        "--local-damping", choices=("omit", "cundall"), default="omit",
+        help="--lammps: omit grainlab's local damping (LAMMPS 2021) or write fix damping/cundall (LAMMPS 2023+)",
+    )  # fmt: skip
+    p.add_argument("--out", metavar="FOLDER", help="output folder (default: DIR/vtk, DIR/lammps)")
     p.add_argument(
         "--ascii", action="store_true", help="write ASCII data arrays instead of base64 binary"
     )
@@ -43,8 +71,10 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if not args.vtk:
-        raise ValueError("nothing to export: give a format, e.g. --vtk")
+    if args.vtk == args.lammps:
+        raise ValueError("give one format: --vtk or --lammps")
+    if args.lammps:
+        return _lammps(args)
     from pathlib import Path
 
     from grainlab.io.results import ensure_output_folder
@@ -58,4 +88,29 @@ def run(args: argparse.Namespace) -> int:
         f"grainlab export: {len(done.files)} snapshot(s) -> {done.pvd} "
         f"(time = {done.time_quantity}); open it in ParaView"
     )
+    return 0
+
+
+def _lammps(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from grainlab.io.lammps_input import LammpsShear, simulation_to_export, write_lammps_shear
+    from grainlab.io.results import ensure_output_folder
+
+    for flag, value in (("--shear-rate", args.shear_rate), ("--shear-strain", args.shear_strain)):
+        if value is None:
+            raise ValueError(f"{flag}: required with --lammps")
+    shear = LammpsShear(args.shear_rate, args.shear_strain, args.dump_every, args.local_damping)
+    source = Path(args.dir)
+    sim = simulation_to_export(source)
+    default = source / "lammps" if source.is_dir() else source.with_name(source.name + ".lammps")
+    out = Path(args.out) if args.out is not None else default
+    ensure_output_folder(out)
+    done = write_lammps_shear(sim, out, shear)
+    print(
+        f"grainlab export: {sim.n_particles} disks, {done.steps} steps -> {done.input_file} and {done.data_file.name}; "
+        f"run 'mpirun -np 2 lmp -in {done.input_file.name}' in {out}"
+    )
+    for item in done.dropped:
+        print(f"  not carried: {item}")
     return 0

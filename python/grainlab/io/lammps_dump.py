@@ -94,6 +94,7 @@ class DumpFrame:
     line_numbers: NDArray[np.int64]  # 1-based file line of each row
     box: NDArray[np.float64] | None
     boundary: list[str]
+    tilt: float  # the xy tilt of a triclinic box (m), 0 for an orthogonal one
     time: float | None
     header_line: int
 
@@ -116,11 +117,19 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
         if not lines[k].strip():
             k += 1
             continue
-        if not lines[k].startswith("ITEM: TIMESTEP"):
-            raise FileFormatError(
-                path, k + 1, f"expected 'ITEM: TIMESTEP', found {lines[k][:60]!r}"
-            )
-        frame: dict[str, Any] = {"box": None, "boundary": [], "time": None, "count": None, "line": k + 1}
+        frame: dict[str, Any] = {
+            "box": None, "tilt": 0.0, "boundary": [], "time": None, "count": None, "line": k + 1
+        }  # fmt: skip
+        if lines[k].startswith("ITEM: TIME") and not lines[k].startswith("ITEM: TIMESTEP"):
+            # `dump_modify time yes` puts the time first
+            try:
+                frame["time"] = float(lines[k + 1].split()[0])
+            except (IndexError, ValueError):
+                raise FileFormatError(path, k + 2, "expected the simulation time") from None
+            k += 2
+        if k >= n_lines or not lines[k].startswith("ITEM: TIMESTEP"):
+            found = lines[k][:60] if k < n_lines else "the end of the file"
+            raise FileFormatError(path, k + 1, f"expected 'ITEM: TIMESTEP', found {found!r}")
         if k + 1 >= n_lines:
             frames.append({**frame, "truncated": (n_lines, "file ends after 'ITEM: TIMESTEP'")})
             break
@@ -150,8 +159,9 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
                 k += 2
             elif item.startswith("ITEM: BOX BOUNDS"):
                 flags = item.split()[3:]
-                if "xy" in flags:
-                    raise FileFormatError(path, k + 1, "triclinic boxes are not supported")
+                triclinic = flags[:3] == ["xy", "xz", "yz"]
+                if triclinic:
+                    flags = flags[3:]
                 if len(flags) != 3 or not all(_BOUNDARY_FLAG.match(f) for f in flags):
                     raise FileFormatError(
                         path,
@@ -164,13 +174,15 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
                     frame["truncated"] = (n_lines, "file ends inside the box bounds")
                     break
                 try:
-                    frame["box"] = np.array(
-                        [[float(v) for v in lines[k + 1 + a].split()[:2]] for a in range(3)]
-                    )
+                    frame["box"], frame["tilt"] = _box_bounds(lines[k + 1 : k + 4], triclinic)
                 except (IndexError, ValueError):
                     raise FileFormatError(
-                        path, k + 2, "expected three lines of box bounds 'lo hi'"
+                        path,
+                        k + 2,
+                        "expected three lines of box bounds 'lo hi'" + (" tilt" if triclinic else ""),
                     ) from None
+                except _TiltOutOfPlane as error:
+                    raise FileFormatError(path, k + 3, str(error)) from None
                 for axis, name in ((0, "x"), (1, "y")):
                     lo, hi = frame["box"][axis]
                     if not -MAX_LENGTH_M <= lo < hi <= MAX_LENGTH_M:
@@ -231,6 +243,27 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
     return frames
 
 
+class _TiltOutOfPlane(Exception):
+    """A triclinic box leaning out of the x-y plane (xz or yz not 0)."""
+
+
+def _box_bounds(rows: list[str], triclinic: bool) -> tuple[NDArray[np.float64], float]:
+    """``[[xlo, xhi], [ylo, yhi], [zlo, zhi]]`` and the tilt ``xy`` of a dump's three
+    box lines. A triclinic dump gives the bounding box and the tilts ``xy xz yz``;
+    the cell's own bounds are the bounding box less the tilt's reach."""
+    values = [[float(v) for v in row.split()[: 3 if triclinic else 2]] for row in rows]
+    if len(rows) != 3 or any(len(v) != (3 if triclinic else 2) for v in values):
+        raise ValueError("box bounds")
+    box = np.array([v[:2] for v in values])
+    if not triclinic:
+        return box, 0.0
+    xy, xz, yz = values[0][2], values[1][2], values[2][2]
+    if xz != 0.0 or yz != 0.0:
+        raise _TiltOutOfPlane(f"a triclinic box leaning out of the x-y plane (xz {xz!r}, yz {yz!r}) is 3D")
+    box[0] -= (min(0.0, xy), max(0.0, xy))
+    return box, xy
+
+
 def list_timesteps(path: str | Path) -> list[int]:
     """The timesteps of the frames in a dump file, in file order (a last frame cut
     short by the end of the file is left out)."""
@@ -272,6 +305,7 @@ def read_dump_frames(path: str | Path, timestep: int | None = None) -> DumpFrame
         line_numbers=numbers,
         box=f["box"],
         boundary=f["boundary"],
+        tilt=f["tilt"],
         time=f["time"],
         header_line=f["header_line"],
     )
@@ -349,7 +383,7 @@ def read_lammps_dump(
             if scaled:
                 if box2 is None:
                     raise FileFormatError(path, where, "scaled coordinates need the box bounds")
-                x = box2[0, 0] + x * (box2[0, 1] - box2[0, 0])
+                x = box2[0, 0] + x * (box2[0, 1] - box2[0, 0]) + y * frame.tilt
                 y = box2[1, 0] + y * (box2[1, 1] - box2[1, 0])
             used |= {xn, yn}
             position_columns = f"{xn} {yn}"
@@ -420,6 +454,10 @@ def read_lammps_dump(
     periodic = (False, False)
     if frame.boundary:
         periodic = (frame.boundary[0] == "pp", frame.boundary[1] == "pp")
+    if frame.tilt != 0.0 and not periodic[1]:
+        raise FileFormatError(path, where, "a triclinic box with xy tilt needs y periodic ('pp')")
+    if frame.tilt != 0.0 and z_policy != "refuse":
+        raise ValueError(f"z_policy: {z_policy!r} is not supported in a triclinic (tilted) box")
     metadata = {
         "source": str(path),
         "format": "lammps-dump",
@@ -432,6 +470,7 @@ def read_lammps_dump(
         particle_fields=fields,
         box=box2,
         periodic=periodic if box2 is not None else (False, False),
+        tilt=frame.tilt,
         time=frame.time,
         metadata=metadata,
     )

@@ -92,7 +92,7 @@ def _write_array(
 
 
 #: Attributes of a snapshot group that a scalar may not be named as.
-_RESERVED_ATTRS = frozenset({"n_particles", "n_contacts", "periodic", "time", "step", "scalars", "index"})
+_RESERVED_ATTRS = frozenset({"n_particles", "n_contacts", "periodic", "tilt", "time", "step", "scalars", "index"})
 
 
 def _scalars(attrs: Any) -> dict[str, float]:
@@ -140,6 +140,8 @@ def _write_snapshot_group(
     group.attrs["n_particles"] = np.int64(snapshot.n_particles)
     group.attrs["n_contacts"] = np.int64(snapshot.n_contacts)
     group.attrs["periodic"] = np.array(snapshot.periodic, dtype=np.int8)
+    if snapshot.tilt != 0.0:  # a leaning periodic cell (absent: a rectangle)
+        group.attrs["tilt"] = np.float64(snapshot.tilt)
     if snapshot.time is not None:
         group.attrs["time"] = np.float64(snapshot.time)
     for name, value in snapshot.scalars.items():  # each an attribute of its own name
@@ -186,6 +188,7 @@ def _read_snapshot_group_v1(group: h5py.Group, path: Path) -> Snapshot:
             particle_fields=fields("particle_fields"),
             box=get("box"),
             periodic=periodic,  # type: ignore[arg-type]
+            tilt=float(attrs.get("tilt", 0.0)),
             time=float(attrs["time"]) if "time" in attrs else None,
             scalars=_scalars(attrs),
             metadata=metadata,
