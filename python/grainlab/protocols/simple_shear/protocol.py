@@ -223,10 +223,7 @@ def _snapshot(sim: Simulation, run: SimpleShearRun, values: dict[str, float]) ->
     kind = np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8)
     scalars = {name: values[name] for name in ("shear_strain", "shear_stress_pa", "normal_stress_pa",
                                                 "friction_coefficient", "volumetric_strain", "cell_tilt")}
-    cell = sim.cell
-    assert cell is not None
-    return sim.snapshot(kind=kind, scalars=scalars, step=sim.step_count,
-                        cell_a_m=list(cell.a), cell_b_m=list(cell.b), cell_origin_m=list(cell.origin))
+    return sim.snapshot(kind=kind, scalars=scalars, step=sim.step_count)  # with the cell's box and tilt
 
 
 def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, float]:
