@@ -5,12 +5,13 @@ the membrane's disks; ``--sample default``: the paper's 3,518) with one engine t
 a drift of the machine's speed falls on all of them alike (alternated
 repetitions). Each run's loading phase is timed by the run itself
 (``summary.json``'s ``wall_time_by_phase_s``: ``shear`` for the biaxial and
-cyclic tests, ``load`` for the oedometer), and its steps are the difference of
+cyclic and simple-shear tests, ``load`` for the oedometer), and its steps are the difference of
 the first and last records' ``step`` (the oedometer's summary's ``load_steps``:
 it records at the load steps' ends only); the figure is particles x steps / seconds.
 Medians over ``--repeat`` rounds, then each test's ratio to the biaxial test on
-the same disks (the cyclic test: with the membrane; the constant-volume test and
-the oedometer: grains alone, between rigid walls, ``boundary.kind = walls``); the
+the same disks (the cyclic test: with the membrane; the constant-volume test,
+the oedometer and periodic simple shear, on a sample of the biaxial test's
+size: grains alone, between rigid walls, ``boundary.kind = walls``); the
 last line printed is one JSON object.
 
     python benchmarks/protocol_speed.py --repeat 5       # about 7 minutes
@@ -43,13 +44,18 @@ TESTS: dict[str, tuple[list[str], str, str]] = {
     "constant volume": (["biaxial", "--set", "shear.final_strain=0.03", "--set", "shear.volume=constant"], "shear",
                         "biaxial, walls"),
     "oedometer": (["run", "oedometer"], "load", "biaxial, walls"),
+    # the biaxial test's sample size (30 x 60 mm quick, 75 x 150 mm default) in a periodic cell, 30 % of shear
+    "simple shear": (["run", "simple_shear", "--set", "sample.height=0.06", "--set", "simple_shear.final_strain=0.3",
+                      "--set", "simple_shear.snapshot_strains=[0, 0.3]"], "shear", "biaxial, walls"),
 }
 #: Every run's options; the monotonic tests also take two snapshots only, as the others.
 COMMON = ["--no-report", "--no-progress", "--set", "run.threads=1"]
 SNAPSHOTS = ["--set", "shear.snapshot_strains=[0, 0.03]"]
 #: On the default sample (3,518 grains) a third of the strain path, for the same time.
 DEFAULT_SAMPLE = {"shear.final_strain=0.03": "shear.final_strain=0.01", "cyclic.cycles=3": "cyclic.cycles=1",
-                  "shear.snapshot_strains=[0, 0.03]": "shear.snapshot_strains=[0, 0.01]"}
+                  "shear.snapshot_strains=[0, 0.03]": "shear.snapshot_strains=[0, 0.01]",
+                  "sample.height=0.06": "sample.height=0.15", "simple_shear.final_strain=0.3": "simple_shear.final_strain=0.1",
+                  "simple_shear.snapshot_strains=[0, 0.3]": "simple_shear.snapshot_strains=[0, 0.1]"}
 
 
 def one_run(name: str, quick: bool) -> float:
