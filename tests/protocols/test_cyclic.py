@@ -162,3 +162,90 @@ def test_the_quick_default_run_is_the_one_docs_protocols_md_prints(tmp_path, cap
     printed = capsys.readouterr().out.splitlines()[0]
     quoted = next(line for line in DOCS.read_text().splitlines() if line.startswith("grainlab cyclic: 563"))
     assert printed.split("; ")[:-1] == quoted.split("; ")[:-1], (printed, quoted)
+
+
+# stress control: two cycles of q = +/-30 kPa on the quick sample, a checkpoint at every record
+STRESS = ["cyclic.control=stress", "cyclic.stress_amplitude=30 kPa", "cyclic.cycles=2", "run.threads=1",
+          "run.checkpoint_interval=1e-6"]
+
+
+@pytest.fixture(scope="module")
+def stress_config():
+    return resolve_config("cyclic", overrides=STRESS, quick=True)
+
+
+@pytest.fixture(scope="module")
+def stress_run(tmp_path_factory, stress_config):
+    out = tmp_path_factory.mktemp("cyclic_stress") / "run"
+    runner.run_protocol(CyclicProtocol(stress_config), out)
+    return out
+
+
+def test_stress_control_turns_where_the_deviator_reaches_the_amplitude(stress_run):
+    """The platens turn at q = +/-A_q: the rule is asked every 100 steps, so a turn
+    overshoots by at most what 100 steps add (a few per cent of A_q here)."""
+    ts = {k: np.asarray(v, dtype=np.float64) for k, v in read_results(stress_run / "run.h5").timeseries.items()}
+    q = ts["axial_stress_pa"] - ts["confining_pressure_pa"]
+    cycle = ts[CYCLE]
+    quarters = np.round(4 * cycle).astype(int)
+    first = np.flatnonzero(np.diff(quarters) > 0) + 1  # the record of each event
+    assert list(quarters[first]) == list(range(1, 9))
+    turns = first[(quarters[first] % 4 == 1) | (quarters[first] % 4 == 3)]
+    np.testing.assert_allclose(np.abs(q[turns]), 30e3, rtol=0.05)
+    assert np.all(q[turns][::2] > 0) and np.all(q[turns][1::2] < 0)
+    ends = first[quarters[first] % 4 == 0]
+    assert np.all(np.abs(q[ends]) < 0.1 * 30e3)
+    summary = json.loads((stress_run / "summary.json").read_text())
+    assert len(summary["cycles"]) == 2 and summary["stopped_at_strain_limit"] is False
+    assert summary["cycles"][0]["stress_ratio_compression"] == pytest.approx(1.3, rel=0.05)
+    names = read_results(stress_run / "run.h5").snapshot_names
+    assert names == ["start", "cycle_001_compression", "cycle_001_extension", "cycle_001_end",
+                     "cycle_002_compression", "cycle_002_extension", "cycle_002_end"]
+
+
+@pytest.mark.parametrize("checkpoints", [4, 12])
+def test_a_stopped_stress_controlled_run_resumes_to_the_same_bits(stress_run, tmp_path, monkeypatch, stress_config,
+                                                                   checkpoints):
+    stop_and_resume(CyclicProtocol(stress_config), tmp_path / "run", checkpoints, monkeypatch)
+    assert_same_run(stress_run, tmp_path / "run")
+
+
+def test_a_sample_that_cannot_carry_the_cycles_stops_at_the_strain_limit(tmp_path):
+    """q = +/-90 kPa at sigma_3 = 100 kPa: extension to sigma_1 = 10 kPa is beyond these disks'
+    strength in extension; the loading ends where the axial strain reaches the limit."""
+    config = resolve_config("cyclic", overrides=["cyclic.control=stress", "cyclic.stress_amplitude=90 kPa",
+                                                 "cyclic.cycles=2", "cyclic.strain_limit=0.5 %", "run.threads=1"],
+                            quick=True)
+    result = runner.run_protocol(CyclicProtocol(config), tmp_path / "run")
+    s = result.summary
+    assert s["stopped_at_strain_limit"] is True and len(s["cycles"]) < 2
+    eps = np.asarray(read_results(tmp_path / "run" / "run.h5").timeseries[AXIAL_STRAIN])
+    assert np.abs(eps).max() >= 0.005 and np.abs(eps).max() < 0.0055
+    assert "the axial strain reached +/-0.5 %" in result.one_line()
+
+
+@pytest.mark.parametrize(("override", "message"), [
+    ("cyclic.stress_amplitude=150 kPa", "cyclic.stress_amplitude: 150 kPa reaches beyond the sample"),
+    ("cyclic.strain_amplitude=0.01", "cyclic.strain_amplitude: a stress-controlled test turns at"),
+])
+def test_bad_stress_control_input_gets_one_line_and_no_folder(tmp_path, capsys, override, message):
+    out = tmp_path / "never"
+    assert main(["run", "cyclic", "--quick", "--out", str(out), "--set", "cyclic.control=stress", "--set",
+                 "cyclic.stress_amplitude=50 kPa", "--set", override]) != 0
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1, err
+    assert not out.exists()
+
+
+def test_stress_control_needs_its_amplitude_and_strain_control_refuses_it(tmp_path, capsys):
+    for args, message in ((["--set", "cyclic.control=stress"], "cyclic.stress_amplitude: give the deviator"),
+                          (["--set", "cyclic.stress_amplitude=50 kPa"], "only used with cyclic.control = 'stress'")):
+        assert main(["run", "cyclic", "--quick", "--out", str(tmp_path / "never"), *args]) != 0
+        err = capsys.readouterr().err
+        assert message in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_a_saved_stress_controlled_configuration_reads_back(stress_config):
+    """A checkpoint stores every key; reading it back must not refuse the defaults it holds."""
+    protocol = CyclicProtocol(stress_config)
+    assert protocol.resolve_saved(protocol.config_dict()) == protocol.config_dict()

@@ -146,6 +146,12 @@ def test_bad_input_gets_one_line_and_no_folder(tmp_path, capsys, override, messa
     assert not out.exists()
 
 
+def test_a_saved_constant_volume_configuration_reads_back():
+    """A checkpoint stores every key (simple_shear.normal_stress too): reading it back must not refuse it."""
+    protocol = SimpleShearProtocol(_config("simple_shear.volume=constant"))
+    assert protocol.resolve_saved(protocol.config_dict()) == protocol.config_dict()
+
+
 def test_the_inertial_number_sets_the_rate(free):
     s = json.loads((free / "summary.json").read_text())
     density = resolve_config("simple_shear")["material.density"]

@@ -52,7 +52,11 @@ def render_cyclic(r: RunPage) -> str:
     glance = definition_table([
         ("grains", fmt(s["n_particles"])),
         ("porosity at the start of cycling", fmt(s["porosity_initial"], 4)),
-        ("amplitude, cycles", f"+/- {fmt(100 * s['strain_amplitude'], 3)} % axial strain, {len(cycles)}"),
+        ("amplitude, cycles", (f"+/- {fmt(100 * s['strain_amplitude'], 3)} % axial strain"
+                               if s.get("control", "strain") == "strain"
+                               else f"deviator q +/- {fmt(s['stress_amplitude_pa'] / 1e3, 3)} kPa") + f", {len(cycles)}"
+         + (f" of {s['cycles_asked']} (the axial strain reached +/- {fmt(100 * s['strain_limit'], 3)} %)"
+            if s.get("stopped_at_strain_limit") else "")),
         ("strain rate", f"{fmt(s['strain_rate'], 3, unit='1/s')} (inertial number {fmt(s['inertial_number'], 3)})"),
         ("Z: start -> end", f"{fmt(s['coordination_number_initial'], 4)} -> {fmt(last[COORDINATION_NUMBER], 4)}"),
         ("mean lambda: start -> end",

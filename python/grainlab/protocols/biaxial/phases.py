@@ -260,12 +260,20 @@ def shear(
     snapshot_name_of: Callable[[float], str] = snapshot_name,
     extra: Callable[[int], dict[str, float]] | None = None,
     units: Mapping[str, str] = TIMESERIES_UNITS,
+    rule: Callable[[Simulation, _Run], str] | None = None,
+    event_snapshot: Callable[[int], str | None] | None = None,
 ) -> None:
     """Runs the planned loading (:func:`start_platens`) to its end: the platens reversed
     at the plan's turns, a record (with ``extra(steps since the start)``'s columns, in
     ``units``) on each record step, a snapshot named ``snapshot_name_of(path strain)``
     on each snapshot step, a checkpoint on the wall clock; ``final`` (default
-    ``shear.final_strain``) is the path strain the progress counts to."""
+    ``shear.final_strain``) is the path strain the progress counts to.
+
+    A ``rule(sim, run)`` (a stress-controlled cyclic test's) is asked every
+    WALL_CONTROL_STEPS steps between records; it answers ``""``, ``"turn"`` (the
+    platens reverse there), ``"mark"`` or ``"end"`` (the loading stops there). Each
+    answer but ``""`` is an event: counted in the plan, recorded, and stored as a
+    snapshot when ``event_snapshot(events so far)`` names one."""
     start = time.perf_counter() - run.wall_time.get("shear", 0.0)
     plan = run.shear_plan()
     steps = plan.record_steps
@@ -282,15 +290,42 @@ def shear(
     walls = boundary if isinstance(boundary, WallBoundary) else None
     wall_speed = 0.05 * float(sim.radii[: run.n_grains].min()) / (50 * sim.time_step)
 
-    def advance(to_step: int) -> None:
-        """Runs to ``to_step``; rigid side walls are controlled every WALL_CONTROL_STEPS."""
-        if walls is None:
+    last_event: dict[str, Any] = {"step": -1, "values": {}}
+
+    def on_event(answer: str) -> None:
+        """An event of the rule: counted, recorded and (when named) stored; the
+        platens reversed at a turn; the loading ended at the end."""
+        plan.events += 1
+        if answer == "turn":
+            plan.turn_steps.append(sim.step_count - plan.start_step)
+            _reverse(sim, run, plan)
+        values = record()
+        writer.append_timeseries(values, units=units)
+        last_event.update(step=sim.step_count, values=values)
+        name = None if event_snapshot is None else event_snapshot(plan.events)
+        if name is not None:
+            writer.write_snapshot(name, _snapshot(sim, run, values[AXIAL_STRAIN]), step=sim.step_count,
+                                  walls=_walls(sim, run))
+        if answer == "end":
+            plan.next_record = len(steps)
+
+    def advance(to_step: int) -> bool:
+        """Runs to ``to_step``; rigid side walls are controlled, and the rule asked,
+        every WALL_CONTROL_STEPS. False when the rule ended the loading on the way."""
+        if walls is None and rule is None:
             sim.run(to_step - sim.step_count)
-            return
+            return True
         while sim.step_count < to_step:
             n = min(WALL_CONTROL_STEPS, to_step - sim.step_count)
-            walls.control(sim, n, plan.area0, wall_speed)
+            if walls is not None:
+                walls.control(sim, n, plan.area0, wall_speed)
             sim.run(n)
+            answer = "" if rule is None else rule(sim, run)
+            if answer:
+                on_event(answer)
+                if answer == "end":
+                    return False
+        return True
 
     if plan.next_record == 0 and "0" in snap_steps and writer.n_rows == 0:
         first = record()
@@ -314,9 +349,13 @@ def shear(
             advance(turn)
             _reverse(sim, run, plan)
             continue
-        advance(target)
-        values = record()
-        writer.append_timeseries(values, units=units)
+        if not advance(target):
+            break
+        if last_event["step"] == sim.step_count:  # an event's record is this step's
+            values = last_event["values"]
+        else:
+            values = record()
+            writer.append_timeseries(values, units=units)
         key = str(steps[plan.next_record])
         if key in snap_steps:
             writer.write_snapshot(snapshot_name_of(snap_steps[key]), _snapshot(sim, run, values[AXIAL_STRAIN]),

@@ -42,6 +42,17 @@ def _platens(sim: Simulation, boundary: Boundary) -> _Platens:
     return _Platens(height, area, width, axial_force / width)
 
 
+def deviator_stress(sim: Simulation, run: _Run, config: BiaxialConfig) -> float:
+    """q = sigma_1 - sigma_3' from the platens' and the lateral boundary's forces alone
+    (cheap enough for every 100 steps): sigma_3' is the confining pressure held, or the
+    side walls' stress at constant volume."""
+    boundary = _boundary(run)
+    sigma_1 = _platens(sim, boundary).axial_stress_pa
+    if isinstance(boundary, WallBoundary) and boundary.constant_volume:
+        return sigma_1 - boundary.lateral_stress(sim)
+    return sigma_1 - float(config["consolidation.pressure"])
+
+
 def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, float]:
     """One record of the shearing phase."""
     boundary = _boundary(run)

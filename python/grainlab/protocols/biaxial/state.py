@@ -41,12 +41,17 @@ class ShearPlan:
     #: turning points; none in a monotonic test), and the next of them to come.
     turn_steps: list[int] = field(default_factory=list)
     next_turn: int = 0
+    #: Events a loading's rule has reported so far (a stress-controlled cyclic test's turning
+    #: points and crossings of q = 0; none otherwise).
+    events: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         saved = asdict(self)
         saved["next"] = saved.pop("next_record")
         if not self.turn_steps:  # a monotonic test's checkpoints keep their earlier layout
             del saved["turn_steps"], saved["next_turn"]
+        if not self.events:
+            del saved["events"]
         return saved
 
     @classmethod

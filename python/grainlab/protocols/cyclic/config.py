@@ -29,6 +29,22 @@ CYCLIC_FIELDS: dict[str, Field] = {
         "(compression positive); at most 5 %", minimum=0.0, maximum=0.05, exclusive_minimum=True,
     ),
     "cyclic.cycles": Field("integer", 5, "number of cycles", minimum=1, maximum=1000),
+    "cyclic.control": Field(
+        "choice", "strain",
+        "strain: the platens turn at +/- cyclic.strain_amplitude; stress: they turn where the deviator "
+        "q = sigma_1 - sigma_3' reaches +/- cyclic.stress_amplitude",
+        choices=("strain", "stress"),
+    ),
+    "cyclic.stress_amplitude": Field(
+        "stress", "auto", "deviator amplitude A_q of a stress-controlled test: each cycle goes q = 0 -> +A_q -> "
+        "-A_q -> 0; below sigma_0 (extension to -A_q needs sigma_1 = sigma_3 - A_q > 0)",
+        minimum=0.0, exclusive_minimum=True, allow_auto=True,
+    ),
+    "cyclic.strain_limit": Field(
+        "strain", 0.05, "a stress-controlled test ends when the axial strain reaches +/- this (the sample has "
+        "failed: the cycles it completed are its cycles to failure)", minimum=0.0, maximum=0.2,
+        exclusive_minimum=True,
+    ),
 }
 
 _MONOTONIC_ONLY = ("shear.final_strain", "shear.snapshot_strains")
@@ -37,12 +53,34 @@ _MONOTONIC_ONLY = ("shear.final_strain", "shear.snapshot_strains")
 def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
     check_sample(values, given)
     check_boundary(values, given)
+    if values["cyclic.control"] == "stress":
+        _check_stress_control(values, given)
+        return
+    if values["cyclic.stress_amplitude"] != "auto":
+        raise ConfigError("cyclic.stress_amplitude: only used with cyclic.control = 'stress'")
     amplitude, interval = values["cyclic.strain_amplitude"], values["shear.record_interval"]
     if amplitude < 4 * interval:
         raise ConfigError(
             f"cyclic.strain_amplitude: {amplitude:g} is less than four record intervals "
             f"(shear.record_interval {interval:g}): a cycle's loops would have too few points; "
             "raise it or record more often"
+        )
+
+
+def _check_stress_control(values: dict[str, Any], given: AbstractSet[str]) -> None:
+    amplitude, sigma_0 = values["cyclic.stress_amplitude"], values["consolidation.pressure"]
+    # (a saved configuration holds every key: only a value other than the default is refused)
+    if "cyclic.strain_amplitude" in given and values["cyclic.strain_amplitude"] != CYCLIC_FIELDS[
+            "cyclic.strain_amplitude"].default:
+        raise ConfigError("cyclic.strain_amplitude: a stress-controlled test turns at cyclic.stress_amplitude; "
+                          "its strain bound is cyclic.strain_limit")
+    if amplitude == "auto":
+        raise ConfigError("cyclic.stress_amplitude: give the deviator amplitude of a stress-controlled test, "
+                          "e.g. --set 'cyclic.stress_amplitude=50 kPa'")
+    if amplitude >= sigma_0:
+        raise ConfigError(
+            f"cyclic.stress_amplitude: {amplitude / 1e3:g} kPa reaches beyond the sample: extension to q = -A_q "
+            f"needs sigma_1 = sigma_3 - A_q > 0 with sigma_3 = consolidation.pressure = {sigma_0 / 1e3:g} kPa"
         )
 
 

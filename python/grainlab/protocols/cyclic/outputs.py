@@ -3,8 +3,9 @@ turning points, and its end state: volumetric strain, Z, mean lambda, anisotropy
 ``timeseries.csv``, ``summary.json`` and the figures, all from ``run.h5``.
 
 A cycle's end state is its record nearest ``cycle == k`` (the records fall on
-each cycle's end exactly); its compression and extension turning points are the
-records of largest and smallest axial strain within it. The rules were fixed
+each cycle's end exactly, in strain and in stress control); its compression and
+extension turning points are the records of largest and smallest axial strain
+within it. The rules were fixed
 before any run was seen.
 """
 
@@ -41,10 +42,18 @@ class CyclicResult(RunResult):
 
     def one_line(self) -> str:
         s = self.summary
+        if not s["cycles"]:
+            return (f"grainlab cyclic: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}; no cycle "
+                    f"completed: the axial strain reached +/-{100 * s['strain_limit']:.1f} % in the first; "
+                    f"{s['wall_time_s']:.1f} s -> {self.out_dir}")
         first, last = s["cycles"][0], s["cycles"][-1]
+        amplitude = (f"+/-{100 * s['strain_amplitude']:.2f} %" if s.get("control", "strain") == "strain"
+                     else f"q +/-{s['stress_amplitude_pa'] / 1e3:.1f} kPa")
+        failed = (f" (of {s['cycles_asked']}: the axial strain reached +/-{100 * s['strain_limit']:.1f} %)"
+                  if s.get("stopped_at_strain_limit") else "")
         return (
             f"grainlab cyclic: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}; "
-            f"{len(s['cycles'])} cycles of +/-{100 * s['strain_amplitude']:.2f} %: sigma1/sigma3 at +A "
+            f"{len(s['cycles'])} cycles{failed} of {amplitude}: sigma1/sigma3 at +A "
             f"{first['stress_ratio_compression']:.2f} -> {last['stress_ratio_compression']:.2f}, volumetric strain "
             f"{100 * last[VOLUMETRIC_STRAIN]:.3f} %, Z {s['coordination_number_initial']:.2f} -> "
             f"{last[COORDINATION_NUMBER]:.2f}; {self._undrained()}{s['wall_time_s']:.1f} s -> {self.out_dir}"
@@ -98,7 +107,12 @@ def summarise(run: _Run, config: Config, timeseries: dict[str, np.ndarray], tota
         "coordination_number_initial": float(timeseries[COORDINATION_NUMBER][0]),
         "mean_stability_index_initial": float(timeseries["mean_stability_index"][0]),
         "anisotropy_initial": float(timeseries["anisotropy"][0]),
-        "strain_amplitude": config["cyclic.strain_amplitude"],
+        "control": config["cyclic.control"],
+        "strain_amplitude": config["cyclic.strain_amplitude"] if config["cyclic.control"] == "strain" else None,
+        "stress_amplitude_pa": None if config["cyclic.control"] == "strain" else config["cyclic.stress_amplitude"],
+        "strain_limit": config["cyclic.strain_limit"],
+        "cycles_asked": config["cyclic.cycles"],
+        "stopped_at_strain_limit": len(cycles) < config["cyclic.cycles"],
         "shear_volume": config["shear.volume"],
         "strain_rate": plan.strain_rate,
         "inertial_number": plan.inertial_number,

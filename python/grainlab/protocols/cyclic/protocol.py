@@ -4,11 +4,16 @@ consolidation and flexible boundary under sigma_0, then the platens driven at
 ``cyclic.strain_amplitude``, compression positive), ``cyclic.cycles`` times, the
 confining pressure held. Records every ``shear.record_interval`` of strain path and
 at every turning point; snapshots at the start, at the first and last cycles'
-turning points and at the end of every cycle. :func:`run_cyclic` runs it into a folder."""
+turning points and at the end of every cycle. With ``cyclic.control = "stress"``
+the platens turn where the deviator q reaches +/- ``cyclic.stress_amplitude``
+instead (asked every 100 steps), and the loading ends after the cycles or where
+the axial strain reaches ``cyclic.strain_limit``. :func:`run_cyclic` runs it into
+a folder."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -20,6 +25,8 @@ from grainlab.protocols.biaxial.phases import (
     start_platens,
 )
 from grainlab.protocols.biaxial.rates import check_density_scaling, check_strain_rate
+from grainlab.protocols.biaxial.records import deviator_stress
+from grainlab.protocols.biaxial.state import _boundary as _boundary_of
 from grainlab.protocols.biaxial.state import _Run
 from grainlab.protocols.config import Config
 from grainlab.protocols.cyclic.config import CYCLIC_SCHEMA  # noqa: F401 - registers the schema
@@ -27,8 +34,10 @@ from grainlab.protocols.cyclic.outputs import CyclicResult, summarise, write_out
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import SpecimenProtocol, consolidate
 from grainlab.protocols.triggers import At, Every
+from grainlab.simulation import Simulation
 
-__all__ = ["CyclicProtocol", "cycle_plan", "run_cyclic", "snapshot_name_of"]
+__all__ = ["STRESS_EVENTS", "CyclicProtocol", "cycle_plan", "run_cyclic", "snapshot_name_of", "stress_path_length",
+           "stress_rule", "stress_snapshot_name"]
 
 Context = StageContext[Config, _Run]
 
@@ -68,9 +77,64 @@ def _consolidate(context: Context) -> None:
     consolidate(context.sim, context.state, context.config, context.progress)
 
 
+#: What each event of a stress-controlled cycle is, in order.
+STRESS_EVENTS = ("compression", "unloaded", "extension", "end")
+
+
+def stress_path_length(config: Config) -> float:
+    """The strain path a stress-controlled test may travel at most: every cycle's
+    quarters at the strain limit."""
+    return float(4 * config["cyclic.cycles"] * config["cyclic.strain_limit"])
+
+
+def stress_rule(config: Config) -> Callable[[Simulation, _Run], str]:
+    """The turning rule of a stress-controlled test: the platens load until q reaches
+    +A_q (a turn), unload through q = 0 (a mark) to -A_q (a turn) and load back to
+    q = 0 (a mark, or the end after the last cycle); the loading also ends where the
+    axial strain reaches +/- ``cyclic.strain_limit``."""
+    amplitude, cycles, limit = (config["cyclic.stress_amplitude"], config["cyclic.cycles"],
+                                config["cyclic.strain_limit"])
+
+    def rule(sim: Simulation, run: _Run) -> str:
+        plan = run.shear_plan()
+        bottom, top = sim.wall(_boundary_of(run).bottom_wall), sim.wall(_boundary_of(run).top_wall)
+        strain = (plan.height0 - float(top.points[0, 1] - bottom.points[0, 1])) / plan.height0
+        if abs(strain) >= limit:
+            return "end"
+        q = deviator_stress(sim, run, config)
+        quarter = plan.events % 4
+        if quarter == 0 and q >= amplitude or quarter == 2 and q <= -amplitude:
+            return "turn"
+        if quarter == 1 and q <= 0.0:
+            return "mark"
+        if quarter == 3 and q >= 0.0:
+            return "end" if plan.events + 1 == 4 * cycles else "mark"
+        return ""
+
+    return rule
+
+
+def stress_snapshot_name(cycles: int) -> Callable[[int], str | None]:
+    """The snapshot of a stress-controlled test's event ``k`` (1, 2, ...): the first and
+    last cycles' turning points and every cycle's end, named as the strain-controlled test's."""
+
+    def name(k: int) -> str | None:
+        cycle, what = (k - 1) // 4 + 1, STRESS_EVENTS[(k - 1) % 4]
+        if what == "end" or (what != "unloaded" and cycle in (1, cycles)):
+            return f"cycle_{cycle:03d}_{what}"
+        return None
+
+    return name
+
+
 def _boundary(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
     install_boundary(sim, run, config, context.progress)
+    if config["cyclic.control"] == "stress":
+        start_platens(sim, run, config, final=stress_path_length(config),
+                      records=[Every(config["shear.record_interval"])], snapshots=[0.0])
+        check_shear_plan(sim, run, config, [0.0], key="cyclic.stress_amplitude")
+        return
     final, turns, snapshots = cycle_plan(config["cyclic.strain_amplitude"], config["cyclic.cycles"])
     start_platens(sim, run, config, final=final,
                   records=[Every(config["shear.record_interval"]), At([*turns, *snapshots])],
@@ -83,6 +147,15 @@ def _cycle(context: Context) -> None:
     amplitude = config["cyclic.strain_amplitude"]
     plan = context.state.shear_plan()
     strain_per_step = plan.strain_rate * context.sim.time_step
+    if config["cyclic.control"] == "stress":
+
+        def events(steps: int) -> dict[str, float]:
+            return {STRAIN_PATH: steps * strain_per_step, CYCLE: context.state.shear_plan().events / 4.0}
+
+        shear(context.sim, context.state, config, context.writer, context.save, context.progress,
+              final=stress_path_length(config), snapshot_name_of=lambda path: "start", extra=events,
+              units=CYCLIC.units(), rule=stress_rule(config), event_snapshot=stress_snapshot_name(config["cyclic.cycles"]))
+        return
 
     def path(steps: int) -> dict[str, float]:
         travelled = steps * strain_per_step

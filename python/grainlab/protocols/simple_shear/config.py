@@ -72,7 +72,7 @@ def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
             f"simple_shear.record_interval: {interval:g} exceeds simple_shear.final_strain {final:g}: no record "
             "would be made"
         )
-    if values["simple_shear.volume"] == "constant" and "simple_shear.normal_stress" in given:
+    if values["simple_shear.volume"] == "constant" and values["simple_shear.normal_stress"] != "auto":
         raise ConfigError(
             "simple_shear.normal_stress: a constant-volume run holds the cell's area, not a normal stress; "
             "leave it out or set simple_shear.volume = 'free'"
