@@ -166,3 +166,19 @@ def test_the_example_prints_both_cells(tmp_path):
     lines = printed.splitlines()
     assert [line.split(":")[0] for line in lines] == ["free volume", "constant volume"]
     assert "dilation" in lines[0] and "sigma_n 100.0 ->" in lines[1]
+
+
+def test_contact_dashpots_shorten_the_time_step_and_the_cell_settles(tmp_path):
+    """With dashpots at half of critical the central-difference limit is sqrt(1 + 0.25) - 0.5 = 0.618
+    of the undamped one: a run that kept the undamped step never settled (unbalanced force ratio
+    0.5); with the shortened step it settles and shears."""
+    config = _config("material.contact_damping=0.5", "simple_shear.local_damping=0",
+                     "simple_shear.inertial_number=0.1", "simple_shear.final_strain=0.2",
+                     "simple_shear.snapshot_strains=[0]")
+    result = runner.run_protocol(SimpleShearProtocol(config), tmp_path / "run")
+    undamped = runner.run_protocol(SimpleShearProtocol(_config("simple_shear.final_strain=0.04",
+                                                               "simple_shear.snapshot_strains=[0]")),
+                                   tmp_path / "undamped")
+    ratio = result.summary["time_step_s"] / undamped.summary["time_step_s"]
+    assert ratio == pytest.approx(math.sqrt(1.25) - 0.5, rel=1e-9)
+    assert result.summary["friction_coefficient_steady"] > 0.2

@@ -28,7 +28,13 @@ from grainlab.protocols.simple_shear.cell import CONTROL_STEPS, cell_stress, ser
 from grainlab.protocols.simple_shear.config import SIMPLE_SHEAR_SCHEMA  # noqa: F401 - registers the schema
 from grainlab.protocols.simple_shear.outputs import SimpleShearResult, summarise, write_outputs
 from grainlab.protocols.simple_shear.state import SimpleShearRun
-from grainlab.protocols.specimen import CHUNK_STEPS, SpecimenError, SpecimenProtocol, grain_model
+from grainlab.protocols.specimen import (
+    CHUNK_STEPS,
+    SpecimenError,
+    SpecimenProtocol,
+    damped_time_step_factor,
+    grain_model,
+)
 from grainlab.protocols.triggers import At, Every, WallClock, schedule_steps
 from grainlab.simulation import ContactModel, Simulation
 from grainlab.snapshot import ParticleKind
@@ -139,7 +145,7 @@ def _consolidate(context: Context) -> None:
     sim.set_contact_model(0, 0, ContactModel(config["material.normal_stiffness"], config["material.shear_stiffness"],
                                              config["consolidation.friction"]))
     sim.local_damping = config["material.local_damping"]
-    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0) * damped_time_step_factor(config)
     steps = _equilibrate(sim, run, config, context.progress, "consolidating")
     cell = sim.cell
     assert cell is not None
