@@ -249,3 +249,26 @@ def test_a_saved_stress_controlled_configuration_reads_back(stress_config):
     """A checkpoint stores every key; reading it back must not refuse the defaults it holds."""
     protocol = CyclicProtocol(stress_config)
     assert protocol.resolve_saved(protocol.config_dict()) == protocol.config_dict()
+
+
+STRESS_QUICK = Path(__file__).resolve().parents[2] / "tests" / "data" / "cyclic" / "stress_quick_summary.json"
+
+
+def test_the_docs_quote_the_stress_controlled_run():
+    """docs/protocols.md's stress-controlled run (line and table) is tests/data/cyclic's summary."""
+    s = json.loads(STRESS_QUICK.read_text())
+    text = DOCS.read_text()
+    line = next(x for x in text.splitlines() if x.startswith("grainlab cyclic: 563 grains") and "q +/-" in x)
+    first, last = s["cycles"][0], s["cycles"][-1]
+    assert line.split("; ")[:-1] == [
+        f"grainlab cyclic: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}",
+        f"5 cycles of q +/-{s['stress_amplitude_pa'] / 1e3:.1f} kPa: sigma1/sigma3 at +A "
+        f"{first['stress_ratio_compression']:.2f} -> {last['stress_ratio_compression']:.2f}, volumetric strain "
+        f"{100 * last['volumetric_strain']:.3f} %, Z {s['coordination_number_initial']:.2f} -> "
+        f"{last['coordination_number']:.2f}"]
+    for c in s["cycles"]:
+        row = (f"| {c['cycle']} | {100 * c['axial_strain_compression']:.4f} | {100 * c['axial_strain_extension']:.4f} | "
+               f"{100 * c['volumetric_strain']:.4f} | {c['coordination_number']:.3f} | "
+               f"{c['mean_stability_index']:.4f} | {c['anisotropy']:.3f} |")
+        assert row in text, row
+    assert s["control"] == "stress" and len(s["cycles"]) == 5
