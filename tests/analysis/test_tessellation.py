@@ -94,3 +94,26 @@ def test_membrane_disks_get_cells_but_no_porosity():
 def test_too_few_disks():
     with pytest.raises(ValueError, match="at least 3"):
         power_cells(Snapshot([[0, 0], [1, 0]], [0.5, 0.5]))
+
+
+def test_a_leaning_periodic_cell_is_tiled_and_the_same_lattice_gives_the_same_cells():
+    """A cell sheared along x (tilt t) repeats on the lattice (L, 0), (t, L); the cells of its
+    disks tile it (their areas sum to L^2), and the same disks described with tilt t - L (the
+    same lattice, after the engine's remap) have the same cells."""
+    from grainlab.analysis.tessellation import power_cells
+    from grainlab.snapshot import Snapshot
+
+    rng = np.random.default_rng(3)
+    side, n = 10.0, 60
+    y = rng.uniform(0.0, side, n)
+    x = rng.uniform(0.0, side, n) + 0.3 * y  # inside the parallelogram of tilt 3
+    radii = rng.uniform(0.2, 0.4, n)
+
+    def cells(tilt: float) -> np.ndarray:
+        snap = Snapshot(np.column_stack([x, y]), radii, box=[[0.0, side], [0.0, side]], periodic=(True, True), tilt=tilt)
+        return power_cells(snap).area
+
+    areas = cells(3.0)
+    assert areas.sum() == pytest.approx(side * side, rel=1e-9)
+    assert np.all(areas > 0)
+    np.testing.assert_allclose(cells(3.0 - side), areas, rtol=1e-8)

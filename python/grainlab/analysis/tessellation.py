@@ -115,22 +115,40 @@ def _images(
     return source, points
 
 
+def _lattice_images(x: NDArray[np.float64], span: NDArray[np.float64],
+                    tilt: float) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """The points and their images in the eight cells around a leaning periodic cell
+    (vectors ``(span_x, 0)`` and ``(tilt, span_y)``): (9N,) source and (9N, 2), the
+    originals first."""
+    shifts = [(i, j) for i in (0, -1, 1) for j in (0, -1, 1)]
+    offsets = np.array([[i * span[0] + j * tilt, j * span[1]] for i, j in shifts])
+    n = x.shape[0]
+    source = np.tile(np.arange(n, dtype=np.int64), len(shifts))
+    return source, np.concatenate([x + o for o in offsets])
+
+
 def power_cells(snapshot: Snapshot) -> PowerCells:
     """The power cells (radical Voronoi tessellation) of every particle of
     ``snapshot`` over its region (module docstring)."""
     from scipy.spatial import ConvexHull
 
-    if snapshot.tilt != 0.0:
-        raise ValueError(
-            f"tilt: power cells of a leaning periodic cell (tilt {snapshot.tilt!r} m) are not supported"
-        )
+    tilt = float(snapshot.tilt)
+    if tilt != 0.0 and not all(snapshot.periodic):
+        raise ValueError(f"tilt: a leaning cell (tilt {tilt!r} m) is tessellated only when periodic in x and y")
     n = snapshot.n_particles
     bounds = _region(snapshot)
     span = bounds[:, 1] - bounds[:, 0]
     x = np.array(snapshot.positions, dtype=np.float64)
-    for axis in (0, 1):
-        if snapshot.periodic[axis]:
-            x[:, axis] = bounds[axis, 0] + np.mod(x[:, axis] - bounds[axis, 0], span[axis])
+    if tilt != 0.0:  # into the parallelogram spanned by (span_x, 0) and (tilt, span_y)
+        rows = np.floor((x[:, 1] - bounds[1, 0]) / span[1])
+        x[:, 1] -= rows * span[1]
+        x[:, 0] -= rows * tilt
+        lean = (x[:, 1] - bounds[1, 0]) / span[1] * tilt
+        x[:, 0] = bounds[0, 0] + lean + np.mod(x[:, 0] - bounds[0, 0] - lean, span[0])
+    else:
+        for axis in (0, 1):
+            if snapshot.periodic[axis]:
+                x[:, axis] = bounds[axis, 0] + np.mod(x[:, axis] - bounds[axis, 0], span[axis])
     r = np.asarray(snapshot.radii, dtype=np.float64)
     if n < 3:
         raise ValueError(f"positions: a tessellation needs at least 3 particles, got {n}")
@@ -138,8 +156,11 @@ def power_cells(snapshot: Snapshot) -> PowerCells:
     centre = bounds.mean(axis=1)
     scale = float(np.mean(2.0 * r))
     margin = 3.0 * float(2.0 * r.max())
+    if tilt != 0.0:  # every image of the eight neighbouring cells: one period all round
+        margin = float(span.max())
     while True:
-        source, points = _images(x, bounds, snapshot.periodic, margin)
+        source, points = (_images(x, bounds, snapshot.periodic, margin) if tilt == 0.0
+                          else _lattice_images(x, span, tilt))
         u = (points - centre) / scale
         ru = r[source] / scale
         lifted = np.column_stack([u, (u**2).sum(axis=1) - ru**2])
