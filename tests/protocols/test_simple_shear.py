@@ -182,3 +182,14 @@ def test_contact_dashpots_shorten_the_time_step_and_the_cell_settles(tmp_path):
     ratio = result.summary["time_step_s"] / undamped.summary["time_step_s"]
     assert ratio == pytest.approx(math.sqrt(1.25) - 0.5, rel=1e-9)
     assert result.summary["friction_coefficient_steady"] > 0.2
+
+
+def test_the_viewer_draws_mu_against_the_shear_strain_and_no_band(free):
+    from grainlab.viewer.data import viewer_data
+
+    data = viewer_data(free)
+    assert (data["curve"]["x"], data["curve"]["y"]) == ("shear_strain", "friction_coefficient")
+    assert data["strain_label"] == "shear strain"
+    last = data["snapshots"][-1]
+    assert last["axial_strain"] == pytest.approx(0.6, rel=1e-3)
+    assert last["band"] == {"first": None, "second": None}

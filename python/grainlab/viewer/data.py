@@ -28,7 +28,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.analysis import match_ids
-from grainlab.columns import AXIAL_STRAIN, AXIAL_STRESS_PA, STRESS_RATIO, VERTICAL_STRESS_PA
+from grainlab.columns import (
+    AXIAL_STRAIN,
+    AXIAL_STRESS_PA,
+    FRICTION_COEFFICIENT,
+    SHEAR_STRAIN,
+    STRESS_RATIO,
+    VERTICAL_STRESS_PA,
+)
 from grainlab.io.hdf5 import read_results
 from grainlab.io.vtk import contact_lines
 from grainlab.postprocess.products import RunProducts
@@ -37,8 +44,9 @@ from grainlab.postprocess.vtk import snapshot_arrays
 __all__ = ["CURVE_COLUMNS", "encode", "viewer_data"]
 
 #: Time series columns drawn as the stress–strain curve (x, y), the first pair the file has
-#: (the biaxial test's stress ratio, or the oedometer's vertical stress).
-CURVE_COLUMNS = ((AXIAL_STRAIN, STRESS_RATIO), (AXIAL_STRAIN, AXIAL_STRESS_PA), (AXIAL_STRAIN, VERTICAL_STRESS_PA))
+#: (the biaxial test's stress ratio, the oedometer's vertical stress, simple shear's mu).
+CURVE_COLUMNS = ((AXIAL_STRAIN, STRESS_RATIO), (AXIAL_STRAIN, AXIAL_STRESS_PA), (AXIAL_STRAIN, VERTICAL_STRESS_PA),
+                 (SHEAR_STRAIN, FRICTION_COEFFICIENT))
 
 
 def encode(values: NDArray[Any], dtype: str) -> str:
@@ -68,7 +76,12 @@ def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str, pr
     lines, line_data, _ = contact_lines(snap)
     force = line_data.get("normal_force", np.full(len(lines), np.nan))
     outline: dict[str, Any] = {"first": None, "second": None}
-    if name != products.reference:
+    periodic = any(snap.periodic)
+    if periodic:  # wrapped and sheared with the cell: displacements from the first snapshot mean nothing
+        for key in ("displacement", "local_shear_strain"):
+            arrays[key] = np.full_like(np.asarray(arrays[key], dtype=np.float64), np.nan)
+        arrays["in_shear_band"] = np.zeros(n, dtype=np.uint8)
+    elif name != products.reference:
         try:
             search = products.band_search(name)
             outline = {"first": _band_outline(search.band), "second": _band_outline(search.second)}
@@ -77,7 +90,7 @@ def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str, pr
     disp = arrays["displacement"][:, :2]
     out = {
         "name": name,
-        "axial_strain": snap.axial_strain,
+        "axial_strain": snap.axial_strain if snap.axial_strain is not None else snap.scalars.get(SHEAR_STRAIN),
         "time_s": snap.time,
         "n": n,
         "n_contacts": int(len(lines)),
@@ -144,6 +157,7 @@ def viewer_data(run: str | Path) -> dict[str, Any]:
         "index_dtype": index_dtype,
         "bounds": [bounds[:, 0].min(axis=0).tolist(), bounds[:, 1].max(axis=0).tolist()],
         "peak_stress_ratio": _finite(results.summary.get("peak_stress_ratio")),
+        "strain_label": "shear strain" if curve is not None and curve["x"] == SHEAR_STRAIN else "axial strain",
         "curve": curve,
         "snapshots": [
             _snapshot(name, snap, snaps[0], results.walls(name), index_dtype, products)

@@ -172,7 +172,7 @@
       ctx.arc(sx(a.x[hovered]), sy(a.y[hovered]), a.r[hovered] * scale + 2, 0, 2 * Math.PI);
       ctx.stroke();
     }
-    strainLabel.textContent = "axial strain " + strainText(s) + " (" + s.meta.name + ", " + s.meta.n +
+    strainLabel.textContent = D.strain_label + " " + strainText(s) + " (" + s.meta.name + ", " + s.meta.n +
       " particles, " + s.meta.n_contacts + " contacts drawn)";
     legend.innerHTML = "";
     const bar = document.createElement("span");
@@ -222,7 +222,7 @@
     cctx.strokeRect(CP.left, CP.top, curve.width - CP.left - CP.right, curve.height - CP.top - CP.bottom);
     cctx.fillStyle = "#333";
     cctx.font = "11px sans-serif";
-    cctx.fillText("axial strain (%)", curve.width / 2 - 40, curve.height - 4);
+    cctx.fillText(D.strain_label + " (%)", curve.width / 2 - 40, curve.height - 4);
     cctx.fillText(fmt(b.ymax), 2, CP.top + 8);
     cctx.fillText(fmt(b.ymin), 2, curve.height - CP.bottom);
     cctx.fillText("0", CP.left - 3, curve.height - CP.bottom + 13);
@@ -230,7 +230,7 @@
     cctx.save();
     cctx.translate(12, curve.height / 2 + 30);
     cctx.rotate(-Math.PI / 2);
-    cctx.fillText(D.curve.y === "stress_ratio" ? "\u03c3\u2081/\u03c3\u2083" : D.curve.y, 0, 0);
+    cctx.fillText(D.curve.y === "stress_ratio" ? "\u03c3\u2081/\u03c3\u2083" : D.curve.y === "friction_coefficient" ? "\u03bc = \u03c4/\u03c3\u2099" : D.curve.y, 0, 0);
     cctx.restore();
     cctx.strokeStyle = "#1f77b4";
     cctx.lineWidth = 1.5;
