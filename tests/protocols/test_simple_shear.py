@@ -193,3 +193,22 @@ def test_the_viewer_draws_mu_against_the_shear_strain_and_no_band(free):
     last = data["snapshots"][-1]
     assert last["axial_strain"] == pytest.approx(0.6, rel=1e-3)
     assert last["band"] == {"first": None, "second": None}
+
+
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "protocols.md"
+DEFAULT = Path(__file__).resolve().parents[2] / "tests" / "data" / "simple_shear" / "default_summary.json"
+
+
+def test_the_docs_quote_the_default_runs_summary():
+    """docs/protocols.md's default simple-shear run is tests/data/simple_shear's summary."""
+    s = json.loads(DEFAULT.read_text())
+    text = DOCS.read_text()
+    line = next(x for x in text.splitlines() if x.startswith("grainlab simple_shear (free volume): 1759"))
+    assert line.split("; ")[:-1] == [
+        f"grainlab simple_shear (free volume): {s['n_particles']} grains, I {s['inertial_number_set']:.1e}",
+        f"peak mu {s['friction_coefficient_peak']:.3f} at {100 * s['shear_strain_at_peak']:.1f} %, steady mu "
+        f"{s['friction_coefficient_steady']:.3f}, porosity {s['porosity_steady']:.4f}, Z "
+        f"{s['coordination_number_steady']:.2f} at gamma >= {100 * s['steady_from_strain']:.0f} %"]
+    assert f"{s['shear_steps']:,} steps" in text
+    assert f"mu = {s['friction_coefficient_steady']:.3f} (sd\n{s['friction_coefficient_steady_sd']:.3f})" in text
+    assert f"within {s['rb_residual_mean_abs']:.3f} on average, and {s['rb_residual_max_abs']:.3f}" in text
