@@ -212,3 +212,17 @@ def test_the_docs_quote_the_default_runs_summary():
     assert f"{s['shear_steps']:,} steps" in text
     assert f"mu = {s['friction_coefficient_steady']:.3f} (sd\n{s['friction_coefficient_steady_sd']:.3f})" in text
     assert f"within {s['rb_residual_mean_abs']:.3f} on average, and {s['rb_residual_max_abs']:.3f}" in text
+
+
+def test_the_docs_quote_the_constant_volume_run():
+    s = json.loads((DEFAULT.parent / "constant_volume_summary.json").read_text())
+    text = DOCS.read_text()
+    line = next(x for x in text.splitlines() if x.startswith("grainlab simple_shear (constant volume): 1519"))
+    assert line.split("; ")[:-1] == [
+        f"grainlab simple_shear (constant volume): {s['n_particles']} grains, I {s['inertial_number_set']:.1e}",
+        f"peak mu {s['friction_coefficient_peak']:.3f} at {100 * s['shear_strain_at_peak']:.1f} %, steady mu "
+        f"{s['friction_coefficient_steady']:.3f}, porosity {s['porosity_steady']:.4f}, Z "
+        f"{s['coordination_number_steady']:.2f} at gamma >= {100 * s['steady_from_strain']:.0f} %"]
+    assert f"ends at {s['normal_stress_final_pa'] / 1e3:.1f} kPa (" in text
+    assert f"{s['normal_stress_pa_steady'] / 1e3:.0f}\nkPa on average" in text
+    assert f"residual is at most {s['rb_residual_max_abs']:.3f}" in text
