@@ -226,3 +226,21 @@ def test_the_docs_quote_the_constant_volume_run():
     assert f"ends at {s['normal_stress_final_pa'] / 1e3:.1f} kPa (" in text
     assert f"{s['normal_stress_pa_steady'] / 1e3:.0f}\nkPa on average" in text
     assert f"residual is at most {s['rb_residual_max_abs']:.3f}" in text
+
+
+def test_the_run_keeps_its_sample_for_the_lammps_export(free, tmp_path, capsys):
+    """The folder holds the state at the start of shearing; grainlab export takes it with the
+    run's own shear rate and strain (the deck runs in LAMMPS in tests/io/test_lammps_export.py)."""
+    from grainlab.io.lammps_input import simulation_to_export
+
+    s = json.loads((free / "summary.json").read_text())
+    sim = simulation_to_export(free)
+    assert sim.n_particles == s["n_particles"] and sim.cell is not None
+    assert sim.time_step == pytest.approx(s["time_step_s"], rel=1e-12)
+    out = tmp_path / "lammps"
+    assert main(["export", str(free), "--lammps", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    steps = round(s["final_strain"] / (s["shear_rate_per_s"] * s["time_step_s"]))
+    assert f"{s['n_particles']} disks, {steps} steps" in printed
+    export = json.loads((out / "export.json").read_text())
+    assert json.dumps(export).count(repr(s["shear_rate_per_s"])) >= 1

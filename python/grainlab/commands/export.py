@@ -50,10 +50,12 @@ def register(subparsers: Any) -> None:
         "--lammps", action="store_true", help="write a LAMMPS data file and input deck (periodic simple shear)"
     )
     p.add_argument(
-        "--shear-rate", type=float, metavar="PER_S", help="--lammps: shear rate gamma-dot, 1/s (required)"
+        "--shear-rate", type=float, metavar="PER_S",
+        help="--lammps: shear rate gamma-dot, 1/s (required but for a simple-shear run's folder: its own)"
     )
     p.add_argument(
-        "--shear-strain", type=float, metavar="GAMMA", help="--lammps: shear strain at the end (required)"
+        "--shear-strain", type=float, metavar="GAMMA",
+        help="--lammps: shear strain at the end (required but for a simple-shear run's folder: its own)"
     )
     p.add_argument(
         "--dump-every", type=int, default=0, metavar="STEPS",
@@ -97,11 +99,16 @@ def _lammps(args: argparse.Namespace) -> int:
     from grainlab.io.lammps_input import LammpsShear, simulation_to_export, write_lammps_shear
     from grainlab.io.results import ensure_output_folder
 
-    for flag, value in (("--shear-rate", args.shear_rate), ("--shear-strain", args.shear_strain)):
-        if value is None:
-            raise ValueError(f"{flag}: required with --lammps")
-    shear = LammpsShear(args.shear_rate, args.shear_strain, args.dump_every, args.local_damping)
     source = Path(args.dir)
+    rate, strain = args.shear_rate, args.shear_strain
+    planned = _simple_shear_plan(source)
+    if planned is not None:  # a simple-shear run's folder: its rate and strain unless given
+        rate = planned[0] if rate is None else rate
+        strain = planned[1] if strain is None else strain
+    for flag, value in (("--shear-rate", rate), ("--shear-strain", strain)):
+        if value is None:
+            raise ValueError(f"{flag}: required with --lammps (but for a simple-shear run's folder, whose own it takes)")
+    shear = LammpsShear(rate, strain, args.dump_every, args.local_damping)
     sim = simulation_to_export(source)
     default = source / "lammps" if source.is_dir() else source.with_name(source.name + ".lammps")
     out = Path(args.out) if args.out is not None else default
@@ -114,3 +121,15 @@ def _lammps(args: argparse.Namespace) -> int:
     for item in done.dropped:
         print(f"  not carried: {item}")
     return 0
+
+
+def _simple_shear_plan(source: Any) -> tuple[float, float] | None:
+    """``(shear rate, final strain)`` of the finished simple-shear run in folder ``source``, else None."""
+    from grainlab.io.hdf5 import read_results, results_kind
+    from grainlab.io.results import RESULTS_FILE
+
+    results = source / RESULTS_FILE
+    if not (source.is_dir() and results.is_file() and results_kind(results) == "simple_shear"):
+        return None
+    summary = read_results(results).summary
+    return float(summary["shear_rate_per_s"]), float(summary["final_strain"])

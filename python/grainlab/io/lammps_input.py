@@ -198,8 +198,9 @@ def _checked_state(sim: Simulation) -> ContactModel:
         raise ValueError("sim: the export needs a periodic cell in x and y (Simulation.set_periodic_cell)")
     if cell.a[1] != 0.0:
         raise ValueError(f"sim: the cell's first vector {cell.a} must lie along x (LAMMPS's box)")
-    if sim.walls:
-        raise ValueError(f"sim: {len(sim.walls)} wall(s); the periodic simple shear has none")
+    active = [w for w in sim.walls if w.active]  # inactive walls (a sample's generation box) act on nothing
+    if active:
+        raise ValueError(f"sim: {len(active)} active wall(s); the periodic simple shear has none")
     if sim.n_bonds:
         raise ValueError(f"sim: {sim.n_bonds} bond(s) cannot be exported")
     if np.any(sim.fixity != 0):
@@ -378,19 +379,22 @@ def write_lammps_shear(sim: Simulation, folder: str | Path, shear: LammpsShear) 
 def simulation_to_export(source: str | Path) -> Simulation:
     """The engine state ``grainlab export --lammps`` exports: a file written by
     :meth:`Simulation.save`, a ``checkpoint.h5``, or a run folder holding one (the
-    run where it stands). A ``run.h5`` snapshot is not enough (it lacks the
+    run where it stands) or a simple-shear run's ``shear_start.state`` (its sample
+    at the start of shearing). A ``run.h5`` snapshot is not enough (it lacks the
     densities, the contact model and the time step)."""
     from grainlab.io.hdf5 import read_checkpoint
-    from grainlab.io.results import CHECKPOINT_FILE
+    from grainlab.io.results import CHECKPOINT_FILE, SHEAR_START_FILE
 
     path = Path(source)
     if path.is_dir():
-        if not (path / CHECKPOINT_FILE).is_file():
+        held = [path / name for name in (CHECKPOINT_FILE, SHEAR_START_FILE) if (path / name).is_file()]
+        if not held:
             raise ValueError(
-                f"{path}: no {CHECKPOINT_FILE} (give a state file written by Simulation.save, or a run folder "
-                "with a checkpoint; a run.h5 snapshot lacks the densities, contact model and time step)"
+                f"{path}: no {CHECKPOINT_FILE} or {SHEAR_START_FILE} (give a state file written by Simulation.save, "
+                "a run folder with a checkpoint, or a simple-shear run's folder; a run.h5 snapshot lacks the "
+                "densities, contact model and time step)"
             )
-        path = path / CHECKPOINT_FILE
+        path = held[0]
     if not path.is_file():
         raise ValueError(f"{source}: no such file or folder")
     if path.suffix == ".h5":

@@ -44,6 +44,7 @@ import numpy as np
 __all__ = [
     "timeseries_csv",
     "CHECKPOINT_FILE",
+    "SHEAR_START_FILE",
     "RESULTS_FILE",
     "atomic_path",
     "check_output_folder",
@@ -64,6 +65,9 @@ __all__ = [
 RESULTS_FILE = "run.h5"
 #: Name of the checkpoint file of a run folder.
 CHECKPOINT_FILE = "checkpoint.h5"
+#: The engine state at the start of a periodic simple shear's shearing, kept in its folder
+#: (:meth:`Simulation.save`): ``grainlab export DIR --lammps`` shears it in LAMMPS.
+SHEAR_START_FILE = "shear_start.state"
 
 
 def fsync_file(path: str | os.PathLike[str]) -> None:

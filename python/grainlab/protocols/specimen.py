@@ -81,7 +81,7 @@ class SpecimenProtocol(Protocol[Config, R, Result]):
     of type :attr:`state_type`, in the first stage's phase; it writes :data:`OUTPUT_FILES`."""
 
     state_type: ClassVar[type[SpecimenRun]]
-    output_files = OUTPUT_FILES
+    output_files: ClassVar[tuple[str, ...]] = OUTPUT_FILES
 
     def threads(self) -> int:
         return engine_threads(self.config)

@@ -78,7 +78,8 @@ def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
             "leave it out or set simple_shear.volume = 'free'"
         )
     beyond = [s for s in values["simple_shear.snapshot_strains"] if not 0.0 <= s <= final]
-    if beyond:
+    default = SIMPLE_SHEAR_FIELDS["simple_shear.snapshot_strains"].default
+    if beyond and values["simple_shear.snapshot_strains"] != default:  # the default's beyond a shorter run are left out
         raise ConfigError(
             f"simple_shear.snapshot_strains: {beyond[0]:g} lies outside 0 .. simple_shear.final_strain ({final:g})"
         )

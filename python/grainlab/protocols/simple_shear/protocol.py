@@ -22,6 +22,7 @@ from grainlab._progress import progress_bar
 from grainlab.analysis import StressForceFabric, fabric_summary
 from grainlab.columns import SIMPLE_SHEAR
 from grainlab.io.hdf5.snapshot import snapshot_name
+from grainlab.io.results import SHEAR_START_FILE
 from grainlab.protocols.config import Config
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.simple_shear.cell import CONTROL_STEPS, cell_stress, servo_rate
@@ -30,6 +31,7 @@ from grainlab.protocols.simple_shear.outputs import SimpleShearResult, summarise
 from grainlab.protocols.simple_shear.state import SimpleShearRun
 from grainlab.protocols.specimen import (
     CHUNK_STEPS,
+    OUTPUT_FILES,
     SpecimenError,
     SpecimenProtocol,
     damped_time_step_factor,
@@ -53,7 +55,7 @@ def record_steps(config: Config, steps_per_unit: float) -> tuple[list[int], dict
     """The steps after the start of shearing that carry a record, and those that
     also carry a snapshot (step -> its shear strain)."""
     final = config["simple_shear.final_strain"]
-    strains = [s for s in config["simple_shear.snapshot_strains"] if s > 0]
+    strains = [s for s in config["simple_shear.snapshot_strains"] if 0 < s <= final]
     steps = schedule_steps([Every(config["simple_shear.record_interval"]), At(strains)], final=final,
                            steps_per_unit=steps_per_unit)
     snaps = {round(s * steps_per_unit): s for s in strains}
@@ -184,6 +186,7 @@ def _settle(context: Context) -> None:
     run.start_step = sim.step_count
     run.cell_rate_integral = [0.0, 0.0]
     run.area0, run.height0 = float(cell.area), float(cell.b[1])
+    sim.save(context.writer.path.parent / SHEAR_START_FILE)  # for grainlab export DIR --lammps
     run.wall_time["settle"] = time.perf_counter() - start
 
 
@@ -281,12 +284,14 @@ class SimpleShearProtocol(SpecimenProtocol[SimpleShearRun, SimpleShearResult]):
         Stage("consolidate", _consolidate, "the walls replaced by a periodic cell of their box, the cell "
                                            "servo-controlled to sigma_0 (consolidation friction) until equilibrium"),
         Stage("settle", _settle, "Table 1 friction on, the cell held at sigma_0 until equilibrium; the shear rate "
-                                 "from the inertial number, the shearing's local damping"),
+                                 "from the inertial number, the shearing's local damping; the state saved as "
+                                 "shear_start.state (grainlab export --lammps)"),
         Stage("shear", _shear, "simple shear L = [[0, gamma_dot], [0, L_yy]] to the final strain (L_yy holds "
                                "sigma_n, or 0 at constant volume); a record on each interval, snapshots, "
                                "checkpoints on the wall clock"),
     )
     state_type = SimpleShearRun
+    output_files = (*OUTPUT_FILES, SHEAR_START_FILE)
 
     def state_from_dict(self, saved: Any) -> SimpleShearRun:
         return SimpleShearRun(**{k: v for k, v in saved.items()
