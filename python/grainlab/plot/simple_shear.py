@@ -15,15 +15,18 @@ from numpy.typing import ArrayLike
 from grainlab.columns import (
     COORDINATION_NUMBER,
     FRICTION_COEFFICIENT,
+    NORMAL_STRESS_PA,
     RB_PREDICTED,
     RB_RESIDUAL,
     RB_STRESS_RATIO,
     SHEAR_STRAIN,
+    SHEAR_STRESS_PA,
     VOLUMETRIC_STRAIN,
 )
 from grainlab.plot.files import paper_style
 
-__all__ = ["fabric_figure", "friction_volume_figure", "mu_of_inertial_number_figure", "stress_force_fabric_figure"]
+__all__ = ["fabric_figure", "friction_volume_figure", "mu_of_inertial_number_figure", "stress_force_fabric_figure",
+           "stress_path_figure"]
 
 
 def _gamma(timeseries: Mapping[str, ArrayLike]) -> np.ndarray:
@@ -64,6 +67,30 @@ def fabric_figure(timeseries: Mapping[str, ArrayLike], steady_from: float) -> Fi
             ax.set_ylabel(label)
             _steady(ax, steady_from, gamma)
         axes[-1].set_xlabel(r"shear strain $\gamma$ (%)")
+    return fig
+
+
+def stress_path_figure(timeseries: Mapping[str, ArrayLike], steady_mu: float) -> Figure:
+    """The stress path tau against sigma_n (kPa), with the steady state's line tau = mu sigma_n,
+    and sigma_n against gamma: at constant volume, the undrained test's path."""
+    tau = np.asarray(timeseries[SHEAR_STRESS_PA], dtype=np.float64) / 1e3
+    sigma = np.asarray(timeseries[NORMAL_STRESS_PA], dtype=np.float64) / 1e3
+    with paper_style():
+        fig = Figure(figsize=(6.5, 3.0), layout="constrained")
+        left, right = fig.subplots(1, 2)
+        left.plot(sigma, tau, linewidth=0.9)
+        left.plot(sigma[:1], tau[:1], "o", markersize=3, color="0.3")
+        top = float(np.nanmax(sigma)) * 1.05
+        left.plot([0.0, top], [0.0, steady_mu * top], color="0.4", linewidth=0.8, linestyle=":",
+                  label=rf"steady $\mu$ = {steady_mu:.3f}")
+        left.set_xlim(0.0, top)
+        left.set_ylim(bottom=min(0.0, float(np.nanmin(tau))))
+        left.set_xlabel(r"normal stress $\sigma_n$ (kPa)")
+        left.set_ylabel(r"shear stress $\tau$ (kPa)")
+        left.legend(frameon=False)
+        right.plot(_gamma(timeseries), sigma, linewidth=0.9)
+        right.set_xlabel(r"shear strain $\gamma$ (%)")
+        right.set_ylabel(r"$\sigma_n$ (kPa)")
     return fig
 
 

@@ -23,6 +23,9 @@ FIGURES = {
     "fig03_stress_force_fabric": ("Stress-force-fabric relation", "Measured q/p against Rothenburg and Bathurst's "
                                   "(a + a_n + a_t)/2 projected on the stress direction, on every record, and the "
                                   "residual against the shear strain."),
+    "fig04_stress_path": ("Stress path", "The shear stress against the normal stress, with the steady state's "
+                          "tau = mu sigma_n, and the normal stress against the shear strain: at constant volume, "
+                          "the undrained test's path."),
 }
 
 #: What the simple-shear page shows.

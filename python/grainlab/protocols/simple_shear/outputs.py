@@ -123,4 +123,6 @@ def _figure_tasks(series: dict[str, np.ndarray], summary: dict[str, Any]) -> lis
         FigureTask("fig01_friction_and_volume", simple_shear.friction_volume_figure, (series, steady)),
         FigureTask("fig02_fabric", simple_shear.fabric_figure, (series, steady)),
         FigureTask("fig03_stress_force_fabric", simple_shear.stress_force_fabric_figure, (series,)),
+        FigureTask("fig04_stress_path", simple_shear.stress_path_figure,
+                   (series, summary["friction_coefficient_steady"])),
     ]
