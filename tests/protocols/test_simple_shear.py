@@ -169,9 +169,9 @@ def test_the_example_prints_both_cells(tmp_path):
 
 
 def test_contact_dashpots_shorten_the_time_step_and_act_while_shearing(tmp_path):
-    """With dashpots at half of critical the central-difference limit is sqrt(1 + 0.25) - 0.5 = 0.618
-    of the undamped one: the run's time step is shortened by that factor, it settles (without the
-    dashpots, as Table 1's grains) and shears with them."""
+    """With dashpots at half of critical, the sliding-and-rolling mode is damped at sqrt(3) / 2 of its
+    critical value and its central-difference limit is sqrt(1 + 0.75) - sqrt(0.75) = 0.457 of the
+    undamped one: the run's time step is shortened by that factor, and it settles and shears."""
     config = _config("material.contact_damping=0.5", "simple_shear.local_damping=0",
                      "simple_shear.inertial_number=0.1", "simple_shear.final_strain=0.2",
                      "simple_shear.snapshot_strains=[0]")
@@ -180,7 +180,7 @@ def test_contact_dashpots_shorten_the_time_step_and_act_while_shearing(tmp_path)
                                                                "simple_shear.snapshot_strains=[0]")),
                                    tmp_path / "undamped")
     ratio = result.summary["time_step_s"] / undamped.summary["time_step_s"]
-    assert ratio == pytest.approx(math.sqrt(1.25) - 0.5, rel=1e-9)
+    assert ratio == pytest.approx(math.sqrt(1.75) - math.sqrt(0.75), rel=1e-9)
     assert result.summary["friction_coefficient_steady"] > 0.2
 
 

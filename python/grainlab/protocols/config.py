@@ -131,7 +131,7 @@ SHARED_FIELDS: dict[str, Field] = {
         "number", 0.0, "rolling dashpot, fraction of critical 2 sqrt(I_r k_r), below the cap", minimum=0.0
     ),
     "material.contact_damping": Field(
-        "number", 0.0, "normal and shear contact dashpots between grains and at the platens, fraction of critical "
+        "number", 0.0, "normal and shear contact dashpots between grains, fraction of critical "
         "(0: none, the paper's law)", minimum=0.0
     ),
     "material.density": Field("density", paper.DENSITY_KG_PER_M3, "scaled particle density (Table 1: 2e8 kg/m^3)", **_POSITIVE),

@@ -123,14 +123,11 @@ def engine_threads(config: Config) -> int:
 
 
 def _with_rolling(config: Config, model: ContactModel) -> ContactModel:
-    """``model`` with the rolling resistance and the contact dashpots of ``config``
-    (both off by default; a rolling stiffness of 0 is the engine's rule, ``auto``)."""
+    """``model`` with the rolling resistance of ``config`` (off by default; a
+    stiffness of 0 is the engine's rule, ``auto``)."""
     stiffness = config["material.rolling_stiffness"]
-    damping = float(config["material.contact_damping"])
     return replace(
         model,
-        normal_damping_ratio=damping,
-        shear_damping_ratio=damping,
         rolling_friction=float(config["material.rolling_friction"]),
         rolling_stiffness=0.0 if stiffness == "auto" else float(stiffness),
         rolling_damping_ratio=float(config["material.rolling_damping"]),
@@ -139,17 +136,24 @@ def _with_rolling(config: Config, model: ContactModel) -> ContactModel:
 
 def damped_time_step_factor(config: Config) -> float:
     """What the contact dashpots (``material.contact_damping`` = zeta) take off the
-    critical time step of central differences: ``sqrt(1 + zeta^2) - zeta`` (exactly 1
-    without them), so that a run whose dashpots act from its boundary or shearing on
-    is stable with the time step set while it consolidated."""
-    zeta = float(config["material.contact_damping"])
-    return math.sqrt(1.0 + zeta * zeta) - zeta
+    critical time step of central differences, ``sqrt(1 + z^2) - z`` for a mode
+    damped at z of critical (exactly 1 without them). The shear dashpot damps the
+    contact's sliding-and-rolling mode at z = sqrt(3) zeta: its coefficient is set
+    with the pair's reduced mass m*, while that mode moves the mass m*/3 (each
+    disk's 1/m + r^2/I = 3/m). That mode sets the factor, so that a run whose
+    dashpots act after it consolidated is stable with the time step set then."""
+    z = math.sqrt(3.0) * float(config["material.contact_damping"])
+    return math.sqrt(1.0 + z * z) - z
 
 
 def grain_model(config: Config) -> ContactModel:
-    return _with_rolling(config, ContactModel(
+    """The grains' contact law: Table 1's, with the rolling resistance and the contact
+    dashpots of ``config`` (the platens' contacts have no dashpots: a dashpot's force
+    on a moving servo wall would feed back into its control)."""
+    damping = float(config["material.contact_damping"])
+    return replace(_with_rolling(config, ContactModel(
         config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.friction"]
-    ))
+    )), normal_damping_ratio=damping, shear_damping_ratio=damping)
 
 
 def platen_model(config: Config) -> ContactModel:

@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 import os
 import time
-from dataclasses import replace
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -168,11 +167,8 @@ def _settle(context: Context) -> None:
     """Table 1 friction on, the cell held at sigma_0 until equilibrium again; the shearing's plan."""
     sim, run, config = context.sim, context.state, context.config
     start = time.perf_counter()
-    model = grain_model(config)
-    # settled without the contact dashpots (Table 1 has none): they act from the shearing on
-    sim.set_contact_model(0, 0, replace(model, normal_damping_ratio=0.0, shear_damping_ratio=0.0))
+    sim.set_contact_model(0, 0, grain_model(config))
     _equilibrate(sim, run, config, context.progress, "settling with friction")
-    sim.set_contact_model(0, 0, model)
     cell = sim.cell
     assert cell is not None
     stress = cell_stress(sim, config["material.normal_stiffness"]).total
