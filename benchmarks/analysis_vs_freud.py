@@ -31,7 +31,7 @@ freud gets the same positions in its own convention (untimed): (N, 3) with
 z = 0, shifted to a box centred on the origin, and scaled by a power of two
 (exact) so that the mean diameter is about 1: its 2D Voronoi runs voro++ in a
 3D container whose thickness does not scale with the box, and with metres it
-took 39 s for the 4,000 disks against 0.18 s at this scale. Each library runs
+took 39 s for the 4,000 disks against 0.11 s at this scale. Each library runs
 on ``--threads`` threads (grainlab's kernel pool, ``freud.parallel``); SciPy's
 Qhull under grainlab's cells has one thread. Steps alternate between the two,
 the first of the pair swapped every repetition; medians of ``--repeat`` runs.

@@ -19,11 +19,12 @@ BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 
 @pytest.fixture(scope="module")
 def bench():
+    saved = list(sys.path)  # the benchmark puts its folder on the path too
     sys.path.insert(0, str(BENCHMARKS))
     try:
         yield importlib.import_module("analysis_vs_freud")
     finally:
-        sys.path.remove(str(BENCHMARKS))
+        sys.path[:] = saved
 
 
 @pytest.fixture(scope="module")
