@@ -22,11 +22,12 @@ test-fast:  ## the quick local loop: engine tests and pytest without slow physic
 	cargo test --release -p grainlab-core
 	python -m pytest -m "not slow" -q
 
-bench:  ## every speed figure of docs/engine.md, side by side, medians (about 25 minutes on a quiet 2-core machine)
+bench:  ## every speed figure of docs/engine.md, side by side, medians (about 35 minutes on a quiet 2-core machine; the freud comparison needs pip install freud-analysis)
 	python benchmarks/throughput.py --repeat 9
 	python benchmarks/shared_machine.py --repeat 5
 	python benchmarks/throughput_large.py --repeat 3
 	python benchmarks/analysis_large.py --repeat 3
+	python benchmarks/analysis_vs_freud.py --repeat 3
 	python benchmarks/biaxial_default.py --repeat 1
 	python benchmarks/consolidation.py
 

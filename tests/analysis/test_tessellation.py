@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from factories_analysis import hex_lattice, jittered_packing, square_lattice
 
-from grainlab.analysis.tessellation import LocalPorosity, power_cells
+from grainlab.analysis.tessellation import LocalPorosity, _rim_sites, power_cells
 from grainlab.snapshot import ParticleKind, Snapshot
 
 D = 1e-3
@@ -117,3 +117,15 @@ def test_a_leaning_periodic_cell_is_tiled_and_the_same_lattice_gives_the_same_ce
     assert areas.sum() == pytest.approx(side * side, rel=1e-9)
     assert np.all(areas > 0)
     np.testing.assert_allclose(cells(3.0 - side), areas, rtol=1e-8)
+
+
+def test_the_rim_of_a_triangle_fan_leaves_out_its_inner_points():
+    """The closed-cell test reads the rim: the points on an edge of one triangle only.
+    A hexagon fanned about its centre 0 (points 1-6) has its centre inside; two
+    triangles sharing the edge 7-8 have all four of their corners on the rim."""
+    fan = np.array([[0, k, k % 6 + 1] for k in range(1, 7)])
+    pair = np.array([[7, 8, 9], [8, 7, 10]])
+    assert _rim_sites(fan, 11).tolist() == [1, 2, 3, 4, 5, 6]
+    assert _rim_sites(pair, 11).tolist() == [7, 8, 9, 10]
+    both = _rim_sites(np.concatenate([fan, pair]).astype(np.int32), 11)
+    assert both.tolist() == [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]
