@@ -244,3 +244,20 @@ def test_the_run_keeps_its_sample_for_the_lammps_export(free, tmp_path, capsys):
     assert f"{s['n_particles']} disks, {steps} steps" in printed
     export = json.loads((out / "export.json").read_text())
     assert json.dumps(export).count(repr(s["shear_rate_per_s"])) >= 1
+
+
+def test_the_docs_quote_the_mu_of_i_sweep():
+    """docs/protocols.md's mu(I) table and lines are tests/data/simple_shear/mu_of_i.json's, and
+    the sweep shows the rheology's form: mu rising and nu falling with I."""
+    d = json.loads((DEFAULT.parent / "mu_of_i.json").read_text())
+    text = DOCS.read_text()
+    for m in d["means"]:
+        row = (f"| {m['inertial_number_set']:g} | {m['inertial_number']:.4f} | {m['friction_coefficient']:.3f} | "
+               f"{m['solid_fraction']:.3f} | {m['coordination_number']:.2f} | {m['anisotropy']:.3f} | "
+               f"{m['mean_stability_index']:.4f} |")
+        assert row in text, row
+    f = d["fit"]
+    assert f"mu = {f['mu_min']:.3f} +\n{f['b']:.2f} I and nu = {f['nu_max']:.3f} - {f['a']:.2f} I" in text
+    assert len(d["runs"]) == 12 and f["b"] > 0 and f["a"] > 0
+    mu = [m["friction_coefficient"] for m in d["means"]]
+    assert mu[-1] > mu[0] + 0.2

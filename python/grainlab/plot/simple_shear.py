@@ -115,23 +115,28 @@ def stress_force_fabric_figure(timeseries: Mapping[str, ArrayLike]) -> Figure:
 
 
 def mu_of_inertial_number_figure(inertial_number: ArrayLike, friction: ArrayLike, porosity: ArrayLike,
-                                 fit: tuple[float, float] | None = None) -> Figure:
+                                 fit: tuple[float, float, float, float] | None = None,
+                                 fit_max: float | None = None) -> Figure:
     """Steady-state mu and solid fraction against I (log axis) over a rate sweep,
-    with the fitted line mu_min + b I when given."""
+    with the fitted lines mu_min + b I and nu_max - a I (``fit = (mu_min, b, nu_max,
+    a)``) drawn over the runs they were fitted to (I up to ``fit_max``)."""
     i = np.asarray(inertial_number, dtype=np.float64)
     with paper_style():
         fig = Figure(figsize=(6.5, 3.0), layout="constrained")
         left, right = fig.subplots(1, 2)
         left.plot(i, np.asarray(friction, dtype=np.float64), "o", markersize=4)
+        right.plot(i, 1.0 - np.asarray(porosity, dtype=np.float64), "s", markersize=4)
         if fit is not None:
-            grid = np.geomspace(i.min(), i.max(), 50)
+            grid = np.geomspace(i.min(), i.max() if fit_max is None else fit_max, 50)
             left.plot(grid, fit[0] + fit[1] * grid, color="0.4", linewidth=0.8,
                       label=rf"$\mu = {fit[0]:.3f} + {fit[1]:.2f}\,I$")
+            right.plot(grid, fit[2] - fit[3] * grid, color="0.4", linewidth=0.8,
+                       label=rf"$\nu = {fit[2]:.3f} - {fit[3]:.2f}\,I$")
             left.legend(frameon=False)
+            right.legend(frameon=False)
         left.set_xscale("log")
         left.set_xlabel("inertial number $I$")
         left.set_ylabel(r"steady $\mu$")
-        right.plot(i, 1.0 - np.asarray(porosity, dtype=np.float64), "s", markersize=4)
         right.set_xscale("log")
         right.set_xlabel("inertial number $I$")
         right.set_ylabel(r"solid fraction $\nu$")

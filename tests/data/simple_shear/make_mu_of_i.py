@@ -57,7 +57,8 @@ def main(sweep: Path, out: Path, figure: Path | None) -> None:
 
         fig = mu_of_inertial_number_figure([r["inertial_number"] for r in runs],
                                            [r["friction_coefficient"] for r in runs],
-                                           [1.0 - r["solid_fraction"] for r in runs], (fit["mu_min"], fit["b"]))
+                                           [1.0 - r["solid_fraction"] for r in runs],
+                                           (fit["mu_min"], fit["b"], fit["nu_max"], fit["a"]), FIT_MAX)
         fig.savefig(figure, dpi=150)
 
 
