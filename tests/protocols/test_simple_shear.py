@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -30,6 +31,12 @@ SMALL = ["simple_shear.final_strain=0.6", "simple_shear.record_interval=0.02", "
          "simple_shear.snapshot_strains=[0, 0.3, 0.6]", "run.threads=1"]
 
 
+#: At constant volume a looser sample (as docs/protocols.md's run): the dense default, held at its
+#: area, climbs to megapascals, where Table 1's soft contacts reach the engine's overlap limit.
+LOOSE_CONSTANT = ("simple_shear.volume=constant", "sample.porosity=0.24", "sample.generation_friction=0.9",
+                  "consolidation.friction=0.9")
+
+
 def _config(*extra: str):  # type: ignore[no-untyped-def]
     return resolve_config("simple_shear", overrides=[*SMALL, *extra], quick=True)
 
@@ -44,7 +51,7 @@ def free(tmp_path_factory):
 @pytest.fixture(scope="module")
 def constant(tmp_path_factory):
     out = tmp_path_factory.mktemp("simple_shear") / "constant"
-    runner.run_protocol(SimpleShearProtocol(_config("simple_shear.volume=constant")), out)
+    runner.run_protocol(SimpleShearProtocol(_config(*LOOSE_CONSTANT)), out)
     return out
 
 
@@ -81,8 +88,8 @@ def test_the_constant_volume_cell_holds_its_area(constant):
     ts = _series(constant)
     np.testing.assert_allclose(ts["area_m2"], ts["area_m2"][0], rtol=1e-12)
     assert np.all(ts["volumetric_strain"] == pytest.approx(0.0, abs=1e-12))
-    # a dense sample wants to dilate: held at constant volume, its normal stress rises
-    assert ts["normal_stress_pa"][1:].max() > 1.2 * ts["normal_stress_pa"][0]
+    # a loose sample wants to contract: held at its area, its normal stress falls
+    assert ts["normal_stress_pa"][1:].min() < 0.8 * ts["normal_stress_pa"][0]
 
 
 def test_the_shear_work_is_what_the_grains_dissipate_and_store(constant):
@@ -165,7 +172,7 @@ def test_the_example_prints_both_cells(tmp_path):
                              capture_output=True, text=True).stdout
     lines = printed.splitlines()
     assert [line.split(":")[0] for line in lines] == ["free volume", "constant volume"]
-    assert "dilation" in lines[0] and "sigma_n 100.0 ->" in lines[1]
+    assert "dilation" in lines[0] and re.search(r"sigma_n \d+\.\d -> \d+\.\d kPa", lines[1])
 
 
 def test_contact_dashpots_shorten_the_time_step_and_act_while_shearing(tmp_path):

@@ -388,14 +388,9 @@ impl Engine {
                 g.shape()
             )));
         }
-        let Some(cell) = self.sim.cell().cloned() else {
-            return Err(PyValueError::new_err(
-                "velocity_gradient: set a periodic cell first",
-            ));
-        };
-        let mut cell = cell;
-        cell.velocity_gradient = [[g[[0, 0]], g[[0, 1]]], [g[[1, 0]], g[[1, 1]]]];
-        self.sim.set_cell(Some(cell)).map_err(to_py_err)
+        self.sim
+            .set_velocity_gradient([[g[[0, 0]], g[[0, 1]]], [g[[1, 0]], g[[1, 1]]]])
+            .map_err(to_py_err)
     }
 
     #[getter]

@@ -437,6 +437,31 @@ impl Simulation {
         Ok(())
     }
 
+    /// Sets the periodic cell's imposed velocity gradient alone (1/s), keeping the
+    /// neighbour lists: their rebuild criterion follows the cell's accumulated map,
+    /// whatever the gradient was, so a test that steers the cell every few steps
+    /// (a stress-controlled cell) does not pay a rebuild each time.
+    pub fn set_velocity_gradient(&mut self, gradient: Mat2) -> Result<()> {
+        if self.cell.is_none() {
+            return Err(EngineError::invalid(
+                "velocity_gradient",
+                "set a periodic cell first",
+            ));
+        }
+        for row in &gradient {
+            for &v in row {
+                crate::error::require_finite("cell.velocity_gradient", v)?;
+            }
+        }
+        // the last step's displacement was made in the old flow
+        self.modify_motion(|s| {
+            if let Some(cell) = &mut s.cell {
+                cell.velocity_gradient = gradient;
+            }
+        });
+        Ok(())
+    }
+
     /// Adds a wall and returns its id.
     pub fn add_wall(&mut self, wall: Wall) -> usize {
         self.walls.push(wall);
