@@ -343,6 +343,7 @@ macro_rules! pair_kernel {
             single_model: $sim.materials.single_undamped_model(),
             undamped: $sim.materials.undamped(),
             rolling: $sim.materials.rolling(),
+            rolling_damped: $sim.materials.rolling_damped(),
             vector: $sim.simd,
         }
     };
@@ -372,8 +373,10 @@ pub(crate) struct PairKernel<'a> {
     pub(crate) single_model: Option<ContactModel>,
     /// No model has a dashpot.
     pub(crate) undamped: bool,
-    /// Some model has rolling resistance (which the four-pair loop lacks).
+    /// Some model has rolling resistance (the four-pair loop then evaluates it).
     pub(crate) rolling: bool,
+    /// Some model with rolling resistance has a rolling dashpot.
+    pub(crate) rolling_damped: bool,
     /// Whether undamped pairs run four at a time ([`crate::Simulation::set_simd`]).
     pub(crate) vector: bool,
 }
@@ -422,10 +425,11 @@ impl PairKernel<'_> {
 
     /// The loop of [`PairKernel::run`]: `DEFORMING` when the cell has a velocity
     /// gradient, `SINGLE` when [`PairKernel::single_model`] is set, `DASHPOTS`
-    /// unless no model has a dashpot (whose terms are then skipped, as the law
-    /// skips them for a zero damping ratio). Without dashpots, and when
-    /// [`PairKernel::vector`] is set, four pairs at a time
-    /// ([`PairKernel::pairs_by_four`], the same bits).
+    /// unless no model has a normal or shear dashpot (whose terms are then
+    /// skipped, as the law skips them for a zero damping ratio). Without those
+    /// dashpots, and when [`PairKernel::vector`] is set, four pairs at a time
+    /// ([`PairKernel::pairs_by_four`], the same bits), with the rolling law
+    /// (and its dashpot) when some model has rolling resistance.
     ///
     /// # Safety
     /// As [`PairKernel::run`].
@@ -444,10 +448,19 @@ impl PairKernel<'_> {
         sink: &mut S,
     ) -> ContactTally {
         // (`vector` is never set where the four-pair loop does not exist)
-        if !DASHPOTS && self.vector && !self.rolling && crate::law::LANES {
+        if !DASHPOTS && self.vector && crate::law::LANES {
+            // the rolling law compiled in only for a table that has it, so
+            // that the loop without it is the same code as before
             #[cfg(target_arch = "x86_64")]
-            return self
-                .pairs_by_four::<MEASURE, DEFORMING, SINGLE, S>(first, records, sliding, sink);
+            return if self.rolling {
+                self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, true, S>(
+                    first, records, sliding, sink,
+                )
+            } else {
+                self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, false, S>(
+                    first, records, sliding, sink,
+                )
+            };
         }
         let mut tally = ContactTally::default();
         let fixed = self.loop_constants();
