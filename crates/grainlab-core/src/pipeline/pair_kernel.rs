@@ -318,7 +318,8 @@ impl ResetKernel<'_> {
 /// A [`PairKernel`] over the particles `$p` and pair list `$pairs` of simulation
 /// `$sim` (a macro, so that the shear springs can be borrowed mutably apart).
 macro_rules! pair_kernel {
-    ($sim:expr, $p:expr, $pairs:expr, $increment_time:expr) => {
+    ($sim:expr, $p:expr, $pairs:expr, $increment_time:expr) => {{
+        let rolling = $sim.materials.rolling();
         PairKernel {
             position: &$p.position,
             velocity: &$p.velocity,
@@ -342,11 +343,12 @@ macro_rules! pair_kernel {
             max_overlap_ratio: $sim.params.max_overlap_ratio,
             single_model: $sim.materials.single_undamped_model(),
             undamped: $sim.materials.undamped(),
-            rolling: $sim.materials.rolling(),
-            rolling_damped: $sim.materials.rolling_damped(),
+            rolling,
+            // (the table scanned again only when it has rolling resistance)
+            rolling_damped: rolling && $sim.materials.rolling_damped(),
             vector: $sim.simd,
         }
-    };
+    }};
 }
 pub(crate) use pair_kernel;
 
@@ -449,17 +451,19 @@ impl PairKernel<'_> {
     ) -> ContactTally {
         // (`vector` is never set where the four-pair loop does not exist)
         if !DASHPOTS && self.vector && crate::law::LANES {
-            // the rolling law compiled in only for a table that has it, so
-            // that the loop without it is the same code as before
+            // the rolling law (and its dashpot) compiled in only for a table
+            // that has it, so that the loop without it is the same code as before
             #[cfg(target_arch = "x86_64")]
-            return if self.rolling {
-                self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, true, S>(
+            return match (self.rolling, self.rolling_damped) {
+                (false, _) => self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, false, false, S>(
                     first, records, sliding, sink,
-                )
-            } else {
-                self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, false, S>(
+                ),
+                (true, false) => self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, true, false, S>(
                     first, records, sliding, sink,
-                )
+                ),
+                (true, true) => self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, true, true, S>(
+                    first, records, sliding, sink,
+                ),
             };
         }
         let mut tally = ContactTally::default();

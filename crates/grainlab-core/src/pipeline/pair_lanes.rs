@@ -84,7 +84,9 @@ impl PairKernel<'_> {
     /// [`PairKernel::pairs`] without normal and shear dashpots, four pairs at
     /// a time and the rest one at a time; `ROLLING` when some model has
     /// rolling resistance ([`PairKernel::rolling`]: without it the rolling law
-    /// is not compiled in, and the rolling slot of each record is left as it is).
+    /// is not compiled in, and the rolling slot of each record is left as it
+    /// is), `ROLLING_DASHPOT` when one of those has a rolling dashpot
+    /// ([`PairKernel::rolling_damped`]).
     ///
     /// # Safety
     /// As [`PairKernel::run`]; the processor has AVX2 ([`crate::simd::available`]).
@@ -94,6 +96,7 @@ impl PairKernel<'_> {
         const DEFORMING: bool,
         const SINGLE: bool,
         const ROLLING: bool,
+        const ROLLING_DASHPOT: bool,
         S: ForceSink,
     >(
         &self,
@@ -115,7 +118,6 @@ impl PairKernel<'_> {
         );
         let increment_time = _mm256_set1_pd(self.increment_time);
         let dt = _mm256_set1_pd(self.dt);
-        let rolling_damped = ROLLING && self.rolling_damped;
         let sign_bit = _mm256_set1_pd(-0.0);
         let one = _mm256_set1_pd(1.0);
         let max_overlap_ratio = _mm256_set1_pd(self.max_overlap_ratio);
@@ -222,16 +224,23 @@ impl PairKernel<'_> {
                 }
                 (lanes(kn), lanes(ks), lanes(mu))
             };
-            // the law, lane by lane ([`law_by_four`]); each record starts with
-            // the shear spring (`law::LANES`); without `ROLLING` the rolling
-            // slot, off in every model of the table, is left as it is
-            let spring_before: [f64; 4] =
+            // the law, lane by lane ([`law_by_four`]); each record is [shear
+            // spring, rolling spring] (`law::LANES`): with `ROLLING` the four
+            // records unpack into both springs' lanes (stored back one by
+            // one, which measured fewer instructions than 128-bit stores),
+            // without it the rolling slot, off in every model of the table,
+            // is left as it is
+            let mut spring_before: [f64; 4] =
                 std::array::from_fn(|l| records.get_unchecked(k0 + l)[TANGENTIAL_HISTORY.start]);
-            let spring = lanes(spring_before);
+            let mut spring = lanes(spring_before);
+            let mut rolling_before = _mm256_setzero_pd();
+            if ROLLING {
+                let record = |l: usize| _mm_loadu_pd(records.as_ptr().add(k0 + l) as *const f64);
+                (spring, rolling_before) = unpack([record(0), record(1), record(2), record(3)]);
+                spring_before = in_order(spring);
+            }
             let slid_before = slid_lanes(sliding.as_ptr().add(k0));
             let rolling = if ROLLING {
-                let rolling_before: [f64; 4] =
-                    std::array::from_fn(|l| records.get_unchecked(k0 + l)[ROLLING_HISTORY.start]);
                 let (mu_r, k_r, eta_r) = if SINGLE {
                     let m = &fixed.single;
                     (
@@ -252,7 +261,7 @@ impl PairKernel<'_> {
                     (lanes(mu_r), lanes(k_r), lanes(eta_r))
                 };
                 // I + m r^2 of both bodies, combined as `PairKernel::one_pair` does
-                let rolling_inertia = if rolling_damped {
+                let rolling_inertia = if ROLLING_DASHPOT {
                     let mut inertia = [[0.0; 4]; 2];
                     let mut mass = [[0.0; 4]; 2];
                     for l in 0..4 {
@@ -282,12 +291,12 @@ impl PairKernel<'_> {
                     eta_r,
                     rolling_velocity: _mm256_sub_pd(lanes(wj), lanes(wi)),
                     rolling_inertia,
-                    spring: lanes(rolling_before),
+                    spring: rolling_before,
                 }
             } else {
                 FourRolling::off()
             };
-            let law = law_by_four::<ROLLING>(
+            let law = law_by_four::<ROLLING, ROLLING_DASHPOT>(
                 FourContacts {
                     kn,
                     ks,
@@ -303,7 +312,6 @@ impl PairKernel<'_> {
                 rolling,
                 increment_time,
                 dt,
-                rolling_damped,
             );
             let new_spring = law.spring;
             let slides = law.slides;
@@ -328,6 +336,8 @@ impl PairKernel<'_> {
             // contact forgets its whole record, as the scalar loop does
             let sliding_bits = pair_order(_mm256_movemask_pd(slides));
             let touching_bits = pair_order(touching_bits as i32);
+            // with `ROLLING`, the records [shear, rolling] of pairs 0 and 1,
+            // then 2 and 3, from the lanes (the inverse of `unpack`)
             let (overlap, new_spring) = (in_order(overlap), in_order(new_spring));
             let rolling_record = if ROLLING {
                 in_order(law.rolling_record)
@@ -356,16 +366,21 @@ impl PairKernel<'_> {
             let (torque_i, torque_j) = (in_order(torque_i), in_order(torque_j));
             let (trial, capped) = (in_order(law.trial), in_order(law.capped));
             let (nx, ny) = (in_order(nx), in_order(ny));
-            let [rolling_spring, rolling_moment, rolling_energy, rolling_dissipation] = if ROLLING {
+            let [rolling_spring, rolling_moment, rolling_dissipation] = if ROLLING {
                 [
                     law.rolling_spring,
                     law.rolling_moment,
-                    law.rolling_energy,
                     law.rolling_dissipation,
                 ]
                 .map(|v| in_order(v))
             } else {
-                [[0.0; 4]; 4]
+                [[0.0; 4]; 3]
+            };
+            // (its division only on a measured step)
+            let rolling_energy = if ROLLING && MEASURE {
+                in_order(law.rolling_energy)
+            } else {
+                [0.0; 4]
             };
             // the bookkeeping, one touching pair at a time in pair order
             let mut touched = touching_bits;
@@ -520,19 +535,19 @@ pub(super) struct FourLaws {
 /// (branches as selects of the value the branch keeps), the torques; with
 /// `ROLLING`, the rolling law of [`crate::law::rolling::RollingSpring`] from
 /// `rolling` (its stiffness rule, increment, cap, plastic work, energy, and,
-/// when `rolling_dashpot` says some lane may have one, its dashpot); and, for
+/// with `DASHPOT` (some lane may have one), its dashpot) for pairs of
+/// particles (`r_i > 0`: `R* = r_i r_j / (r_i + r_j)`); and, for
 /// a pair that does not touch, the record [`crate::law::history::forget`]
 /// leaves. Every operation is a correctly rounded IEEE one (no fused
 /// multiply-add), so each lane has the scalar law's bits (the test below
 /// checks it on random contacts).
 #[inline]
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn law_by_four<const ROLLING: bool>(
+pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
     c: FourContacts,
     rolling: FourRolling,
     increment_time: __m256d,
     dt: __m256d,
-    rolling_dashpot: bool,
 ) -> FourLaws {
     let sign_bit = _mm256_set1_pd(-0.0);
     let zero = _mm256_setzero_pd();
@@ -586,14 +601,10 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool>(
     // scalar law returns at once for mu_r == 0: slot, torques as they are)
     let r = rolling;
     let on = _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(r.mu_r, zero), c.touching);
-    // R* = r_i r_j / (r_i + r_j), or r_j against a wall (r_i = 0)
-    let r_star = _mm256_blendv_pd(
-        _mm256_div_pd(
-            _mm256_mul_pd(c.radius_i, c.radius_j),
-            _mm256_add_pd(c.radius_i, c.radius_j),
-        ),
-        c.radius_j,
-        _mm256_cmp_pd::<_CMP_EQ_OQ>(c.radius_i, zero),
+    // R* = r_i r_j / (r_i + r_j) (two particles: never the wall's r_j)
+    let r_star = _mm256_div_pd(
+        _mm256_mul_pd(c.radius_i, c.radius_j),
+        _mm256_add_pd(c.radius_i, c.radius_j),
     );
     // k_r: the given one when > 0, else 2.25 k_n mu_r^2 R*^2 (left to right)
     let rule = _mm256_mul_pd(
@@ -637,7 +648,7 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool>(
         k_r,
     );
     let mut moment = moment_spring;
-    if rolling_dashpot {
+    if DASHPOT {
         // below the cap, with eta_r > 0: -2 eta_r sqrt(I_r k_r) w on top, its
         // power c_r w^2 dt dissipated
         let damped = _mm256_andnot_pd(
@@ -803,13 +814,12 @@ mod tests {
         rolling: [[f64; 4]; 5],
     }
 
-    /// `law_by_four::<ROLLING>` on four contacts.
-    fn by_four<const ROLLING: bool>(
+    /// `law_by_four::<ROLLING, DASHPOT>` on four contacts.
+    fn by_four<const ROLLING: bool, const DASHPOT: bool>(
         contacts: &[Contact],
         touching: [bool; 4],
         increment_time: f64,
         dt: f64,
-        rolling_dashpot: bool,
     ) -> Lanes {
         let pick = |f: &dyn Fn(&Contact) -> f64| {
             let v: [f64; 4] = std::array::from_fn(|l| f(&contacts[l]));
@@ -842,12 +852,11 @@ mod tests {
         };
         // SAFETY: the callers checked AVX2
         unsafe {
-            let law = law_by_four::<ROLLING>(
+            let law = law_by_four::<ROLLING, DASHPOT>(
                 four,
                 rolling,
                 _mm256_set1_pd(increment_time),
                 _mm256_set1_pd(dt),
-                rolling_dashpot,
             );
             Lanes {
                 slides: pair_order(_mm256_movemask_pd(law.slides)),
@@ -903,7 +912,11 @@ mod tests {
             let dashpot = (round / 4) % 2 == 1;
             let contacts: Vec<Contact> = (0..4).map(|_| draw(&mut rng, dashpot)).collect();
             let touching: [bool; 4] = std::array::from_fn(|_| rng.next() % 8 != 0);
-            let out = by_four::<ROLLING>(&contacts, touching, increment_time, dt, dashpot);
+            let out = if dashpot {
+                by_four::<ROLLING, true>(&contacts, touching, increment_time, dt)
+            } else {
+                by_four::<ROLLING, false>(&contacts, touching, increment_time, dt)
+            };
             for (l, c) in contacts.iter().enumerate() {
                 let mut record = c.record;
                 let mut flag = c.slid;
