@@ -116,6 +116,9 @@ pub(crate) struct PairRecord {
     pub(crate) shear_spring: f64,
     /// Whether the spring is at the Coulomb cap.
     pub(crate) sliding: bool,
+    /// The rolling spring after the update, the moment on `j` (N m; 0 without
+    /// rolling resistance).
+    pub(crate) rolling_spring: f64,
 }
 
 /// Keeps every contact's record, in pair order (`None`: not in contact).
@@ -135,6 +138,7 @@ impl ForceSink for RecordSink {
             elastic_normal: c.elastic_normal,
             shear_spring: c.shear_spring,
             sliding: c.sliding,
+            rolling_spring: c.rolling_spring,
         });
     }
 }
