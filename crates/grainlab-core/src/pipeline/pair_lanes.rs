@@ -30,6 +30,7 @@ use std::arch::x86_64::*;
 
 use super::pair_kernel::{no_contact, ContactTally, ForceSink, PairKernel};
 use crate::diagnostics::ContactDissipation;
+use crate::law::rolling::RollingSpring;
 use crate::law::tangential::ShearSpring;
 use crate::law::{
     elastic_energy, ContactForce, ContactRecord, ROLLING_HISTORY, TANGENTIAL_HISTORY,
@@ -366,15 +367,20 @@ impl PairKernel<'_> {
             let (torque_i, torque_j) = (in_order(torque_i), in_order(torque_j));
             let (trial, capped) = (in_order(law.trial), in_order(law.capped));
             let (nx, ny) = (in_order(nx), in_order(ny));
-            let [rolling_spring, rolling_moment, rolling_dissipation] = if ROLLING {
-                [
-                    law.rolling_spring,
-                    law.rolling_moment,
-                    law.rolling_dissipation,
-                ]
-                .map(|v| in_order(v))
+            let [rolling_spring, rolling_moment] = if ROLLING {
+                [law.rolling_spring, law.rolling_moment].map(|v| in_order(v))
             } else {
-                [[0.0; 4]; 3]
+                [[0.0; 4]; 2]
+            };
+            let rolling_power = if ROLLING_DASHPOT {
+                in_order(law.rolling_power)
+            } else {
+                [0.0; 4]
+            };
+            let plastic_bits = if ROLLING {
+                pair_order(_mm256_movemask_pd(law.rolling_plastic))
+            } else {
+                0
             };
             // (its division only on a measured step)
             let rolling_energy = if ROLLING && MEASURE {
@@ -413,10 +419,23 @@ impl PairKernel<'_> {
                     tally.dissipation.friction +=
                         ShearSpring::slip_work(model, spring_before[l], trial[l], capped[l]);
                 }
-                if ROLLING {
-                    // the contact's rolling dissipation, +0 for most (as the
-                    // scalar loop adds it)
-                    tally.dissipation.rolling += rolling_dissipation[l];
+                // the contact's rolling dissipation, as the scalar loop adds it
+                // (0 + the plastic work or the dashpot's power); the others
+                // add +0, which leaves the sum (never -0) as it is
+                if plastic_bits & (1 << l) != 0 {
+                    // (what it reads taken out of the lanes only here: a few
+                    // contacts in a thousand are at the cap in a dense packing)
+                    let [k_r, before, trial, capped] = [
+                        law.rolling_stiffness,
+                        rolling.spring,
+                        law.rolling_trial,
+                        law.rolling_capped,
+                    ]
+                    .map(|v| in_order(v)[l]);
+                    tally.dissipation.rolling +=
+                        0.0 + RollingSpring::plastic_work(k_r, before, trial, capped);
+                } else if ROLLING_DASHPOT {
+                    tally.dissipation.rolling += 0.0 + rolling_power[l];
                 }
                 if MEASURE {
                     let (en, fs) = (elastic_normal, new_spring[l]);
@@ -521,12 +540,22 @@ pub(super) struct FourLaws {
     /// [`crate::law::history::forget`] leaves it).
     pub(super) rolling_record: __m256d,
     /// With the rolling law, [`ContactForce`]'s `rolling_spring`,
-    /// `rolling_moment`, `rolling_energy` and `dissipation.rolling` (each 0
-    /// where `mu_r` is 0).
+    /// `rolling_moment` and `rolling_energy` (each 0 where `mu_r` is 0).
     pub(super) rolling_spring: __m256d,
     pub(super) rolling_moment: __m256d,
     pub(super) rolling_energy: __m256d,
-    pub(super) rolling_dissipation: __m256d,
+    /// With the rolling law: `k_r`, the rolling springs plus the increment
+    /// before the cap, the cap with the trial's sign, and all-ones lanes where
+    /// the rolling spring ends at the cap (its plastic work is
+    /// [`RollingSpring::plastic_work`] of those, the contact's whole rolling
+    /// dissipation).
+    pub(super) rolling_stiffness: __m256d,
+    pub(super) rolling_trial: __m256d,
+    pub(super) rolling_capped: __m256d,
+    pub(super) rolling_plastic: __m256d,
+    /// With the rolling dashpot, its power `c_r w^2 dt` where it acts (below
+    /// the cap; +0 elsewhere): the contact's whole rolling dissipation there.
+    pub(super) rolling_power: __m256d,
 }
 
 /// The contact law of four pairs without normal and shear dashpots, lane by
@@ -592,7 +621,11 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
         rolling_spring: zero,
         rolling_moment: zero,
         rolling_energy: zero,
-        rolling_dissipation: zero,
+        rolling_stiffness: zero,
+        rolling_trial: zero,
+        rolling_capped: zero,
+        rolling_plastic: zero,
+        rolling_power: zero,
     };
     if !ROLLING {
         return laws;
@@ -633,16 +666,10 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
         _mm256_and_pd(sign_bit, rolling_trial),
     );
     let moment_spring = _mm256_blendv_pd(rolling_trial, rolling_capped, plastic);
-    // the plastic work 0.5 (before + capped) (trial - capped) / k_r
+    // (the plastic work, a division, is booked by the loop for the few
+    // contacts at the cap, from `rolling_trial` and `rolling_capped`, as the
+    // slip's work is)
     let half = _mm256_set1_pd(0.5);
-    let plastic_work = _mm256_div_pd(
-        _mm256_mul_pd(
-            _mm256_mul_pd(half, _mm256_add_pd(r.spring, rolling_capped)),
-            _mm256_sub_pd(rolling_trial, rolling_capped),
-        ),
-        k_r,
-    );
-    let mut dissipated = _mm256_and_pd(plastic, plastic_work);
     let energy = _mm256_div_pd(
         _mm256_mul_pd(_mm256_mul_pd(half, moment_spring), moment_spring),
         k_r,
@@ -662,7 +689,7 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
         let c_r_w = _mm256_mul_pd(c_r, w);
         moment = _mm256_blendv_pd(moment, _mm256_sub_pd(moment, c_r_w), damped);
         let power = _mm256_mul_pd(_mm256_mul_pd(c_r_w, w), dt);
-        dissipated = _mm256_blendv_pd(dissipated, power, damped);
+        laws.rolling_power = _mm256_and_pd(damped, power);
     }
     torque_i = _mm256_blendv_pd(torque_i, _mm256_sub_pd(torque_i, moment), on);
     torque_j = _mm256_blendv_pd(torque_j, _mm256_add_pd(torque_j, moment), on);
@@ -674,8 +701,10 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
     laws.rolling_spring = _mm256_and_pd(on, moment_spring);
     laws.rolling_moment = _mm256_and_pd(on, moment);
     laws.rolling_energy = _mm256_and_pd(on, energy);
-    // the contact's entry starts at +0 and gets the work or the power added
-    laws.rolling_dissipation = _mm256_add_pd(zero, _mm256_and_pd(on, dissipated));
+    laws.rolling_stiffness = k_r;
+    laws.rolling_trial = rolling_trial;
+    laws.rolling_capped = rolling_capped;
+    laws.rolling_plastic = plastic;
     laws
 }
 
@@ -683,7 +712,6 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
 mod tests {
     use super::*;
     use crate::law::history::forget;
-    use crate::law::rolling::RollingSpring;
     use crate::law::{
         contact_law, ContactKinematics, HISTORY_WIDTH, ROLLING_HISTORY, TANGENTIAL_HISTORY,
     };
@@ -811,6 +839,8 @@ mod tests {
         torque_j: [f64; 4],
         trial: [f64; 4],
         capped: [f64; 4],
+        /// The rolling slot, spring, moment, energy, and the dissipation as
+        /// the loop books it.
         rolling: [[f64; 4]; 5],
     }
 
@@ -866,14 +896,34 @@ mod tests {
                 torque_j: in_order(law.torque_j),
                 trial: in_order(law.trial),
                 capped: in_order(law.capped),
-                rolling: [
-                    law.rolling_record,
-                    law.rolling_spring,
-                    law.rolling_moment,
-                    law.rolling_energy,
-                    law.rolling_dissipation,
-                ]
-                .map(|v| in_order(v)),
+                rolling: {
+                    let [record, spring, moment, energy, k_r, before, trial, capped, power] = [
+                        law.rolling_record,
+                        law.rolling_spring,
+                        law.rolling_moment,
+                        law.rolling_energy,
+                        law.rolling_stiffness,
+                        rolling.spring,
+                        law.rolling_trial,
+                        law.rolling_capped,
+                        law.rolling_power,
+                    ]
+                    .map(|v| in_order(v));
+                    let plastic = pair_order(_mm256_movemask_pd(law.rolling_plastic));
+                    // the contact's rolling dissipation as the loop books it
+                    let dissipation = std::array::from_fn(|l| {
+                        if plastic & (1 << l) != 0 {
+                            0.0 + RollingSpring::plastic_work(
+                                k_r[l], before[l], trial[l], capped[l],
+                            )
+                        } else if DASHPOT {
+                            0.0 + power[l]
+                        } else {
+                            0.0
+                        }
+                    });
+                    [record, spring, moment, energy, dissipation]
+                },
             }
         }
     }
