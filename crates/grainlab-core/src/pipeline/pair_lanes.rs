@@ -419,12 +419,31 @@ impl PairKernel<'_> {
                     tally.dissipation.friction +=
                         ShearSpring::slip_work(model, spring_before[l], trial[l], capped[l]);
                 }
-                // the contact's rolling dissipation, as the scalar loop adds it
-                // (0 + the plastic work or the dashpot's power); the others
-                // add +0, which leaves the sum (never -0) as it is
+                if MEASURE {
+                    let (en, fs) = (elastic_normal, new_spring[l]);
+                    tally.elastic += elastic_energy(model, en, fs);
+                    if ROLLING && rolling_energy[l] != 0.0 {
+                        tally.elastic += rolling_energy[l];
+                    }
+                    tally.force_sum += (en * en + fs * fs).sqrt();
+                    tally.contacts += 1;
+                }
+            }
+            // the contacts' rolling dissipation in pair order, as the scalar
+            // loop adds it (0 + the plastic work or the dashpot's power; its
+            // own sum, so apart from the loop above): the contacts at the cap
+            // (a few in a thousand in a dense packing) and, with the dashpot,
+            // every touching one; the others add +0, which leaves the sum
+            // (never -0) as it is
+            let mut booked = if ROLLING_DASHPOT {
+                touching_bits
+            } else {
+                plastic_bits
+            };
+            while booked != 0 {
+                let l = booked.trailing_zeros() as usize;
+                booked &= booked - 1;
                 if plastic_bits & (1 << l) != 0 {
-                    // (what it reads taken out of the lanes only here: a few
-                    // contacts in a thousand are at the cap in a dense packing)
                     let [k_r, before, trial, capped] = [
                         law.rolling_stiffness,
                         rolling.spring,
@@ -434,17 +453,8 @@ impl PairKernel<'_> {
                     .map(|v| in_order(v)[l]);
                     tally.dissipation.rolling +=
                         0.0 + RollingSpring::plastic_work(k_r, before, trial, capped);
-                } else if ROLLING_DASHPOT {
+                } else {
                     tally.dissipation.rolling += 0.0 + rolling_power[l];
-                }
-                if MEASURE {
-                    let (en, fs) = (elastic_normal, new_spring[l]);
-                    tally.elastic += elastic_energy(model, en, fs);
-                    if ROLLING && rolling_energy[l] != 0.0 {
-                        tally.elastic += rolling_energy[l];
-                    }
-                    tally.force_sum += (en * en + fs * fs).sqrt();
-                    tally.contacts += 1;
                 }
             }
             k0 += 4;
