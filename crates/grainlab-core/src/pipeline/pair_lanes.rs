@@ -231,14 +231,15 @@ impl PairKernel<'_> {
             // one, which measured fewer instructions than 128-bit stores),
             // without it the rolling slot, off in every model of the table,
             // is left as it is
-            let mut spring_before: [f64; 4] =
+            // (with `ROLLING`, `spring_before` is not read: a slip's work
+            // takes its spring out of the lanes)
+            let spring_before: [f64; 4] =
                 std::array::from_fn(|l| records.get_unchecked(k0 + l)[TANGENTIAL_HISTORY.start]);
             let mut spring = lanes(spring_before);
             let mut rolling_before = _mm256_setzero_pd();
             if ROLLING {
                 let record = |l: usize| _mm_loadu_pd(records.as_ptr().add(k0 + l) as *const f64);
                 (spring, rolling_before) = unpack([record(0), record(1), record(2), record(3)]);
-                spring_before = in_order(spring);
             }
             let slid_before = slid_lanes(sliding.as_ptr().add(k0));
             let rolling = if ROLLING {
@@ -416,8 +417,13 @@ impl PairKernel<'_> {
                 if slid {
                     // the slip's work (the tangential sub-model's); a sticking
                     // contact adds +0, which leaves the sum (never -0) as it is
+                    let before = if ROLLING {
+                        in_order(spring)[l]
+                    } else {
+                        spring_before[l]
+                    };
                     tally.dissipation.friction +=
-                        ShearSpring::slip_work(model, spring_before[l], trial[l], capped[l]);
+                        ShearSpring::slip_work(model, before, trial[l], capped[l]);
                 }
                 if MEASURE {
                     let (en, fs) = (elastic_normal, new_spring[l]);
