@@ -112,6 +112,21 @@ class Contacts:
     see docs/contact-law.md. The torque of a contact on ``i`` is
     ``r_i * shear_force + rolling_moment``, on ``j`` ``r_j * shear_force -
     rolling_moment``.
+
+    Two touching disks held in place, ``i`` turning against ``j``: the rolling
+    moment on ``i`` is ``-k_r dtheta`` while below its cap
+    ``mu_r R* normal_force`` (here 0.05 N m):
+
+    >>> from grainlab import ContactModel, Simulation
+    >>> model = ContactModel(1e7, 1e7, 0.5, rolling_friction=0.1, rolling_stiffness=10.0)
+    >>> sim = Simulation([[0.0, 0.0], [1.9e-3, 0.0]], [1e-3, 1e-3], 2650.0, contact_model=model)
+    >>> sim.fixity = [7, 7]  # every degree of freedom prescribed: the spins stay
+    >>> sim.angular_velocities = [1.0, 0.0]
+    >>> sim.run(100)
+    >>> c = sim.contacts()
+    >>> dtheta = sim.rotations[0] - sim.rotations[1]
+    >>> bool(abs(c.rolling_moment[0] - (-10.0 * dtheta)) < 1e-12)
+    True
     """
 
     i: NDArray[np.uint32]
