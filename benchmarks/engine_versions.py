@@ -18,7 +18,9 @@ Keep a copy of the old build before changing the engine::
 
 Instruction counts are steadier than times on a loaded machine: ``--count``
 also runs each build once under ``valgrind --tool=callgrind`` (1,000 steps,
-one thread) and prints the instructions executed.
+one thread) and prints the instructions executed. ``--rolling-friction MU``
+gives both builds' contact model rolling resistance (the example's
+``--rolling-friction=MU``; both builds must know it).
 
 The last line printed is one JSON object with the medians and ratios.
 """
@@ -43,10 +45,18 @@ def spin(stop_at: float) -> None:
         x += 1
 
 
-def run_once(binary: str, threads: int, steps: int) -> float:
+def options(rolling_friction: float) -> list[str]:
+    """The example's options after threads and steps."""
+    return [f"--rolling-friction={rolling_friction!r}"] if rolling_friction > 0.0 else []
+
+
+def run_once(binary: str, threads: int, steps: int, rolling_friction: float = 0.0) -> float:
     """Particle-steps per second of one run of ``binary``."""
     out = subprocess.run(
-        [binary, str(threads), str(steps)], check=True, capture_output=True, text=True
+        [binary, str(threads), str(steps), *options(rolling_friction)],
+        check=True,
+        capture_output=True,
+        text=True,
     ).stdout
     match = re.search(r"particle_steps_per_s=([0-9.eE+-]+)", out)
     if match is None:
@@ -54,10 +64,11 @@ def run_once(binary: str, threads: int, steps: int) -> float:
     return float(match.group(1))
 
 
-def instructions(binary: str, steps: int) -> int:
+def instructions(binary: str, steps: int, rolling_friction: float = 0.0) -> int:
     """Instructions executed by one single-thread run (callgrind)."""
     done = subprocess.run(
-        ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", binary, "1", str(steps)],
+        ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", binary, "1", str(steps),
+         *options(rolling_friction)],
         check=True,
         capture_output=True,
         text=True,
@@ -77,12 +88,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--steps", type=int, default=5000)
     parser.add_argument("--busy", action="store_true", help="keep one core busy during every run")
     parser.add_argument("--count", action="store_true", help="also count instructions (valgrind)")
+    parser.add_argument(
+        "--rolling-friction", type=float, default=0.0, metavar="MU",
+        help="rolling resistance mu_r of both builds' contact model (0: none)",
+    )
     args = parser.parse_args(argv)
     for name in (args.a, args.b):
         if not Path(name).is_file():
             raise SystemExit(f"no such build: {name}")
     if args.repeat < 1 or args.steps < 1:
         raise SystemExit("--repeat and --steps must be >= 1")
+    if not args.rolling_friction >= 0.0:
+        raise SystemExit(f"--rolling-friction: must be >= 0, got {args.rolling_friction}")
 
     runs: dict[str, list[float]] = {}
     for _ in range(args.repeat):
@@ -93,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
                     hog = multiprocessing.Process(target=spin, args=(time.time() + 600,))
                     hog.start()
                 try:
-                    speed = run_once(binary, threads, args.steps)
+                    speed = run_once(binary, threads, args.steps, args.rolling_friction)
                 finally:
                     if hog is not None:
                         hog.terminate()
@@ -114,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"    {label.upper()}: {singles}")
     if args.count:
         for label, binary in (("a", args.a), ("b", args.b)):
-            summary[f"instructions_{label}"] = instructions(binary, 1000)
+            summary[f"instructions_{label}"] = instructions(binary, 1000, args.rolling_friction)
         ratio = summary["instructions_b"] / summary["instructions_a"]
         print(
             f"  instructions, 1 thread, 1,100 steps: A {summary['instructions_a']:,}"

@@ -14,7 +14,14 @@ processes in place of threads. The last line printed is one JSON object with
 the medians under ``grainlab_1``, ``grainlab_2``, ``lammps_1``, ``lammps_2``
 (null when LAMMPS is missing).
 
-Usage: ``python benchmarks/throughput.py [--repeat 5] [--steps 20000]``
+With ``--rolling-friction MU`` each grainlab run is followed by the same run
+with rolling resistance (``rolling_friction = MU``, its stiffness from the
+rule, no rolling dashpot), alternated with it; the medians are added under
+``grainlab_rolling_1`` and ``grainlab_rolling_2`` with their ratios to the runs
+without (docs/contact-law.md, "Speed").
+
+Usage: ``python benchmarks/throughput.py [--repeat 5] [--steps 20000]
+[--no-lammps] [--rolling-friction 0.1]``
 """
 
 from __future__ import annotations
@@ -52,14 +59,17 @@ def tiled_packing(tiles: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return positions, radii, box
 
 
-def grainlab_run(threads: int, steps: int, warmup: int = 100, tiles: int = 1) -> dict[str, float]:
-    """``steps`` timed steps of the common case (tiled ``tiles`` x ``tiles``) after ``warmup`` untimed ones."""
+def grainlab_run(
+    threads: int, steps: int, warmup: int = 100, tiles: int = 1, rolling_friction: float = 0.0
+) -> dict[str, float]:
+    """``steps`` timed steps of the common case (tiled ``tiles`` x ``tiles``) after ``warmup`` untimed
+    ones, with rolling resistance ``rolling_friction`` (0: none, the common case)."""
     positions, radii, box = tiled_packing(tiles)
     sim = grainlab.Simulation(
         positions,
         radii,
         2.0e8,
-        contact_model=grainlab.ContactModel(8.45e7, 8.45e7, 0.9),
+        contact_model=grainlab.ContactModel(8.45e7, 8.45e7, 0.9, rolling_friction=rolling_friction),
         time_step=TIME_STEP,
         threads=threads,
     )
@@ -83,10 +93,22 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--steps", type=int, default=20_000)
     parser.add_argument("--no-lammps", action="store_true", help="skip LAMMPS even if installed")
+    parser.add_argument(
+        "--rolling-friction", type=float, default=0.0, metavar="MU",
+        help="also time each grainlab run with rolling resistance mu_r = MU, alternated (0: not)",
+    )
     args = parser.parse_args(argv)
+    if args.repeat < 1 or args.steps < 1:
+        parser.error("--repeat and --steps must be >= 1")
+    if not args.rolling_friction >= 0.0:
+        parser.error(f"--rolling-friction: must be >= 0, got {args.rolling_friction}")
+    rolling = args.rolling_friction > 0.0
 
     have_lammps = not args.no_lammps and lammps_runner.find_lammps() is not None
-    samples: dict[str, list[float]] = {k: [] for k in ("grainlab_1", "grainlab_2", "lammps_1", "lammps_2")}
+    names = ["grainlab_1", "grainlab_2", "lammps_1", "lammps_2"]
+    if rolling:
+        names += ["grainlab_rolling_1", "grainlab_rolling_2"]
+    samples: dict[str, list[float]] = {k: [] for k in names}
     print(f"common case: {PACKING.name}, {args.steps} timed steps, {args.repeat} repetitions")
     if not have_lammps:
         print("LAMMPS not found: grainlab only (apt-get install lammps openmpi-bin for the comparison)")
@@ -95,6 +117,10 @@ def main(argv: list[str] | None = None) -> int:
             g = grainlab_run(n, args.steps)
             samples[f"grainlab_{n}"].append(g["particle_steps_per_s"])
             line = f"run {rep + 1}: grainlab {n} thread(s) {g['particle_steps_per_s']:.3e} (Z {g['z_start']:.2f} -> {g['z_end']:.2f})"
+            if rolling:
+                r = grainlab_run(n, args.steps, rolling_friction=args.rolling_friction)
+                samples[f"grainlab_rolling_{n}"].append(r["particle_steps_per_s"])
+                line += f" | rolling {r['particle_steps_per_s']:.3e}"
             if have_lammps:
                 lam = lammps_runner.run_lammps_throughput(PACKING, n, steps=args.steps)
                 samples[f"lammps_{n}"].append(lam["particle_steps_per_s"])
@@ -109,6 +135,12 @@ def main(argv: list[str] | None = None) -> int:
         ratio = f"  grainlab/LAMMPS = {g / lam:.2f}x" if lam else ""
         print(f"  {n} thread(s): grainlab {g:.3e}" + (f"  LAMMPS {lam:.3e}" if lam else "") + ratio)
     print(f"  grainlab speed-up 1 -> 2 threads: {medians['grainlab_2'] / medians['grainlab_1']:.2f}x")
+    if rolling:
+        for n in (1, 2):
+            on, off = medians[f"grainlab_rolling_{n}"], medians[f"grainlab_{n}"]
+            assert on is not None and off is not None
+            medians[f"rolling_ratio_{n}"] = on / off
+            print(f"  rolling_friction {args.rolling_friction}, {n} thread(s): {on:.3e}, {on / off:.3f}x without")
     print(json.dumps(medians))
     return 0
 

@@ -99,6 +99,7 @@ class _ContactArrays(TypedDict):
     normal_force: NDArray[np.float64]
     shear_force: NDArray[np.float64]
     sliding: NDArray[np.bool_]
+    rolling_moment: NDArray[np.float64]
 
 class _Contacts(_ContactArrays):
     i: NDArray[np.uint32]

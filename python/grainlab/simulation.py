@@ -104,8 +104,29 @@ class Contacts:
     step's force evaluation computes them, ``normal_force = kn * overlap`` and
     the shear spring with the increment of the displacement since the last
     evaluation, capped at ``mu * normal_force``; ``sliding`` is true exactly
-    where ``|shear_force| = mu * normal_force``. Forces are the elastic parts
-    (no dashpot forces); see docs/contact-law.md.
+    where ``|shear_force| = mu * normal_force``. ``rolling_moment`` is the
+    rolling resistance's moment **on i** (N m, counter-clockwise positive; its
+    opposite acts on ``j``), the rolling spring with its increment, capped at
+    ``mu_r R* normal_force``; 0 without rolling resistance and for bonds.
+    Forces and moments are the elastic parts (no dashpot forces or moments);
+    see docs/contact-law.md. The torque of a contact on ``i`` is
+    ``r_i * shear_force + rolling_moment``, on ``j`` ``r_j * shear_force -
+    rolling_moment``.
+
+    Two touching disks held in place, ``i`` turning against ``j``: the rolling
+    moment on ``i`` is ``-k_r dtheta`` while below its cap
+    ``mu_r R* normal_force`` (here 0.05 N m):
+
+    >>> from grainlab import ContactModel, Simulation
+    >>> model = ContactModel(1e7, 1e7, 0.5, rolling_friction=0.1, rolling_stiffness=10.0)
+    >>> sim = Simulation([[0.0, 0.0], [1.9e-3, 0.0]], [1e-3, 1e-3], 2650.0, contact_model=model)
+    >>> sim.fixity = [7, 7]  # every degree of freedom prescribed: the spins stay
+    >>> sim.angular_velocities = [1.0, 0.0]
+    >>> sim.run(100)
+    >>> c = sim.contacts()
+    >>> dtheta = sim.rotations[0] - sim.rotations[1]
+    >>> bool(abs(c.rolling_moment[0] - (-10.0 * dtheta)) < 1e-12)
+    True
     """
 
     i: NDArray[np.uint32]
@@ -117,6 +138,7 @@ class Contacts:
     shear_force: NDArray[np.float64]
     sliding: NDArray[np.bool_]
     bonded: NDArray[np.bool_]
+    rolling_moment: NDArray[np.float64]
 
     def __len__(self) -> int:
         return len(self.i)
@@ -131,8 +153,10 @@ class Contacts:
 class WallContacts:
     """Particle-wall contacts, in the same consistent state and the same convention
     as :class:`Contacts` with the wall as ``j``: ``normal`` points from the particle
-    to the wall, ``normal_force`` is compression positive and ``shear_force`` acts
-    on the particle along ``(-n_y, n_x)``."""
+    to the wall, ``normal_force`` is compression positive, ``shear_force`` acts
+    on the particle along ``(-n_y, n_x)`` and ``rolling_moment`` (N m,
+    counter-clockwise positive, 0 without rolling resistance) on the particle;
+    the contact's torque on the particle is ``r * shear_force + rolling_moment``."""
 
     wall: NDArray[np.uint32]
     particle: NDArray[np.uint32]
@@ -142,6 +166,7 @@ class WallContacts:
     normal_force: NDArray[np.float64]
     shear_force: NDArray[np.float64]
     sliding: NDArray[np.bool_]
+    rolling_moment: NDArray[np.float64]
 
     def __len__(self) -> int:
         return len(self.wall)
@@ -898,13 +923,16 @@ class Simulation:
         """Current particle-particle contacts (overlap > 0) and bonds, with the forces
         the next step will apply (the state is not changed)."""
         d = self._engine.contacts()
-        d["shear_force"] = -d["shear_force"]  # the engine reports it on j
+        # the engine reports both on j (0 - M: a moment of 0 stays +0)
+        d["shear_force"] = -d["shear_force"]
+        d["rolling_moment"] = 0.0 - d["rolling_moment"]
         return Contacts(**{k: _readonly(v) for k, v in d.items()})
 
     def wall_contacts(self) -> WallContacts:
         """Current particle-wall contacts, with the forces the next step will apply."""
         d = self._engine.wall_contacts()
-        # the engine's normal points from the wall to the particle, its shear along rot90 of that
+        # the engine's normal points from the wall to the particle, its shear along rot90 of
+        # that; its rolling moment is on the particle already
         d["normal"] = -d["normal"]
         d["shear_force"] = -d["shear_force"]
         return WallContacts(**{k: _readonly(v) for k, v in d.items()})

@@ -5,7 +5,7 @@ use crate::pipeline::Simulation;
 use crate::vec2::{scale, Vec2};
 
 /// One row of the contact table while it is assembled.
-type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool);
+type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool, f64);
 
 /// Particle-particle contacts and bonds, sorted by `(i, j)` with `i < j`,
 /// in external (user) particle indices.
@@ -16,8 +16,10 @@ type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool);
 /// displacement made since the last evaluation (none when velocities were just
 /// set), capped at `mu * normal_force`. `normal` points from `i` to `j`;
 /// `normal_force` (N, `kn * overlap`, >= 0 unless bonded) and `shear_force`
-/// (N, along `perp(normal)`) are the forces on `j`, elastic parts only (the
-/// optional viscous dashpots are not included).
+/// (N, along `perp(normal)`) are the forces on `j`, and `rolling_moment` (N m,
+/// counter-clockwise positive) the rolling resistance's moment on `j` (its
+/// opposite acts on `i`), elastic parts only (the optional viscous dashpots,
+/// the rolling one too, are not included).
 #[derive(Debug, Clone, Default)]
 pub struct ContactList {
     /// First particle.
@@ -38,6 +40,9 @@ pub struct ContactList {
     pub sliding: Vec<bool>,
     /// Whether the pair is a bond.
     pub bonded: Vec<bool>,
+    /// Rolling moment on `j` (N m), the rolling spring `M_r`: 0 without rolling
+    /// resistance and for bonds.
+    pub rolling_moment: Vec<f64>,
 }
 
 /// Particle-wall contacts, sorted by `(wall, particle)` (external particle
@@ -61,6 +66,9 @@ pub struct WallContactList {
     pub shear_force: Vec<f64>,
     /// Whether the shear force is at the Coulomb cap.
     pub sliding: Vec<bool>,
+    /// Rolling moment on the particle (N m, the rolling spring `M_r`; 0
+    /// without rolling resistance).
+    pub rolling_moment: Vec<f64>,
 }
 
 impl Simulation {
@@ -85,6 +93,7 @@ impl Simulation {
                     c.shear_spring,
                     c.sliding,
                     false,
+                    c.rolling_spring,
                 ));
             }
         }
@@ -102,11 +111,13 @@ impl Simulation {
                 f.shear_force,
                 false,
                 true,
+                0.0,
             ));
         }
-        // external indices, i < j: swapping a pair flips its normal, and nothing
-        // else (the shear force on the new j along the new tangent is unchanged,
-        // and the contact point, mid-overlap, is the same seen from either disk)
+        // external indices, i < j: swapping a pair flips its normal and the
+        // rolling moment (now on the other disk), and nothing else (the shear
+        // force on the new j along the new tangent is unchanged, and the
+        // contact point, mid-overlap, is the same seen from either disk)
         for r in rows.iter_mut() {
             let (i, j) = (
                 self.external_index(r.0 as usize) as u32,
@@ -117,6 +128,8 @@ impl Simulation {
             } else {
                 (r.0, r.1) = (j, i);
                 r.3 = [-r.3[0], -r.3[1]];
+                // (0 - M: a moment of 0 stays +0)
+                r.9 = 0.0 - r.9;
             }
         }
         rows.sort_by_key(|r| (r.0, r.1));
@@ -131,6 +144,7 @@ impl Simulation {
             out.shear_force.push(r.6);
             out.sliding.push(r.7);
             out.bonded.push(r.8);
+            out.rolling_moment.push(r.9);
         }
         Ok(out)
     }
@@ -157,6 +171,7 @@ impl Simulation {
                 out.normal_force.push(c.elastic_normal);
                 out.shear_force.push(c.shear_spring);
                 out.sliding.push(c.sliding);
+                out.rolling_moment.push(c.rolling_spring);
             }
         }
         let mut idx: Vec<usize> = (0..out.wall.len()).collect();
@@ -170,6 +185,7 @@ impl Simulation {
             normal_force: idx.iter().map(|&k| out.normal_force[k]).collect(),
             shear_force: idx.iter().map(|&k| out.shear_force[k]).collect(),
             sliding: idx.iter().map(|&k| out.sliding[k]).collect(),
+            rolling_moment: idx.iter().map(|&k| out.rolling_moment[k]).collect(),
         })
     }
 }

@@ -163,9 +163,17 @@ impl MaterialTable {
     }
 
     /// Whether any model of the table has rolling resistance (`rolling_friction`
-    /// above 0): the four-pair lanes, which have none, then do not run.
+    /// above 0): the four-pair lanes then evaluate the rolling law too.
     pub fn rolling(&self) -> bool {
         self.models.iter().any(|m| m.rolling_friction != 0.0)
+    }
+
+    /// Whether any model with rolling resistance has a rolling dashpot: the
+    /// four-pair lanes then gather the masses and inertias it reads.
+    pub fn rolling_damped(&self) -> bool {
+        self.models
+            .iter()
+            .any(|m| m.rolling_friction != 0.0 && m.rolling_damping_ratio > 0.0)
     }
 
     /// Largest normal or shear stiffness of any model involving group `g`.

@@ -4,7 +4,7 @@
 //! elastic rolling oscillation; and its bits on 1 and 2 threads.
 mod common;
 use common::*;
-use grainlab_core::{ContactModel, Simulation, StepParameters, Wall, WallShape};
+use grainlab_core::{ContactModel, Particles, Simulation, StepParameters, Wall, WallShape};
 
 const R: f64 = 1.0e-3;
 const G: f64 = 9.81;
@@ -216,8 +216,8 @@ fn the_elastic_rolling_spring_oscillates_at_sqrt_k_r_over_i() {
 }
 
 /// A packing with rolling resistance gives the same bits on 1 and 2 threads,
-/// and with the four-pair lanes asked for or not (they do not run for a
-/// table with rolling resistance: the scalar loop evaluates every pair).
+/// and with the four-pair lanes or the scalar loop (two models, one with a
+/// rolling dashpot: the lanes' several-model variant with the dashpot).
 #[test]
 fn rolling_resistance_gives_the_same_bits_on_one_and_two_threads_and_without_lanes() {
     let run = |threads: usize, simd: bool| {
@@ -250,6 +250,75 @@ fn rolling_resistance_gives_the_same_bits_on_one_and_two_threads_and_without_lan
     let reference = run(1, true);
     assert_eq!(run(2, true), reference, "2 threads");
     assert_eq!(run(1, false), reference, "scalar loop");
+}
+
+/// A periodic packing in simple shear whose one contact model (no normal or
+/// shear dashpot) has rolling resistance: the four-pair lanes run with their
+/// rolling law (the single-model, deforming-cell variant), with and without
+/// the rolling dashpot. The same bits as the scalar loop and on 2 threads: the
+/// motion, every record (shear and rolling springs), the contact list and the
+/// ledger.
+#[test]
+fn the_four_pair_lanes_with_rolling_resistance_give_the_scalar_loops_bits() {
+    for rolling_damping_ratio in [0.0, 0.3] {
+        let run = |threads: usize, simd: bool| {
+            let grid = dense_periodic(18, 1.0e-3, 0.5, 21, threads);
+            let p = grid.particles();
+            let mut m = ContactModel::linear(KN, KN, 0.5);
+            m.rolling_friction = 0.2;
+            m.rolling_damping_ratio = rolling_damping_ratio;
+            let particles =
+                Particles::new(p.position.clone(), p.radius.clone(), vec![DENSITY]).unwrap();
+            let dt = grid.params().time_step;
+            let mut sim = Simulation::new(particles, m, dt, threads).unwrap();
+            let mut cell = grid.cell().cloned().unwrap();
+            cell.velocity_gradient = [[0.0, 0.4], [0.0, 0.0]];
+            sim.set_cell(Some(cell)).unwrap();
+            assert!(sim.materials().single_undamped_model().is_some());
+            set_random_motion(
+                &mut sim,
+                &mut Rng::new(3),
+                (-0.02, 0.02),
+                (-0.02, 0.02),
+                (-20.0, 20.0),
+            );
+            let used = sim.set_simd(simd);
+            sim.run(600).unwrap();
+            let mut bits: Vec<u64> = Vec::new();
+            let p = sim.particles();
+            bits.extend(p.angular_velocity.iter().map(|w| w.to_bits()));
+            bits.extend(p.position.iter().flat_map(|x| x.map(f64::to_bits)));
+            let records = &sim.neighbors().pairs.history.records;
+            bits.extend(records.iter().flat_map(|r| r.map(f64::to_bits)));
+            let loaded = records.iter().filter(|r| r[1] != 0.0).count();
+            assert!(loaded > 100, "{loaded} rolling springs");
+            let e = sim.energy();
+            bits.extend(
+                [
+                    e.elastic,
+                    e.kinetic,
+                    e.rolling_dissipated,
+                    e.friction_dissipated,
+                ]
+                .map(f64::to_bits),
+            );
+            assert!(e.rolling_dissipated > 0.0);
+            bits.extend(contact_list_bits(&mut sim));
+            (bits, used)
+        };
+        let (reference, used) = run(1, true);
+        if !used {
+            eprintln!("no AVX2 on this processor: the scalar loop against itself");
+        }
+        assert!(
+            run(1, false).0 == reference,
+            "scalar loop, eta_r {rolling_damping_ratio}"
+        );
+        assert!(
+            run(2, true).0 == reference,
+            "2 threads, eta_r {rolling_damping_ratio}"
+        );
+    }
 }
 
 /// The critical time step counts the rolling spring in the rotational

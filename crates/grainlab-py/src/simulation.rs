@@ -596,6 +596,7 @@ impl Engine {
         d.set_item("shear_force", values_to_py(py, &c.shear_force))?;
         d.set_item("sliding", values_to_py(py, &c.sliding))?;
         d.set_item("bonded", values_to_py(py, &c.bonded))?;
+        d.set_item("rolling_moment", values_to_py(py, &c.rolling_moment))?;
         Ok(d)
     }
 
@@ -610,6 +611,7 @@ impl Engine {
         d.set_item("normal_force", values_to_py(py, &c.normal_force))?;
         d.set_item("shear_force", values_to_py(py, &c.shear_force))?;
         d.set_item("sliding", values_to_py(py, &c.sliding))?;
+        d.set_item("rolling_moment", values_to_py(py, &c.rolling_moment))?;
         Ok(d)
     }
 

@@ -6,7 +6,7 @@
 //! the elastic-plastic rolling spring, off unless a model has `rolling_friction`). [`contact_law`] runs them in that order for one contact and
 //! returns its forces, its torques on both bodies and each sub-model's
 //! dissipation; the pair kernel, its AVX2 lanes (checked against it bit for
-//! bit), the wall contacts, the springs' catch-up and the contact queries all
+//! bit, rolling resistance included), the wall contacts, the springs' catch-up and the contact queries all
 //! call it.
 //!
 //! Each sub-model declares the history it carries per contact
@@ -150,14 +150,18 @@ pub const ROLLING_HISTORY: Range<usize> =
     TANGENTIAL_HISTORY.end..TANGENTIAL_HISTORY.end + Rolling::HISTORY;
 
 /// Whether the four-pair AVX2 loop evaluates this law (every sub-model has
-/// lanes, and the record starts with the tangential spring, which the lanes
-/// load). The lanes have no rolling resistance: the kernel runs them only for
-/// a table without it ([`crate::material::MaterialTable::rolling`]).
+/// lanes, and the record is the tangential spring then the rolling spring,
+/// which the lanes load: the shear spring alone, or with rolling resistance
+/// both as one 128-bit pair). The lanes' rolling law is compiled in only for
+/// a table with rolling resistance
+/// ([`crate::material::MaterialTable::rolling`]).
 pub const LANES: bool = Normal::LANES
     && Damping::LANES
     && Tangential::LANES
     && Rolling::LANES
-    && TANGENTIAL_HISTORY.start == 0;
+    && TANGENTIAL_HISTORY.start == 0
+    && ROLLING_HISTORY.start == 1
+    && HISTORY_WIDTH == 2;
 
 /// One contact's history: every sub-model's values, in its slot; all zero for
 /// a contact that has not touched (or has separated).

@@ -17,15 +17,18 @@ use crate::material::ContactModel;
 ///
 /// With `rolling_friction` 0 (the default) it does nothing: no torque, no
 /// dissipation, its slot of the record left as it is (so the paper's law keeps
-/// its bits, and the four-pair lanes, which do not evaluate rolling, run).
+/// its bits). The four-pair lanes (`pipeline/pair_lanes.rs`, `law_by_four`)
+/// evaluate it with the same bits, compiled in only for a table with rolling
+/// resistance.
 #[derive(Debug, Clone, Copy)]
 pub struct RollingSpring;
 
 impl SubModel for RollingSpring {
     const NAME: &'static str = "elastic-plastic rolling spring with dashpot";
     const HISTORY: usize = 1;
-    /// The lanes evaluate it only while it is off (`rolling_friction` 0 in
-    /// every model, [`crate::material::MaterialTable::rolling`]).
+    /// The lanes evaluate it, its dashpot included (with rolling resistance in
+    /// some model, [`crate::material::MaterialTable::rolling`]; without, they
+    /// leave its slot as it is).
     const LANES: bool = true;
 }
 

@@ -116,6 +116,9 @@ pub(crate) struct PairRecord {
     pub(crate) shear_spring: f64,
     /// Whether the spring is at the Coulomb cap.
     pub(crate) sliding: bool,
+    /// The rolling spring after the update, the moment on `j` (N m; 0 without
+    /// rolling resistance).
+    pub(crate) rolling_spring: f64,
 }
 
 /// Keeps every contact's record, in pair order (`None`: not in contact).
@@ -135,6 +138,7 @@ impl ForceSink for RecordSink {
             elastic_normal: c.elastic_normal,
             shear_spring: c.shear_spring,
             sliding: c.sliding,
+            rolling_spring: c.rolling_spring,
         });
     }
 }
@@ -318,7 +322,8 @@ impl ResetKernel<'_> {
 /// A [`PairKernel`] over the particles `$p` and pair list `$pairs` of simulation
 /// `$sim` (a macro, so that the shear springs can be borrowed mutably apart).
 macro_rules! pair_kernel {
-    ($sim:expr, $p:expr, $pairs:expr, $increment_time:expr) => {
+    ($sim:expr, $p:expr, $pairs:expr, $increment_time:expr) => {{
+        let rolling = $sim.materials.rolling();
         PairKernel {
             position: &$p.position,
             velocity: &$p.velocity,
@@ -342,10 +347,12 @@ macro_rules! pair_kernel {
             max_overlap_ratio: $sim.params.max_overlap_ratio,
             single_model: $sim.materials.single_undamped_model(),
             undamped: $sim.materials.undamped(),
-            rolling: $sim.materials.rolling(),
+            rolling,
+            // (the table scanned again only when it has rolling resistance)
+            rolling_damped: rolling && $sim.materials.rolling_damped(),
             vector: $sim.simd,
         }
-    };
+    }};
 }
 pub(crate) use pair_kernel;
 
@@ -372,8 +379,10 @@ pub(crate) struct PairKernel<'a> {
     pub(crate) single_model: Option<ContactModel>,
     /// No model has a dashpot.
     pub(crate) undamped: bool,
-    /// Some model has rolling resistance (which the four-pair loop lacks).
+    /// Some model has rolling resistance (the four-pair loop then evaluates it).
     pub(crate) rolling: bool,
+    /// Some model with rolling resistance has a rolling dashpot.
+    pub(crate) rolling_damped: bool,
     /// Whether undamped pairs run four at a time ([`crate::Simulation::set_simd`]).
     pub(crate) vector: bool,
 }
@@ -422,10 +431,11 @@ impl PairKernel<'_> {
 
     /// The loop of [`PairKernel::run`]: `DEFORMING` when the cell has a velocity
     /// gradient, `SINGLE` when [`PairKernel::single_model`] is set, `DASHPOTS`
-    /// unless no model has a dashpot (whose terms are then skipped, as the law
-    /// skips them for a zero damping ratio). Without dashpots, and when
-    /// [`PairKernel::vector`] is set, four pairs at a time
-    /// ([`PairKernel::pairs_by_four`], the same bits).
+    /// unless no model has a normal or shear dashpot (whose terms are then
+    /// skipped, as the law skips them for a zero damping ratio). Without those
+    /// dashpots, and when [`PairKernel::vector`] is set, four pairs at a time
+    /// ([`PairKernel::pairs_by_four`], the same bits), with the rolling law
+    /// (and its dashpot) when some model has rolling resistance.
     ///
     /// # Safety
     /// As [`PairKernel::run`].
@@ -444,10 +454,21 @@ impl PairKernel<'_> {
         sink: &mut S,
     ) -> ContactTally {
         // (`vector` is never set where the four-pair loop does not exist)
-        if !DASHPOTS && self.vector && !self.rolling && crate::law::LANES {
+        if !DASHPOTS && self.vector && crate::law::LANES {
+            // the rolling law (and its dashpot) compiled in only for a table
+            // that has it, so that the loop without it is the same code as before
             #[cfg(target_arch = "x86_64")]
-            return self
-                .pairs_by_four::<MEASURE, DEFORMING, SINGLE, S>(first, records, sliding, sink);
+            return match (self.rolling, self.rolling_damped) {
+                (false, _) => self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, false, false, S>(
+                    first, records, sliding, sink,
+                ),
+                (true, false) => self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, true, false, S>(
+                    first, records, sliding, sink,
+                ),
+                (true, true) => self.pairs_by_four::<MEASURE, DEFORMING, SINGLE, true, true, S>(
+                    first, records, sliding, sink,
+                ),
+            };
         }
         let mut tally = ContactTally::default();
         let fixed = self.loop_constants();

@@ -2,14 +2,16 @@
 //! AVX2, with the same bits as the scalar loop of `pair_kernel.rs`.
 //!
 //! The law of four pairs is [`law_by_four`]: the sub-models of
-//! [`crate::law::contact_law`] without dashpots (normal spring, shear spring
-//! with its cap, no rolling), lane by lane; its test gives both the same
-//! random contacts and requires the same bits. The loop runs only while every
-//! sub-model of the law has lanes ([`crate::law::LANES`]).
+//! [`crate::law::contact_law`] without the normal and shear dashpots (normal
+//! spring, shear spring with its cap and, compiled in only for a table with
+//! rolling resistance, the rolling spring with its cap and its dashpot), lane
+//! by lane; its test gives both the same random contacts and requires the
+//! same bits. The loop runs only while every sub-model of the law has lanes
+//! ([`crate::law::LANES`]).
 //!
 //! Why the bits are the same: every pair's law is computed lane by lane with
 //! the operations of the scalar code in its order (IEEE additions,
-//! multiplications, one division and one square root per pair, all correctly
+//! multiplications, divisions and square roots, all correctly
 //! rounded in both forms, and no fused multiply-add, which Rust never forms on
 //! its own), and branches become selects of the value the branch would have
 //! kept. What is summed over pairs, the forces and torques on the particles and
@@ -28,8 +30,11 @@ use std::arch::x86_64::*;
 
 use super::pair_kernel::{no_contact, ContactTally, ForceSink, PairKernel};
 use crate::diagnostics::ContactDissipation;
+use crate::law::rolling::RollingSpring;
 use crate::law::tangential::ShearSpring;
-use crate::law::{elastic_energy, ContactForce, ContactRecord, TANGENTIAL_HISTORY};
+use crate::law::{
+    elastic_energy, ContactForce, ContactRecord, ROLLING_HISTORY, TANGENTIAL_HISTORY,
+};
 use crate::simd::spill;
 
 /// `_mm256_permute4x64_pd`'s selector that swaps lanes 1 and 2: pairs in
@@ -77,8 +82,12 @@ unsafe fn slid_lanes(flags: *const bool) -> __m256d {
 }
 
 impl PairKernel<'_> {
-    /// [`PairKernel::pairs`] without dashpots, four pairs at a time and the
-    /// rest one at a time.
+    /// [`PairKernel::pairs`] without normal and shear dashpots, four pairs at
+    /// a time and the rest one at a time; `ROLLING` when some model has
+    /// rolling resistance ([`PairKernel::rolling`]: without it the rolling law
+    /// is not compiled in, and the rolling slot of each record is left as it
+    /// is), `ROLLING_DASHPOT` when one of those has a rolling dashpot
+    /// ([`PairKernel::rolling_damped`]).
     ///
     /// # Safety
     /// As [`PairKernel::run`]; the processor has AVX2 ([`crate::simd::available`]).
@@ -87,6 +96,8 @@ impl PairKernel<'_> {
         const MEASURE: bool,
         const DEFORMING: bool,
         const SINGLE: bool,
+        const ROLLING: bool,
+        const ROLLING_DASHPOT: bool,
         S: ForceSink,
     >(
         &self,
@@ -107,6 +118,7 @@ impl PairKernel<'_> {
             _mm256_set1_pd(g[1][1]),
         );
         let increment_time = _mm256_set1_pd(self.increment_time);
+        let dt = _mm256_set1_pd(self.dt);
         let sign_bit = _mm256_set1_pd(-0.0);
         let one = _mm256_set1_pd(1.0);
         let max_overlap_ratio = _mm256_set1_pd(self.max_overlap_ratio);
@@ -213,14 +225,80 @@ impl PairKernel<'_> {
                 }
                 (lanes(kn), lanes(ks), lanes(mu))
             };
-            // the law, lane by lane ([`law_by_four`]); each record starts with
-            // the shear spring (`law::LANES`); the rolling slot, off in every
-            // model of a table the lanes run for, is left as it is
+            // the law, lane by lane ([`law_by_four`]); each record is [shear
+            // spring, rolling spring] (`law::LANES`): with `ROLLING` the four
+            // records unpack into both springs' lanes (stored back one by
+            // one, which measured fewer instructions than 128-bit stores),
+            // without it the rolling slot, off in every model of the table,
+            // is left as it is
+            // (with `ROLLING`, `spring_before` is not read: a slip's work
+            // takes its spring out of the lanes)
             let spring_before: [f64; 4] =
                 std::array::from_fn(|l| records.get_unchecked(k0 + l)[TANGENTIAL_HISTORY.start]);
-            let spring = lanes(spring_before);
+            let mut spring = lanes(spring_before);
+            let mut rolling_before = _mm256_setzero_pd();
+            if ROLLING {
+                let record = |l: usize| _mm_loadu_pd(records.as_ptr().add(k0 + l) as *const f64);
+                (spring, rolling_before) = unpack([record(0), record(1), record(2), record(3)]);
+            }
             let slid_before = slid_lanes(sliding.as_ptr().add(k0));
-            let law = law_by_four(
+            let rolling = if ROLLING {
+                let (mu_r, k_r, eta_r) = if SINGLE {
+                    let m = &fixed.single;
+                    (
+                        _mm256_set1_pd(m.rolling_friction),
+                        _mm256_set1_pd(m.rolling_stiffness),
+                        _mm256_set1_pd(m.rolling_damping_ratio),
+                    )
+                } else {
+                    let (mut mu_r, mut k_r, mut eta_r) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+                    for l in 0..4 {
+                        let m = self.model_of::<SINGLE>(&fixed, &columns, k0 + l);
+                        (mu_r[l], k_r[l], eta_r[l]) = (
+                            m.rolling_friction,
+                            m.rolling_stiffness,
+                            m.rolling_damping_ratio,
+                        );
+                    }
+                    (lanes(mu_r), lanes(k_r), lanes(eta_r))
+                };
+                // I + m r^2 of both bodies, combined as `PairKernel::one_pair` does
+                let rolling_inertia = if ROLLING_DASHPOT {
+                    let mut inertia = [[0.0; 4]; 2];
+                    let mut mass = [[0.0; 4]; 2];
+                    for l in 0..4 {
+                        for (side, &q) in ij[l].iter().enumerate() {
+                            inertia[side][l] = *self.inertia.get_unchecked(q);
+                            mass[side][l] = *self.mass.get_unchecked(q);
+                        }
+                    }
+                    let about_i = _mm256_add_pd(
+                        lanes(inertia[0]),
+                        _mm256_mul_pd(_mm256_mul_pd(lanes(mass[0]), r_i), r_i),
+                    );
+                    let about_j = _mm256_add_pd(
+                        lanes(inertia[1]),
+                        _mm256_mul_pd(_mm256_mul_pd(lanes(mass[1]), r_j), r_j),
+                    );
+                    _mm256_div_pd(
+                        _mm256_mul_pd(about_i, about_j),
+                        _mm256_add_pd(about_i, about_j),
+                    )
+                } else {
+                    _mm256_setzero_pd()
+                };
+                FourRolling {
+                    mu_r,
+                    k_r,
+                    eta_r,
+                    rolling_velocity: _mm256_sub_pd(lanes(wj), lanes(wi)),
+                    rolling_inertia,
+                    spring: rolling_before,
+                }
+            } else {
+                FourRolling::off()
+            };
+            let law = law_by_four::<ROLLING, ROLLING_DASHPOT>(
                 FourContacts {
                     kn,
                     ks,
@@ -233,7 +311,9 @@ impl PairKernel<'_> {
                     touching,
                     slid_before,
                 },
+                rolling,
                 increment_time,
+                dt,
             );
             let new_spring = law.spring;
             let slides = law.slides;
@@ -258,11 +338,22 @@ impl PairKernel<'_> {
             // contact forgets its whole record, as the scalar loop does
             let sliding_bits = pair_order(_mm256_movemask_pd(slides));
             let touching_bits = pair_order(touching_bits as i32);
+            // with `ROLLING`, the records [shear, rolling] of pairs 0 and 1,
+            // then 2 and 3, from the lanes (the inverse of `unpack`)
             let (overlap, new_spring) = (in_order(overlap), in_order(new_spring));
+            let rolling_record = if ROLLING {
+                in_order(law.rolling_record)
+            } else {
+                [0.0; 4]
+            };
             for (l, &after) in new_spring.iter().enumerate() {
                 let k = k0 + l;
                 if touching_bits & (1 << l) != 0 {
-                    records.get_unchecked_mut(k)[TANGENTIAL_HISTORY.start] = after;
+                    let record = records.get_unchecked_mut(k);
+                    record[TANGENTIAL_HISTORY.start] = after;
+                    if ROLLING {
+                        record[ROLLING_HISTORY.start] = rolling_record[l];
+                    }
                     *sliding.get_unchecked_mut(k) = sliding_bits & (1 << l) != 0;
                 } else {
                     no_contact(
@@ -277,6 +368,27 @@ impl PairKernel<'_> {
             let (torque_i, torque_j) = (in_order(torque_i), in_order(torque_j));
             let (trial, capped) = (in_order(law.trial), in_order(law.capped));
             let (nx, ny) = (in_order(nx), in_order(ny));
+            let [rolling_spring, rolling_moment] = if ROLLING {
+                [law.rolling_spring, law.rolling_moment].map(|v| in_order(v))
+            } else {
+                [[0.0; 4]; 2]
+            };
+            let rolling_power = if ROLLING_DASHPOT {
+                in_order(law.rolling_power)
+            } else {
+                [0.0; 4]
+            };
+            let plastic_bits = if ROLLING {
+                pair_order(_mm256_movemask_pd(law.rolling_plastic))
+            } else {
+                0
+            };
+            // (its division only on a measured step)
+            let rolling_energy = if ROLLING && MEASURE {
+                in_order(law.rolling_energy)
+            } else {
+                [0.0; 4]
+            };
             // the bookkeeping, one touching pair at a time in pair order
             let mut touched = touching_bits;
             while touched != 0 {
@@ -295,9 +407,9 @@ impl PairKernel<'_> {
                     sliding: slid,
                     torque_i: torque_i[l],
                     torque_j: torque_j[l],
-                    rolling_spring: 0.0,
-                    rolling_moment: 0.0,
-                    rolling_energy: 0.0,
+                    rolling_spring: rolling_spring[l],
+                    rolling_moment: rolling_moment[l],
+                    rolling_energy: rolling_energy[l],
                     dissipation: ContactDissipation::default(), // (not read by the record)
                 };
                 sink.record(k, overlap[l], [nx[l], ny[l]], &c);
@@ -305,14 +417,50 @@ impl PairKernel<'_> {
                 if slid {
                     // the slip's work (the tangential sub-model's); a sticking
                     // contact adds +0, which leaves the sum (never -0) as it is
+                    let before = if ROLLING {
+                        in_order(spring)[l]
+                    } else {
+                        spring_before[l]
+                    };
                     tally.dissipation.friction +=
-                        ShearSpring::slip_work(model, spring_before[l], trial[l], capped[l]);
+                        ShearSpring::slip_work(model, before, trial[l], capped[l]);
                 }
                 if MEASURE {
                     let (en, fs) = (elastic_normal, new_spring[l]);
                     tally.elastic += elastic_energy(model, en, fs);
+                    if ROLLING && rolling_energy[l] != 0.0 {
+                        tally.elastic += rolling_energy[l];
+                    }
                     tally.force_sum += (en * en + fs * fs).sqrt();
                     tally.contacts += 1;
+                }
+            }
+            // the contacts' rolling dissipation in pair order, as the scalar
+            // loop adds it (0 + the plastic work or the dashpot's power; its
+            // own sum, so apart from the loop above): the contacts at the cap
+            // (a few in a thousand in a dense packing) and, with the dashpot,
+            // every touching one; the others add +0, which leaves the sum
+            // (never -0) as it is
+            let mut booked = if ROLLING_DASHPOT {
+                touching_bits
+            } else {
+                plastic_bits
+            };
+            while booked != 0 {
+                let l = booked.trailing_zeros() as usize;
+                booked &= booked - 1;
+                if plastic_bits & (1 << l) != 0 {
+                    let [k_r, before, trial, capped] = [
+                        law.rolling_stiffness,
+                        rolling.spring,
+                        law.rolling_trial,
+                        law.rolling_capped,
+                    ]
+                    .map(|v| in_order(v)[l]);
+                    tally.dissipation.rolling +=
+                        0.0 + RollingSpring::plastic_work(k_r, before, trial, capped);
+                } else {
+                    tally.dissipation.rolling += 0.0 + rolling_power[l];
                 }
             }
             k0 += 4;
@@ -351,6 +499,41 @@ pub(super) struct FourContacts {
     pub(super) slid_before: __m256d,
 }
 
+/// The rolling part of four pairs, in register order, as [`law_by_four`]
+/// reads it when it has the rolling law.
+#[derive(Clone, Copy)]
+pub(super) struct FourRolling {
+    /// Rolling friction `mu_r`, the given rolling stiffness (0: the rule) and
+    /// the rolling dashpot's damping ratio.
+    pub(super) mu_r: __m256d,
+    pub(super) k_r: __m256d,
+    pub(super) eta_r: __m256d,
+    /// `omega_j - omega_i` (rad/s).
+    pub(super) rolling_velocity: __m256d,
+    /// The equivalent rotational inertia about the contact (kg m^2; read only
+    /// with the rolling dashpot).
+    pub(super) rolling_inertia: __m256d,
+    /// The rolling springs before the update (N m).
+    pub(super) spring: __m256d,
+}
+
+impl FourRolling {
+    /// No rolling part (for the law without it, which does not read it).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn off() -> FourRolling {
+        let zero = _mm256_setzero_pd();
+        FourRolling {
+            mu_r: zero,
+            k_r: zero,
+            eta_r: zero,
+            rolling_velocity: zero,
+            rolling_inertia: zero,
+            spring: zero,
+        }
+    }
+}
+
 /// What [`law_by_four`] gives, in register order.
 #[derive(Clone, Copy)]
 pub(super) struct FourLaws {
@@ -365,21 +548,52 @@ pub(super) struct FourLaws {
     /// The springs after the update (a pair that does not touch: its record
     /// as [`crate::law::history::forget`] leaves it).
     pub(super) spring: __m256d,
-    /// Torques on `i` and `j`, `-r Fs`.
+    /// Torques on `i` and `j`, `-r Fs`, and with the rolling law `-M_r` and `+M_r`.
     pub(super) torque_i: __m256d,
     pub(super) torque_j: __m256d,
+    /// With the rolling law: the rolling slot of the record after the update
+    /// (left as it is where `mu_r` is 0; a pair that does not touch: as
+    /// [`crate::law::history::forget`] leaves it).
+    pub(super) rolling_record: __m256d,
+    /// With the rolling law, [`ContactForce`]'s `rolling_spring`,
+    /// `rolling_moment` and `rolling_energy` (each 0 where `mu_r` is 0).
+    pub(super) rolling_spring: __m256d,
+    pub(super) rolling_moment: __m256d,
+    pub(super) rolling_energy: __m256d,
+    /// With the rolling law: `k_r`, the rolling springs plus the increment
+    /// before the cap, the cap with the trial's sign, and all-ones lanes where
+    /// the rolling spring ends at the cap (its plastic work is
+    /// [`RollingSpring::plastic_work`] of those, the contact's whole rolling
+    /// dissipation).
+    pub(super) rolling_stiffness: __m256d,
+    pub(super) rolling_trial: __m256d,
+    pub(super) rolling_capped: __m256d,
+    pub(super) rolling_plastic: __m256d,
+    /// With the rolling dashpot, its power `c_r w^2 dt` where it acts (below
+    /// the cap; +0 elsewhere): the contact's whole rolling dissipation there.
+    pub(super) rolling_power: __m256d,
 }
 
-/// The undamped contact law of four pairs, lane by lane with the scalar
-/// operations of [`crate::law::contact_law`] in their order: the normal
-/// spring, the shear spring's increment and Coulomb cap (branches as selects
-/// of the value the branch keeps), the torques; and, for a pair that does not
-/// touch, the record [`crate::law::history::forget`] leaves. Every operation is
-/// a correctly rounded IEEE one (no fused multiply-add), so each lane has the
-/// scalar law's bits (the test below checks it on random contacts).
+/// The contact law of four pairs without normal and shear dashpots, lane by
+/// lane with the scalar operations of [`crate::law::contact_law`] in their
+/// order: the normal spring, the shear spring's increment and Coulomb cap
+/// (branches as selects of the value the branch keeps), the torques; with
+/// `ROLLING`, the rolling law of [`crate::law::rolling::RollingSpring`] from
+/// `rolling` (its stiffness rule, increment, cap, plastic work, energy, and,
+/// with `DASHPOT` (some lane may have one), its dashpot) for pairs of
+/// particles (`r_i > 0`: `R* = r_i r_j / (r_i + r_j)`); and, for
+/// a pair that does not touch, the record [`crate::law::history::forget`]
+/// leaves. Every operation is a correctly rounded IEEE one (no fused
+/// multiply-add), so each lane has the scalar law's bits (the test below
+/// checks it on random contacts).
 #[inline]
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn law_by_four(c: FourContacts, increment_time: __m256d) -> FourLaws {
+pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
+    c: FourContacts,
+    rolling: FourRolling,
+    increment_time: __m256d,
+    dt: __m256d,
+) -> FourLaws {
     let sign_bit = _mm256_set1_pd(-0.0);
     let zero = _mm256_setzero_pd();
     // normal: the linear spring
@@ -400,14 +614,18 @@ pub(super) unsafe fn law_by_four(c: FourContacts, increment_time: __m256d) -> Fo
         _mm256_and_pd(sign_bit, trial),
     );
     let law_spring = _mm256_blendv_pd(trial, capped, slides);
-    // a pair out of contact keeps a spring of +-0 unless it slid, else gets +0
-    let keeps = _mm256_andnot_pd(c.slid_before, _mm256_cmp_pd::<_CMP_EQ_OQ>(c.spring, zero));
+    // a pair out of contact keeps its record if it is all +-0 and it did not
+    // slide, else gets +0 (with the rolling law the record is two wide)
+    let mut keeps = _mm256_andnot_pd(c.slid_before, _mm256_cmp_pd::<_CMP_EQ_OQ>(c.spring, zero));
+    if ROLLING {
+        keeps = _mm256_and_pd(keeps, _mm256_cmp_pd::<_CMP_EQ_OQ>(rolling.spring, zero));
+    }
     let idle_spring = _mm256_and_pd(keeps, c.spring);
     let spring = _mm256_blendv_pd(idle_spring, law_spring, c.touching);
-    // (no dashpot, no rolling resistance:) the torques of the shear force
-    let torque_i = _mm256_mul_pd(_mm256_xor_pd(c.radius_i, sign_bit), spring);
-    let torque_j = _mm256_mul_pd(_mm256_xor_pd(c.radius_j, sign_bit), spring);
-    FourLaws {
+    // (no normal or shear dashpot:) the torques of the shear force
+    let mut torque_i = _mm256_mul_pd(_mm256_xor_pd(c.radius_i, sign_bit), spring);
+    let mut torque_j = _mm256_mul_pd(_mm256_xor_pd(c.radius_j, sign_bit), spring);
+    let mut laws = FourLaws {
         elastic_normal,
         trial,
         capped,
@@ -415,14 +633,104 @@ pub(super) unsafe fn law_by_four(c: FourContacts, increment_time: __m256d) -> Fo
         spring,
         torque_i,
         torque_j,
+        rolling_record: zero,
+        rolling_spring: zero,
+        rolling_moment: zero,
+        rolling_energy: zero,
+        rolling_stiffness: zero,
+        rolling_trial: zero,
+        rolling_capped: zero,
+        rolling_plastic: zero,
+        rolling_power: zero,
+    };
+    if !ROLLING {
+        return laws;
     }
+    // rolling: on where the pair touches and its model has mu_r != 0 (the
+    // scalar law returns at once for mu_r == 0: slot, torques as they are)
+    let r = rolling;
+    let on = _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(r.mu_r, zero), c.touching);
+    // R* = r_i r_j / (r_i + r_j) (two particles: never the wall's r_j)
+    let r_star = _mm256_div_pd(
+        _mm256_mul_pd(c.radius_i, c.radius_j),
+        _mm256_add_pd(c.radius_i, c.radius_j),
+    );
+    // k_r: the given one when > 0, else 2.25 k_n mu_r^2 R*^2 (left to right)
+    let rule = _mm256_mul_pd(
+        _mm256_mul_pd(
+            _mm256_mul_pd(
+                _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(2.25), c.kn), r.mu_r),
+                r.mu_r,
+            ),
+            r_star,
+        ),
+        r_star,
+    );
+    let k_r = _mm256_blendv_pd(rule, r.k_r, _mm256_cmp_pd::<_CMP_GT_OQ>(r.k_r, zero));
+    let w = r.rolling_velocity;
+    let rolling_trial = _mm256_sub_pd(
+        r.spring,
+        _mm256_mul_pd(_mm256_mul_pd(k_r, w), increment_time),
+    );
+    let rolling_cap = _mm256_mul_pd(_mm256_mul_pd(r.mu_r, r_star), elastic_normal);
+    let plastic = _mm256_and_pd(
+        on,
+        _mm256_cmp_pd::<_CMP_GE_OQ>(_mm256_andnot_pd(sign_bit, rolling_trial), rolling_cap),
+    );
+    let rolling_capped = _mm256_or_pd(
+        _mm256_andnot_pd(sign_bit, rolling_cap),
+        _mm256_and_pd(sign_bit, rolling_trial),
+    );
+    let moment_spring = _mm256_blendv_pd(rolling_trial, rolling_capped, plastic);
+    // (the plastic work, a division, is booked by the loop for the few
+    // contacts at the cap, from `rolling_trial` and `rolling_capped`, as the
+    // slip's work is)
+    let half = _mm256_set1_pd(0.5);
+    let energy = _mm256_div_pd(
+        _mm256_mul_pd(_mm256_mul_pd(half, moment_spring), moment_spring),
+        k_r,
+    );
+    let mut moment = moment_spring;
+    if DASHPOT {
+        // below the cap, with eta_r > 0: -2 eta_r sqrt(I_r k_r) w on top, its
+        // power c_r w^2 dt dissipated
+        let damped = _mm256_andnot_pd(
+            plastic,
+            _mm256_and_pd(on, _mm256_cmp_pd::<_CMP_GT_OQ>(r.eta_r, zero)),
+        );
+        let c_r = _mm256_mul_pd(
+            _mm256_mul_pd(_mm256_set1_pd(2.0), r.eta_r),
+            _mm256_sqrt_pd(_mm256_mul_pd(r.rolling_inertia, k_r)),
+        );
+        let c_r_w = _mm256_mul_pd(c_r, w);
+        moment = _mm256_blendv_pd(moment, _mm256_sub_pd(moment, c_r_w), damped);
+        let power = _mm256_mul_pd(_mm256_mul_pd(c_r_w, w), dt);
+        laws.rolling_power = _mm256_and_pd(damped, power);
+    }
+    torque_i = _mm256_blendv_pd(torque_i, _mm256_sub_pd(torque_i, moment), on);
+    torque_j = _mm256_blendv_pd(torque_j, _mm256_add_pd(torque_j, moment), on);
+    let idle_rolling = _mm256_and_pd(keeps, r.spring);
+    let touching_rolling = _mm256_blendv_pd(r.spring, moment_spring, on);
+    laws.torque_i = torque_i;
+    laws.torque_j = torque_j;
+    laws.rolling_record = _mm256_blendv_pd(idle_rolling, touching_rolling, c.touching);
+    laws.rolling_spring = _mm256_and_pd(on, moment_spring);
+    laws.rolling_moment = _mm256_and_pd(on, moment);
+    laws.rolling_energy = _mm256_and_pd(on, energy);
+    laws.rolling_stiffness = k_r;
+    laws.rolling_trial = rolling_trial;
+    laws.rolling_capped = rolling_capped;
+    laws.rolling_plastic = plastic;
+    laws
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::law::history::forget;
-    use crate::law::{contact_law, ContactKinematics, HISTORY_WIDTH, TANGENTIAL_HISTORY};
+    use crate::law::{
+        contact_law, ContactKinematics, HISTORY_WIDTH, ROLLING_HISTORY, TANGENTIAL_HISTORY,
+    };
     use crate::material::ContactModel;
 
     /// A small deterministic generator (xorshift64*), for reproducible random contacts.
@@ -448,11 +756,31 @@ mod tests {
                 v
             }
         }
+        /// A spring before the update against its `cap`: at +0, at -0, at the
+        /// cap either way, or anywhere within 1.5 times it.
+        fn spring(&mut self, cap: f64) -> f64 {
+            match self.next() % 6 {
+                0 => 0.0,
+                1 => -0.0,
+                2 => cap,
+                3 => -cap,
+                _ => (2.0 * self.unit() - 1.0) * 1.5 * cap,
+            }
+        }
     }
 
-    /// One random contact: a model, its kinematics, the spring before and
-    /// whether it slid; some springs sit exactly at the cap, at +0, at -0.
-    fn random_contact(rng: &mut Random) -> (ContactModel, ContactKinematics, f64, bool) {
+    /// One random contact as the law reads it: its model, kinematics and record
+    /// before the update, and whether it slid.
+    struct Contact {
+        model: ContactModel,
+        kinematics: ContactKinematics,
+        record: ContactRecord,
+        slid: bool,
+    }
+
+    /// A random contact without rolling resistance; some springs sit exactly
+    /// at the cap, at +0, at -0.
+    fn random_contact(rng: &mut Random) -> Contact {
         let mu = match rng.next() % 5 {
             0 => 0.0,
             _ => rng.unit(),
@@ -475,15 +803,270 @@ mod tests {
             rolling_velocity: 0.0,
             rolling_inertia: 0.0,
         };
-        let cap = model.friction * model.normal_stiffness * kinematics.overlap;
-        let spring = match rng.next() % 6 {
+        let mut record = [0.0; HISTORY_WIDTH];
+        record[TANGENTIAL_HISTORY.start] =
+            rng.spring(model.friction * model.normal_stiffness * kinematics.overlap);
+        Contact {
+            model,
+            kinematics,
+            record,
+            slid: rng.next() % 3 == 0,
+        }
+    }
+
+    /// A random contact with rolling resistance (`mu_r` 0 in a fifth of them,
+    /// the stiffness given or from the rule, a rolling dashpot when `dashpot`
+    /// and in two thirds of those), its rolling spring at +-0, at the cap
+    /// `mu_r R* F_n`, or within 1.5 times it.
+    fn random_rolling_contact(rng: &mut Random, dashpot: bool) -> Contact {
+        let mut c = random_contact(rng);
+        let m = &mut c.model;
+        m.rolling_friction = match rng.next() % 5 {
             0 => 0.0,
-            1 => -0.0,
-            2 => cap,
-            3 => -cap,
-            _ => (2.0 * rng.unit() - 1.0) * 1.5 * cap,
+            _ => 0.5 * rng.unit(),
         };
-        (model, kinematics, spring, rng.next() % 3 == 0)
+        m.rolling_stiffness = match rng.next() % 2 {
+            0 => 0.0,
+            _ => rng.magnitude(-4.0, 2.0, false),
+        };
+        m.rolling_damping_ratio = if dashpot && rng.next() % 3 != 0 {
+            rng.unit()
+        } else {
+            0.0
+        };
+        let k = &mut c.kinematics;
+        k.rolling_velocity = match rng.next() % 6 {
+            0 => 0.0,
+            _ => rng.magnitude(-3.0, 3.0, true),
+        };
+        k.rolling_inertia = rng.magnitude(-12.0, -6.0, false);
+        let r_star = k.radius_i * k.radius_j / (k.radius_i + k.radius_j);
+        let cap = m.rolling_friction * r_star * m.normal_stiffness * k.overlap;
+        c.record[ROLLING_HISTORY.start] = rng.spring(cap);
+        c
+    }
+
+    /// What a round of four contacts gave in the lanes, in pair order.
+    struct Lanes {
+        slides: u32,
+        spring: [f64; 4],
+        normal: [f64; 4],
+        torque_i: [f64; 4],
+        torque_j: [f64; 4],
+        trial: [f64; 4],
+        capped: [f64; 4],
+        /// The rolling slot, spring, moment, energy, and the dissipation as
+        /// the loop books it.
+        rolling: [[f64; 4]; 5],
+    }
+
+    /// `law_by_four::<ROLLING, DASHPOT>` on four contacts.
+    fn by_four<const ROLLING: bool, const DASHPOT: bool>(
+        contacts: &[Contact],
+        touching: [bool; 4],
+        increment_time: f64,
+        dt: f64,
+    ) -> Lanes {
+        let pick = |f: &dyn Fn(&Contact) -> f64| {
+            let v: [f64; 4] = std::array::from_fn(|l| f(&contacts[l]));
+            // SAFETY: the callers checked AVX2
+            unsafe { lanes(v) }
+        };
+        let mask = |m: [bool; 4]| {
+            let v: [f64; 4] = m.map(|b| if b { f64::from_bits(u64::MAX) } else { 0.0 });
+            unsafe { lanes(v) }
+        };
+        let four = FourContacts {
+            kn: pick(&|c| c.model.normal_stiffness),
+            ks: pick(&|c| c.model.shear_stiffness),
+            mu: pick(&|c| c.model.friction),
+            overlap: pick(&|c| c.kinematics.overlap),
+            tangential_velocity: pick(&|c| c.kinematics.tangential_velocity),
+            radius_i: pick(&|c| c.kinematics.radius_i),
+            radius_j: pick(&|c| c.kinematics.radius_j),
+            spring: pick(&|c| c.record[TANGENTIAL_HISTORY.start]),
+            touching: mask(touching),
+            slid_before: mask(std::array::from_fn(|l| contacts[l].slid)),
+        };
+        let rolling = FourRolling {
+            mu_r: pick(&|c| c.model.rolling_friction),
+            k_r: pick(&|c| c.model.rolling_stiffness),
+            eta_r: pick(&|c| c.model.rolling_damping_ratio),
+            rolling_velocity: pick(&|c| c.kinematics.rolling_velocity),
+            rolling_inertia: pick(&|c| c.kinematics.rolling_inertia),
+            spring: pick(&|c| c.record[ROLLING_HISTORY.start]),
+        };
+        // SAFETY: the callers checked AVX2
+        unsafe {
+            let law = law_by_four::<ROLLING, DASHPOT>(
+                four,
+                rolling,
+                _mm256_set1_pd(increment_time),
+                _mm256_set1_pd(dt),
+            );
+            Lanes {
+                slides: pair_order(_mm256_movemask_pd(law.slides)),
+                spring: in_order(law.spring),
+                normal: in_order(law.elastic_normal),
+                torque_i: in_order(law.torque_i),
+                torque_j: in_order(law.torque_j),
+                trial: in_order(law.trial),
+                capped: in_order(law.capped),
+                rolling: {
+                    let [record, spring, moment, energy, k_r, before, trial, capped, power] = [
+                        law.rolling_record,
+                        law.rolling_spring,
+                        law.rolling_moment,
+                        law.rolling_energy,
+                        law.rolling_stiffness,
+                        rolling.spring,
+                        law.rolling_trial,
+                        law.rolling_capped,
+                        law.rolling_power,
+                    ]
+                    .map(|v| in_order(v));
+                    let plastic = pair_order(_mm256_movemask_pd(law.rolling_plastic));
+                    // the contact's rolling dissipation as the loop books it
+                    let dissipation = std::array::from_fn(|l| {
+                        if plastic & (1 << l) != 0 {
+                            0.0 + RollingSpring::plastic_work(
+                                k_r[l], before[l], trial[l], capped[l],
+                            )
+                        } else if DASHPOT {
+                            0.0 + power[l]
+                        } else {
+                            0.0
+                        }
+                    });
+                    [record, spring, moment, energy, dissipation]
+                },
+            }
+        }
+    }
+
+    /// How often each branch of the law was seen.
+    #[derive(Default, Debug)]
+    struct Seen {
+        sliding: usize,
+        sticking: usize,
+        apart: usize,
+        rolling_plastic: usize,
+        rolling_elastic: usize,
+        rolling_damped: usize,
+        rolling_off: usize,
+    }
+
+    /// Compares lane by lane `law_by_four::<ROLLING>` with the scalar law on
+    /// `rounds` rounds of four contacts from `draw`, bit for bit: the forces,
+    /// torques, the whole record after the update (a pair apart: as `forget`
+    /// leaves it), the sliding flag, the slip's work as the loop books it and,
+    /// with `ROLLING`, the rolling law's every output.
+    fn compare<const ROLLING: bool>(
+        seed: u64,
+        rounds: usize,
+        draw: &dyn Fn(&mut Random, bool) -> Contact,
+    ) -> Seen {
+        let mut rng = Random(seed);
+        let dt = 1.0e-6;
+        let mut seen = Seen::default();
+        for round in 0..rounds {
+            let increment_time = if round % 4 == 0 { 0.0 } else { dt };
+            // every other four rounds with rolling dashpots, the rest without
+            // (and then the lanes' dashpot path is not taken); with and without
+            // an increment both ways (a spring at its cap and no increment: the
+            // cap's `>=`, which leaves the dashpot off, decides)
+            let dashpot = (round / 4) % 2 == 1;
+            let contacts: Vec<Contact> = (0..4).map(|_| draw(&mut rng, dashpot)).collect();
+            let touching: [bool; 4] = std::array::from_fn(|_| rng.next() % 8 != 0);
+            let out = if dashpot {
+                by_four::<ROLLING, true>(&contacts, touching, increment_time, dt)
+            } else {
+                by_four::<ROLLING, false>(&contacts, touching, increment_time, dt)
+            };
+            for (l, c) in contacts.iter().enumerate() {
+                let mut record = c.record;
+                let mut flag = c.slid;
+                let what = format!(
+                    "round {round}, lane {l}: {:?} {:?} {:?} {}",
+                    c.model, c.kinematics, c.record, c.slid
+                );
+                if !touching[l] {
+                    forget(&mut record, &mut flag);
+                    assert_eq!(
+                        out.spring[l].to_bits(),
+                        record[TANGENTIAL_HISTORY.start].to_bits(),
+                        "apart: {what}"
+                    );
+                    if ROLLING {
+                        assert_eq!(
+                            out.rolling[0][l].to_bits(),
+                            record[ROLLING_HISTORY.start].to_bits(),
+                            "apart: {what}"
+                        );
+                    }
+                    assert_eq!(out.slides & (1 << l), 0);
+                    seen.apart += 1;
+                    continue;
+                }
+                let f =
+                    contact_law::<false>(&c.model, &c.kinematics, dt, increment_time, &mut record);
+                let lane_sliding = out.slides & (1 << l) != 0;
+                assert_eq!(lane_sliding, f.sliding, "{what}");
+                let bits = |v: f64| v.to_bits();
+                assert_eq!(
+                    bits(out.spring[l]),
+                    bits(record[TANGENTIAL_HISTORY.start]),
+                    "{what}"
+                );
+                assert_eq!(bits(out.spring[l]), bits(f.shear), "{what}");
+                assert_eq!(bits(out.normal[l]), bits(f.normal), "{what}");
+                assert_eq!(bits(out.torque_i[l]), bits(f.torque_i), "{what}");
+                assert_eq!(bits(out.torque_j[l]), bits(f.torque_j), "{what}");
+                // the slip's work as the loop books it, into a sum that starts at +0
+                let work = if lane_sliding {
+                    ShearSpring::slip_work(
+                        &c.model,
+                        c.record[TANGENTIAL_HISTORY.start],
+                        out.trial[l],
+                        out.capped[l],
+                    )
+                } else {
+                    0.0
+                };
+                assert_eq!(
+                    bits(0.0 + work),
+                    bits(0.0 + f.dissipation.friction),
+                    "{what}"
+                );
+                if f.sliding {
+                    seen.sliding += 1;
+                } else {
+                    seen.sticking += 1;
+                }
+                if !ROLLING {
+                    continue;
+                }
+                let [slot, spring, moment, energy, dissipated] = out.rolling.map(|v| v[l]);
+                assert_eq!(bits(slot), bits(record[ROLLING_HISTORY.start]), "{what}");
+                assert_eq!(bits(spring), bits(f.rolling_spring), "{what}");
+                assert_eq!(bits(moment), bits(f.rolling_moment), "{what}");
+                assert_eq!(bits(energy), bits(f.rolling_energy), "{what}");
+                assert_eq!(bits(dissipated), bits(f.dissipation.rolling), "{what}");
+                let m = &c.model;
+                let r_star = RollingSpring::effective_radius(&c.kinematics);
+                if m.rolling_friction == 0.0 {
+                    seen.rolling_off += 1;
+                } else if f.rolling_spring.abs() == m.rolling_friction * r_star * f.elastic_normal {
+                    seen.rolling_plastic += 1;
+                } else {
+                    seen.rolling_elastic += 1;
+                    if f.rolling_moment != f.rolling_spring {
+                        seen.rolling_damped += 1;
+                    }
+                }
+            }
+        }
+        seen
     }
 
     #[test]
@@ -492,82 +1075,35 @@ mod tests {
             eprintln!("no AVX2 on this processor: the four-pair loop never runs");
             return;
         }
-        let mut rng = Random(0x9e37_79b9_7f4a_7c15);
-        let dt = 1.0e-6;
-        let (mut sliding_seen, mut sticking_seen, mut apart_seen) = (0, 0, 0);
-        // (a width-1 forget, as `law_by_four` keeps it for a pair apart: the
-        // loop forgets the whole record with the scalar `forget`)
-        for round in 0..20_000 {
-            let increment_time = if round % 4 == 0 { 0.0 } else { dt };
-            let contacts: Vec<_> = (0..4).map(|_| random_contact(&mut rng)).collect();
-            let touching: [bool; 4] = std::array::from_fn(|_| rng.next() % 8 != 0);
-            let pick = |f: &dyn Fn(&(ContactModel, ContactKinematics, f64, bool)) -> f64| {
-                let v: [f64; 4] = std::array::from_fn(|l| f(&contacts[l]));
-                // SAFETY: AVX2 checked above
-                unsafe { lanes(v) }
-            };
-            let mask = |m: [bool; 4]| {
-                let v: [f64; 4] = m.map(|b| if b { f64::from_bits(u64::MAX) } else { 0.0 });
-                unsafe { lanes(v) }
-            };
-            let four = FourContacts {
-                kn: pick(&|c| c.0.normal_stiffness),
-                ks: pick(&|c| c.0.shear_stiffness),
-                mu: pick(&|c| c.0.friction),
-                overlap: pick(&|c| c.1.overlap),
-                tangential_velocity: pick(&|c| c.1.tangential_velocity),
-                radius_i: pick(&|c| c.1.radius_i),
-                radius_j: pick(&|c| c.1.radius_j),
-                spring: pick(&|c| c.2),
-                touching: mask(touching),
-                slid_before: mask(std::array::from_fn(|l| contacts[l].3)),
-            };
-            // SAFETY: AVX2 checked above
-            let law = unsafe { law_by_four(four, _mm256_set1_pd(increment_time)) };
-            let slides = pair_order(unsafe { _mm256_movemask_pd(law.slides) });
-            let out = |v: __m256d| unsafe { in_order(v) };
-            let (spring, torque_i, torque_j) =
-                (out(law.spring), out(law.torque_i), out(law.torque_j));
-            let (normal, trial, capped) =
-                (out(law.elastic_normal), out(law.trial), out(law.capped));
-            for (l, (model, kinematics, before, slid)) in contacts.iter().enumerate() {
-                let mut record = [0.0; HISTORY_WIDTH];
-                record[TANGENTIAL_HISTORY.start] = *before;
-                let mut flag = *slid;
-                if !touching[l] {
-                    forget(&mut record, &mut flag);
-                    assert_eq!(spring[l].to_bits(), record[0].to_bits(), "apart, lane {l}");
-                    assert_eq!(slides & (1 << l), 0);
-                    apart_seen += 1;
-                    continue;
-                }
-                let c = contact_law::<false>(model, kinematics, dt, increment_time, &mut record);
-                let lane_sliding = slides & (1 << l) != 0;
-                let what = format!("round {round}, lane {l}: {model:?} {kinematics:?} {before}");
-                assert_eq!(lane_sliding, c.sliding, "{what}");
-                assert_eq!(spring[l].to_bits(), record[0].to_bits(), "{what}");
-                assert_eq!(spring[l].to_bits(), c.shear.to_bits(), "{what}");
-                assert_eq!(normal[l].to_bits(), c.normal.to_bits(), "{what}");
-                assert_eq!(torque_i[l].to_bits(), c.torque_i.to_bits(), "{what}");
-                assert_eq!(torque_j[l].to_bits(), c.torque_j.to_bits(), "{what}");
-                // the slip's work as the loop books it, into a sum that starts at +0
-                let work = if lane_sliding {
-                    ShearSpring::slip_work(model, *before, trial[l], capped[l])
-                } else {
-                    0.0
-                };
-                assert_eq!(
-                    (0.0 + work).to_bits(),
-                    (0.0 + c.dissipation.friction).to_bits()
-                );
-                if c.sliding {
-                    sliding_seen += 1;
-                } else {
-                    sticking_seen += 1;
-                }
-            }
-        }
+        let seen = compare::<false>(0x9e37_79b9_7f4a_7c15, 20_000, &|rng, _| random_contact(rng));
         // the random contacts cover every branch of the law
-        assert!(sliding_seen > 10_000 && sticking_seen > 10_000 && apart_seen > 5_000);
+        assert!(
+            seen.sliding > 10_000 && seen.sticking > 10_000 && seen.apart > 5_000,
+            "{seen:?}"
+        );
+    }
+
+    /// The lanes with the rolling law (`ROLLING`) against the scalar law with
+    /// rolling resistance: models with and without it side by side, the
+    /// stiffness given and from the rule, the rolling spring at its cap and
+    /// below it, with and without a rolling dashpot.
+    #[test]
+    fn four_lanes_with_the_rolling_law_give_the_contact_laws_bits_on_random_contacts() {
+        if !crate::simd::available() {
+            eprintln!("no AVX2 on this processor: the four-pair loop never runs");
+            return;
+        }
+        let seen = compare::<true>(0x2545_f491_4f6c_dd1d, 20_000, &random_rolling_contact);
+        assert!(
+            seen.sliding > 10_000 && seen.sticking > 10_000 && seen.apart > 5_000,
+            "{seen:?}"
+        );
+        assert!(
+            seen.rolling_plastic > 10_000
+                && seen.rolling_elastic > 10_000
+                && seen.rolling_damped > 5_000
+                && seen.rolling_off > 5_000,
+            "{seen:?}"
+        );
     }
 }

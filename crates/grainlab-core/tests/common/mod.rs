@@ -208,6 +208,7 @@ pub fn contact_list_bits(sim: &mut Simulation) -> Vec<u64> {
             c.overlap[k],
             c.normal_force[k],
             c.shear_force[k],
+            c.rolling_moment[k],
         ];
         bits.extend(v.iter().map(|x| x.to_bits()));
     }
