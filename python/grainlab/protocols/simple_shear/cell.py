@@ -35,7 +35,8 @@ from numpy.typing import NDArray
 
 from grainlab.simulation import Simulation
 
-__all__ = ["CONTROL_STEPS", "INTEGRAL_SHARE", "RELAXATION", "CellStress", "cell_stress", "servo_rate"]
+__all__ = ["CONTROL_STEPS", "INTEGRAL_SHARE", "RELAXATION", "CellStress", "cell_stress", "servo_rate",
+           "side_stress"]
 
 #: Steps between two settings of the cell's rate.
 CONTROL_STEPS = 100
@@ -80,6 +81,28 @@ def cell_stress(sim: Simulation, normal_stiffness: float) -> CellStress:
     n4 = c.normal**4
     stiffness = normal_stiffness * (length**2) @ n4 / area
     return CellStress(contact, kinetic, (float(stiffness[0]), float(stiffness[1])), area)
+
+
+def side_stress(sim: Simulation, normal_stiffness: float, side: int) -> tuple[float, float]:
+    """``(sigma_kk, E_kk)`` of side ``k`` (0: x, 1: y) alone, as :func:`cell_stress`
+    gives them (to rounding) at a third of its cost: what the control reads every
+    100 steps."""
+    cell = sim.cell
+    if cell is None:
+        raise ValueError("side_stress: the simulation has no periodic cell")
+    area = float(cell.area)
+    c = sim.contacts()
+    radii = sim.radii
+    length = radii[c.i] + radii[c.j] - c.overlap
+    n_k = c.normal[:, side]
+    # the force on j along k: normal_force n_k - shear_force (on i) t_k, t = (-n_y, n_x)
+    tangent_k = -c.normal[:, 1] if side == 0 else c.normal[:, 0]
+    on_j = c.normal_force * n_k - c.shear_force * tangent_k
+    lever = length * n_k
+    v = sim.velocities[:, side]
+    stress = (float(lever @ on_j) + float(sim.masses @ (v * v))) / area
+    stiffness = normal_stiffness * float((lever * lever) @ (n_k * n_k)) / area
+    return stress, stiffness
 
 
 def servo_rate(stress_pa: float, target_pa: float, stiffness_pa: float, interval_s: float, max_rate: float,

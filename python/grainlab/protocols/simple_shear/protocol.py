@@ -25,7 +25,7 @@ from grainlab.io.hdf5.snapshot import snapshot_name
 from grainlab.io.results import SHEAR_START_FILE
 from grainlab.protocols.config import Config
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
-from grainlab.protocols.simple_shear.cell import CONTROL_STEPS, cell_stress, servo_rate
+from grainlab.protocols.simple_shear.cell import CONTROL_STEPS, cell_stress, servo_rate, side_stress
 from grainlab.protocols.simple_shear.config import SIMPLE_SHEAR_SCHEMA  # noqa: F401 - registers the schema
 from grainlab.protocols.simple_shear.outputs import SimpleShearResult, summarise, write_outputs
 from grainlab.protocols.simple_shear.state import SimpleShearRun
@@ -75,20 +75,24 @@ def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int,
     """Runs to ``to_step``, the cell's side rates set every CONTROL_STEPS steps (counted from
     ``run.start_step``) to hold ``targets`` (sigma_xx, sigma_yy; None: that side's rate 0)."""
     kn = config["material.normal_stiffness"]
+    if targets == (None, None):  # nothing to hold: the gradient is set once
+        wanted = ((0.0, shear_rate), (0.0, 0.0))
+        cell = sim.cell
+        if cell is None or cell.velocity_gradient != wanted:
+            sim.set_velocity_gradient(wanted)
+        sim.run(to_step - sim.step_count)
+        return
     while sim.step_count < to_step:
         into = (sim.step_count - run.start_step) % CONTROL_STEPS
         if into == 0:
             rates = [0.0, 0.0]
-            if targets != (None, None):
-                stress = cell_stress(sim, kn)
-                total = stress.total
-                interval = CONTROL_STEPS * sim.time_step
-                cap = _max_rate(sim, config, shear_rate)
-                for k, target in enumerate(targets):
-                    if target is not None:
-                        rates[k], run.cell_rate_integral[k] = servo_rate(
-                            float(total[k, k]), target, stress.stiffness_pa[k], interval, cap,
-                            run.cell_rate_integral[k])
+            interval = CONTROL_STEPS * sim.time_step
+            cap = _max_rate(sim, config, shear_rate)
+            for k, target in enumerate(targets):
+                if target is not None:
+                    stress, stiffness = side_stress(sim, kn, k)
+                    rates[k], run.cell_rate_integral[k] = servo_rate(
+                        stress, target, stiffness, interval, cap, run.cell_rate_integral[k])
             sim.set_velocity_gradient([[rates[0], shear_rate], [0.0, rates[1]]])
         sim.run(min(CONTROL_STEPS - into, to_step - sim.step_count))
 
