@@ -10,7 +10,7 @@ from grainlab.study.plan import load_plan, run_sweep
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = subparsers.add_parser(
         "sweep",
-        help="a parameter sweep (grid or zip) of packing runs or of a test (biaxial, oedometer)",
+        help="a parameter sweep (grid or zip) of packing runs or of a test (biaxial, oedometer, cyclic, simple_shear)",
         description=(
             "Runs every combination named by PLAN.toml (docs/study.md), each in OUT/runs/run_NNNN, "
             "one row per run in OUT/sweep.csv. Resumable: rerunning skips finished runs."
