@@ -23,7 +23,7 @@ from grainlab.cli import main
 from grainlab.columns import SIMPLE_SHEAR
 from grainlab.io.hdf5 import read_results
 from grainlab.protocols.registry import resolve_config
-from grainlab.protocols.simple_shear import SimpleShearProtocol, snapshot_name_of
+from grainlab.protocols.simple_shear import SimpleShearProtocol, SimpleShearResult, snapshot_name_of
 from grainlab.report import detect_kind
 
 # the quick cell (about 280 grains) to 60 % strain at I = 0.01: past one remap, a few seconds
@@ -206,16 +206,19 @@ DOCS = Path(__file__).resolve().parents[2] / "docs" / "protocols.md"
 DEFAULT = Path(__file__).resolve().parents[2] / "tests" / "data" / "simple_shear" / "default_summary.json"
 
 
+def _assert_quoted_line(text: str, summary: dict, start: str) -> None:
+    """The docs' line starting with ``start`` is what the run printed for ``summary``, but
+    for its wall time and folder (``SimpleShearResult.one_line``)."""
+    line = next(x for x in text.splitlines() if x.startswith(start))
+    printed = SimpleShearResult(Path("run"), summary).one_line()
+    assert line.split("; ")[:-1] == printed.split("; ")[:-1]
+
+
 def test_the_docs_quote_the_default_runs_summary():
     """docs/protocols.md's default simple-shear run is tests/data/simple_shear's summary."""
     s = json.loads(DEFAULT.read_text())
     text = DOCS.read_text()
-    line = next(x for x in text.splitlines() if x.startswith("grainlab simple_shear (free volume): 1759"))
-    assert line.split("; ")[:-1] == [
-        f"grainlab simple_shear (free volume): {s['n_particles']} grains, I {s['inertial_number_set']:.1e}",
-        f"peak mu {s['friction_coefficient_peak']:.3f} at {100 * s['shear_strain_at_peak']:.1f} %, steady mu "
-        f"{s['friction_coefficient_steady']:.3f}, porosity {s['porosity_steady']:.4f}, Z "
-        f"{s['coordination_number_steady']:.2f} at gamma >= {100 * s['steady_from_strain']:.0f} %"]
+    _assert_quoted_line(text, s, "grainlab simple_shear (free volume): 1759")
     assert f"{s['shear_steps']:,} steps" in text
     assert f"mu = {s['friction_coefficient_steady']:.3f} (sd\n{s['friction_coefficient_steady_sd']:.3f})" in text
     assert f"within {s['rb_residual_mean_abs']:.3f} on average, and {s['rb_residual_max_abs']:.3f}" in text
@@ -224,12 +227,7 @@ def test_the_docs_quote_the_default_runs_summary():
 def test_the_docs_quote_the_constant_volume_run():
     s = json.loads((DEFAULT.parent / "constant_volume_summary.json").read_text())
     text = DOCS.read_text()
-    line = next(x for x in text.splitlines() if x.startswith("grainlab simple_shear (constant volume): 1519"))
-    assert line.split("; ")[:-1] == [
-        f"grainlab simple_shear (constant volume): {s['n_particles']} grains, I {s['inertial_number_set']:.1e}",
-        f"peak mu {s['friction_coefficient_peak']:.3f} at {100 * s['shear_strain_at_peak']:.1f} %, steady mu "
-        f"{s['friction_coefficient_steady']:.3f}, porosity {s['porosity_steady']:.4f}, Z "
-        f"{s['coordination_number_steady']:.2f} at gamma >= {100 * s['steady_from_strain']:.0f} %"]
+    _assert_quoted_line(text, s, "grainlab simple_shear (constant volume): 1519")
     assert f"ends at {s['normal_stress_final_pa'] / 1e3:.1f} kPa (" in text
     assert f"{s['normal_stress_pa_steady'] / 1e3:.0f}\nkPa on average" in text
     assert f"residual is at most {s['rb_residual_max_abs']:.3f}" in text
@@ -274,14 +272,13 @@ def test_the_controls_side_stress_is_the_cells_stress(free):
     """What the control reads every 100 steps (one side, cheaply) is the cell's stress and its
     affine stiffness, to rounding."""
     from grainlab.io.lammps_input import simulation_to_export
-    from grainlab.protocols.simple_shear.cell import cell_stress, side_stress
+    from grainlab.protocols.simple_shear.cell import cell_stress, side_stresses
 
     sim = simulation_to_export(free)
     sim.set_velocity_gradient([[0.0, 0.05], [0.0, 0.0]])
     sim.run(300)
     full = cell_stress(sim, 8.45e7)
-    for k in (0, 1):
-        stress, stiffness = side_stress(sim, 8.45e7, k)
+    for k, (stress, stiffness) in zip((0, 1), side_stresses(sim, 8.45e7, (0, 1)), strict=True):
         assert stress == pytest.approx(float(full.total[k, k]), rel=1e-12)
         assert stiffness == pytest.approx(full.stiffness_pa[k], rel=1e-12)
     assert full.total[1, 1] > 0 and full.stiffness_pa[1] > 0

@@ -25,7 +25,12 @@ from grainlab.io.hdf5.snapshot import snapshot_name
 from grainlab.io.results import SHEAR_START_FILE
 from grainlab.protocols.config import Config
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
-from grainlab.protocols.simple_shear.cell import CONTROL_STEPS, cell_stress, servo_rate, side_stress
+from grainlab.protocols.simple_shear.cell import (
+    CONTROL_STEPS,
+    cell_stress,
+    servo_rate,
+    side_stresses,
+)
 from grainlab.protocols.simple_shear.config import SIMPLE_SHEAR_SCHEMA  # noqa: F401 - registers the schema
 from grainlab.protocols.simple_shear.outputs import SimpleShearResult, summarise, write_outputs
 from grainlab.protocols.simple_shear.state import SimpleShearRun
@@ -88,11 +93,11 @@ def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int,
             rates = [0.0, 0.0]
             interval = CONTROL_STEPS * sim.time_step
             cap = _max_rate(sim, config, shear_rate)
-            for k, target in enumerate(targets):
-                if target is not None:
-                    stress, stiffness = side_stress(sim, kn, k)
-                    rates[k], run.cell_rate_integral[k] = servo_rate(
-                        stress, target, stiffness, interval, cap, run.cell_rate_integral[k])
+            held = [(k, target) for k, target in enumerate(targets) if target is not None]
+            measured = side_stresses(sim, kn, [k for k, _ in held])
+            for (k, target), (stress, stiffness) in zip(held, measured, strict=True):
+                rates[k], run.cell_rate_integral[k] = servo_rate(
+                    stress, target, stiffness, interval, cap, run.cell_rate_integral[k])
             sim.set_velocity_gradient([[rates[0], shear_rate], [0.0, rates[1]]])
         sim.run(min(CONTROL_STEPS - into, to_step - sim.step_count))
 
@@ -189,7 +194,7 @@ def _settle(context: Context) -> None:
     sim.local_damping = config["material.local_damping"] if damping == "auto" else float(damping)
     run.start_step = sim.step_count
     run.cell_rate_integral = [0.0, 0.0]
-    run.area0, run.height0 = float(cell.area), float(cell.b[1])
+    run.area0 = float(cell.area)
     sim.save(context.writer.path.parent / SHEAR_START_FILE)  # for grainlab export DIR --lammps
     run.wall_time["settle"] = time.perf_counter() - start
 
