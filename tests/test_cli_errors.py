@@ -109,3 +109,13 @@ def test_a_bad_rolling_resistance_is_one_line_before_any_folder(tmp_path, capsys
     assert cli.main(["biaxial", "--quick", "--set", setting, "--out", str(out)]) == 2
     _one_line(capsys, message)
     assert not out.exists()
+
+
+def test_an_export_of_a_missing_source_says_so_before_asking_for_the_shear(tmp_path, capsys):
+    missing = tmp_path / "nonexistent"
+    assert cli.main(["export", str(missing), "--lammps"]) == 2
+    _one_line(capsys, f"{missing}: no such file or folder")
+    # a folder with no state to export is named as such, not as a missing --shear-rate
+    assert cli.main(["export", str(tmp_path), "--lammps"]) == 2
+    _one_line(capsys, f"{tmp_path}: no checkpoint.h5 or shear_start.state")
+    assert not (tmp_path / "lammps").exists()

@@ -191,3 +191,25 @@ def test_simple_shear_in_lammps_on_two_processes_matches_grainlab(tmp_path: Path
     assert np.all(np.abs(ours[:, 1] - theirs[:, 1]) < 0.1), (ours, theirs)
     # not vacuous: the shear mobilised the packing and changed its contacts
     assert np.all(theirs[:, 0] > 0.2) and np.all(theirs[:, 1] < 3.9)
+
+
+def test_grainlab_analyze_reads_the_decks_own_dumps(tmp_path, capsys):
+    # the deck's `dump_modify ... time yes` opens every frame with ITEM: TIME, before
+    # ITEM: TIMESTEP: format detection must take it for a LAMMPS dump, as the reader does
+    from grainlab import cli
+    from grainlab.io import detect_format
+
+    side, r = 6, 0.5
+    rows = "".join(
+        f"{k + 1} {1.0 * (k % side) + r:.17g} {1.0 * (k // side) + r:.17g} {r}\n" for k in range(side * side)
+    )
+    dump = tmp_path / "atoms.dump"
+    dump.write_text(
+        f"ITEM: TIME\n0.25\nITEM: TIMESTEP\n100\nITEM: NUMBER OF ATOMS\n{side * side}\n"
+        f"ITEM: BOX BOUNDS pp pp pp\n0 {side}\n0 {side}\n-0.5 0.5\nITEM: ATOMS id x y radius\n{rows}"
+    )
+    assert detect_format(dump) == "lammps-dump"
+    assert cli.main(["analyze", str(dump), "--tolerance", "1e-9", "--out", str(tmp_path / "out")]) == 0
+    fabric = json.loads((tmp_path / "out" / "fabric.json").read_text())
+    # a square lattice in a periodic box: four contacts per disk, two per disk in the count
+    assert fabric["n_contacts"] == 2 * side * side

@@ -100,6 +100,7 @@ def _lammps(args: argparse.Namespace) -> int:
     from grainlab.io.results import ensure_output_folder
 
     source = Path(args.dir)
+    sim = simulation_to_export(source)  # first: a missing or unusable source is the first thing to say
     rate, strain = args.shear_rate, args.shear_strain
     planned = _simple_shear_plan(source)
     if planned is not None:  # a simple-shear run's folder: its rate and strain unless given
@@ -109,7 +110,6 @@ def _lammps(args: argparse.Namespace) -> int:
         if value is None:
             raise ValueError(f"{flag}: required with --lammps (but for a simple-shear run's folder, whose own it takes)")
     shear = LammpsShear(rate, strain, args.dump_every, args.local_damping)
-    sim = simulation_to_export(source)
     default = source / "lammps" if source.is_dir() else source.with_name(source.name + ".lammps")
     out = Path(args.out) if args.out is not None else default
     ensure_output_folder(out)

@@ -81,7 +81,8 @@ def detect_format(path: str | Path) -> str:
     ]
     if not lines:
         raise FileFormatError(p, None, "empty file: cannot tell its format")
-    if lines[0].startswith("ITEM: TIMESTEP"):
+    # a dump written with `dump_modify ... time yes` opens each frame with ITEM: TIME
+    if lines[0].startswith("ITEM: TIMESTEP") or lines[0].startswith("ITEM: TIME"):
         return "lammps-dump"
     header = {h.strip().lower() for h in lines[0].split(",")}
     if {"id", "x", "y", "radius"} <= header:
@@ -93,7 +94,7 @@ def detect_format(path: str | Path) -> str:
         None,
         "unknown format: expected a particles CSV (header id,x,y,radius; other names with a "
         "column mapping, --columns id=ID,x=pos_x,...), a PFC ball table (id,pos_x,pos_y,radius), "
-        "a LAMMPS dump (first line 'ITEM: TIMESTEP'), a YADE text export (first line '#format "
+        "a LAMMPS dump (first line 'ITEM: TIMESTEP' or 'ITEM: TIME'), a YADE text export (first line '#format "
         f"x_y_z_r') or a legacy VTK file; the first line is {lines[0][:60]!r}",
     )
 
