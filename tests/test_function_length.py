@@ -1,0 +1,106 @@
+"""The function-length rule (ARCHITECTURE.md, "Function length"), run by ``make lint``.
+
+No Python function of the package is longer than :data:`PYTHON_LIMIT` lines and
+no Rust function of the two crates longer than :data:`RUST_LIMIT`, counted from
+the ``def`` / ``fn`` line to the function's last line (docstring and comments
+included, a nested function inside its parent's count too). A Rust hot kernel
+may be longer when the line just above its ``fn`` (or above its attributes)
+says why, as a comment starting ``// hot kernel:``. Python has no exception.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PYTHON_LIMIT = 80
+RUST_LIMIT = 120
+HOT_KERNEL = "// hot kernel:"
+
+
+def python_functions(package: Path = ROOT / "python" / "grainlab") -> list[tuple[str, int]]:
+    """``(file:qualified name, lines)`` of every function and method of the package."""
+    found = []
+    for path in sorted(package.rglob("*.py")):
+        tree = ast.parse(path.read_text(), filename=str(path))
+        stack: list[tuple[ast.AST, str]] = [(tree, "")]
+        while stack:
+            node, prefix = stack.pop()
+            for child in ast.iter_child_nodes(node):
+                if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+                    name = f"{prefix}{child.name}"
+                    if not isinstance(child, ast.ClassDef):
+                        lines = (child.end_lineno or child.lineno) - child.lineno + 1
+                        found.append((f"{path.relative_to(ROOT)}:{name}", lines))
+                    stack.append((child, name + "."))
+                else:
+                    stack.append((child, prefix))
+    return found
+
+
+_FN = re.compile(r"^\s*(pub(\([a-z]+\))?\s+)?(const\s+)?(unsafe\s+)?(extern\s+\"C\"\s+)?fn\s+(\w+)")
+
+
+def _strip(line: str) -> str:
+    """A Rust line without its string and char literals and its line comment (enough to count braces)."""
+    line = re.sub(r'"(\\.|[^"\\])*"', '""', line)
+    line = re.sub(r"'(\\.|[^'\\])'", "''", line)
+    return line.split("//", 1)[0]
+
+
+def rust_functions(crates: Path = ROOT / "crates") -> list[tuple[str, int, bool]]:
+    """``(file:fn name, lines, says it is a hot kernel)`` of every Rust function with a body."""
+    found = []
+    for path in sorted(crates.rglob("*.rs")):
+        lines = path.read_text().splitlines()
+        for k, line in enumerate(lines):
+            match = _FN.match(line)
+            if not match:
+                continue
+            depth, opened, end = 0, False, None
+            for m in range(k, len(lines)):
+                code = _strip(lines[m])
+                if not opened and ";" in code and "{" not in code:
+                    break  # a declaration without a body (a trait's)
+                depth += code.count("{") - code.count("}")
+                opened = opened or "{" in code
+                if opened and depth <= 0:
+                    end = m
+                    break
+            if end is None:
+                continue
+            above = k - 1
+            while above >= 0 and lines[above].strip().startswith(("#[", "///")):
+                above -= 1
+            hot = above >= 0 and lines[above].strip().startswith(HOT_KERNEL)
+            found.append((f"{path.relative_to(ROOT)}:{match.group(6)}", end - k + 1, hot))
+    return found
+
+
+def test_the_rule_counts_what_it_says():
+    src = "def outer():\n    x = 1\n\n    def inner():\n        return x\n    return inner\n"
+    tree = ast.parse(src)
+    outer = tree.body[0]
+    assert isinstance(outer, ast.FunctionDef) and outer.end_lineno == 6
+    assert _FN.match("    pub(crate) fn law_by_four<const R: bool>(") is not None
+    assert _FN.match("    fn run(&mut self) -> Result<()>;") is not None
+    assert _strip('let s = "{"; // }') == 'let s = ""; '
+
+
+def test_no_python_function_is_longer_than_the_limit():
+    long = sorted(
+        (f"{name}: {lines} lines" for name, lines in python_functions() if lines > PYTHON_LIMIT)
+    )
+    assert not long, f"{len(long)} Python function(s) over {PYTHON_LIMIT} lines (split them):\n" + "\n".join(long)
+
+
+def test_no_rust_function_is_longer_than_the_limit_but_a_hot_kernel_that_says_why():
+    long = sorted(
+        f"{name}: {lines} lines" for name, lines, hot in rust_functions() if lines > RUST_LIMIT and not hot
+    )
+    assert not long, (
+        f"{len(long)} Rust function(s) over {RUST_LIMIT} lines (split them, or for a hot kernel say why "
+        f"on the line above: '{HOT_KERNEL} ...'):\n" + "\n".join(long)
+    )
