@@ -7,13 +7,13 @@ build:  ## install grainlab (release build of the Rust engine)
 dev:  ## editable install: Python edits are live; rerun after Rust edits
 	pip install -e .
 
-lint:  ## formatting and lints, Rust and Python, types (mypy strict, the compiled module's stub), the import-layer contract (ARCHITECTURE.md)
+lint:  ## formatting and lints, Rust and Python, types (mypy strict, the compiled module's stub), the import-layer contract and the function-length rule (ARCHITECTURE.md)
 	cargo fmt --all -- --check
 	cargo clippy --release -p grainlab-core -p grainlab-py -- -D warnings
 	ruff check python tests benchmarks examples
 	python -m mypy python/grainlab
 	python -m mypy.stubtest grainlab._core
-	python -m pytest -q -p no:cacheprovider tests/test_layers.py
+	python -m pytest -q -p no:cacheprovider tests/test_layers.py tests/test_function_length.py
 
 test:  ## the whole suite, as CI runs it
 	bash .ci/run
