@@ -2,48 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Any, Generic, TypeVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from grainlab import _kernels
+from grainlab.analysis._compute import NotComputedError as NotComputedError  # re-exported
 from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot, boundary_end_groups
-
-#: A measure's results record (see :class:`Computable`).
-R = TypeVar("R")
-
-
-class NotComputedError(AttributeError):
-    """Raised when a result property is read before ``compute`` ran."""
-
-
-class Computable(Generic[R]):
-    """Base for freud-style analysis objects: results raise until computed.
-
-    ``R`` is the measure's results record, a frozen dataclass with one typed
-    field per result; ``compute`` stores one with :meth:`_store`.
-    """
-
-    _results: R | None = None
-
-    def _computed(self, name: str) -> R:
-        """The results record, read for the result ``name`` (named in the error
-        raised before ``compute`` ran)."""
-        if self._results is None:
-            raise NotComputedError(
-                f"{type(self).__name__}.{name} is not available: call compute(...) first"
-            )
-        return self._results
-
-    def _store(self, results: R) -> None:
-        self._results = results
-
-    def _repr_html_(self) -> str:
-        """A small table for notebooks: the repr, the scalar results, the arrays' shapes and means."""
-        from grainlab._repr import measure_html
-
-        return measure_html(self)
 
 
 def contact_ends(

@@ -61,14 +61,13 @@ Example
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize
 
-from grainlab.analysis._util import Computable
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis.band_fabric import roc_auc
 
 __all__ = ["STRATA", "BandContacts"]
@@ -135,16 +134,7 @@ def cross_fitted_scores(x: NDArray[np.float64], y: NDArray[np.bool_], seed: int 
     return scores
 
 
-@dataclass(frozen=True, eq=False)
-class _BandContactsResults:
-    strata: dict[str, dict[str, float]]
-    stratified_difference: float
-    auc_within: float
-    auc_contacts: float
-    auc_contacts_lambda: float
-
-
-class BandContacts(Computable[_BandContactsResults]):
+class BandContacts(Compute):
     """The band against the rest at equal contact number (module docstring).
 
     Attributes (after :meth:`compute`)
@@ -196,39 +186,28 @@ class BandContacts(Computable[_BandContactsResults]):
             ok = np.isfinite(lam) | (counts < 2)
             auc_contacts = roc_auc(cross_fitted_scores(_design(lam[ok], counts[ok], False), band[ok]), band[ok])
             auc_both = roc_auc(cross_fitted_scores(_design(lam[ok], counts[ok], True), band[ok]), band[ok])
-        self._store(_BandContactsResults(
+        self._store(
             strata=strata,
             stratified_difference=weighted / weight_sum if weight_sum else math.nan,
             auc_within=pair_auc / pairs if pairs else math.nan,
             auc_contacts=auc_contacts,
             auc_contacts_lambda=auc_both,
-        ))
+        )
         return self
 
-    @property
-    def strata(self) -> dict[str, dict[str, float]]:
-        """Per stratum: counts, means, difference and AUC of lambda."""
-        return self._computed("strata").strata
-
-    @property
-    def stratified_difference(self) -> float:
-        """Band minus rest mean lambda at equal contact number (Mantel-Haenszel weights)."""
-        return self._computed("stratified_difference").stratified_difference
-
-    @property
-    def auc_within(self) -> float:
-        """lambda's ROC AUC for band membership among grains of equal contact number."""
-        return self._computed("auc_within").auc_within
-
-    @property
-    def auc_contacts(self) -> float:
-        """Out-of-sample ROC AUC of the contact number alone."""
-        return self._computed("auc_contacts").auc_contacts
-
-    @property
-    def auc_contacts_lambda(self) -> float:
-        """Out-of-sample ROC AUC of the contact number and lambda together."""
-        return self._computed("auc_contacts_lambda").auc_contacts_lambda
+    strata = Computed[dict[str, dict[str, float]]](
+        "Per stratum: counts, means, difference and AUC of lambda."
+    )
+    stratified_difference = Computed[float](
+        "Band minus rest mean lambda at equal contact number (Mantel-Haenszel weights)."
+    )
+    auc_within = Computed[float](
+        "lambda's ROC AUC for band membership among grains of equal contact number."
+    )
+    auc_contacts = Computed[float]("Out-of-sample ROC AUC of the contact number alone.")
+    auc_contacts_lambda = Computed[float](
+        "Out-of-sample ROC AUC of the contact number and lambda together."
+    )
 
     @property
     def auc_gain(self) -> float:

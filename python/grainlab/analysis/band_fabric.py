@@ -47,7 +47,6 @@ Example
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -55,7 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 from scipy.stats import mannwhitneyu
 
-from grainlab.analysis._util import Computable
+from grainlab.analysis._compute import Compute, Computed
 
 __all__ = ["GROUP_MEASURES", "BandFabric", "coarse_grained", "roc_auc"]
 
@@ -150,18 +149,7 @@ def _group(
     }
 
 
-@dataclass(frozen=True, eq=False)
-class _BandFabricResults:
-    """The results of :class:`BandFabric` (see its properties)."""
-
-    inside: dict[str, float]
-    outside: dict[str, float]
-    auc_lambda: float
-    auc_lambda_field: float
-    lambda_field: NDArray[np.float64]
-
-
-class BandFabric(Computable[_BandFabricResults]):
+class BandFabric(Compute):
     """Fabric of the grains inside and outside a band, and the AUC of lambda
     as a classifier of band membership (module docstring).
 
@@ -233,40 +221,23 @@ class BandFabric(Computable[_BandFabricResults]):
         radius = self.coarse_radius * float(np.mean(d)) if n else 1.0
         field = coarse_grained(pos, lam, radius) if n else np.zeros(0)
         self._store(
-            _BandFabricResults(
-                inside=_group(band, lam, counts, grain, rot),
-                outside=_group(~band, lam, counts, grain, rot),
-                auc_lambda=roc_auc(lam, band),
-                auc_lambda_field=roc_auc(field, band),
-                lambda_field=field,
-            )
+            inside=_group(band, lam, counts, grain, rot),
+            outside=_group(~band, lam, counts, grain, rot),
+            auc_lambda=roc_auc(lam, band),
+            auc_lambda_field=roc_auc(field, band),
+            lambda_field=field,
         )
         return self
 
-    @property
-    def inside(self) -> dict[str, float]:
-        """:data:`GROUP_MEASURES` of the band's grains."""
-        return self._computed("inside").inside
-
-    @property
-    def outside(self) -> dict[str, float]:
-        """:data:`GROUP_MEASURES` of the grains outside the band."""
-        return self._computed("outside").outside
-
-    @property
-    def auc_lambda(self) -> float:
-        """ROC AUC of per-grain lambda for band membership."""
-        return self._computed("auc_lambda").auc_lambda
-
-    @property
-    def auc_lambda_field(self) -> float:
-        """ROC AUC of the coarse-grained lambda field for band membership."""
-        return self._computed("auc_lambda_field").auc_lambda_field
-
-    @property
-    def lambda_field(self) -> NDArray[np.float64]:
-        """(N,) lambda averaged over ``coarse_radius`` mean diameters around each grain."""
-        return self._computed("lambda_field").lambda_field
+    inside = Computed[dict[str, float]](":data:`GROUP_MEASURES` of the band's grains.")
+    outside = Computed[dict[str, float]](":data:`GROUP_MEASURES` of the grains outside the band.")
+    auc_lambda = Computed[float]("ROC AUC of per-grain lambda for band membership.")
+    auc_lambda_field = Computed[float](
+        "ROC AUC of the coarse-grained lambda field for band membership."
+    )
+    lambda_field = Computed[NDArray[np.float64]](
+        "(N,) lambda averaged over ``coarse_radius`` mean diameters around each grain."
+    )
 
     def summary(self) -> dict[str, Any]:
         """Every number, JSON-ready: ``inside_*``, ``outside_*``, the AUCs."""

@@ -124,6 +124,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from grainlab.analysis._compute import Computed
 from grainlab.analysis.shear_band import SlabBand, _best
 
 __all__ = ["MIN_GRAINS", "SHARE_HIGH", "SHARE_LOW", "DisplacementBand"]
@@ -349,30 +350,7 @@ class _Reading:
     """Residual of the two blocks joined across the band."""
 
 
-@dataclass(frozen=True, eq=False)
-class _DisplacementBandResults:
-    """The results of :class:`DisplacementBand` (see its properties)."""
-
-    found: bool
-    reason: str
-    angle: float
-    thickness: float
-    thickness_diameters: float
-    center: NDArray[np.float64]
-    normal: NDArray[np.float64]
-    members: NDArray[np.bool_]
-    residual_reduction: float
-    jump: NDArray[np.float64]
-    relative_motion: NDArray[np.float64]
-    profile: tuple[NDArray[np.float64], NDArray[np.float64]]
-    profile_smooth: NDArray[np.float64]
-    mean_diameter: float
-    positions: NDArray[np.float64]
-    radii: NDArray[np.float64]
-    displacement: NDArray[np.float64]
-
-
-class DisplacementBand(SlabBand[_DisplacementBandResults]):
+class DisplacementBand(SlabBand):
     r"""The shear band as the zone between two blocks that move differently (Fig. 11).
 
     See the module docstring for the method, the acceptance tests and how
@@ -540,25 +518,23 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         share = np.full(n, np.nan)
         share[valid] = t
         self._store(
-            _DisplacementBandResults(
-                found=not problems,
-                reason="; ".join(problems),
-                angle=angle,
-                thickness=trans.thickness * d_mean,
-                thickness_diameters=trans.thickness,
-                center=center,
-                normal=normal,
-                members=members,
-                residual_reduction=float(reduction),
-                jump=jump,
-                relative_motion=share,
-                profile=((trans.centers - mid) * d_mean, trans.mean_share),
-                profile_smooth=trans.smooth,
-                mean_diameter=d_mean,
-                positions=pos,
-                radii=rad,
-                displacement=disp,
-            )
+            found=not problems,
+            reason="; ".join(problems),
+            angle=angle,
+            thickness=trans.thickness * d_mean,
+            thickness_diameters=trans.thickness,
+            center=center,
+            normal=normal,
+            members=members,
+            residual_reduction=float(reduction),
+            jump=jump,
+            relative_motion=share,
+            profile=((trans.centers - mid) * d_mean, trans.mean_share),
+            profile_smooth=trans.smooth,
+            mean_diameter=d_mean,
+            _positions=pos,
+            _radii=rad,
+            _displacement=disp,
         )
         return self
 
@@ -656,16 +632,13 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
             ]
         return []
 
-    @property
-    def residual_reduction(self) -> float:
-        """Share of the residual of one affine motion of the whole sample that the
-        two blocks' motions remove, 1 - S_2/S_1, in [0, 1]."""
-        return self._computed("residual_reduction").residual_reduction
-
-    @property
-    def jump(self) -> NDArray[np.float64]:
-        """(2,) displacement of block B relative to block A at :attr:`center`, m."""
-        return self._computed("jump").jump
+    residual_reduction = Computed[float](
+        "Share of the residual of one affine motion of the whole sample that the two blocks' "
+        "motions remove, 1 - S_2/S_1, in [0, 1]."
+    )
+    jump = Computed[NDArray[np.float64]](
+        "(2,) displacement of block B relative to block A at :attr:`center`, m."
+    )
 
     @property
     def jump_magnitude(self) -> float:
@@ -682,22 +655,19 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         """Component of :attr:`jump` along :attr:`normal`, m (positive: the blocks part)."""
         return float(self.jump @ self.normal)
 
-    @property
-    def relative_motion(self) -> NDArray[np.float64]:
-        """(N,) each grain's share of the blocks' relative motion (0 with block A,
-        1 with block B), NaN for the grains not considered."""
-        return self._computed("relative_motion").relative_motion
+    relative_motion = Computed[NDArray[np.float64]](
+        "(N,) each grain's share of the blocks' relative motion (0 with block A, 1 with block B), "
+        "NaN for the grains not considered."
+    )
+    profile = Computed[tuple[NDArray[np.float64], NDArray[np.float64]]](
+        "Distance from the band's centre line (m) and mean share of each bin."
+    )
+    profile_smooth = Computed[NDArray[np.float64]](
+        "(B,) the smoothed share of each bin of :attr:`profile`, on which the edges are read "
+        "(where it crosses 0.1 and 0.9)."
+    )
 
-    @property
-    def profile(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Distance from the band's centre line (m) and mean share of each bin."""
-        return self._computed("profile").profile
-
-    @property
-    def profile_smooth(self) -> NDArray[np.float64]:
-        """(B,) the smoothed share of each bin of :attr:`profile`, on which the
-        edges are read (where it crosses 0.1 and 0.9)."""
-        return self._computed("profile_smooth").profile_smooth
+    _displacement = Computed[NDArray[np.float64]]("(N, 2) the displacements read, m.")
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (NaN and inf as None, angles in degrees, lengths in m)."""
@@ -724,9 +694,9 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         outlined; returns the axes."""
         from grainlab import plot
 
-        r = self._computed("positions")
+        disp = self._displacement
         ax = plot.particle_map(
-            r.positions, r.radii, np.hypot(r.displacement[:, 0], r.displacement[:, 1]), ax=ax,
+            self._positions, self._radii, np.hypot(disp[:, 0], disp[:, 1]), ax=ax,
             label="displacement magnitude (m)", **kwargs,
         )
         plot.outline_shear_band(ax, self)

@@ -80,19 +80,14 @@ Normal-force anisotropy a_n
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, _kernels
-from grainlab.analysis._util import (
-    Computable,
-    contact_ends,
-    has_boundary,
-    repeated_boundary_contacts,
-)
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import contact_ends, has_boundary, repeated_boundary_contacts
 from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot
 
 __all__ = [
@@ -300,20 +295,7 @@ def fabric_tensor(normals: ArrayLike, weights: ArrayLike | None = None) -> NDArr
 
 
 # --------------------------------------------------------------------------- classes
-@dataclass(frozen=True, eq=False)
-class _CoordinationNumberResults:
-    """The results of :class:`CoordinationNumber` (see its properties)."""
-
-    coordination_number: float
-    mechanical_coordination_number: float
-    n_contacts: NDArray[np.int64]
-    rattlers: NDArray[np.bool_]
-    count_distribution: NDArray[np.float64]
-    n_particles: int
-    n_contacts_total: int
-
-
-class CoordinationNumber(Computable[_CoordinationNumberResults]):
+class CoordinationNumber(Compute):
     r"""Coordination number Z, mechanical coordination number Z_m, contact counts.
 
     .. math:: Z = \frac{2 N_c}{N_p}, \qquad Z_m = \frac{2 N_c^m}{N_p^m}
@@ -409,52 +391,27 @@ class CoordinationNumber(Computable[_CoordinationNumberResults]):
         if n_p:
             dist /= n_p
         self._store(
-            _CoordinationNumberResults(
-                coordination_number=z,
-                mechanical_coordination_number=z_m,
-                n_contacts=counts,
-                rattlers=rat,
-                count_distribution=dist,
-                n_particles=n_p,
-                n_contacts_total=int(a.size),
-            )
+            coordination_number=z,
+            mechanical_coordination_number=z_m,
+            n_contacts=counts,
+            rattlers=rat,
+            count_distribution=dist,
+            n_particles=n_p,
+            n_contacts_total=int(a.size),
         )
         return self
 
-    @property
-    def coordination_number(self) -> float:
-        """Z = 2 Nc / Np."""
-        return self._computed("coordination_number").coordination_number
-
-    @property
-    def mechanical_coordination_number(self) -> float:
-        """Z_m over the particles left after iterative rattler removal."""
-        return self._computed("mechanical_coordination_number").mechanical_coordination_number
-
-    @property
-    def n_contacts(self) -> NDArray[np.int64]:
-        """(N,) contacts per particle."""
-        return self._computed("n_contacts").n_contacts
-
-    @property
-    def rattlers(self) -> NDArray[np.bool_]:
-        """(N,) mask of the rattlers."""
-        return self._computed("rattlers").rattlers
-
-    @property
-    def count_distribution(self) -> NDArray[np.float64]:
-        """Fraction of sample particles with k contacts, k = 0, 1, 2, ..."""
-        return self._computed("count_distribution").count_distribution
-
-    @property
-    def n_particles(self) -> int:
-        """N_p, the number of sample particles."""
-        return self._computed("n_particles").n_particles
-
-    @property
-    def n_contacts_total(self) -> int:
-        """N_c, the number of contacts used."""
-        return self._computed("n_contacts_total").n_contacts_total
+    coordination_number = Computed[float]("Z = 2 Nc / Np.")
+    mechanical_coordination_number = Computed[float](
+        "Z_m over the particles left after iterative rattler removal."
+    )
+    n_contacts = Computed[NDArray[np.int64]]("(N,) contacts per particle.")
+    rattlers = Computed[NDArray[np.bool_]]("(N,) mask of the rattlers.")
+    count_distribution = Computed[NDArray[np.float64]](
+        "Fraction of sample particles with k contacts, k = 0, 1, 2, ..."
+    )
+    n_particles = Computed[int]("N_p, the number of sample particles.")
+    n_contacts_total = Computed[int]("N_c, the number of contacts used.")
 
     def plot(self, ax: Any = None) -> Any:
         """Bar chart of the contact-count distribution; returns the axes."""
@@ -469,21 +426,7 @@ class CoordinationNumber(Computable[_CoordinationNumberResults]):
         )
 
 
-@dataclass(frozen=True, eq=False)
-class _ContactAnisotropyResults:
-    """The results of :class:`ContactAnisotropy` (see its properties)."""
-
-    histogram: NDArray[np.float64]
-    bin_edges: NDArray[np.float64]
-    anisotropy: float
-    direction: float
-    anisotropy_binned: float
-    direction_binned: float
-    fabric_tensor: NDArray[np.float64]
-    total: float
-
-
-class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
+class ContactAnisotropy(Compute):
     r"""Contact-normal (or normal-force) distribution and its anisotropy (Eq. 6–8).
 
     Fitted distribution (Eq. 6): :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos
@@ -592,28 +535,21 @@ class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
         else:
             af, tf = anisotropy_fourier(angles, weights)
         self._store(
-            _ContactAnisotropyResults(
-                histogram=values,
-                bin_edges=edges,
-                anisotropy=af,
-                direction=tf,
-                anisotropy_binned=a7,
-                direction_binned=t7,
-                fabric_tensor=phi,
-                total=float(n_used if weights is None else weights.sum()),
-            )
+            histogram=values,
+            bin_edges=edges,
+            anisotropy=af,
+            direction=tf,
+            anisotropy_binned=a7,
+            direction_binned=t7,
+            fabric_tensor=phi,
+            total=float(n_used if weights is None else weights.sum()),
         )
         return self
 
-    @property
-    def histogram(self) -> NDArray[np.float64]:
-        """(bins,) bin contents, each contact counted in both directions."""
-        return self._computed("histogram").histogram
-
-    @property
-    def bin_edges(self) -> NDArray[np.float64]:
-        """(bins + 1,) bin edges, rad."""
-        return self._computed("bin_edges").bin_edges
+    histogram = Computed[NDArray[np.float64]](
+        "(bins,) bin contents, each contact counted in both directions."
+    )
+    bin_edges = Computed[NDArray[np.float64]]("(bins + 1,) bin edges, rad.")
 
     @property
     def bin_centers(self) -> NDArray[np.float64]:
@@ -621,45 +557,31 @@ class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
         e = self.bin_edges
         return 0.5 * (e[1:] + e[:-1])
 
-    @property
-    def anisotropy(self) -> float:
-        """a (or a_n), exact: twice the modulus of the mean of exp(2 i theta)."""
-        return self._computed("anisotropy").anisotropy
-
-    @property
-    def direction(self) -> float:
-        """theta_a, exact: half the argument of the mean of exp(2 i theta), rad in [0, pi)."""
-        return self._computed("direction").direction
-
-    @property
-    def anisotropy_binned(self) -> float:
-        """a (or a_n) by Eq. 7 as printed, from the histogram."""
-        return self._computed("anisotropy_binned").anisotropy_binned
-
-    @property
-    def direction_binned(self) -> float:
-        """theta_a by Eq. 8 (atan2 form) from the histogram, rad in [0, pi)."""
-        return self._computed("direction_binned").direction_binned
+    anisotropy = Computed[float](
+        "a (or a_n), exact: twice the modulus of the mean of exp(2 i theta)."
+    )
+    direction = Computed[float](
+        "theta_a, exact: half the argument of the mean of exp(2 i theta), rad in [0, pi)."
+    )
+    anisotropy_binned = Computed[float]("a (or a_n) by Eq. 7 as printed, from the histogram.")
+    direction_binned = Computed[float](
+        "theta_a by Eq. 8 (atan2 form) from the histogram, rad in [0, pi)."
+    )
 
     @property
     def anisotropy_fourier(self) -> float:
         """The exact a, :attr:`anisotropy` under its earlier name."""
-        return self._computed("anisotropy").anisotropy
+        return self.anisotropy
 
     @property
     def direction_fourier(self) -> float:
         """The exact theta_a, :attr:`direction` under its earlier name."""
-        return self._computed("direction").direction
+        return self.direction
 
-    @property
-    def fabric_tensor(self) -> NDArray[np.float64]:
-        """(2, 2) fabric tensor (force-weighted for weight='normal_force')."""
-        return self._computed("fabric_tensor").fabric_tensor
-
-    @property
-    def total(self) -> float:
-        """Contacts used (or their total normal force, N)."""
-        return self._computed("total").total
+    fabric_tensor = Computed[NDArray[np.float64]](
+        "(2, 2) fabric tensor (force-weighted for weight='normal_force')."
+    )
+    total = Computed[float]("Contacts used (or their total normal force, N).")
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Polar diagram with the fitted E(theta) (paper Figs. 6–7); returns the axes."""

@@ -28,33 +28,20 @@ and the fraction of sample grains in chains.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.analysis._util import Computable, axial_direction
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import axial_direction
 from grainlab.analysis.stress import GrainStress, branch_vectors
 from grainlab.snapshot import Snapshot
 
 __all__ = ["ForceChains"]
 
 
-@dataclass(frozen=True, eq=False)
-class _ForceChainsResults:
-    """The results of :class:`ForceChains` (see its properties)."""
-
-    snapshot: Snapshot
-    major_stress: NDArray[np.float64]
-    highly_stressed: NDArray[np.bool_]
-    links: NDArray[np.bool_]
-    chain: NDArray[np.int64]
-    lengths: NDArray[np.int64]
-    orientations: NDArray[np.float64]
-
-
-class ForceChains(Computable[_ForceChainsResults]):
+class ForceChains(Compute):
     r"""Force chains: highly stressed grains linked along their major principal directions.
 
     Grain p is highly stressed when :math:`\sigma_1^p > \bar\sigma_1`; a
@@ -153,26 +140,24 @@ class ForceChains(Computable[_ForceChainsResults]):
         )
         orientations = axial_direction(np.angle(sums))
         self._store(
-            _ForceChainsResults(
-                snapshot, major, high, links, chain, lengths, orientations.astype(np.float64)
-            )
+            _snapshot=snapshot,
+            major_stress=major,
+            highly_stressed=high,
+            links=links,
+            chain=chain,
+            lengths=lengths,
+            orientations=orientations.astype(np.float64),
         )
         return self
 
-    @property
-    def chain(self) -> NDArray[np.int64]:
-        """(N,) chain number of each grain (longest first), -1 outside chains."""
-        return self._computed("chain").chain
-
-    @property
-    def lengths(self) -> NDArray[np.int64]:
-        """(n_chains,) grains in each chain."""
-        return self._computed("lengths").lengths
-
-    @property
-    def orientations(self) -> NDArray[np.float64]:
-        """(n_chains,) axial mean direction of each chain's links, rad in [0, pi)."""
-        return self._computed("orientations").orientations
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    chain = Computed[NDArray[np.int64]](
+        "(N,) chain number of each grain (longest first), -1 outside chains."
+    )
+    lengths = Computed[NDArray[np.int64]]("(n_chains,) grains in each chain.")
+    orientations = Computed[NDArray[np.float64]](
+        "(n_chains,) axial mean direction of each chain's links, rad in [0, pi)."
+    )
 
     @property
     def n_chains(self) -> int:
@@ -187,7 +172,7 @@ class ForceChains(Computable[_ForceChainsResults]):
     @property
     def fraction_in_chains(self) -> float:
         """Fraction of the sample grains that belong to a chain."""
-        snap = self._computed("chain").snapshot
+        snap = self._snapshot
         sample = snap.is_sample
         return float((self.chain[sample] >= 0).mean()) if sample.any() else float("nan")
 
@@ -199,20 +184,11 @@ class ForceChains(Computable[_ForceChainsResults]):
         s = np.sum(self.lengths * np.exp(2j * self.orientations))
         return float(axial_direction(np.angle(s)))
 
-    @property
-    def major_stress(self) -> NDArray[np.float64]:
-        """(N,) each grain's major principal stress, Pa."""
-        return self._computed("major_stress").major_stress
-
-    @property
-    def highly_stressed(self) -> NDArray[np.bool_]:
-        """(N,) grains with sigma_1 above the mean over the sample grains."""
-        return self._computed("highly_stressed").highly_stressed
-
-    @property
-    def links(self) -> NDArray[np.bool_]:
-        """(Nc,) the contacts joining two grains of one chain."""
-        return self._computed("links").links
+    major_stress = Computed[NDArray[np.float64]]("(N,) each grain's major principal stress, Pa.")
+    highly_stressed = Computed[NDArray[np.bool_]](
+        "(N,) grains with sigma_1 above the mean over the sample grains."
+    )
+    links = Computed[NDArray[np.bool_]]("(Nc,) the contacts joining two grains of one chain.")
 
     def summary(self) -> dict[str, float | int]:
         """The chains' numbers: count, mean and longest length, fraction of grains,
@@ -229,7 +205,7 @@ class ForceChains(Computable[_ForceChainsResults]):
         """The chains' links over the grains, one colour per chain; returns the axes."""
         from grainlab.plot import networks
 
-        snap = self._computed("links").snapshot
+        snap = self._snapshot
         links = self.links
         start = np.asarray(snap.positions)[np.asarray(snap.contact_i)[links]]
         k = self.chain[np.asarray(snap.contact_i)[links]]

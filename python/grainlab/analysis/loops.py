@@ -31,33 +31,19 @@ A hexagonal lattice has loops of size 3 only, a square lattice of size 4.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.analysis._util import Computable
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis.fabric import rattlers
 from grainlab.snapshot import Snapshot
 
 __all__ = ["ContactLoops"]
 
 
-@dataclass(frozen=True, eq=False)
-class _ContactLoopsResults:
-    """The results of :class:`ContactLoops` (see its properties)."""
-
-    snapshot: Snapshot
-    in_graph: NDArray[np.bool_]
-    cyclomatic_number: int
-    loop_sizes: NDArray[np.int64]
-    grain_loop_size: NDArray[np.float64]
-    n_edges: int
-    n_components: int
-
-
-class ContactLoops(Computable[_ContactLoopsResults]):
+class ContactLoops(Compute):
     r"""Independent cycles and minimal loops (faces) of the contact graph.
 
     .. math:: L = E - V + C,
@@ -151,21 +137,19 @@ class ContactLoops(Computable[_ContactLoopsResults]):
         with np.errstate(invalid="ignore", divide="ignore"):
             grain_loop = np.where(count > 0, total / count, np.nan)
         self._store(
-            _ContactLoopsResults(
-                snapshot, keep, cyclomatic, loop_sizes, grain_loop, n_edges, n_components
-            )
+            _snapshot=snapshot,
+            in_graph=keep,
+            cyclomatic_number=cyclomatic,
+            loop_sizes=loop_sizes,
+            grain_loop_size=grain_loop,
+            n_edges=n_edges,
+            n_components=n_components,
         )
         return self
 
-    @property
-    def cyclomatic_number(self) -> int:
-        """L = E - V + C, the independent cycles of the graph used."""
-        return self._computed("cyclomatic_number").cyclomatic_number
-
-    @property
-    def loop_sizes(self) -> NDArray[np.int64]:
-        """(F,) the size of each minimal loop (bounded face)."""
-        return self._computed("loop_sizes").loop_sizes
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    cyclomatic_number = Computed[int]("L = E - V + C, the independent cycles of the graph used.")
+    loop_sizes = Computed[NDArray[np.int64]]("(F,) the size of each minimal loop (bounded face).")
 
     @property
     def n_loops(self) -> int:
@@ -183,25 +167,14 @@ class ContactLoops(Computable[_ContactLoopsResults]):
         counts = np.bincount(self.loop_sizes).astype(np.float64)
         return counts / counts.sum() if counts.sum() else counts
 
-    @property
-    def grain_loop_size(self) -> NDArray[np.float64]:
-        """(N,) mean size of the loops each grain sits on, NaN for none."""
-        return self._computed("grain_loop_size").grain_loop_size
-
-    @property
-    def in_graph(self) -> NDArray[np.bool_]:
-        """(N,) the grains of the graph (the sample, less the rattlers by default)."""
-        return self._computed("in_graph").in_graph
-
-    @property
-    def n_edges(self) -> int:
-        """E, the contacts of the graph."""
-        return self._computed("n_edges").n_edges
-
-    @property
-    def n_components(self) -> int:
-        """C, its connected components."""
-        return self._computed("n_components").n_components
+    grain_loop_size = Computed[NDArray[np.float64]](
+        "(N,) mean size of the loops each grain sits on, NaN for none."
+    )
+    in_graph = Computed[NDArray[np.bool_]](
+        "(N,) the grains of the graph (the sample, less the rattlers by default)."
+    )
+    n_edges = Computed[int]("E, the contacts of the graph.")
+    n_components = Computed[int]("C, its connected components.")
 
     def summary(self) -> dict[str, Any]:
         """The loops' numbers: L, the loops' count, mean size and size fractions."""
@@ -216,7 +189,7 @@ class ContactLoops(Computable[_ContactLoopsResults]):
         """Particle map coloured by the mean size of each grain's loops; returns the axes."""
         from grainlab import plot
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         return plot.particle_map(
             snap.positions,
             snap.radii,

@@ -34,7 +34,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.analysis._util import Computable, grain_contacts, principal_stresses
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import grain_contacts, principal_stresses
 from grainlab.analysis.stress import branch_vectors, contact_stress
 from grainlab.analysis.stress_fabric import Anisotropies, force_anisotropies
 from grainlab.snapshot import Snapshot
@@ -83,19 +84,7 @@ def _deviator(s: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.asarray(s - 0.5 * np.trace(s) * np.eye(2), dtype=np.float64)
 
 
-@dataclass(frozen=True, eq=False)
-class _ForceNetworksResults:
-    """The results of :class:`ForceNetworks` (see its properties)."""
-
-    snapshot: Snapshot
-    mean_normal_force: float
-    strong: Network
-    weak: Network
-    whole: Network
-    in_strong_network: NDArray[np.bool_]
-
-
-class ForceNetworks(Computable[_ForceNetworksResults]):
+class ForceNetworks(Compute):
     r"""The strong and weak force networks split at the mean normal force.
 
     Strong: :math:`f_n > \langle f_n\rangle`; weak: the rest. Each network's
@@ -188,41 +177,23 @@ class ForceNetworks(Computable[_ForceNetworksResults]):
             cj[strong & (cj >= 0)], minlength=n
         )
         self._store(
-            _ForceNetworksResults(
-                snapshot,
-                mean,
-                network(strong),
-                network(weak),
-                network(used),
-                (touched > 0) & snapshot.is_sample,
-            )
+            _snapshot=snapshot,
+            mean_normal_force=mean,
+            strong=network(strong),
+            weak=network(weak),
+            whole=network(used),
+            in_strong_network=(touched > 0) & snapshot.is_sample,
         )
         return self
 
-    @property
-    def mean_normal_force(self) -> float:
-        """<f_n> over the contacts used, N: the threshold."""
-        return self._computed("mean_normal_force").mean_normal_force
-
-    @property
-    def strong(self) -> Network:
-        """The strong network, f_n > <f_n>."""
-        return self._computed("strong").strong
-
-    @property
-    def weak(self) -> Network:
-        """The weak network, f_n <= <f_n>."""
-        return self._computed("weak").weak
-
-    @property
-    def whole(self) -> Network:
-        """All the contacts used, measured the same way."""
-        return self._computed("whole").whole
-
-    @property
-    def in_strong_network(self) -> NDArray[np.bool_]:
-        """(N,) sample grains with at least one strong contact."""
-        return self._computed("in_strong_network").in_strong_network
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    mean_normal_force = Computed[float]("<f_n> over the contacts used, N: the threshold.")
+    strong = Computed["Network"]("The strong network, f_n > <f_n>.")
+    weak = Computed["Network"]("The weak network, f_n <= <f_n>.")
+    whole = Computed["Network"]("All the contacts used, measured the same way.")
+    in_strong_network = Computed[NDArray[np.bool_]](
+        "(N,) sample grains with at least one strong contact."
+    )
 
     def summary(self) -> dict[str, float | int]:
         """Every scalar by name (``strong_a_n``, ``weak_deviatoric_share``, ...)."""
@@ -236,7 +207,7 @@ class ForceNetworks(Computable[_ForceNetworksResults]):
         strong black, weak grey; returns the axes."""
         from grainlab.plot import networks
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         used = self.whole.contacts
         start = np.asarray(snap.positions)[np.asarray(snap.contact_i)[used]]
         fn = np.asarray(snap.normal_force)[used]

@@ -96,13 +96,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Protocol, TypeVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import uniform_filter1d
 
-from grainlab.analysis._util import Computable, finite_mean
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import finite_mean
 from grainlab.snapshot import Snapshot
 
 __all__ = ["ShearBand", "Slab", "SlabBand"]
@@ -306,82 +307,15 @@ def _band_profile(
     return _Profile(centers, prof, smooth, keep, background, peak, edge(left, left - 1), edge(right, right + 1))
 
 
-@dataclass(frozen=True, eq=False)
-class _ShearBandResults:
-    """The results of :class:`ShearBand` (see its properties)."""
-
-    found: bool
-    reason: str
-    angle: float
-    thickness: float
-    thickness_diameters: float
-    center: NDArray[np.float64]
-    normal: NDArray[np.float64]
-    members: NDArray[np.bool_]
-    mean_lambda_inside: float
-    mean_lambda_outside: float
-    contrast: float
-    prominence: float
-    score: float
-    peak_strain: float
-    background_strain: float
-    profile: tuple[NDArray[np.float64], NDArray[np.float64]]
-    profile_crossing: NDArray[np.bool_]
-    second: ShearBand | None
-    mean_diameter: float
-    positions: NDArray[np.float64]
-    radii: NDArray[np.float64]
-    shear_strain: NDArray[np.float64]
-
-
-class _SlabRecord(Protocol):
-    """What a straight-slab band's results record holds (both readings' records do)."""
-
-    @property
-    def found(self) -> bool: ...
-    @property
-    def reason(self) -> str: ...
-    @property
-    def angle(self) -> float: ...
-    @property
-    def thickness(self) -> float: ...
-    @property
-    def thickness_diameters(self) -> float: ...
-    @property
-    def mean_diameter(self) -> float: ...
-    @property
-    def center(self) -> NDArray[np.float64]: ...
-    @property
-    def normal(self) -> NDArray[np.float64]: ...
-    @property
-    def members(self) -> NDArray[np.bool_]: ...
-    @property
-    def positions(self) -> NDArray[np.float64]: ...
-
-
-S = TypeVar("S", bound=_SlabRecord)
-
-
-class SlabBand(Computable[S]):
+class SlabBand(Compute):
     """A band modelled as a straight slab (a centre line, a thickness): the results
     and the outline that every reading of the band shares (:class:`ShearBand`,
     :class:`~grainlab.analysis.band_readings.DisplacementBand`). How the slab is
     found and accepted, and so what its thickness measures, is the subclass's."""
 
-    @property
-    def found(self) -> bool:
-        """Whether the band passed the acceptance tests (the class docstring)."""
-        return self._computed("found").found
-
-    @property
-    def reason(self) -> str:
-        """Why the band was not accepted ("" when :attr:`found`)."""
-        return self._computed("reason").reason
-
-    @property
-    def angle(self) -> float:
-        """Band direction, rad in [0, pi), CCW from +x."""
-        return self._computed("angle").angle
+    found = Computed[bool]("Whether the band passed the acceptance tests (the class docstring).")
+    reason = Computed[str]("Why the band was not accepted (empty when :attr:`found`).")
+    angle = Computed[float]("Band direction, rad in [0, pi), CCW from +x.")
 
     @property
     def angle_degrees(self) -> float:
@@ -399,40 +333,19 @@ class SlabBand(Computable[S]):
         direction of a biaxial test loaded along y), degrees in [0, 90]."""
         return float(np.degrees(self.inclination))
 
-    @property
-    def thickness(self) -> float:
-        """Band thickness, m (the class docstring says what it measures)."""
-        return self._computed("thickness").thickness
-
-    @property
-    def thickness_diameters(self) -> float:
-        """Band thickness in mean particle diameters."""
-        return self._computed("thickness_diameters").thickness_diameters
-
-    @property
-    def mean_diameter(self) -> float:
-        """Mean diameter of the particles considered, m."""
-        return self._computed("mean_diameter").mean_diameter
-
-    @property
-    def center(self) -> NDArray[np.float64]:
-        """(2,) a point on the centre line, m."""
-        return self._computed("center").center
-
-    @property
-    def normal(self) -> NDArray[np.float64]:
-        """(2,) unit normal of the band."""
-        return self._computed("normal").normal
-
-    @property
-    def members(self) -> NDArray[np.bool_]:
-        """(N,) particles inside the band."""
-        return self._computed("members").members
+    thickness = Computed[float]("Band thickness, m (the class docstring says what it measures).")
+    thickness_diameters = Computed[float]("Band thickness in mean particle diameters.")
+    mean_diameter = Computed[float]("Mean diameter of the particles considered, m.")
+    center = Computed[NDArray[np.float64]]("(2,) a point on the centre line, m.")
+    normal = Computed[NDArray[np.float64]]("(2,) unit normal of the band.")
+    members = Computed[NDArray[np.bool_]]("(N,) particles inside the band.")
+    _positions = Computed[NDArray[np.float64]]("(N, 2) the particles' positions, m.")
+    _radii = Computed[NDArray[np.float64]]("(N,) the particles' radii, m.")
 
     @property
     def slab(self) -> Slab:
         """The band's straight slab alone (no per-particle data): what a results file stores of it."""
-        pos = self._computed("slab").positions
+        pos = self._positions
         extent = (
             np.array([[pos[:, 0].min(), pos[:, 0].max()], [pos[:, 1].min(), pos[:, 1].max()]])
             if pos.shape[0]
@@ -520,7 +433,7 @@ class Slab:
     __hash__ = None  # type: ignore[assignment]
 
 
-class ShearBand(SlabBand[_ShearBandResults]):
+class ShearBand(SlabBand):
     r"""Locate the dominant shear band (and a second one) in a per-particle strain field.
 
     See the module docstring for the method and for how to read the angle.
@@ -675,30 +588,28 @@ class ShearBand(SlabBand[_ShearBandResults]):
             second = self._second_band(data, rest, angle, stability_index, n_contacts)
         peak = profile.peak
         self._store(
-            _ShearBandResults(
-                found=not problems,
-                reason="; ".join(problems),
-                angle=angle,
-                thickness=float(profile.thickness),
-                thickness_diameters=float(profile.thickness / data.d_mean),
-                center=center,
-                normal=normal,
-                members=members,
-                mean_lambda_inside=lam_in,
-                mean_lambda_outside=lam_out,
-                contrast=float(excess / peak) if peak > 0 and excess > 0 else 0.0,
-                prominence=float(prominence),
-                score=score,
-                peak_strain=peak,
-                background_strain=profile.background,
-                profile=(profile.centers - profile.s_mid, profile.mean_strain),
-                profile_crossing=profile.crossing,
-                second=second,
-                mean_diameter=data.d_mean,
-                positions=data.pos,
-                radii=data.rad,
-                shear_strain=data.gamma,
-            )
+            found=not problems,
+            reason="; ".join(problems),
+            angle=angle,
+            thickness=float(profile.thickness),
+            thickness_diameters=float(profile.thickness / data.d_mean),
+            center=center,
+            normal=normal,
+            members=members,
+            mean_lambda_inside=lam_in,
+            mean_lambda_outside=lam_out,
+            contrast=float(excess / peak) if peak > 0 and excess > 0 else 0.0,
+            prominence=float(prominence),
+            score=score,
+            peak_strain=peak,
+            background_strain=profile.background,
+            profile=(profile.centers - profile.s_mid, profile.mean_strain),
+            profile_crossing=profile.crossing,
+            second=second,
+            mean_diameter=data.d_mean,
+            _positions=data.pos,
+            _radii=data.rad,
+            _shear_strain=data.gamma,
         )
         return self
 
@@ -813,57 +724,29 @@ class ShearBand(SlabBand[_ShearBandResults]):
         pick = rng.choice(p.shape[0], size=k, replace=False)
         return p[pick], g[pick]
 
-    @property
-    def mean_lambda_inside(self) -> float:
-        """Mean stability index of the band's particles."""
-        return self._computed("mean_lambda_inside").mean_lambda_inside
-
-    @property
-    def mean_lambda_outside(self) -> float:
-        """Mean stability index of the other particles."""
-        return self._computed("mean_lambda_outside").mean_lambda_outside
-
-    @property
-    def contrast(self) -> float:
-        """(peak - background) / peak of the strain profile, in [0, 1]."""
-        return self._computed("contrast").contrast
-
-    @property
-    def prominence(self) -> float:
-        """Excess strain of the band over the background divided by the largest
-        excess elsewhere on the profile (inf when nothing else is above it)."""
-        return self._computed("prominence").prominence
-
-    @property
-    def score(self) -> float:
-        """Adjusted eta² of the strain with the bins across the band (share of
-        the strain variance that the profile explains), at the band's angle."""
-        return self._computed("score").score
-
-    @property
-    def peak_strain(self) -> float:
-        """Largest (3-bin smoothed) mean strain across the band."""
-        return self._computed("peak_strain").peak_strain
-
-    @property
-    def background_strain(self) -> float:
-        """Median strain of the particles considered."""
-        return self._computed("background_strain").background_strain
-
-    @property
-    def profile(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Distance from the centre line (m) and mean strain of each bin."""
-        return self._computed("profile").profile
-
-    @property
-    def profile_crossing(self) -> NDArray[np.bool_]:
-        """(B,) bins of :attr:`profile` that cross the sample (used for the peak)."""
-        return self._computed("profile_crossing").profile_crossing
-
-    @property
-    def second(self) -> ShearBand | None:
-        """The band found once this band's particles are removed, or None."""
-        return self._computed("second").second
+    mean_lambda_inside = Computed[float]("Mean stability index of the band's particles.")
+    mean_lambda_outside = Computed[float]("Mean stability index of the other particles.")
+    contrast = Computed[float]("(peak - background) / peak of the strain profile, in [0, 1].")
+    prominence = Computed[float](
+        "Excess strain of the band over the background divided by the largest excess elsewhere on "
+        "the profile (inf when nothing else is above it)."
+    )
+    score = Computed[float](
+        "Adjusted eta² of the strain with the bins across the band (share of the strain variance "
+        "that the profile explains), at the band's angle."
+    )
+    peak_strain = Computed[float]("Largest (3-bin smoothed) mean strain across the band.")
+    background_strain = Computed[float]("Median strain of the particles considered.")
+    profile = Computed[tuple[NDArray[np.float64], NDArray[np.float64]]](
+        "Distance from the centre line (m) and mean strain of each bin."
+    )
+    profile_crossing = Computed[NDArray[np.bool_]](
+        "(B,) bins of :attr:`profile` that cross the sample (used for the peak)."
+    )
+    _shear_strain = Computed[NDArray[np.float64]]("(N,) the strain field searched.")
+    second = Computed["ShearBand | None"](
+        "The band found once this band's particles are removed, or None."
+    )
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (NaN and inf as None, angles in degrees), with
@@ -894,9 +777,9 @@ class ShearBand(SlabBand[_ShearBandResults]):
         from grainlab import plot
 
         ax = plot.particle_map(
-            self._computed("positions").positions,
-            self._computed("radii").radii,
-            self._computed("shear_strain").shear_strain,
+            self._positions,
+            self._radii,
+            self._shear_strain,
             ax=ax,
             label=r"local shear strain $\gamma$",
             **kwargs,

@@ -76,15 +76,14 @@ operation.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, _kernels
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis._util import (
-    Computable,
     contact_ends,
     contact_ends_in_list_order,
     finite_mean,
@@ -279,18 +278,7 @@ def stability_index_of_angles(
     return float(lam[0])
 
 
-@dataclass(frozen=True, eq=False)
-class _StabilityIndexResults:
-    """The results of :class:`StabilityIndex` (see its properties)."""
-
-    stability_index: NDArray[np.float64]
-    n_contacts: NDArray[np.int64]
-    mean: float
-    mean_all: float
-    snapshot: Snapshot
-
-
-class StabilityIndex(Computable[_StabilityIndexResults]):
+class StabilityIndex(Compute):
     r"""Geometrical stability index lambda of every particle (paper Sec. 5).
 
     See the module docstring for the formula. Contact angles come from the
@@ -413,42 +401,30 @@ class StabilityIndex(Computable[_StabilityIndexResults]):
         sample = snapshot.is_sample
         lam[~sample] = np.nan
         self._store(
-            _StabilityIndexResults(
-                stability_index=lam,
-                n_contacts=counts,
-                mean=finite_mean(lam, sample & (counts >= 2)),
-                mean_all=finite_mean(lam, sample),
-                snapshot=snapshot,
-            )
+            stability_index=lam,
+            n_contacts=counts,
+            mean=finite_mean(lam, sample & (counts >= 2)),
+            mean_all=finite_mean(lam, sample),
+            _snapshot=snapshot,
         )
         return self
 
-    @property
-    def stability_index(self) -> NDArray[np.float64]:
-        """(N,) lambda per particle; NaN for membrane particles."""
-        return self._computed("stability_index").stability_index
-
-    @property
-    def n_contacts(self) -> NDArray[np.int64]:
-        """(N,) number of contacts per particle used for lambda (boundary bodies
-        counted as ``boundary`` says)."""
-        return self._computed("n_contacts").n_contacts
-
-    @property
-    def mean(self) -> float:
-        """Mean lambda over sample particles with >= 2 contacts."""
-        return self._computed("mean").mean
-
-    @property
-    def mean_all(self) -> float:
-        """Mean lambda over all sample particles (0/1 contact counted as 1)."""
-        return self._computed("mean_all").mean_all
+    stability_index = Computed[NDArray[np.float64]](
+        "(N,) lambda per particle; NaN for membrane particles."
+    )
+    n_contacts = Computed[NDArray[np.int64]](
+        "(N,) number of contacts per particle used for lambda (boundary bodies counted as "
+        "``boundary`` says)."
+    )
+    mean = Computed[float]("Mean lambda over sample particles with >= 2 contacts.")
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    mean_all = Computed[float]("Mean lambda over all sample particles (0/1 contact counted as 1).")
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Particle map coloured by lambda (paper Fig. 12); returns the axes."""
         from grainlab import plot
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         return plot.particle_map(
             snap.positions,
             snap.radii,

@@ -43,14 +43,13 @@ Excess shear strain
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from grainlab.analysis._util import Computable
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.snapshot import Snapshot
 
 __all__ = ["LocalStrain", "match_ids", "neighbour_pairs"]
@@ -91,25 +90,7 @@ def neighbour_pairs(
     return pairs[:, 0], pairs[:, 1]
 
 
-@dataclass(frozen=True, eq=False)
-class _LocalStrainResults:
-    """The results of :class:`LocalStrain` (see its properties)."""
-
-    displacement: NDArray[np.float64]
-    rotation: NDArray[np.float64]
-    deformation_gradient: NDArray[np.float64]
-    strain: NDArray[np.float64]
-    shear_strain: NDArray[np.float64]
-    excess_shear_strain: NDArray[np.float64]
-    background_strain: NDArray[np.float64]
-    volumetric_strain: NDArray[np.float64]
-    d2min: NDArray[np.float64]
-    n_neighbours: NDArray[np.int64]
-    cutoff: float
-    current: Snapshot
-
-
-class LocalStrain(Computable[_LocalStrainResults]):
+class LocalStrain(Compute):
     r"""Displacement, rotation, best-fit local strain and D2min between two snapshots.
 
     See the module docstring for the formulas and sign conventions.
@@ -246,27 +227,22 @@ class LocalStrain(Computable[_LocalStrainResults]):
         dev = eps - background
         excess = np.hypot(dev[:, 0, 0] - dev[:, 1, 1], 2.0 * dev[:, 0, 1])
         self._store(
-            _LocalStrainResults(
-                displacement=disp,
-                rotation=rot,
-                deformation_gradient=F,
-                strain=eps,
-                shear_strain=shear,
-                excess_shear_strain=excess,
-                background_strain=background,
-                volumetric_strain=eps[:, 0, 0] + eps[:, 1, 1],
-                d2min=d2min,
-                n_neighbours=count,
-                cutoff=cutoff,
-                current=current,
-            )
+            displacement=disp,
+            rotation=rot,
+            deformation_gradient=F,
+            strain=eps,
+            shear_strain=shear,
+            excess_shear_strain=excess,
+            background_strain=background,
+            volumetric_strain=eps[:, 0, 0] + eps[:, 1, 1],
+            d2min=d2min,
+            n_neighbours=count,
+            cutoff_used=cutoff,
+            _current=current,
         )
         return self
 
-    @property
-    def displacement(self) -> NDArray[np.float64]:
-        """(N, 2) displacement from the reference, m."""
-        return self._computed("displacement").displacement
+    displacement = Computed[NDArray[np.float64]]("(N, 2) displacement from the reference, m.")
 
     @property
     def displacement_magnitude(self) -> NDArray[np.float64]:
@@ -274,61 +250,36 @@ class LocalStrain(Computable[_LocalStrainResults]):
         d = self.displacement
         return np.hypot(d[:, 0], d[:, 1])
 
-    @property
-    def rotation(self) -> NDArray[np.float64]:
-        """(N,) rotation increment, rad, CCW positive."""
-        return self._computed("rotation").rotation
+    rotation = Computed[NDArray[np.float64]]("(N,) rotation increment, rad, CCW positive.")
+    deformation_gradient = Computed[NDArray[np.float64]](
+        "(N, 2, 2) best-fit local deformation gradient F."
+    )
+    strain = Computed[NDArray[np.float64]]("(N, 2, 2) local strain tensor, compression positive.")
+    shear_strain = Computed[NDArray[np.float64]](
+        "(N,) maximum engineering shear strain (2D shear invariant)."
+    )
+    excess_shear_strain = Computed[NDArray[np.float64]](
+        "(N,) shear invariant of the local strain minus the background strain."
+    )
+    background_strain = Computed[NDArray[np.float64]](
+        "(2, 2) component-wise median of the local strains (compression positive)."
+    )
+    volumetric_strain = Computed[NDArray[np.float64]](
+        "(N,) volumetric strain, compression positive."
+    )
+    d2min = Computed[NDArray[np.float64]]("(N,) Falk–Langer D2min, m².")
+    n_neighbours = Computed[NDArray[np.int64]](
+        "(N,) number of reference neighbours used in the fit."
+    )
 
-    @property
-    def deformation_gradient(self) -> NDArray[np.float64]:
-        """(N, 2, 2) best-fit local deformation gradient F."""
-        return self._computed("deformation_gradient").deformation_gradient
-
-    @property
-    def strain(self) -> NDArray[np.float64]:
-        """(N, 2, 2) local strain tensor, compression positive."""
-        return self._computed("strain").strain
-
-    @property
-    def shear_strain(self) -> NDArray[np.float64]:
-        """(N,) maximum engineering shear strain (2D shear invariant)."""
-        return self._computed("shear_strain").shear_strain
-
-    @property
-    def excess_shear_strain(self) -> NDArray[np.float64]:
-        """(N,) shear invariant of the local strain minus the background strain."""
-        return self._computed("excess_shear_strain").excess_shear_strain
-
-    @property
-    def background_strain(self) -> NDArray[np.float64]:
-        """(2, 2) component-wise median of the local strains (compression positive)."""
-        return self._computed("background_strain").background_strain
-
-    @property
-    def volumetric_strain(self) -> NDArray[np.float64]:
-        """(N,) volumetric strain, compression positive."""
-        return self._computed("volumetric_strain").volumetric_strain
-
-    @property
-    def d2min(self) -> NDArray[np.float64]:
-        """(N,) Falk–Langer D2min, m²."""
-        return self._computed("d2min").d2min
-
-    @property
-    def n_neighbours(self) -> NDArray[np.int64]:
-        """(N,) number of reference neighbours used in the fit."""
-        return self._computed("n_neighbours").n_neighbours
-
-    @property
-    def cutoff_used(self) -> float:
-        """Neighbour radius used, m (NaN for neighbours='contacts')."""
-        return self._computed("cutoff").cutoff
+    cutoff_used = Computed[float]("Neighbour radius used, m (NaN for neighbours='contacts').")
+    _current = Computed[Snapshot]("The current snapshot (drawn by plot).")
 
     def plot(self, ax: Any = None, quantity: str = "displacement", **kwargs: Any) -> Any:
         """Particle map coloured by displacement magnitude (Fig. 11) or shear strain."""
         from grainlab import plot
 
-        snap = self._computed("current").current
+        snap = self._current
         if quantity == "displacement":
             values, label = self.displacement_magnitude, "displacement magnitude (m)"
         elif quantity == "shear_strain":

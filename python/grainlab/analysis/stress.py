@@ -39,13 +39,13 @@ On a :class:`~grainlab.snapshot.Snapshot` (docs/fabric.md, "Stress"):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from grainlab.analysis._util import Computable, principal_stresses, sample_bounds
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import principal_stresses, sample_bounds
 from grainlab.snapshot import Snapshot
 
 __all__ = [
@@ -225,18 +225,7 @@ def grain_stress(snapshot: Snapshot, area: ArrayLike | None = None) -> NDArray[n
     return np.asarray(-out / v[:, None, None], dtype=np.float64)
 
 
-@dataclass(frozen=True, eq=False)
-class _GrainStressResults:
-    """The results of :class:`GrainStress` (see its properties)."""
-
-    snapshot: Snapshot
-    stress: NDArray[np.float64]
-    major: NDArray[np.float64]
-    minor: NDArray[np.float64]
-    major_direction: NDArray[np.float64]
-
-
-class GrainStress(Computable[_GrainStressResults]):
+class GrainStress(Compute):
     r"""The Love-Weber stress of each grain and its principal values.
 
     .. math::
@@ -272,34 +261,26 @@ class GrainStress(Computable[_GrainStressResults]):
         """Compute every grain's stress in ``snapshot``; returns ``self``."""
         stress = grain_stress(snapshot, self.area)
         major, minor, direction = principal_stresses(stress)
-        self._store(_GrainStressResults(snapshot, stress, major, minor, direction))
+        self._store(
+            _snapshot=snapshot, stress=stress, major=major, minor=minor, major_direction=direction
+        )
         return self
 
-    @property
-    def stress(self) -> NDArray[np.float64]:
-        """(N, 2, 2) stress of each grain, Pa, compression positive."""
-        return self._computed("stress").stress
-
-    @property
-    def major(self) -> NDArray[np.float64]:
-        """(N,) major principal stress sigma_1, Pa."""
-        return self._computed("major").major
-
-    @property
-    def minor(self) -> NDArray[np.float64]:
-        """(N,) minor principal stress sigma_2, Pa."""
-        return self._computed("minor").minor
-
-    @property
-    def major_direction(self) -> NDArray[np.float64]:
-        """(N,) direction of sigma_1, rad in [0, pi) from +x (0 where sigma_1 = sigma_2)."""
-        return self._computed("major_direction").major_direction
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    stress = Computed[NDArray[np.float64]](
+        "(N, 2, 2) stress of each grain, Pa, compression positive."
+    )
+    major = Computed[NDArray[np.float64]]("(N,) major principal stress sigma_1, Pa.")
+    minor = Computed[NDArray[np.float64]]("(N,) minor principal stress sigma_2, Pa.")
+    major_direction = Computed[NDArray[np.float64]](
+        "(N,) direction of sigma_1, rad in [0, pi) from +x (0 where sigma_1 = sigma_2)."
+    )
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Particle map coloured by the major principal stress; returns the axes."""
         from grainlab import plot
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         values = np.where(snap.is_sample, self.major, np.nan)
         return plot.particle_map(
             snap.positions, snap.radii, values, ax=ax, cmap="magma_r",
@@ -310,16 +291,7 @@ class GrainStress(Computable[_GrainStressResults]):
         return f"GrainStress(area={'disks' if self.area is None else 'given'})"
 
 
-@dataclass(frozen=True, eq=False)
-class _LoveWeberResults:
-    """The results of :class:`LoveWeberStress` (see its properties)."""
-
-    stress: NDArray[np.float64]
-    area: float
-    n_particles: int
-
-
-class LoveWeberStress(Computable[_LoveWeberResults]):
+class LoveWeberStress(Compute):
     r"""The average (Love-Weber) stress of a region of a snapshot.
 
     .. math:: \sigma = -\frac{1}{A}\sum_{p \in R}\sum_{c \ni p}
@@ -369,23 +341,13 @@ class LoveWeberStress(Computable[_LoveWeberResults]):
         # the particle sum, each particle's moment sum_c sym((x_c - x_p) (x) f^p_c)
         moments = grain_stress(snapshot, np.ones(n_p))
         stress = np.asarray(moments[selected].sum(axis=0) / area, dtype=np.float64)
-        self._store(_LoveWeberResults(stress, area, int(selected.sum())))
+        self._store(stress=stress, region_area=area, n_particles=int(selected.sum()))
         return self
 
-    @property
-    def stress(self) -> NDArray[np.float64]:
-        """(2, 2) stress of the region, Pa, compression positive."""
-        return self._computed("stress").stress
+    stress = Computed[NDArray[np.float64]]("(2, 2) stress of the region, Pa, compression positive.")
 
-    @property
-    def region_area(self) -> float:
-        """The region's area used, m^2."""
-        return self._computed("region_area").area
-
-    @property
-    def n_particles(self) -> int:
-        """Particles in the region."""
-        return self._computed("n_particles").n_particles
+    region_area = Computed[float]("The region's area used, m^2.")
+    n_particles = Computed[int]("Particles in the region.")
 
     @property
     def mean_stress(self) -> float:

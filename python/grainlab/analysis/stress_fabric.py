@@ -79,8 +79,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis._util import (
-    Computable,
     axial_direction,
     grain_contacts,
     principal_stresses,
@@ -168,22 +168,7 @@ def _normal_products(normals: NDArray[np.float64]) -> tuple[NDArray[np.float64],
     return second, fourth
 
 
-@dataclass(frozen=True, eq=False)
-class _FabricTensorResults:
-    """The results of :class:`FabricTensor` (see its properties)."""
-
-    tensor: NDArray[np.float64]
-    fourth_order: NDArray[np.float64]
-    anisotropy: float
-    direction: float
-    fourth_harmonic: float
-    strong_part: NDArray[np.float64] | None
-    weak_part: NDArray[np.float64] | None
-    n_contacts: int
-    angles: NDArray[np.float64]
-
-
-class FabricTensor(Computable[_FabricTensorResults]):
+class FabricTensor(Compute):
     r"""Satake's fabric tensor, its fourth-order companion and its strong and weak parts.
 
     .. math::
@@ -238,58 +223,42 @@ class FabricTensor(Computable[_FabricTensorResults]):
             strong = _normal_products(normals[strong_mask])[0] / n_c
             weak = _normal_products(normals[~strong_mask])[0] / n_c
         self._store(
-            _FabricTensorResults(
-                tensor, fourth, anisotropy, direction, harmonic, strong, weak, n_c, angles
-            )
+            tensor=tensor,
+            fourth_order=fourth,
+            anisotropy=anisotropy,
+            direction=direction,
+            fourth_harmonic=harmonic,
+            strong_part=strong,
+            weak_part=weak,
+            n_contacts=n_c,
+            _angles=angles,
         )
         return self
 
-    @property
-    def tensor(self) -> NDArray[np.float64]:
-        """(2, 2) phi_ij, trace 1."""
-        return self._computed("tensor").tensor
-
-    @property
-    def fourth_order(self) -> NDArray[np.float64]:
-        """(2, 2, 2, 2) phi_ijkl, its contractions phi_ijkk = phi_ij."""
-        return self._computed("fourth_order").fourth_order
-
-    @property
-    def anisotropy(self) -> float:
-        """a = 2 (phi_1 - phi_2)."""
-        return self._computed("anisotropy").anisotropy
-
-    @property
-    def direction(self) -> float:
-        """theta_a, the major direction of phi, rad in [0, pi)."""
-        return self._computed("direction").direction
-
-    @property
-    def fourth_harmonic(self) -> float:
-        """b_4 = |mean of exp(4 i theta)|: 0 for a hexagonal lattice, 1 for a square one."""
-        return self._computed("fourth_harmonic").fourth_harmonic
-
-    @property
-    def strong_part(self) -> NDArray[np.float64] | None:
-        """(2, 2) phi^s, the strong contacts' share of phi (None without forces)."""
-        return self._computed("strong_part").strong_part
-
-    @property
-    def weak_part(self) -> NDArray[np.float64] | None:
-        """(2, 2) phi^w = phi - phi^s (None without forces)."""
-        return self._computed("weak_part").weak_part
-
-    @property
-    def n_contacts(self) -> int:
-        """N_c, the contacts used."""
-        return self._computed("n_contacts").n_contacts
+    _angles = Computed[NDArray[np.float64]]("(Nc,) the contact angles used, rad (drawn by plot).")
+    tensor = Computed[NDArray[np.float64]]("(2, 2) phi_ij, trace 1.")
+    fourth_order = Computed[NDArray[np.float64]](
+        "(2, 2, 2, 2) phi_ijkl, its contractions phi_ijkk = phi_ij."
+    )
+    anisotropy = Computed[float]("a = 2 (phi_1 - phi_2).")
+    direction = Computed[float]("theta_a, the major direction of phi, rad in [0, pi).")
+    fourth_harmonic = Computed[float](
+        "b_4 = |mean of exp(4 i theta)|: 0 for a hexagonal lattice, 1 for a square one."
+    )
+    strong_part = Computed[NDArray[np.float64] | None](
+        "(2, 2) phi^s, the strong contacts' share of phi (None without forces)."
+    )
+    weak_part = Computed[NDArray[np.float64] | None](
+        "(2, 2) phi^w = phi - phi^s (None without forces)."
+    )
+    n_contacts = Computed[int]("N_c, the contacts used.")
 
     def plot(self, ax: Any = None) -> Any:
         """Rose diagram of the contact normals with the fitted E(theta); returns the axes."""
         from grainlab import plot
         from grainlab.analysis.fabric import angular_histogram
 
-        values, _ = angular_histogram(self._computed("angles").angles, 18)
+        values, _ = angular_histogram(self._angles, 18)
         return plot.polar_distribution(
             values, anisotropy=self.anisotropy, direction=self.direction, ax=ax
         )
@@ -298,18 +267,7 @@ class FabricTensor(Computable[_FabricTensorResults]):
         return f"FabricTensor(include_boundary={self.include_boundary})"
 
 
-@dataclass(frozen=True, eq=False)
-class _StressForceFabricResults:
-    """The results of :class:`StressForceFabric` (see its properties)."""
-
-    anisotropies: Anisotropies
-    stress: NDArray[np.float64]
-    stress_direction: float
-    stress_ratio: float
-    predicted_stress_ratio: float
-
-
-class StressForceFabric(Computable[_StressForceFabricResults]):
+class StressForceFabric(Compute):
     r"""Rothenburg and Bathurst's stress-force-fabric relation, with its residual.
 
     .. math::
@@ -374,34 +332,27 @@ class StressForceFabric(Computable[_StressForceFabricResults]):
         ]
         predicted = float(0.5 * np.sum(terms)) if np.isfinite(rb.a_n) else float("nan")
         self._store(
-            _StressForceFabricResults(rb, stress, float(direction), ratio, predicted)
+            anisotropies=rb,
+            stress=stress,
+            stress_direction=float(direction),
+            stress_ratio=ratio,
+            predicted_stress_ratio=predicted,
         )
         return self
 
-    @property
-    def anisotropies(self) -> Anisotropies:
-        """a, a_n, a_t, their directions and f0 (:class:`Anisotropies`)."""
-        return self._computed("anisotropies").anisotropies
-
-    @property
-    def stress(self) -> NDArray[np.float64]:
-        """(2, 2) the contacts' stress, Pa (over the snapshot's region)."""
-        return self._computed("stress").stress
-
-    @property
-    def stress_direction(self) -> float:
-        """theta_sigma, the major principal direction of :attr:`stress`, rad."""
-        return self._computed("stress_direction").stress_direction
-
-    @property
-    def stress_ratio(self) -> float:
-        """q/p = (sigma_1 - sigma_2) / (sigma_1 + sigma_2), measured."""
-        return self._computed("stress_ratio").stress_ratio
-
-    @property
-    def predicted_stress_ratio(self) -> float:
-        """(1/2) sum of the anisotropies projected on theta_sigma."""
-        return self._computed("predicted_stress_ratio").predicted_stress_ratio
+    anisotropies = Computed["Anisotropies"](
+        "a, a_n, a_t, their directions and f0 (:class:`Anisotropies`)."
+    )
+    stress = Computed[NDArray[np.float64]](
+        "(2, 2) the contacts' stress, Pa (over the snapshot's region)."
+    )
+    stress_direction = Computed[float](
+        "theta_sigma, the major principal direction of :attr:`stress`, rad."
+    )
+    stress_ratio = Computed[float]("q/p = (sigma_1 - sigma_2) / (sigma_1 + sigma_2), measured.")
+    predicted_stress_ratio = Computed[float](
+        "(1/2) sum of the anisotropies projected on theta_sigma."
+    )
 
     @property
     def residual(self) -> float:

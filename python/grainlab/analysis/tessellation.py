@@ -46,7 +46,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.analysis._util import Computable, sample_bounds
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import sample_bounds
 from grainlab.snapshot import Snapshot
 
 __all__ = ["LocalPorosity", "PowerCells", "power_cell_areas", "power_cells"]
@@ -217,17 +218,7 @@ def power_cell_areas(snapshot: Snapshot) -> NDArray[np.float64]:
     return power_cells(snapshot).area
 
 
-@dataclass(frozen=True, eq=False)
-class _LocalPorosityResults:
-    """The results of :class:`LocalPorosity` (see its properties)."""
-
-    snapshot: Snapshot
-    cells: PowerCells
-    local_porosity: NDArray[np.float64]
-    porosity: float
-
-
-class LocalPorosity(Computable[_LocalPorosityResults]):
+class LocalPorosity(Compute):
     r"""Local porosity of each grain from its power (radical Voronoi) cell.
 
     .. math:: n_p = 1 - \frac{\pi r_p^2}{A_p},\qquad
@@ -267,34 +258,27 @@ class LocalPorosity(Computable[_LocalPorosityResults]):
             local = np.where(sample & (cells.area > 0.0), 1.0 - solid / cells.area, np.nan)
         total = float(cells.area[sample].sum())
         porosity = 1.0 - float(solid[sample].sum()) / total if total > 0 else float("nan")
-        self._store(_LocalPorosityResults(snapshot, cells, local, porosity))
+        self._store(_snapshot=snapshot, cells=cells, local_porosity=local, porosity=porosity)
         return self
 
-    @property
-    def cells(self) -> PowerCells:
-        """The power cells (:class:`PowerCells`)."""
-        return self._computed("cells").cells
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    cells = Computed["PowerCells"]("The power cells (:class:`PowerCells`).")
 
     @property
     def cell_area(self) -> NDArray[np.float64]:
         """(N,) area of each particle's power cell, m^2."""
-        return self._computed("cell_area").cells.area
+        return self.cells.area
 
-    @property
-    def local_porosity(self) -> NDArray[np.float64]:
-        """(N,) 1 - pi r^2 / A_p of each sample grain (NaN for membrane disks)."""
-        return self._computed("local_porosity").local_porosity
-
-    @property
-    def porosity(self) -> float:
-        """1 - (grains' disk area) / (their cells' area)."""
-        return self._computed("porosity").porosity
+    local_porosity = Computed[NDArray[np.float64]](
+        "(N,) 1 - pi r^2 / A_p of each sample grain (NaN for membrane disks)."
+    )
+    porosity = Computed[float]("1 - (grains' disk area) / (their cells' area).")
 
     def plot(self, ax: Any = None) -> Any:
         """The power cells coloured by local porosity, the disks on top; returns the axes."""
         from grainlab.plot import networks
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         cells = self.cells
         return networks.cell_map(
             cells.vertices,
