@@ -1,5 +1,7 @@
 """Results declared once: the Computed descriptor and the Compute base."""
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -48,3 +50,12 @@ def test_a_reading_inherits_the_slab_results_and_adds_its_own():
                                   box=[[0, 6], [0, 6]], periodic=(True, True), tolerance=1e-9)
     z = CoordinationNumber().compute(snap)
     assert z.coordination_number == 4.0 and z.n_contacts.shape == (36,)
+
+
+def test_a_computed_measure_pickles_with_its_results():
+    """Measures travel to worker processes (the figure pool) with their results."""
+    x, y = np.meshgrid(np.arange(6.0), np.arange(6.0))
+    snap = Snapshot.from_geometry(np.c_[x.ravel(), y.ravel()], np.full(36, 0.5),
+                                  box=[[0, 6], [0, 6]], periodic=(True, True), tolerance=1e-9)
+    z = pickle.loads(pickle.dumps(CoordinationNumber().compute(snap)))
+    assert z.coordination_number == 4.0 and np.array_equal(z.n_contacts, np.full(36, 4))

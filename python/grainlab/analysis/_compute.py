@@ -61,9 +61,12 @@ class Compute:
             for name, value in vars(klass).items():
                 if isinstance(value, Computed):
                     names[name] = None
-        cls._record = dataclasses.make_dataclass(
+        record = dataclasses.make_dataclass(
             f"{cls.__name__}Results", list(names), frozen=True, eq=False
         )
+        record.__module__ = cls.__module__  # where pickle finds it
+        record.__qualname__ = f"{cls.__qualname__}._record"
+        cls._record = record
 
     def _computed(self, name: str) -> Any:
         """The results record, read for the result ``name`` (named in the error

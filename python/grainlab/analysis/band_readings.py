@@ -125,6 +125,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab.analysis._compute import Computed
+from grainlab.analysis.band_acceptance import (
+    crossing_problems,
+    reduction_problems,
+    transition_problems,
+)
 from grainlab.analysis.shear_band import SlabBand, _best
 
 __all__ = ["MIN_GRAINS", "SHARE_HIGH", "SHARE_LOW", "DisplacementBand"]
@@ -304,12 +309,8 @@ def _transition(s: NDArray[np.float64], t: NDArray[np.float64], bin_width: float
 
     s_lo, level_lo = edge(left, left - 1)
     s_hi, level_hi = edge(right, right + 1)
-    problems = []
-    if not (level_lo == SHARE_LOW and level_hi == SHARE_HIGH):
-        problems.append(
-            f"the transition does not reach block A's motion (share <= {SHARE_LOW:g}) on one "
-            f"side and block B's (share >= {SHARE_HIGH:g}) on the other inside the sample"
-        )
+    reaches = level_lo == SHARE_LOW and level_hi == SHARE_HIGH
+    problems = transition_problems(reaches, SHARE_LOW, SHARE_HIGH)
     return _Transition(centers, mean, smooth, s_lo, s_hi, tuple(problems))
 
 
@@ -463,27 +464,10 @@ class DisplacementBand(SlabBand):
         The steps (module docstring): the scan for the slip line
         (:meth:`_slip_line`), its refinement (:meth:`_refined`, reading the band
         at each angle with :meth:`_reading`), the blocks' motions and the profile
-        across the line (:meth:`_band`), the acceptance tests (here and
-        :meth:`_crossing_problems`).
+        across the line (:meth:`_band`), the acceptance tests
+        (:mod:`~grainlab.analysis.band_acceptance`).
         """
-        pos = np.asarray(positions, dtype=np.float64)
-        disp = np.asarray(displacement, dtype=np.float64)
-        rad = np.asarray(radii, dtype=np.float64)
-        n = pos.shape[0] if pos.ndim == 2 else -1
-        if pos.shape != (n, 2) or disp.shape != (n, 2) or rad.shape != (n,):
-            raise ValueError(
-                "positions, displacement, radii: expected shapes (N, 2), (N, 2), (N,), got "
-                f"{pos.shape}, {disp.shape}, {rad.shape}"
-            )
-        considered = np.ones(n, bool) if mask is None else np.asarray(mask, bool)
-        if considered.shape != (n,):
-            raise ValueError(f"mask: expected shape ({n},), got {considered.shape}")
-        valid = considered & np.isfinite(pos).all(axis=1) & np.isfinite(disp).all(axis=1)
-        if valid.sum() < MIN_GRAINS:
-            raise ValueError(
-                f"displacement: need at least {MIN_GRAINS} grains with a finite displacement, "
-                f"got {int(valid.sum())}"
-            )
+        pos, disp, rad, considered, valid = _checked(positions, displacement, radii, mask)
         d_mean = float(np.mean(2.0 * rad[considered]))
         origin = pos[valid].mean(axis=0)
         p = (pos[valid] - origin) / d_mean  # lengths in mean diameters from here on
@@ -495,32 +479,28 @@ class DisplacementBand(SlabBand):
         scale = math.sqrt(one_block / rest.shape[0]) if one_block > 0 else 1.0
         v = rest / scale
         r = self._refined(p, v, self._slip_line(p, v))
-        angle, offset, trans, t, coef_a, coef_b = r.angle, r.offset, r.trans, r.share, r.coef_a, r.coef_b
-        normal = np.array([-np.sin(angle), np.cos(angle)])
+        trans = r.trans
+        normal = np.array([-np.sin(r.angle), np.cos(r.angle)])
         # nothing left by one affine motion (beyond round-off): nothing for two blocks to explain
         affine = one_block <= 1e-20 * float(np.sum(disp[valid] ** 2))
         reduction = 0.0 if affine else max(1.0 - r.residual / float(np.sum(v * v)), 0.0)
         mid = 0.5 * (trans.s_lo + trans.s_hi)
-        center = origin + (offset + mid) * d_mean * normal
+        center = origin + (r.offset + mid) * d_mean * normal
         c = (center - origin) / d_mean
-        jump = (_at(coef_b, c[None, :]) - _at(coef_a, c[None, :]))[0] * scale
+        jump = (_at(r.coef_b, c[None, :]) - _at(r.coef_a, c[None, :]))[0] * scale
         s_all = ((pos - center) @ normal) / d_mean
-        half = 0.5 * trans.thickness
-        members = considered & np.isfinite(pos).all(axis=1) & (np.abs(s_all) <= half)
-        problems = list(trans.problems)
-        if reduction < self.min_reduction:
-            problems.insert(
-                0,
-                f"two blocks explain little more than one motion of the whole sample: they remove "
-                f"{100 * reduction:.0f} % of its residual (min_reduction = {self.min_reduction:g})",
-            )
-        problems += self._crossing_problems(pos[valid], s_all[valid], members[valid], normal, trans.thickness, d_mean)
-        share = np.full(n, np.nan)
-        share[valid] = t
+        members = considered & np.isfinite(pos).all(axis=1) & (np.abs(s_all) <= 0.5 * trans.thickness)
+        problems = reduction_problems(reduction, self.min_reduction) + list(trans.problems)
+        tangent = np.array([normal[1], -normal[0]])
+        problems += crossing_problems(
+            pos[valid], tangent, s_all[valid], trans.thickness, 1.0, d_mean, self.crossing
+        )
+        share = np.full(pos.shape[0], np.nan)
+        share[valid] = r.share
         self._store(
             found=not problems,
             reason="; ".join(problems),
-            angle=angle,
+            angle=r.angle,
             thickness=trans.thickness * d_mean,
             thickness_diameters=trans.thickness,
             center=center,
@@ -609,29 +589,6 @@ class DisplacementBand(SlabBand):
         assert trans is not None
         return trans, t, coef_a, coef_b
 
-    def _crossing_problems(
-        self,
-        pos: NDArray[np.float64],
-        s: NDArray[np.float64],
-        members: NDArray[np.bool_],
-        normal: NDArray[np.float64],
-        thickness: float,
-        d_mean: float,
-    ) -> list[str]:
-        """Whether the band crosses the sample (``s`` from its centre line, mean diameters)."""
-        tangent = np.array([normal[1], -normal[0]])
-        side = float(np.ptp(pos, axis=0).min())
-        near = np.abs(s) <= max(0.5 * thickness, 1.0)
-        chord = float(np.ptp(pos[near] @ tangent)) if near.sum() > 1 else 0.0
-        span = float(np.ptp(pos[members] @ tangent)) if members.sum() > 1 else 0.0
-        if chord < self.crossing * side or span < self.crossing * chord:
-            return [
-                f"does not cross the sample (its grains span {span / d_mean:.1f} mean diameters "
-                f"of a {chord / d_mean:.1f}-diameter chord; the sample's smaller side is "
-                f"{side / d_mean:.1f})"
-            ]
-        return []
-
     residual_reduction = Computed[float](
         "Share of the residual of one affine motion of the whole sample that the two blocks' "
         "motions remove, 1 - S_2/S_1, in [0, 1]."
@@ -708,6 +665,32 @@ class DisplacementBand(SlabBand):
             f"min_share={self.min_share}, min_reduction={self.min_reduction}, "
             f"crossing={self.crossing})"
         )
+
+
+def _checked(
+    positions: ArrayLike, displacement: ArrayLike, radii: ArrayLike, mask: ArrayLike | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
+    """:meth:`DisplacementBand.compute`'s input as arrays, checked, with the grains
+    considered and those of them with a finite position and displacement."""
+    pos = np.asarray(positions, dtype=np.float64)
+    disp = np.asarray(displacement, dtype=np.float64)
+    rad = np.asarray(radii, dtype=np.float64)
+    n = pos.shape[0] if pos.ndim == 2 else -1
+    if pos.shape != (n, 2) or disp.shape != (n, 2) or rad.shape != (n,):
+        raise ValueError(
+            "positions, displacement, radii: expected shapes (N, 2), (N, 2), (N,), got "
+            f"{pos.shape}, {disp.shape}, {rad.shape}"
+        )
+    considered = np.ones(n, bool) if mask is None else np.asarray(mask, bool)
+    if considered.shape != (n,):
+        raise ValueError(f"mask: expected shape ({n},), got {considered.shape}")
+    valid = considered & np.isfinite(pos).all(axis=1) & np.isfinite(disp).all(axis=1)
+    if valid.sum() < MIN_GRAINS:
+        raise ValueError(
+            f"displacement: need at least {MIN_GRAINS} grains with a finite displacement, "
+            f"got {int(valid.sum())}"
+        )
+    return pos, disp, rad, considered, valid
 
 
 def _subset(

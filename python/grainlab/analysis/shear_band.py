@@ -104,17 +104,18 @@ from scipy.ndimage import uniform_filter1d
 
 from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis._util import finite_mean
+from grainlab.analysis.band_acceptance import (
+    FLANK_D,
+    MIN_EXCESS,
+    profile_prominence,
+    strain_band_problems,
+)
 from grainlab.snapshot import Snapshot
 
 __all__ = ["ShearBand", "Slab", "SlabBand"]
 
 #: The second band's direction differs from the first's by at least this much (rad).
 _SECOND_SEPARATION = np.radians(20.0)
-#: Least width (mean diameters) of each flank of a band: left out of the prominence's
-#: "elsewhere" and of the search for the second band.
-_FLANK_D = 2.0
-#: Excess strain (and fraction of the largest strain) below which there is no band at all.
-_MIN_EXCESS = 1.0e-9
 #: Width (mean diameters) of the running mean over the profile bins.
 _SMOOTH_D = 2.0
 #: Width of the window (mean diameters) over which bin counts are summed to judge
@@ -584,7 +585,7 @@ class ShearBand(SlabBand):
             lam_out = finite_mean(lam, use & ~members)
         second = None
         if self.find_second:
-            rest = data.valid & (np.abs(s_all) > 0.5 * profile.thickness + _FLANK_D * data.d_mean)
+            rest = data.valid & (np.abs(s_all) > 0.5 * profile.thickness + FLANK_D * data.d_mean)
             second = self._second_band(data, rest, angle, stability_index, n_contacts)
         peak = profile.peak
         self._store(
@@ -644,37 +645,19 @@ class ShearBand(SlabBand):
         return angle, score
 
     def _acceptance(self, profile: _Profile, data: _BandInput) -> tuple[float, float, list[str]]:
-        """Step 3: how far the band stands out of the rest of the profile: its
-        excess strain over the background, its prominence and what fails."""
+        """Step 3: the band's excess strain over the background, its prominence and
+        what fails (:mod:`~grainlab.analysis.band_acceptance`)."""
         excess = profile.peak - profile.background
-        if excess <= max(_MIN_EXCESS, _MIN_EXCESS * float(np.max(np.abs(data.g)))):
+        if excess <= max(MIN_EXCESS, MIN_EXCESS * float(np.max(np.abs(data.g)))):
             excess = 0.0  # round-off: a uniform (affine) deformation has no band
-        # the band's flanks: one band thickness (at least 2 mean diameters) on each side
-        thickness = profile.thickness
-        flank = 0.5 * thickness + max(thickness, _FLANK_D * data.d_mean)
-        away = profile.crossing & (np.abs(profile.centers - profile.s_mid) > flank)
-        elsewhere = float(profile.smooth[away].max()) - profile.background if away.any() else 0.0
-        if excess <= 0.0:
-            prominence = 0.0
-        elif elsewhere <= 0.0:
-            prominence = math.inf
-        else:
-            prominence = excess / elsewhere
-        problems = []
-        if excess <= 0.0:
-            problems.append("no part of the profile stands above the background strain")
-        else:
-            if thickness / data.d_mean < self.min_thickness:
-                problems.append(
-                    f"thinner ({thickness / data.d_mean:.2f} mean diameters) than "
-                    f"min_thickness = {self.min_thickness:g}"
-                )
-            if prominence < self.min_prominence:
-                problems.append(
-                    f"does not stand out: prominence {prominence:.2f} < min_prominence = "
-                    f"{self.min_prominence:g} (another part of the profile is "
-                    f"{100 * elsewhere / excess:.0f} % as high above the background)"
-                )
+        prominence, elsewhere = profile_prominence(
+            excess, profile.smooth, profile.centers - profile.s_mid, profile.crossing,
+            profile.background, profile.thickness, data.d_mean,
+        )
+        problems = strain_band_problems(
+            excess, prominence, elsewhere, profile.thickness / data.d_mean,
+            self.min_thickness, self.min_prominence,
+        )
         return excess, prominence, problems
 
     def _second_band(

@@ -50,6 +50,14 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
 from grainlab.analysis._util import finite_mean
+from grainlab.analysis.band_acceptance import (
+    CROSSING,
+    candidate_reason,
+    crossing_problems,
+    permutation_p_value,
+    significance_problems,
+    slab_eta2,
+)
 from grainlab.analysis.band_readings import MIN_GRAINS, DisplacementBand
 from grainlab.analysis.shear_band import ShearBand, Slab
 from grainlab.analysis.stability import StabilityIndex
@@ -72,9 +80,9 @@ __all__ = [
     "slab_members",
 ]
 
-#: Band acceptance: minimum thickness (mean diameters), crossing fractions, permutations.
+#: Band acceptance: minimum thickness (mean diameters), permutations (the crossing
+#: fractions: :data:`~grainlab.analysis.band_acceptance.CROSSING`).
 MIN_THICKNESS_D = 1.0
-CROSSING = 0.75
 N_PERMUTATIONS = 19
 #: Grains closer than this many mean diameters to the boundary are left out of the search.
 EDGE_D = 1.0
@@ -215,25 +223,6 @@ def interior_grains(snap: Snapshot, d_mean: float) -> NDArray[np.bool_]:
     return inside
 
 
-def _eta2(
-    pos: NDArray[np.float64], gamma: NDArray[np.float64], normal: NDArray[np.float64], width: float
-) -> float:
-    """Adjusted correlation ratio of ``gamma`` with bins across the slab (as ShearBand scores)."""
-    s = pos @ normal
-    b = ((s - s.min()) / width).astype(np.int64)
-    counts = np.bincount(b)
-    sums = np.bincount(b, weights=gamma)
-    occupied = counts > 0
-    m = gamma.size
-    mean = float(gamma.mean())
-    total = float(((gamma - mean) ** 2).sum())
-    if total <= 0.0:
-        return 0.0
-    between = float((sums[occupied] ** 2 / counts[occupied]).sum()) - m * mean**2
-    n_bins = int(occupied.sum())
-    return 1.0 - (1.0 - between / total) * (m - 1) / max(m - n_bins, 1)
-
-
 def find_band(
     reference: Snapshot,
     current: Snapshot,
@@ -292,60 +281,26 @@ def _accepted_band(
     """The band of the per-grain ``field`` (N_grains,) of ``snap`` and its acceptance
     (module docstring): the one code path of the strain band (:func:`find_band`) and
     of the band in any field (:func:`find_field_band`), its numbers unlabelled."""
-    name, reference_name, axial_strain = "", "", math.nan
     g = snap.is_sample
     pos, rad = snap.positions[g], snap.radii[g]
     d_mean = float(np.mean(2.0 * rad)) if rad.size else math.nan
-    gamma = field
     interior = interior_grains(snap, d_mean)
-    valid = interior & np.isfinite(gamma)
-    lam = stability.stability_index[g]
-    counts = stability.n_contacts[g]
-
-    def missing(reason: str, **numbers: Any) -> BandSearch:
-        values: dict[str, Any] = {
-            "angle_deg": math.nan,
-            "inclination_deg": math.nan,
-            "thickness_m": math.nan,
-            "thickness_diameters": math.nan,
-            "contrast": math.nan,
-            "n_grains": 0,
-            "mean_lambda_inside": math.nan,
-            "mean_lambda_outside": math.nan,
-            "p_value": math.nan,
-        }
-        values.update(numbers)
-        return BandSearch(
-            BandNumbers(name, reference_name, axial_strain, False, reason, **values), None, displacement
-        )
-
+    valid = interior & np.isfinite(field)
     if int(valid.sum()) < 10:
-        return missing(
+        return _missing(
+            displacement,
             f"only {int(valid.sum())} grains away from the boundary have {words.having} "
-            "(at least 10 are needed)"
+            "(at least 10 are needed)",
         )
-    band = ShearBand(min_thickness=MIN_THICKNESS_D).compute(pos, gamma, rad, mask=interior)
-    side = float(np.ptp(pos, axis=0).min())
-    # significance against random rearrangements of the same values
-    width = band.bin_width * float(np.mean(2.0 * rad[interior]))
-    eta = _eta2(pos[valid], gamma[valid], band.normal, width)
-    rng = np.random.default_rng(PERMUTATION_SEED)
-    shuffled = gamma.copy()
-    null = np.empty(N_PERMUTATIONS)
-    for k in range(N_PERMUTATIONS):
-        shuffled[valid] = rng.permutation(gamma[valid])
-        trial = ShearBand(second=False).compute(pos, shuffled, rad, mask=interior)
-        null[k] = _eta2(pos[valid], shuffled[valid], trial.normal, width)
-    p_value = float((1 + np.sum(null >= eta)) / (N_PERMUTATIONS + 1))
-
-    problems = _band_problems(band, pos, d_mean, side)
-    if p_value > 0.05:
-        problems.append(
-            f"not significant (p = {p_value:.2f} against {N_PERMUTATIONS} random "
-            f"rearrangements of the {words.values})"
-        )
+    band = ShearBand(min_thickness=MIN_THICKNESS_D).compute(pos, field, rad, mask=interior)
+    p_value = _p_value(band, pos, field, rad, interior, valid)
+    problems = _band_problems(band, pos, d_mean)
+    problems += significance_problems(p_value, N_PERMUTATIONS, words.values)
+    if problems:
+        reason = candidate_reason(band.angle_degrees, band.thickness_diameters, problems)
+        return _missing(displacement, reason, p_value=p_value, prominence=band.prominence)
     members = slab_members(band, pos)
-    use = counts >= 2
+    lam, use = stability.stability_index[g], stability.n_contacts[g] >= 2
     numbers: dict[str, Any] = {
         "angle_deg": band.angle_degrees,
         "inclination_deg": band.inclination_degrees,
@@ -358,39 +313,71 @@ def _accepted_band(
         "p_value": p_value,
         "prominence": band.prominence,
     }
-    if problems:
-        return missing(
-            f"best candidate at {band.angle_degrees:.1f} deg, {band.thickness_diameters:.1f} "
-            "mean diameters thick: " + "; ".join(problems),
-            p_value=p_value,
-            prominence=band.prominence,
-        )
     second = band.second
     accepted_second: Slab | None = None
     if second is not None:
-        second_problems = _band_problems(second, pos, d_mean, side)
-        numbers.update(
-            second_found=not second_problems,
-            second_reason=(
-                f"best candidate at {second.angle_degrees:.1f} deg, "
-                f"{second.thickness_diameters:.1f} mean diameters thick: "
-                + "; ".join(second_problems)
-                if second_problems
-                else ""
-            ),
-            second_angle_deg=second.angle_degrees,
-            second_inclination_deg=second.inclination_degrees,
-            second_thickness_diameters=second.thickness_diameters,
-            second_contrast=second.contrast,
-            second_prominence=second.prominence,
-        )
+        second_problems = _band_problems(second, pos, d_mean)
+        numbers.update(_second_numbers(second, second_problems))
         accepted_second = None if second_problems else second.slab
     return BandSearch(
-        BandNumbers(name, reference_name, axial_strain, True, "", **numbers),
-        band.slab,
-        displacement,
-        accepted_second,
+        BandNumbers("", "", math.nan, True, "", **numbers), band.slab, displacement, accepted_second
     )
+
+
+def _missing(displacement: NDArray[np.float64], reason: str, **numbers: Any) -> BandSearch:
+    """A search that accepted no band, and why (its numbers unlabelled, NaN unless given)."""
+    values: dict[str, Any] = {
+        "angle_deg": math.nan,
+        "inclination_deg": math.nan,
+        "thickness_m": math.nan,
+        "thickness_diameters": math.nan,
+        "contrast": math.nan,
+        "n_grains": 0,
+        "mean_lambda_inside": math.nan,
+        "mean_lambda_outside": math.nan,
+        "p_value": math.nan,
+    }
+    values.update(numbers)
+    return BandSearch(BandNumbers("", "", math.nan, False, reason, **values), None, displacement)
+
+
+def _p_value(
+    band: ShearBand,
+    pos: NDArray[np.float64],
+    field: NDArray[np.float64],
+    rad: NDArray[np.float64],
+    interior: NDArray[np.bool_],
+    valid: NDArray[np.bool_],
+) -> float:
+    """The band's significance: its eta² against the bands found in
+    :data:`N_PERMUTATIONS` random rearrangements of the same values (fixed seed)."""
+    width = band.bin_width * float(np.mean(2.0 * rad[interior]))
+    eta = slab_eta2(pos[valid], field[valid], band.normal, width)
+    rng = np.random.default_rng(PERMUTATION_SEED)
+    shuffled = field.copy()
+    null = np.empty(N_PERMUTATIONS)
+    for k in range(N_PERMUTATIONS):
+        shuffled[valid] = rng.permutation(field[valid])
+        trial = ShearBand(second=False).compute(pos, shuffled, rad, mask=interior)
+        null[k] = slab_eta2(pos[valid], shuffled[valid], trial.normal, width)
+    return permutation_p_value(eta, null)
+
+
+def _second_numbers(second: ShearBand, problems: list[str]) -> dict[str, Any]:
+    """The ``second_*`` fields of :class:`BandNumbers` for the candidate ``second``."""
+    return {
+        "second_found": not problems,
+        "second_reason": (
+            candidate_reason(second.angle_degrees, second.thickness_diameters, problems)
+            if problems
+            else ""
+        ),
+        "second_angle_deg": second.angle_degrees,
+        "second_inclination_deg": second.inclination_degrees,
+        "second_thickness_diameters": second.thickness_diameters,
+        "second_contrast": second.contrast,
+        "second_prominence": second.prominence,
+    }
 
 
 def slab_members(band: ShearBand | Slab, pos: NDArray[np.float64]) -> NDArray[np.bool_]:
@@ -398,25 +385,12 @@ def slab_members(band: ShearBand | Slab, pos: NDArray[np.float64]) -> NDArray[np
     return (band if isinstance(band, Slab) else band.slab).members(pos)
 
 
-def _band_problems(
-    band: ShearBand, pos: NDArray[np.float64], d_mean: float, side: float
-) -> list[str]:
+def _band_problems(band: ShearBand, pos: NDArray[np.float64], d_mean: float) -> list[str]:
     """Why a candidate band fails acceptance tests 1 and 2 (module docstring); [] if it passes."""
     problems = [band.reason] if not band.found else []
     tangent = np.array([np.cos(band.angle), np.sin(band.angle)])
     s = (pos - band.center) @ band.normal
-    members = np.abs(s) <= 0.5 * band.thickness
-    # crossing: chord of the centre line through the grains and the members' cover of it
-    near = np.abs(s) <= max(0.5 * band.thickness, d_mean)
-    chord = float(np.ptp(pos[near] @ tangent)) if near.sum() > 1 else 0.0
-    span = float(np.ptp(pos[members] @ tangent)) if members.sum() > 1 else 0.0
-    if chord < CROSSING * side or span < CROSSING * chord:
-        problems.append(
-            f"does not cross the sample (its grains span {span / d_mean:.1f} mean diameters "
-            f"of a {chord / d_mean:.1f}-diameter chord; the sample's smaller side is "
-            f"{side / d_mean:.1f})"
-        )
-    return problems
+    return problems + crossing_problems(pos, tangent, s, band.thickness, d_mean, d_mean, CROSSING)
 
 
 def lambda_indicator(stability: StabilityIndex) -> NDArray[np.float64]:
