@@ -90,6 +90,50 @@ def neighbour_pairs(
     return pairs[:, 0], pairs[:, 1]
 
 
+def _deformation_gradients(
+    own: NDArray[np.int64],
+    d0: NDArray[np.float64],
+    d: NDArray[np.float64],
+    n: int,
+    matched: NDArray[np.bool_],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """Each particle's best-fit ``F`` (N, 2, 2) mapping its reference branch vectors
+    ``d0`` (K, 2) to the current ones ``d`` (K, 2) (``own`` (K,): the owner of each),
+    the residual D2min (N,) m² and the neighbour count (N,); NaN where fewer than 2
+    neighbours or a degenerate neighbourhood leave F undetermined."""
+
+    def acc(w: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.bincount(own, weights=w, minlength=n).astype(np.float64)
+
+    x = np.stack(
+        [
+            acc(d[:, 0] * d0[:, 0]),
+            acc(d[:, 0] * d0[:, 1]),
+            acc(d[:, 1] * d0[:, 0]),
+            acc(d[:, 1] * d0[:, 1]),
+        ],
+        axis=1,
+    ).reshape(n, 2, 2)
+    y00, y01, y11 = acc(d0[:, 0] ** 2), acc(d0[:, 0] * d0[:, 1]), acc(d0[:, 1] ** 2)
+    det = y00 * y11 - y01 * y01
+    count = np.bincount(own, minlength=n)
+    good = (count >= 2) & (det > 1e-10 * (y00 + y11) ** 2) & matched
+    inv = np.zeros((n, 2, 2))
+    safe = np.where(good, det, 1.0)
+    inv[:, 0, 0] = y11 / safe
+    inv[:, 1, 1] = y00 / safe
+    inv[:, 0, 1] = inv[:, 1, 0] = -y01 / safe
+    F = np.einsum("nij,njk->nik", x, inv)
+    F[~good] = np.nan
+
+    resid = d - np.einsum("kij,kj->ki", F[own], d0)
+    d2min = np.bincount(own, weights=np.einsum("ki,ki->k", resid, resid), minlength=n).astype(
+        np.float64
+    )
+    d2min[~good] = np.nan
+    return F, d2min, count
+
+
 class LocalStrain(Compute):
     r"""Displacement, rotation, best-fit local strain and D2min between two snapshots.
 
@@ -186,35 +230,7 @@ class LocalStrain(Compute):
         d0 = np.concatenate([d0, -d0])
         d = np.concatenate([d, -d])
 
-        def acc(w: NDArray[np.float64]) -> NDArray[np.float64]:
-            return np.bincount(own, weights=w, minlength=n).astype(np.float64)
-
-        x = np.stack(
-            [
-                acc(d[:, 0] * d0[:, 0]),
-                acc(d[:, 0] * d0[:, 1]),
-                acc(d[:, 1] * d0[:, 0]),
-                acc(d[:, 1] * d0[:, 1]),
-            ],
-            axis=1,
-        ).reshape(n, 2, 2)
-        y00, y01, y11 = acc(d0[:, 0] ** 2), acc(d0[:, 0] * d0[:, 1]), acc(d0[:, 1] ** 2)
-        det = y00 * y11 - y01 * y01
-        count = np.bincount(own, minlength=n)
-        good = (count >= 2) & (det > 1e-10 * (y00 + y11) ** 2) & matched
-        inv = np.zeros((n, 2, 2))
-        safe = np.where(good, det, 1.0)
-        inv[:, 0, 0] = y11 / safe
-        inv[:, 1, 1] = y00 / safe
-        inv[:, 0, 1] = inv[:, 1, 0] = -y01 / safe
-        F = np.einsum("nij,njk->nik", x, inv)
-        F[~good] = np.nan
-
-        resid = d - np.einsum("kij,kj->ki", F[own], d0)
-        d2min = np.bincount(own, weights=np.einsum("ki,ki->k", resid, resid), minlength=n).astype(
-            np.float64
-        )
-        d2min[~good] = np.nan
+        F, d2min, count = _deformation_gradients(own, d0, d, n, matched)
 
         eye = np.eye(2)
         if self.strain_measure == "small":
