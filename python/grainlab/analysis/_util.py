@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -201,3 +202,18 @@ def axial_direction(doubled: Any) -> Any:
     angle near 2 pi, such as a horizontal axis, would otherwise give pi)."""
     theta = np.mod(0.5 * np.asarray(doubled, dtype=np.float64), np.pi)
     return np.where(theta > np.pi - 1e-12, 0.0, theta)
+
+
+def json_number(x: float | None) -> float | None:
+    """``x`` as a JSON number: None for None, NaN and inf."""
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def random_subset(
+    p: NDArray[np.float64], v: NDArray[np.float64], k: int, rng: np.random.Generator
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """At most ``k`` rows of ``p`` and ``v`` (a random subset when there are more)."""
+    if p.shape[0] <= k:
+        return p, v
+    pick = rng.choice(p.shape[0], size=k, replace=False)
+    return p[pick], v[pick]

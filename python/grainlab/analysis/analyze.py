@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from grainlab.analysis._util import json_number
 from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
 from grainlab.analysis.force_chains import ForceChains
 from grainlab.analysis.loops import ContactLoops
@@ -48,9 +49,7 @@ class AnalysisResult:
 
     def summary(self) -> dict[str, Any]:
         """The scalar results, as written to ``fabric.json`` (angles in degrees)."""
-
-        def num(x: float | None) -> float | None:
-            return None if x is None or not math.isfinite(x) else float(x)
+        num = json_number
 
         a = self.anisotropy
         fa = self.force_anisotropy
@@ -127,9 +126,7 @@ class AnalysisResult:
     def network_summary(self) -> dict[str, Any]:
         """The fabric tensor, loops, porosity, force networks, stress-force-fabric
         and force chains' scalars (``fabric.json``; None where not computed)."""
-
-        def num(x: float | None) -> float | None:
-            return None if x is None or not math.isfinite(x) else float(x)
+        num = json_number
 
         def nums(values: dict[str, Any]) -> dict[str, Any]:
             return {

@@ -1,39 +1,12 @@
 r"""Fabric inside and outside a shear band, and how well lambda alone finds the band.
 
-Given one snapshot's per-grain stability index lambda (and contact counts)
-and a band membership (True for the grains inside the band), :class:`BandFabric`
-measures both groups of grains:
-
-- ``mean_lambda``: mean lambda over the group's grains with at least 2 contacts
-  (the library's :attr:`StabilityIndex.mean <grainlab.analysis.StabilityIndex.mean>`);
-- ``mean_lambda_all``: over every grain of the group, the 0- and 1-contact
-  grains at lambda = 1 (:attr:`StabilityIndex.mean_all
-  <grainlab.analysis.StabilityIndex.mean_all>`);
-- ``coordination_number``: mean grain-grain contacts per grain of the group;
-- ``fraction_0``, ``fraction_1``, ``fraction_2``, ``fraction_3_or_more``:
-  shares of the group's grains with 0, 1, 2 and >= 3 contacts (counted as
-  lambda counts them), and ``fraction_2_of_load_bearing`` /
-  ``fraction_3_or_more_of_load_bearing``: the same among the grains with >= 2
-  contacts (the paper's Fig. 13 filters out the 0- and 1-contact grains);
-- ``fraction_lambda_above_half``: share with lambda > 0.5 (every grain);
-- ``mean_abs_rotation_rad``: mean absolute rotation since a reference state.
-
-**Does lambda alone locate the band?** The area under the ROC curve of a
-score s as a classifier of membership,
-
-.. math::
-
-   \mathrm{AUC} = P(s_{in} > s_{out}) + \tfrac12 P(s_{in} = s_{out})
-   = \frac{U_{in}}{n_{in}\, n_{out}},
-
-the Mann-Whitney U statistic of the band grains' scores against the others'
-(:func:`roc_auc`): 1 when every band grain scores above every other grain,
-0.5 when the score carries no information, 0 when it ranks them the other way.
-It is computed for the per-grain lambda (``auc_lambda``, every grain, 0/1
-contacts at lambda = 1) and for the lambda field coarse-grained over a disk of
-``coarse_radius`` mean diameters around each grain (``auc_lambda_field``,
-:func:`coarse_grained`), which asks whether a *region* of high lambda marks
-the band even when single grains scatter.
+:class:`BandFabric` gives :data:`GROUP_MEASURES` of the band's grains and of
+the others (mean lambda under both conventions, contacts per grain, the shares
+of 0-, 1-, 2- and >= 3-contact grains, of lambda > 0.5, the mean |rotation|),
+and the ROC AUC (:func:`roc_auc`, the Mann-Whitney U over
+:math:`n_{in} n_{out}`) of per-grain lambda and of lambda coarse-grained over
+a disk (:func:`coarse_grained`) as classifiers of band membership.
+docs/analysis.md, "The band against the rest".
 
 Example
 -------
@@ -159,15 +132,6 @@ class BandFabric(Compute):
         Radius of the disk that :func:`coarse_grained` averages lambda over,
         in mean grain diameters (the local strain's neighbourhood,
         docs/fabric.md).
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    inside, outside : dict
-        :data:`GROUP_MEASURES` of the band's grains and of the others.
-    auc_lambda : float
-        ROC AUC of per-grain lambda (NaN when a group is empty).
-    auc_lambda_field : float
-        ROC AUC of the coarse-grained lambda field.
 
     Example
     -------

@@ -1,81 +1,22 @@
-r"""Fabric measures: coordination numbers, contact-normal distribution, anisotropy.
+r"""Fabric measures: coordination numbers, the contact-normal distribution, anisotropy.
 
-Conventions (docs/conventions.md, docs/fabric.md):
+Angles in rad, CCW from +x; a contact's normal line counts in both directions
+(:math:`\theta`, :math:`\theta + \pi`). By default only contacts between sample
+particles count (``include_boundary=True`` adds walls and membrane disks).
 
-* Angles in rad inside the code, CCW from +x; a contact's normal *line* is
-  counted in both directions (:math:`\theta` and :math:`\theta + \pi`), so the
-  angular distributions are centrosymmetric.
-* By default only contacts between sample particles enter the fabric measures
-  (contacts with walls and membrane particles are left out, as is usual for
-  Z = 2 Nc / Np); ``include_boundary=True`` adds them.
+* :math:`Z = 2 N_c / N_p`; :math:`Z_m` the same after the iterative removal of
+  the rattlers, particles with fewer than ``min_contacts`` (2) contacts.
+* Eq. 6, :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos 2(\theta-\theta_a)]`:
+  the exact :math:`a = 2|\frac{1}{W}\sum_c w_c e^{2i\theta_c}|`,
+  :math:`\theta_a = \frac12\arg\sum_c w_c e^{2i\theta_c}` in [0, pi)
+  (= :math:`2(\phi_1 - \phi_2)` of the fabric tensor
+  :math:`\phi = \frac1W\sum_c w_c n_c\otimes n_c`), and Eq. 7-8 as printed on
+  an ``ng``-bin histogram (atan2 for tan^-1; angles within ``edge_tolerance``
+  of a bin edge count half to each bin).
+* a_n: the same with each contact weighted by its normal force (N).
 
-Coordination number
-    :math:`Z = 2 N_c / N_p` with :math:`N_p` the sample particles and
-    :math:`N_c` the contacts between them (with boundary contacts included,
-    :math:`Z` is the mean number of contacts per sample particle, each
-    boundary body counted once per particle unless ``boundary="each"``).
-
-Mechanical coordination number (rattler rule)
-    A *rattler* is a particle with fewer than ``min_contacts`` contacts
-    (default 2: with friction a grain needs at least two contacts to carry
-    load, and 0/1-contact grains carry none; this is Thornton's rule). Rattlers
-    are removed *iteratively*: removing one may leave a neighbour below the
-    threshold. :math:`Z_m = 2 N_c^m / N_p^m` over the remaining particles and
-    the contacts among them. ``min_contacts=3`` gives the frictionless
-    isostatic rule (d + 1 in 2D).
-
-Anisotropy: the exact estimate (the headline value)
-    Fitting Eq. 6, :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos
-    2(\theta-\theta_a)]`, to the contact normals by their second Fourier
-    moment,
-
-    .. math::
-
-       a = 2\,\Bigl|\tfrac{1}{W}\sum_c w_c\, e^{2 i \theta_c}\Bigr|,\qquad
-       \theta_a = \tfrac12 \arg \sum_c w_c\, e^{2 i \theta_c},
-
-    unbinned and unbiased for Eq. 6. In terms of the 2D fabric tensor
-    :math:`\phi = \frac{1}{W}\sum_c w_c\, n_c \otimes n_c` (trace 1, 2D
-    prefactors: :math:`\phi = \tfrac12 I + \tfrac{a}{4} \begin{pmatrix}
-    \cos 2\theta_a & \sin 2\theta_a \\ \sin 2\theta_a & -\cos 2\theta_a
-    \end{pmatrix}`), :math:`a = 2(\phi_1 - \phi_2)` and :math:`\theta_a` is
-    the direction of the major eigenvector. A hexagonal or a square lattice
-    gives exactly 0 (six or four directions have no second harmonic).
-
-Contact-normal histogram and Eq. 7–8 as printed (the binned value)
-    ``ng`` bins of width :math:`\Delta\theta = 2\pi/n_g` over
-    :math:`[0, 2\pi)`, bin ``g = 1..ng`` covering
-    :math:`[(g-1)\Delta\theta, g\Delta\theta)`; :math:`N_g` counts the contact
-    ends in bin g (each contact twice) and :math:`N = \sum_g N_g`. An angle
-    within ``edge_tolerance`` (default :data:`EDGE_TOLERANCE_RAD`) of a bin
-    edge counts half to each of the two bins, so that contacts lying on edges
-    (lattices) do not fall into one bin or the other by round-off.
-
-    .. math::
-
-       a = \frac{2 \sin\Delta\theta}{N \Delta\theta}
-           \sqrt{S^2 + C^2},\qquad
-       \theta_a = \tfrac12 \operatorname{atan2}(S, C),\qquad
-       S = \sum_g N_g \sin((2g-1)\Delta\theta),\;
-       C = \sum_g N_g \cos((2g-1)\Delta\theta).
-
-    The paper writes :math:`\tan^{-1}(S/C)`; we use ``atan2`` so that
-    :math:`\theta_a \in [0, \pi)` is the direction of the major axis.
-    Binning a distribution of Eq. 6 multiplies its second harmonic by
-    :math:`\sin\Delta\theta/\Delta\theta`, so the printed prefactor returns
-    :math:`a (\sin\Delta\theta / \Delta\theta)^2` in expectation, 0.960 a at
-    18 bins. Binning also moves each contact to its bin centre: directions
-    whose spacing is a whole number of bins (a hexagonal lattice at 18 bins)
-    keep a = 0, others do not (a square lattice gives
-    :math:`\frac{\sin\Delta\theta}{\Delta\theta}\, 2\sin\frac{\Delta\theta}{2}
-    = 0.340` at 18 bins, 90° being 4.5 bins).
-
-Normal-force anisotropy a_n
-    The same formulas with each contact weighted by its normal force
-    :math:`f_n` (Eq. 7 with :math:`N_g` the sum of normal forces in bin g and
-    :math:`N` the total), as the paper's Fig. 7 draws it. This force-weighted
-    measure combines contact-orientation and force-magnitude anisotropy (to
-    first order :math:`a + a_n^{RB}` of Rothenburg & Bathurst).
+Formulas, binning effects and lattice answers: docs/fabric.md, "Coordination
+number Z" to "Contact-force anisotropy a_n".
 """
 
 from __future__ import annotations
@@ -315,17 +256,6 @@ class CoordinationNumber(Compute):
         :class:`~grainlab.analysis.StabilityIndex` does; ``"each"`` counts
         every contact (every membrane disk touched).
 
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    coordination_number, mechanical_coordination_number : float
-    n_contacts : (N,) int
-        Contacts per particle (0 for membrane particles).
-    rattlers : (N,) bool
-    count_distribution : (max + 1,) float
-        Fraction of sample particles with 0, 1, 2, ... contacts.
-    n_particles, n_contacts_total : int
-        N_p and N_c used for Z.
-
     Example
     -------
     >>> import numpy as np
@@ -405,7 +335,7 @@ class CoordinationNumber(Compute):
     mechanical_coordination_number = Computed[float](
         "Z_m over the particles left after iterative rattler removal."
     )
-    n_contacts = Computed[NDArray[np.int64]]("(N,) contacts per particle.")
+    n_contacts = Computed[NDArray[np.int64]]("(N,) contacts per particle (0 for membrane particles).")
     rattlers = Computed[NDArray[np.bool_]]("(N,) mask of the rattlers.")
     count_distribution = Computed[NDArray[np.float64]](
         "Fraction of sample particles with k contacts, k = 0, 1, 2, ..."
@@ -448,23 +378,6 @@ class ContactAnisotropy(Compute):
         the distribution is one of contact normals).
     edge_tolerance : float, rad, default :data:`EDGE_TOLERANCE_RAD`
         Angles this close to a bin edge count half to each neighbouring bin.
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    anisotropy, direction : float
-        a (or a_n) and theta_a (rad, [0, pi)): the exact estimate, unbinned.
-    anisotropy_binned, direction_binned : float
-        The same by Eq. 7–8 as printed, from :attr:`histogram`.
-    anisotropy_fourier, direction_fourier : float
-        Equal to :attr:`anisotropy` and :attr:`direction` (their earlier name).
-    histogram : (bins,) float
-        Counts N_g (or summed normal force, N) per bin, each contact twice
-        (halves for contacts on a bin edge).
-    bin_edges : (bins + 1,) float, rad
-    fabric_tensor : (2, 2) float
-        ``sum w n (x) n / sum w``.
-    total : float
-        Number of contacts used (or the sum of their normal forces).
 
     Example
     -------

@@ -1,29 +1,11 @@
-r"""Force chains by the criterion of Peters et al. (2005) (docs/fabric.md,
-"Force chains").
+r"""Force chains by the criterion of Peters et al. (2005).
 
-1. Each grain's Love-Weber stress
-   :math:`\sigma^p = -\frac{1}{\pi r_p^2}\sum_{c \ni p}\operatorname{sym}((x_c - x_p)\otimes f^p_c)`
-   (:class:`~grainlab.analysis.stress.GrainStress`), its major principal
-   stress :math:`\sigma_1^p` and direction :math:`m_p`.
-2. A grain is **highly stressed** when :math:`\sigma_1^p > \bar\sigma_1`,
-   the mean over the sample grains (every grain, rattlers at 0, as Peters et
-   al. average over all particles), by more than a relative 1e-9 (grains
-   loaded alike differ by round-off only: a uniformly loaded lattice has no
-   highly stressed grain).
-3. Two highly stressed grains in contact are **linked** when their branch
-   vector :math:`l` is within ``angle`` (default 45°) of both major
-   directions, :math:`|\hat l\cdot m_p| \ge \cos(\text{angle})` and the same
-   for the other grain.
-4. A **force chain** is a connected set of linked grains of at least
-   ``min_grains`` (default 3) grains. Each grain belongs to at most one
-   chain; a chain may branch where the criterion links a grain to more than
-   two others (Peters et al. follow single paths; in a dense packing the two
-   agree but for the rare branch).
-
-Statistics: each chain's length (its grains), its orientation
-:math:`\theta = \tfrac12\arg\sum_{\text{links}} e^{2i\theta_l}` in [0°, 180°)
-(the axial mean of its links' directions), the chains' number, mean length
-and the fraction of sample grains in chains.
+Grains whose major principal stress exceeds the sample grains' mean (by a
+relative 1e-9) are highly stressed; two in contact are linked when their
+branch vector lies within ``angle`` (45°) of both major directions; a chain is
+a connected set of linked grains of at least ``min_grains`` (3), each grain in
+at most one. Orientation: the axial mean :math:`\tfrac12\arg\sum e^{2i\theta_l}`
+of its links, in [0, pi). docs/fabric.md, "Force chains".
 """
 
 from __future__ import annotations
@@ -56,19 +38,6 @@ class ForceChains(Compute):
         principal direction.
     min_grains : int, default 3
         Fewest grains in a chain.
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    chain : (N,) int
-        The chain of each grain, 0, 1, ... (longest first), -1 for none.
-    lengths : (n_chains,) int
-        Grains per chain.
-    orientations : (n_chains,) float, rad in [0, pi)
-    n_chains, mean_length, fraction_in_chains : summary numbers.
-    major_stress : (N,) float, Pa
-    highly_stressed : (N,) bool
-    links : (Nc,) bool
-        The contacts that link two grains of one chain.
 
     Example
     -------
@@ -154,7 +123,7 @@ class ForceChains(Compute):
     chain = Computed[NDArray[np.int64]](
         "(N,) chain number of each grain (longest first), -1 outside chains."
     )
-    lengths = Computed[NDArray[np.int64]]("(n_chains,) grains in each chain.")
+    lengths = Computed[NDArray[np.int64]]("(n_chains,) grains in each chain, longest first.")
     orientations = Computed[NDArray[np.float64]](
         "(n_chains,) axial mean direction of each chain's links, rad in [0, pi)."
     )

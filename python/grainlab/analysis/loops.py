@@ -1,32 +1,11 @@
-r"""The loops of the contact network (docs/fabric.md, "Loops").
+r"""The loops of the contact network: cyclomatic number and minimal loops.
 
-The **contact graph** has the sample grains as vertices and their contacts
-with each other as edges (walls and membrane disks are not part of it); by
-default the rattlers are removed first, iteratively, by Thornton's rule
-(grains with fewer than 2 contacts,
-:func:`~grainlab.analysis.fabric.rattlers`), which also removes every
-dangling branch, as Kruyt and Rothenburg's loop analysis does.
-
-Independent cycles
-    The cyclomatic number :math:`L = E - V + C` (edges, vertices, connected
-    components, isolated grains each a component).
-
-Minimal loops
-    Drawn with straight branches between centres, the contact graph of
-    disks is planar, and its **faces** are the minimal loops (Kruyt and
-    Rothenburg; Tordesillas et al. call them minimal cycles): the smallest
-    closed paths of contacts enclosing a void. Each face is traced through
-    the half-edges: with every grain's contacts sorted counter-clockwise,
-    the half-edge after :math:`u \to v` is :math:`v \to w`, w the contact of
-    v just clockwise from u, which keeps the face on the left. A face's
-    **size** is its number of half-edges (its grains, for a simple loop).
-    Summed along a face, the turns between successive branches give
-    :math:`+2\pi` for a bounded face, :math:`-2\pi` for the outer boundary
-    of a bounded packing and 0 for a face that wraps around a periodic cell;
-    only the bounded faces are loops. In a bounded connected packing the
-    loops number :math:`L` (Euler); in a periodic cell :math:`L - 1`.
-
-A hexagonal lattice has loops of size 3 only, a square lattice of size 4.
+The contact graph: sample grains and their contacts with each other, the
+rattlers removed first by default (Thornton's rule, iteratively). The
+cyclomatic number :math:`L = E - V + C`; the minimal loops are the bounded
+faces of the planar graph of branches, traced through the half-edges, a
+loop's size its number of half-edges (a hexagonal lattice has loops of 3, a
+square one of 4). docs/fabric.md, "Loops of the contact network".
 """
 
 from __future__ import annotations
@@ -55,20 +34,6 @@ class ContactLoops(Compute):
     ----------
     remove_rattlers : bool, default True
         Remove the rattlers (fewer than 2 contacts, iteratively) first.
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    cyclomatic_number : int
-        L = E - V + C of the graph used.
-    loop_sizes : (F,) int
-        Size of each minimal loop.
-    size_distribution : (max + 1,) float
-        Fraction of the loops of each size 0, 1, 2, ... (0, 1, 2 are empty).
-    mean_loop_size : float
-    grain_loop_size : (N,) float
-        Mean size of the loops a grain sits on (NaN for grains on none).
-    in_graph : (N,) bool
-        The grains of the graph.
 
     Example
     -------

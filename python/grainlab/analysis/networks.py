@@ -1,29 +1,14 @@
-r"""The strong and weak force networks (Radjai et al. 1998; docs/fabric.md,
-"Strong and weak networks").
+r"""The strong and weak force networks (Radjai et al. 1998).
 
-The contacts between sample grains (``include_boundary`` adds those with
-walls and membrane disks) are split at their mean normal force
-:math:`\langle f_n\rangle`: the **strong** network holds the contacts with
-:math:`f_n > \langle f_n\rangle`, the **weak** one the rest. For each network
-k (and for all the contacts together):
-
-* its anisotropies :math:`a, a_n, a_t` and directions (Rothenburg and
-  Bathurst's forms fitted to the network's own contacts,
-  :func:`~grainlab.analysis.stress_fabric.force_anisotropies`);
-* its stress, the contact form restricted to the network,
-  :math:`\sigma^k = \frac{1}{A}\sum_{c \in k}\operatorname{sym}(l_c\otimes f_c)`
-  (:func:`~grainlab.analysis.stress.contact_stress`), so
-  :math:`\sigma^s + \sigma^w = \sigma`;
-* its share of the deviatoric stress, the projection of its deviator on the
-  whole one,
-
-  .. math:: \chi_k = \frac{\operatorname{dev}\sigma^k : \operatorname{dev}\sigma}
-                          {\operatorname{dev}\sigma : \operatorname{dev}\sigma},
-            \qquad \chi_s + \chi_w = 1,
-
-  and of the mean stress, :math:`p_k / p` (also summing to 1). Radjai et
-  al. found the weak network's deviatoric share near zero (or negative):
-  it carries pressure, the strong one the shear.
+Contacts between sample grains (``include_boundary`` adds walls and membrane
+disks) split at their mean normal force: strong :math:`f_n > \langle
+f_n\rangle`, weak the rest. Each network (and the whole) has its anisotropies
+(:func:`~grainlab.analysis.stress_fabric.force_anisotropies`), its stress
+(:func:`~grainlab.analysis.stress.contact_stress`, :math:`\sigma^s + \sigma^w
+= \sigma`), its deviatoric share :math:`\chi_k = \operatorname{dev}\sigma^k :
+\operatorname{dev}\sigma / \operatorname{dev}\sigma : \operatorname{dev}\sigma`
+and mean-stress share :math:`p_k / p` (each pair summing to 1).
+docs/fabric.md, "Strong and weak networks".
 """
 
 from __future__ import annotations
@@ -101,13 +86,6 @@ class ForceNetworks(Compute):
     area : float, m^2, optional
         For the stresses (default the snapshot's region); the shares do not
         depend on it.
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    mean_normal_force : float, N
-    strong, weak, whole : :class:`Network`
-    in_strong_network : (N,) bool
-        Grains with at least one strong contact.
 
     Example
     -------

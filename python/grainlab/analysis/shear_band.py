@@ -1,100 +1,20 @@
-r"""Shear band detection from a per-particle shear strain field.
+r"""The shear band as a straight slab in a per-particle strain field.
 
-The band is modelled as a straight slab: a centre line at angle
-:math:`\beta` (CCW from +x, in [0°, 180°)) and a thickness :math:`w`.
-
-1. **Orientation.** For a trial angle :math:`\beta` the particles are
-   projected on the slab normal :math:`n = (-\sin\beta, \cos\beta)`,
-   :math:`s = (x - \bar x) \cdot n`, and binned in ``s`` (bins of
-   ``bin_width``, default half a mean diameter). Only the bins where the
-   slab *crosses the sample* take part: those with at least ``min_fill``
-   (default 1/2) times as many particles within 2 mean diameters as the
-   fullest position of that angle. The ends of the range, where a slab
-   only clips a corner of the sample, hold few particles; in a biaxial
-   test the platen corners concentrate strain there, and a slab through a
-   corner would otherwise win both the angle score and the peak search
-   (the reason why earlier versions found no band on real runs). The score
-   is the adjusted correlation ratio of the strain with the bin,
-
-   .. math::
-
-      \eta^2 = \frac{\sum_b n_b (\bar\gamma_b - \bar\gamma)^2}
-                    {\sum_p (\gamma_p - \bar\gamma)^2},\qquad
-      \eta^2_{adj} = 1 - (1 - \eta^2)\frac{M - 1}{M - B},
-
-   (M particles, B occupied bins, over the bins used), the share of the
-   strain variance that the profile across the slab explains
-   (:attr:`ShearBand.score`). It is largest when the bins run parallel to
-   the band. A 1° scan over [0°, 180°) is refined with 0.05° steps around
-   the best angle and a parabola through the top three scores (the middle
-   of a plateau of equal scores).
-2. **Profile and thickness.** At the best angle the bin means
-   :math:`\bar\gamma_b` form the profile across the band (:attr:`profile`).
-   It is smoothed to the mean strain of the particles within about one mean
-   diameter of each bin. With the background :math:`\gamma_0` the median
-   strain and the peak :math:`\gamma_{max}` the largest smoothed value among
-   the bins that cross the sample, the band is the run of those bins around
-   the peak where the smoothed profile is above half height
-   :math:`\gamma_0 + (\gamma_{max} - \gamma_0)/2`; its edges are
-   interpolated linearly between the mean positions of the particles in
-   neighbouring bins. ``thickness`` is their distance (m), the full width at
-   half height of the band's strain profile; ``thickness_diameters`` divides
-   by the mean diameter. The kinematic shear zone (where the displacement
-   parallel to the band changes) is wider: the strain tails off on both
-   sides of the half-height edges.
-3. **Members.** Sample particles whose centre lies inside the slab.
-4. **Acceptance** (:attr:`found`, :attr:`reason`). The band's excess strain
-   :math:`\gamma_{max} - \gamma_0` is compared with the largest excess of the
-   smoothed profile elsewhere (beyond one band thickness, at least 2 mean
-   diameters, from each edge, bins crossing the sample only):
-   ``prominence`` is their ratio. A band is accepted when it is at least
-   ``min_thickness`` (1) mean diameter thick and its prominence is at least
-   ``min_prominence`` (2). On noise (strains shuffled over the grains of a
-   real run, or random non-affine displacements of a packing) the
-   prominence stayed below 1.8 in 240 trials; real bands at 10 % axial strain
-   score 3 to 5. A candidate that fails keeps all its numbers, so that a
-   report can show it as a candidate; :attr:`reason` says what failed.
-5. **Second band** (:attr:`second`). The same search over the particles
-   outside the first band and its flanks (2 mean diameters beyond each
-   edge), at directions at least 20° away from the first band's: in a
-   biaxial test, the conjugate band. It is a ShearBand of its own, with its
-   own :attr:`found`; its members may include first-band particles where the
-   bands cross.
-
-``contrast = (gamma_max - gamma_0) / gamma_max`` in [0, 1] tells how much of
-the strain in the band is excess over the background (0: nothing stands
-out). ``shear_strain`` is a dimensionless strain: an excess below 1e-9 counts
-as none (round-off of an affine deformation).
-
-Reading the angle
-    :attr:`angle_degrees` is the direction of the band's centre line, CCW
-    from +x, in [0°, 180°): a band rising to the right has an angle below
-    90°, a band falling to the right an angle above 90°. The inclination to
-    a direction at angle :math:`\alpha` (e.g. the minor principal stress
-    :math:`\sigma_3`) is the acute angle between the two lines,
-    :math:`\theta = |((\beta - \alpha + 90°) \bmod 180°) - 90°|`, in
-    [0°, 90°]. In a biaxial test loaded along y, :math:`\sigma_3` is
-    horizontal (:math:`\alpha = 0`): :math:`\theta = \min(\beta, 180° -
-    \beta)`, which :attr:`inclination_degrees` gives. That :math:`\theta` is
-    the angle the classical predictions give: Mohr–Coulomb
-    :math:`45° + \varphi/2`, Roscoe :math:`45° + \psi/2`, Arthur
-    :math:`45° + (\varphi + \psi)/4` (friction angle :math:`\varphi`,
-    dilatancy angle :math:`\psi`).
-
-Which field to pass: :attr:`LocalStrain.excess_shear_strain` (the shear
-invariant of each particle's strain minus the background strain) separates a
-band from a homogeneous deformation of the whole sample better than the total
-:attr:`LocalStrain.shear_strain`, whose invariant mixes the two non-linearly;
-:func:`grainlab.analysis.analyze_snapshot` and the biaxial figures use it.
-
-For a report, :meth:`ShearBand.summary` gives the scalars as a JSON-ready
-dict (``found``, ``reason``, ``angle_deg``, ``inclination_deg``,
-``thickness_diameters``, ``contrast``, ``prominence``, ..., ``second``).
+A centre line at angle :math:`\beta` (CCW from +x, [0°, 180°)) and a
+thickness: the angle maximises the adjusted correlation ratio
+:math:`\eta^2_{adj}` of the strain with bins across the slab (bins that cross
+the sample only); the thickness is the full width at half height of the
+smoothed profile around its peak; a band is accepted when at least
+``min_thickness`` mean diameters thick and its ``prominence`` at least
+``min_prominence`` (:mod:`~grainlab.analysis.band_acceptance`); a second
+(conjugate) band is searched outside the first, at least 20° away.
+``inclination_degrees = min(beta, 180° - beta)``. Pass
+:attr:`LocalStrain.excess_shear_strain`. The method, its thresholds and how to
+read the angle: docs/fabric.md, "Shear band".
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -103,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import uniform_filter1d
 
 from grainlab.analysis._compute import Compute, Computed
-from grainlab.analysis._util import finite_mean
+from grainlab.analysis._util import finite_mean, json_number, random_subset
 from grainlab.analysis.band_acceptance import (
     FLANK_D,
     MIN_EXCESS,
@@ -315,7 +235,10 @@ class SlabBand(Compute):
     found and accepted, and so what its thickness measures, is the subclass's."""
 
     found = Computed[bool]("Whether the band passed the acceptance tests (the class docstring).")
-    reason = Computed[str]("Why the band was not accepted (empty when :attr:`found`).")
+    reason = Computed[str](
+        "Why the band was not accepted (empty when :attr:`found`); the other results "
+        "describe the candidate either way."
+    )
     angle = Computed[float]("Band direction, rad in [0, pi), CCW from +x.")
 
     @property
@@ -338,7 +261,7 @@ class SlabBand(Compute):
     thickness_diameters = Computed[float]("Band thickness in mean particle diameters.")
     mean_diameter = Computed[float]("Mean diameter of the particles considered, m.")
     center = Computed[NDArray[np.float64]]("(2,) a point on the centre line, m.")
-    normal = Computed[NDArray[np.float64]]("(2,) unit normal of the band.")
+    normal = Computed[NDArray[np.float64]]("(2,) unit normal of the band, (-sin angle, cos angle) (into block B of a displacement band).")
     members = Computed[NDArray[np.bool_]]("(N,) particles inside the band.")
     _positions = Computed[NDArray[np.float64]]("(N, 2) the particles' positions, m.")
     _radii = Computed[NDArray[np.float64]]("(N,) the particles' radii, m.")
@@ -437,7 +360,7 @@ class Slab:
 class ShearBand(SlabBand):
     r"""Locate the dominant shear band (and a second one) in a per-particle strain field.
 
-    See the module docstring for the method and for how to read the angle.
+    The method, its thresholds and how to read the angle: docs/fabric.md, "Shear band".
 
     Parameters
     ----------
@@ -447,56 +370,15 @@ class ShearBand(SlabBand):
         Particles used for the coarse angle scan (a fixed-seed random subset
         when there are more); the refinement uses up to 5 times as many.
     min_fill : float, default 0.5
-        A slab position counts only where the slab crosses the sample: the
-        particles within 2 mean diameters of it are at least ``min_fill``
-        times as many as at the fullest position of that angle. Slab ends
-        that only clip a corner of the sample (where the platen corners
-        concentrate strain) are left out of the angle score and of the peak
-        search. 0 uses every bin.
+        A bin counts only where the slab crosses the sample: the particles
+        within 2 mean diameters of it are at least ``min_fill`` times those at
+        the fullest position of that angle (0: every bin).
     min_thickness : float, default 1.0
         Thinnest band accepted (:attr:`found`), in mean diameters.
     min_prominence : float, default 2.0
-        Accepted bands stand out from the profile: the band's excess strain
-        over the background is at least ``min_prominence`` times the largest
-        excess elsewhere on the profile (:attr:`prominence`).
+        Least :attr:`prominence` of an accepted band.
     second : bool, default True
-        Also look for a second band (:attr:`second`) among the particles
-        outside the first band and its flanks, at least 20° away from its
-        direction: the conjugate band of a biaxial test.
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    found : bool
-        Whether the band passes the acceptance tests (thickness, prominence).
-    reason : str
-        Why it did not ("" when found). The other results describe the
-        candidate either way.
-    angle : float
-        Band direction, rad in [0, pi), CCW from +x.
-    angle_degrees : float
-    inclination, inclination_degrees : float
-        Acute angle between the band and the x axis, [0, pi/2] (the
-        inclination to the horizontal sigma_3 direction of a biaxial test).
-    thickness : float, m
-    thickness_diameters : float
-        Thickness in mean particle diameters.
-    center : (2,) float, m
-        A point on the band's centre line.
-    members : (N,) bool
-        Sample particles inside the band.
-    mean_lambda_inside, mean_lambda_outside : float
-        Mean stability index inside / outside the band (particles with at
-        least 2 contacts when ``n_contacts`` is given); NaN without lambda.
-    contrast, prominence, score, peak_strain, background_strain : float
-    mean_diameter : float, m
-    profile : tuple of (B,) arrays
-        Bin centres ``s`` (m, from the centre line) and mean strain.
-    profile_crossing : (B,) bool
-        The profile bins where the slab crosses the sample (the ones used).
-    second : ShearBand or None
-        The strongest band among the particles outside the first one (its
-        own :attr:`found`, :attr:`angle`, ...); None with ``second=False`` or
-        when fewer than 10 particles are left.
+        Also look for a second (conjugate) band, :attr:`second`.
 
     :meth:`summary` gives the scalars (and the second band's) as a JSON-ready dict.
 
@@ -621,12 +503,12 @@ class ShearBand(SlabBand):
         parabola through the best three) and its score."""
         rng = np.random.default_rng(0)
         coarse = np.radians(np.arange(0.0, 180.0, 1.0))
-        pc, gc = self._subset(p, g, self.max_points, rng)
+        pc, gc = random_subset(p, g, self.max_points, rng)
         sc = _scores(pc, gc, coarse, width, window, self.min_fill)
         sc[self._avoided(coarse)] = -np.inf
         best = coarse[_best(sc)]
         fine = best + np.radians(np.arange(-1.5, 1.5 + 1e-9, 0.05))
-        pf, gf = self._subset(p, g, 5 * self.max_points, rng)
+        pf, gf = random_subset(p, g, 5 * self.max_points, rng)
         sf = _scores(pf, gf, fine, width, window, self.min_fill)
         sf[self._avoided(fine)] = -np.inf
         k = _best(sf)
@@ -698,17 +580,11 @@ class ShearBand(SlabBand):
         close: NDArray[np.bool_] = np.abs(diff) < _SECOND_SEPARATION
         return close
 
-    @staticmethod
-    def _subset(
-        p: NDArray[np.float64], g: NDArray[np.float64], k: int, rng: np.random.Generator
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        if p.shape[0] <= k:
-            return p, g
-        pick = rng.choice(p.shape[0], size=k, replace=False)
-        return p[pick], g[pick]
-
-    mean_lambda_inside = Computed[float]("Mean stability index of the band's particles.")
-    mean_lambda_outside = Computed[float]("Mean stability index of the other particles.")
+    mean_lambda_inside = Computed[float](
+        "Mean stability index of the band's particles (those with at least 2 contacts when "
+        "``n_contacts`` is given); NaN without lambda."
+    )
+    mean_lambda_outside = Computed[float]("The same of the other particles.")
     contrast = Computed[float]("(peak - background) / peak of the strain profile, in [0, 1].")
     prominence = Computed[float](
         "Excess strain of the band over the background divided by the largest excess elsewhere on "
@@ -728,30 +604,28 @@ class ShearBand(SlabBand):
     )
     _shear_strain = Computed[NDArray[np.float64]]("(N,) the strain field searched.")
     second = Computed["ShearBand | None"](
-        "The band found once this band's particles are removed, or None."
+        "The strongest band among the particles outside this one and its flanks (its own "
+        ":attr:`found`, ...); None with ``second=False`` or fewer than 10 particles left."
     )
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (NaN and inf as None, angles in degrees), with
         ``second`` the same dict of the second band (or None)."""
 
-        def num(x: float) -> float | None:
-            return float(x) if math.isfinite(x) else None
-
         second = self.second
         return {
             "found": self.found,
             "reason": self.reason,
-            "angle_deg": num(self.angle_degrees),
-            "inclination_deg": num(self.inclination_degrees),
-            "thickness_m": num(self.thickness),
-            "thickness_diameters": num(self.thickness_diameters),
-            "contrast": num(self.contrast),
-            "prominence": num(self.prominence),
-            "score": num(self.score),
+            "angle_deg": json_number(self.angle_degrees),
+            "inclination_deg": json_number(self.inclination_degrees),
+            "thickness_m": json_number(self.thickness),
+            "thickness_diameters": json_number(self.thickness_diameters),
+            "contrast": json_number(self.contrast),
+            "prominence": json_number(self.prominence),
+            "score": json_number(self.score),
             "n_particles": int(self.members.sum()),
-            "mean_lambda_inside": num(self.mean_lambda_inside),
-            "mean_lambda_outside": num(self.mean_lambda_outside),
+            "mean_lambda_inside": json_number(self.mean_lambda_inside),
+            "mean_lambda_outside": json_number(self.mean_lambda_outside),
             "second": second.summary() if second is not None else None,
         }
 

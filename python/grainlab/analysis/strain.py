@@ -1,44 +1,14 @@
 r"""Kinematics between two snapshots: displacement, rotation, local strain, D2min.
 
-Particles are matched by :attr:`Snapshot.ids`; results are indexed like the
-*current* snapshot and are NaN for particles absent from the reference.
-
-Local deformation gradient (Falk & Langer 1998)
-    For particle ``i`` with neighbours ``j`` in the *reference* snapshot
-    (centres within ``cutoff``, or its contacts), :math:`d^0_{ij} = X_j - X_i`
-    and :math:`d_{ij} = x_j - x_i` (minimum image in periodic directions).
-    The best-fit :math:`F_i` minimises :math:`\sum_j |d_{ij} - F_i d^0_{ij}|^2`:
-
-    .. math::
-
-       F_i = X_i Y_i^{-1},\quad X_i = \sum_j d_{ij} \otimes d^0_{ij},\quad
-       Y_i = \sum_j d^0_{ij} \otimes d^0_{ij},
-
-    and the residual is the non-affine measure
-    :math:`D^2_{min,i} = \sum_j |d_{ij} - F_i d^0_{ij}|^2` (m²). Particles with
-    fewer than 2 non-collinear neighbours get NaN.
-
-Strain (compression positive, docs/conventions.md)
-    small: :math:`\varepsilon = I - \tfrac12(F + F^T)`;
-    green: :math:`\varepsilon = -\tfrac12(F^T F - I)`.
-    Volumetric strain :math:`\varepsilon_v = \varepsilon_{xx} +
-    \varepsilon_{yy}` (compression positive). The 2D shear strain invariant is
-    the maximum engineering shear strain (the diameter of Mohr's circle),
-
-    .. math::
-
-       \gamma = \sqrt{(\varepsilon_{xx} - \varepsilon_{yy})^2
-                      + 4 \varepsilon_{xy}^2},
-
-    so a simple shear of amount :math:`\gamma` gives :math:`\gamma`.
-
-Excess shear strain
-    The same invariant of :math:`\varepsilon_i - \bar\varepsilon`, where
-    the background strain :math:`\bar\varepsilon` is the component-wise
-    median of the finite local strains: the part of the local deformation
-    that the sample as a whole does not share. A shear band in an otherwise
-    homogeneously deforming sample stands out in it cleanly; it is the field
-    :class:`~grainlab.analysis.shear_band.ShearBand` is given by default.
+Particles matched by id; results indexed like the current snapshot, NaN where
+unmatched. Per particle, the best-fit :math:`F_i = X_i Y_i^{-1}` of its
+reference neighbours' branch vectors (Falk & Langer 1998),
+:math:`D^2_{min} = \sum_j |d_{ij} - F_i d^0_{ij}|^2` (m²); strain compression
+positive, small :math:`I - \tfrac12(F + F^T)` or Green :math:`-\tfrac12(F^TF -
+I)`; shear strain :math:`\gamma = \sqrt{(\varepsilon_{xx} -
+\varepsilon_{yy})^2 + 4\varepsilon_{xy}^2}`, and the excess shear strain, the
+same of :math:`\varepsilon_i - \bar\varepsilon` (:math:`\bar\varepsilon` the
+component-wise median). docs/fabric.md, "Local strain and D2min".
 """
 
 from __future__ import annotations
@@ -150,20 +120,6 @@ class LocalStrain(Compute):
     strain : {"small", "green"}, default "small"
         Infinitesimal strain from sym(F) or Green–Lagrange strain.
 
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    displacement : (N, 2) float, m
-    displacement_magnitude : (N,) float, m
-    rotation : (N,) float, rad (NaN unless both snapshots have rotations)
-    deformation_gradient : (N, 2, 2) float
-    strain : (N, 2, 2) float, compression positive
-    shear_strain : (N,) float
-    excess_shear_strain : (N,) float
-    background_strain : (2, 2) float
-    volumetric_strain : (N,) float, compression positive
-    d2min : (N,) float, m²
-    n_neighbours : (N,) int
-
     Example
     -------
     >>> import numpy as np
@@ -266,7 +222,9 @@ class LocalStrain(Compute):
         d = self.displacement
         return np.hypot(d[:, 0], d[:, 1])
 
-    rotation = Computed[NDArray[np.float64]]("(N,) rotation increment, rad, CCW positive.")
+    rotation = Computed[NDArray[np.float64]](
+        "(N,) rotation increment, rad, CCW positive (NaN unless both snapshots have rotations)."
+    )
     deformation_gradient = Computed[NDArray[np.float64]](
         "(N, 2, 2) best-fit local deformation gradient F."
     )
@@ -287,7 +245,6 @@ class LocalStrain(Compute):
     n_neighbours = Computed[NDArray[np.int64]](
         "(N,) number of reference neighbours used in the fit."
     )
-
     cutoff_used = Computed[float]("Neighbour radius used, m (NaN for neighbours='contacts').")
     _current = Computed[Snapshot]("The current snapshot (drawn by plot).")
 

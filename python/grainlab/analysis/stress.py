@@ -1,40 +1,16 @@
-r"""The average stress tensor of a set of particles from their contact forces
-(Love-Weber), a check on boundary stresses; the stress of each grain, of a
-region and of a set of contacts (a force network).
+r"""Love-Weber stress from contact forces: of each grain, of a region, of a set of contacts.
 
-For particles ``p`` in a region of area ``A`` (unit thickness), with contact
-forces ``f_c`` acting on ``p`` at contact points ``x_c``::
+Compression positive, Pa, unit thickness. For the particles ``p`` of a region
+of area ``A``, with the forces ``f_c`` on ``p`` at the contact points ``x_c``,
 
-    sigma_ij = -(1 / A) * sum_p sum_{c of p} (x_c - x_p)_i (f_c)_j
+.. math:: \sigma = -\frac{1}{A}\sum_p\sum_{c \ni p}\operatorname{sym}((x_c - x_p)\otimes f_c),
 
-symmetrised, **compression positive** (hence the minus sign). Every contact of a
-selected particle counts, including those with walls and with particles outside
-the selection (the boundary forces), so in static equilibrium the result equals
-the boundary stress.
-
-On a :class:`~grainlab.snapshot.Snapshot` (docs/fabric.md, "Stress"):
-
-* the force on particle i of contact c is
-  :math:`f^i_c = -f_{n,c}\, n_c + f_{s,c}\, t_c`, ``t = rot90(n)``, and
-  :math:`-f^i_c` acts on j (or on the wall); the contact point is the stored
-  one, else :math:`x_i + (r_i - \delta_c/2)\, n_c` with the overlap
-  :math:`\delta_c = r_i + r_j - |l_c|` (a wall contact without a point:
-  :math:`x_i + r_i n_c`);
-* the stress of a set C of contacts (:func:`contact_stress`) is the contact
-  (branch-vector) form
-
-  .. math:: \sigma^C = \frac{1}{A}\sum_{c \in C} \operatorname{sym}(l_c \otimes (-f^i_c)),
-
-  with the branch vector :math:`l_c = x_j - x_i` (minimum image; a wall
-  contact: contact point minus :math:`x_i`); summed over every contact of a
-  region it is the particle sum above, term by term. It is linear in the
-  contacts, so the stresses of disjoint sets of contacts add up to that of
-  their union (the strong and weak networks);
-* the stress of grain p (:func:`grain_stress`, :class:`GrainStress`) is
-  the particle sum over p alone,
-  :math:`\sigma^p = -\frac{1}{V_p}\sum_{c \ni p}\operatorname{sym}((x_c - x_p)\otimes f^p_c)`,
-  with :math:`V_p = \pi r_p^2` (unit thickness) or any area given (a power
-  cell, :class:`~grainlab.analysis.tessellation.LocalPorosity`).
+every contact of a selected particle counted (walls and particles outside
+included: in equilibrium, the boundary stress). The contact (branch-vector)
+form :math:`\frac1A\sum_{c\in C}\operatorname{sym}(l_c\otimes(-f^i_c))` is
+linear in the contacts (:func:`contact_stress`); a grain's stress divides by
+:math:`\pi r_p^2` or any area given. Forces, contact points and branch
+vectors: docs/fabric.md, "Stress: grains, regions and sets of contacts".
 """
 
 from __future__ import annotations

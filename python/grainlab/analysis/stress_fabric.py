@@ -1,74 +1,23 @@
-r"""Satake's fabric tensor and the stress-force-fabric relation of Rothenburg
-and Bathurst (docs/fabric.md, "Fabric tensor" and "Stress-force-fabric").
+r"""Satake's fabric tensor and Rothenburg and Bathurst's stress-force-fabric relation.
 
-Contacts used: those between sample grains by default (``include_boundary``
-adds the grains' contacts with walls and membrane disks), each once, its
-normal :math:`n_c = (\cos\theta_c, \sin\theta_c)` from i to j.
+Contacts between sample grains by default (``include_boundary`` adds walls and
+membrane disks), each once, normal :math:`n_c` from i to j.
+:math:`\phi_{ij} = \frac{1}{N_c}\sum_c n_i n_j` (trace 1),
+:math:`\phi_{ijkl}` its fourth-order companion, :math:`b_4 = |\langle
+e^{4i\theta}\rangle|`, and with forces the strong and weak parts. The forms
+:math:`E(\theta)`, :math:`\bar f_n = f_0[1 + a_n\cos 2(\theta-\theta_n)]`,
+:math:`\bar f_t = f_0 a_t\sin 2(\theta-\theta_t)` (and the branch lengths'
+:math:`a_l`) are least-squares fits to the contacts (NaN with normals in
+fewer than three directions modulo 180°), and
 
-Satake's fabric tensor (2D, trace 1) and its fourth-order companion
-    .. math::
+.. math::
 
-       \phi_{ij} = \frac{1}{N_c}\sum_c n_i n_j,\qquad
-       \phi_{ijkl} = \frac{1}{N_c}\sum_c n_i n_j n_k n_l ,
+   \frac{q}{p} = \frac{\sigma_1 - \sigma_2}{\sigma_1 + \sigma_2} \approx
+   \tfrac12\left[a\cos 2(\theta_a - \theta_\sigma) + a_n\cos 2(\theta_n -
+   \theta_\sigma) + a_t\cos 2(\theta_t - \theta_\sigma)\right].
 
-    :math:`a = 2(\phi_1 - \phi_2)` and :math:`\theta_a` the major direction
-    (the exact estimate of Eq. 6, :mod:`grainlab.analysis.fabric`). The
-    fourth harmonic :math:`b_4 = |\langle e^{4i\theta}\rangle|` is what
-    :math:`\phi_{ij}` cannot see: a hexagonal lattice has :math:`\phi = I/2`,
-    :math:`\phi_{xxxx} = 3/8` and :math:`b_4 = 0`; a square lattice has
-    :math:`\phi = I/2` too, but :math:`\phi_{xxxx} = 1/2` and
-    :math:`b_4 = 1`. With forces, the **strong and weak parts**
-    :math:`\phi^{s,w}_{ij} = \frac{1}{N_c}\sum_{c \in s,w} n_i n_j`
-    (contacts with :math:`f_n` above / not above the mean, Radjai et al.
-    1998) sum to :math:`\phi`.
-
-Anisotropies of Rothenburg and Bathurst (1989)
-    .. math::
-
-       E(\theta) = \tfrac{1}{2\pi}[1 + a\cos 2(\theta - \theta_a)],\quad
-       \bar f_n(\theta) = f_0[1 + a_n\cos 2(\theta - \theta_n)],\quad
-       \bar f_t(\theta) = f_0\, a_t \sin 2(\theta - \theta_t),
-
-    :math:`a, \theta_a` from the second moment of the normals (as above);
-    :math:`f_0, a_n, \theta_n` the least-squares fit of the contacts'
-    normal forces, :math:`f_{n,c} \approx c_0 + c_1\cos 2\theta_c + c_2\sin
-    2\theta_c`, :math:`f_0 = c_0`, :math:`a_n = \sqrt{c_1^2 + c_2^2}/c_0`,
-    :math:`\theta_n = \frac12\operatorname{atan2}(c_2, c_1)`; :math:`a_t,
-    \theta_t` the fit :math:`f_{t,c} \approx d_1\cos 2\theta_c + d_2\sin
-    2\theta_c`, :math:`a_t = \sqrt{d_1^2+d_2^2}/c_0`, :math:`\theta_t =
-    \frac12\operatorname{atan2}(-d_1, d_2)` (``f_t`` the shear force on i
-    along ``rot90(n)``, so that a positive :math:`a_t` adds to the stress
-    along :math:`\theta_t`). Being fits to the forces themselves, these are
-    exact whenever the forces follow the forms, whatever the normals; NaN
-    when the normals take fewer than three directions modulo 180° (two
-    directions cannot separate :math:`f_0` from :math:`a_n`) and :math:`a_t`
-    NaN without shear forces. The branch lengths are fitted the same way,
-    :math:`|l_c| \approx l_0[1 + a_l\cos 2(\theta_c - \theta_l)]` (Ouadfel
-    and Rothenburg's branch-length anisotropy, 0 for disks of one size).
-
-Stress-force-fabric relation
-    With the stress of the same contacts (:func:`~grainlab.analysis.stress.contact_stress`),
-    principal values :math:`\sigma_1 \ge \sigma_2` and major direction
-    :math:`\theta_\sigma`, Rothenburg and Bathurst's first-order relation is
-
-    .. math::
-
-       \frac{q}{p} = \frac{\sigma_1 - \sigma_2}{\sigma_1 + \sigma_2}
-       \approx \tfrac12\left[a\cos 2(\theta_a - \theta_\sigma)
-       + a_n\cos 2(\theta_n - \theta_\sigma)
-       + a_t\cos 2(\theta_t - \theta_\sigma)\right],
-
-    (coaxial: :math:`\tfrac12(a + a_n + a_t)`), and
-    :math:`\sigma_1/\sigma_2 = (1 + q/p)/(1 - q/p)`. The measure reports
-    both sides and the residual measured − predicted: the products of
-    anisotropies, the fourth and higher harmonics of the normals and of the
-    forces, and the branch-length anisotropy of a polydisperse packing,
-    which the relation leaves out; the last is also reported, and the
-    prediction and residual with :math:`\tfrac12 a_l\cos 2(\theta_l -
-    \theta_\sigma)` added. On a hexagonal lattice with forces of
-    the forms the residual is 0 (its normals have no fourth harmonic); a
-    square lattice loaded along one axis has a = 0, q/p = 1, and its
-    :math:`a_n` is NaN (two directions).
+Fits, signs and known answers: docs/fabric.md, "Fabric tensor (Satake)" and
+"Stress-force-fabric relation".
 """
 
 from __future__ import annotations

@@ -1,41 +1,13 @@
-r"""The radical Voronoi tessellation (power diagram) of a disk packing and the
-local porosity of each grain (docs/fabric.md, "Local porosity").
+r"""The power diagram (radical Voronoi tessellation) of a disk packing and local porosity.
 
-The **power cell** of disk p (centre :math:`x_p`, radius :math:`r_p`) is the
-set of points nearer to it in the power distance than to any other disk,
-
-.. math::
-
-   C_p = \{x : |x - x_p|^2 - r_p^2 \le |x - x_q|^2 - r_q^2\ \ \forall q\},
-
-so the boundary between two touching disks runs through their contact point
-(in a plain Voronoi tessellation of centres it cuts the larger disk), each
-disk lies inside its own cell when disks do not overlap, and the cells tile
-the plane: this is the tessellation for polydisperse disks. The **local
-porosity** of grain p is
-
-.. math:: n_p = 1 - \frac{\pi r_p^2}{A_p},
-
-with :math:`A_p` the area of its cell (unit thickness); the porosity of the
-sample is :math:`1 - \sum_p \pi r_p^2 / \sum_p A_p` over its grains.
-
-The region tessellated is the snapshot's region (its box, else the rectangle
-bounding the disks, :func:`~grainlab.analysis._util.sample_bounds`, widened
-in a non-periodic direction to hold every disk). A periodic direction is
-tessellated with periodic images, a bounded one with the mirror images of
-the disks across its two edges, so the cells end exactly on the edge and
-every point of the region belongs to one cell: the cells sum to the region's
-area. Every particle has a cell (membrane disks too: they bound the cells of
-the grains next to them).
-
-Implementation: the power diagram is the dual of the regular triangulation,
-which is the lower convex hull of the points lifted to
-:math:`(x, y, |x|^2 - r^2)` (``scipy.spatial.ConvexHull``, Qhull); the vertex
-of the cells of a lower face's three disks is the point
-:math:`(\alpha/2, \beta/2)` of its plane :math:`z = \alpha x + \beta y +
-\gamma`. Images are made only within a margin of the edges (3 largest
-diameters, doubled until every cell is closed and no missing image could
-cut a cell). No Python loop runs over particles.
+The cell of disk p is :math:`\{x : |x - x_p|^2 - r_p^2 \le |x - x_q|^2 - r_q^2\
+\forall q\}`; the local porosity :math:`n_p = 1 - \pi r_p^2 / A_p` (unit
+thickness) and the sample's :math:`1 - \sum_p \pi r_p^2 / \sum_p A_p` over
+its grains. The region is the snapshot's (:func:`~grainlab.analysis._util.sample_bounds`),
+tessellated with periodic images or mirror images across bounded edges, so
+the cells sum to its area; every particle has a cell. The diagram is the dual
+of the lower convex hull of the lifted points (Qhull). docs/fabric.md,
+"Local porosity".
 """
 
 from __future__ import annotations
@@ -229,15 +201,6 @@ class LocalPorosity(Compute):
     cells of area :math:`\tfrac{\sqrt3}{2} d^2`, so
     :math:`n_p = 1 - \pi/(2\sqrt3) = 0.0931`.
 
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    cell_area : (N,) float, m^2
-    local_porosity : (N,) float
-        NaN for membrane disks and for a particle without a cell.
-    porosity : float
-        Of the sample grains' cells together.
-    cells : :class:`PowerCells`
-
     Example
     -------
     >>> import numpy as np
@@ -270,7 +233,8 @@ class LocalPorosity(Compute):
         return self.cells.area
 
     local_porosity = Computed[NDArray[np.float64]](
-        "(N,) 1 - pi r^2 / A_p of each sample grain (NaN for membrane disks)."
+        "(N,) 1 - pi r^2 / A_p of each sample grain (NaN for membrane disks and a particle "
+        "without a cell)."
     )
     porosity = Computed[float]("1 - (grains' disk area) / (their cells' area).")
 

@@ -1,42 +1,18 @@
-r"""The shear band of a biaxial run, found and accepted (or not) between two snapshots.
+"""The shear band of a biaxial run, found and accepted (or not) between two snapshots.
 
-:func:`find_band` fits the grains' local strain since a reference snapshot
-(:class:`~grainlab.analysis.LocalStrain`, on the **grains only**: membrane
-disks are much smaller than the grains and are not part of the sample; they
-would set the neighbour radius and the background strain) and searches it
-with :class:`~grainlab.analysis.ShearBand`. Grains whose centre lies within
-one mean diameter of the boundary (membrane disk centres and platen contact
-points; the grains' bounding box when there are neither) are left out of the
-search, since their one-sided neighbourhoods give spurious strains; they
-still belong to the band when they lie inside it. The candidate band is
-accepted when it
-
-1. passes ShearBand's own tests (:attr:`ShearBand.found
-   <grainlab.analysis.ShearBand.found>`): at least one mean grain diameter
-   thick, and its excess strain over the background at least twice the
-   largest excess elsewhere on the profile across it,
-2. crosses the sample: the centre line's chord through the grains is at
-   least 3/4 of the sample's smaller side and the band's grains cover at
-   least 3/4 of that chord (a slab that cuts off a corner is not a band),
-3. explains more of the strain variance (adjusted eta², as ShearBand scores
-   it) than the band found in each of 19 random rearrangements of the same
-   strain values over the same grains (p <= 0.05, fixed seed).
-
-Otherwise the band is "not found" and :attr:`BandNumbers.reason` says why.
-The **second band** (ShearBand's second pass, without the first band's
-grains and at least 20 degrees away from its direction: the conjugate band
-of a biaxial test) is reported in the ``second_*`` fields of
-:class:`BandNumbers` and accepted when it passes tests 1 and 2 (and the
-first band was found). Means of lambda in and out of the band are over
-grains with at least 2 contacts (the paper's 0.34 vs 0.31).
-
-**Other readings of the band.** :func:`find_field_band` runs the same search
-and the same acceptance (one code path: :func:`find_band` is the field band of
-the excess local strain) on any per-grain field; Fig. 12's band is its band of
-:func:`lambda_indicator`, the grains with lambda > 0.5. :func:`displacement_band`
-reads Fig. 11's band, the zone between two blocks of the grains' displacement
-field (:class:`~grainlab.analysis.DisplacementBand`, with its own acceptance).
-:func:`band_labels` labels the grains by any of the three readings.
+:func:`find_band` searches the grains' excess local strain since a reference
+snapshot (:class:`~grainlab.analysis.LocalStrain` on the grains only) with
+:class:`~grainlab.analysis.ShearBand`, leaving out the grains within
+:data:`EDGE_D` mean diameters of the boundary, and accepts the candidate by
+the rules of :mod:`grainlab.analysis.band_acceptance`: ShearBand's own tests,
+crossing the sample, and a permutation test against :data:`N_PERMUTATIONS`
+random rearrangements of the values (p <= 0.05, fixed seed); the second band
+by the first two. :func:`find_field_band` runs the same search and acceptance
+(one code path) on any per-grain field, Fig. 12's being
+:func:`lambda_indicator`; :func:`displacement_band` reads Fig. 11's band
+(:class:`~grainlab.analysis.DisplacementBand`); :func:`band_labels` labels the
+grains by any reading. docs/analysis.md, "Figures of a biaxial run" and
+"Three readings of the shear band".
 """
 
 from __future__ import annotations
