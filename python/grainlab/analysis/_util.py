@@ -16,27 +16,17 @@ from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot, boundary_end_
 def contact_ends(
     snapshot: Snapshot, *, include_boundary: bool, boundary: str = "each"
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
-    """Owner particle and contact angle of every contact *end* on a sample particle.
+    """Owner particle and contact angle of every contact *end* on a sample particle:
+    ``owner (K,)``, ``angle (K,)`` in [0, 2 pi) and the (Nc,) mask of the contacts used.
 
-    Each particle–particle contact gives two ends (angle theta on i, theta +
-    pi on j); a wall contact gives one end on its particle. Ends on membrane
-    particles are dropped; with ``include_boundary=False`` so are the contacts
-    with walls or membrane particles.
-
-    ``boundary="body"`` merges the ends of one particle on one boundary body
-    (a wall, one membrane chain: :meth:`Snapshot.boundary_bodies`) into one
-    end at the normal-force-weighted mean direction of those contacts
-    (unweighted when they carry no force, or the snapshot has no forces; the
-    first contact's direction if the mean vanishes). ``"each"`` keeps every
-    contact.
-
-    Order: first the ends on the ``i`` side of the used contacts, in
-    contact-list order, then those on the ``j`` side (a merged end sits where
-    the first end of its group does); :func:`contact_ends_in_list_order` gives
-    each particle's ends in the order of the contact list instead.
-
-    Returns ``owner (K,)``, ``angle (K,)`` in [0, 2 pi) and the (Nc,) mask of
-    the contacts used.
+    A particle-particle contact gives two ends (theta on i, theta + pi on j), a
+    wall contact one; ends on membrane particles are dropped, and with
+    ``include_boundary=False`` the contacts with walls or membrane particles.
+    ``boundary="body"`` merges a particle's ends on one boundary body into one at
+    the normal-force-weighted mean direction (docs/fabric.md, "Boundary
+    contacts"). Order: the ends on the ``i`` side of the used contacts, in list
+    order, then those on the ``j`` side (:func:`contact_ends_in_list_order`: each
+    contact's two ends together).
     """
     owner, ends, keep, _ = _contact_ends(snapshot, include_boundary, boundary)
     return owner, ends, keep

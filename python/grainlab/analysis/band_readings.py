@@ -29,14 +29,12 @@ from grainlab.analysis.band_acceptance import (
     reduction_problems,
     transition_problems,
 )
-from grainlab.analysis.shear_band import SlabBand, _best
+from grainlab.analysis.shear_band import SlabBand, _best, binned_profile
 
 __all__ = ["MIN_GRAINS", "SHARE_HIGH", "SHARE_LOW", "DisplacementBand"]
 
 #: The band's edges: the smoothed share of the relative motion crosses these.
 SHARE_LOW, SHARE_HIGH = 0.1, 0.9
-#: Width (mean diameters) of the running mean over the profile bins (as ShearBand's).
-_SMOOTH_D = 2.0
 #: Flank (mean diameters) left out, with the band, of the blocks' refits; number of refits.
 _FLANK_D = 1.0
 _REFITS = 3
@@ -176,15 +174,7 @@ def _transition(s: NDArray[np.float64], t: NDArray[np.float64], bin_width: float
     s_ok, t_ok = s[ok], t[ok]
     b = ((s_ok - s_ok.min()) / bin_width).astype(np.int64)
     counts = np.bincount(b).astype(np.float64)
-    sums = np.bincount(b, weights=t_ok)
-    occupied = counts > 0
-    centers = np.bincount(b, weights=s_ok)[occupied] / counts[occupied]
-    mean = sums[occupied] / counts[occupied]
-    half_window = max(1, int(np.floor(0.5 * _SMOOTH_D / bin_width + 0.5)))
-    kernel = np.ones(2 * half_window + 1)
-    near_sums = np.convolve(sums, kernel, mode="same")
-    near_counts = np.convolve(counts, kernel, mode="same")
-    smooth = (near_sums / np.maximum(near_counts, 1.0))[occupied]
+    _, centers, mean, smooth = binned_profile(b, counts, t_ok, s_ok, bin_width)
     inside = (smooth > SHARE_LOW) & (smooth < SHARE_HIGH)
     if not inside.any():
         return _no_transition(

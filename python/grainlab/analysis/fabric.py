@@ -241,7 +241,7 @@ class CoordinationNumber(Compute):
 
     .. math:: Z = \frac{2 N_c}{N_p}, \qquad Z_m = \frac{2 N_c^m}{N_p^m}
 
-    (see the module docstring for the rattler rule).
+    (the rattler rule: docs/fabric.md, "Mechanical coordination number Z_m").
 
     Parameters
     ----------
@@ -363,7 +363,8 @@ class ContactAnisotropy(Compute):
     2(\theta - \theta_a)]`. The headline :attr:`anisotropy` and
     :attr:`direction` are the exact (unbinned) estimate from the second
     Fourier moment; :attr:`anisotropy_binned` and :attr:`direction_binned`
-    are the paper's Eq. 7–8 on the histogram (see the module docstring).
+    are the paper's Eq. 7–8 on the histogram (docs/fabric.md,
+    "Contact-normal distribution and anisotropy (Eq. 6–8)").
 
     Parameters
     ----------

@@ -187,6 +187,28 @@ class _Profile:
         return 0.5 * (self.s_lo + self.s_hi)
 
 
+def binned_profile(
+    b: NDArray[np.int64],
+    counts: NDArray[Any],
+    values: NDArray[np.float64],
+    s: NDArray[np.float64],
+    bin_width: float,
+) -> tuple[NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """A profile of ``values`` across a band from the bin ``b`` of each point and the
+    bins' ``counts``: the occupied bins, their points' mean ``s`` and mean value, and
+    the mean value of the points within about ``_SMOOTH_D / 2`` mean diameters of
+    each (``bin_width`` in mean diameters); the last three for occupied bins only."""
+    sums = np.bincount(b, weights=values, minlength=counts.size)
+    occupied = counts > 0
+    centers = np.bincount(b, weights=s, minlength=counts.size)[occupied] / counts[occupied]
+    half_window = max(1, int(np.floor(0.5 * _SMOOTH_D / bin_width + 0.5)))
+    kernel = np.ones(2 * half_window + 1)
+    near_sums = np.convolve(sums, kernel, mode="same")
+    near_counts = np.convolve(counts.astype(np.float64), kernel, mode="same")
+    smooth = (near_sums / np.maximum(near_counts, 1.0))[occupied]
+    return occupied, centers, sums[occupied] / counts[occupied], smooth
+
+
 def _band_profile(
     s: NDArray[np.float64], g: NDArray[np.float64], width: float, window: int, bin_width: float, min_fill: float
 ) -> _Profile:
@@ -194,16 +216,8 @@ def _band_profile(
     half-height edges around the highest smoothed bin that crosses the sample."""
     b2, counts2, crossing2 = _slab_bins(s, width, window, min_fill)
     b, counts, crossing = b2[0], counts2[0], crossing2[0]
-    sums = np.bincount(b, weights=g, minlength=counts.size)
-    occupied = counts > 0
-    centers = np.bincount(b, weights=s, minlength=counts.size)[occupied] / counts[occupied]
-    prof = sums[occupied] / counts[occupied]
+    occupied, centers, prof, smooth = binned_profile(b, counts, g, s, bin_width)
     keep = crossing[occupied]
-    half_window = max(1, int(np.floor(0.5 * _SMOOTH_D / bin_width + 0.5)))
-    kernel = np.ones(2 * half_window + 1)
-    near_sums = np.convolve(sums, kernel, mode="same")
-    near_counts = np.convolve(counts.astype(np.float64), kernel, mode="same")
-    smooth = (near_sums / np.maximum(near_counts, 1.0))[occupied]
     background = float(np.median(g))
     ipeak = int(np.argmax(np.where(keep, smooth, -np.inf)))
     peak = float(smooth[ipeak])

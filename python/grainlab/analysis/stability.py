@@ -116,33 +116,16 @@ def stability_index(
     anchor: str = "min",
     deviation: str = "sum",
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """Stability index of every particle from its contact ends.
+    """Stability index of every particle from its contact ends: ``owner`` (K,) int,
+    the particle (``0 <= owner < n_particles``) of each end (a particle-particle
+    contact gives two), and ``angles`` (K,) rad, CCW from +x (taken modulo 2 pi).
 
-    Parameters
-    ----------
-    owner : (K,) int
-        Particle index (``0 <= owner < n_particles``) of each contact end.
-        A particle–particle contact contributes two ends (one per particle).
-    angles : (K,) float, rad
-        Angle of each end on its particle, CCW from +x (any real value; taken
-        modulo 2 pi).
-    n_particles : int
-    slots : {"angular", "list", "nearest"}, default "angular"
-    anchor : {"min", "mean"}, default "min"
-    deviation : {"sum", "per_contact"}, default "sum"
-        The reading of Eq. 9-11 (module docstring). With ``slots="list"`` each
-        particle's ends are taken in the order they appear in ``owner`` /
-        ``angles`` (a stable sort by owner keeps it). The default reading runs
-        in the compiled kernel, the others in NumPy.
-
-    Returns
-    -------
-    lam : (n_particles,) float
-        lambda >= 0 (at most floor(n^2/4)/n for n contacts under the default
-        reading; see the module docstring); 1 for particles with 0 or 1
-        contact.
-    counts : (n_particles,) int
-        Number of contacts of each particle.
+    Returns ``lam`` (n_particles,), lambda >= 0 (1 for 0 or 1 contact; at most
+    floor(n^2/4)/n for n contacts under the default reading), and ``counts``
+    (n_particles,), the ends of each particle. ``slots``, ``anchor``,
+    ``deviation``: the reading of Eq. 9-11 (docs/fabric.md, "Readings of Eqs.
+    9-11"; with ``slots="list"`` a particle's ends are taken in the order given);
+    the default runs in the compiled kernel, the others in NumPy.
     """
     default = _check_reading(slots, anchor, deviation)
     owner = np.asarray(owner, dtype=np.int64).reshape(-1)

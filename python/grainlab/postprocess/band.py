@@ -389,26 +389,14 @@ def find_field_band(
 ) -> BandSearch:
     """The band of a per-grain ``field`` of ``snapshot``, accepted as the strain band is.
 
-    ``field`` is (N,) per particle of ``snapshot`` (membrane disks' entries are
-    not read) or (N_grains,) per sample grain, in the grains' order; NaN
-    entries are left out. The search and its acceptance are :func:`find_band`'s
-    (the module docstring: ShearBand's tests, crossing the sample, the
-    permutation test against 19 rearrangements of the field's values; edge
-    grains left out of the search), on ``field`` instead of the local strain.
-    ``stability`` (``snapshot``'s computed :class:`StabilityIndex`, computed
-    with the defaults when None) gives the means of lambda in and out of the
-    band. There is no reference state: :attr:`BandSearch.displacement` is NaN
-    and :attr:`BandNumbers.reference` empty. Searches are not kept.
-
-    **Fig. 12's band** is :func:`lambda_indicator`'s field, ``lambda > 0.5``
-    per grain (``band_labels(..., reading="lambda")``). The indicator, not
-    lambda coarse-grained over a disk of 2 mean diameters: it is the paper's
-    reading of the figure (the zone of grains with lambda above 0.5), and the
-    permutation test needs values that are exchangeable between grains when
-    there is no band. A coarse-grained field is correlated over its disk, so
-    that every rearrangement of its values is rougher than the field itself
-    and any smooth field would pass as significant; ShearBand smooths its
-    profile across the band anyway (over about 2 mean diameters).
+    ``field`` is (N,) per particle (membrane disks' entries not read) or
+    (N_grains,) per sample grain; NaN entries are left out. The search and its
+    acceptance are :func:`find_band`'s, on ``field``; ``stability`` (computed with
+    the defaults when None) gives the means of lambda in and out of the band.
+    Without a reference state :attr:`BandSearch.displacement` is NaN and
+    :attr:`BandNumbers.reference` empty. Fig. 12's band is that of
+    :func:`lambda_indicator` (why the indicator: docs/analysis.md, "Three readings
+    of the shear band").
     """
     g = snapshot.is_sample
     values = np.asarray(field, dtype=np.float64)
@@ -455,23 +443,13 @@ def displacement_zone(reference: Snapshot, current: Snapshot) -> DisplacementZon
 
 
 def band_labels(reference: Snapshot, current: Snapshot, reading: str = "strain") -> NDArray[np.int32]:
-    """(N,) per particle of ``current``: 1 inside the accepted shear band, 2
-    inside its accepted conjugate band, 0 elsewhere (membrane disks, and every
-    particle when no band passes the tests).
-
-    ``reading`` (one of :data:`READINGS`) says where the band is read:
-
-    * ``"strain"`` (default): the bands the figures outline, found in the
-      grains' local strain since ``reference`` (:func:`find_band`);
-    * ``"displacement"``: the zone between the two blocks of the grains'
-      displacements since ``reference`` (:func:`displacement_band`, Fig. 11):
-      label 1 for its members, no conjugate band;
-    * ``"lambda"``: the band of the grains with lambda > 0.5 in ``current``
-      (:func:`find_field_band` on :func:`lambda_indicator`, ``StabilityIndex()``
-      defaults; Fig. 12), with its conjugate band as for the strain.
-
-    The labels are found anew; a run's are stored in its ``run.h5``
-    (:class:`grainlab.postprocess.products.RunProducts`).
+    """(N,) per particle of ``current``: 1 inside the accepted shear band, 2 inside
+    its accepted conjugate band, 0 elsewhere (membrane disks, and every particle
+    when no band passes the tests), the band read as ``reading`` (one of
+    :data:`READINGS`) says: ``"strain"`` (:func:`find_band`), ``"displacement"``
+    (:func:`displacement_band`, Fig. 11: label 1 only) or ``"lambda"``
+    (:func:`find_field_band` on :func:`lambda_indicator`, Fig. 12). Found anew;
+    a run's are stored in its ``run.h5`` (:class:`~grainlab.postprocess.products.RunProducts`).
     """
     if reading not in READINGS:
         raise ValueError(f"reading: must be one of {', '.join(map(repr, READINGS))}, got {reading!r}")
