@@ -59,3 +59,14 @@ def test_a_computed_measure_pickles_with_its_results():
                                   box=[[0, 6], [0, 6]], periodic=(True, True), tolerance=1e-9)
     z = pickle.loads(pickle.dumps(CoordinationNumber().compute(snap)))
     assert z.coordination_number == 4.0 and np.array_equal(z.n_contacts, np.full(36, 4))
+
+
+def test_the_repr_shows_the_declared_parameters_under_their_constructor_names():
+    assert repr(ShearBand(second=False, min_fill=0.25)) == (
+        "ShearBand(bin_width=0.5, max_points=20000, min_fill=0.25, min_thickness=1.0, "
+        "min_prominence=2.0, second=False)"
+    )
+    assert repr(CoordinationNumber(3, True, "each")) == (
+        "CoordinationNumber(min_contacts=3, include_boundary=True, boundary='each')"
+    )
+    assert repr(_Pair()) == "_Pair()"

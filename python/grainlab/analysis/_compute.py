@@ -1,11 +1,9 @@
 """A measure's computed results, each declared once (not public API).
 
-A measure subclasses :class:`Compute` and declares each result as a class
-attribute, ``name = Computed[type]("doc")``: the doc is what ``help()`` and
-the API docs show, the type what mypy checks readers against, and reading it
-before ``compute`` stored a value raises :class:`NotComputedError` naming the
-measure and the result. ``compute`` stores every declared result at once with
-:meth:`Compute._store`; the stored record is a frozen dataclass made from the
+``name = Computed[type]("doc")`` on a :class:`Compute` subclass gives the result's
+doc (``help()``, the API), its type (mypy) and the :class:`NotComputedError`,
+naming the measure and the result, raised before ``compute`` stored it with
+:meth:`Compute._store`. The stored record is a frozen dataclass made from the
 declarations (the notebook table lists its fields).
 """
 
@@ -52,6 +50,8 @@ class Compute:
 
     #: The record type of the class's results (made from its declarations).
     _record: ClassVar[type]
+    #: The constructor's parameters the repr shows, ``"name"`` or ``"name=attribute"``.
+    _parameters: ClassVar[tuple[str, ...]] = ()
     _results: Any = None
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -80,6 +80,11 @@ class Compute:
     def _store(self, **results: Any) -> None:
         """Store every declared result (a missing or unknown name is a TypeError)."""
         self._results = self._record(**results)
+
+    def __repr__(self) -> str:
+        shown = (p.partition("=") for p in self._parameters)
+        args = ", ".join(f"{name}={getattr(self, attr or name)!r}" for name, _, attr in shown)
+        return f"{type(self).__name__}({args})"
 
     def _repr_html_(self) -> str:
         """A small table for notebooks: the repr, the scalar results, the arrays' shapes and means."""

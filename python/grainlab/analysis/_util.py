@@ -35,15 +35,9 @@ def contact_ends(
 def contact_ends_in_list_order(
     snapshot: Snapshot, *, include_boundary: bool, boundary: str = "each"
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
-    """:func:`contact_ends` (the same ends, owners and angles, bit for bit) in the
-    order of the snapshot's contact list.
-
-    Contact ``c`` (``i``-``j``) gives its end on ``i``, then its end on ``j``,
-    before contact ``c + 1``'s ends, so each particle's ends come in the order
-    of its contacts in the list (the creation order, in a code that keeps
-    it). A merged boundary end (``boundary="body"``) sits where the first of
-    the particle's contacts with that body, in list order, is.
-    """
+    """:func:`contact_ends` (the same ends, bit for bit) in the order of the contact
+    list: contact ``c`` gives its end on ``i``, then on ``j``, before contact ``c + 1``'s
+    (a merged boundary end sits at the particle's first contact with that body)."""
     owner, ends, keep, source = _contact_ends(snapshot, include_boundary, boundary)
     order = np.argsort(source, kind="stable")  # a contact's i end before its j end
     return owner[order], ends[order], keep

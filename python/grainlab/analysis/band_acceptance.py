@@ -1,13 +1,10 @@
 """When a candidate shear band is a band: the acceptance rules of every reading.
 
-The strain band (:class:`~grainlab.analysis.ShearBand`), the displacement band
-(:class:`~grainlab.analysis.DisplacementBand`) and the bands that
-:mod:`grainlab.postprocess.band` accepts in a run (strain, lambda) judge their
-candidates here, with pure functions of numbers and arrays. Each rule returns
-the list of what fails (empty: passes), in words that name the numbers; a
-reading joins its lists into its ``reason``. The rules and their thresholds:
-docs/fabric.md, "Shear band", and docs/analysis.md, "Three readings of the
-shear band".
+:class:`~grainlab.analysis.ShearBand`, :class:`~grainlab.analysis.DisplacementBand`
+and :mod:`grainlab.postprocess.band` judge their candidates with these pure
+functions; each rule returns what fails (empty: passes), in words that name the
+numbers. The rules and thresholds: docs/fabric.md, "Shear band", and
+docs/analysis.md, "Three readings of the shear band".
 """
 
 from __future__ import annotations
@@ -18,18 +15,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = [
-    "CROSSING",
-    "FLANK_D",
-    "MIN_EXCESS",
-    "candidate_reason",
-    "crossing_problems",
-    "permutation_p_value",
-    "profile_prominence",
-    "reduction_problems",
-    "significance_problems",
-    "slab_eta2",
-    "strain_band_problems",
-    "transition_problems",
+    "CROSSING", "FLANK_D", "MIN_EXCESS", "candidate_reason", "crossing_problems",
+    "permutation_p_value", "profile_prominence", "reduction_problems", "significance_problems",
+    "slab_eta2", "strain_band_problems", "transition_problems",
 ]
 
 #: The band's centre line crosses at least this share of the sample's smaller side, and
@@ -51,13 +39,12 @@ def profile_prominence(
     thickness: float,
     d_mean: float,
 ) -> tuple[float, float]:
-    """``(prominence, elsewhere)`` of a strain band of ``excess`` strain over the
+    """``(prominence, elsewhere)`` of a strain band with ``excess`` strain over the
     ``background``: ``elsewhere`` is the largest excess of the smoothed profile
-    ``smooth`` (B,) beyond the band's flanks (``distance`` (B,) from its centre line
-    greater than half its ``thickness`` plus one thickness, at least
-    :data:`FLANK_D` mean diameters; only the bins ``crossing`` the sample), and
-    ``prominence = excess / elsewhere`` (0 without excess, inf when nothing else
-    is above the background). Lengths in m."""
+    ``smooth`` (B,) among the ``crossing`` bins beyond the band's flanks (``distance``
+    from its centre line > half its ``thickness`` + max(thickness, :data:`FLANK_D`
+    mean diameters), m); ``prominence = excess / elsewhere`` (0 without excess, inf
+    when nothing else is above the background)."""
     flank = 0.5 * thickness + max(thickness, FLANK_D * d_mean)
     away = crossing & (np.abs(distance) > flank)
     elsewhere = float(smooth[away].max()) - background if away.any() else 0.0
@@ -104,14 +91,11 @@ def crossing_problems(
     d_mean: float,
     crossing: float = CROSSING,
 ) -> list[str]:
-    """Whether a band crosses the sample of the grains at ``pos`` (M, 2) m.
-
-    ``s`` (M,) is each grain's distance from the centre line (of direction
-    ``tangent``), in the unit of ``thickness`` and ``reach`` (the least half
-    width of the strip around the line that measures its chord). The chord of
-    the centre line through the grains must be at least ``crossing`` of the
-    sample's smaller side, and the band's grains must cover ``crossing`` of the
-    chord; ``d_mean`` (m) is the unit of the message."""
+    """Whether a band crosses the sample of the grains at ``pos`` (M, 2) m: the chord
+    of its centre line (direction ``tangent``) through the grains within ``reach`` of
+    it is at least ``crossing`` of the sample's smaller side, and the band's grains
+    cover ``crossing`` of the chord. ``s`` (M,) is each grain's distance from the
+    line, in the unit of ``thickness`` and ``reach``; ``d_mean`` (m) the message's."""
     side = float(np.ptp(pos, axis=0).min())
     members = np.abs(s) <= 0.5 * thickness
     near = np.abs(s) <= max(0.5 * thickness, reach)

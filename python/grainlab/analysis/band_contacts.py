@@ -183,6 +183,3 @@ class BandContacts(Compute):
         from grainlab import plot
 
         return plot.band_strata(self.strata, ax=ax, **kwargs)
-
-    def __repr__(self) -> str:
-        return "BandContacts()"

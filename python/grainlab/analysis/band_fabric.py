@@ -145,6 +145,8 @@ class BandFabric(Compute):
     (1.0, 1.0, 1.0)
     """
 
+    _parameters = ("coarse_radius",)
+
     def __init__(self, coarse_radius: float = 2.0) -> None:
         if not (math.isfinite(coarse_radius) and coarse_radius > 0):
             raise ValueError(f"coarse_radius: expected a number > 0, got {coarse_radius!r}")
@@ -212,6 +214,3 @@ class BandFabric(Compute):
         out["auc_lambda"] = self.auc_lambda
         out["auc_lambda_field"] = self.auc_lambda_field
         return out
-
-    def __repr__(self) -> str:
-        return f"BandFabric(coarse_radius={self.coarse_radius})"

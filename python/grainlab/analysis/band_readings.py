@@ -281,6 +281,8 @@ class DisplacementBand(SlabBand):
     (True, 0.3)
     """
 
+    _parameters = ("bin_width", "max_points", "min_share", "min_reduction", "crossing")
+
     def __init__(
         self,
         bin_width: float = 0.5,
@@ -320,11 +322,8 @@ class DisplacementBand(SlabBand):
         since the reference (rows with a NaN are left out); ``radii`` (N,) m;
         ``mask`` (N,) bool restricts the grains considered.
 
-        The steps (module docstring): the scan for the slip line
-        (:meth:`_slip_line`), its refinement (:meth:`_refined`, reading the band
-        at each angle with :meth:`_reading`), the blocks' motions and the profile
-        across the line (:meth:`_band`), the acceptance tests
-        (:mod:`~grainlab.analysis.band_acceptance`).
+        Steps: :meth:`_slip_line`, :meth:`_refined` (:meth:`_reading`, :meth:`_band`
+        at each angle), :mod:`~grainlab.analysis.band_acceptance`.
         """
         pos, disp, rad, considered, valid = _checked(positions, displacement, radii, mask)
         d_mean = float(np.mean(2.0 * rad[considered]))
@@ -487,14 +486,8 @@ class DisplacementBand(SlabBand):
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (NaN and inf as None, angles in degrees, lengths in m)."""
-
         return {
-            "found": self.found,
-            "reason": self.reason,
-            "angle_deg": json_number(self.angle_degrees),
-            "inclination_deg": json_number(self.inclination_degrees),
-            "thickness_m": json_number(self.thickness),
-            "thickness_diameters": json_number(self.thickness_diameters),
+            **self._slab_summary(),
             "n_particles": int(self.members.sum()),
             "residual_reduction": json_number(self.residual_reduction),
             "jump_m": json_number(self.jump_magnitude),
@@ -514,13 +507,6 @@ class DisplacementBand(SlabBand):
         )
         plot.outline_shear_band(ax, self)
         return ax
-
-    def __repr__(self) -> str:
-        return (
-            f"DisplacementBand(bin_width={self.bin_width}, max_points={self.max_points}, "
-            f"min_share={self.min_share}, min_reduction={self.min_reduction}, "
-            f"crossing={self.crossing})"
-        )
 
 
 def _checked(

@@ -267,6 +267,8 @@ class CoordinationNumber(Compute):
     4.0
     """
 
+    _parameters = ("min_contacts", "include_boundary", "boundary")
+
     def __init__(
         self, min_contacts: int = 2, include_boundary: bool = False, boundary: str = "body"
     ) -> None:
@@ -349,12 +351,6 @@ class CoordinationNumber(Compute):
 
         return plot.contact_count_distribution(self.count_distribution, ax=ax)
 
-    def __repr__(self) -> str:
-        return (
-            f"CoordinationNumber(min_contacts={self.min_contacts}, "
-            f"include_boundary={self.include_boundary}, boundary={self.boundary!r})"
-        )
-
 
 class ContactAnisotropy(Compute):
     r"""Contact-normal (or normal-force) distribution and its anisotropy (Eq. 6–8).
@@ -391,6 +387,8 @@ class ContactAnisotropy(Compute):
     >>> round(fabric.anisotropy, 12), round(fabric.anisotropy_binned, 4)
     (0.0, 0.0591)
     """
+
+    _parameters = ("bins", "weight", "include_boundary", "edge_tolerance")
 
     def __init__(
         self,
@@ -508,10 +506,4 @@ class ContactAnisotropy(Compute):
             ax=ax,
             kind="forces" if self.weight == "normal_force" else "contacts",
             **kwargs,
-        )
-
-    def __repr__(self) -> str:
-        return (
-            f"ContactAnisotropy(bins={self.bins}, weight={self.weight!r}, "
-            f"include_boundary={self.include_boundary}, edge_tolerance={self.edge_tolerance!r})"
         )

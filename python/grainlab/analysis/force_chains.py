@@ -55,6 +55,8 @@ class ForceChains(Compute):
     (1, [5], 90.0)
     """
 
+    _parameters = ("angle", "min_grains")
+
     def __init__(self, angle: float = 45.0, min_grains: int = 3) -> None:
         if not 0.0 <= angle <= 90.0:
             raise ValueError(f"angle: must be in [0, 90] degrees, got {angle!r}")
@@ -189,6 +191,3 @@ class ForceChains(Compute):
             ax=ax,
             title=f"{self.n_chains} force chains (Peters et al. 2005, {self.angle:g}°)",
         )
-
-    def __repr__(self) -> str:
-        return f"ForceChains(angle={self.angle!r}, min_grains={self.min_grains})"

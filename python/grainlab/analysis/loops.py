@@ -46,6 +46,8 @@ class ContactLoops(Compute):
     (9, [4, 4, 4, 4, 4, 4, 4, 4, 4])
     """
 
+    _parameters = ("remove_rattlers",)
+
     def __init__(self, remove_rattlers: bool = True) -> None:
         self.remove_rattlers = bool(remove_rattlers)
 
@@ -164,6 +166,3 @@ class ContactLoops(Compute):
             vmin=3.0,
             label="mean size of the grain's loops",
         )
-
-    def __repr__(self) -> str:
-        return f"ContactLoops(remove_rattlers={self.remove_rattlers})"

@@ -104,6 +104,8 @@ class ForceNetworks(Compute):
     (1.5, -0.5)
     """
 
+    _parameters = ("include_boundary", "area")
+
     def __init__(self, include_boundary: bool = False, area: float | None = None) -> None:
         if area is not None and not area > 0:
             raise ValueError(f"area: must be > 0, got {area}")
@@ -202,6 +204,3 @@ class ForceNetworks(Compute):
             title=f"force network (strong: f_n > {self.mean_normal_force:.3g} N)",
             legend=[("strong", "k"), ("weak", "0.6")],
         )
-
-    def __repr__(self) -> str:
-        return f"ForceNetworks(include_boundary={self.include_boundary}, area={self.area!r})"

@@ -299,6 +299,18 @@ class SlabBand(Compute):
             extent=extent,
         )
 
+    def _slab_summary(self) -> dict[str, Any]:
+        """The first entries of every reading's ``summary()``: found, reason, angles
+        (degrees), thickness (m and mean diameters), JSON-ready."""
+        return {
+            "found": self.found,
+            "reason": self.reason,
+            "angle_deg": json_number(self.angle_degrees),
+            "inclination_deg": json_number(self.inclination_degrees),
+            "thickness_m": json_number(self.thickness),
+            "thickness_diameters": json_number(self.thickness_diameters),
+        }
+
     def outline(self, extent: ArrayLike | None = None) -> list[NDArray[np.float64]]:
         """The two band edges as (2, 2) segments clipped to ``extent`` ``[[x0, x1], [y0, y1]]``.
 
@@ -411,6 +423,15 @@ class ShearBand(SlabBand):
     False
     """
 
+    _parameters = (
+        "bin_width",
+        "max_points",
+        "min_fill",
+        "min_thickness",
+        "min_prominence",
+        "second=find_second",
+    )
+
     def __init__(
         self,
         bin_width: float = 0.5,
@@ -456,10 +477,8 @@ class ShearBand(SlabBand):
         ``shear_strain`` (N,), NaN entries are ignored; ``radii`` (N,) m;
         ``mask`` (N,) bool restricts the particles considered.
 
-        The steps: the band's orientation (:meth:`_orientation`), its profile and
-        edges across it (:func:`_band_profile`), the acceptance tests
-        (:meth:`_acceptance`), lambda inside and outside, and a second band
-        (:meth:`_second_band`).
+        Steps: :meth:`_orientation`, :func:`_band_profile`, :meth:`_acceptance`,
+        lambda inside and outside, :meth:`_second_band`.
         """
         data = _BandInput.of(positions, shear_strain, radii, mask)
         width = self.bin_width * data.d_mean
@@ -625,15 +644,9 @@ class ShearBand(SlabBand):
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (NaN and inf as None, angles in degrees), with
         ``second`` the same dict of the second band (or None)."""
-
         second = self.second
         return {
-            "found": self.found,
-            "reason": self.reason,
-            "angle_deg": json_number(self.angle_degrees),
-            "inclination_deg": json_number(self.inclination_degrees),
-            "thickness_m": json_number(self.thickness),
-            "thickness_diameters": json_number(self.thickness_diameters),
+            **self._slab_summary(),
             "contrast": json_number(self.contrast),
             "prominence": json_number(self.prominence),
             "score": json_number(self.score),
@@ -657,13 +670,6 @@ class ShearBand(SlabBand):
         )
         plot.outline_shear_band(ax, self)
         return ax
-
-    def __repr__(self) -> str:
-        return (
-            f"ShearBand(bin_width={self.bin_width}, max_points={self.max_points}, "
-            f"min_fill={self.min_fill}, min_thickness={self.min_thickness}, "
-            f"min_prominence={self.min_prominence}, second={self.find_second})"
-        )
 
 
 def _clip_line(

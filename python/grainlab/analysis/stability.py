@@ -245,6 +245,8 @@ class StabilityIndex(Compute):
     0.333333333333
     """
 
+    _parameters = ("include_boundary", "boundary", "slots", "anchor", "deviation")
+
     def __init__(
         self,
         include_boundary: bool = True,
@@ -338,10 +340,4 @@ class StabilityIndex(Compute):
             vmin=0.0,
             vmax=1.0,
             **kwargs,
-        )
-
-    def __repr__(self) -> str:
-        return (
-            f"StabilityIndex(include_boundary={self.include_boundary}, boundary={self.boundary!r}, "
-            f"slots={self.slots!r}, anchor={self.anchor!r}, deviation={self.deviation!r})"
         )

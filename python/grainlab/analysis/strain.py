@@ -133,6 +133,8 @@ class LocalStrain(Compute):
     True
     """
 
+    _parameters = ("neighbours", "cutoff", "strain=strain_measure")
+
     def __init__(
         self, neighbours: str = "radius", cutoff: float | None = None, strain: str = "small"
     ) -> None:
@@ -262,9 +264,3 @@ class LocalStrain(Compute):
                 f"quantity: must be 'displacement' or 'shear_strain', got {quantity!r}"
             )
         return plot.particle_map(snap.positions, snap.radii, values, ax=ax, label=label, **kwargs)
-
-    def __repr__(self) -> str:
-        return (
-            f"LocalStrain(neighbours={self.neighbours!r}, cutoff={self.cutoff!r}, "
-            f"strain={self.strain_measure!r})"
-        )

@@ -294,6 +294,8 @@ class LoveWeberStress(Compute):
     0.25
     """
 
+    _parameters = ("area",)
+
     def __init__(self, area: float | None = None) -> None:
         if area is not None and not area > 0:
             raise ValueError(f"area: must be > 0, got {area}")
@@ -336,6 +338,3 @@ class LoveWeberStress(Compute):
         """q = (sigma_1 - sigma_2) / 2, Pa."""
         s1, s2, _ = principal_stresses(self.stress)
         return float(0.5 * (s1 - s2))
-
-    def __repr__(self) -> str:
-        return f"LoveWeberStress(area={self.area!r})"

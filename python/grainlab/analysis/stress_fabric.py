@@ -147,6 +147,8 @@ class FabricTensor(Compute):
     ([[0.5, 0.0], [0.0, 0.5]], 0.5)
     """
 
+    _parameters = ("include_boundary",)
+
     def __init__(self, include_boundary: bool = False) -> None:
         self.include_boundary = bool(include_boundary)
 
@@ -212,9 +214,6 @@ class FabricTensor(Compute):
             values, anisotropy=self.anisotropy, direction=self.direction, ax=ax
         )
 
-    def __repr__(self) -> str:
-        return f"FabricTensor(include_boundary={self.include_boundary})"
-
 
 class StressForceFabric(Compute):
     r"""Rothenburg and Bathurst's stress-force-fabric relation, with its residual.
@@ -254,6 +253,8 @@ class StressForceFabric(Compute):
     >>> round(rb.stress_ratio, 12), round(rb.anisotropies.a_n, 12), round(rb.residual, 12)
     (1.0, 2.0, 0.0)
     """
+
+    _parameters = ("include_boundary",)
 
     def __init__(self, include_boundary: bool = False) -> None:
         self.include_boundary = bool(include_boundary)
@@ -357,6 +358,3 @@ class StressForceFabric(Compute):
             ax.set_title(f"residual {self.residual:+.3f}")
             ax.legend(frameon=False, fontsize=7)
         return ax
-
-    def __repr__(self) -> str:
-        return f"StressForceFabric(include_boundary={self.include_boundary})"

@@ -253,6 +253,3 @@ class LocalPorosity(Compute):
             ax=ax,
             label="local porosity",
         )
-
-    def __repr__(self) -> str:
-        return "LocalPorosity()"

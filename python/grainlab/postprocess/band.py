@@ -208,16 +208,12 @@ def find_band(
     reference_name: str = "",
     axial_strain: float = math.nan,
 ) -> BandSearch:
-    """The shear band of ``current`` since ``reference``, accepted or not (module docstring).
-
-    ``stability`` is ``current``'s computed :class:`StabilityIndex` (for the
-    means in and out of the band); ``name``, ``reference_name`` and
-    ``axial_strain`` label the :class:`BandNumbers`.
-
-    The search (twenty band fits: the band and its permutation test) is made
-    anew on every call; a run's searches are stored in its ``run.h5``
-    (:mod:`grainlab.postprocess.products`) and read from there.
-    """
+    """The shear band of ``current`` since ``reference``, accepted or not (module
+    docstring); ``stability`` is ``current``'s computed :class:`StabilityIndex` (the
+    means of lambda in and out of the band), ``name``, ``reference_name`` and
+    ``axial_strain`` label the :class:`BandNumbers`. Twenty band fits (the band and
+    its permutation test) on every call; a run's searches are stored in its
+    ``run.h5`` (:mod:`grainlab.postprocess.products`)."""
     found = _search(reference, current, stability)
     numbers = replace(found.numbers, snapshot=name, reference=reference_name, axial_strain=axial_strain)
     return replace(found, numbers=numbers)
