@@ -72,7 +72,7 @@ class AnalysisResult:
             "a_binned": num(a.anisotropy_binned),
             "theta_a_binned_deg": num(np.degrees(a.direction_binned)),
             "a_fourier": num(a.anisotropy_fourier),
-            "theta_a_fourier_deg": num(np.degrees(a.direction_fourier)),
+            "theta_a_fourier_deg": num(np.degrees(a.direction)),
             "fabric_tensor": a.fabric_tensor.tolist()
             if np.all(np.isfinite(a.fabric_tensor))
             else None,
@@ -81,7 +81,7 @@ class AnalysisResult:
             "a_n_binned": num(fa.anisotropy_binned) if fa else None,
             "theta_n_binned_deg": num(np.degrees(fa.direction_binned)) if fa else None,
             "a_n_fourier": num(fa.anisotropy_fourier) if fa else None,
-            "theta_n_fourier_deg": num(np.degrees(fa.direction_fourier)) if fa else None,
+            "theta_n_fourier_deg": num(np.degrees(fa.direction)) if fa else None,
             "mean_lambda": num(self.stability.mean),
             "mean_lambda_all": num(self.stability.mean_all),
             "lambda_includes_boundary_contacts": self.stability.include_boundary,

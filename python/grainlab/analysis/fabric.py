@@ -485,11 +485,6 @@ class ContactAnisotropy(Compute):
         """The exact a, :attr:`anisotropy` under its earlier name."""
         return self.anisotropy
 
-    @property
-    def direction_fourier(self) -> float:
-        """The exact theta_a, :attr:`direction` under its earlier name."""
-        return self.direction
-
     fabric_tensor = Computed[NDArray[np.float64]](
         "(2, 2) fabric tensor (force-weighted for weight='normal_force')."
     )
