@@ -2,74 +2,31 @@
 
 from __future__ import annotations
 
-from typing import Any, Generic, TypeVar
+import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from grainlab import _kernels
+from grainlab.analysis._compute import NotComputedError as NotComputedError  # re-exported
 from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot, boundary_end_groups
-
-#: A measure's results record (see :class:`Computable`).
-R = TypeVar("R")
-
-
-class NotComputedError(AttributeError):
-    """Raised when a result property is read before ``compute`` ran."""
-
-
-class Computable(Generic[R]):
-    """Base for freud-style analysis objects: results raise until computed.
-
-    ``R`` is the measure's results record, a frozen dataclass with one typed
-    field per result; ``compute`` stores one with :meth:`_store`.
-    """
-
-    _results: R | None = None
-
-    def _computed(self, name: str) -> R:
-        """The results record, read for the result ``name`` (named in the error
-        raised before ``compute`` ran)."""
-        if self._results is None:
-            raise NotComputedError(
-                f"{type(self).__name__}.{name} is not available: call compute(...) first"
-            )
-        return self._results
-
-    def _store(self, results: R) -> None:
-        self._results = results
-
-    def _repr_html_(self) -> str:
-        """A small table for notebooks: the repr, the scalar results, the arrays' shapes and means."""
-        from grainlab._repr import measure_html
-
-        return measure_html(self)
 
 
 def contact_ends(
     snapshot: Snapshot, *, include_boundary: bool, boundary: str = "each"
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
-    """Owner particle and contact angle of every contact *end* on a sample particle.
+    """Owner particle and contact angle of every contact *end* on a sample particle:
+    ``owner (K,)``, ``angle (K,)`` in [0, 2 pi) and the (Nc,) mask of the contacts used.
 
-    Each particle–particle contact gives two ends (angle theta on i, theta +
-    pi on j); a wall contact gives one end on its particle. Ends on membrane
-    particles are dropped; with ``include_boundary=False`` so are the contacts
-    with walls or membrane particles.
-
-    ``boundary="body"`` merges the ends of one particle on one boundary body
-    (a wall, one membrane chain: :meth:`Snapshot.boundary_bodies`) into one
-    end at the normal-force-weighted mean direction of those contacts
-    (unweighted when they carry no force, or the snapshot has no forces; the
-    first contact's direction if the mean vanishes). ``"each"`` keeps every
-    contact.
-
-    Order: first the ends on the ``i`` side of the used contacts, in
-    contact-list order, then those on the ``j`` side (a merged end sits where
-    the first end of its group does); :func:`contact_ends_in_list_order` gives
-    each particle's ends in the order of the contact list instead.
-
-    Returns ``owner (K,)``, ``angle (K,)`` in [0, 2 pi) and the (Nc,) mask of
-    the contacts used.
+    A particle-particle contact gives two ends (theta on i, theta + pi on j), a
+    wall contact one; ends on membrane particles are dropped, and with
+    ``include_boundary=False`` the contacts with walls or membrane particles.
+    ``boundary="body"`` merges a particle's ends on one boundary body into one at
+    the normal-force-weighted mean direction (docs/fabric.md, "Boundary
+    contacts"). Order: the ends on the ``i`` side of the used contacts, in list
+    order, then those on the ``j`` side (:func:`contact_ends_in_list_order`: each
+    contact's two ends together).
     """
     owner, ends, keep, _ = _contact_ends(snapshot, include_boundary, boundary)
     return owner, ends, keep
@@ -78,15 +35,9 @@ def contact_ends(
 def contact_ends_in_list_order(
     snapshot: Snapshot, *, include_boundary: bool, boundary: str = "each"
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
-    """:func:`contact_ends` (the same ends, owners and angles, bit for bit) in the
-    order of the snapshot's contact list.
-
-    Contact ``c`` (``i``-``j``) gives its end on ``i``, then its end on ``j``,
-    before contact ``c + 1``'s ends, so each particle's ends come in the order
-    of its contacts in the list (the creation order, in a code that keeps
-    it). A merged boundary end (``boundary="body"``) sits where the first of
-    the particle's contacts with that body, in list order, is.
-    """
+    """:func:`contact_ends` (the same ends, bit for bit) in the order of the contact
+    list: contact ``c`` gives its end on ``i``, then on ``j``, before contact ``c + 1``'s
+    (a merged boundary end sits at the particle's first contact with that body)."""
     owner, ends, keep, source = _contact_ends(snapshot, include_boundary, boundary)
     order = np.argsort(source, kind="stable")  # a contact's i end before its j end
     return owner[order], ends[order], keep
@@ -235,3 +186,18 @@ def axial_direction(doubled: Any) -> Any:
     angle near 2 pi, such as a horizontal axis, would otherwise give pi)."""
     theta = np.mod(0.5 * np.asarray(doubled, dtype=np.float64), np.pi)
     return np.where(theta > np.pi - 1e-12, 0.0, theta)
+
+
+def json_number(x: float | None) -> float | None:
+    """``x`` as a JSON number: None for None, NaN and inf."""
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def random_subset(
+    p: NDArray[np.float64], v: NDArray[np.float64], k: int, rng: np.random.Generator
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """At most ``k`` rows of ``p`` and ``v`` (a random subset when there are more)."""
+    if p.shape[0] <= k:
+        return p, v
+    pick = rng.choice(p.shape[0], size=k, replace=False)
+    return p[pick], v[pick]

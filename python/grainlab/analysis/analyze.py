@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from grainlab.analysis._util import json_number
 from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
 from grainlab.analysis.force_chains import ForceChains
 from grainlab.analysis.loops import ContactLoops
@@ -48,9 +49,7 @@ class AnalysisResult:
 
     def summary(self) -> dict[str, Any]:
         """The scalar results, as written to ``fabric.json`` (angles in degrees)."""
-
-        def num(x: float | None) -> float | None:
-            return None if x is None or not math.isfinite(x) else float(x)
+        num = json_number
 
         a = self.anisotropy
         fa = self.force_anisotropy
@@ -73,7 +72,7 @@ class AnalysisResult:
             "a_binned": num(a.anisotropy_binned),
             "theta_a_binned_deg": num(np.degrees(a.direction_binned)),
             "a_fourier": num(a.anisotropy_fourier),
-            "theta_a_fourier_deg": num(np.degrees(a.direction_fourier)),
+            "theta_a_fourier_deg": num(np.degrees(a.direction)),
             "fabric_tensor": a.fabric_tensor.tolist()
             if np.all(np.isfinite(a.fabric_tensor))
             else None,
@@ -82,7 +81,7 @@ class AnalysisResult:
             "a_n_binned": num(fa.anisotropy_binned) if fa else None,
             "theta_n_binned_deg": num(np.degrees(fa.direction_binned)) if fa else None,
             "a_n_fourier": num(fa.anisotropy_fourier) if fa else None,
-            "theta_n_fourier_deg": num(np.degrees(fa.direction_fourier)) if fa else None,
+            "theta_n_fourier_deg": num(np.degrees(fa.direction)) if fa else None,
             "mean_lambda": num(self.stability.mean),
             "mean_lambda_all": num(self.stability.mean_all),
             "lambda_includes_boundary_contacts": self.stability.include_boundary,
@@ -127,9 +126,7 @@ class AnalysisResult:
     def network_summary(self) -> dict[str, Any]:
         """The fabric tensor, loops, porosity, force networks, stress-force-fabric
         and force chains' scalars (``fabric.json``; None where not computed)."""
-
-        def num(x: float | None) -> float | None:
-            return None if x is None or not math.isfinite(x) else float(x)
+        num = json_number
 
         def nums(values: dict[str, Any]) -> dict[str, Any]:
             return {
@@ -272,34 +269,15 @@ def analyze_snapshot(
     lambda_anchor: str = "min",
     lambda_deviation: str = "sum",
 ) -> AnalysisResult:
-    """Compute the fabric measures, lambda, and (with a reference) strain and shear band.
+    """Every measure of ``snapshot`` and, with ``reference`` (an earlier state of the
+    same particles, matched by id), its local strain and shear band; writes nothing.
 
-    Parameters
-    ----------
-    snapshot
-        The state to analyse.
-    reference
-        An earlier state of the same particles (matched by id) for
-        displacements, local strain and the shear band; without it those are
-        NaN / absent and the summary says so.
-    bins
-        Angular bins over 360° for Eq. 7–8 and the polar diagrams.
-    min_contacts
-        Rattler threshold for the mechanical coordination number.
-    lambda_include_boundary, fabric_include_boundary
-        Whether wall / membrane contacts count for lambda (default yes) and
-        for Z and the anisotropies (default no).
-    strain_neighbours, strain_cutoff
-        Neighbourhood of the local strain fit (see :class:`LocalStrain`).
-    lambda_slots, lambda_anchor, lambda_deviation
-        The reading of Eq. 9-11 for lambda: :class:`StabilityIndex`'s
-        ``slots``, ``anchor`` and ``deviation`` (default ``"angular"``,
-        ``"min"``, ``"sum"``; checked before any work). Under another reading
-        the summary also carries ``lambda_reading``.
-
-    Returns
-    -------
-    AnalysisResult
+    ``bins``: angular bins over 360° (Eq. 7-8, the roses); ``min_contacts``: Z_m's
+    rattler threshold; ``lambda_include_boundary``, ``fabric_include_boundary``:
+    whether wall and membrane contacts count for lambda (yes) and for Z and the
+    anisotropies (no); ``strain_*``: :class:`LocalStrain`'s neighbourhood;
+    ``lambda_*``: :class:`StabilityIndex`'s reading of Eqs. 9-11, checked before
+    any work. What is measured, and when: docs/analysis.md, "Everything at once".
     """
     stability = StabilityIndex(  # checks the reading before any work
         include_boundary=lambda_include_boundary,
@@ -329,40 +307,12 @@ def analyze_snapshot(
         porosity = LocalPorosity().compute(snapshot)
     except (ValueError, RuntimeError) as error:  # fewer than 3 disks, all in a line (Qhull)
         notes.append(f"no power cells, local porosity not computed: {str(error).splitlines()[0]}")
-    networks = stress_force_fabric = grains = chains = None
-    if snapshot.normal_force is not None and float(np.sum(snapshot.normal_force)) > 0.0:
-        networks = ForceNetworks(include_boundary=fabric_include_boundary).compute(snapshot)
-        stress_force_fabric = StressForceFabric(include_boundary=fabric_include_boundary).compute(
-            snapshot
-        )
-        grains = GrainStress().compute(snapshot)
-        chains = ForceChains().compute(snapshot, grains)
-    else:
-        notes.append(
-            "no contact forces: force networks, stress-force-fabric and force chains not computed"
-        )
-    strain = band = None
-    if reference is None:
-        notes.append(
-            "no reference snapshot: displacement, local_shear_strain and in_shear_band are empty, "
-            "and no shear band was detected"
-        )
-    else:
-        strain = LocalStrain(neighbours=strain_neighbours, cutoff=strain_cutoff).compute(
-            reference, snapshot
-        )
-        missing = int((reference.index_of(np.asarray(snapshot.ids)) < 0).sum())
-        if missing:
-            notes.append(f"{missing} particles have no match (by id) in the reference snapshot")
-        if int(np.isfinite(strain.excess_shear_strain[snapshot.is_sample]).sum()) >= 10:
-            band = ShearBand().compute(
-                snapshot,
-                strain.excess_shear_strain,
-                stability_index=stability.stability_index,
-                n_contacts=stability.n_contacts,
-            )
-        else:
-            notes.append("fewer than 10 particles with a local strain: no shear band detected")
+    networks, stress_force_fabric, grains, chains = _force_measures(
+        snapshot, fabric_include_boundary, notes
+    )
+    strain, band = _strain_and_band(
+        snapshot, reference, stability, LocalStrain(strain_neighbours, strain_cutoff), notes
+    )
     return AnalysisResult(
         snapshot,
         coordination,
@@ -380,3 +330,52 @@ def analyze_snapshot(
         grain_stress=grains,
         chains=chains,
     )
+
+
+def _force_measures(
+    snapshot: Snapshot, include_boundary: bool, notes: list[str]
+) -> tuple[
+    ForceNetworks | None, StressForceFabric | None, GrainStress | None, ForceChains | None
+]:
+    """:func:`analyze_snapshot`'s measures of the contact forces (None without forces,
+    and a note saying so)."""
+    if snapshot.normal_force is None or float(np.sum(snapshot.normal_force)) <= 0.0:
+        notes.append(
+            "no contact forces: force networks, stress-force-fabric and force chains not computed"
+        )
+        return None, None, None, None
+    networks = ForceNetworks(include_boundary=include_boundary).compute(snapshot)
+    stress_force_fabric = StressForceFabric(include_boundary=include_boundary).compute(snapshot)
+    grains = GrainStress().compute(snapshot)
+    return networks, stress_force_fabric, grains, ForceChains().compute(snapshot, grains)
+
+
+def _strain_and_band(
+    snapshot: Snapshot,
+    reference: Snapshot | None,
+    stability: StabilityIndex,
+    strain: LocalStrain,
+    notes: list[str],
+) -> tuple[LocalStrain | None, ShearBand | None]:
+    """:func:`analyze_snapshot`'s local strain since ``reference`` and the shear band in
+    its excess strain (None where they cannot be measured, and a note saying why)."""
+    if reference is None:
+        notes.append(
+            "no reference snapshot: displacement, local_shear_strain and in_shear_band are empty, "
+            "and no shear band was detected"
+        )
+        return None, None
+    strain.compute(reference, snapshot)
+    missing = int((reference.index_of(np.asarray(snapshot.ids)) < 0).sum())
+    if missing:
+        notes.append(f"{missing} particles have no match (by id) in the reference snapshot")
+    if int(np.isfinite(strain.excess_shear_strain[snapshot.is_sample]).sum()) < 10:
+        notes.append("fewer than 10 particles with a local strain: no shear band detected")
+        return strain, None
+    band = ShearBand().compute(
+        snapshot,
+        strain.excess_shear_strain,
+        stability_index=stability.stability_index,
+        n_contacts=stability.n_contacts,
+    )
+    return strain, band

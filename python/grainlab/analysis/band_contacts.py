@@ -1,49 +1,13 @@
 r"""The band against the rest at equal contact number: is lambda more than a contact count?
 
-A grain's lambda depends on its number of contacts n: 0- and 1-contact grains
-sit at 1 by definition, and for n >= 2 the largest lambda grows with n
-(:mod:`~grainlab.analysis.stability`). Band grains have fewer contacts than
-the rest. A difference of mean lambda between band and rest can therefore
-come from the contact count alone. :class:`BandContacts` separates the two.
-
-**Strata.** The grains with n = 2, 3, 4 and >= 5 contacts (:data:`STRATA`,
-counted as lambda counts them) each give a band-against-rest difference of
-mean lambda, :math:`d_s = \bar\lambda_{in,s} - \bar\lambda_{out,s}`, with the
-counts of both groups. The **stratified difference** pools the strata that
-hold grains on both sides, each weighted as in a Mantel-Haenszel estimate,
-
-.. math::
-
-   d = \frac{\sum_s w_s d_s}{\sum_s w_s},\qquad
-   w_s = \frac{n_{in,s}\, n_{out,s}}{n_{in,s} + n_{out,s}},
-
-the band's excess lambda over grains of the same contact number.
-
-**lambda within strata as a classifier.** The ROC AUC of lambda for band
-membership within each stratum (:func:`~grainlab.analysis.band_fabric.roc_auc`),
-pooled over strata with weights :math:`n_{in,s} n_{out,s}` (the number of
-band-rest pairs each compares):
-
-.. math::
-
-   \mathrm{AUC}_{within} = \frac{\sum_s n_{in,s} n_{out,s}\,\mathrm{AUC}_s}
-                                {\sum_s n_{in,s} n_{out,s}},
-
-the probability that a band grain has a higher lambda than a grain of the
-rest **with the same number of contacts** (0.5: no information beyond n).
-
-**What lambda adds to n.** Two logistic models of band membership over every
-grain: the contact number alone (one indicator per class 0, 1, 2, 3, 4, >= 5:
-the band's share of each class), and the contact number with lambda (the same
-indicators plus lambda times the indicator of each class n >= 2: its own
-slope per class). Each is fitted by maximum likelihood with a small ridge
-penalty (``scipy.optimize.minimize``, L-BFGS-B; the penalty keeps a class with
-no band grain finite) and scored **out of sample**: the grains are split in two
-halves at random (fixed seed), each half scored by the model fitted on the other
-(two-fold cross-fitting), so that the extra parameters cannot raise the AUC by
-fitting noise. ``auc_contacts`` and ``auc_contacts_lambda`` are the ROC AUCs of
-the two models' out-of-sample scores, ``auc_gain`` their difference: what
-lambda adds to the contact number in telling band grains from the rest.
+:class:`BandContacts` splits the grains into the strata of :data:`STRATA`
+(n = 2, 3, 4, >= 5 contacts, as lambda counts them) and gives per stratum the
+band-minus-rest mean lambda :math:`d_s`, pooled with Mantel-Haenszel weights
+:math:`w_s = n_{in,s} n_{out,s} / (n_{in,s} + n_{out,s})`, lambda's ROC AUC
+within strata pooled over band-rest pairs, and the out-of-sample AUCs of two
+logistic models of membership (the contact class alone; with lambda, one slope
+per class n >= 2; ridge-penalised, two-fold cross-fitted with
+:data:`SPLIT_SEED`). docs/analysis.md, "The band against the rest".
 
 Example
 -------
@@ -61,14 +25,13 @@ Example
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize
 
-from grainlab.analysis._util import Computable
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis.band_fabric import roc_auc
 
 __all__ = ["STRATA", "BandContacts"]
@@ -135,32 +98,8 @@ def cross_fitted_scores(x: NDArray[np.float64], y: NDArray[np.bool_], seed: int 
     return scores
 
 
-@dataclass(frozen=True, eq=False)
-class _BandContactsResults:
-    strata: dict[str, dict[str, float]]
-    stratified_difference: float
-    auc_within: float
-    auc_contacts: float
-    auc_contacts_lambda: float
-
-
-class BandContacts(Computable[_BandContactsResults]):
+class BandContacts(Compute):
     """The band against the rest at equal contact number (module docstring).
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    strata : dict
-        Per stratum label (``"2"``, ``"3"``, ``"4"``, ``"5+"``): ``n_inside``,
-        ``n_outside``, ``mean_inside``, ``mean_outside``, ``difference`` (band
-        minus rest mean lambda) and ``auc_lambda`` (lambda's ROC AUC for band
-        membership within the stratum); NaN where a group is empty.
-    stratified_difference : float
-        The strata's differences pooled with Mantel-Haenszel weights.
-    auc_within : float
-        lambda's AUC within strata, pooled over band-rest pairs.
-    auc_contacts, auc_contacts_lambda, auc_gain : float
-        Out-of-sample AUCs of the contact-number model and of the
-        contact-number-and-lambda model, and their difference.
     """
 
     def compute(self, stability_index: ArrayLike, n_contacts: ArrayLike, members: ArrayLike) -> BandContacts:
@@ -196,39 +135,30 @@ class BandContacts(Computable[_BandContactsResults]):
             ok = np.isfinite(lam) | (counts < 2)
             auc_contacts = roc_auc(cross_fitted_scores(_design(lam[ok], counts[ok], False), band[ok]), band[ok])
             auc_both = roc_auc(cross_fitted_scores(_design(lam[ok], counts[ok], True), band[ok]), band[ok])
-        self._store(_BandContactsResults(
+        self._store(
             strata=strata,
             stratified_difference=weighted / weight_sum if weight_sum else math.nan,
             auc_within=pair_auc / pairs if pairs else math.nan,
             auc_contacts=auc_contacts,
             auc_contacts_lambda=auc_both,
-        ))
+        )
         return self
 
-    @property
-    def strata(self) -> dict[str, dict[str, float]]:
-        """Per stratum: counts, means, difference and AUC of lambda."""
-        return self._computed("strata").strata
-
-    @property
-    def stratified_difference(self) -> float:
-        """Band minus rest mean lambda at equal contact number (Mantel-Haenszel weights)."""
-        return self._computed("stratified_difference").stratified_difference
-
-    @property
-    def auc_within(self) -> float:
-        """lambda's ROC AUC for band membership among grains of equal contact number."""
-        return self._computed("auc_within").auc_within
-
-    @property
-    def auc_contacts(self) -> float:
-        """Out-of-sample ROC AUC of the contact number alone."""
-        return self._computed("auc_contacts").auc_contacts
-
-    @property
-    def auc_contacts_lambda(self) -> float:
-        """Out-of-sample ROC AUC of the contact number and lambda together."""
-        return self._computed("auc_contacts_lambda").auc_contacts_lambda
+    strata = Computed[dict[str, dict[str, float]]](
+        "Per stratum label ('2', '3', '4', '5+'): n_inside, n_outside, mean_inside, "
+        "mean_outside, difference (band minus rest mean lambda) and auc_lambda (lambda's ROC "
+        "AUC for band membership within the stratum); NaN where a group is empty."
+    )
+    stratified_difference = Computed[float](
+        "Band minus rest mean lambda at equal contact number (Mantel-Haenszel weights)."
+    )
+    auc_within = Computed[float](
+        "lambda's ROC AUC for band membership among grains of equal contact number."
+    )
+    auc_contacts = Computed[float]("Out-of-sample ROC AUC of the contact number alone.")
+    auc_contacts_lambda = Computed[float](
+        "Out-of-sample ROC AUC of the contact number and lambda together."
+    )
 
     @property
     def auc_gain(self) -> float:
@@ -253,6 +183,3 @@ class BandContacts(Computable[_BandContactsResults]):
         from grainlab import plot
 
         return plot.band_strata(self.strata, ax=ax, **kwargs)
-
-    def __repr__(self) -> str:
-        return "BandContacts()"

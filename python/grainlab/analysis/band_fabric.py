@@ -1,39 +1,12 @@
 r"""Fabric inside and outside a shear band, and how well lambda alone finds the band.
 
-Given one snapshot's per-grain stability index lambda (and contact counts)
-and a band membership (True for the grains inside the band), :class:`BandFabric`
-measures both groups of grains:
-
-- ``mean_lambda``: mean lambda over the group's grains with at least 2 contacts
-  (the library's :attr:`StabilityIndex.mean <grainlab.analysis.StabilityIndex.mean>`);
-- ``mean_lambda_all``: over every grain of the group, the 0- and 1-contact
-  grains at lambda = 1 (:attr:`StabilityIndex.mean_all
-  <grainlab.analysis.StabilityIndex.mean_all>`);
-- ``coordination_number``: mean grain-grain contacts per grain of the group;
-- ``fraction_0``, ``fraction_1``, ``fraction_2``, ``fraction_3_or_more``:
-  shares of the group's grains with 0, 1, 2 and >= 3 contacts (counted as
-  lambda counts them), and ``fraction_2_of_load_bearing`` /
-  ``fraction_3_or_more_of_load_bearing``: the same among the grains with >= 2
-  contacts (the paper's Fig. 13 filters out the 0- and 1-contact grains);
-- ``fraction_lambda_above_half``: share with lambda > 0.5 (every grain);
-- ``mean_abs_rotation_rad``: mean absolute rotation since a reference state.
-
-**Does lambda alone locate the band?** The area under the ROC curve of a
-score s as a classifier of membership,
-
-.. math::
-
-   \mathrm{AUC} = P(s_{in} > s_{out}) + \tfrac12 P(s_{in} = s_{out})
-   = \frac{U_{in}}{n_{in}\, n_{out}},
-
-the Mann-Whitney U statistic of the band grains' scores against the others'
-(:func:`roc_auc`): 1 when every band grain scores above every other grain,
-0.5 when the score carries no information, 0 when it ranks them the other way.
-It is computed for the per-grain lambda (``auc_lambda``, every grain, 0/1
-contacts at lambda = 1) and for the lambda field coarse-grained over a disk of
-``coarse_radius`` mean diameters around each grain (``auc_lambda_field``,
-:func:`coarse_grained`), which asks whether a *region* of high lambda marks
-the band even when single grains scatter.
+:class:`BandFabric` gives :data:`GROUP_MEASURES` of the band's grains and of
+the others (mean lambda under both conventions, contacts per grain, the shares
+of 0-, 1-, 2- and >= 3-contact grains, of lambda > 0.5, the mean |rotation|),
+and the ROC AUC (:func:`roc_auc`, the Mann-Whitney U over
+:math:`n_{in} n_{out}`) of per-grain lambda and of lambda coarse-grained over
+a disk (:func:`coarse_grained`) as classifiers of band membership.
+docs/analysis.md, "The band against the rest".
 
 Example
 -------
@@ -47,7 +20,6 @@ Example
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -55,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 from scipy.stats import mannwhitneyu
 
-from grainlab.analysis._util import Computable
+from grainlab.analysis._compute import Compute, Computed
 
 __all__ = ["GROUP_MEASURES", "BandFabric", "coarse_grained", "roc_auc"]
 
@@ -150,18 +122,7 @@ def _group(
     }
 
 
-@dataclass(frozen=True, eq=False)
-class _BandFabricResults:
-    """The results of :class:`BandFabric` (see its properties)."""
-
-    inside: dict[str, float]
-    outside: dict[str, float]
-    auc_lambda: float
-    auc_lambda_field: float
-    lambda_field: NDArray[np.float64]
-
-
-class BandFabric(Computable[_BandFabricResults]):
+class BandFabric(Compute):
     """Fabric of the grains inside and outside a band, and the AUC of lambda
     as a classifier of band membership (module docstring).
 
@@ -171,15 +132,6 @@ class BandFabric(Computable[_BandFabricResults]):
         Radius of the disk that :func:`coarse_grained` averages lambda over,
         in mean grain diameters (the local strain's neighbourhood,
         docs/fabric.md).
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    inside, outside : dict
-        :data:`GROUP_MEASURES` of the band's grains and of the others.
-    auc_lambda : float
-        ROC AUC of per-grain lambda (NaN when a group is empty).
-    auc_lambda_field : float
-        ROC AUC of the coarse-grained lambda field.
 
     Example
     -------
@@ -192,6 +144,8 @@ class BandFabric(Computable[_BandFabricResults]):
     >>> bf.auc_lambda, bf.inside["fraction_2"], bf.outside["fraction_3_or_more"]
     (1.0, 1.0, 1.0)
     """
+
+    _parameters = ("coarse_radius",)
 
     def __init__(self, coarse_radius: float = 2.0) -> None:
         if not (math.isfinite(coarse_radius) and coarse_radius > 0):
@@ -233,40 +187,23 @@ class BandFabric(Computable[_BandFabricResults]):
         radius = self.coarse_radius * float(np.mean(d)) if n else 1.0
         field = coarse_grained(pos, lam, radius) if n else np.zeros(0)
         self._store(
-            _BandFabricResults(
-                inside=_group(band, lam, counts, grain, rot),
-                outside=_group(~band, lam, counts, grain, rot),
-                auc_lambda=roc_auc(lam, band),
-                auc_lambda_field=roc_auc(field, band),
-                lambda_field=field,
-            )
+            inside=_group(band, lam, counts, grain, rot),
+            outside=_group(~band, lam, counts, grain, rot),
+            auc_lambda=roc_auc(lam, band),
+            auc_lambda_field=roc_auc(field, band),
+            lambda_field=field,
         )
         return self
 
-    @property
-    def inside(self) -> dict[str, float]:
-        """:data:`GROUP_MEASURES` of the band's grains."""
-        return self._computed("inside").inside
-
-    @property
-    def outside(self) -> dict[str, float]:
-        """:data:`GROUP_MEASURES` of the grains outside the band."""
-        return self._computed("outside").outside
-
-    @property
-    def auc_lambda(self) -> float:
-        """ROC AUC of per-grain lambda for band membership."""
-        return self._computed("auc_lambda").auc_lambda
-
-    @property
-    def auc_lambda_field(self) -> float:
-        """ROC AUC of the coarse-grained lambda field for band membership."""
-        return self._computed("auc_lambda_field").auc_lambda_field
-
-    @property
-    def lambda_field(self) -> NDArray[np.float64]:
-        """(N,) lambda averaged over ``coarse_radius`` mean diameters around each grain."""
-        return self._computed("lambda_field").lambda_field
+    inside = Computed[dict[str, float]](":data:`GROUP_MEASURES` of the band's grains.")
+    outside = Computed[dict[str, float]](":data:`GROUP_MEASURES` of the grains outside the band.")
+    auc_lambda = Computed[float]("ROC AUC of per-grain lambda for band membership.")
+    auc_lambda_field = Computed[float](
+        "ROC AUC of the coarse-grained lambda field for band membership."
+    )
+    lambda_field = Computed[NDArray[np.float64]](
+        "(N,) lambda averaged over ``coarse_radius`` mean diameters around each grain."
+    )
 
     def summary(self) -> dict[str, Any]:
         """Every number, JSON-ready: ``inside_*``, ``outside_*``, the AUCs."""
@@ -277,6 +214,3 @@ class BandFabric(Computable[_BandFabricResults]):
         out["auc_lambda"] = self.auc_lambda
         out["auc_lambda_field"] = self.auc_lambda_field
         return out
-
-    def __repr__(self) -> str:
-        return f"BandFabric(coarse_radius={self.coarse_radius})"

@@ -1,118 +1,16 @@
 r"""The shear band read from the grains' cumulative displacements (paper Fig. 11).
 
-Fig. 11 of the paper shows the band in maps of cumulative displacement: the
-zone that separates two blocks of the sample moving differently.
-:class:`DisplacementBand` reads it the same way, from each grain's position
-:math:`x` at the current state and its displacement :math:`u` (N, 2) since a
-reference state, beside :class:`~grainlab.analysis.ShearBand`, which finds the
-band in a per-grain field (the local strain, or lambda).
-
-1. **Slip line.** A straight line at angle :math:`\beta` (CCW from +x, in
-   [0°, 180°)) at offset :math:`c` across the sample splits the grains into
-   block A, :math:`s = (x - \bar x) \cdot n < c`, and block B, :math:`s > c`,
-   with :math:`n = (-\sin\beta, \cos\beta)` and :math:`\bar x` the grains'
-   centroid. Each block's displacements are fitted by least squares with an
-   affine motion of its own, :math:`u_K(x) = a_K + L_K (x - \bar x_K)`
-   (:math:`K = A, B`; a translation and a displacement gradient: a rotation,
-   a stretch and a shear of the block). Only lines that cross the sample are
-   tried: both blocks hold at least ``min_share`` (0.2) of the grains. The
-   scan: for each angle of a 1° scan of [0°, 180°), splits every 1/4 mean
-   diameter across the sample, each split's two fits read from sums of the
-   grains' moments; the line whose two fits leave the least total squared
-   residual gives the angle, which step 3 refines.
-
-   *Why affine blocks, not rigid ones.* The blocks of a biaxial sample deform
-   with it (compressed along the load, dilated across it). One rigid motion
-   cannot follow that homogeneous deformation, and two rigid blocks follow it
-   better whatever the split (a linear field fitted piecewise constant keeps
-   a quarter of its residual): two rigid blocks remove about 70 % of the
-   one-rigid-motion residual of a biaxial compression of a lattice with no
-   band at all. One affine motion of the whole sample fits a homogeneous
-   deformation exactly; with affine blocks only a discontinuity of the
-   motion is left for the split to explain.
-2. **Share of the relative motion; the band.** With
-   :math:`\Delta(x) = u_B(x) - u_A(x)` the relative motion of the two blocks
-   at :math:`x`, each grain's share of it,
-
-   .. math::
-
-      t_i = \frac{(u_i - u_A(x_i)) \cdot \Delta(x_i)}{|\Delta(x_i)|^2},
-
-   is 0 for a grain moving with block A and 1 for one moving with block B
-   (:attr:`DisplacementBand.relative_motion`). It is binned by the distance
-   from the slip line (bins of ``bin_width``, half a mean diameter) and
-   smoothed as :class:`~grainlab.analysis.ShearBand` smooths its profile (the
-   mean share of the grains within about one mean diameter of each bin). The
-   **band** is the run of bins around the slip line where the smoothed profile
-   lies between 0.1 and 0.9: the zone that separates the two moving blocks.
-   Its edges are interpolated linearly where the profile crosses 0.1 and 0.9;
-   ``thickness`` is their distance (0.8 w for a linear transition of width w;
-   a sharp slip reads about 2 mean diameters thick, the smoothing's
-   resolution). Fitted on all their grains, the blocks' motions lean towards
-   each other (each holds part of the transition); they are therefore fitted
-   again without the band and a flank of one mean diameter on each side, and
-   the profile read again, up to 3 times (until the blocks stay the same).
-3. **Refinement.** The two blocks joined across their band model the whole
-   displacement: :math:`\hat u = u_A + \tau(s)\,\Delta`, with :math:`\tau`
-   0 in block A, 1 in block B and rising linearly across the band (through
-   0.1 and 0.9 at its edges). Its residual
-
-   .. math::
-
-      S_2 = \sum_i |u_i - \hat u(x_i)|^2
-
-   is computed at angles within 1.5° of the scan's, in 0.1° steps (at each,
-   the best split every 1/20 mean diameter and steps 1-2), and at the vertex
-   of a parabola through the best three: the reading with the least
-   :math:`S_2` is the band. Unlike the step of the scan, this model does not
-   count the band's own width against it (a clean wide band is as well
-   explained as a sharp slip).
-4. **Members.** The grains considered whose centre lies between the edges.
-5. **Acceptance** (:attr:`found`, :attr:`reason`). The candidate is accepted
-   when
-
-   * the two blocks explain the displacement much better than one motion of
-     the whole sample: the share of the residual :math:`S_1` of one affine
-     motion fitted to every grain that the two blocks remove,
-     :math:`\rho = 1 - S_2 / S_1` (:attr:`residual_reduction`), is at least
-     ``min_reduction`` (0.6);
-   * the profile reaches block A's motion (:math:`t \le 0.1`) on one side of
-     the band and block B's (:math:`t \ge 0.9`) on the other inside the sample;
-   * the band crosses the sample, as the strain band of a biaxial run must
-     (``grainlab.postprocess.band``): the chord of its centre line through the
-     grains is at least ``crossing`` (3/4) of the sample's smaller side, and
-     its members cover at least ``crossing`` of that chord.
-
-   The threshold on :math:`\rho` was fixed on synthetic fields
-   (``tests/analysis/test_band_readings.py`` repeats the calibration in
-   small), never on simulations: 80 trials of each field without a band and
-   8 of each band, on jittered triangular lattices of 580 to 3,500 grains (17
-   to 45 grains across). **Without a band**, a rigid motion or a homogeneous
-   biaxial compression plus independent noise gave :math:`\rho \le 0.02`;
-   noise correlated over 2 and 4 mean diameters (where its correlation falls
-   to 1/e; granular flow swirls over a few diameters) at most 0.21 and 0.49.
-   Noise correlated over 6 mean diameters passed once in 80 (0.64, in a
-   sample 17 grains across), over 10 in 17 of 80: a field correlated over
-   half the sample's width *is* two blocks at that scale, and this reading
-   does not tell it from a band. **With a band** (a block sliding by a jump J
-   through a linear transition w wide), without noise :math:`\rho \ge 0.82`
-   for w from 0 to 10 mean diameters (0.40 when a 16-diameter band filled
-   most of the narrowest sample); with independent noise of standard
-   deviation :math:`\sigma` per component, a sharp slip is accepted from
-   J = 8 :math:`\sigma` (7 of 8; all from 10 :math:`\sigma`, none at
-   6 :math:`\sigma`), a band 6 diameters wide in 4 of 8 at 8 :math:`\sigma`,
-   7 of 8 at 10 and all at 12: the band must stand well out of the noise. A
-   candidate that fails keeps all its numbers; :attr:`reason` says what failed.
-6. **Jump.** :attr:`jump` is :math:`\Delta` at the band's centre (the point
-   of its centre line nearest the grains' centroid): the displacement of block
-   B relative to block A, m; :attr:`slip` is its component along the band
-   (positive along :math:`(\cos\beta, \sin\beta)`), :attr:`opening` its
-   component across it (positive when the blocks move apart: dilation).
-
-Angles are read as :class:`~grainlab.analysis.ShearBand`'s:
-:attr:`angle_degrees` in [0°, 180°) CCW from +x, :attr:`inclination_degrees`
-the acute angle to the horizontal (the minor principal stress direction of
-a biaxial test loaded along y).
+:class:`DisplacementBand`: a straight slip line splits the grains into blocks
+A and B, each fitted with an affine motion of its own (1° scan, then 1.5°
+refinement); each grain's share of the blocks' relative motion,
+:math:`t = (u - u_A)\cdot\Delta / |\Delta|^2` with :math:`\Delta = u_B - u_A`,
+is 0 in block A and 1 in block B, and the band is the zone where its smoothed
+profile lies between 0.1 and 0.9. Accepted when the two blocks remove at
+least ``min_reduction`` of the residual of one affine motion,
+:math:`\rho = 1 - S_2/S_1`, the profile reaches both blocks' motions and the
+band crosses the sample (:mod:`~grainlab.analysis.band_acceptance`). The
+method and how its threshold was fixed: docs/analysis.md, "Three readings of
+the shear band".
 """
 
 from __future__ import annotations
@@ -124,14 +22,19 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from grainlab.analysis.shear_band import SlabBand, _best
+from grainlab.analysis._compute import Computed
+from grainlab.analysis._util import json_number, random_subset
+from grainlab.analysis.band_acceptance import (
+    crossing_problems,
+    reduction_problems,
+    transition_problems,
+)
+from grainlab.analysis.shear_band import SlabBand, _best, binned_profile
 
 __all__ = ["MIN_GRAINS", "SHARE_HIGH", "SHARE_LOW", "DisplacementBand"]
 
 #: The band's edges: the smoothed share of the relative motion crosses these.
 SHARE_LOW, SHARE_HIGH = 0.1, 0.9
-#: Width (mean diameters) of the running mean over the profile bins (as ShearBand's).
-_SMOOTH_D = 2.0
 #: Flank (mean diameters) left out, with the band, of the blocks' refits; number of refits.
 _FLANK_D = 1.0
 _REFITS = 3
@@ -271,15 +174,7 @@ def _transition(s: NDArray[np.float64], t: NDArray[np.float64], bin_width: float
     s_ok, t_ok = s[ok], t[ok]
     b = ((s_ok - s_ok.min()) / bin_width).astype(np.int64)
     counts = np.bincount(b).astype(np.float64)
-    sums = np.bincount(b, weights=t_ok)
-    occupied = counts > 0
-    centers = np.bincount(b, weights=s_ok)[occupied] / counts[occupied]
-    mean = sums[occupied] / counts[occupied]
-    half_window = max(1, int(np.floor(0.5 * _SMOOTH_D / bin_width + 0.5)))
-    kernel = np.ones(2 * half_window + 1)
-    near_sums = np.convolve(sums, kernel, mode="same")
-    near_counts = np.convolve(counts, kernel, mode="same")
-    smooth = (near_sums / np.maximum(near_counts, 1.0))[occupied]
+    _, centers, mean, smooth = binned_profile(b, counts, t_ok, s_ok, bin_width)
     inside = (smooth > SHARE_LOW) & (smooth < SHARE_HIGH)
     if not inside.any():
         return _no_transition(
@@ -303,12 +198,8 @@ def _transition(s: NDArray[np.float64], t: NDArray[np.float64], bin_width: float
 
     s_lo, level_lo = edge(left, left - 1)
     s_hi, level_hi = edge(right, right + 1)
-    problems = []
-    if not (level_lo == SHARE_LOW and level_hi == SHARE_HIGH):
-        problems.append(
-            f"the transition does not reach block A's motion (share <= {SHARE_LOW:g}) on one "
-            f"side and block B's (share >= {SHARE_HIGH:g}) on the other inside the sample"
-        )
+    reaches = level_lo == SHARE_LOW and level_hi == SHARE_HIGH
+    problems = transition_problems(reaches, SHARE_LOW, SHARE_HIGH)
     return _Transition(centers, mean, smooth, s_lo, s_hi, tuple(problems))
 
 
@@ -349,34 +240,11 @@ class _Reading:
     """Residual of the two blocks joined across the band."""
 
 
-@dataclass(frozen=True, eq=False)
-class _DisplacementBandResults:
-    """The results of :class:`DisplacementBand` (see its properties)."""
-
-    found: bool
-    reason: str
-    angle: float
-    thickness: float
-    thickness_diameters: float
-    center: NDArray[np.float64]
-    normal: NDArray[np.float64]
-    members: NDArray[np.bool_]
-    residual_reduction: float
-    jump: NDArray[np.float64]
-    relative_motion: NDArray[np.float64]
-    profile: tuple[NDArray[np.float64], NDArray[np.float64]]
-    profile_smooth: NDArray[np.float64]
-    mean_diameter: float
-    positions: NDArray[np.float64]
-    radii: NDArray[np.float64]
-    displacement: NDArray[np.float64]
-
-
-class DisplacementBand(SlabBand[_DisplacementBandResults]):
+class DisplacementBand(SlabBand):
     r"""The shear band as the zone between two blocks that move differently (Fig. 11).
 
-    See the module docstring for the method, the acceptance tests and how
-    their threshold was fixed.
+    The method, the acceptance tests and how their threshold was fixed:
+    docs/analysis.md, "Three readings of the shear band".
 
     Parameters
     ----------
@@ -396,36 +264,6 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         smaller side through the grains, and its members cover at least this
         share of that chord, in [0, 1].
 
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    found : bool
-    reason : str
-        Why the candidate was not accepted ("" when found).
-    angle, angle_degrees : float
-        Band direction, rad / degrees in [0, pi) / [0°, 180°), CCW from +x.
-    inclination, inclination_degrees : float
-        Acute angle between the band and the x axis.
-    thickness : float, m
-    thickness_diameters : float
-    center : (2,) float, m
-        A point on the band's centre line.
-    normal : (2,) float
-        Unit normal of the band, pointing into block B.
-    members : (N,) bool
-        Grains inside the band.
-    residual_reduction : float
-        :math:`1 - S_2/S_1`, the share of the one-block residual removed.
-    jump : (2,) float, m
-        Displacement of block B relative to block A at :attr:`center`.
-    jump_magnitude, slip, opening : float, m
-    relative_motion : (N,) float
-        Each grain's share of the relative motion (0: block A, 1: block B).
-    profile : tuple of (B,) arrays
-        Distance from the band's centre line (m) and mean share of each bin.
-    profile_smooth : (B,) float
-        The smoothed share, on which the edges are read.
-    mean_diameter : float, m
-
     Example
     -------
     A lattice whose upper half slides 0.3 along the line y = 20, with a linear
@@ -442,6 +280,8 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
     >>> bool(abs(band.thickness_diameters - 4.8) < 0.5), round(band.slip, 2)
     (True, 0.3)
     """
+
+    _parameters = ("bin_width", "max_points", "min_share", "min_reduction", "crossing")
 
     def __init__(
         self,
@@ -482,30 +322,10 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         since the reference (rows with a NaN are left out); ``radii`` (N,) m;
         ``mask`` (N,) bool restricts the grains considered.
 
-        The steps (module docstring): the scan for the slip line
-        (:meth:`_slip_line`), its refinement (:meth:`_refined`, reading the band
-        at each angle with :meth:`_reading`), the blocks' motions and the profile
-        across the line (:meth:`_band`), the acceptance tests (here and
-        :meth:`_crossing_problems`).
+        Steps: :meth:`_slip_line`, :meth:`_refined` (:meth:`_reading`, :meth:`_band`
+        at each angle), :mod:`~grainlab.analysis.band_acceptance`.
         """
-        pos = np.asarray(positions, dtype=np.float64)
-        disp = np.asarray(displacement, dtype=np.float64)
-        rad = np.asarray(radii, dtype=np.float64)
-        n = pos.shape[0] if pos.ndim == 2 else -1
-        if pos.shape != (n, 2) or disp.shape != (n, 2) or rad.shape != (n,):
-            raise ValueError(
-                "positions, displacement, radii: expected shapes (N, 2), (N, 2), (N,), got "
-                f"{pos.shape}, {disp.shape}, {rad.shape}"
-            )
-        considered = np.ones(n, bool) if mask is None else np.asarray(mask, bool)
-        if considered.shape != (n,):
-            raise ValueError(f"mask: expected shape ({n},), got {considered.shape}")
-        valid = considered & np.isfinite(pos).all(axis=1) & np.isfinite(disp).all(axis=1)
-        if valid.sum() < MIN_GRAINS:
-            raise ValueError(
-                f"displacement: need at least {MIN_GRAINS} grains with a finite displacement, "
-                f"got {int(valid.sum())}"
-            )
+        pos, disp, rad, considered, valid = _checked(positions, displacement, radii, mask)
         d_mean = float(np.mean(2.0 * rad[considered]))
         origin = pos[valid].mean(axis=0)
         p = (pos[valid] - origin) / d_mean  # lengths in mean diameters from here on
@@ -517,48 +337,42 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         scale = math.sqrt(one_block / rest.shape[0]) if one_block > 0 else 1.0
         v = rest / scale
         r = self._refined(p, v, self._slip_line(p, v))
-        angle, offset, trans, t, coef_a, coef_b = r.angle, r.offset, r.trans, r.share, r.coef_a, r.coef_b
-        normal = np.array([-np.sin(angle), np.cos(angle)])
+        trans = r.trans
+        normal = np.array([-np.sin(r.angle), np.cos(r.angle)])
         # nothing left by one affine motion (beyond round-off): nothing for two blocks to explain
         affine = one_block <= 1e-20 * float(np.sum(disp[valid] ** 2))
         reduction = 0.0 if affine else max(1.0 - r.residual / float(np.sum(v * v)), 0.0)
         mid = 0.5 * (trans.s_lo + trans.s_hi)
-        center = origin + (offset + mid) * d_mean * normal
+        center = origin + (r.offset + mid) * d_mean * normal
         c = (center - origin) / d_mean
-        jump = (_at(coef_b, c[None, :]) - _at(coef_a, c[None, :]))[0] * scale
+        jump = (_at(r.coef_b, c[None, :]) - _at(r.coef_a, c[None, :]))[0] * scale
         s_all = ((pos - center) @ normal) / d_mean
-        half = 0.5 * trans.thickness
-        members = considered & np.isfinite(pos).all(axis=1) & (np.abs(s_all) <= half)
-        problems = list(trans.problems)
-        if reduction < self.min_reduction:
-            problems.insert(
-                0,
-                f"two blocks explain little more than one motion of the whole sample: they remove "
-                f"{100 * reduction:.0f} % of its residual (min_reduction = {self.min_reduction:g})",
-            )
-        problems += self._crossing_problems(pos[valid], s_all[valid], members[valid], normal, trans.thickness, d_mean)
-        share = np.full(n, np.nan)
-        share[valid] = t
+        members = considered & np.isfinite(pos).all(axis=1) & (np.abs(s_all) <= 0.5 * trans.thickness)
+        problems = reduction_problems(reduction, self.min_reduction) + list(trans.problems)
+        tangent = np.array([normal[1], -normal[0]])
+        problems += crossing_problems(
+            pos[valid], tangent, s_all[valid], trans.thickness, 1.0, d_mean, self.crossing
+        )
+        share = np.full(pos.shape[0], np.nan)
+        share[valid] = r.share
         self._store(
-            _DisplacementBandResults(
-                found=not problems,
-                reason="; ".join(problems),
-                angle=angle,
-                thickness=trans.thickness * d_mean,
-                thickness_diameters=trans.thickness,
-                center=center,
-                normal=normal,
-                members=members,
-                residual_reduction=float(reduction),
-                jump=jump,
-                relative_motion=share,
-                profile=((trans.centers - mid) * d_mean, trans.mean_share),
-                profile_smooth=trans.smooth,
-                mean_diameter=d_mean,
-                positions=pos,
-                radii=rad,
-                displacement=disp,
-            )
+            found=not problems,
+            reason="; ".join(problems),
+            angle=r.angle,
+            thickness=trans.thickness * d_mean,
+            thickness_diameters=trans.thickness,
+            center=center,
+            normal=normal,
+            members=members,
+            residual_reduction=float(reduction),
+            jump=jump,
+            relative_motion=share,
+            profile=((trans.centers - mid) * d_mean, trans.mean_share),
+            profile_smooth=trans.smooth,
+            mean_diameter=d_mean,
+            _positions=pos,
+            _radii=rad,
+            _displacement=disp,
         )
         return self
 
@@ -566,7 +380,7 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         """Step 1, the scan: the angle (rad, [0, pi)), in 1 degree steps, of the line
         whose two blocks, split at it (a step between them), fit best."""
         coarse = np.radians(np.arange(0.0, 180.0, 1.0))
-        pc, vc = _subset(p, v, self.max_points, np.random.default_rng(0))
+        pc, vc = random_subset(p, v, self.max_points, np.random.default_rng(0))
         res, _ = _splits(pc, vc, coarse, self.min_share, _SCAN_STEP_D)
         if not np.isfinite(res).any():
             raise ValueError("positions: the grains lie on one line; no split leaves two blocks")
@@ -633,39 +447,13 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         assert trans is not None
         return trans, t, coef_a, coef_b
 
-    def _crossing_problems(
-        self,
-        pos: NDArray[np.float64],
-        s: NDArray[np.float64],
-        members: NDArray[np.bool_],
-        normal: NDArray[np.float64],
-        thickness: float,
-        d_mean: float,
-    ) -> list[str]:
-        """Whether the band crosses the sample (``s`` from its centre line, mean diameters)."""
-        tangent = np.array([normal[1], -normal[0]])
-        side = float(np.ptp(pos, axis=0).min())
-        near = np.abs(s) <= max(0.5 * thickness, 1.0)
-        chord = float(np.ptp(pos[near] @ tangent)) if near.sum() > 1 else 0.0
-        span = float(np.ptp(pos[members] @ tangent)) if members.sum() > 1 else 0.0
-        if chord < self.crossing * side or span < self.crossing * chord:
-            return [
-                f"does not cross the sample (its grains span {span / d_mean:.1f} mean diameters "
-                f"of a {chord / d_mean:.1f}-diameter chord; the sample's smaller side is "
-                f"{side / d_mean:.1f})"
-            ]
-        return []
-
-    @property
-    def residual_reduction(self) -> float:
-        """Share of the residual of one affine motion of the whole sample that the
-        two blocks' motions remove, 1 - S_2/S_1, in [0, 1]."""
-        return self._computed("residual_reduction").residual_reduction
-
-    @property
-    def jump(self) -> NDArray[np.float64]:
-        """(2,) displacement of block B relative to block A at :attr:`center`, m."""
-        return self._computed("jump").jump
+    residual_reduction = Computed[float](
+        "Share of the residual of one affine motion of the whole sample that the two blocks' "
+        "motions remove, 1 - S_2/S_1, in [0, 1]."
+    )
+    jump = Computed[NDArray[np.float64]](
+        "(2,) displacement of block B relative to block A at :attr:`center`, m."
+    )
 
     @property
     def jump_magnitude(self) -> float:
@@ -682,41 +470,29 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         """Component of :attr:`jump` along :attr:`normal`, m (positive: the blocks part)."""
         return float(self.jump @ self.normal)
 
-    @property
-    def relative_motion(self) -> NDArray[np.float64]:
-        """(N,) each grain's share of the blocks' relative motion (0 with block A,
-        1 with block B), NaN for the grains not considered."""
-        return self._computed("relative_motion").relative_motion
+    relative_motion = Computed[NDArray[np.float64]](
+        "(N,) each grain's share of the blocks' relative motion (0 with block A, 1 with block B), "
+        "NaN for the grains not considered."
+    )
+    profile = Computed[tuple[NDArray[np.float64], NDArray[np.float64]]](
+        "Distance from the band's centre line (m) and mean share of each bin."
+    )
+    profile_smooth = Computed[NDArray[np.float64]](
+        "(B,) the smoothed share of each bin of :attr:`profile`, on which the edges are read "
+        "(where it crosses 0.1 and 0.9)."
+    )
 
-    @property
-    def profile(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Distance from the band's centre line (m) and mean share of each bin."""
-        return self._computed("profile").profile
-
-    @property
-    def profile_smooth(self) -> NDArray[np.float64]:
-        """(B,) the smoothed share of each bin of :attr:`profile`, on which the
-        edges are read (where it crosses 0.1 and 0.9)."""
-        return self._computed("profile_smooth").profile_smooth
+    _displacement = Computed[NDArray[np.float64]]("(N, 2) the displacements read, m.")
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (NaN and inf as None, angles in degrees, lengths in m)."""
-
-        def num(x: float) -> float | None:
-            return float(x) if math.isfinite(x) else None
-
         return {
-            "found": self.found,
-            "reason": self.reason,
-            "angle_deg": num(self.angle_degrees),
-            "inclination_deg": num(self.inclination_degrees),
-            "thickness_m": num(self.thickness),
-            "thickness_diameters": num(self.thickness_diameters),
+            **self._slab_summary(),
             "n_particles": int(self.members.sum()),
-            "residual_reduction": num(self.residual_reduction),
-            "jump_m": num(self.jump_magnitude),
-            "slip_m": num(self.slip),
-            "opening_m": num(self.opening),
+            "residual_reduction": json_number(self.residual_reduction),
+            "jump_m": json_number(self.jump_magnitude),
+            "slip_m": json_number(self.slip),
+            "opening_m": json_number(self.opening),
         }
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
@@ -724,27 +500,36 @@ class DisplacementBand(SlabBand[_DisplacementBandResults]):
         outlined; returns the axes."""
         from grainlab import plot
 
-        r = self._computed("positions")
+        disp = self._displacement
         ax = plot.particle_map(
-            r.positions, r.radii, np.hypot(r.displacement[:, 0], r.displacement[:, 1]), ax=ax,
+            self._positions, self._radii, np.hypot(disp[:, 0], disp[:, 1]), ax=ax,
             label="displacement magnitude (m)", **kwargs,
         )
         plot.outline_shear_band(ax, self)
         return ax
 
-    def __repr__(self) -> str:
-        return (
-            f"DisplacementBand(bin_width={self.bin_width}, max_points={self.max_points}, "
-            f"min_share={self.min_share}, min_reduction={self.min_reduction}, "
-            f"crossing={self.crossing})"
+
+def _checked(
+    positions: ArrayLike, displacement: ArrayLike, radii: ArrayLike, mask: ArrayLike | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
+    """:meth:`DisplacementBand.compute`'s input as arrays, checked, with the grains
+    considered and those of them with a finite position and displacement."""
+    pos = np.asarray(positions, dtype=np.float64)
+    disp = np.asarray(displacement, dtype=np.float64)
+    rad = np.asarray(radii, dtype=np.float64)
+    n = pos.shape[0] if pos.ndim == 2 else -1
+    if pos.shape != (n, 2) or disp.shape != (n, 2) or rad.shape != (n,):
+        raise ValueError(
+            "positions, displacement, radii: expected shapes (N, 2), (N, 2), (N,), got "
+            f"{pos.shape}, {disp.shape}, {rad.shape}"
         )
-
-
-def _subset(
-    p: NDArray[np.float64], v: NDArray[np.float64], k: int, rng: np.random.Generator
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """At most ``k`` of the grains (a random subset when there are more)."""
-    if p.shape[0] <= k:
-        return p, v
-    pick = rng.choice(p.shape[0], size=k, replace=False)
-    return p[pick], v[pick]
+    considered = np.ones(n, bool) if mask is None else np.asarray(mask, bool)
+    if considered.shape != (n,):
+        raise ValueError(f"mask: expected shape ({n},), got {considered.shape}")
+    valid = considered & np.isfinite(pos).all(axis=1) & np.isfinite(disp).all(axis=1)
+    if valid.sum() < MIN_GRAINS:
+        raise ValueError(
+            f"displacement: need at least {MIN_GRAINS} grains with a finite displacement, "
+            f"got {int(valid.sum())}"
+        )
+    return pos, disp, rad, considered, valid

@@ -1,98 +1,34 @@
-r"""Fabric measures: coordination numbers, contact-normal distribution, anisotropy.
+r"""Fabric measures: coordination numbers, the contact-normal distribution, anisotropy.
 
-Conventions (docs/conventions.md, docs/fabric.md):
+Angles in rad, CCW from +x; a contact's normal line counts in both directions
+(:math:`\theta`, :math:`\theta + \pi`). By default only contacts between sample
+particles count (``include_boundary=True`` adds walls and membrane disks).
 
-* Angles in rad inside the code, CCW from +x; a contact's normal *line* is
-  counted in both directions (:math:`\theta` and :math:`\theta + \pi`), so the
-  angular distributions are centrosymmetric.
-* By default only contacts between sample particles enter the fabric measures
-  (contacts with walls and membrane particles are left out, as is usual for
-  Z = 2 Nc / Np); ``include_boundary=True`` adds them.
+* :math:`Z = 2 N_c / N_p`; :math:`Z_m` the same after the iterative removal of
+  the rattlers, particles with fewer than ``min_contacts`` (2) contacts.
+* Eq. 6, :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos 2(\theta-\theta_a)]`:
+  the exact :math:`a = 2|\frac{1}{W}\sum_c w_c e^{2i\theta_c}|`,
+  :math:`\theta_a = \frac12\arg\sum_c w_c e^{2i\theta_c}` in [0, pi)
+  (= :math:`2(\phi_1 - \phi_2)` of the fabric tensor
+  :math:`\phi = \frac1W\sum_c w_c n_c\otimes n_c`), and Eq. 7-8 as printed on
+  an ``ng``-bin histogram (atan2 for tan^-1; angles within ``edge_tolerance``
+  of a bin edge count half to each bin).
+* a_n: the same with each contact weighted by its normal force (N).
 
-Coordination number
-    :math:`Z = 2 N_c / N_p` with :math:`N_p` the sample particles and
-    :math:`N_c` the contacts between them (with boundary contacts included,
-    :math:`Z` is the mean number of contacts per sample particle, each
-    boundary body counted once per particle unless ``boundary="each"``).
-
-Mechanical coordination number (rattler rule)
-    A *rattler* is a particle with fewer than ``min_contacts`` contacts
-    (default 2: with friction a grain needs at least two contacts to carry
-    load, and 0/1-contact grains carry none; this is Thornton's rule). Rattlers
-    are removed *iteratively*: removing one may leave a neighbour below the
-    threshold. :math:`Z_m = 2 N_c^m / N_p^m` over the remaining particles and
-    the contacts among them. ``min_contacts=3`` gives the frictionless
-    isostatic rule (d + 1 in 2D).
-
-Anisotropy: the exact estimate (the headline value)
-    Fitting Eq. 6, :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos
-    2(\theta-\theta_a)]`, to the contact normals by their second Fourier
-    moment,
-
-    .. math::
-
-       a = 2\,\Bigl|\tfrac{1}{W}\sum_c w_c\, e^{2 i \theta_c}\Bigr|,\qquad
-       \theta_a = \tfrac12 \arg \sum_c w_c\, e^{2 i \theta_c},
-
-    unbinned and unbiased for Eq. 6. In terms of the 2D fabric tensor
-    :math:`\phi = \frac{1}{W}\sum_c w_c\, n_c \otimes n_c` (trace 1, 2D
-    prefactors: :math:`\phi = \tfrac12 I + \tfrac{a}{4} \begin{pmatrix}
-    \cos 2\theta_a & \sin 2\theta_a \\ \sin 2\theta_a & -\cos 2\theta_a
-    \end{pmatrix}`), :math:`a = 2(\phi_1 - \phi_2)` and :math:`\theta_a` is
-    the direction of the major eigenvector. A hexagonal or a square lattice
-    gives exactly 0 (six or four directions have no second harmonic).
-
-Contact-normal histogram and Eq. 7–8 as printed (the binned value)
-    ``ng`` bins of width :math:`\Delta\theta = 2\pi/n_g` over
-    :math:`[0, 2\pi)`, bin ``g = 1..ng`` covering
-    :math:`[(g-1)\Delta\theta, g\Delta\theta)`; :math:`N_g` counts the contact
-    ends in bin g (each contact twice) and :math:`N = \sum_g N_g`. An angle
-    within ``edge_tolerance`` (default :data:`EDGE_TOLERANCE_RAD`) of a bin
-    edge counts half to each of the two bins, so that contacts lying on edges
-    (lattices) do not fall into one bin or the other by round-off.
-
-    .. math::
-
-       a = \frac{2 \sin\Delta\theta}{N \Delta\theta}
-           \sqrt{S^2 + C^2},\qquad
-       \theta_a = \tfrac12 \operatorname{atan2}(S, C),\qquad
-       S = \sum_g N_g \sin((2g-1)\Delta\theta),\;
-       C = \sum_g N_g \cos((2g-1)\Delta\theta).
-
-    The paper writes :math:`\tan^{-1}(S/C)`; we use ``atan2`` so that
-    :math:`\theta_a \in [0, \pi)` is the direction of the major axis.
-    Binning a distribution of Eq. 6 multiplies its second harmonic by
-    :math:`\sin\Delta\theta/\Delta\theta`, so the printed prefactor returns
-    :math:`a (\sin\Delta\theta / \Delta\theta)^2` in expectation, 0.960 a at
-    18 bins. Binning also moves each contact to its bin centre: directions
-    whose spacing is a whole number of bins (a hexagonal lattice at 18 bins)
-    keep a = 0, others do not (a square lattice gives
-    :math:`\frac{\sin\Delta\theta}{\Delta\theta}\, 2\sin\frac{\Delta\theta}{2}
-    = 0.340` at 18 bins, 90° being 4.5 bins).
-
-Normal-force anisotropy a_n
-    The same formulas with each contact weighted by its normal force
-    :math:`f_n` (Eq. 7 with :math:`N_g` the sum of normal forces in bin g and
-    :math:`N` the total), as the paper's Fig. 7 draws it. This force-weighted
-    measure combines contact-orientation and force-magnitude anisotropy (to
-    first order :math:`a + a_n^{RB}` of Rothenburg & Bathurst).
+Formulas, binning effects and lattice answers: docs/fabric.md, "Coordination
+number Z" to "Contact-force anisotropy a_n".
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, _kernels
-from grainlab.analysis._util import (
-    Computable,
-    contact_ends,
-    has_boundary,
-    repeated_boundary_contacts,
-)
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import contact_ends, has_boundary, repeated_boundary_contacts
 from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot
 
 __all__ = [
@@ -300,25 +236,12 @@ def fabric_tensor(normals: ArrayLike, weights: ArrayLike | None = None) -> NDArr
 
 
 # --------------------------------------------------------------------------- classes
-@dataclass(frozen=True, eq=False)
-class _CoordinationNumberResults:
-    """The results of :class:`CoordinationNumber` (see its properties)."""
-
-    coordination_number: float
-    mechanical_coordination_number: float
-    n_contacts: NDArray[np.int64]
-    rattlers: NDArray[np.bool_]
-    count_distribution: NDArray[np.float64]
-    n_particles: int
-    n_contacts_total: int
-
-
-class CoordinationNumber(Computable[_CoordinationNumberResults]):
+class CoordinationNumber(Compute):
     r"""Coordination number Z, mechanical coordination number Z_m, contact counts.
 
     .. math:: Z = \frac{2 N_c}{N_p}, \qquad Z_m = \frac{2 N_c^m}{N_p^m}
 
-    (see the module docstring for the rattler rule).
+    (the rattler rule: docs/fabric.md, "Mechanical coordination number Z_m").
 
     Parameters
     ----------
@@ -333,17 +256,6 @@ class CoordinationNumber(Computable[_CoordinationNumberResults]):
         :class:`~grainlab.analysis.StabilityIndex` does; ``"each"`` counts
         every contact (every membrane disk touched).
 
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    coordination_number, mechanical_coordination_number : float
-    n_contacts : (N,) int
-        Contacts per particle (0 for membrane particles).
-    rattlers : (N,) bool
-    count_distribution : (max + 1,) float
-        Fraction of sample particles with 0, 1, 2, ... contacts.
-    n_particles, n_contacts_total : int
-        N_p and N_c used for Z.
-
     Example
     -------
     >>> import numpy as np
@@ -354,6 +266,8 @@ class CoordinationNumber(Computable[_CoordinationNumberResults]):
     >>> CoordinationNumber().compute(snap).coordination_number
     4.0
     """
+
+    _parameters = ("min_contacts", "include_boundary", "boundary")
 
     def __init__(
         self, min_contacts: int = 2, include_boundary: bool = False, boundary: str = "body"
@@ -409,52 +323,27 @@ class CoordinationNumber(Computable[_CoordinationNumberResults]):
         if n_p:
             dist /= n_p
         self._store(
-            _CoordinationNumberResults(
-                coordination_number=z,
-                mechanical_coordination_number=z_m,
-                n_contacts=counts,
-                rattlers=rat,
-                count_distribution=dist,
-                n_particles=n_p,
-                n_contacts_total=int(a.size),
-            )
+            coordination_number=z,
+            mechanical_coordination_number=z_m,
+            n_contacts=counts,
+            rattlers=rat,
+            count_distribution=dist,
+            n_particles=n_p,
+            n_contacts_total=int(a.size),
         )
         return self
 
-    @property
-    def coordination_number(self) -> float:
-        """Z = 2 Nc / Np."""
-        return self._computed("coordination_number").coordination_number
-
-    @property
-    def mechanical_coordination_number(self) -> float:
-        """Z_m over the particles left after iterative rattler removal."""
-        return self._computed("mechanical_coordination_number").mechanical_coordination_number
-
-    @property
-    def n_contacts(self) -> NDArray[np.int64]:
-        """(N,) contacts per particle."""
-        return self._computed("n_contacts").n_contacts
-
-    @property
-    def rattlers(self) -> NDArray[np.bool_]:
-        """(N,) mask of the rattlers."""
-        return self._computed("rattlers").rattlers
-
-    @property
-    def count_distribution(self) -> NDArray[np.float64]:
-        """Fraction of sample particles with k contacts, k = 0, 1, 2, ..."""
-        return self._computed("count_distribution").count_distribution
-
-    @property
-    def n_particles(self) -> int:
-        """N_p, the number of sample particles."""
-        return self._computed("n_particles").n_particles
-
-    @property
-    def n_contacts_total(self) -> int:
-        """N_c, the number of contacts used."""
-        return self._computed("n_contacts_total").n_contacts_total
+    coordination_number = Computed[float]("Z = 2 Nc / Np.")
+    mechanical_coordination_number = Computed[float](
+        "Z_m over the particles left after iterative rattler removal."
+    )
+    n_contacts = Computed[NDArray[np.int64]]("(N,) contacts per particle (0 for membrane particles).")
+    rattlers = Computed[NDArray[np.bool_]]("(N,) mask of the rattlers.")
+    count_distribution = Computed[NDArray[np.float64]](
+        "Fraction of sample particles with k contacts, k = 0, 1, 2, ..."
+    )
+    n_particles = Computed[int]("N_p, the number of sample particles.")
+    n_contacts_total = Computed[int]("N_c, the number of contacts used.")
 
     def plot(self, ax: Any = None) -> Any:
         """Bar chart of the contact-count distribution; returns the axes."""
@@ -462,35 +351,16 @@ class CoordinationNumber(Computable[_CoordinationNumberResults]):
 
         return plot.contact_count_distribution(self.count_distribution, ax=ax)
 
-    def __repr__(self) -> str:
-        return (
-            f"CoordinationNumber(min_contacts={self.min_contacts}, "
-            f"include_boundary={self.include_boundary}, boundary={self.boundary!r})"
-        )
 
-
-@dataclass(frozen=True, eq=False)
-class _ContactAnisotropyResults:
-    """The results of :class:`ContactAnisotropy` (see its properties)."""
-
-    histogram: NDArray[np.float64]
-    bin_edges: NDArray[np.float64]
-    anisotropy: float
-    direction: float
-    anisotropy_binned: float
-    direction_binned: float
-    fabric_tensor: NDArray[np.float64]
-    total: float
-
-
-class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
+class ContactAnisotropy(Compute):
     r"""Contact-normal (or normal-force) distribution and its anisotropy (Eq. 6–8).
 
     Fitted distribution (Eq. 6): :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos
     2(\theta - \theta_a)]`. The headline :attr:`anisotropy` and
     :attr:`direction` are the exact (unbinned) estimate from the second
     Fourier moment; :attr:`anisotropy_binned` and :attr:`direction_binned`
-    are the paper's Eq. 7–8 on the histogram (see the module docstring).
+    are the paper's Eq. 7–8 on the histogram (docs/fabric.md,
+    "Contact-normal distribution and anisotropy (Eq. 6–8)").
 
     Parameters
     ----------
@@ -506,23 +376,6 @@ class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
     edge_tolerance : float, rad, default :data:`EDGE_TOLERANCE_RAD`
         Angles this close to a bin edge count half to each neighbouring bin.
 
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    anisotropy, direction : float
-        a (or a_n) and theta_a (rad, [0, pi)): the exact estimate, unbinned.
-    anisotropy_binned, direction_binned : float
-        The same by Eq. 7–8 as printed, from :attr:`histogram`.
-    anisotropy_fourier, direction_fourier : float
-        Equal to :attr:`anisotropy` and :attr:`direction` (their earlier name).
-    histogram : (bins,) float
-        Counts N_g (or summed normal force, N) per bin, each contact twice
-        (halves for contacts on a bin edge).
-    bin_edges : (bins + 1,) float, rad
-    fabric_tensor : (2, 2) float
-        ``sum w n (x) n / sum w``.
-    total : float
-        Number of contacts used (or the sum of their normal forces).
-
     Example
     -------
     >>> import numpy as np
@@ -534,6 +387,8 @@ class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
     >>> round(fabric.anisotropy, 12), round(fabric.anisotropy_binned, 4)
     (0.0, 0.0591)
     """
+
+    _parameters = ("bins", "weight", "include_boundary", "edge_tolerance")
 
     def __init__(
         self,
@@ -592,28 +447,21 @@ class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
         else:
             af, tf = anisotropy_fourier(angles, weights)
         self._store(
-            _ContactAnisotropyResults(
-                histogram=values,
-                bin_edges=edges,
-                anisotropy=af,
-                direction=tf,
-                anisotropy_binned=a7,
-                direction_binned=t7,
-                fabric_tensor=phi,
-                total=float(n_used if weights is None else weights.sum()),
-            )
+            histogram=values,
+            bin_edges=edges,
+            anisotropy=af,
+            direction=tf,
+            anisotropy_binned=a7,
+            direction_binned=t7,
+            fabric_tensor=phi,
+            total=float(n_used if weights is None else weights.sum()),
         )
         return self
 
-    @property
-    def histogram(self) -> NDArray[np.float64]:
-        """(bins,) bin contents, each contact counted in both directions."""
-        return self._computed("histogram").histogram
-
-    @property
-    def bin_edges(self) -> NDArray[np.float64]:
-        """(bins + 1,) bin edges, rad."""
-        return self._computed("bin_edges").bin_edges
+    histogram = Computed[NDArray[np.float64]](
+        "(bins,) bin contents, each contact counted in both directions."
+    )
+    bin_edges = Computed[NDArray[np.float64]]("(bins + 1,) bin edges, rad.")
 
     @property
     def bin_centers(self) -> NDArray[np.float64]:
@@ -621,45 +469,26 @@ class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
         e = self.bin_edges
         return 0.5 * (e[1:] + e[:-1])
 
-    @property
-    def anisotropy(self) -> float:
-        """a (or a_n), exact: twice the modulus of the mean of exp(2 i theta)."""
-        return self._computed("anisotropy").anisotropy
-
-    @property
-    def direction(self) -> float:
-        """theta_a, exact: half the argument of the mean of exp(2 i theta), rad in [0, pi)."""
-        return self._computed("direction").direction
-
-    @property
-    def anisotropy_binned(self) -> float:
-        """a (or a_n) by Eq. 7 as printed, from the histogram."""
-        return self._computed("anisotropy_binned").anisotropy_binned
-
-    @property
-    def direction_binned(self) -> float:
-        """theta_a by Eq. 8 (atan2 form) from the histogram, rad in [0, pi)."""
-        return self._computed("direction_binned").direction_binned
+    anisotropy = Computed[float](
+        "a (or a_n), exact: twice the modulus of the mean of exp(2 i theta)."
+    )
+    direction = Computed[float](
+        "theta_a, exact: half the argument of the mean of exp(2 i theta), rad in [0, pi)."
+    )
+    anisotropy_binned = Computed[float]("a (or a_n) by Eq. 7 as printed, from the histogram.")
+    direction_binned = Computed[float](
+        "theta_a by Eq. 8 (atan2 form) from the histogram, rad in [0, pi)."
+    )
 
     @property
     def anisotropy_fourier(self) -> float:
         """The exact a, :attr:`anisotropy` under its earlier name."""
-        return self._computed("anisotropy").anisotropy
+        return self.anisotropy
 
-    @property
-    def direction_fourier(self) -> float:
-        """The exact theta_a, :attr:`direction` under its earlier name."""
-        return self._computed("direction").direction
-
-    @property
-    def fabric_tensor(self) -> NDArray[np.float64]:
-        """(2, 2) fabric tensor (force-weighted for weight='normal_force')."""
-        return self._computed("fabric_tensor").fabric_tensor
-
-    @property
-    def total(self) -> float:
-        """Contacts used (or their total normal force, N)."""
-        return self._computed("total").total
+    fabric_tensor = Computed[NDArray[np.float64]](
+        "(2, 2) fabric tensor (force-weighted for weight='normal_force')."
+    )
+    total = Computed[float]("Contacts used (or their total normal force, N).")
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Polar diagram with the fitted E(theta) (paper Figs. 6–7); returns the axes."""
@@ -672,10 +501,4 @@ class ContactAnisotropy(Computable[_ContactAnisotropyResults]):
             ax=ax,
             kind="forces" if self.weight == "normal_force" else "contacts",
             **kwargs,
-        )
-
-    def __repr__(self) -> str:
-        return (
-            f"ContactAnisotropy(bins={self.bins}, weight={self.weight!r}, "
-            f"include_boundary={self.include_boundary}, edge_tolerance={self.edge_tolerance!r})"
         )

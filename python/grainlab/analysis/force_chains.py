@@ -1,60 +1,29 @@
-r"""Force chains by the criterion of Peters et al. (2005) (docs/fabric.md,
-"Force chains").
+r"""Force chains by the criterion of Peters et al. (2005).
 
-1. Each grain's Love-Weber stress
-   :math:`\sigma^p = -\frac{1}{\pi r_p^2}\sum_{c \ni p}\operatorname{sym}((x_c - x_p)\otimes f^p_c)`
-   (:class:`~grainlab.analysis.stress.GrainStress`), its major principal
-   stress :math:`\sigma_1^p` and direction :math:`m_p`.
-2. A grain is **highly stressed** when :math:`\sigma_1^p > \bar\sigma_1`,
-   the mean over the sample grains (every grain, rattlers at 0, as Peters et
-   al. average over all particles), by more than a relative 1e-9 (grains
-   loaded alike differ by round-off only: a uniformly loaded lattice has no
-   highly stressed grain).
-3. Two highly stressed grains in contact are **linked** when their branch
-   vector :math:`l` is within ``angle`` (default 45°) of both major
-   directions, :math:`|\hat l\cdot m_p| \ge \cos(\text{angle})` and the same
-   for the other grain.
-4. A **force chain** is a connected set of linked grains of at least
-   ``min_grains`` (default 3) grains. Each grain belongs to at most one
-   chain; a chain may branch where the criterion links a grain to more than
-   two others (Peters et al. follow single paths; in a dense packing the two
-   agree but for the rare branch).
-
-Statistics: each chain's length (its grains), its orientation
-:math:`\theta = \tfrac12\arg\sum_{\text{links}} e^{2i\theta_l}` in [0°, 180°)
-(the axial mean of its links' directions), the chains' number, mean length
-and the fraction of sample grains in chains.
+Grains whose major principal stress exceeds the sample grains' mean (by a
+relative 1e-9) are highly stressed; two in contact are linked when their
+branch vector lies within ``angle`` (45°) of both major directions; a chain is
+a connected set of linked grains of at least ``min_grains`` (3), each grain in
+at most one. Orientation: the axial mean :math:`\tfrac12\arg\sum e^{2i\theta_l}`
+of its links, in [0, pi). docs/fabric.md, "Force chains".
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.analysis._util import Computable, axial_direction
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import axial_direction
 from grainlab.analysis.stress import GrainStress, branch_vectors
 from grainlab.snapshot import Snapshot
 
 __all__ = ["ForceChains"]
 
 
-@dataclass(frozen=True, eq=False)
-class _ForceChainsResults:
-    """The results of :class:`ForceChains` (see its properties)."""
-
-    snapshot: Snapshot
-    major_stress: NDArray[np.float64]
-    highly_stressed: NDArray[np.bool_]
-    links: NDArray[np.bool_]
-    chain: NDArray[np.int64]
-    lengths: NDArray[np.int64]
-    orientations: NDArray[np.float64]
-
-
-class ForceChains(Computable[_ForceChainsResults]):
+class ForceChains(Compute):
     r"""Force chains: highly stressed grains linked along their major principal directions.
 
     Grain p is highly stressed when :math:`\sigma_1^p > \bar\sigma_1`; a
@@ -69,19 +38,6 @@ class ForceChains(Computable[_ForceChainsResults]):
         principal direction.
     min_grains : int, default 3
         Fewest grains in a chain.
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    chain : (N,) int
-        The chain of each grain, 0, 1, ... (longest first), -1 for none.
-    lengths : (n_chains,) int
-        Grains per chain.
-    orientations : (n_chains,) float, rad in [0, pi)
-    n_chains, mean_length, fraction_in_chains : summary numbers.
-    major_stress : (N,) float, Pa
-    highly_stressed : (N,) bool
-    links : (Nc,) bool
-        The contacts that link two grains of one chain.
 
     Example
     -------
@@ -98,6 +54,8 @@ class ForceChains(Computable[_ForceChainsResults]):
     >>> chains.n_chains, chains.lengths.tolist(), round(float(np.degrees(chains.orientations[0])), 9)
     (1, [5], 90.0)
     """
+
+    _parameters = ("angle", "min_grains")
 
     def __init__(self, angle: float = 45.0, min_grains: int = 3) -> None:
         if not 0.0 <= angle <= 90.0:
@@ -153,26 +111,24 @@ class ForceChains(Computable[_ForceChainsResults]):
         )
         orientations = axial_direction(np.angle(sums))
         self._store(
-            _ForceChainsResults(
-                snapshot, major, high, links, chain, lengths, orientations.astype(np.float64)
-            )
+            _snapshot=snapshot,
+            major_stress=major,
+            highly_stressed=high,
+            links=links,
+            chain=chain,
+            lengths=lengths,
+            orientations=orientations.astype(np.float64),
         )
         return self
 
-    @property
-    def chain(self) -> NDArray[np.int64]:
-        """(N,) chain number of each grain (longest first), -1 outside chains."""
-        return self._computed("chain").chain
-
-    @property
-    def lengths(self) -> NDArray[np.int64]:
-        """(n_chains,) grains in each chain."""
-        return self._computed("lengths").lengths
-
-    @property
-    def orientations(self) -> NDArray[np.float64]:
-        """(n_chains,) axial mean direction of each chain's links, rad in [0, pi)."""
-        return self._computed("orientations").orientations
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    chain = Computed[NDArray[np.int64]](
+        "(N,) chain number of each grain (longest first), -1 outside chains."
+    )
+    lengths = Computed[NDArray[np.int64]]("(n_chains,) grains in each chain, longest first.")
+    orientations = Computed[NDArray[np.float64]](
+        "(n_chains,) axial mean direction of each chain's links, rad in [0, pi)."
+    )
 
     @property
     def n_chains(self) -> int:
@@ -187,7 +143,7 @@ class ForceChains(Computable[_ForceChainsResults]):
     @property
     def fraction_in_chains(self) -> float:
         """Fraction of the sample grains that belong to a chain."""
-        snap = self._computed("chain").snapshot
+        snap = self._snapshot
         sample = snap.is_sample
         return float((self.chain[sample] >= 0).mean()) if sample.any() else float("nan")
 
@@ -199,20 +155,11 @@ class ForceChains(Computable[_ForceChainsResults]):
         s = np.sum(self.lengths * np.exp(2j * self.orientations))
         return float(axial_direction(np.angle(s)))
 
-    @property
-    def major_stress(self) -> NDArray[np.float64]:
-        """(N,) each grain's major principal stress, Pa."""
-        return self._computed("major_stress").major_stress
-
-    @property
-    def highly_stressed(self) -> NDArray[np.bool_]:
-        """(N,) grains with sigma_1 above the mean over the sample grains."""
-        return self._computed("highly_stressed").highly_stressed
-
-    @property
-    def links(self) -> NDArray[np.bool_]:
-        """(Nc,) the contacts joining two grains of one chain."""
-        return self._computed("links").links
+    major_stress = Computed[NDArray[np.float64]]("(N,) each grain's major principal stress, Pa.")
+    highly_stressed = Computed[NDArray[np.bool_]](
+        "(N,) grains with sigma_1 above the mean over the sample grains."
+    )
+    links = Computed[NDArray[np.bool_]]("(Nc,) the contacts joining two grains of one chain.")
 
     def summary(self) -> dict[str, float | int]:
         """The chains' numbers: count, mean and longest length, fraction of grains,
@@ -229,7 +176,7 @@ class ForceChains(Computable[_ForceChainsResults]):
         """The chains' links over the grains, one colour per chain; returns the axes."""
         from grainlab.plot import networks
 
-        snap = self._computed("links").snapshot
+        snap = self._snapshot
         links = self.links
         start = np.asarray(snap.positions)[np.asarray(snap.contact_i)[links]]
         k = self.chain[np.asarray(snap.contact_i)[links]]
@@ -244,6 +191,3 @@ class ForceChains(Computable[_ForceChainsResults]):
             ax=ax,
             title=f"{self.n_chains} force chains (Peters et al. 2005, {self.angle:g}°)",
         )
-
-    def __repr__(self) -> str:
-        return f"ForceChains(angle={self.angle!r}, min_grains={self.min_grains})"

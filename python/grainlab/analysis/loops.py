@@ -1,63 +1,28 @@
-r"""The loops of the contact network (docs/fabric.md, "Loops").
+r"""The loops of the contact network: cyclomatic number and minimal loops.
 
-The **contact graph** has the sample grains as vertices and their contacts
-with each other as edges (walls and membrane disks are not part of it); by
-default the rattlers are removed first, iteratively, by Thornton's rule
-(grains with fewer than 2 contacts,
-:func:`~grainlab.analysis.fabric.rattlers`), which also removes every
-dangling branch, as Kruyt and Rothenburg's loop analysis does.
-
-Independent cycles
-    The cyclomatic number :math:`L = E - V + C` (edges, vertices, connected
-    components, isolated grains each a component).
-
-Minimal loops
-    Drawn with straight branches between centres, the contact graph of
-    disks is planar, and its **faces** are the minimal loops (Kruyt and
-    Rothenburg; Tordesillas et al. call them minimal cycles): the smallest
-    closed paths of contacts enclosing a void. Each face is traced through
-    the half-edges: with every grain's contacts sorted counter-clockwise,
-    the half-edge after :math:`u \to v` is :math:`v \to w`, w the contact of
-    v just clockwise from u, which keeps the face on the left. A face's
-    **size** is its number of half-edges (its grains, for a simple loop).
-    Summed along a face, the turns between successive branches give
-    :math:`+2\pi` for a bounded face, :math:`-2\pi` for the outer boundary
-    of a bounded packing and 0 for a face that wraps around a periodic cell;
-    only the bounded faces are loops. In a bounded connected packing the
-    loops number :math:`L` (Euler); in a periodic cell :math:`L - 1`.
-
-A hexagonal lattice has loops of size 3 only, a square lattice of size 4.
+The contact graph: sample grains and their contacts with each other, the
+rattlers removed first by default (Thornton's rule, iteratively). The
+cyclomatic number :math:`L = E - V + C`; the minimal loops are the bounded
+faces of the planar graph of branches, traced through the half-edges, a
+loop's size its number of half-edges (a hexagonal lattice has loops of 3, a
+square one of 4). docs/fabric.md, "Loops of the contact network".
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.analysis._util import Computable
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis.fabric import rattlers
 from grainlab.snapshot import Snapshot
 
 __all__ = ["ContactLoops"]
 
 
-@dataclass(frozen=True, eq=False)
-class _ContactLoopsResults:
-    """The results of :class:`ContactLoops` (see its properties)."""
-
-    snapshot: Snapshot
-    in_graph: NDArray[np.bool_]
-    cyclomatic_number: int
-    loop_sizes: NDArray[np.int64]
-    grain_loop_size: NDArray[np.float64]
-    n_edges: int
-    n_components: int
-
-
-class ContactLoops(Computable[_ContactLoopsResults]):
+class ContactLoops(Compute):
     r"""Independent cycles and minimal loops (faces) of the contact graph.
 
     .. math:: L = E - V + C,
@@ -70,20 +35,6 @@ class ContactLoops(Computable[_ContactLoopsResults]):
     remove_rattlers : bool, default True
         Remove the rattlers (fewer than 2 contacts, iteratively) first.
 
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    cyclomatic_number : int
-        L = E - V + C of the graph used.
-    loop_sizes : (F,) int
-        Size of each minimal loop.
-    size_distribution : (max + 1,) float
-        Fraction of the loops of each size 0, 1, 2, ... (0, 1, 2 are empty).
-    mean_loop_size : float
-    grain_loop_size : (N,) float
-        Mean size of the loops a grain sits on (NaN for grains on none).
-    in_graph : (N,) bool
-        The grains of the graph.
-
     Example
     -------
     >>> import numpy as np
@@ -94,6 +45,8 @@ class ContactLoops(Computable[_ContactLoopsResults]):
     >>> loops.cyclomatic_number, loops.loop_sizes.tolist()
     (9, [4, 4, 4, 4, 4, 4, 4, 4, 4])
     """
+
+    _parameters = ("remove_rattlers",)
 
     def __init__(self, remove_rattlers: bool = True) -> None:
         self.remove_rattlers = bool(remove_rattlers)
@@ -151,21 +104,19 @@ class ContactLoops(Computable[_ContactLoopsResults]):
         with np.errstate(invalid="ignore", divide="ignore"):
             grain_loop = np.where(count > 0, total / count, np.nan)
         self._store(
-            _ContactLoopsResults(
-                snapshot, keep, cyclomatic, loop_sizes, grain_loop, n_edges, n_components
-            )
+            _snapshot=snapshot,
+            in_graph=keep,
+            cyclomatic_number=cyclomatic,
+            loop_sizes=loop_sizes,
+            grain_loop_size=grain_loop,
+            n_edges=n_edges,
+            n_components=n_components,
         )
         return self
 
-    @property
-    def cyclomatic_number(self) -> int:
-        """L = E - V + C, the independent cycles of the graph used."""
-        return self._computed("cyclomatic_number").cyclomatic_number
-
-    @property
-    def loop_sizes(self) -> NDArray[np.int64]:
-        """(F,) the size of each minimal loop (bounded face)."""
-        return self._computed("loop_sizes").loop_sizes
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    cyclomatic_number = Computed[int]("L = E - V + C, the independent cycles of the graph used.")
+    loop_sizes = Computed[NDArray[np.int64]]("(F,) the size of each minimal loop (bounded face).")
 
     @property
     def n_loops(self) -> int:
@@ -183,25 +134,14 @@ class ContactLoops(Computable[_ContactLoopsResults]):
         counts = np.bincount(self.loop_sizes).astype(np.float64)
         return counts / counts.sum() if counts.sum() else counts
 
-    @property
-    def grain_loop_size(self) -> NDArray[np.float64]:
-        """(N,) mean size of the loops each grain sits on, NaN for none."""
-        return self._computed("grain_loop_size").grain_loop_size
-
-    @property
-    def in_graph(self) -> NDArray[np.bool_]:
-        """(N,) the grains of the graph (the sample, less the rattlers by default)."""
-        return self._computed("in_graph").in_graph
-
-    @property
-    def n_edges(self) -> int:
-        """E, the contacts of the graph."""
-        return self._computed("n_edges").n_edges
-
-    @property
-    def n_components(self) -> int:
-        """C, its connected components."""
-        return self._computed("n_components").n_components
+    grain_loop_size = Computed[NDArray[np.float64]](
+        "(N,) mean size of the loops each grain sits on, NaN for none."
+    )
+    in_graph = Computed[NDArray[np.bool_]](
+        "(N,) the grains of the graph (the sample, less the rattlers by default)."
+    )
+    n_edges = Computed[int]("E, the contacts of the graph.")
+    n_components = Computed[int]("C, its connected components.")
 
     def summary(self) -> dict[str, Any]:
         """The loops' numbers: L, the loops' count, mean size and size fractions."""
@@ -216,7 +156,7 @@ class ContactLoops(Computable[_ContactLoopsResults]):
         """Particle map coloured by the mean size of each grain's loops; returns the axes."""
         from grainlab import plot
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         return plot.particle_map(
             snap.positions,
             snap.radii,
@@ -226,6 +166,3 @@ class ContactLoops(Computable[_ContactLoopsResults]):
             vmin=3.0,
             label="mean size of the grain's loops",
         )
-
-    def __repr__(self) -> str:
-        return f"ContactLoops(remove_rattlers={self.remove_rattlers})"

@@ -1,29 +1,14 @@
-r"""The strong and weak force networks (Radjai et al. 1998; docs/fabric.md,
-"Strong and weak networks").
+r"""The strong and weak force networks (Radjai et al. 1998).
 
-The contacts between sample grains (``include_boundary`` adds those with
-walls and membrane disks) are split at their mean normal force
-:math:`\langle f_n\rangle`: the **strong** network holds the contacts with
-:math:`f_n > \langle f_n\rangle`, the **weak** one the rest. For each network
-k (and for all the contacts together):
-
-* its anisotropies :math:`a, a_n, a_t` and directions (Rothenburg and
-  Bathurst's forms fitted to the network's own contacts,
-  :func:`~grainlab.analysis.stress_fabric.force_anisotropies`);
-* its stress, the contact form restricted to the network,
-  :math:`\sigma^k = \frac{1}{A}\sum_{c \in k}\operatorname{sym}(l_c\otimes f_c)`
-  (:func:`~grainlab.analysis.stress.contact_stress`), so
-  :math:`\sigma^s + \sigma^w = \sigma`;
-* its share of the deviatoric stress, the projection of its deviator on the
-  whole one,
-
-  .. math:: \chi_k = \frac{\operatorname{dev}\sigma^k : \operatorname{dev}\sigma}
-                          {\operatorname{dev}\sigma : \operatorname{dev}\sigma},
-            \qquad \chi_s + \chi_w = 1,
-
-  and of the mean stress, :math:`p_k / p` (also summing to 1). Radjai et
-  al. found the weak network's deviatoric share near zero (or negative):
-  it carries pressure, the strong one the shear.
+Contacts between sample grains (``include_boundary`` adds walls and membrane
+disks) split at their mean normal force: strong :math:`f_n > \langle
+f_n\rangle`, weak the rest. Each network (and the whole) has its anisotropies
+(:func:`~grainlab.analysis.stress_fabric.force_anisotropies`), its stress
+(:func:`~grainlab.analysis.stress.contact_stress`, :math:`\sigma^s + \sigma^w
+= \sigma`), its deviatoric share :math:`\chi_k = \operatorname{dev}\sigma^k :
+\operatorname{dev}\sigma / \operatorname{dev}\sigma : \operatorname{dev}\sigma`
+and mean-stress share :math:`p_k / p` (each pair summing to 1).
+docs/fabric.md, "Strong and weak networks".
 """
 
 from __future__ import annotations
@@ -34,7 +19,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.analysis._util import Computable, grain_contacts, principal_stresses
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import grain_contacts, principal_stresses
 from grainlab.analysis.stress import branch_vectors, contact_stress
 from grainlab.analysis.stress_fabric import Anisotropies, force_anisotropies
 from grainlab.snapshot import Snapshot
@@ -83,19 +69,7 @@ def _deviator(s: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.asarray(s - 0.5 * np.trace(s) * np.eye(2), dtype=np.float64)
 
 
-@dataclass(frozen=True, eq=False)
-class _ForceNetworksResults:
-    """The results of :class:`ForceNetworks` (see its properties)."""
-
-    snapshot: Snapshot
-    mean_normal_force: float
-    strong: Network
-    weak: Network
-    whole: Network
-    in_strong_network: NDArray[np.bool_]
-
-
-class ForceNetworks(Computable[_ForceNetworksResults]):
+class ForceNetworks(Compute):
     r"""The strong and weak force networks split at the mean normal force.
 
     Strong: :math:`f_n > \langle f_n\rangle`; weak: the rest. Each network's
@@ -113,13 +87,6 @@ class ForceNetworks(Computable[_ForceNetworksResults]):
         For the stresses (default the snapshot's region); the shares do not
         depend on it.
 
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    mean_normal_force : float, N
-    strong, weak, whole : :class:`Network`
-    in_strong_network : (N,) bool
-        Grains with at least one strong contact.
-
     Example
     -------
     A hexagonal lattice whose horizontal contacts carry 3 N and the others 1 N:
@@ -136,6 +103,8 @@ class ForceNetworks(Computable[_ForceNetworksResults]):
     >>> round(nets.strong.deviatoric_share, 12), round(nets.weak.deviatoric_share, 12)
     (1.5, -0.5)
     """
+
+    _parameters = ("include_boundary", "area")
 
     def __init__(self, include_boundary: bool = False, area: float | None = None) -> None:
         if area is not None and not area > 0:
@@ -188,41 +157,23 @@ class ForceNetworks(Computable[_ForceNetworksResults]):
             cj[strong & (cj >= 0)], minlength=n
         )
         self._store(
-            _ForceNetworksResults(
-                snapshot,
-                mean,
-                network(strong),
-                network(weak),
-                network(used),
-                (touched > 0) & snapshot.is_sample,
-            )
+            _snapshot=snapshot,
+            mean_normal_force=mean,
+            strong=network(strong),
+            weak=network(weak),
+            whole=network(used),
+            in_strong_network=(touched > 0) & snapshot.is_sample,
         )
         return self
 
-    @property
-    def mean_normal_force(self) -> float:
-        """<f_n> over the contacts used, N: the threshold."""
-        return self._computed("mean_normal_force").mean_normal_force
-
-    @property
-    def strong(self) -> Network:
-        """The strong network, f_n > <f_n>."""
-        return self._computed("strong").strong
-
-    @property
-    def weak(self) -> Network:
-        """The weak network, f_n <= <f_n>."""
-        return self._computed("weak").weak
-
-    @property
-    def whole(self) -> Network:
-        """All the contacts used, measured the same way."""
-        return self._computed("whole").whole
-
-    @property
-    def in_strong_network(self) -> NDArray[np.bool_]:
-        """(N,) sample grains with at least one strong contact."""
-        return self._computed("in_strong_network").in_strong_network
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    mean_normal_force = Computed[float]("<f_n> over the contacts used, N: the threshold.")
+    strong = Computed["Network"]("The strong network, f_n > <f_n>.")
+    weak = Computed["Network"]("The weak network, f_n <= <f_n>.")
+    whole = Computed["Network"]("All the contacts used, measured the same way.")
+    in_strong_network = Computed[NDArray[np.bool_]](
+        "(N,) sample grains with at least one strong contact."
+    )
 
     def summary(self) -> dict[str, float | int]:
         """Every scalar by name (``strong_a_n``, ``weak_deviatoric_share``, ...)."""
@@ -236,7 +187,7 @@ class ForceNetworks(Computable[_ForceNetworksResults]):
         strong black, weak grey; returns the axes."""
         from grainlab.plot import networks
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         used = self.whole.contacts
         start = np.asarray(snap.positions)[np.asarray(snap.contact_i)[used]]
         fn = np.asarray(snap.normal_force)[used]
@@ -253,6 +204,3 @@ class ForceNetworks(Computable[_ForceNetworksResults]):
             title=f"force network (strong: f_n > {self.mean_normal_force:.3g} N)",
             legend=[("strong", "k"), ("weak", "0.6")],
         )
-
-    def __repr__(self) -> str:
-        return f"ForceNetworks(include_boundary={self.include_boundary}, area={self.area!r})"

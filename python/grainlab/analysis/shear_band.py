@@ -1,119 +1,41 @@
-r"""Shear band detection from a per-particle shear strain field.
+r"""The shear band as a straight slab in a per-particle strain field.
 
-The band is modelled as a straight slab: a centre line at angle
-:math:`\beta` (CCW from +x, in [0°, 180°)) and a thickness :math:`w`.
-
-1. **Orientation.** For a trial angle :math:`\beta` the particles are
-   projected on the slab normal :math:`n = (-\sin\beta, \cos\beta)`,
-   :math:`s = (x - \bar x) \cdot n`, and binned in ``s`` (bins of
-   ``bin_width``, default half a mean diameter). Only the bins where the
-   slab *crosses the sample* take part: those with at least ``min_fill``
-   (default 1/2) times as many particles within 2 mean diameters as the
-   fullest position of that angle. The ends of the range, where a slab
-   only clips a corner of the sample, hold few particles; in a biaxial
-   test the platen corners concentrate strain there, and a slab through a
-   corner would otherwise win both the angle score and the peak search
-   (the reason why earlier versions found no band on real runs). The score
-   is the adjusted correlation ratio of the strain with the bin,
-
-   .. math::
-
-      \eta^2 = \frac{\sum_b n_b (\bar\gamma_b - \bar\gamma)^2}
-                    {\sum_p (\gamma_p - \bar\gamma)^2},\qquad
-      \eta^2_{adj} = 1 - (1 - \eta^2)\frac{M - 1}{M - B},
-
-   (M particles, B occupied bins, over the bins used), the share of the
-   strain variance that the profile across the slab explains
-   (:attr:`ShearBand.score`). It is largest when the bins run parallel to
-   the band. A 1° scan over [0°, 180°) is refined with 0.05° steps around
-   the best angle and a parabola through the top three scores (the middle
-   of a plateau of equal scores).
-2. **Profile and thickness.** At the best angle the bin means
-   :math:`\bar\gamma_b` form the profile across the band (:attr:`profile`).
-   It is smoothed to the mean strain of the particles within about one mean
-   diameter of each bin. With the background :math:`\gamma_0` the median
-   strain and the peak :math:`\gamma_{max}` the largest smoothed value among
-   the bins that cross the sample, the band is the run of those bins around
-   the peak where the smoothed profile is above half height
-   :math:`\gamma_0 + (\gamma_{max} - \gamma_0)/2`; its edges are
-   interpolated linearly between the mean positions of the particles in
-   neighbouring bins. ``thickness`` is their distance (m), the full width at
-   half height of the band's strain profile; ``thickness_diameters`` divides
-   by the mean diameter. The kinematic shear zone (where the displacement
-   parallel to the band changes) is wider: the strain tails off on both
-   sides of the half-height edges.
-3. **Members.** Sample particles whose centre lies inside the slab.
-4. **Acceptance** (:attr:`found`, :attr:`reason`). The band's excess strain
-   :math:`\gamma_{max} - \gamma_0` is compared with the largest excess of the
-   smoothed profile elsewhere (beyond one band thickness, at least 2 mean
-   diameters, from each edge, bins crossing the sample only):
-   ``prominence`` is their ratio. A band is accepted when it is at least
-   ``min_thickness`` (1) mean diameter thick and its prominence is at least
-   ``min_prominence`` (2). On noise (strains shuffled over the grains of a
-   real run, or random non-affine displacements of a packing) the
-   prominence stayed below 1.8 in 240 trials; real bands at 10 % axial strain
-   score 3 to 5. A candidate that fails keeps all its numbers, so that a
-   report can show it as a candidate; :attr:`reason` says what failed.
-5. **Second band** (:attr:`second`). The same search over the particles
-   outside the first band and its flanks (2 mean diameters beyond each
-   edge), at directions at least 20° away from the first band's: in a
-   biaxial test, the conjugate band. It is a ShearBand of its own, with its
-   own :attr:`found`; its members may include first-band particles where the
-   bands cross.
-
-``contrast = (gamma_max - gamma_0) / gamma_max`` in [0, 1] tells how much of
-the strain in the band is excess over the background (0: nothing stands
-out). ``shear_strain`` is a dimensionless strain: an excess below 1e-9 counts
-as none (round-off of an affine deformation).
-
-Reading the angle
-    :attr:`angle_degrees` is the direction of the band's centre line, CCW
-    from +x, in [0°, 180°): a band rising to the right has an angle below
-    90°, a band falling to the right an angle above 90°. The inclination to
-    a direction at angle :math:`\alpha` (e.g. the minor principal stress
-    :math:`\sigma_3`) is the acute angle between the two lines,
-    :math:`\theta = |((\beta - \alpha + 90°) \bmod 180°) - 90°|`, in
-    [0°, 90°]. In a biaxial test loaded along y, :math:`\sigma_3` is
-    horizontal (:math:`\alpha = 0`): :math:`\theta = \min(\beta, 180° -
-    \beta)`, which :attr:`inclination_degrees` gives. That :math:`\theta` is
-    the angle the classical predictions give: Mohr–Coulomb
-    :math:`45° + \varphi/2`, Roscoe :math:`45° + \psi/2`, Arthur
-    :math:`45° + (\varphi + \psi)/4` (friction angle :math:`\varphi`,
-    dilatancy angle :math:`\psi`).
-
-Which field to pass: :attr:`LocalStrain.excess_shear_strain` (the shear
-invariant of each particle's strain minus the background strain) separates a
-band from a homogeneous deformation of the whole sample better than the total
-:attr:`LocalStrain.shear_strain`, whose invariant mixes the two non-linearly;
-:func:`grainlab.analysis.analyze_snapshot` and the biaxial figures use it.
-
-For a report, :meth:`ShearBand.summary` gives the scalars as a JSON-ready
-dict (``found``, ``reason``, ``angle_deg``, ``inclination_deg``,
-``thickness_diameters``, ``contrast``, ``prominence``, ..., ``second``).
+A centre line at angle :math:`\beta` (CCW from +x, [0°, 180°)) and a
+thickness: the angle maximises the adjusted correlation ratio
+:math:`\eta^2_{adj}` of the strain with bins across the slab (bins that cross
+the sample only); the thickness is the full width at half height of the
+smoothed profile around its peak; a band is accepted when at least
+``min_thickness`` mean diameters thick and its ``prominence`` at least
+``min_prominence`` (:mod:`~grainlab.analysis.band_acceptance`); a second
+(conjugate) band is searched outside the first, at least 20° away.
+``inclination_degrees = min(beta, 180° - beta)``. Pass
+:attr:`LocalStrain.excess_shear_strain`. The method, its thresholds and how to
+read the angle: docs/fabric.md, "Shear band".
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-from typing import Any, Protocol, TypeVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import uniform_filter1d
 
-from grainlab.analysis._util import Computable, finite_mean
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import finite_mean, json_number, random_subset
+from grainlab.analysis.band_acceptance import (
+    FLANK_D,
+    MIN_EXCESS,
+    profile_prominence,
+    strain_band_problems,
+)
 from grainlab.snapshot import Snapshot
 
 __all__ = ["ShearBand", "Slab", "SlabBand"]
 
 #: The second band's direction differs from the first's by at least this much (rad).
 _SECOND_SEPARATION = np.radians(20.0)
-#: Least width (mean diameters) of each flank of a band: left out of the prominence's
-#: "elsewhere" and of the search for the second band.
-_FLANK_D = 2.0
-#: Excess strain (and fraction of the largest strain) below which there is no band at all.
-_MIN_EXCESS = 1.0e-9
 #: Width (mean diameters) of the running mean over the profile bins.
 _SMOOTH_D = 2.0
 #: Width of the window (mean diameters) over which bin counts are summed to judge
@@ -265,6 +187,28 @@ class _Profile:
         return 0.5 * (self.s_lo + self.s_hi)
 
 
+def binned_profile(
+    b: NDArray[np.int64],
+    counts: NDArray[Any],
+    values: NDArray[np.float64],
+    s: NDArray[np.float64],
+    bin_width: float,
+) -> tuple[NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """A profile of ``values`` across a band from the bin ``b`` of each point and the
+    bins' ``counts``: the occupied bins, their points' mean ``s`` and mean value, and
+    the mean value of the points within about ``_SMOOTH_D / 2`` mean diameters of
+    each (``bin_width`` in mean diameters); the last three for occupied bins only."""
+    sums = np.bincount(b, weights=values, minlength=counts.size)
+    occupied = counts > 0
+    centers = np.bincount(b, weights=s, minlength=counts.size)[occupied] / counts[occupied]
+    half_window = max(1, int(np.floor(0.5 * _SMOOTH_D / bin_width + 0.5)))
+    kernel = np.ones(2 * half_window + 1)
+    near_sums = np.convolve(sums, kernel, mode="same")
+    near_counts = np.convolve(counts.astype(np.float64), kernel, mode="same")
+    smooth = (near_sums / np.maximum(near_counts, 1.0))[occupied]
+    return occupied, centers, sums[occupied] / counts[occupied], smooth
+
+
 def _band_profile(
     s: NDArray[np.float64], g: NDArray[np.float64], width: float, window: int, bin_width: float, min_fill: float
 ) -> _Profile:
@@ -272,16 +216,8 @@ def _band_profile(
     half-height edges around the highest smoothed bin that crosses the sample."""
     b2, counts2, crossing2 = _slab_bins(s, width, window, min_fill)
     b, counts, crossing = b2[0], counts2[0], crossing2[0]
-    sums = np.bincount(b, weights=g, minlength=counts.size)
-    occupied = counts > 0
-    centers = np.bincount(b, weights=s, minlength=counts.size)[occupied] / counts[occupied]
-    prof = sums[occupied] / counts[occupied]
+    occupied, centers, prof, smooth = binned_profile(b, counts, g, s, bin_width)
     keep = crossing[occupied]
-    half_window = max(1, int(np.floor(0.5 * _SMOOTH_D / bin_width + 0.5)))
-    kernel = np.ones(2 * half_window + 1)
-    near_sums = np.convolve(sums, kernel, mode="same")
-    near_counts = np.convolve(counts.astype(np.float64), kernel, mode="same")
-    smooth = (near_sums / np.maximum(near_counts, 1.0))[occupied]
     background = float(np.median(g))
     ipeak = int(np.argmax(np.where(keep, smooth, -np.inf)))
     peak = float(smooth[ipeak])
@@ -306,82 +242,18 @@ def _band_profile(
     return _Profile(centers, prof, smooth, keep, background, peak, edge(left, left - 1), edge(right, right + 1))
 
 
-@dataclass(frozen=True, eq=False)
-class _ShearBandResults:
-    """The results of :class:`ShearBand` (see its properties)."""
-
-    found: bool
-    reason: str
-    angle: float
-    thickness: float
-    thickness_diameters: float
-    center: NDArray[np.float64]
-    normal: NDArray[np.float64]
-    members: NDArray[np.bool_]
-    mean_lambda_inside: float
-    mean_lambda_outside: float
-    contrast: float
-    prominence: float
-    score: float
-    peak_strain: float
-    background_strain: float
-    profile: tuple[NDArray[np.float64], NDArray[np.float64]]
-    profile_crossing: NDArray[np.bool_]
-    second: ShearBand | None
-    mean_diameter: float
-    positions: NDArray[np.float64]
-    radii: NDArray[np.float64]
-    shear_strain: NDArray[np.float64]
-
-
-class _SlabRecord(Protocol):
-    """What a straight-slab band's results record holds (both readings' records do)."""
-
-    @property
-    def found(self) -> bool: ...
-    @property
-    def reason(self) -> str: ...
-    @property
-    def angle(self) -> float: ...
-    @property
-    def thickness(self) -> float: ...
-    @property
-    def thickness_diameters(self) -> float: ...
-    @property
-    def mean_diameter(self) -> float: ...
-    @property
-    def center(self) -> NDArray[np.float64]: ...
-    @property
-    def normal(self) -> NDArray[np.float64]: ...
-    @property
-    def members(self) -> NDArray[np.bool_]: ...
-    @property
-    def positions(self) -> NDArray[np.float64]: ...
-
-
-S = TypeVar("S", bound=_SlabRecord)
-
-
-class SlabBand(Computable[S]):
+class SlabBand(Compute):
     """A band modelled as a straight slab (a centre line, a thickness): the results
     and the outline that every reading of the band shares (:class:`ShearBand`,
     :class:`~grainlab.analysis.band_readings.DisplacementBand`). How the slab is
     found and accepted, and so what its thickness measures, is the subclass's."""
 
-    @property
-    def found(self) -> bool:
-        """Whether the band passed the acceptance tests (the class docstring)."""
-        return self._computed("found").found
-
-    @property
-    def reason(self) -> str:
-        """Why the band was not accepted ("" when :attr:`found`)."""
-        return self._computed("reason").reason
-
-    @property
-    def angle(self) -> float:
-        """Band direction, rad in [0, pi), CCW from +x."""
-        return self._computed("angle").angle
+    found = Computed[bool]("Whether the band passed the acceptance tests (the class docstring).")
+    reason = Computed[str](
+        "Why the band was not accepted (empty when :attr:`found`); the other results "
+        "describe the candidate either way."
+    )
+    angle = Computed[float]("Band direction, rad in [0, pi), CCW from +x.")
 
     @property
     def angle_degrees(self) -> float:
@@ -399,40 +271,19 @@ class SlabBand(Computable[S]):
         direction of a biaxial test loaded along y), degrees in [0, 90]."""
         return float(np.degrees(self.inclination))
 
-    @property
-    def thickness(self) -> float:
-        """Band thickness, m (the class docstring says what it measures)."""
-        return self._computed("thickness").thickness
-
-    @property
-    def thickness_diameters(self) -> float:
-        """Band thickness in mean particle diameters."""
-        return self._computed("thickness_diameters").thickness_diameters
-
-    @property
-    def mean_diameter(self) -> float:
-        """Mean diameter of the particles considered, m."""
-        return self._computed("mean_diameter").mean_diameter
-
-    @property
-    def center(self) -> NDArray[np.float64]:
-        """(2,) a point on the centre line, m."""
-        return self._computed("center").center
-
-    @property
-    def normal(self) -> NDArray[np.float64]:
-        """(2,) unit normal of the band."""
-        return self._computed("normal").normal
-
-    @property
-    def members(self) -> NDArray[np.bool_]:
-        """(N,) particles inside the band."""
-        return self._computed("members").members
+    thickness = Computed[float]("Band thickness, m (the class docstring says what it measures).")
+    thickness_diameters = Computed[float]("Band thickness in mean particle diameters.")
+    mean_diameter = Computed[float]("Mean diameter of the particles considered, m.")
+    center = Computed[NDArray[np.float64]]("(2,) a point on the centre line, m.")
+    normal = Computed[NDArray[np.float64]]("(2,) unit normal of the band, (-sin angle, cos angle) (into block B of a displacement band).")
+    members = Computed[NDArray[np.bool_]]("(N,) particles inside the band.")
+    _positions = Computed[NDArray[np.float64]]("(N, 2) the particles' positions, m.")
+    _radii = Computed[NDArray[np.float64]]("(N,) the particles' radii, m.")
 
     @property
     def slab(self) -> Slab:
         """The band's straight slab alone (no per-particle data): what a results file stores of it."""
-        pos = self._computed("slab").positions
+        pos = self._positions
         extent = (
             np.array([[pos[:, 0].min(), pos[:, 0].max()], [pos[:, 1].min(), pos[:, 1].max()]])
             if pos.shape[0]
@@ -447,6 +298,18 @@ class SlabBand(Computable[S]):
             thickness_diameters=self.thickness_diameters,
             extent=extent,
         )
+
+    def _slab_summary(self) -> dict[str, Any]:
+        """The first entries of every reading's ``summary()``: found, reason, angles
+        (degrees), thickness (m and mean diameters), JSON-ready."""
+        return {
+            "found": self.found,
+            "reason": self.reason,
+            "angle_deg": json_number(self.angle_degrees),
+            "inclination_deg": json_number(self.inclination_degrees),
+            "thickness_m": json_number(self.thickness),
+            "thickness_diameters": json_number(self.thickness_diameters),
+        }
 
     def outline(self, extent: ArrayLike | None = None) -> list[NDArray[np.float64]]:
         """The two band edges as (2, 2) segments clipped to ``extent`` ``[[x0, x1], [y0, y1]]``.
@@ -520,10 +383,10 @@ class Slab:
     __hash__ = None  # type: ignore[assignment]
 
 
-class ShearBand(SlabBand[_ShearBandResults]):
+class ShearBand(SlabBand):
     r"""Locate the dominant shear band (and a second one) in a per-particle strain field.
 
-    See the module docstring for the method and for how to read the angle.
+    The method, its thresholds and how to read the angle: docs/fabric.md, "Shear band".
 
     Parameters
     ----------
@@ -533,56 +396,15 @@ class ShearBand(SlabBand[_ShearBandResults]):
         Particles used for the coarse angle scan (a fixed-seed random subset
         when there are more); the refinement uses up to 5 times as many.
     min_fill : float, default 0.5
-        A slab position counts only where the slab crosses the sample: the
-        particles within 2 mean diameters of it are at least ``min_fill``
-        times as many as at the fullest position of that angle. Slab ends
-        that only clip a corner of the sample (where the platen corners
-        concentrate strain) are left out of the angle score and of the peak
-        search. 0 uses every bin.
+        A bin counts only where the slab crosses the sample: the particles
+        within 2 mean diameters of it are at least ``min_fill`` times those at
+        the fullest position of that angle (0: every bin).
     min_thickness : float, default 1.0
         Thinnest band accepted (:attr:`found`), in mean diameters.
     min_prominence : float, default 2.0
-        Accepted bands stand out from the profile: the band's excess strain
-        over the background is at least ``min_prominence`` times the largest
-        excess elsewhere on the profile (:attr:`prominence`).
+        Least :attr:`prominence` of an accepted band.
     second : bool, default True
-        Also look for a second band (:attr:`second`) among the particles
-        outside the first band and its flanks, at least 20° away from its
-        direction: the conjugate band of a biaxial test.
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    found : bool
-        Whether the band passes the acceptance tests (thickness, prominence).
-    reason : str
-        Why it did not ("" when found). The other results describe the
-        candidate either way.
-    angle : float
-        Band direction, rad in [0, pi), CCW from +x.
-    angle_degrees : float
-    inclination, inclination_degrees : float
-        Acute angle between the band and the x axis, [0, pi/2] (the
-        inclination to the horizontal sigma_3 direction of a biaxial test).
-    thickness : float, m
-    thickness_diameters : float
-        Thickness in mean particle diameters.
-    center : (2,) float, m
-        A point on the band's centre line.
-    members : (N,) bool
-        Sample particles inside the band.
-    mean_lambda_inside, mean_lambda_outside : float
-        Mean stability index inside / outside the band (particles with at
-        least 2 contacts when ``n_contacts`` is given); NaN without lambda.
-    contrast, prominence, score, peak_strain, background_strain : float
-    mean_diameter : float, m
-    profile : tuple of (B,) arrays
-        Bin centres ``s`` (m, from the centre line) and mean strain.
-    profile_crossing : (B,) bool
-        The profile bins where the slab crosses the sample (the ones used).
-    second : ShearBand or None
-        The strongest band among the particles outside the first one (its
-        own :attr:`found`, :attr:`angle`, ...); None with ``second=False`` or
-        when fewer than 10 particles are left.
+        Also look for a second (conjugate) band, :attr:`second`.
 
     :meth:`summary` gives the scalars (and the second band's) as a JSON-ready dict.
 
@@ -600,6 +422,15 @@ class ShearBand(SlabBand[_ShearBandResults]):
     >>> band.second is not None and band.second.found  # nothing else stands out
     False
     """
+
+    _parameters = (
+        "bin_width",
+        "max_points",
+        "min_fill",
+        "min_thickness",
+        "min_prominence",
+        "second=find_second",
+    )
 
     def __init__(
         self,
@@ -646,10 +477,8 @@ class ShearBand(SlabBand[_ShearBandResults]):
         ``shear_strain`` (N,), NaN entries are ignored; ``radii`` (N,) m;
         ``mask`` (N,) bool restricts the particles considered.
 
-        The steps: the band's orientation (:meth:`_orientation`), its profile and
-        edges across it (:func:`_band_profile`), the acceptance tests
-        (:meth:`_acceptance`), lambda inside and outside, and a second band
-        (:meth:`_second_band`).
+        Steps: :meth:`_orientation`, :func:`_band_profile`, :meth:`_acceptance`,
+        lambda inside and outside, :meth:`_second_band`.
         """
         data = _BandInput.of(positions, shear_strain, radii, mask)
         width = self.bin_width * data.d_mean
@@ -671,34 +500,32 @@ class ShearBand(SlabBand[_ShearBandResults]):
             lam_out = finite_mean(lam, use & ~members)
         second = None
         if self.find_second:
-            rest = data.valid & (np.abs(s_all) > 0.5 * profile.thickness + _FLANK_D * data.d_mean)
+            rest = data.valid & (np.abs(s_all) > 0.5 * profile.thickness + FLANK_D * data.d_mean)
             second = self._second_band(data, rest, angle, stability_index, n_contacts)
         peak = profile.peak
         self._store(
-            _ShearBandResults(
-                found=not problems,
-                reason="; ".join(problems),
-                angle=angle,
-                thickness=float(profile.thickness),
-                thickness_diameters=float(profile.thickness / data.d_mean),
-                center=center,
-                normal=normal,
-                members=members,
-                mean_lambda_inside=lam_in,
-                mean_lambda_outside=lam_out,
-                contrast=float(excess / peak) if peak > 0 and excess > 0 else 0.0,
-                prominence=float(prominence),
-                score=score,
-                peak_strain=peak,
-                background_strain=profile.background,
-                profile=(profile.centers - profile.s_mid, profile.mean_strain),
-                profile_crossing=profile.crossing,
-                second=second,
-                mean_diameter=data.d_mean,
-                positions=data.pos,
-                radii=data.rad,
-                shear_strain=data.gamma,
-            )
+            found=not problems,
+            reason="; ".join(problems),
+            angle=angle,
+            thickness=float(profile.thickness),
+            thickness_diameters=float(profile.thickness / data.d_mean),
+            center=center,
+            normal=normal,
+            members=members,
+            mean_lambda_inside=lam_in,
+            mean_lambda_outside=lam_out,
+            contrast=float(excess / peak) if peak > 0 and excess > 0 else 0.0,
+            prominence=float(prominence),
+            score=score,
+            peak_strain=peak,
+            background_strain=profile.background,
+            profile=(profile.centers - profile.s_mid, profile.mean_strain),
+            profile_crossing=profile.crossing,
+            second=second,
+            mean_diameter=data.d_mean,
+            _positions=data.pos,
+            _radii=data.rad,
+            _shear_strain=data.gamma,
         )
         return self
 
@@ -709,12 +536,12 @@ class ShearBand(SlabBand[_ShearBandResults]):
         parabola through the best three) and its score."""
         rng = np.random.default_rng(0)
         coarse = np.radians(np.arange(0.0, 180.0, 1.0))
-        pc, gc = self._subset(p, g, self.max_points, rng)
+        pc, gc = random_subset(p, g, self.max_points, rng)
         sc = _scores(pc, gc, coarse, width, window, self.min_fill)
         sc[self._avoided(coarse)] = -np.inf
         best = coarse[_best(sc)]
         fine = best + np.radians(np.arange(-1.5, 1.5 + 1e-9, 0.05))
-        pf, gf = self._subset(p, g, 5 * self.max_points, rng)
+        pf, gf = random_subset(p, g, 5 * self.max_points, rng)
         sf = _scores(pf, gf, fine, width, window, self.min_fill)
         sf[self._avoided(fine)] = -np.inf
         k = _best(sf)
@@ -733,37 +560,19 @@ class ShearBand(SlabBand[_ShearBandResults]):
         return angle, score
 
     def _acceptance(self, profile: _Profile, data: _BandInput) -> tuple[float, float, list[str]]:
-        """Step 3: how far the band stands out of the rest of the profile: its
-        excess strain over the background, its prominence and what fails."""
+        """Step 3: the band's excess strain over the background, its prominence and
+        what fails (:mod:`~grainlab.analysis.band_acceptance`)."""
         excess = profile.peak - profile.background
-        if excess <= max(_MIN_EXCESS, _MIN_EXCESS * float(np.max(np.abs(data.g)))):
+        if excess <= max(MIN_EXCESS, MIN_EXCESS * float(np.max(np.abs(data.g)))):
             excess = 0.0  # round-off: a uniform (affine) deformation has no band
-        # the band's flanks: one band thickness (at least 2 mean diameters) on each side
-        thickness = profile.thickness
-        flank = 0.5 * thickness + max(thickness, _FLANK_D * data.d_mean)
-        away = profile.crossing & (np.abs(profile.centers - profile.s_mid) > flank)
-        elsewhere = float(profile.smooth[away].max()) - profile.background if away.any() else 0.0
-        if excess <= 0.0:
-            prominence = 0.0
-        elif elsewhere <= 0.0:
-            prominence = math.inf
-        else:
-            prominence = excess / elsewhere
-        problems = []
-        if excess <= 0.0:
-            problems.append("no part of the profile stands above the background strain")
-        else:
-            if thickness / data.d_mean < self.min_thickness:
-                problems.append(
-                    f"thinner ({thickness / data.d_mean:.2f} mean diameters) than "
-                    f"min_thickness = {self.min_thickness:g}"
-                )
-            if prominence < self.min_prominence:
-                problems.append(
-                    f"does not stand out: prominence {prominence:.2f} < min_prominence = "
-                    f"{self.min_prominence:g} (another part of the profile is "
-                    f"{100 * elsewhere / excess:.0f} % as high above the background)"
-                )
+        prominence, elsewhere = profile_prominence(
+            excess, profile.smooth, profile.centers - profile.s_mid, profile.crossing,
+            profile.background, profile.thickness, data.d_mean,
+        )
+        problems = strain_band_problems(
+            excess, prominence, elsewhere, profile.thickness / data.d_mean,
+            self.min_thickness, self.min_prominence,
+        )
         return excess, prominence, problems
 
     def _second_band(
@@ -804,88 +613,46 @@ class ShearBand(SlabBand[_ShearBandResults]):
         close: NDArray[np.bool_] = np.abs(diff) < _SECOND_SEPARATION
         return close
 
-    @staticmethod
-    def _subset(
-        p: NDArray[np.float64], g: NDArray[np.float64], k: int, rng: np.random.Generator
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        if p.shape[0] <= k:
-            return p, g
-        pick = rng.choice(p.shape[0], size=k, replace=False)
-        return p[pick], g[pick]
-
-    @property
-    def mean_lambda_inside(self) -> float:
-        """Mean stability index of the band's particles."""
-        return self._computed("mean_lambda_inside").mean_lambda_inside
-
-    @property
-    def mean_lambda_outside(self) -> float:
-        """Mean stability index of the other particles."""
-        return self._computed("mean_lambda_outside").mean_lambda_outside
-
-    @property
-    def contrast(self) -> float:
-        """(peak - background) / peak of the strain profile, in [0, 1]."""
-        return self._computed("contrast").contrast
-
-    @property
-    def prominence(self) -> float:
-        """Excess strain of the band over the background divided by the largest
-        excess elsewhere on the profile (inf when nothing else is above it)."""
-        return self._computed("prominence").prominence
-
-    @property
-    def score(self) -> float:
-        """Adjusted eta² of the strain with the bins across the band (share of
-        the strain variance that the profile explains), at the band's angle."""
-        return self._computed("score").score
-
-    @property
-    def peak_strain(self) -> float:
-        """Largest (3-bin smoothed) mean strain across the band."""
-        return self._computed("peak_strain").peak_strain
-
-    @property
-    def background_strain(self) -> float:
-        """Median strain of the particles considered."""
-        return self._computed("background_strain").background_strain
-
-    @property
-    def profile(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Distance from the centre line (m) and mean strain of each bin."""
-        return self._computed("profile").profile
-
-    @property
-    def profile_crossing(self) -> NDArray[np.bool_]:
-        """(B,) bins of :attr:`profile` that cross the sample (used for the peak)."""
-        return self._computed("profile_crossing").profile_crossing
-
-    @property
-    def second(self) -> ShearBand | None:
-        """The band found once this band's particles are removed, or None."""
-        return self._computed("second").second
+    mean_lambda_inside = Computed[float](
+        "Mean stability index of the band's particles (those with at least 2 contacts when "
+        "``n_contacts`` is given); NaN without lambda."
+    )
+    mean_lambda_outside = Computed[float]("The same of the other particles.")
+    contrast = Computed[float]("(peak - background) / peak of the strain profile, in [0, 1].")
+    prominence = Computed[float](
+        "Excess strain of the band over the background divided by the largest excess elsewhere on "
+        "the profile (inf when nothing else is above it)."
+    )
+    score = Computed[float](
+        "Adjusted eta² of the strain with the bins across the band (share of the strain variance "
+        "that the profile explains), at the band's angle."
+    )
+    peak_strain = Computed[float]("Largest (3-bin smoothed) mean strain across the band.")
+    background_strain = Computed[float]("Median strain of the particles considered.")
+    profile = Computed[tuple[NDArray[np.float64], NDArray[np.float64]]](
+        "Distance from the centre line (m) and mean strain of each bin."
+    )
+    profile_crossing = Computed[NDArray[np.bool_]](
+        "(B,) bins of :attr:`profile` that cross the sample (used for the peak)."
+    )
+    _shear_strain = Computed[NDArray[np.float64]]("(N,) the strain field searched.")
+    second = Computed["ShearBand | None"](
+        "The strongest band among the particles outside this one and its flanks (its own "
+        ":attr:`found`, ...); None with ``second=False`` or fewer than 10 particles left."
+    )
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready scalars (NaN and inf as None, angles in degrees), with
         ``second`` the same dict of the second band (or None)."""
-
-        def num(x: float) -> float | None:
-            return float(x) if math.isfinite(x) else None
-
         second = self.second
         return {
-            "found": self.found,
-            "reason": self.reason,
-            "angle_deg": num(self.angle_degrees),
-            "inclination_deg": num(self.inclination_degrees),
-            "thickness_m": num(self.thickness),
-            "thickness_diameters": num(self.thickness_diameters),
-            "contrast": num(self.contrast),
-            "prominence": num(self.prominence),
-            "score": num(self.score),
+            **self._slab_summary(),
+            "contrast": json_number(self.contrast),
+            "prominence": json_number(self.prominence),
+            "score": json_number(self.score),
             "n_particles": int(self.members.sum()),
-            "mean_lambda_inside": num(self.mean_lambda_inside),
-            "mean_lambda_outside": num(self.mean_lambda_outside),
+            "mean_lambda_inside": json_number(self.mean_lambda_inside),
+            "mean_lambda_outside": json_number(self.mean_lambda_outside),
             "second": second.summary() if second is not None else None,
         }
 
@@ -894,22 +661,15 @@ class ShearBand(SlabBand[_ShearBandResults]):
         from grainlab import plot
 
         ax = plot.particle_map(
-            self._computed("positions").positions,
-            self._computed("radii").radii,
-            self._computed("shear_strain").shear_strain,
+            self._positions,
+            self._radii,
+            self._shear_strain,
             ax=ax,
             label=r"local shear strain $\gamma$",
             **kwargs,
         )
         plot.outline_shear_band(ax, self)
         return ax
-
-    def __repr__(self) -> str:
-        return (
-            f"ShearBand(bin_width={self.bin_width}, max_points={self.max_points}, "
-            f"min_fill={self.min_fill}, min_thickness={self.min_thickness}, "
-            f"min_prominence={self.min_prominence}, second={self.find_second})"
-        )
 
 
 def _clip_line(

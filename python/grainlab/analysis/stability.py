@@ -1,90 +1,35 @@
-r"""The geometrical stability index lambda (paper Sec. 5; docs/fabric.md).
+r"""The geometrical stability index lambda (paper Sec. 5, Eqs. 9-11).
 
-For a particle with ``n`` contacts at angles sorted counter-clockwise,
-:math:`\phi_0 \le \phi_1 \le \dots \le \phi_{n-1}` in :math:`[0, 2\pi)`:
+For ``n >= 2`` contacts at angles :math:`\phi_0 \le \dots \le \phi_{n-1}` in
+[0, 2 pi), with each contact ``k`` as the reference of the stable arrangement
+:math:`\phi_k + 2\pi m/n`,
 
-* ``n = 0`` or ``n = 1``: :math:`\lambda = 1` (the particle cannot be stable);
-* ``n >= 2``: take each contact ``k`` in turn as the reference. The stable
-  arrangement :math:`S_n` from it puts ``n`` positions at
-  :math:`\phi_k + 2\pi m/n`, ``m = 0 .. n-1``, and the contact ``m`` places
-  after ``k`` in angular order is compared with position ``m``. The deviation
-  is the sum of the minimum angles between each contact and its stable
-  position (Eq. 9),
+.. math::
 
-  .. math::
+   dS_n^{(k)} = \sum_{m=0}^{n-1}\left|\operatorname{wrap}\!\left(\phi_{(k+m) \bmod n}
+   - \phi_k - \tfrac{2\pi m}{n}\right)\right|,\qquad
+   \lambda = \frac{\min_k dS_n^{(k)}}{2\pi},
 
-     d S_n^{(k)} = \sum_{m=0}^{n-1}
-        \left| \operatorname{wrap}\!\left(\phi_{(k+m) \bmod n} - \phi_k
-        - \tfrac{2\pi m}{n}\right) \right|,
-
-  with :math:`|\operatorname{wrap}(x)| \in [0, \pi]` the minimum angle.
-  :math:`D = \min_k d S_n^{(k)}` (Eq. 10) and :math:`\lambda = D / 2\pi`
-  (Eq. 11, ``D / 360°``).
-
-Equal spacing gives 0; contacts at 0° and 90° give 1/4; at 0°, 60°, 120° give
-1/3, the largest value three equal disks around a fourth can reach.
-
-Range (the default reading): lambda is not bounded by 1. For ``n >= 2`` contacts it lies in
-:math:`[0, \lfloor n^2/4 \rfloor / n]` (1/2, 2/3, 1, 6/5, 3/2, 12/7, 2, 20/9,
-5/2 for n = 2 ... 10), reached when all contacts sit at one angle, where
-every reference gives :math:`dS_n = \sum_m \min(m, n - m)\,2\pi/n`. So
-lambda > 1 needs five or more contacts crowded on one side of the particle.
-Neighbours of the particle's own size sit at least 60° apart; sampling such
-arrangements gives at most 1/3 (n = 2, 3, 4; 1/5 for n = 5, 0 for the only
-n = 6 arrangement). Many small disks touching one
-side of a grain, as membrane disks do, could exceed 1: :class:`StabilityIndex`
-therefore counts each boundary body once by default (``boundary="body"``).
-
-Readings (docs/fabric.md, "Readings of Eqs. 9-11"): Eq. 9-10 leave room for
-other readings, three keyword options of :class:`StabilityIndex`,
-:func:`stability_index` and :func:`stability_index_of_angles`, the defaults
-being the one above (``"angular/min/sum"``, the text's "the minimum value of
-dSn is D"):
-
-* ``slots``: which stable position each contact is compared with.
-  ``"angular"`` (default) as above; ``"list"``: the contact ``m`` places after
-  ``k`` in the order the contacts are *given* (wrapping around), as a code
-  keeping its contacts in creation order (PFC) would read "starting with the
-  first contact point"; ``"nearest"``: each contact with the nearest position
-  of :math:`S_n` anchored at ``k``,
-  :math:`\min_m |\operatorname{wrap}(\phi_j - \phi_k - 2\pi m/n)|` (several
-  contacts may share one), never more than ``"angular"`` (each term at most
-  :math:`\pi/n`).
-* ``anchor``: ``"min"`` (default, Eq. 10) :math:`D = \min_k dS_n^{(k)}`, or
-  ``"mean"``: :math:`D = \frac{1}{n}\sum_k dS_n^{(k)}` (>= the minimum).
-* ``deviation``: ``"sum"`` (default, Eq. 9 as written) or ``"per_contact"``:
-  ``D / (n - 1)``, the mean over the ``n - 1`` deviations summed (the
-  reference's own is 0); the same lambda for ``n = 2``.
-
-0- and 1-contact particles get 1 under every reading. Contacts at 0°, 60°,
-120°: ``angular`` 1/3 (``min/sum``), 4/9 (``mean/sum``), 1/6
-(``min/per_contact``), 2/9 (``mean/per_contact``); ``nearest`` 1/6, 2/9, 1/12,
-1/9; ``list`` as ``angular`` when the contacts are given in that order, but
-given as 0°, 120°, 60° it gives 1/2, 2/3, 1/4, 1/3. The default reading runs
-in the compiled kernel; the others in NumPy only
-(:func:`_stability_index_numpy`, the same grouping by contact count).
-
-Implementation: writing :math:`e_j = \phi_j - 2\pi j/n`, the deviation of
-contact ``j`` from reference ``k`` is :math:`|\operatorname{wrap}(e_j - e_k)|`
-for every ``j`` (also past the wrap-around), and :math:`|e_j - e_k| < 2\pi`,
-so the minimum angle is :math:`\min(|x|, 2\pi - |x|)`. The kernel runs in the
-Rust engine crate, one particle at a time on every core (docs/analysis.md,
-"Speed"); the NumPy reference (:func:`_stability_index_numpy`) groups the
-particles by their number of contacts, each group one ``(m, n, n)`` array
-operation.
+and :math:`\lambda = 1` for 0 or 1 contact. Equal spacing gives 0; 0° and 90°
+give 1/4; 0°, 60°, 120° give 1/3. lambda lies in
+:math:`[0, \lfloor n^2/4\rfloor / n]`, so boundary bodies count once per grain
+by default. The keywords ``slots`` (``"angular"``, ``"list"``, ``"nearest"``),
+``anchor`` (``"min"``, ``"mean"``) and ``deviation`` (``"sum"``,
+``"per_contact"``) choose other readings of Eqs. 9-10; only the default runs
+in the compiled kernel. Definitions, range, readings and the implementation:
+docs/fabric.md, "Geometrical stability index λ".
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, _kernels
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis._util import (
-    Computable,
     contact_ends,
     contact_ends_in_list_order,
     finite_mean,
@@ -171,33 +116,16 @@ def stability_index(
     anchor: str = "min",
     deviation: str = "sum",
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """Stability index of every particle from its contact ends.
+    """Stability index of every particle from its contact ends: ``owner`` (K,) int,
+    the particle (``0 <= owner < n_particles``) of each end (a particle-particle
+    contact gives two), and ``angles`` (K,) rad, CCW from +x (taken modulo 2 pi).
 
-    Parameters
-    ----------
-    owner : (K,) int
-        Particle index (``0 <= owner < n_particles``) of each contact end.
-        A particle–particle contact contributes two ends (one per particle).
-    angles : (K,) float, rad
-        Angle of each end on its particle, CCW from +x (any real value; taken
-        modulo 2 pi).
-    n_particles : int
-    slots : {"angular", "list", "nearest"}, default "angular"
-    anchor : {"min", "mean"}, default "min"
-    deviation : {"sum", "per_contact"}, default "sum"
-        The reading of Eq. 9-11 (module docstring). With ``slots="list"`` each
-        particle's ends are taken in the order they appear in ``owner`` /
-        ``angles`` (a stable sort by owner keeps it). The default reading runs
-        in the compiled kernel, the others in NumPy.
-
-    Returns
-    -------
-    lam : (n_particles,) float
-        lambda >= 0 (at most floor(n^2/4)/n for n contacts under the default
-        reading; see the module docstring); 1 for particles with 0 or 1
-        contact.
-    counts : (n_particles,) int
-        Number of contacts of each particle.
+    Returns ``lam`` (n_particles,), lambda >= 0 (1 for 0 or 1 contact; at most
+    floor(n^2/4)/n for n contacts under the default reading), and ``counts``
+    (n_particles,), the ends of each particle. ``slots``, ``anchor``,
+    ``deviation``: the reading of Eq. 9-11 (docs/fabric.md, "Readings of Eqs.
+    9-11"; with ``slots="list"`` a particle's ends are taken in the order given);
+    the default runs in the compiled kernel, the others in NumPy.
     """
     default = _check_reading(slots, anchor, deviation)
     owner = np.asarray(owner, dtype=np.int64).reshape(-1)
@@ -279,18 +207,7 @@ def stability_index_of_angles(
     return float(lam[0])
 
 
-@dataclass(frozen=True, eq=False)
-class _StabilityIndexResults:
-    """The results of :class:`StabilityIndex` (see its properties)."""
-
-    stability_index: NDArray[np.float64]
-    n_contacts: NDArray[np.int64]
-    mean: float
-    mean_all: float
-    snapshot: Snapshot
-
-
-class StabilityIndex(Computable[_StabilityIndexResults]):
+class StabilityIndex(Compute):
     r"""Geometrical stability index lambda of every particle (paper Sec. 5).
 
     See the module docstring for the formula. Contact angles come from the
@@ -300,50 +217,21 @@ class StabilityIndex(Computable[_StabilityIndexResults]):
     Parameters
     ----------
     include_boundary : bool, default True
-        Count contacts with walls and membrane particles among a particle's
-        contacts. The default follows the paper's algorithm, which takes all
-        active contacts of a particle: a platen or membrane supports a grain
-        as a neighbour does. With False, only contacts between sample
-        particles count.
+        Count contacts with walls and membrane particles (the paper takes all
+        of a particle's active contacts); False: only those between sample
+        particles.
     boundary : {"body", "each"}, default "body"
-        How boundary contacts count. ``"body"``: each boundary body (a wall,
-        one membrane chain, :meth:`Snapshot.boundary_bodies`) is one contact
-        of the grain, at the normal-force-weighted mean direction of the
-        grain's contacts with it (unweighted without forces): a chain of small
-        membrane disks supports a grain as one membrane does, and its
-        discretisation does not change lambda. ``"each"``: every contact
-        counts, each membrane disk touched as a neighbour (then lambda can
-        exceed 1 along the membrane).
+        ``"body"``: each boundary body (a wall, one membrane chain) is one
+        contact of the grain, at the normal-force-weighted mean direction of
+        its contacts with it; ``"each"``: every contact (docs/fabric.md,
+        "Boundary contacts").
     slots : {"angular", "list", "nearest"}, default "angular"
     anchor : {"min", "mean"}, default "min"
     deviation : {"sum", "per_contact"}, default "sum"
-        Keyword only: the reading of Eq. 9-11 (module docstring; docs/fabric.md,
-        "Readings of Eqs. 9-11"). The default, the text's "the minimum value of
-        dSn is D" with contacts taken in angular order, runs in the compiled
-        kernel; the others in NumPy. ``slots="list"`` takes each particle's
-        contacts in the order of the snapshot's contact list: contact ``c``
-        (``i``-``j``) gives the end on ``i`` and the end on ``j`` at position
-        ``c``, so a particle's ends come in the order of its contacts in the
-        list, whichever side of them it is on; with ``boundary="body"`` the
-        one end of a boundary body sits where the particle's first contact
-        with that body (in list order) is.
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    stability_index : (N,) float
-        lambda >= 0 (0/1-contact particles 1; under the default reading above 1
-        only with five or more crowded contacts); NaN for membrane particles
-        (not part of the sample).
-    n_contacts : (N,) int
-        Number of contacts used for each particle, counted as lambda counts
-        them (each boundary body once with ``boundary="body"``; 0 for
-        membrane particles).
-    mean : float
-        Mean lambda over sample particles with at least 2 contacts (the paper
-        filters out particles with 0 or 1 contact, whose lambda is 1 by
-        definition).
-    mean_all : float
-        Mean lambda over all sample particles, 0/1-contact ones counted as 1.
+        Keyword only: the reading of Eq. 9-11 (docs/fabric.md, "Readings of
+        Eqs. 9-11"; ``slots="list"`` takes a particle's contacts in the order
+        of the contact list). The default runs in the compiled kernel, the
+        others in NumPy.
 
     Example
     -------
@@ -356,6 +244,8 @@ class StabilityIndex(Computable[_StabilityIndexResults]):
     >>> round(float(StabilityIndex().compute(snap).stability_index[0]), 12)
     0.333333333333
     """
+
+    _parameters = ("include_boundary", "boundary", "slots", "anchor", "deviation")
 
     def __init__(
         self,
@@ -413,42 +303,34 @@ class StabilityIndex(Computable[_StabilityIndexResults]):
         sample = snapshot.is_sample
         lam[~sample] = np.nan
         self._store(
-            _StabilityIndexResults(
-                stability_index=lam,
-                n_contacts=counts,
-                mean=finite_mean(lam, sample & (counts >= 2)),
-                mean_all=finite_mean(lam, sample),
-                snapshot=snapshot,
-            )
+            stability_index=lam,
+            n_contacts=counts,
+            mean=finite_mean(lam, sample & (counts >= 2)),
+            mean_all=finite_mean(lam, sample),
+            _snapshot=snapshot,
         )
         return self
 
-    @property
-    def stability_index(self) -> NDArray[np.float64]:
-        """(N,) lambda per particle; NaN for membrane particles."""
-        return self._computed("stability_index").stability_index
-
-    @property
-    def n_contacts(self) -> NDArray[np.int64]:
-        """(N,) number of contacts per particle used for lambda (boundary bodies
-        counted as ``boundary`` says)."""
-        return self._computed("n_contacts").n_contacts
-
-    @property
-    def mean(self) -> float:
-        """Mean lambda over sample particles with >= 2 contacts."""
-        return self._computed("mean").mean
-
-    @property
-    def mean_all(self) -> float:
-        """Mean lambda over all sample particles (0/1 contact counted as 1)."""
-        return self._computed("mean_all").mean_all
+    stability_index = Computed[NDArray[np.float64]](
+        "(N,) lambda >= 0 per particle (1 with 0 or 1 contact; above 1 under the default "
+        "reading only with five or more crowded contacts); NaN for membrane particles."
+    )
+    n_contacts = Computed[NDArray[np.int64]](
+        "(N,) contacts per particle as lambda counts them (each boundary body once with "
+        "``boundary='body'``; 0 for membrane particles)."
+    )
+    mean = Computed[float](
+        "Mean lambda over sample particles with >= 2 contacts (the paper filters out those "
+        "with 0 or 1, whose lambda is 1 by definition)."
+    )
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    mean_all = Computed[float]("Mean lambda over all sample particles (0/1 contact counted as 1).")
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Particle map coloured by lambda (paper Fig. 12); returns the axes."""
         from grainlab import plot
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         return plot.particle_map(
             snap.positions,
             snap.radii,
@@ -458,10 +340,4 @@ class StabilityIndex(Computable[_StabilityIndexResults]):
             vmin=0.0,
             vmax=1.0,
             **kwargs,
-        )
-
-    def __repr__(self) -> str:
-        return (
-            f"StabilityIndex(include_boundary={self.include_boundary}, boundary={self.boundary!r}, "
-            f"slots={self.slots!r}, anchor={self.anchor!r}, deviation={self.deviation!r})"
         )

@@ -1,56 +1,25 @@
 r"""Kinematics between two snapshots: displacement, rotation, local strain, D2min.
 
-Particles are matched by :attr:`Snapshot.ids`; results are indexed like the
-*current* snapshot and are NaN for particles absent from the reference.
-
-Local deformation gradient (Falk & Langer 1998)
-    For particle ``i`` with neighbours ``j`` in the *reference* snapshot
-    (centres within ``cutoff``, or its contacts), :math:`d^0_{ij} = X_j - X_i`
-    and :math:`d_{ij} = x_j - x_i` (minimum image in periodic directions).
-    The best-fit :math:`F_i` minimises :math:`\sum_j |d_{ij} - F_i d^0_{ij}|^2`:
-
-    .. math::
-
-       F_i = X_i Y_i^{-1},\quad X_i = \sum_j d_{ij} \otimes d^0_{ij},\quad
-       Y_i = \sum_j d^0_{ij} \otimes d^0_{ij},
-
-    and the residual is the non-affine measure
-    :math:`D^2_{min,i} = \sum_j |d_{ij} - F_i d^0_{ij}|^2` (m²). Particles with
-    fewer than 2 non-collinear neighbours get NaN.
-
-Strain (compression positive, docs/conventions.md)
-    small: :math:`\varepsilon = I - \tfrac12(F + F^T)`;
-    green: :math:`\varepsilon = -\tfrac12(F^T F - I)`.
-    Volumetric strain :math:`\varepsilon_v = \varepsilon_{xx} +
-    \varepsilon_{yy}` (compression positive). The 2D shear strain invariant is
-    the maximum engineering shear strain (the diameter of Mohr's circle),
-
-    .. math::
-
-       \gamma = \sqrt{(\varepsilon_{xx} - \varepsilon_{yy})^2
-                      + 4 \varepsilon_{xy}^2},
-
-    so a simple shear of amount :math:`\gamma` gives :math:`\gamma`.
-
-Excess shear strain
-    The same invariant of :math:`\varepsilon_i - \bar\varepsilon`, where
-    the background strain :math:`\bar\varepsilon` is the component-wise
-    median of the finite local strains: the part of the local deformation
-    that the sample as a whole does not share. A shear band in an otherwise
-    homogeneously deforming sample stands out in it cleanly; it is the field
-    :class:`~grainlab.analysis.shear_band.ShearBand` is given by default.
+Particles matched by id; results indexed like the current snapshot, NaN where
+unmatched. Per particle, the best-fit :math:`F_i = X_i Y_i^{-1}` of its
+reference neighbours' branch vectors (Falk & Langer 1998),
+:math:`D^2_{min} = \sum_j |d_{ij} - F_i d^0_{ij}|^2` (m²); strain compression
+positive, small :math:`I - \tfrac12(F + F^T)` or Green :math:`-\tfrac12(F^TF -
+I)`; shear strain :math:`\gamma = \sqrt{(\varepsilon_{xx} -
+\varepsilon_{yy})^2 + 4\varepsilon_{xy}^2}`, and the excess shear strain, the
+same of :math:`\varepsilon_i - \bar\varepsilon` (:math:`\bar\varepsilon` the
+component-wise median). docs/fabric.md, "Local strain and D2min".
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from grainlab.analysis._util import Computable
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.snapshot import Snapshot
 
 __all__ = ["LocalStrain", "match_ids", "neighbour_pairs"]
@@ -91,25 +60,51 @@ def neighbour_pairs(
     return pairs[:, 0], pairs[:, 1]
 
 
-@dataclass(frozen=True, eq=False)
-class _LocalStrainResults:
-    """The results of :class:`LocalStrain` (see its properties)."""
+def _deformation_gradients(
+    own: NDArray[np.int64],
+    d0: NDArray[np.float64],
+    d: NDArray[np.float64],
+    n: int,
+    matched: NDArray[np.bool_],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """Each particle's best-fit ``F`` (N, 2, 2) mapping its reference branch vectors
+    ``d0`` (K, 2) to the current ones ``d`` (K, 2) (``own`` (K,): the owner of each),
+    the residual D2min (N,) m² and the neighbour count (N,); NaN where fewer than 2
+    neighbours or a degenerate neighbourhood leave F undetermined."""
 
-    displacement: NDArray[np.float64]
-    rotation: NDArray[np.float64]
-    deformation_gradient: NDArray[np.float64]
-    strain: NDArray[np.float64]
-    shear_strain: NDArray[np.float64]
-    excess_shear_strain: NDArray[np.float64]
-    background_strain: NDArray[np.float64]
-    volumetric_strain: NDArray[np.float64]
-    d2min: NDArray[np.float64]
-    n_neighbours: NDArray[np.int64]
-    cutoff: float
-    current: Snapshot
+    def acc(w: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.bincount(own, weights=w, minlength=n).astype(np.float64)
+
+    x = np.stack(
+        [
+            acc(d[:, 0] * d0[:, 0]),
+            acc(d[:, 0] * d0[:, 1]),
+            acc(d[:, 1] * d0[:, 0]),
+            acc(d[:, 1] * d0[:, 1]),
+        ],
+        axis=1,
+    ).reshape(n, 2, 2)
+    y00, y01, y11 = acc(d0[:, 0] ** 2), acc(d0[:, 0] * d0[:, 1]), acc(d0[:, 1] ** 2)
+    det = y00 * y11 - y01 * y01
+    count = np.bincount(own, minlength=n)
+    good = (count >= 2) & (det > 1e-10 * (y00 + y11) ** 2) & matched
+    inv = np.zeros((n, 2, 2))
+    safe = np.where(good, det, 1.0)
+    inv[:, 0, 0] = y11 / safe
+    inv[:, 1, 1] = y00 / safe
+    inv[:, 0, 1] = inv[:, 1, 0] = -y01 / safe
+    F = np.einsum("nij,njk->nik", x, inv)
+    F[~good] = np.nan
+
+    resid = d - np.einsum("kij,kj->ki", F[own], d0)
+    d2min = np.bincount(own, weights=np.einsum("ki,ki->k", resid, resid), minlength=n).astype(
+        np.float64
+    )
+    d2min[~good] = np.nan
+    return F, d2min, count
 
 
-class LocalStrain(Computable[_LocalStrainResults]):
+class LocalStrain(Compute):
     r"""Displacement, rotation, best-fit local strain and D2min between two snapshots.
 
     See the module docstring for the formulas and sign conventions.
@@ -125,20 +120,6 @@ class LocalStrain(Computable[_LocalStrainResults]):
     strain : {"small", "green"}, default "small"
         Infinitesimal strain from sym(F) or Green–Lagrange strain.
 
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    displacement : (N, 2) float, m
-    displacement_magnitude : (N,) float, m
-    rotation : (N,) float, rad (NaN unless both snapshots have rotations)
-    deformation_gradient : (N, 2, 2) float
-    strain : (N, 2, 2) float, compression positive
-    shear_strain : (N,) float
-    excess_shear_strain : (N,) float
-    background_strain : (2, 2) float
-    volumetric_strain : (N,) float, compression positive
-    d2min : (N,) float, m²
-    n_neighbours : (N,) int
-
     Example
     -------
     >>> import numpy as np
@@ -151,6 +132,8 @@ class LocalStrain(Computable[_LocalStrainResults]):
     >>> bool(np.allclose(s.shear_strain, 0.02)) and bool(np.allclose(s.d2min, 0.0))
     True
     """
+
+    _parameters = ("neighbours", "cutoff", "strain=strain_measure")
 
     def __init__(
         self, neighbours: str = "radius", cutoff: float | None = None, strain: str = "small"
@@ -205,35 +188,7 @@ class LocalStrain(Computable[_LocalStrainResults]):
         d0 = np.concatenate([d0, -d0])
         d = np.concatenate([d, -d])
 
-        def acc(w: NDArray[np.float64]) -> NDArray[np.float64]:
-            return np.bincount(own, weights=w, minlength=n).astype(np.float64)
-
-        x = np.stack(
-            [
-                acc(d[:, 0] * d0[:, 0]),
-                acc(d[:, 0] * d0[:, 1]),
-                acc(d[:, 1] * d0[:, 0]),
-                acc(d[:, 1] * d0[:, 1]),
-            ],
-            axis=1,
-        ).reshape(n, 2, 2)
-        y00, y01, y11 = acc(d0[:, 0] ** 2), acc(d0[:, 0] * d0[:, 1]), acc(d0[:, 1] ** 2)
-        det = y00 * y11 - y01 * y01
-        count = np.bincount(own, minlength=n)
-        good = (count >= 2) & (det > 1e-10 * (y00 + y11) ** 2) & matched
-        inv = np.zeros((n, 2, 2))
-        safe = np.where(good, det, 1.0)
-        inv[:, 0, 0] = y11 / safe
-        inv[:, 1, 1] = y00 / safe
-        inv[:, 0, 1] = inv[:, 1, 0] = -y01 / safe
-        F = np.einsum("nij,njk->nik", x, inv)
-        F[~good] = np.nan
-
-        resid = d - np.einsum("kij,kj->ki", F[own], d0)
-        d2min = np.bincount(own, weights=np.einsum("ki,ki->k", resid, resid), minlength=n).astype(
-            np.float64
-        )
-        d2min[~good] = np.nan
+        F, d2min, count = _deformation_gradients(own, d0, d, n, matched)
 
         eye = np.eye(2)
         if self.strain_measure == "small":
@@ -246,27 +201,22 @@ class LocalStrain(Computable[_LocalStrainResults]):
         dev = eps - background
         excess = np.hypot(dev[:, 0, 0] - dev[:, 1, 1], 2.0 * dev[:, 0, 1])
         self._store(
-            _LocalStrainResults(
-                displacement=disp,
-                rotation=rot,
-                deformation_gradient=F,
-                strain=eps,
-                shear_strain=shear,
-                excess_shear_strain=excess,
-                background_strain=background,
-                volumetric_strain=eps[:, 0, 0] + eps[:, 1, 1],
-                d2min=d2min,
-                n_neighbours=count,
-                cutoff=cutoff,
-                current=current,
-            )
+            displacement=disp,
+            rotation=rot,
+            deformation_gradient=F,
+            strain=eps,
+            shear_strain=shear,
+            excess_shear_strain=excess,
+            background_strain=background,
+            volumetric_strain=eps[:, 0, 0] + eps[:, 1, 1],
+            d2min=d2min,
+            n_neighbours=count,
+            cutoff_used=cutoff,
+            _current=current,
         )
         return self
 
-    @property
-    def displacement(self) -> NDArray[np.float64]:
-        """(N, 2) displacement from the reference, m."""
-        return self._computed("displacement").displacement
+    displacement = Computed[NDArray[np.float64]]("(N, 2) displacement from the reference, m.")
 
     @property
     def displacement_magnitude(self) -> NDArray[np.float64]:
@@ -274,61 +224,37 @@ class LocalStrain(Computable[_LocalStrainResults]):
         d = self.displacement
         return np.hypot(d[:, 0], d[:, 1])
 
-    @property
-    def rotation(self) -> NDArray[np.float64]:
-        """(N,) rotation increment, rad, CCW positive."""
-        return self._computed("rotation").rotation
-
-    @property
-    def deformation_gradient(self) -> NDArray[np.float64]:
-        """(N, 2, 2) best-fit local deformation gradient F."""
-        return self._computed("deformation_gradient").deformation_gradient
-
-    @property
-    def strain(self) -> NDArray[np.float64]:
-        """(N, 2, 2) local strain tensor, compression positive."""
-        return self._computed("strain").strain
-
-    @property
-    def shear_strain(self) -> NDArray[np.float64]:
-        """(N,) maximum engineering shear strain (2D shear invariant)."""
-        return self._computed("shear_strain").shear_strain
-
-    @property
-    def excess_shear_strain(self) -> NDArray[np.float64]:
-        """(N,) shear invariant of the local strain minus the background strain."""
-        return self._computed("excess_shear_strain").excess_shear_strain
-
-    @property
-    def background_strain(self) -> NDArray[np.float64]:
-        """(2, 2) component-wise median of the local strains (compression positive)."""
-        return self._computed("background_strain").background_strain
-
-    @property
-    def volumetric_strain(self) -> NDArray[np.float64]:
-        """(N,) volumetric strain, compression positive."""
-        return self._computed("volumetric_strain").volumetric_strain
-
-    @property
-    def d2min(self) -> NDArray[np.float64]:
-        """(N,) Falk–Langer D2min, m²."""
-        return self._computed("d2min").d2min
-
-    @property
-    def n_neighbours(self) -> NDArray[np.int64]:
-        """(N,) number of reference neighbours used in the fit."""
-        return self._computed("n_neighbours").n_neighbours
-
-    @property
-    def cutoff_used(self) -> float:
-        """Neighbour radius used, m (NaN for neighbours='contacts')."""
-        return self._computed("cutoff").cutoff
+    rotation = Computed[NDArray[np.float64]](
+        "(N,) rotation increment, rad, CCW positive (NaN unless both snapshots have rotations)."
+    )
+    deformation_gradient = Computed[NDArray[np.float64]](
+        "(N, 2, 2) best-fit local deformation gradient F."
+    )
+    strain = Computed[NDArray[np.float64]]("(N, 2, 2) local strain tensor, compression positive.")
+    shear_strain = Computed[NDArray[np.float64]](
+        "(N,) maximum engineering shear strain (2D shear invariant)."
+    )
+    excess_shear_strain = Computed[NDArray[np.float64]](
+        "(N,) shear invariant of the local strain minus the background strain."
+    )
+    background_strain = Computed[NDArray[np.float64]](
+        "(2, 2) component-wise median of the local strains (compression positive)."
+    )
+    volumetric_strain = Computed[NDArray[np.float64]](
+        "(N,) volumetric strain, compression positive."
+    )
+    d2min = Computed[NDArray[np.float64]]("(N,) Falk–Langer D2min, m².")
+    n_neighbours = Computed[NDArray[np.int64]](
+        "(N,) number of reference neighbours used in the fit."
+    )
+    cutoff_used = Computed[float]("Neighbour radius used, m (NaN for neighbours='contacts').")
+    _current = Computed[Snapshot]("The current snapshot (drawn by plot).")
 
     def plot(self, ax: Any = None, quantity: str = "displacement", **kwargs: Any) -> Any:
         """Particle map coloured by displacement magnitude (Fig. 11) or shear strain."""
         from grainlab import plot
 
-        snap = self._computed("current").current
+        snap = self._current
         if quantity == "displacement":
             values, label = self.displacement_magnitude, "displacement magnitude (m)"
         elif quantity == "shear_strain":
@@ -338,9 +264,3 @@ class LocalStrain(Computable[_LocalStrainResults]):
                 f"quantity: must be 'displacement' or 'shear_strain', got {quantity!r}"
             )
         return plot.particle_map(snap.positions, snap.radii, values, ax=ax, label=label, **kwargs)
-
-    def __repr__(self) -> str:
-        return (
-            f"LocalStrain(neighbours={self.neighbours!r}, cutoff={self.cutoff!r}, "
-            f"strain={self.strain_measure!r})"
-        )

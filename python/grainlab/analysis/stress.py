@@ -1,51 +1,27 @@
-r"""The average stress tensor of a set of particles from their contact forces
-(Love-Weber), a check on boundary stresses; the stress of each grain, of a
-region and of a set of contacts (a force network).
+r"""Love-Weber stress from contact forces: of each grain, of a region, of a set of contacts.
 
-For particles ``p`` in a region of area ``A`` (unit thickness), with contact
-forces ``f_c`` acting on ``p`` at contact points ``x_c``::
+Compression positive, Pa, unit thickness. For the particles ``p`` of a region
+of area ``A``, with the forces ``f_c`` on ``p`` at the contact points ``x_c``,
 
-    sigma_ij = -(1 / A) * sum_p sum_{c of p} (x_c - x_p)_i (f_c)_j
+.. math:: \sigma = -\frac{1}{A}\sum_p\sum_{c \ni p}\operatorname{sym}((x_c - x_p)\otimes f_c),
 
-symmetrised, **compression positive** (hence the minus sign). Every contact of a
-selected particle counts, including those with walls and with particles outside
-the selection (the boundary forces), so in static equilibrium the result equals
-the boundary stress.
-
-On a :class:`~grainlab.snapshot.Snapshot` (docs/fabric.md, "Stress"):
-
-* the force on particle i of contact c is
-  :math:`f^i_c = -f_{n,c}\, n_c + f_{s,c}\, t_c`, ``t = rot90(n)``, and
-  :math:`-f^i_c` acts on j (or on the wall); the contact point is the stored
-  one, else :math:`x_i + (r_i - \delta_c/2)\, n_c` with the overlap
-  :math:`\delta_c = r_i + r_j - |l_c|` (a wall contact without a point:
-  :math:`x_i + r_i n_c`);
-* the stress of a set C of contacts (:func:`contact_stress`) is the contact
-  (branch-vector) form
-
-  .. math:: \sigma^C = \frac{1}{A}\sum_{c \in C} \operatorname{sym}(l_c \otimes (-f^i_c)),
-
-  with the branch vector :math:`l_c = x_j - x_i` (minimum image; a wall
-  contact: contact point minus :math:`x_i`); summed over every contact of a
-  region it is the particle sum above, term by term. It is linear in the
-  contacts, so the stresses of disjoint sets of contacts add up to that of
-  their union (the strong and weak networks);
-* the stress of grain p (:func:`grain_stress`, :class:`GrainStress`) is
-  the particle sum over p alone,
-  :math:`\sigma^p = -\frac{1}{V_p}\sum_{c \ni p}\operatorname{sym}((x_c - x_p)\otimes f^p_c)`,
-  with :math:`V_p = \pi r_p^2` (unit thickness) or any area given (a power
-  cell, :class:`~grainlab.analysis.tessellation.LocalPorosity`).
+every contact of a selected particle counted (walls and particles outside
+included: in equilibrium, the boundary stress). The contact (branch-vector)
+form :math:`\frac1A\sum_{c\in C}\operatorname{sym}(l_c\otimes(-f^i_c))` is
+linear in the contacts (:func:`contact_stress`); a grain's stress divides by
+:math:`\pi r_p^2` or any area given. Forces, contact points and branch
+vectors: docs/fabric.md, "Stress: grains, regions and sets of contacts".
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from grainlab.analysis._util import Computable, principal_stresses, sample_bounds
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import principal_stresses, sample_bounds
 from grainlab.snapshot import Snapshot
 
 __all__ = [
@@ -225,18 +201,7 @@ def grain_stress(snapshot: Snapshot, area: ArrayLike | None = None) -> NDArray[n
     return np.asarray(-out / v[:, None, None], dtype=np.float64)
 
 
-@dataclass(frozen=True, eq=False)
-class _GrainStressResults:
-    """The results of :class:`GrainStress` (see its properties)."""
-
-    snapshot: Snapshot
-    stress: NDArray[np.float64]
-    major: NDArray[np.float64]
-    minor: NDArray[np.float64]
-    major_direction: NDArray[np.float64]
-
-
-class GrainStress(Computable[_GrainStressResults]):
+class GrainStress(Compute):
     r"""The Love-Weber stress of each grain and its principal values.
 
     .. math::
@@ -272,34 +237,26 @@ class GrainStress(Computable[_GrainStressResults]):
         """Compute every grain's stress in ``snapshot``; returns ``self``."""
         stress = grain_stress(snapshot, self.area)
         major, minor, direction = principal_stresses(stress)
-        self._store(_GrainStressResults(snapshot, stress, major, minor, direction))
+        self._store(
+            _snapshot=snapshot, stress=stress, major=major, minor=minor, major_direction=direction
+        )
         return self
 
-    @property
-    def stress(self) -> NDArray[np.float64]:
-        """(N, 2, 2) stress of each grain, Pa, compression positive."""
-        return self._computed("stress").stress
-
-    @property
-    def major(self) -> NDArray[np.float64]:
-        """(N,) major principal stress sigma_1, Pa."""
-        return self._computed("major").major
-
-    @property
-    def minor(self) -> NDArray[np.float64]:
-        """(N,) minor principal stress sigma_2, Pa."""
-        return self._computed("minor").minor
-
-    @property
-    def major_direction(self) -> NDArray[np.float64]:
-        """(N,) direction of sigma_1, rad in [0, pi) from +x (0 where sigma_1 = sigma_2)."""
-        return self._computed("major_direction").major_direction
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    stress = Computed[NDArray[np.float64]](
+        "(N, 2, 2) stress of each grain, Pa, compression positive."
+    )
+    major = Computed[NDArray[np.float64]]("(N,) major principal stress sigma_1, Pa.")
+    minor = Computed[NDArray[np.float64]]("(N,) minor principal stress sigma_2, Pa.")
+    major_direction = Computed[NDArray[np.float64]](
+        "(N,) direction of sigma_1, rad in [0, pi) from +x (0 where sigma_1 = sigma_2)."
+    )
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Particle map coloured by the major principal stress; returns the axes."""
         from grainlab import plot
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         values = np.where(snap.is_sample, self.major, np.nan)
         return plot.particle_map(
             snap.positions, snap.radii, values, ax=ax, cmap="magma_r",
@@ -310,16 +267,7 @@ class GrainStress(Computable[_GrainStressResults]):
         return f"GrainStress(area={'disks' if self.area is None else 'given'})"
 
 
-@dataclass(frozen=True, eq=False)
-class _LoveWeberResults:
-    """The results of :class:`LoveWeberStress` (see its properties)."""
-
-    stress: NDArray[np.float64]
-    area: float
-    n_particles: int
-
-
-class LoveWeberStress(Computable[_LoveWeberResults]):
+class LoveWeberStress(Compute):
     r"""The average (Love-Weber) stress of a region of a snapshot.
 
     .. math:: \sigma = -\frac{1}{A}\sum_{p \in R}\sum_{c \ni p}
@@ -346,6 +294,8 @@ class LoveWeberStress(Computable[_LoveWeberResults]):
     0.25
     """
 
+    _parameters = ("area",)
+
     def __init__(self, area: float | None = None) -> None:
         if area is not None and not area > 0:
             raise ValueError(f"area: must be > 0, got {area}")
@@ -369,23 +319,13 @@ class LoveWeberStress(Computable[_LoveWeberResults]):
         # the particle sum, each particle's moment sum_c sym((x_c - x_p) (x) f^p_c)
         moments = grain_stress(snapshot, np.ones(n_p))
         stress = np.asarray(moments[selected].sum(axis=0) / area, dtype=np.float64)
-        self._store(_LoveWeberResults(stress, area, int(selected.sum())))
+        self._store(stress=stress, region_area=area, n_particles=int(selected.sum()))
         return self
 
-    @property
-    def stress(self) -> NDArray[np.float64]:
-        """(2, 2) stress of the region, Pa, compression positive."""
-        return self._computed("stress").stress
+    stress = Computed[NDArray[np.float64]]("(2, 2) stress of the region, Pa, compression positive.")
 
-    @property
-    def region_area(self) -> float:
-        """The region's area used, m^2."""
-        return self._computed("region_area").area
-
-    @property
-    def n_particles(self) -> int:
-        """Particles in the region."""
-        return self._computed("n_particles").n_particles
+    region_area = Computed[float]("The region's area used, m^2.")
+    n_particles = Computed[int]("Particles in the region.")
 
     @property
     def mean_stress(self) -> float:
@@ -398,6 +338,3 @@ class LoveWeberStress(Computable[_LoveWeberResults]):
         """q = (sigma_1 - sigma_2) / 2, Pa."""
         s1, s2, _ = principal_stresses(self.stress)
         return float(0.5 * (s1 - s2))
-
-    def __repr__(self) -> str:
-        return f"LoveWeberStress(area={self.area!r})"

@@ -1,74 +1,23 @@
-r"""Satake's fabric tensor and the stress-force-fabric relation of Rothenburg
-and Bathurst (docs/fabric.md, "Fabric tensor" and "Stress-force-fabric").
+r"""Satake's fabric tensor and Rothenburg and Bathurst's stress-force-fabric relation.
 
-Contacts used: those between sample grains by default (``include_boundary``
-adds the grains' contacts with walls and membrane disks), each once, its
-normal :math:`n_c = (\cos\theta_c, \sin\theta_c)` from i to j.
+Contacts between sample grains by default (``include_boundary`` adds walls and
+membrane disks), each once, normal :math:`n_c` from i to j.
+:math:`\phi_{ij} = \frac{1}{N_c}\sum_c n_i n_j` (trace 1),
+:math:`\phi_{ijkl}` its fourth-order companion, :math:`b_4 = |\langle
+e^{4i\theta}\rangle|`, and with forces the strong and weak parts. The forms
+:math:`E(\theta)`, :math:`\bar f_n = f_0[1 + a_n\cos 2(\theta-\theta_n)]`,
+:math:`\bar f_t = f_0 a_t\sin 2(\theta-\theta_t)` (and the branch lengths'
+:math:`a_l`) are least-squares fits to the contacts (NaN with normals in
+fewer than three directions modulo 180°), and
 
-Satake's fabric tensor (2D, trace 1) and its fourth-order companion
-    .. math::
+.. math::
 
-       \phi_{ij} = \frac{1}{N_c}\sum_c n_i n_j,\qquad
-       \phi_{ijkl} = \frac{1}{N_c}\sum_c n_i n_j n_k n_l ,
+   \frac{q}{p} = \frac{\sigma_1 - \sigma_2}{\sigma_1 + \sigma_2} \approx
+   \tfrac12\left[a\cos 2(\theta_a - \theta_\sigma) + a_n\cos 2(\theta_n -
+   \theta_\sigma) + a_t\cos 2(\theta_t - \theta_\sigma)\right].
 
-    :math:`a = 2(\phi_1 - \phi_2)` and :math:`\theta_a` the major direction
-    (the exact estimate of Eq. 6, :mod:`grainlab.analysis.fabric`). The
-    fourth harmonic :math:`b_4 = |\langle e^{4i\theta}\rangle|` is what
-    :math:`\phi_{ij}` cannot see: a hexagonal lattice has :math:`\phi = I/2`,
-    :math:`\phi_{xxxx} = 3/8` and :math:`b_4 = 0`; a square lattice has
-    :math:`\phi = I/2` too, but :math:`\phi_{xxxx} = 1/2` and
-    :math:`b_4 = 1`. With forces, the **strong and weak parts**
-    :math:`\phi^{s,w}_{ij} = \frac{1}{N_c}\sum_{c \in s,w} n_i n_j`
-    (contacts with :math:`f_n` above / not above the mean, Radjai et al.
-    1998) sum to :math:`\phi`.
-
-Anisotropies of Rothenburg and Bathurst (1989)
-    .. math::
-
-       E(\theta) = \tfrac{1}{2\pi}[1 + a\cos 2(\theta - \theta_a)],\quad
-       \bar f_n(\theta) = f_0[1 + a_n\cos 2(\theta - \theta_n)],\quad
-       \bar f_t(\theta) = f_0\, a_t \sin 2(\theta - \theta_t),
-
-    :math:`a, \theta_a` from the second moment of the normals (as above);
-    :math:`f_0, a_n, \theta_n` the least-squares fit of the contacts'
-    normal forces, :math:`f_{n,c} \approx c_0 + c_1\cos 2\theta_c + c_2\sin
-    2\theta_c`, :math:`f_0 = c_0`, :math:`a_n = \sqrt{c_1^2 + c_2^2}/c_0`,
-    :math:`\theta_n = \frac12\operatorname{atan2}(c_2, c_1)`; :math:`a_t,
-    \theta_t` the fit :math:`f_{t,c} \approx d_1\cos 2\theta_c + d_2\sin
-    2\theta_c`, :math:`a_t = \sqrt{d_1^2+d_2^2}/c_0`, :math:`\theta_t =
-    \frac12\operatorname{atan2}(-d_1, d_2)` (``f_t`` the shear force on i
-    along ``rot90(n)``, so that a positive :math:`a_t` adds to the stress
-    along :math:`\theta_t`). Being fits to the forces themselves, these are
-    exact whenever the forces follow the forms, whatever the normals; NaN
-    when the normals take fewer than three directions modulo 180° (two
-    directions cannot separate :math:`f_0` from :math:`a_n`) and :math:`a_t`
-    NaN without shear forces. The branch lengths are fitted the same way,
-    :math:`|l_c| \approx l_0[1 + a_l\cos 2(\theta_c - \theta_l)]` (Ouadfel
-    and Rothenburg's branch-length anisotropy, 0 for disks of one size).
-
-Stress-force-fabric relation
-    With the stress of the same contacts (:func:`~grainlab.analysis.stress.contact_stress`),
-    principal values :math:`\sigma_1 \ge \sigma_2` and major direction
-    :math:`\theta_\sigma`, Rothenburg and Bathurst's first-order relation is
-
-    .. math::
-
-       \frac{q}{p} = \frac{\sigma_1 - \sigma_2}{\sigma_1 + \sigma_2}
-       \approx \tfrac12\left[a\cos 2(\theta_a - \theta_\sigma)
-       + a_n\cos 2(\theta_n - \theta_\sigma)
-       + a_t\cos 2(\theta_t - \theta_\sigma)\right],
-
-    (coaxial: :math:`\tfrac12(a + a_n + a_t)`), and
-    :math:`\sigma_1/\sigma_2 = (1 + q/p)/(1 - q/p)`. The measure reports
-    both sides and the residual measured − predicted: the products of
-    anisotropies, the fourth and higher harmonics of the normals and of the
-    forces, and the branch-length anisotropy of a polydisperse packing,
-    which the relation leaves out; the last is also reported, and the
-    prediction and residual with :math:`\tfrac12 a_l\cos 2(\theta_l -
-    \theta_\sigma)` added. On a hexagonal lattice with forces of
-    the forms the residual is 0 (its normals have no fourth harmonic); a
-    square lattice loaded along one axis has a = 0, q/p = 1, and its
-    :math:`a_n` is NaN (two directions).
+Fits, signs and known answers: docs/fabric.md, "Fabric tensor (Satake)" and
+"Stress-force-fabric relation".
 """
 
 from __future__ import annotations
@@ -79,8 +28,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis._util import (
-    Computable,
     axial_direction,
     grain_contacts,
     principal_stresses,
@@ -168,22 +117,7 @@ def _normal_products(normals: NDArray[np.float64]) -> tuple[NDArray[np.float64],
     return second, fourth
 
 
-@dataclass(frozen=True, eq=False)
-class _FabricTensorResults:
-    """The results of :class:`FabricTensor` (see its properties)."""
-
-    tensor: NDArray[np.float64]
-    fourth_order: NDArray[np.float64]
-    anisotropy: float
-    direction: float
-    fourth_harmonic: float
-    strong_part: NDArray[np.float64] | None
-    weak_part: NDArray[np.float64] | None
-    n_contacts: int
-    angles: NDArray[np.float64]
-
-
-class FabricTensor(Computable[_FabricTensorResults]):
+class FabricTensor(Compute):
     r"""Satake's fabric tensor, its fourth-order companion and its strong and weak parts.
 
     .. math::
@@ -213,6 +147,8 @@ class FabricTensor(Computable[_FabricTensorResults]):
     ([[0.5, 0.0], [0.0, 0.5]], 0.5)
     """
 
+    _parameters = ("include_boundary",)
+
     def __init__(self, include_boundary: bool = False) -> None:
         self.include_boundary = bool(include_boundary)
 
@@ -238,78 +174,48 @@ class FabricTensor(Computable[_FabricTensorResults]):
             strong = _normal_products(normals[strong_mask])[0] / n_c
             weak = _normal_products(normals[~strong_mask])[0] / n_c
         self._store(
-            _FabricTensorResults(
-                tensor, fourth, anisotropy, direction, harmonic, strong, weak, n_c, angles
-            )
+            tensor=tensor,
+            fourth_order=fourth,
+            anisotropy=anisotropy,
+            direction=direction,
+            fourth_harmonic=harmonic,
+            strong_part=strong,
+            weak_part=weak,
+            n_contacts=n_c,
+            _angles=angles,
         )
         return self
 
-    @property
-    def tensor(self) -> NDArray[np.float64]:
-        """(2, 2) phi_ij, trace 1."""
-        return self._computed("tensor").tensor
-
-    @property
-    def fourth_order(self) -> NDArray[np.float64]:
-        """(2, 2, 2, 2) phi_ijkl, its contractions phi_ijkk = phi_ij."""
-        return self._computed("fourth_order").fourth_order
-
-    @property
-    def anisotropy(self) -> float:
-        """a = 2 (phi_1 - phi_2)."""
-        return self._computed("anisotropy").anisotropy
-
-    @property
-    def direction(self) -> float:
-        """theta_a, the major direction of phi, rad in [0, pi)."""
-        return self._computed("direction").direction
-
-    @property
-    def fourth_harmonic(self) -> float:
-        """b_4 = |mean of exp(4 i theta)|: 0 for a hexagonal lattice, 1 for a square one."""
-        return self._computed("fourth_harmonic").fourth_harmonic
-
-    @property
-    def strong_part(self) -> NDArray[np.float64] | None:
-        """(2, 2) phi^s, the strong contacts' share of phi (None without forces)."""
-        return self._computed("strong_part").strong_part
-
-    @property
-    def weak_part(self) -> NDArray[np.float64] | None:
-        """(2, 2) phi^w = phi - phi^s (None without forces)."""
-        return self._computed("weak_part").weak_part
-
-    @property
-    def n_contacts(self) -> int:
-        """N_c, the contacts used."""
-        return self._computed("n_contacts").n_contacts
+    _angles = Computed[NDArray[np.float64]]("(Nc,) the contact angles used, rad (drawn by plot).")
+    tensor = Computed[NDArray[np.float64]]("(2, 2) phi_ij, trace 1.")
+    fourth_order = Computed[NDArray[np.float64]](
+        "(2, 2, 2, 2) phi_ijkl, its contractions phi_ijkk = phi_ij."
+    )
+    anisotropy = Computed[float]("a = 2 (phi_1 - phi_2).")
+    direction = Computed[float]("theta_a, the major direction of phi, rad in [0, pi).")
+    fourth_harmonic = Computed[float](
+        "b_4 = |mean of exp(4 i theta)|: 0 for a hexagonal lattice, 1 for a square one."
+    )
+    strong_part = Computed[NDArray[np.float64] | None](
+        "(2, 2) phi^s, the strong contacts' share of phi (None without forces)."
+    )
+    weak_part = Computed[NDArray[np.float64] | None](
+        "(2, 2) phi^w = phi - phi^s (None without forces)."
+    )
+    n_contacts = Computed[int]("N_c, the contacts used.")
 
     def plot(self, ax: Any = None) -> Any:
         """Rose diagram of the contact normals with the fitted E(theta); returns the axes."""
         from grainlab import plot
         from grainlab.analysis.fabric import angular_histogram
 
-        values, _ = angular_histogram(self._computed("angles").angles, 18)
+        values, _ = angular_histogram(self._angles, 18)
         return plot.polar_distribution(
             values, anisotropy=self.anisotropy, direction=self.direction, ax=ax
         )
 
-    def __repr__(self) -> str:
-        return f"FabricTensor(include_boundary={self.include_boundary})"
 
-
-@dataclass(frozen=True, eq=False)
-class _StressForceFabricResults:
-    """The results of :class:`StressForceFabric` (see its properties)."""
-
-    anisotropies: Anisotropies
-    stress: NDArray[np.float64]
-    stress_direction: float
-    stress_ratio: float
-    predicted_stress_ratio: float
-
-
-class StressForceFabric(Computable[_StressForceFabricResults]):
+class StressForceFabric(Compute):
     r"""Rothenburg and Bathurst's stress-force-fabric relation, with its residual.
 
     .. math::
@@ -348,6 +254,8 @@ class StressForceFabric(Computable[_StressForceFabricResults]):
     (1.0, 2.0, 0.0)
     """
 
+    _parameters = ("include_boundary",)
+
     def __init__(self, include_boundary: bool = False) -> None:
         self.include_boundary = bool(include_boundary)
 
@@ -374,34 +282,27 @@ class StressForceFabric(Computable[_StressForceFabricResults]):
         ]
         predicted = float(0.5 * np.sum(terms)) if np.isfinite(rb.a_n) else float("nan")
         self._store(
-            _StressForceFabricResults(rb, stress, float(direction), ratio, predicted)
+            anisotropies=rb,
+            stress=stress,
+            stress_direction=float(direction),
+            stress_ratio=ratio,
+            predicted_stress_ratio=predicted,
         )
         return self
 
-    @property
-    def anisotropies(self) -> Anisotropies:
-        """a, a_n, a_t, their directions and f0 (:class:`Anisotropies`)."""
-        return self._computed("anisotropies").anisotropies
-
-    @property
-    def stress(self) -> NDArray[np.float64]:
-        """(2, 2) the contacts' stress, Pa (over the snapshot's region)."""
-        return self._computed("stress").stress
-
-    @property
-    def stress_direction(self) -> float:
-        """theta_sigma, the major principal direction of :attr:`stress`, rad."""
-        return self._computed("stress_direction").stress_direction
-
-    @property
-    def stress_ratio(self) -> float:
-        """q/p = (sigma_1 - sigma_2) / (sigma_1 + sigma_2), measured."""
-        return self._computed("stress_ratio").stress_ratio
-
-    @property
-    def predicted_stress_ratio(self) -> float:
-        """(1/2) sum of the anisotropies projected on theta_sigma."""
-        return self._computed("predicted_stress_ratio").predicted_stress_ratio
+    anisotropies = Computed["Anisotropies"](
+        "a, a_n, a_t, their directions and f0 (:class:`Anisotropies`)."
+    )
+    stress = Computed[NDArray[np.float64]](
+        "(2, 2) the contacts' stress, Pa (over the snapshot's region)."
+    )
+    stress_direction = Computed[float](
+        "theta_sigma, the major principal direction of :attr:`stress`, rad."
+    )
+    stress_ratio = Computed[float]("q/p = (sigma_1 - sigma_2) / (sigma_1 + sigma_2), measured.")
+    predicted_stress_ratio = Computed[float](
+        "(1/2) sum of the anisotropies projected on theta_sigma."
+    )
 
     @property
     def residual(self) -> float:
@@ -457,6 +358,3 @@ class StressForceFabric(Computable[_StressForceFabricResults]):
             ax.set_title(f"residual {self.residual:+.3f}")
             ax.legend(frameon=False, fontsize=7)
         return ax
-
-    def __repr__(self) -> str:
-        return f"StressForceFabric(include_boundary={self.include_boundary})"

@@ -1,41 +1,13 @@
-r"""The radical Voronoi tessellation (power diagram) of a disk packing and the
-local porosity of each grain (docs/fabric.md, "Local porosity").
+r"""The power diagram (radical Voronoi tessellation) of a disk packing and local porosity.
 
-The **power cell** of disk p (centre :math:`x_p`, radius :math:`r_p`) is the
-set of points nearer to it in the power distance than to any other disk,
-
-.. math::
-
-   C_p = \{x : |x - x_p|^2 - r_p^2 \le |x - x_q|^2 - r_q^2\ \ \forall q\},
-
-so the boundary between two touching disks runs through their contact point
-(in a plain Voronoi tessellation of centres it cuts the larger disk), each
-disk lies inside its own cell when disks do not overlap, and the cells tile
-the plane: this is the tessellation for polydisperse disks. The **local
-porosity** of grain p is
-
-.. math:: n_p = 1 - \frac{\pi r_p^2}{A_p},
-
-with :math:`A_p` the area of its cell (unit thickness); the porosity of the
-sample is :math:`1 - \sum_p \pi r_p^2 / \sum_p A_p` over its grains.
-
-The region tessellated is the snapshot's region (its box, else the rectangle
-bounding the disks, :func:`~grainlab.analysis._util.sample_bounds`, widened
-in a non-periodic direction to hold every disk). A periodic direction is
-tessellated with periodic images, a bounded one with the mirror images of
-the disks across its two edges, so the cells end exactly on the edge and
-every point of the region belongs to one cell: the cells sum to the region's
-area. Every particle has a cell (membrane disks too: they bound the cells of
-the grains next to them).
-
-Implementation: the power diagram is the dual of the regular triangulation,
-which is the lower convex hull of the points lifted to
-:math:`(x, y, |x|^2 - r^2)` (``scipy.spatial.ConvexHull``, Qhull); the vertex
-of the cells of a lower face's three disks is the point
-:math:`(\alpha/2, \beta/2)` of its plane :math:`z = \alpha x + \beta y +
-\gamma`. Images are made only within a margin of the edges (3 largest
-diameters, doubled until every cell is closed and no missing image could
-cut a cell). No Python loop runs over particles.
+The cell of disk p is :math:`\{x : |x - x_p|^2 - r_p^2 \le |x - x_q|^2 - r_q^2\
+\forall q\}`; the local porosity :math:`n_p = 1 - \pi r_p^2 / A_p` (unit
+thickness) and the sample's :math:`1 - \sum_p \pi r_p^2 / \sum_p A_p` over
+its grains. The region is the snapshot's (:func:`~grainlab.analysis._util.sample_bounds`),
+tessellated with periodic images or mirror images across bounded edges, so
+the cells sum to its area; every particle has a cell. The diagram is the dual
+of the lower convex hull of the lifted points (Qhull). docs/fabric.md,
+"Local porosity".
 """
 
 from __future__ import annotations
@@ -46,7 +18,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.analysis._util import Computable, sample_bounds
+from grainlab.analysis._compute import Compute, Computed
+from grainlab.analysis._util import sample_bounds
 from grainlab.snapshot import Snapshot
 
 __all__ = ["LocalPorosity", "PowerCells", "power_cell_areas", "power_cells"]
@@ -217,17 +190,7 @@ def power_cell_areas(snapshot: Snapshot) -> NDArray[np.float64]:
     return power_cells(snapshot).area
 
 
-@dataclass(frozen=True, eq=False)
-class _LocalPorosityResults:
-    """The results of :class:`LocalPorosity` (see its properties)."""
-
-    snapshot: Snapshot
-    cells: PowerCells
-    local_porosity: NDArray[np.float64]
-    porosity: float
-
-
-class LocalPorosity(Computable[_LocalPorosityResults]):
+class LocalPorosity(Compute):
     r"""Local porosity of each grain from its power (radical Voronoi) cell.
 
     .. math:: n_p = 1 - \frac{\pi r_p^2}{A_p},\qquad
@@ -237,15 +200,6 @@ class LocalPorosity(Computable[_LocalPorosityResults]):
     periodic hexagonal lattice of touching disks of diameter d has hexagonal
     cells of area :math:`\tfrac{\sqrt3}{2} d^2`, so
     :math:`n_p = 1 - \pi/(2\sqrt3) = 0.0931`.
-
-    Attributes (after :meth:`compute`)
-    ----------------------------------
-    cell_area : (N,) float, m^2
-    local_porosity : (N,) float
-        NaN for membrane disks and for a particle without a cell.
-    porosity : float
-        Of the sample grains' cells together.
-    cells : :class:`PowerCells`
 
     Example
     -------
@@ -267,34 +221,28 @@ class LocalPorosity(Computable[_LocalPorosityResults]):
             local = np.where(sample & (cells.area > 0.0), 1.0 - solid / cells.area, np.nan)
         total = float(cells.area[sample].sum())
         porosity = 1.0 - float(solid[sample].sum()) / total if total > 0 else float("nan")
-        self._store(_LocalPorosityResults(snapshot, cells, local, porosity))
+        self._store(_snapshot=snapshot, cells=cells, local_porosity=local, porosity=porosity)
         return self
 
-    @property
-    def cells(self) -> PowerCells:
-        """The power cells (:class:`PowerCells`)."""
-        return self._computed("cells").cells
+    _snapshot = Computed[Snapshot]("The snapshot measured (drawn by plot).")
+    cells = Computed["PowerCells"]("The power cells (:class:`PowerCells`).")
 
     @property
     def cell_area(self) -> NDArray[np.float64]:
         """(N,) area of each particle's power cell, m^2."""
-        return self._computed("cell_area").cells.area
+        return self.cells.area
 
-    @property
-    def local_porosity(self) -> NDArray[np.float64]:
-        """(N,) 1 - pi r^2 / A_p of each sample grain (NaN for membrane disks)."""
-        return self._computed("local_porosity").local_porosity
-
-    @property
-    def porosity(self) -> float:
-        """1 - (grains' disk area) / (their cells' area)."""
-        return self._computed("porosity").porosity
+    local_porosity = Computed[NDArray[np.float64]](
+        "(N,) 1 - pi r^2 / A_p of each sample grain (NaN for membrane disks and a particle "
+        "without a cell)."
+    )
+    porosity = Computed[float]("1 - (grains' disk area) / (their cells' area).")
 
     def plot(self, ax: Any = None) -> Any:
         """The power cells coloured by local porosity, the disks on top; returns the axes."""
         from grainlab.plot import networks
 
-        snap = self._computed("snapshot").snapshot
+        snap = self._snapshot
         cells = self.cells
         return networks.cell_map(
             cells.vertices,
@@ -305,6 +253,3 @@ class LocalPorosity(Computable[_LocalPorosityResults]):
             ax=ax,
             label="local porosity",
         )
-
-    def __repr__(self) -> str:
-        return "LocalPorosity()"

@@ -1,42 +1,18 @@
-r"""The shear band of a biaxial run, found and accepted (or not) between two snapshots.
+"""The shear band of a biaxial run, found and accepted (or not) between two snapshots.
 
-:func:`find_band` fits the grains' local strain since a reference snapshot
-(:class:`~grainlab.analysis.LocalStrain`, on the **grains only**: membrane
-disks are much smaller than the grains and are not part of the sample; they
-would set the neighbour radius and the background strain) and searches it
-with :class:`~grainlab.analysis.ShearBand`. Grains whose centre lies within
-one mean diameter of the boundary (membrane disk centres and platen contact
-points; the grains' bounding box when there are neither) are left out of the
-search, since their one-sided neighbourhoods give spurious strains; they
-still belong to the band when they lie inside it. The candidate band is
-accepted when it
-
-1. passes ShearBand's own tests (:attr:`ShearBand.found
-   <grainlab.analysis.ShearBand.found>`): at least one mean grain diameter
-   thick, and its excess strain over the background at least twice the
-   largest excess elsewhere on the profile across it,
-2. crosses the sample: the centre line's chord through the grains is at
-   least 3/4 of the sample's smaller side and the band's grains cover at
-   least 3/4 of that chord (a slab that cuts off a corner is not a band),
-3. explains more of the strain variance (adjusted eta², as ShearBand scores
-   it) than the band found in each of 19 random rearrangements of the same
-   strain values over the same grains (p <= 0.05, fixed seed).
-
-Otherwise the band is "not found" and :attr:`BandNumbers.reason` says why.
-The **second band** (ShearBand's second pass, without the first band's
-grains and at least 20 degrees away from its direction: the conjugate band
-of a biaxial test) is reported in the ``second_*`` fields of
-:class:`BandNumbers` and accepted when it passes tests 1 and 2 (and the
-first band was found). Means of lambda in and out of the band are over
-grains with at least 2 contacts (the paper's 0.34 vs 0.31).
-
-**Other readings of the band.** :func:`find_field_band` runs the same search
-and the same acceptance (one code path: :func:`find_band` is the field band of
-the excess local strain) on any per-grain field; Fig. 12's band is its band of
-:func:`lambda_indicator`, the grains with lambda > 0.5. :func:`displacement_band`
-reads Fig. 11's band, the zone between two blocks of the grains' displacement
-field (:class:`~grainlab.analysis.DisplacementBand`, with its own acceptance).
-:func:`band_labels` labels the grains by any of the three readings.
+:func:`find_band` searches the grains' excess local strain since a reference
+snapshot (:class:`~grainlab.analysis.LocalStrain` on the grains only) with
+:class:`~grainlab.analysis.ShearBand`, leaving out the grains within
+:data:`EDGE_D` mean diameters of the boundary, and accepts the candidate by
+the rules of :mod:`grainlab.analysis.band_acceptance`: ShearBand's own tests,
+crossing the sample, and a permutation test against :data:`N_PERMUTATIONS`
+random rearrangements of the values (p <= 0.05, fixed seed); the second band
+by the first two. :func:`find_field_band` runs the same search and acceptance
+(one code path) on any per-grain field, Fig. 12's being
+:func:`lambda_indicator`; :func:`displacement_band` reads Fig. 11's band
+(:class:`~grainlab.analysis.DisplacementBand`); :func:`band_labels` labels the
+grains by any reading. docs/analysis.md, "Figures of a biaxial run" and
+"Three readings of the shear band".
 """
 
 from __future__ import annotations
@@ -50,6 +26,14 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
 from grainlab.analysis._util import finite_mean
+from grainlab.analysis.band_acceptance import (
+    CROSSING,
+    candidate_reason,
+    crossing_problems,
+    permutation_p_value,
+    significance_problems,
+    slab_eta2,
+)
 from grainlab.analysis.band_readings import MIN_GRAINS, DisplacementBand
 from grainlab.analysis.shear_band import ShearBand, Slab
 from grainlab.analysis.stability import StabilityIndex
@@ -72,9 +56,9 @@ __all__ = [
     "slab_members",
 ]
 
-#: Band acceptance: minimum thickness (mean diameters), crossing fractions, permutations.
+#: Band acceptance: minimum thickness (mean diameters), permutations (the crossing
+#: fractions: :data:`~grainlab.analysis.band_acceptance.CROSSING`).
 MIN_THICKNESS_D = 1.0
-CROSSING = 0.75
 N_PERMUTATIONS = 19
 #: Grains closer than this many mean diameters to the boundary are left out of the search.
 EDGE_D = 1.0
@@ -215,25 +199,6 @@ def interior_grains(snap: Snapshot, d_mean: float) -> NDArray[np.bool_]:
     return inside
 
 
-def _eta2(
-    pos: NDArray[np.float64], gamma: NDArray[np.float64], normal: NDArray[np.float64], width: float
-) -> float:
-    """Adjusted correlation ratio of ``gamma`` with bins across the slab (as ShearBand scores)."""
-    s = pos @ normal
-    b = ((s - s.min()) / width).astype(np.int64)
-    counts = np.bincount(b)
-    sums = np.bincount(b, weights=gamma)
-    occupied = counts > 0
-    m = gamma.size
-    mean = float(gamma.mean())
-    total = float(((gamma - mean) ** 2).sum())
-    if total <= 0.0:
-        return 0.0
-    between = float((sums[occupied] ** 2 / counts[occupied]).sum()) - m * mean**2
-    n_bins = int(occupied.sum())
-    return 1.0 - (1.0 - between / total) * (m - 1) / max(m - n_bins, 1)
-
-
 def find_band(
     reference: Snapshot,
     current: Snapshot,
@@ -243,16 +208,12 @@ def find_band(
     reference_name: str = "",
     axial_strain: float = math.nan,
 ) -> BandSearch:
-    """The shear band of ``current`` since ``reference``, accepted or not (module docstring).
-
-    ``stability`` is ``current``'s computed :class:`StabilityIndex` (for the
-    means in and out of the band); ``name``, ``reference_name`` and
-    ``axial_strain`` label the :class:`BandNumbers`.
-
-    The search (twenty band fits: the band and its permutation test) is made
-    anew on every call; a run's searches are stored in its ``run.h5``
-    (:mod:`grainlab.postprocess.products`) and read from there.
-    """
+    """The shear band of ``current`` since ``reference``, accepted or not (module
+    docstring); ``stability`` is ``current``'s computed :class:`StabilityIndex` (the
+    means of lambda in and out of the band), ``name``, ``reference_name`` and
+    ``axial_strain`` label the :class:`BandNumbers`. Twenty band fits (the band and
+    its permutation test) on every call; a run's searches are stored in its
+    ``run.h5`` (:mod:`grainlab.postprocess.products`)."""
     found = _search(reference, current, stability)
     numbers = replace(found.numbers, snapshot=name, reference=reference_name, axial_strain=axial_strain)
     return replace(found, numbers=numbers)
@@ -292,60 +253,26 @@ def _accepted_band(
     """The band of the per-grain ``field`` (N_grains,) of ``snap`` and its acceptance
     (module docstring): the one code path of the strain band (:func:`find_band`) and
     of the band in any field (:func:`find_field_band`), its numbers unlabelled."""
-    name, reference_name, axial_strain = "", "", math.nan
     g = snap.is_sample
     pos, rad = snap.positions[g], snap.radii[g]
     d_mean = float(np.mean(2.0 * rad)) if rad.size else math.nan
-    gamma = field
     interior = interior_grains(snap, d_mean)
-    valid = interior & np.isfinite(gamma)
-    lam = stability.stability_index[g]
-    counts = stability.n_contacts[g]
-
-    def missing(reason: str, **numbers: Any) -> BandSearch:
-        values: dict[str, Any] = {
-            "angle_deg": math.nan,
-            "inclination_deg": math.nan,
-            "thickness_m": math.nan,
-            "thickness_diameters": math.nan,
-            "contrast": math.nan,
-            "n_grains": 0,
-            "mean_lambda_inside": math.nan,
-            "mean_lambda_outside": math.nan,
-            "p_value": math.nan,
-        }
-        values.update(numbers)
-        return BandSearch(
-            BandNumbers(name, reference_name, axial_strain, False, reason, **values), None, displacement
-        )
-
+    valid = interior & np.isfinite(field)
     if int(valid.sum()) < 10:
-        return missing(
+        return _missing(
+            displacement,
             f"only {int(valid.sum())} grains away from the boundary have {words.having} "
-            "(at least 10 are needed)"
+            "(at least 10 are needed)",
         )
-    band = ShearBand(min_thickness=MIN_THICKNESS_D).compute(pos, gamma, rad, mask=interior)
-    side = float(np.ptp(pos, axis=0).min())
-    # significance against random rearrangements of the same values
-    width = band.bin_width * float(np.mean(2.0 * rad[interior]))
-    eta = _eta2(pos[valid], gamma[valid], band.normal, width)
-    rng = np.random.default_rng(PERMUTATION_SEED)
-    shuffled = gamma.copy()
-    null = np.empty(N_PERMUTATIONS)
-    for k in range(N_PERMUTATIONS):
-        shuffled[valid] = rng.permutation(gamma[valid])
-        trial = ShearBand(second=False).compute(pos, shuffled, rad, mask=interior)
-        null[k] = _eta2(pos[valid], shuffled[valid], trial.normal, width)
-    p_value = float((1 + np.sum(null >= eta)) / (N_PERMUTATIONS + 1))
-
-    problems = _band_problems(band, pos, d_mean, side)
-    if p_value > 0.05:
-        problems.append(
-            f"not significant (p = {p_value:.2f} against {N_PERMUTATIONS} random "
-            f"rearrangements of the {words.values})"
-        )
+    band = ShearBand(min_thickness=MIN_THICKNESS_D).compute(pos, field, rad, mask=interior)
+    p_value = _p_value(band, pos, field, rad, interior, valid)
+    problems = _band_problems(band, pos, d_mean)
+    problems += significance_problems(p_value, N_PERMUTATIONS, words.values)
+    if problems:
+        reason = candidate_reason(band.angle_degrees, band.thickness_diameters, problems)
+        return _missing(displacement, reason, p_value=p_value, prominence=band.prominence)
     members = slab_members(band, pos)
-    use = counts >= 2
+    lam, use = stability.stability_index[g], stability.n_contacts[g] >= 2
     numbers: dict[str, Any] = {
         "angle_deg": band.angle_degrees,
         "inclination_deg": band.inclination_degrees,
@@ -358,39 +285,71 @@ def _accepted_band(
         "p_value": p_value,
         "prominence": band.prominence,
     }
-    if problems:
-        return missing(
-            f"best candidate at {band.angle_degrees:.1f} deg, {band.thickness_diameters:.1f} "
-            "mean diameters thick: " + "; ".join(problems),
-            p_value=p_value,
-            prominence=band.prominence,
-        )
     second = band.second
     accepted_second: Slab | None = None
     if second is not None:
-        second_problems = _band_problems(second, pos, d_mean, side)
-        numbers.update(
-            second_found=not second_problems,
-            second_reason=(
-                f"best candidate at {second.angle_degrees:.1f} deg, "
-                f"{second.thickness_diameters:.1f} mean diameters thick: "
-                + "; ".join(second_problems)
-                if second_problems
-                else ""
-            ),
-            second_angle_deg=second.angle_degrees,
-            second_inclination_deg=second.inclination_degrees,
-            second_thickness_diameters=second.thickness_diameters,
-            second_contrast=second.contrast,
-            second_prominence=second.prominence,
-        )
+        second_problems = _band_problems(second, pos, d_mean)
+        numbers.update(_second_numbers(second, second_problems))
         accepted_second = None if second_problems else second.slab
     return BandSearch(
-        BandNumbers(name, reference_name, axial_strain, True, "", **numbers),
-        band.slab,
-        displacement,
-        accepted_second,
+        BandNumbers("", "", math.nan, True, "", **numbers), band.slab, displacement, accepted_second
     )
+
+
+def _missing(displacement: NDArray[np.float64], reason: str, **numbers: Any) -> BandSearch:
+    """A search that accepted no band, and why (its numbers unlabelled, NaN unless given)."""
+    values: dict[str, Any] = {
+        "angle_deg": math.nan,
+        "inclination_deg": math.nan,
+        "thickness_m": math.nan,
+        "thickness_diameters": math.nan,
+        "contrast": math.nan,
+        "n_grains": 0,
+        "mean_lambda_inside": math.nan,
+        "mean_lambda_outside": math.nan,
+        "p_value": math.nan,
+    }
+    values.update(numbers)
+    return BandSearch(BandNumbers("", "", math.nan, False, reason, **values), None, displacement)
+
+
+def _p_value(
+    band: ShearBand,
+    pos: NDArray[np.float64],
+    field: NDArray[np.float64],
+    rad: NDArray[np.float64],
+    interior: NDArray[np.bool_],
+    valid: NDArray[np.bool_],
+) -> float:
+    """The band's significance: its eta² against the bands found in
+    :data:`N_PERMUTATIONS` random rearrangements of the same values (fixed seed)."""
+    width = band.bin_width * float(np.mean(2.0 * rad[interior]))
+    eta = slab_eta2(pos[valid], field[valid], band.normal, width)
+    rng = np.random.default_rng(PERMUTATION_SEED)
+    shuffled = field.copy()
+    null = np.empty(N_PERMUTATIONS)
+    for k in range(N_PERMUTATIONS):
+        shuffled[valid] = rng.permutation(field[valid])
+        trial = ShearBand(second=False).compute(pos, shuffled, rad, mask=interior)
+        null[k] = slab_eta2(pos[valid], shuffled[valid], trial.normal, width)
+    return permutation_p_value(eta, null)
+
+
+def _second_numbers(second: ShearBand, problems: list[str]) -> dict[str, Any]:
+    """The ``second_*`` fields of :class:`BandNumbers` for the candidate ``second``."""
+    return {
+        "second_found": not problems,
+        "second_reason": (
+            candidate_reason(second.angle_degrees, second.thickness_diameters, problems)
+            if problems
+            else ""
+        ),
+        "second_angle_deg": second.angle_degrees,
+        "second_inclination_deg": second.inclination_degrees,
+        "second_thickness_diameters": second.thickness_diameters,
+        "second_contrast": second.contrast,
+        "second_prominence": second.prominence,
+    }
 
 
 def slab_members(band: ShearBand | Slab, pos: NDArray[np.float64]) -> NDArray[np.bool_]:
@@ -398,25 +357,12 @@ def slab_members(band: ShearBand | Slab, pos: NDArray[np.float64]) -> NDArray[np
     return (band if isinstance(band, Slab) else band.slab).members(pos)
 
 
-def _band_problems(
-    band: ShearBand, pos: NDArray[np.float64], d_mean: float, side: float
-) -> list[str]:
+def _band_problems(band: ShearBand, pos: NDArray[np.float64], d_mean: float) -> list[str]:
     """Why a candidate band fails acceptance tests 1 and 2 (module docstring); [] if it passes."""
     problems = [band.reason] if not band.found else []
     tangent = np.array([np.cos(band.angle), np.sin(band.angle)])
     s = (pos - band.center) @ band.normal
-    members = np.abs(s) <= 0.5 * band.thickness
-    # crossing: chord of the centre line through the grains and the members' cover of it
-    near = np.abs(s) <= max(0.5 * band.thickness, d_mean)
-    chord = float(np.ptp(pos[near] @ tangent)) if near.sum() > 1 else 0.0
-    span = float(np.ptp(pos[members] @ tangent)) if members.sum() > 1 else 0.0
-    if chord < CROSSING * side or span < CROSSING * chord:
-        problems.append(
-            f"does not cross the sample (its grains span {span / d_mean:.1f} mean diameters "
-            f"of a {chord / d_mean:.1f}-diameter chord; the sample's smaller side is "
-            f"{side / d_mean:.1f})"
-        )
-    return problems
+    return problems + crossing_problems(pos, tangent, s, band.thickness, d_mean, d_mean, CROSSING)
 
 
 def lambda_indicator(stability: StabilityIndex) -> NDArray[np.float64]:
@@ -439,26 +385,14 @@ def find_field_band(
 ) -> BandSearch:
     """The band of a per-grain ``field`` of ``snapshot``, accepted as the strain band is.
 
-    ``field`` is (N,) per particle of ``snapshot`` (membrane disks' entries are
-    not read) or (N_grains,) per sample grain, in the grains' order; NaN
-    entries are left out. The search and its acceptance are :func:`find_band`'s
-    (the module docstring: ShearBand's tests, crossing the sample, the
-    permutation test against 19 rearrangements of the field's values; edge
-    grains left out of the search), on ``field`` instead of the local strain.
-    ``stability`` (``snapshot``'s computed :class:`StabilityIndex`, computed
-    with the defaults when None) gives the means of lambda in and out of the
-    band. There is no reference state: :attr:`BandSearch.displacement` is NaN
-    and :attr:`BandNumbers.reference` empty. Searches are not kept.
-
-    **Fig. 12's band** is :func:`lambda_indicator`'s field, ``lambda > 0.5``
-    per grain (``band_labels(..., reading="lambda")``). The indicator, not
-    lambda coarse-grained over a disk of 2 mean diameters: it is the paper's
-    reading of the figure (the zone of grains with lambda above 0.5), and the
-    permutation test needs values that are exchangeable between grains when
-    there is no band. A coarse-grained field is correlated over its disk, so
-    that every rearrangement of its values is rougher than the field itself
-    and any smooth field would pass as significant; ShearBand smooths its
-    profile across the band anyway (over about 2 mean diameters).
+    ``field`` is (N,) per particle (membrane disks' entries not read) or
+    (N_grains,) per sample grain; NaN entries are left out. The search and its
+    acceptance are :func:`find_band`'s, on ``field``; ``stability`` (computed with
+    the defaults when None) gives the means of lambda in and out of the band.
+    Without a reference state :attr:`BandSearch.displacement` is NaN and
+    :attr:`BandNumbers.reference` empty. Fig. 12's band is that of
+    :func:`lambda_indicator` (why the indicator: docs/analysis.md, "Three readings
+    of the shear band").
     """
     g = snapshot.is_sample
     values = np.asarray(field, dtype=np.float64)
@@ -505,23 +439,13 @@ def displacement_zone(reference: Snapshot, current: Snapshot) -> DisplacementZon
 
 
 def band_labels(reference: Snapshot, current: Snapshot, reading: str = "strain") -> NDArray[np.int32]:
-    """(N,) per particle of ``current``: 1 inside the accepted shear band, 2
-    inside its accepted conjugate band, 0 elsewhere (membrane disks, and every
-    particle when no band passes the tests).
-
-    ``reading`` (one of :data:`READINGS`) says where the band is read:
-
-    * ``"strain"`` (default): the bands the figures outline, found in the
-      grains' local strain since ``reference`` (:func:`find_band`);
-    * ``"displacement"``: the zone between the two blocks of the grains'
-      displacements since ``reference`` (:func:`displacement_band`, Fig. 11):
-      label 1 for its members, no conjugate band;
-    * ``"lambda"``: the band of the grains with lambda > 0.5 in ``current``
-      (:func:`find_field_band` on :func:`lambda_indicator`, ``StabilityIndex()``
-      defaults; Fig. 12), with its conjugate band as for the strain.
-
-    The labels are found anew; a run's are stored in its ``run.h5``
-    (:class:`grainlab.postprocess.products.RunProducts`).
+    """(N,) per particle of ``current``: 1 inside the accepted shear band, 2 inside
+    its accepted conjugate band, 0 elsewhere (membrane disks, and every particle
+    when no band passes the tests), the band read as ``reading`` (one of
+    :data:`READINGS`) says: ``"strain"`` (:func:`find_band`), ``"displacement"``
+    (:func:`displacement_band`, Fig. 11: label 1 only) or ``"lambda"``
+    (:func:`find_field_band` on :func:`lambda_indicator`, Fig. 12). Found anew;
+    a run's are stored in its ``run.h5`` (:class:`~grainlab.postprocess.products.RunProducts`).
     """
     if reading not in READINGS:
         raise ValueError(f"reading: must be one of {', '.join(map(repr, READINGS))}, got {reading!r}")
