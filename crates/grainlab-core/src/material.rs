@@ -4,13 +4,60 @@ use serde::{Deserialize, Serialize};
 use crate::error::{require_non_negative, require_positive, EngineError, Result};
 use crate::state::MAX_GROUPS;
 
-/// Parameters of the linear contact law with Coulomb friction (docs/contact-law.md).
+/// Which contact law a pair of material groups follows (docs/contact-law.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum ContactLaw {
+    /// Linear springs `kn`, `ks` with Coulomb friction and optional dashpots
+    /// (the paper's law, PFC's linear model).
+    #[default]
+    Linear,
+    /// Hertz's normal force and Mindlin's no-slip tangential stiffness from the
+    /// grains' Young's modulus and Poisson ratio, damped to a coefficient of
+    /// restitution, with Coulomb friction (LAMMPS `pair granular hertz/material
+    /// ... damping coeff_restitution tangential mindlin`).
+    HertzMindlin,
+}
+
+impl ContactLaw {
+    /// The law's name as the configuration spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactLaw::Linear => "linear",
+            ContactLaw::HertzMindlin => "hertz_mindlin",
+        }
+    }
+
+    /// The law named `name` (`linear` or `hertz_mindlin`).
+    pub fn from_name(name: &str) -> Result<Self> {
+        match name {
+            "linear" => Ok(ContactLaw::Linear),
+            "hertz_mindlin" => Ok(ContactLaw::HertzMindlin),
+            other => Err(EngineError::invalid(
+                "contact_law",
+                format!("unknown law {other:?} (known: linear, hertz_mindlin)"),
+            )),
+        }
+    }
+}
+
+/// Parameters of a pair's contact law with Coulomb friction (docs/contact-law.md).
 ///
-/// `normal_stiffness` and `shear_stiffness` are *contact* stiffnesses (N/m);
-/// the damping ratios are fractions of critical damping of the viscous
-/// dashpots (0 disables them; local damping is separate, per particle).
+/// For the linear law `normal_stiffness` and `shear_stiffness` are *contact*
+/// stiffnesses (N/m) and the damping ratios fractions of critical damping of
+/// the viscous dashpots (0 disables them; local damping is separate, per
+/// particle). For Hertz-Mindlin the stiffnesses follow from
+/// `youngs_modulus` and `poisson_ratio` and the overlap, the damping from
+/// `restitution`; `normal_stiffness` and `shear_stiffness` are then not read.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ContactModel {
+    /// The contact law of the pair.
+    pub law: ContactLaw,
+    /// Young's modulus E of the grains (Pa), Hertz-Mindlin only.
+    pub youngs_modulus: f64,
+    /// Poisson ratio nu of the grains, in (-1, 0.5); Hertz-Mindlin only.
+    pub poisson_ratio: f64,
+    /// Normal coefficient of restitution e in (0, 1]; Hertz-Mindlin only (1: elastic).
+    pub restitution: f64,
     /// Normal contact stiffness kn (N/m).
     pub normal_stiffness: f64,
     /// Shear contact stiffness ks (N/m).
@@ -39,6 +86,10 @@ impl ContactModel {
     /// Linear spring model without viscous damping.
     pub fn linear(normal_stiffness: f64, shear_stiffness: f64, friction: f64) -> Self {
         ContactModel {
+            law: ContactLaw::Linear,
+            youngs_modulus: 0.0,
+            poisson_ratio: 0.0,
+            restitution: 1.0,
             normal_stiffness,
             shear_stiffness,
             friction,
@@ -51,8 +102,32 @@ impl ContactModel {
         }
     }
 
+    /// Hertz-Mindlin between grains of Young's modulus `youngs_modulus` (Pa)
+    /// and Poisson ratio `poisson_ratio`, damped to the coefficient of
+    /// restitution `restitution`, with Coulomb friction `friction`.
+    pub fn hertz_mindlin(
+        youngs_modulus: f64,
+        poisson_ratio: f64,
+        restitution: f64,
+        friction: f64,
+    ) -> Self {
+        ContactModel {
+            law: ContactLaw::HertzMindlin,
+            youngs_modulus,
+            poisson_ratio,
+            restitution,
+            // not read by the law; kept valid for what checks every model's fields
+            normal_stiffness: 1.0,
+            shear_stiffness: 1.0,
+            ..ContactModel::linear(1.0, 1.0, friction)
+        }
+    }
+
     /// Checks every field's range.
     pub fn validate(&self, field: &str) -> Result<()> {
+        if self.law == ContactLaw::HertzMindlin {
+            self.validate_hertz_mindlin(field)?;
+        }
         require_positive(&format!("{field}.normal_stiffness"), self.normal_stiffness)?;
         require_positive(&format!("{field}.shear_stiffness"), self.shear_stiffness)?;
         require_non_negative(&format!("{field}.friction"), self.friction)?;
@@ -73,6 +148,32 @@ impl ContactModel {
             &format!("{field}.rolling_damping_ratio"),
             self.rolling_damping_ratio,
         )?;
+        Ok(())
+    }
+
+    /// The ranges of Hertz-Mindlin's parameters.
+    fn validate_hertz_mindlin(&self, field: &str) -> Result<()> {
+        require_positive(&format!("{field}.youngs_modulus"), self.youngs_modulus)?;
+        let nu = self.poisson_ratio;
+        if !(nu > -1.0 && nu < 0.5) {
+            return Err(EngineError::invalid(
+                &format!("{field}.poisson_ratio"),
+                format!("{nu} is outside (-1, 0.5)"),
+            ));
+        }
+        let e = self.restitution;
+        if !(e > 0.0 && e <= 1.0) {
+            return Err(EngineError::invalid(
+                &format!("{field}.restitution"),
+                format!("{e} is outside (0, 1]"),
+            ));
+        }
+        if self.normal_damping_ratio != 0.0 || self.shear_damping_ratio != 0.0 {
+            return Err(EngineError::invalid(
+                &format!("{field}.normal_damping_ratio"),
+                "Hertz-Mindlin is damped by its restitution, not by damping ratios (give 0)",
+            ));
+        }
         Ok(())
     }
 }
@@ -155,11 +256,15 @@ impl MaterialTable {
         (self.undamped() && self.models.iter().all(|m| *m == first)).then_some(first)
     }
 
-    /// Whether no model of the table has a dashpot.
+    /// Whether no model of the table has a dashpot, and every one is linear
+    /// (the force kernels' dashpot-free loops, the four-pair lanes among them,
+    /// evaluate the linear law only; a Hertz-Mindlin pair runs the law itself).
     pub fn undamped(&self) -> bool {
-        self.models
-            .iter()
-            .all(|m| m.normal_damping_ratio == 0.0 && m.shear_damping_ratio == 0.0)
+        self.models.iter().all(|m| {
+            m.law == ContactLaw::Linear
+                && m.normal_damping_ratio == 0.0
+                && m.shear_damping_ratio == 0.0
+        })
     }
 
     /// Whether any model of the table has rolling resistance (`rolling_friction`
@@ -176,12 +281,24 @@ impl MaterialTable {
             .any(|m| m.rolling_friction != 0.0 && m.rolling_damping_ratio > 0.0)
     }
 
-    /// Largest normal or shear stiffness of any model involving group `g`.
-    pub fn max_stiffness_for_group(&self, g: u8) -> f64 {
+    /// Largest normal or shear stiffness of any model involving group `g`, for
+    /// a particle of radius `radius`: a Hertz-Mindlin model's tangent
+    /// stiffnesses at the largest overlap a run allows, `max_overlap_ratio`
+    /// of the radius, between two such particles
+    /// ([`crate::law::hertz::tangent_stiffness`]).
+    pub fn max_stiffness_for_group(&self, g: u8, radius: f64, max_overlap_ratio: f64) -> f64 {
         (0..MAX_GROUPS as u8)
             .map(|other| {
                 let m = self.get(g, other);
-                m.normal_stiffness.max(m.shear_stiffness)
+                match m.law {
+                    ContactLaw::Linear => m.normal_stiffness.max(m.shear_stiffness),
+                    ContactLaw::HertzMindlin => {
+                        let r_star = 0.5 * radius;
+                        let overlap = max_overlap_ratio * radius;
+                        let (kn, ks) = crate::law::hertz::tangent_stiffness(m, overlap, r_star);
+                        kn.max(ks)
+                    }
+                }
             })
             .fold(0.0, f64::max)
     }

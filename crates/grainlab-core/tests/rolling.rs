@@ -351,7 +351,11 @@ fn the_catch_up_gives_the_rolling_spring_its_increment() {
     assert!(before > 0.0 && w < 0.0, "{before} {w}");
     sim.catch_up_shear_springs();
     let after = sim.neighbors().wall_pairs.history.records[0][1];
-    let k_r = grainlab_core::law::rolling::RollingSpring::stiffness(sim.materials().get(0, 1), R);
+    let k_r = grainlab_core::law::rolling::RollingSpring::stiffness(
+        sim.materials().get(0, 1),
+        sim.materials().get(0, 1).normal_stiffness,
+        R,
+    );
     assert_eq!(after, before - k_r * w * dt);
     // a change of the motion now (the springs current) adds no second increment
     let v = sim.particles().velocity.clone();

@@ -66,7 +66,8 @@ impl ContactHistory {
         self.records[k].iter().any(|&v| v != 0.0) || self.sliding[k]
     }
 
-    /// Contact `k`'s shear spring, the tangential sub-model's value (N).
+    /// Contact `k`'s tangential sub-model value: the shear spring (N) of a
+    /// linear contact, the tangential displacement (m) of a Hertz-Mindlin one.
     pub fn shear_spring(&self, k: usize) -> f64 {
         self.records[k][TANGENTIAL_HISTORY.start]
     }

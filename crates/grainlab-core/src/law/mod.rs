@@ -32,9 +32,10 @@
 use std::ops::Range;
 
 use crate::diagnostics::ContactDissipation;
-use crate::material::ContactModel;
+use crate::material::{ContactLaw, ContactModel};
 
 pub mod damping;
+pub mod hertz;
 pub mod history;
 pub mod normal;
 pub mod rolling;
@@ -214,6 +215,12 @@ pub struct ContactForce {
     pub rolling_moment: f64,
     /// The rolling spring's elastic energy `M_r^2 / (2 k_r)` (J; 0 when off).
     pub rolling_energy: f64,
+    /// The normal force's tangent stiffness `dF_n / d(overlap)` at this overlap
+    /// (N/m): `kn` for the linear law, `2 E* a` for Hertz-Mindlin; the servo's
+    /// stiffness sum and the rolling stiffness rule read it.
+    pub normal_stiffness: f64,
+    /// The tangential spring's stiffness (N/m): `ks`, or Mindlin's `8 G* a`.
+    pub shear_stiffness: f64,
     /// Energy each dissipating sub-model took out of the system this step (J).
     pub dissipation: ContactDissipation,
 }
@@ -237,6 +244,9 @@ pub fn contact_law<const DASHPOTS: bool>(
     increment_time: f64,
     record: &mut ContactRecord,
 ) -> ContactForce {
+    if model.law == ContactLaw::HertzMindlin {
+        return hertz::contact_law(model, kinematics, dt, increment_time, record);
+    }
     let mut dissipation = ContactDissipation::default();
     let elastic_normal =
         Normal::elastic_force(model, kinematics.overlap, &mut record[NORMAL_HISTORY]);
@@ -269,6 +279,8 @@ pub fn contact_law<const DASHPOTS: bool>(
         rolling_spring: 0.0,
         rolling_moment: 0.0,
         rolling_energy: 0.0,
+        normal_stiffness: model.normal_stiffness,
+        shear_stiffness: model.shear_stiffness,
         dissipation,
     };
     Rolling::apply(
@@ -282,19 +294,43 @@ pub fn contact_law<const DASHPOTS: bool>(
     force
 }
 
-/// Elastic energy stored in a contact with normal force `normal` and shear spring `shear` (J).
+/// The tangent stiffnesses `(k_n, k_s)` (N/m) of `model`'s law at `overlap`
+/// (m) between bodies of effective radius `r_star` (m): `(kn, ks)` for the
+/// linear law, `(2 E* a, 8 G* a)` for Hertz-Mindlin. The time step asks it.
+#[inline]
+pub fn tangent_stiffness(model: &ContactModel, overlap: f64, r_star: f64) -> (f64, f64) {
+    match model.law {
+        ContactLaw::Linear => (model.normal_stiffness, model.shear_stiffness),
+        ContactLaw::HertzMindlin => hertz::tangent_stiffness(model, overlap, r_star),
+    }
+}
+
+/// Elastic energy stored in a linear contact with normal force `normal` and
+/// shear spring `shear` (J).
 #[inline(always)]
 pub fn elastic_energy(model: &ContactModel, normal: f64, shear: f64) -> f64 {
     0.5 * normal * normal / model.normal_stiffness + 0.5 * shear * shear / model.shear_stiffness
 }
 
 impl ContactForce {
-    /// Elastic energy stored in the contact (J): [`elastic_energy`] plus the
-    /// rolling spring's, added only when there is one (so that a contact
+    /// Elastic energy of the law's normal and tangential springs (J), without
+    /// the rolling spring's: [`elastic_energy`] for the linear law,
+    /// [`hertz::stored_energy`] for Hertz-Mindlin.
+    #[inline(always)]
+    pub fn spring_energy(&self, model: &ContactModel) -> f64 {
+        match model.law {
+            ContactLaw::Linear => elastic_energy(model, self.elastic_normal, self.shear_spring),
+            ContactLaw::HertzMindlin => hertz::stored_energy(self),
+        }
+    }
+
+    /// Elastic energy stored in the contact (J): the law's springs
+    /// ([`elastic_energy`] for the linear law, [`hertz::stored_energy`]) plus
+    /// the rolling spring's, added only when there is one (so that a contact
     /// without rolling resistance keeps its bits).
     #[inline(always)]
     pub fn stored_energy(&self, model: &ContactModel) -> f64 {
-        let e = elastic_energy(model, self.elastic_normal, self.shear_spring);
+        let e = self.spring_energy(model);
         if self.rolling_energy != 0.0 {
             e + self.rolling_energy
         } else {
@@ -558,7 +594,10 @@ mod tests {
         let r_star = rolling::RollingSpring::effective_radius(&k);
         assert_eq!(r_star, 0.75);
         let k_r = 2.25 * 1.0e6 * 0.2 * 0.2 * 0.75 * 0.75;
-        assert_eq!(rolling::RollingSpring::stiffness(&m, r_star), k_r);
+        assert_eq!(
+            rolling::RollingSpring::stiffness(&m, m.normal_stiffness, r_star),
+            k_r
+        );
         let mut record = [0.0; HISTORY_WIDTH];
         let dt = 1.0e-7; // k_r dtheta = 5.06e-3 N m, below the cap 0.3 N m
         let f = contact_law::<true>(&m, &k, dt, dt, &mut record);

@@ -46,14 +46,15 @@ impl RollingSpring {
     }
 
     /// The rolling stiffness `k_r` (N m/rad) of `model` at a contact of
-    /// effective radius `r_star`: the given one, or the rule `2.25 k_n mu_r^2 R*^2`.
+    /// effective radius `r_star` and normal tangent stiffness `normal_stiffness`
+    /// (the law's `k_n`): the given one, or the rule `2.25 k_n mu_r^2 R*^2`.
     #[inline(always)]
-    pub fn stiffness(model: &ContactModel, r_star: f64) -> f64 {
+    pub fn stiffness(model: &ContactModel, normal_stiffness: f64, r_star: f64) -> f64 {
         if model.rolling_stiffness > 0.0 {
             model.rolling_stiffness
         } else {
             let mu_r = model.rolling_friction;
-            2.25 * model.normal_stiffness * mu_r * mu_r * r_star * r_star
+            2.25 * normal_stiffness * mu_r * mu_r * r_star * r_star
         }
     }
 
@@ -82,7 +83,7 @@ impl RollingModel for RollingSpring {
             return;
         }
         let r_star = Self::effective_radius(kinematics);
-        let k_r = Self::stiffness(model, r_star);
+        let k_r = Self::stiffness(model, force.normal_stiffness, r_star);
         let w = kinematics.rolling_velocity;
         let spring = &mut history[0];
         let trial = *spring - k_r * w * increment_time;

@@ -32,6 +32,8 @@ pub(crate) struct WallSlot {
     /// Elastic energy (J) and force magnitude (N), measured steps only.
     pub elastic: f64,
     pub force_norm: f64,
+    /// The contact's normal tangent stiffness (N/m), for the wall's stiffness sum.
+    pub stiffness: f64,
     /// The overlap exceeds the allowed fraction of the radius.
     pub overlap_violation: bool,
     /// Whether the pair touched (a pair in the list may be apart).

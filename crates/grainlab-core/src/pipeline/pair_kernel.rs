@@ -7,10 +7,8 @@ use crate::cell::PeriodicCell;
 use crate::contact::ContactGeometry;
 use crate::diagnostics::ContactDissipation;
 use crate::law::history::{forget, HistoryRun};
-use crate::law::{
-    contact_law, elastic_energy, ContactForce, ContactKinematics, ContactRecord, HISTORY_WIDTH,
-};
-use crate::material::{ContactModel, MaterialTable};
+use crate::law::{contact_law, ContactForce, ContactKinematics, ContactRecord, HISTORY_WIDTH};
+use crate::material::{ContactLaw, ContactModel, MaterialTable};
 use crate::parallel::DisjointWriter;
 use crate::state::ParticleMotion;
 use crate::vec2::{add, dot, mat_vec, perp, scale, sub, Mat2, Vec2};
@@ -614,13 +612,16 @@ impl PairKernel<'_> {
         );
         let vt = dot(dv, t) - (wi * ri + wj * rj);
         let model = self.model_of::<SINGLE>(fixed, columns, k);
-        let reduced_mass =
-            if DASHPOTS && (model.normal_damping_ratio > 0.0 || model.shear_damping_ratio > 0.0) {
-                let (mi, mj) = (self.mass[i], self.mass[j]);
-                mi * mj / (mi + mj)
-            } else {
-                0.0
-            };
+        let reduced_mass = if DASHPOTS
+            && (model.normal_damping_ratio > 0.0
+                || model.shear_damping_ratio > 0.0
+                || model.law == ContactLaw::HertzMindlin)
+        {
+            let (mi, mj) = (self.mass[i], self.mass[j]);
+            mi * mj / (mi + mj)
+        } else {
+            0.0
+        };
         let kinematics = ContactKinematics {
             overlap,
             normal_velocity: vn,
@@ -682,8 +683,8 @@ impl PairKernel<'_> {
         tally.dissipation.add(&c.dissipation);
         tally.overlap_violation |= p.overlap > self.max_overlap_ratio * p.ri.min(p.rj);
         if MEASURE {
-            let spring = c.shear_spring;
-            tally.elastic += elastic_energy(model, model.normal_stiffness * p.overlap, spring);
+            // the rolling spring's energy added apart, in this order (the lanes' bits)
+            tally.elastic += c.spring_energy(model);
             if c.rolling_energy != 0.0 {
                 tally.elastic += c.rolling_energy;
             }

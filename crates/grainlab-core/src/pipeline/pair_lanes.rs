@@ -410,6 +410,8 @@ impl PairKernel<'_> {
                     rolling_spring: rolling_spring[l],
                     rolling_moment: rolling_moment[l],
                     rolling_energy: rolling_energy[l],
+                    normal_stiffness: model.normal_stiffness,
+                    shear_stiffness: model.shear_stiffness,
                     dissipation: ContactDissipation::default(), // (not read by the record)
                 };
                 sink.record(k, overlap[l], [nx[l], ny[l]], &c);

@@ -15,6 +15,7 @@ use crate::error::{
     require_finite_points, require_finite_values, require_non_negative, require_positive,
     EngineError, Result,
 };
+use crate::law;
 use crate::law::rolling::RollingSpring;
 use crate::law::ContactForce;
 use crate::material::{ContactModel, MaterialTable};
@@ -26,7 +27,7 @@ use crate::wall::{Wall, WallControl};
 
 /// The first bytes of [`Simulation::to_bytes`]: the layout of the state that
 /// follows (bincode of [`Simulation`]); a new field makes a new tag.
-const STATE_TAG: &[u8; 8] = b"GLSTATE4";
+const STATE_TAG: &[u8; 8] = b"GLSTATE5";
 
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -919,7 +920,11 @@ impl Simulation {
     /// where `k_n,i`, `k_s,i` and `k_r,i` sum the normal, shear and rolling
     /// stiffnesses of particle `i`'s current contacts and bonds (one contact of
     /// its stiffest model when it has none; rolling only where a model has
-    /// rolling resistance).
+    /// rolling resistance). A contact's stiffnesses are its law's tangent ones
+    /// at its overlap ([`law::tangent_stiffness`]: `kn`, `ks` for the linear
+    /// law, `2 E* a`, `8 G* a` for Hertz-Mindlin, whose "stiffest contact" is
+    /// the one at the largest overlap a run allows, `max_overlap_ratio` of the
+    /// radius).
     pub fn critical_time_step(&mut self, safety: f64) -> Result<f64> {
         require_positive("safety", safety)?;
         self.ensure_neighbors()?;
@@ -935,15 +940,18 @@ impl Simulation {
                 add(p.position[j], self.image_offset(pairs.shift[k])),
                 p.position[i],
             );
-            if disk_disk(d, p.radius[i], p.radius[j]).overlap > 0.0 {
+            let overlap = disk_disk(d, p.radius[i], p.radius[j]).overlap;
+            if overlap > 0.0 {
                 let m = self.materials.by_index(pairs.model[k]);
+                let (ri, rj) = (p.radius[i], p.radius[j]);
+                let r_star = ri * rj / (ri + rj);
+                let (k_n, k_s) = law::tangent_stiffness(m, overlap, r_star);
                 for q in [i, j] {
-                    kn[q] += m.normal_stiffness;
-                    ks[q] += m.shear_stiffness;
+                    kn[q] += k_n;
+                    ks[q] += k_s;
                 }
                 if m.rolling_friction > 0.0 {
-                    let (ri, rj) = (p.radius[i], p.radius[j]);
-                    let k_r = RollingSpring::stiffness(m, ri * rj / (ri + rj));
+                    let k_r = RollingSpring::stiffness(m, k_n, r_star);
                     kr[i] += k_r;
                     kr[j] += k_r;
                 }
@@ -952,16 +960,16 @@ impl Simulation {
         let wp = &self.neighbors.wall_pairs;
         for k in 0..wp.wall.len() {
             let q = wp.particle[k] as usize;
-            if self.walls[wp.wall[k] as usize]
+            let overlap = self.walls[wp.wall[k] as usize]
                 .disk_contact(p.position[q], p.radius[q])
-                .overlap
-                > 0.0
-            {
+                .overlap;
+            if overlap > 0.0 {
                 let m = self.materials.by_index(wp.model[k]);
-                kn[q] += m.normal_stiffness;
-                ks[q] += m.shear_stiffness;
+                let (k_n, k_s) = law::tangent_stiffness(m, overlap, p.radius[q]);
+                kn[q] += k_n;
+                ks[q] += k_s;
                 if m.rolling_friction > 0.0 {
-                    kr[q] += RollingSpring::stiffness(m, p.radius[q]);
+                    kr[q] += RollingSpring::stiffness(m, k_n, p.radius[q]);
                 }
             }
         }
@@ -973,7 +981,11 @@ impl Simulation {
         }
         let mut dt = f64::INFINITY;
         for q in 0..n {
-            let fallback = self.materials.max_stiffness_for_group(p.group[q]);
+            let fallback = self.materials.max_stiffness_for_group(
+                p.group[q],
+                p.radius[q],
+                self.params.max_overlap_ratio,
+            );
             let kn_q = if kn[q] > 0.0 { kn[q] } else { fallback };
             let ks_q = if ks[q] > 0.0 { ks[q] } else { fallback };
             let r = p.radius[q];

@@ -432,6 +432,7 @@ impl Simulation {
                             force: add(scale(n, c.normal), scale(perp(n), c.shear)),
                             torque: c.torque_j,
                             dissipation: c.dissipation,
+                            stiffness: c.normal_stiffness,
                             overlap_violation: g.overlap > max_overlap_ratio * r,
                             active: true,
                             ..WallSlot::default()
@@ -556,6 +557,7 @@ impl Simulation {
                 WallSlot {
                     force: f,
                     dissipation: c.dissipation,
+                    stiffness: c.normal_stiffness,
                     overlap_violation: g.overlap > self.params.max_overlap_ratio * r,
                     elastic: if MEASURE { c.stored_energy(model) } else { 0.0 },
                     force_norm: if MEASURE {
@@ -568,7 +570,7 @@ impl Simulation {
             };
             wall.force = sub(wall.force, slot.force);
             wall.contact_count += 1;
-            wall.stiffness_sum += model.normal_stiffness;
+            wall.stiffness_sum += slot.stiffness;
             tally.dissipation.add(&slot.dissipation);
             tally.overlap_violation |= slot.overlap_violation;
             if MEASURE {
