@@ -54,6 +54,10 @@ class _ContactModel(TypedDict):
     rolling_stiffness: float
     rolling_damping_ratio: float
     enabled: bool
+    law: str
+    youngs_modulus: float
+    poisson_ratio: float
+    restitution: float
 
 class _Cell(TypedDict):
     origin: tuple[float, float]
@@ -188,6 +192,10 @@ class Engine:
         rolling_stiffness: float = 0.0,
         rolling_damping_ratio: float = 0.0,
         enabled: bool = True,
+        law: str = "linear",
+        youngs_modulus: float = 0.0,
+        poisson_ratio: float = 0.0,
+        restitution: float = 1.0,
     ) -> None: ...
     def contact_model(self, group_a: int, group_b: int) -> _ContactModel: ...
 

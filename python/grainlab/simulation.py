@@ -57,7 +57,8 @@ _STATE_MAGIC = b"GRAINLAB-ENGINE-STATE\n"
 
 @dataclass(frozen=True)
 class ContactModel:
-    """Linear contact law with Coulomb friction between two material groups.
+    """The contact law with Coulomb friction between two material groups: linear
+    (the default) or Hertz-Mindlin (``law="hertz_mindlin"``).
 
     ``normal_stiffness`` and ``shear_stiffness`` are *contact* stiffnesses kn, ks
     (N/m): ``Fn = kn * overlap``, ``dFs = -ks * ds`` (paper Eq. 2-4). The damping
@@ -70,7 +71,32 @@ class ContactModel:
     ``rolling_stiffness`` k_r (N m/rad), 0 for the rule
     ``2.25 kn mu_r^2 R*^2``; ``rolling_damping_ratio`` a fraction of
     ``2 sqrt(I_r k_r)`` acting below the cap.
+
+    Hertz-Mindlin (docs/contact-law.md, "Hertz-Mindlin"), as LAMMPS's ``pair
+    granular hertz/material E damping nu tangential mindlin`` computes it:
+    ``Fn = 4/3 E* sqrt(R*) overlap^(3/2)`` with ``E* = E / (2 (1 - nu^2))``,
+    Mindlin's tangential stiffness ``8 G* a`` (``a = sqrt(R* overlap)``,
+    ``G* = E / (4 (2 - nu) (1 + nu))``), a normal dashpot set from the
+    coefficient of restitution; the stiffnesses and damping ratios above are
+    then not read (give the damping ratios 0). :meth:`hertz_mindlin` makes one.
     """
+
+    @classmethod
+    def hertz_mindlin(
+        cls, youngs_modulus: float, poisson_ratio: float, restitution: float, friction: float, **rolling: float
+    ) -> ContactModel:
+        """Hertz-Mindlin between grains of Young's modulus ``youngs_modulus`` (Pa)
+        and Poisson ratio ``poisson_ratio``, damped to the coefficient of
+        restitution ``restitution``, with Coulomb friction ``friction``;
+        ``rolling`` takes the rolling resistance's fields.
+
+        >>> ContactModel.hertz_mindlin(70e9, 0.25, 0.5, 0.5).law
+        'hertz_mindlin'
+        """
+        return cls(
+            friction=friction, law="hertz_mindlin", youngs_modulus=youngs_modulus,
+            poisson_ratio=poisson_ratio, restitution=restitution, **rolling,  # type: ignore[arg-type]
+        )
 
     normal_stiffness: float = TABLE1_STIFFNESS_N_PER_M
     shear_stiffness: float = TABLE1_STIFFNESS_N_PER_M
@@ -82,6 +108,14 @@ class ContactModel:
     rolling_damping_ratio: float = 0.0
     enabled: bool = True
     """False: the two groups do not interact at all (they pass through each other)."""
+    law: str = "linear"
+    """The contact law: ``"linear"`` (the springs above) or ``"hertz_mindlin"``."""
+    youngs_modulus: float = 0.0
+    """Young's modulus E of the grains (Pa), read by Hertz-Mindlin only."""
+    poisson_ratio: float = 0.0
+    """Poisson ratio nu of the grains, in (-1, 0.5), read by Hertz-Mindlin only."""
+    restitution: float = 1.0
+    """Normal coefficient of restitution e in (0, 1] (1: elastic), read by Hertz-Mindlin only."""
 
 
 def _tangent(normal: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -773,6 +807,10 @@ class Simulation:
             float(model.rolling_stiffness),
             float(model.rolling_damping_ratio),
             bool(model.enabled),
+            str(model.law),
+            float(model.youngs_modulus),
+            float(model.poisson_ratio),
+            float(model.restitution),
         )
 
     def contact_model(self, group_a: int, group_b: int) -> ContactModel:

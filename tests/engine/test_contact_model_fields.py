@@ -18,6 +18,8 @@ from grainlab import ContactModel, Simulation, _core
 
 ROOT = Path(__file__).resolve().parents[2]
 GROUPS = ("group_a", "group_b")
+#: Hertz-Mindlin's fields, each a value of its own inside its range
+HERTZ_MINDLIN = {"youngs_modulus": 7.0e10, "poisson_ratio": 0.25, "restitution": 0.625}
 
 
 def rust_fields() -> list[str]:
@@ -35,9 +37,13 @@ def rust_defaults() -> dict[str, object]:
     assert linear is not None
     arguments = re.findall(r"(\w+): f64", linear.group(1))
     values: dict[str, object] = {}
+    laws = {"ContactLaw::Linear": "linear"}
     for name, value in re.findall(r"(\w+): ([^,\s]+),", linear.group(2)):
         if name not in arguments:
-            values[name] = value == "true" if value in ("true", "false") else float(value)
+            if value in laws:
+                values[name] = laws[value]
+            else:
+                values[name] = value == "true" if value in ("true", "false") else float(value)
     return values
 
 
@@ -101,9 +107,14 @@ def test_every_field_goes_to_the_engine_and_comes_back() -> None:
     fields = rust_fields()
     values: dict[str, object] = {}
     for k, f in enumerate(dataclasses.fields(ContactModel)):
-        values[f.name] = (
-            (not f.default) if isinstance(f.default, bool) else 1.0e6 * (k + 1) + 0.125 * k
-        )
+        if f.name == "law":  # a name, not a number: the law that is not the default
+            values[f.name] = "hertz_mindlin"
+        elif f.name in HERTZ_MINDLIN:  # values in its ranges, each its own
+            values[f.name] = HERTZ_MINDLIN[f.name]
+        elif f.name.endswith("damping_ratio") and f.name != "rolling_damping_ratio":
+            values[f.name] = 0.0  # Hertz-Mindlin is damped by its restitution
+        else:
+            values[f.name] = (not f.default) if isinstance(f.default, bool) else 1.0e6 * (k + 1) + 0.125 * k
     assert list(values) == fields
     model = ContactModel(**values)  # type: ignore[arg-type]
     sim = Simulation([[0.0, 0.0]], [1e-3], density=2.0e8, time_step=1e-6)

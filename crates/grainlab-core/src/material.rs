@@ -50,14 +50,6 @@ impl ContactLaw {
 /// `restitution`; `normal_stiffness` and `shear_stiffness` are then not read.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ContactModel {
-    /// The contact law of the pair.
-    pub law: ContactLaw,
-    /// Young's modulus E of the grains (Pa), Hertz-Mindlin only.
-    pub youngs_modulus: f64,
-    /// Poisson ratio nu of the grains, in (-1, 0.5); Hertz-Mindlin only.
-    pub poisson_ratio: f64,
-    /// Normal coefficient of restitution e in (0, 1]; Hertz-Mindlin only (1: elastic).
-    pub restitution: f64,
     /// Normal contact stiffness kn (N/m).
     pub normal_stiffness: f64,
     /// Shear contact stiffness ks (N/m).
@@ -80,16 +72,20 @@ pub struct ContactModel {
     /// Whether the two groups interact at all; `false` lets them pass through
     /// each other (e.g. the disks of a membrane chain, held together by bonds).
     pub enabled: bool,
+    /// The contact law of the pair.
+    pub law: ContactLaw,
+    /// Young's modulus E of the grains (Pa), Hertz-Mindlin only.
+    pub youngs_modulus: f64,
+    /// Poisson ratio nu of the grains, in (-1, 0.5); Hertz-Mindlin only.
+    pub poisson_ratio: f64,
+    /// Normal coefficient of restitution e in (0, 1]; Hertz-Mindlin only (1: elastic).
+    pub restitution: f64,
 }
 
 impl ContactModel {
     /// Linear spring model without viscous damping.
     pub fn linear(normal_stiffness: f64, shear_stiffness: f64, friction: f64) -> Self {
         ContactModel {
-            law: ContactLaw::Linear,
-            youngs_modulus: 0.0,
-            poisson_ratio: 0.0,
-            restitution: 1.0,
             normal_stiffness,
             shear_stiffness,
             friction,
@@ -99,6 +95,10 @@ impl ContactModel {
             rolling_stiffness: 0.0,
             rolling_damping_ratio: 0.0,
             enabled: true,
+            law: ContactLaw::Linear,
+            youngs_modulus: 0.0,
+            poisson_ratio: 0.0,
+            restitution: 1.0,
         }
     }
 

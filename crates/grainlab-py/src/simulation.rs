@@ -1,6 +1,7 @@
 //! `grainlab._core.Engine`: the engine's simulation, method for method.
 use grainlab_core::{
-    ContactModel, Particles, PeriodicCell, ServoControl, Simulation, Wall, WallControl, WallShape,
+    ContactLaw, ContactModel, Particles, PeriodicCell, ServoControl, Simulation, Wall, WallControl,
+    WallShape,
 };
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -171,7 +172,7 @@ impl Engine {
         self.sim.set_skin(skin).map_err(to_py_err)
     }
 
-    #[pyo3(signature = (group_a, group_b, normal_stiffness, shear_stiffness, friction, normal_damping_ratio, shear_damping_ratio, rolling_friction=0.0, rolling_stiffness=0.0, rolling_damping_ratio=0.0, enabled=true))]
+    #[pyo3(signature = (group_a, group_b, normal_stiffness, shear_stiffness, friction, normal_damping_ratio, shear_damping_ratio, rolling_friction=0.0, rolling_stiffness=0.0, rolling_damping_ratio=0.0, enabled=true, law="linear", youngs_modulus=0.0, poisson_ratio=0.0, restitution=1.0))]
     #[allow(clippy::too_many_arguments)]
     fn set_contact_model(
         &mut self,
@@ -186,7 +187,12 @@ impl Engine {
         rolling_stiffness: f64,
         rolling_damping_ratio: f64,
         enabled: bool,
+        law: &str,
+        youngs_modulus: f64,
+        poisson_ratio: f64,
+        restitution: f64,
     ) -> PyResult<()> {
+        let law = ContactLaw::from_name(law).map_err(to_py_err)?;
         let model = ContactModel {
             normal_stiffness,
             shear_stiffness,
@@ -197,6 +203,10 @@ impl Engine {
             rolling_stiffness,
             rolling_damping_ratio,
             enabled,
+            law,
+            youngs_modulus,
+            poisson_ratio,
+            restitution,
         };
         self.sim
             .set_contact_model(group_a, group_b, model)
@@ -228,6 +238,10 @@ impl Engine {
         d.set_item("rolling_stiffness", m.rolling_stiffness)?;
         d.set_item("rolling_damping_ratio", m.rolling_damping_ratio)?;
         d.set_item("enabled", m.enabled)?;
+        d.set_item("law", m.law.name())?;
+        d.set_item("youngs_modulus", m.youngs_modulus)?;
+        d.set_item("poisson_ratio", m.poisson_ratio)?;
+        d.set_item("restitution", m.restitution)?;
         Ok(d)
     }
 

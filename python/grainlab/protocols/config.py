@@ -134,6 +134,24 @@ SHARED_FIELDS: dict[str, Field] = {
         "number", 0.0, "normal and shear contact dashpots between grains, fraction of critical "
         "(0: none, the paper's law)", minimum=0.0
     ),
+    "material.contact_law": Field(
+        "choice", "linear",
+        "contact law between grains and at the platens: 'linear' (kn, ks: the paper's) or "
+        "'hertz_mindlin' (material.youngs_modulus, poisson_ratio, restitution)",
+        choices=("linear", "hertz_mindlin"),
+    ),
+    "material.youngs_modulus": Field(
+        "stress", 70.0e9, "Young's modulus E of the grains, read by hertz_mindlin (quartz: about 70 GPa)",
+        **_POSITIVE,
+    ),
+    "material.poisson_ratio": Field(
+        "number", 0.25, "Poisson ratio of the grains, read by hertz_mindlin",
+        minimum=-1.0, maximum=0.5, exclusive_minimum=True, exclusive_maximum=True,
+    ),
+    "material.restitution": Field(
+        "number", 0.5, "normal coefficient of restitution of hertz_mindlin's dashpot (1: elastic)",
+        minimum=0.0, maximum=1.0, exclusive_minimum=True,
+    ),
     "material.density": Field("density", paper.DENSITY_KG_PER_M3, "scaled particle density (Table 1: 2e8 kg/m^3)", **_POSITIVE),
     "material.limiting_contact_pressure": Field(
         "stress", paper.LIMITING_CONTACT_PRESSURE_PA, "p_y of the density scaling factor, paper Eq. 16 (Table 1: 150 MPa)", **_POSITIVE
@@ -448,8 +466,14 @@ def _grading_curve(v: dict[str, Any], given: AbstractSet[str]) -> None:
 
 def check_sample(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
     """The checks of :data:`SHARED_FIELDS` that span several keys (the grading, the
-    sample's size against its grains); a 'curve' grading sets ``sample.d_min/d_max``."""
+    sample's size against its grains, Hertz-Mindlin without contact dashpots); a
+    'curve' grading sets ``sample.d_min/d_max``."""
     _grading_curve(v, given)
+    if v["material.contact_law"] == "hertz_mindlin" and v["material.contact_damping"] > 0:
+        raise ConfigError(
+            "material.contact_damping: hertz_mindlin is damped by material.restitution, "
+            "not by contact dashpots (give 0)"
+        )
     if v["sample.d_min"] > v["sample.d_max"]:
         raise ConfigError(
             f"sample.d_min: {v['sample.d_min']:g} m exceeds sample.d_max {v['sample.d_max']:g} m"

@@ -146,20 +146,32 @@ def damped_time_step_factor(config: Config) -> float:
     return math.sqrt(1.0 + z * z) - z
 
 
+def contact_law(config: Config, friction: float) -> ContactModel:
+    """The contact law of ``material.contact_law`` at Coulomb friction ``friction``:
+    the linear springs ``material.normal_stiffness``/``shear_stiffness``, or
+    Hertz-Mindlin from ``material.youngs_modulus``, ``poisson_ratio`` and
+    ``restitution`` (docs/contact-law.md). The sample's radius expansion and the
+    membrane's disks keep the linear springs: the first is geometry, the second a
+    numerical boundary."""
+    if config["material.contact_law"] == "hertz_mindlin":
+        return ContactModel.hertz_mindlin(
+            float(config["material.youngs_modulus"]), float(config["material.poisson_ratio"]),
+            float(config["material.restitution"]), float(friction),
+        )
+    return ContactModel(config["material.normal_stiffness"], config["material.shear_stiffness"], friction)
+
+
 def grain_model(config: Config) -> ContactModel:
     """The grains' contact law: Table 1's, with the rolling resistance and the contact
     dashpots of ``config`` (the platens' contacts have no dashpots: a dashpot's force
     on a moving servo wall would feed back into its control)."""
     damping = float(config["material.contact_damping"])
-    return replace(_with_rolling(config, ContactModel(
-        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.friction"]
-    )), normal_damping_ratio=damping, shear_damping_ratio=damping)
+    model = _with_rolling(config, contact_law(config, config["material.friction"]))
+    return replace(model, normal_damping_ratio=damping, shear_damping_ratio=damping)
 
 
 def platen_model(config: Config) -> ContactModel:
-    return _with_rolling(config, ContactModel(
-        config["material.normal_stiffness"], config["material.shear_stiffness"], config["material.platen_friction"]
-    ))
+    return _with_rolling(config, contact_law(config, config["material.platen_friction"]))
 
 
 def generate(config: Config, threads: int, progress: bool, state: type[R], phase: str,
@@ -212,9 +224,7 @@ def consolidate(
     """Servo-controls the box to the confining pressure until equilibrium;
     ``on_chunk(state, steps)`` after every chunk (``benchmarks/consolidation.py``)."""
     start = time.perf_counter()
-    consolidation_model = ContactModel(
-        config["material.normal_stiffness"], config["material.shear_stiffness"], config["consolidation.friction"]
-    )
+    consolidation_model = contact_law(config, config["consolidation.friction"])
     sim.set_contact_model(0, 0, consolidation_model)
     sim.set_contact_model(0, 1, platen_model(config))
     sim.local_damping = config["material.local_damping"]

@@ -195,8 +195,7 @@ pub struct ContactKinematics {
 /// What the contact law returns for one contact in one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactForce {
-    /// Normal force on `j` along `n` (N), dashpot included: >= 0 for the linear
-    /// law; Hertz-Mindlin's dashpot may pull a little as a contact opens.
+    /// Normal force on `j` along `n` (N), >= 0 for unbonded contacts, dashpot included.
     pub normal: f64,
     /// Elastic normal force `kn * overlap` (N), which the Coulomb cap refers to.
     pub elastic_normal: f64,
