@@ -171,7 +171,11 @@ def grain_model(config: Config) -> ContactModel:
 
 
 def platen_model(config: Config) -> ContactModel:
-    return _with_rolling(config, contact_law(config, config["material.platen_friction"]))
+    """The grains' law at the platens (and the box's walls), without a dashpot
+    (Hertz-Mindlin's restitution 1): a dashpot's force on a servo wall follows the
+    wall's own velocity and feeds back into its control, which then never settles."""
+    model = contact_law(config, config["material.platen_friction"])
+    return _with_rolling(config, replace(model, restitution=1.0))
 
 
 def generate(config: Config, threads: int, progress: bool, state: type[R], phase: str,
