@@ -555,8 +555,9 @@ def _cell_of_snapshot(cell: PeriodicCell | None) -> dict[str, Any]:
 
 
 class Simulation:
-    """A 2D disk DEM simulation (linear contacts with shear history and Coulomb
-    friction, PFC local damping, leapfrog integration) run by the Rust engine.
+    """A 2D disk DEM simulation (contacts with shear history and Coulomb friction,
+    linear or Hertz-Mindlin per pair of material groups (:class:`ContactModel`),
+    PFC local damping, leapfrog integration) run by the Rust engine.
 
     Parameters
     ----------
