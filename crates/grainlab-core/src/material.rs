@@ -182,15 +182,47 @@ impl ContactModel {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct MaterialTable {
     models: Vec<ContactModel>,
+    /// What the force kernels ask of the whole table at every step, kept with
+    /// it (a scan of every pair's model each step cost the step a few percent).
+    summary: TableSummary,
+}
+
+/// The table's answers to the force kernels' questions, made anew at every change.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+struct TableSummary {
+    single_undamped_model: Option<ContactModel>,
+    undamped: bool,
+    rolling: bool,
+    rolling_damped: bool,
+}
+
+impl TableSummary {
+    fn of(models: &[ContactModel]) -> Self {
+        let undamped = models.iter().all(|m| {
+            m.law == ContactLaw::Linear
+                && m.normal_damping_ratio == 0.0
+                && m.shear_damping_ratio == 0.0
+        });
+        let first = models.first().copied();
+        let single = first.filter(|f| undamped && models.iter().all(|m| m == f));
+        TableSummary {
+            single_undamped_model: single,
+            undamped,
+            rolling: models.iter().any(|m| m.rolling_friction != 0.0),
+            rolling_damped: models
+                .iter()
+                .any(|m| m.rolling_friction != 0.0 && m.rolling_damping_ratio > 0.0),
+        }
+    }
 }
 
 impl MaterialTable {
     /// Every pair of groups uses `model`.
     pub fn uniform(model: ContactModel) -> Result<Self> {
         model.validate("contact_model")?;
-        Ok(MaterialTable {
-            models: vec![model; MAX_GROUPS * MAX_GROUPS],
-        })
+        let models = vec![model; MAX_GROUPS * MAX_GROUPS];
+        let summary = TableSummary::of(&models);
+        Ok(MaterialTable { models, summary })
     }
 
     /// Checks that `a` and `b` name material groups.
@@ -212,6 +244,7 @@ impl MaterialTable {
         model.validate("contact_model")?;
         self.models[a * MAX_GROUPS + b] = model;
         self.models[b * MAX_GROUPS + a] = model;
+        self.summary = TableSummary::of(&self.models);
         Ok(())
     }
 
@@ -252,33 +285,26 @@ impl MaterialTable {
     /// dashpot: the force kernels then keep it in registers and skip the
     /// dashpot terms (same results, fewer instructions).
     pub fn single_undamped_model(&self) -> Option<ContactModel> {
-        let first = *self.models.first()?;
-        (self.undamped() && self.models.iter().all(|m| *m == first)).then_some(first)
+        self.summary.single_undamped_model
     }
 
     /// Whether no model of the table has a dashpot, and every one is linear
     /// (the force kernels' dashpot-free loops, the four-pair lanes among them,
     /// evaluate the linear law only; a Hertz-Mindlin pair runs the law itself).
     pub fn undamped(&self) -> bool {
-        self.models.iter().all(|m| {
-            m.law == ContactLaw::Linear
-                && m.normal_damping_ratio == 0.0
-                && m.shear_damping_ratio == 0.0
-        })
+        self.summary.undamped
     }
 
     /// Whether any model of the table has rolling resistance (`rolling_friction`
     /// above 0): the four-pair lanes then evaluate the rolling law too.
     pub fn rolling(&self) -> bool {
-        self.models.iter().any(|m| m.rolling_friction != 0.0)
+        self.summary.rolling
     }
 
     /// Whether any model with rolling resistance has a rolling dashpot: the
     /// four-pair lanes then gather the masses and inertias it reads.
     pub fn rolling_damped(&self) -> bool {
-        self.models
-            .iter()
-            .any(|m| m.rolling_friction != 0.0 && m.rolling_damping_ratio > 0.0)
+        self.summary.rolling_damped
     }
 
     /// Largest normal or shear stiffness of any model involving group `g`, for

@@ -1,13 +1,18 @@
-//! The contact law, split into sub-models as LAMMPS GRANULAR splits it:
-//! **normal** ([`normal::LinearSpring`]: `kn * overlap`), **damping**
+//! The contact laws, chosen per pair of material groups
+//! ([`crate::material::ContactLaw`]): the linear law and Hertz-Mindlin
+//! ([`hertz`]). The linear law is split into sub-models as LAMMPS GRANULAR
+//! splits it: **normal** ([`normal::LinearSpring`]: `kn * overlap`), **damping**
 //! ([`damping::ViscousDashpots`]: the optional normal and shear dashpots),
 //! **tangential** ([`tangential::ShearSpring`]: the incremental shear spring
 //! with its Coulomb cap, paper Eq. 2-4) and **rolling** ([`rolling::RollingSpring`]:
-//! the elastic-plastic rolling spring, off unless a model has `rolling_friction`). [`contact_law`] runs them in that order for one contact and
+//! the elastic-plastic rolling spring, off unless a model has `rolling_friction`,
+//! Hertz-Mindlin's too). [`contact_law`] runs them in that order for one linear
+//! contact (and hands a Hertz-Mindlin one to [`hertz::contact_law`]) and
 //! returns its forces, its torques on both bodies and each sub-model's
-//! dissipation; the pair kernel, its AVX2 lanes (checked against it bit for
-//! bit, rolling resistance included), the wall contacts, the springs' catch-up and the contact queries all
-//! call it.
+//! dissipation; the pair kernel, the wall contacts, the springs' catch-up and
+//! the contact queries call it. The AVX2 lanes (`pipeline/pair_lanes.rs`,
+//! `law_by_four`) write the linear law's operations again, four pairs at a time,
+//! and their tests hold them to its bits, rolling resistance included.
 //!
 //! Each sub-model declares the history it carries per contact
 //! ([`SubModel::HISTORY`] values); one contact's history is one

@@ -4,7 +4,7 @@
 //!    missed (wraps particles into the periodic cell, carries contact history over).
 //! 2. **Reset**: follower loads of the pressure chains at the current positions;
 //!    resultant = external force + gravity + follower load, per stripe of particles.
-//! 3. **Particle contacts**: linear law with shear history and Coulomb cap,
+//! 3. **Particle contacts**: each pair's contact law (linear or Hertz-Mindlin, `law/`),
 //!    stripes in parallel, then the cross-stripe pairs. The shear increment is the
 //!    displacement since the last force evaluation: none on a step that starts
 //!    from full-step velocities (see [`Simulation::catch_up_shear_springs`]).

@@ -82,6 +82,7 @@ unsafe fn slid_lanes(flags: *const bool) -> __m256d {
 }
 
 impl PairKernel<'_> {
+    // hot kernel: every undamped pair of every step, four at a time; split, its registers would spill across calls
     /// [`PairKernel::pairs`] without normal and shear dashpots, four pairs at
     /// a time and the rest one at a time; `ROLLING` when some model has
     /// rolling resistance ([`PairKernel::rolling`]: without it the rolling law
@@ -576,6 +577,7 @@ pub(super) struct FourLaws {
     pub(super) rolling_power: __m256d,
 }
 
+// hot kernel: the law of four pairs in AVX2 registers, inlined into the pair loop; split, the lanes would go through memory
 /// The contact law of four pairs without normal and shear dashpots, lane by
 /// lane with the scalar operations of [`crate::law::contact_law`] in their
 /// order: the normal spring, the shear spring's increment and Coulomb cap
