@@ -17,6 +17,7 @@ from grainlab._html import (
     figure,
     figures,
     fmt,
+    number,
     page,
     paragraph,
     section,
@@ -53,10 +54,6 @@ def _details(summary_text: str, body: Markup) -> Markup:
 def _header(title: str, lines: list[Any]) -> Markup:
     body = "".join(f"<p>{escape(line)}</p>" for line in lines)
     return Markup(f"<h1>{escape(title)}</h1>{body}")
-
-
-def _num(x: Any) -> float:
-    return float(x) if isinstance(x, int | float) and not isinstance(x, bool) else math.nan
 
 
 def _footer() -> str:
@@ -165,13 +162,13 @@ def _fabric_states(r: BiaxialReport) -> Markup:
             (
                 role,
                 s.get("snapshot", ""),
-                fmt(_num(s.get(AXIAL_STRAIN)), percent=True),
-                fmt(_num(s.get("a")), 3),
-                fmt(_num(s.get("theta_a_deg")), 3),
-                fmt(_num(s.get("a_n")), 3),
-                fmt(_num(s.get("theta_n_deg")), 3),
-                fmt(_num(s.get("mean_lambda")), 3),
-                fmt(_num(s.get("coordination_number")), 3),
+                fmt(number(s.get(AXIAL_STRAIN)), percent=True),
+                fmt(number(s.get("a")), 3),
+                fmt(number(s.get("theta_a_deg")), 3),
+                fmt(number(s.get("a_n")), 3),
+                fmt(number(s.get("theta_n_deg")), 3),
+                fmt(number(s.get("mean_lambda")), 3),
+                fmt(number(s.get("coordination_number")), 3),
             )
         )
     if not rows:
@@ -207,8 +204,8 @@ def render_biaxial(r: BiaxialReport) -> str:
     glance = _glance(
         [
             ("grains", fmt(r.n_grains)),
-            ("porosity at the start of shearing", fmt(_num(s.get("porosity_initial")), 3)),
-            ("initial coordination number Z", fmt(_num(s.get("coordination_number_initial")), 3)),
+            ("porosity at the start of shearing", fmt(number(s.get("porosity_initial")), 3)),
+            ("initial coordination number Z", fmt(number(s.get("coordination_number_initial")), 3)),
             ("peak stress ratio σ₁/σ₃", fmt(r.peak_ratio, 3)),
             ("axial strain at the peak", fmt(r.peak_strain, percent=True)),
             ("friction angle φ (peak)", _deg(r.phi)),
@@ -259,13 +256,13 @@ def render_biaxial(r: BiaxialReport) -> str:
          f"{fmt(1e3 * float(d.min()), 3)} to {fmt(1e3 * float(d.max()), 3)} mm, mean {fmt(1e3 * float(d.mean()), 3)} mm"),
         ("requested grading", r.grading_name),
         ("porosity after generation, nominal / overlap-corrected",
-         f"{fmt(_num(s.get('porosity_generated')), 4)} / {fmt(_num(s.get('porosity_generated_overlap_corrected')), 4)}"),
-        ("stress locked in by the generation", fmt(_num(s.get("generation_stress_pa")) / 1e3, 4, unit="kPa")),
+         f"{fmt(number(s.get('porosity_generated')), 4)} / {fmt(number(s.get('porosity_generated_overlap_corrected')), 4)}"),
+        ("stress locked in by the generation", fmt(number(s.get("generation_stress_pa")) / 1e3, 4, unit="kPa")),
         ("porosity after consolidation (rigid box), nominal / overlap-corrected",
-         f"{fmt(_num(s.get('porosity_after_consolidation')), 4)} / "
-         f"{fmt(_num(s.get('porosity_after_consolidation_overlap_corrected')), 4)}"),
-        ("porosity at the start of shearing (membrane), nominal", fmt(_num(s.get("porosity_initial")), 4)),
-        ("coordination number Z at the start of shearing", fmt(_num(s.get("coordination_number_initial")), 4)),
+         f"{fmt(number(s.get('porosity_after_consolidation')), 4)} / "
+         f"{fmt(number(s.get('porosity_after_consolidation_overlap_corrected')), 4)}"),
+        ("porosity at the start of shearing (membrane), nominal", fmt(number(s.get("porosity_initial")), 4)),
+        ("coordination number Z at the start of shearing", fmt(number(s.get("coordination_number_initial")), 4)),
     ]
     ts = r.timeseries
     if "mechanical_coordination_number" in ts:
@@ -274,11 +271,11 @@ def render_biaxial(r: BiaxialReport) -> str:
              fmt(float(ts["mechanical_coordination_number"][0]), 4))
         )
     sample_items += [
-        ("strain rate", fmt(_num(s.get("strain_rate")), 4, unit="1/s")),
+        ("strain rate", fmt(number(s.get("strain_rate")), 4, unit="1/s")),
         ("inertial number (heaviest grain, damped) / mean diameter",
-         f"{fmt(_num(s.get('inertial_number')), 3)} / {fmt(_num(s.get('inertial_number_mean_diameter')), 3)}"),
-        ("density scaling factor I (Eq. 16 with p_y)", fmt(_num(s.get("density_scaling_factor")), 3)),
-        ("time step", fmt(_num(s.get("time_step_s")), 4, unit="s")),
+         f"{fmt(number(s.get('inertial_number')), 3)} / {fmt(number(s.get('inertial_number_mean_diameter')), 3)}"),
+        ("density scaling factor I (Eq. 16 with p_y)", fmt(number(s.get("density_scaling_factor")), 3)),
+        ("time step", fmt(number(s.get("time_step_s")), 4, unit="s")),
         ("records", fmt(len(ts[AXIAL_STRAIN]))),
         ("snapshots", ", ".join(res.snapshot_names)),
     ]
@@ -458,8 +455,8 @@ def render_study(r: StudyReport) -> str:
         [
             ("packings", fmt(len(r.rows))),
             ("statuses", ", ".join(f"{k} {v}" for k, v in r.statuses.items())),
-            ("Fig. 17 fit R² (all packings)", fmt(_num(fit.get("r2")), 3)),
-            ("campaign wall time", fmt(_num(s.get("campaign_wall_time_s")), 3, unit="s")),
+            ("Fig. 17 fit R² (all packings)", fmt(number(fit.get("r2")), 3)),
+            ("campaign wall time", fmt(number(s.get("campaign_wall_time_s")), 3, unit="s")),
         ]
     )
     sections = [section("glance", "At a glance", glance)]
@@ -508,8 +505,8 @@ def render_study(r: StudyReport) -> str:
     trends = s.get("trends") or {}
     if fit or trends:
         fit_rows = [("Fig. 17: λ = slope a + intercept (all packings)",
-                     f"slope {fmt(_num(fit.get('slope')), 4)}, intercept {fmt(_num(fit.get('intercept')), 4)}, "
-                     f"R² {fmt(_num(fit.get('r2')), 4)}, n = {fit.get('n', 'n/a')}")]
+                     f"slope {fmt(number(fit.get('slope')), 4)}, intercept {fmt(number(fit.get('intercept')), 4)}, "
+                     f"R² {fmt(number(fit.get('r2')), 4)}, n = {fit.get('n', 'n/a')}")]
         fit_rows += [(k.replace("_", " "), _trend(v)) for k, v in trends.items()]
         fig_parts.append(Markup("<h3>Fits</h3>"))
         fig_parts.append(definition_table(fit_rows))
@@ -522,8 +519,8 @@ def render_study(r: StudyReport) -> str:
         )
     )
     time_rows = [
-        ("campaign (all runs, figures, table)", fmt(_num(s.get("campaign_wall_time_s")), 4)),
-        ("sum of the runs' own wall times", fmt(_num(s.get("runs_wall_time_s_sum")), 4)),
+        ("campaign (all runs, figures, table)", fmt(number(s.get("campaign_wall_time_s")), 4)),
+        ("sum of the runs' own wall times", fmt(number(s.get("runs_wall_time_s_sum")), 4)),
     ]
     per_run = [
         (row.get("name") or f"{row.get('kind')}_{row.get('porosity_target')}", row.get("status", ""),
