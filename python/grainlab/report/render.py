@@ -26,6 +26,7 @@ from grainlab._html import (
 from grainlab.columns import AXIAL_STRAIN
 from grainlab.report.band import ACCEPTANCE
 from grainlab.report.biaxial import BiaxialReport
+from grainlab.report.run_page import footer
 from grainlab.report.study import StudyReport, param_unit
 
 __all__ = ["render_biaxial", "render_study"]
@@ -54,10 +55,6 @@ def _details(summary_text: str, body: Markup) -> Markup:
 def _header(title: str, lines: list[Any]) -> Markup:
     body = "".join(f"<p>{escape(line)}</p>" for line in lines)
     return Markup(f"<h1>{escape(title)}</h1>{body}")
-
-
-def _footer() -> str:
-    return f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, no network)."
 
 
 # ----------------------------------------------------------------------------- biaxial
@@ -181,12 +178,11 @@ def _fabric_states(r: BiaxialReport) -> Markup:
     )
 
 
-def render_biaxial(r: BiaxialReport) -> str:
-    """The biaxial report page."""
-    res, s = r.results, r.summary
-    figs = r.figures
+def _biaxial_header(r: BiaxialReport) -> Markup:
+    """The head of the page: the run, when it ran, this report, the folder."""
+    res = r.results
     finished = res.attrs.get("finished", "unknown")
-    header = _header(
+    return _header(
         f"grainlab biaxial test: {r.folder.resolve().name}",
         [
             f"Run by grainlab {res.grainlab_version}: started {res.created}, finished {finished}, status "
@@ -195,13 +191,18 @@ def render_biaxial(r: BiaxialReport) -> str:
             Markup(f"Folder: <code>{escape(str(r.folder.resolve()))}</code>"),
         ],
     )
+
+
+def _glance_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "At a glance" section: the run's headline numbers."""
+    s = r.summary
     band = r.band_end
     band_glance = (
         f"{fmt(band.inclination_deg, 3)} deg, {fmt(band.thickness_diameters, 3)} diameters"
         if band is not None and band.found
         else "not found"
     )
-    glance = _glance(
+    return section("glance", "At a glance", _glance(
         [
             ("grains", fmt(r.n_grains)),
             ("porosity at the start of shearing", fmt(number(s.get("porosity_initial")), 3)),
@@ -213,9 +214,11 @@ def render_biaxial(r: BiaxialReport) -> str:
             ("shear band (inclination, thickness)", band_glance),
             ("wall time", fmt(r.wall_total, 3, unit="s")),
         ]
-    )
-    sections = [section("glance", "At a glance", glance)]
+    ))
 
+
+def _rerun_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "How to rerun" section: the command, the configuration file, the report again."""
     rerun_parts: list[Any] = [
         paragraph("The same test again (keys equal to the defaults left out):"),
         code_block(r.rerun.command),
@@ -227,10 +230,13 @@ def render_biaxial(r: BiaxialReport) -> str:
         _details("config.toml (the resolved configuration)", code_block(r.rerun.toml)),
         paragraph(f"Rebuild this report: grainlab report {shlex.quote(str(r.folder.resolve()))}", "note"),
     ]
-    sections.append(section("rerun", "How to rerun", *rerun_parts))
+    return section("rerun", "How to rerun", *rerun_parts)
 
+
+def _config_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Resolved configuration" section: every key, those that differ from the defaults highlighted."""
     rows = [(c.key, c.shown, c.unit, c.default, c.paper, c.help) for c in r.config_rows]
-    sections.append(
+    return (
         section(
             "config",
             "Resolved configuration",
@@ -248,6 +254,10 @@ def render_biaxial(r: BiaxialReport) -> str:
         )
     )
 
+
+def _sample_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Sample" section: the grains, the porosities and Z, the rates, the grading curve."""
+    s, res = r.summary, r.results
     d = r.diameters
     sample_items = [
         ("grains", fmt(r.n_grains)),
@@ -287,7 +297,7 @@ def render_biaxial(r: BiaxialReport) -> str:
         r.grading_png,
         "drawn by the report",
     )
-    sections.append(
+    return (
         section(
             "sample",
             "Sample",
@@ -301,6 +311,10 @@ def render_biaxial(r: BiaxialReport) -> str:
         )
     )
 
+
+def _macro_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Macro curves" section: the stress ratio and the volumetric strain."""
+    figs = r.figures
     macro_fig = EmbeddedFigure(
         "macro",
         "Stress ratio and volumetric strain, with the peak and the dilation fit",
@@ -311,8 +325,12 @@ def render_biaxial(r: BiaxialReport) -> str:
     )
     macro_figs = [macro_fig] + [figs[k] for k in ("fig08_stress_ratio", "fig10_volumetric_strain", "fig19_stress_path")
                                 if k in figs]
-    sections.append(section("macro", "Macro curves", figures(macro_figs)))
+    return section("macro", "Macro curves", figures(macro_figs))
 
+
+def _fabric_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Fabric figures" section: the fabric at the snapshots and Figs. 6-14."""
+    figs = r.figures
     fabric_parts: list[Any] = [
         paragraph(f"Fabric numbers from {r.fabric_source}.", "note"),
         _fabric_states(r),
@@ -320,14 +338,17 @@ def render_biaxial(r: BiaxialReport) -> str:
     order = ("fig06_contact_normals", "fig07_normal_forces", "fig09_anisotropy", "fig18_coordination_number",
              "fig11_displacement", "fig12_stability_index", "fig13_contact_count", "fig14_mean_stability_index")
     fabric_parts.append(figures(figs[k] for k in order if k in figs))
-    sections.append(section("fabric", "Fabric figures (Figs. 6-14)", *fabric_parts))
+    return section("fabric", "Fabric figures (Figs. 6-14)", *fabric_parts)
 
+
+def _angle_formulas(r: BiaxialReport) -> Markup:
+    """How phi and psi are computed from this run's records, and the classical inclinations."""
     dl = r.dilation
 
     def pct(x: float) -> Markup:
         return escape(fmt(x, percent=True))
 
-    formulas = Markup(
+    return Markup(
         '<p class="formula">Friction angle at the peak record (row '
         f"{r.peak_row}, ε<sub>1</sub> = {pct(r.peak_strain)}, R = σ<sub>1</sub>/σ<sub>3</sub> = "
         f"{escape(fmt(r.peak_ratio, 4))}): sin φ = (σ<sub>1</sub> − σ<sub>3</sub>)/(σ<sub>1</sub> + "
@@ -341,6 +362,11 @@ def render_biaxial(r: BiaxialReport) -> str:
         '<p class="formula">Inclination to the σ<sub>3</sub> (horizontal) direction: Mohr–Coulomb '
         "45° + φ/2, Roscoe 45° + ψ/2, Arthur 45° + (φ + ψ)/4.</p>"
     )
+
+
+def _band_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Shear band and classical angles" section: the band, the formulas, the angles beside it."""
+    band = r.band_end
     band_parts: list[Any] = [
         paragraph(
             "The band is located by grainlab.analysis.ShearBand in the excess local shear strain of the grains "
@@ -357,7 +383,7 @@ def render_biaxial(r: BiaxialReport) -> str:
             "'grainlab report --redraw' recomputes them with the installed grainlab.",
             "note",
         ),
-        formulas,
+        _angle_formulas(r),
         _classical_table(r),
     ]
     if not (band is not None and band.found):
@@ -372,9 +398,12 @@ def render_biaxial(r: BiaxialReport) -> str:
         closest = r.angles.closest(math.radians(band.inclination_deg))
         if closest:
             band_parts.append(paragraph(f"The band's inclination is closest to the {closest} angle."))
-    sections.append(section("band", "Shear band and classical angles", *band_parts))
+    return section("band", "Shear band and classical angles", *band_parts)
 
-    sections.append(
+
+def _paper_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "The paper beside this run" section: its stated values and the claims on this run."""
+    return (
         section(
             "paper",
             "The paper beside this run",
@@ -387,6 +416,9 @@ def render_biaxial(r: BiaxialReport) -> str:
         )
     )
 
+
+def _time_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Wall time" section: each phase's share of the run."""
     total = r.wall_total
     time_rows = [
         (name, what, fmt(t, 4), fmt(t / total, percent=True) if total > 0 else "n/a") for name, what, t in r.wall_times
@@ -395,7 +427,7 @@ def render_biaxial(r: BiaxialReport) -> str:
     if other > 1e-3:
         time_rows.append(("other", "records, files", fmt(other, 3), fmt(other / total, percent=True)))
     time_rows.append(("total", "generation to the end of shearing, as recorded", fmt(total, 4), "100.00 %"))
-    sections.append(
+    return (
         section(
             "time",
             "Wall time",
@@ -412,13 +444,14 @@ def render_biaxial(r: BiaxialReport) -> str:
             ),
         )
     )
-    sections.append(section("notes", "Notes", _notes(r.notes)))
-    return page(
-        f"grainlab biaxial report: {r.folder.resolve().name}",
-        header,
-        sections,
-        _footer(),
-    )
+
+
+def render_biaxial(r: BiaxialReport) -> str:
+    """The biaxial report page: its sections in the page's order."""
+    sections = [_glance_section(r), _rerun_section(r), _config_section(r), _sample_section(r), _macro_section(r),
+                _fabric_section(r), _band_section(r), _paper_section(r), _time_section(r),
+                section("notes", "Notes", _notes(r.notes))]
+    return page(f"grainlab biaxial report: {r.folder.resolve().name}", _biaxial_header(r), sections, footer())
 
 
 # ----------------------------------------------------------------------------- study
@@ -540,5 +573,5 @@ def render_study(r: StudyReport) -> str:
         f"grainlab study report: {r.folder.resolve().name}",
         header,
         sections,
-        _footer(),
+        footer(),
     )
