@@ -473,6 +473,67 @@ def _trend(value: Any) -> str:
     return fmt(value, 4)
 
 
+def _study_table_section(r: StudyReport) -> tuple[str, str, Markup]:
+    """The "study.csv" section: one row per packing, free text below the table."""
+    # the free-text columns go below the table, one line per packing that has any,
+    # so that the table keeps one line per row
+    texts = [c for c in r.columns if c in ("note", "error")]
+    columns = [c for c in r.columns if c not in texts]
+    rows = [[_cell(c, row.get(c, "")) for c in columns] for row in r.rows]
+    numeric = [k for k, c in enumerate(columns) if c not in ("kind", "status", "name")]
+    remarks = [
+        (str(row.get("name", "")), c, str(row.get(c, "")))
+        for row in r.rows
+        for c in texts
+        if str(row.get(c, "")).strip()
+    ]
+    table_parts: list[Any] = [
+        paragraph("One row per packing, as written (numbers to 4 significant digits).", "note"),
+        table(columns, rows, numeric=numeric, css_class="wide"),
+    ]
+    if remarks:
+        table_parts.append(table(["packing", "column", "text"], remarks, cell_classes={2: "note"}))
+    return section("table", "study.csv", *table_parts)
+
+
+def _study_figures_section(r: StudyReport) -> tuple[str, str, Markup]:
+    """The "Figures 15-17 and fits" section."""
+    s = r.summary
+    fit = s.get("fig17_fit") or {}
+    fig_parts: list[Any] = [figures(r.figures.values())]
+    trends = s.get("trends") or {}
+    if fit or trends:
+        fit_rows = [("Fig. 17: λ = slope a + intercept (all packings)",
+                     f"slope {fmt(number(fit.get('slope')), 4)}, intercept {fmt(number(fit.get('intercept')), 4)}, "
+                     f"R² {fmt(number(fit.get('r2')), 4)}, n = {fit.get('n', 'n/a')}")]
+        fit_rows += [(k.replace("_", " "), _trend(v)) for k, v in trends.items()]
+        fig_parts.append(Markup("<h3>Fits</h3>"))
+        fig_parts.append(definition_table(fit_rows))
+    return section("figures", "Figures 15-17 and fits", *fig_parts)
+
+
+def _study_time_section(r: StudyReport) -> tuple[str, str, Markup]:
+    """The "Wall time" section: the campaign's and each run's."""
+    s = r.summary
+    time_rows = [
+        ("campaign (all runs, figures, table)", fmt(number(s.get("campaign_wall_time_s")), 4)),
+        ("sum of the runs' own wall times", fmt(number(s.get("runs_wall_time_s_sum")), 4)),
+    ]
+    per_run = [
+        (row.get("name") or f"{row.get('kind')}_{row.get('porosity_target')}", row.get("status", ""),
+         _cell("wall_time_s", row.get("wall_time_s", "")))
+        for row in r.rows
+    ]
+    return (
+        section(
+            "time",
+            "Wall time",
+            definition_table(time_rows),
+            table(["run", "status", "wall time (s)"], per_run, numeric=(2,)),
+        )
+    )
+
+
 def render_study(r: StudyReport) -> str:
     """The study report page."""
     s = r.summary
@@ -515,35 +576,8 @@ def render_study(r: StudyReport) -> str:
             table(["parameter", "value", "SI unit"], params, numeric=(1,)),
         )
     )
-    # the free-text columns go below the table, one line per packing that has any,
-    # so that the table keeps one line per row
-    texts = [c for c in r.columns if c in ("note", "error")]
-    columns = [c for c in r.columns if c not in texts]
-    rows = [[_cell(c, row.get(c, "")) for c in columns] for row in r.rows]
-    numeric = [k for k, c in enumerate(columns) if c not in ("kind", "status", "name")]
-    remarks = [
-        (str(row.get("name", "")), c, str(row.get(c, "")))
-        for row in r.rows
-        for c in texts
-        if str(row.get(c, "")).strip()
-    ]
-    table_parts: list[Any] = [
-        paragraph("One row per packing, as written (numbers to 4 significant digits).", "note"),
-        table(columns, rows, numeric=numeric, css_class="wide"),
-    ]
-    if remarks:
-        table_parts.append(table(["packing", "column", "text"], remarks, cell_classes={2: "note"}))
-    sections.append(section("table", "study.csv", *table_parts))
-    fig_parts: list[Any] = [figures(r.figures.values())]
-    trends = s.get("trends") or {}
-    if fit or trends:
-        fit_rows = [("Fig. 17: λ = slope a + intercept (all packings)",
-                     f"slope {fmt(number(fit.get('slope')), 4)}, intercept {fmt(number(fit.get('intercept')), 4)}, "
-                     f"R² {fmt(number(fit.get('r2')), 4)}, n = {fit.get('n', 'n/a')}")]
-        fit_rows += [(k.replace("_", " "), _trend(v)) for k, v in trends.items()]
-        fig_parts.append(Markup("<h3>Fits</h3>"))
-        fig_parts.append(definition_table(fit_rows))
-    sections.append(section("figures", "Figures 15-17 and fits", *fig_parts))
+    sections.append(_study_table_section(r))
+    sections.append(_study_figures_section(r))
     sections.append(
         section(
             "paper",
@@ -551,23 +585,7 @@ def render_study(r: StudyReport) -> str:
             table(["claim", "paper", "this study", "where in the paper"], r.claims, cell_classes={2: "note"}),
         )
     )
-    time_rows = [
-        ("campaign (all runs, figures, table)", fmt(number(s.get("campaign_wall_time_s")), 4)),
-        ("sum of the runs' own wall times", fmt(number(s.get("runs_wall_time_s_sum")), 4)),
-    ]
-    per_run = [
-        (row.get("name") or f"{row.get('kind')}_{row.get('porosity_target')}", row.get("status", ""),
-         _cell("wall_time_s", row.get("wall_time_s", "")))
-        for row in r.rows
-    ]
-    sections.append(
-        section(
-            "time",
-            "Wall time",
-            definition_table(time_rows),
-            table(["run", "status", "wall time (s)"], per_run, numeric=(2,)),
-        )
-    )
+    sections.append(_study_time_section(r))
     sections.append(section("notes", "Notes", _notes(r.notes)))
     return page(
         f"grainlab study report: {r.folder.resolve().name}",
