@@ -501,21 +501,16 @@ def gather_biaxial(
     return report
 
 
-def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float) -> BiaxialReport:
-    """:func:`gather_biaxial` but the claims."""
+def _draw_missing(folder: Path, results: Results, saved: dict[str, Any],
+                  redraw: bool) -> tuple[dict[str, Any] | None, str, list[str], list[str]]:
+    """The folder's figures missing (all with ``redraw``) drawn with the functions that
+    drew them with the run; ``(fabric numbers, where they come from, drawn, notes)``."""
     from grainlab.plot import biaxial_curves
     from grainlab.postprocess import FIGURES, fabric_figures, fabric_numbers
 
     ts = results.timeseries
-    summary = dict(results.summary)
-    saved = _read_summary_json(folder)
-    for key, value in saved.items():
-        summary.setdefault(key, value)
     notes: list[str] = []
     regenerated: list[str] = []
-    threads = summary.get("threads") if isinstance(summary.get("threads"), int) else None
-
-    # figures of the folder: draw the missing ones with the functions that drew them
     curves = CURVE_FIGURES + (("fig19_stress_path",) if is_constant_volume(results.config) else ())
     missing_curves = [n for n in curves if not is_usable_png(folder / f"{n}.png")]
     if redraw or missing_curves:
@@ -542,6 +537,29 @@ def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float
         fabric, fabric_source = None, "not available"
     if regenerated:
         notes.append("drawn by this report (missing from the folder or --redraw): " + ", ".join(regenerated))
+    return fabric, fabric_source, regenerated, notes
+
+
+def _wall_times(results: Results, summary: dict[str, Any]) -> tuple[list[tuple[str, str, float]], float]:
+    """Each phase's (name, what, wall time) and the run's total, s."""
+    phases = dict(results.phases) or dict(summary.get("wall_time_by_phase_s") or {})
+    wall = [(name, PHASES.get(name, ""), float(t)) for name, t in phases.items()]
+    total = number(summary.get("wall_time_s"))
+    if not math.isfinite(total):
+        total = float(sum(t for _, _, t in wall))
+    return wall, total
+
+
+def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float) -> BiaxialReport:
+    """:func:`gather_biaxial` but the claims."""
+    ts = results.timeseries
+    summary = dict(results.summary)
+    saved = _read_summary_json(folder)
+    for key, value in saved.items():
+        summary.setdefault(key, value)
+    threads = summary.get("threads") if isinstance(summary.get("threads"), int) else None
+
+    fabric, fabric_source, regenerated, notes = _draw_missing(folder, results, saved, redraw)
 
     # the macro numbers and the angles
     k = _peak_row(ts)
@@ -565,12 +583,7 @@ def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float
     n_membrane = int(summary.get("n_membrane_disks") or int((~grains).sum()))
     grading, grading_name = requested_grading(results.config)
 
-    # wall times
-    phases = dict(results.phases) or dict(summary.get("wall_time_by_phase_s") or {})
-    wall = [(name, PHASES.get(name, ""), float(t)) for name, t in phases.items()]
-    total = number(summary.get("wall_time_s"))
-    if not math.isfinite(total):
-        total = float(sum(t for _, _, t in wall))
+    wall, total = _wall_times(results, summary)
 
     figures: dict[str, EmbeddedFigure] = {}
     for key, title, caption in _figure_specs(fabric, float(eps[k])):
