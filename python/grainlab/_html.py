@@ -27,6 +27,7 @@ __all__ = [
     "figure",
     "figures",
     "fmt",
+    "number",
     "page",
     "paragraph",
     "section",
@@ -47,14 +48,28 @@ def escape(value: Any) -> Markup:
     return Markup(html.escape(str(value), quote=True))
 
 
-def fmt(value: Any, digits: int = 3, *, percent: bool = False, unit: str = "") -> str:
+def number(value: Any) -> float:
+    """``value`` as a float for arithmetic and :func:`fmt`: ints and floats as they
+    are, anything else (None, a flag, text) NaN, which :func:`fmt` shows as ``n/a``.
+
+    >>> number(3), number(0.5), number(None), number(True), number("x")
+    (3.0, 0.5, nan, nan, nan)
+    """
+    return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
+
+
+def fmt(value: Any, digits: int = 3, *, percent: bool = False, unit: str = "", trailing_zeros: bool = True) -> str:
     """A number for a table: ``digits`` significant digits, ``percent`` multiplies
     by 100 and appends ``%``; None and NaN give ``n/a``; other types ``str()``.
+    ``trailing_zeros=False`` writes a float as ``{:.{digits}g}`` (``4.6``,
+    ``1.4e+03``), the reproduction's Markdown tables' style.
 
     >>> fmt(4.601713), fmt(4.0), fmt(0.0145, percent=True), fmt(None), fmt(float("nan")), fmt(3518)
     ('4.60', '4.00', '1.45 %', 'n/a', 'n/a', '3518')
     >>> fmt(3.3261e-3, unit="1/s"), fmt(1395.8), fmt(1.4e6), fmt(True)
     ('0.00333 1/s', '1396', '1400000', 'yes')
+    >>> fmt(4.601713, trailing_zeros=False), fmt(4.0, trailing_zeros=False), fmt(1395.8, trailing_zeros=False)
+    ('4.6', '4', '1.4e+03')
     """
     if value is None:
         return "n/a"
@@ -67,6 +82,8 @@ def fmt(value: Any, digits: int = 3, *, percent: bool = False, unit: str = "") -
             return "n/a"
         if percent:
             text = f"{100.0 * value:.2f} %"
+        elif not trailing_zeros:
+            text = f"{value:.{digits}g}"
         elif 10.0**digits <= abs(value) < 1e9:
             text = f"{value:.0f}"  # 1396, not 1.40e+03
         else:

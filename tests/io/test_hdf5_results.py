@@ -462,3 +462,19 @@ def test_hdf5_reader_is_registered():
     from grainlab.io import READERS
 
     assert READERS["grainlab-hdf5"] is read_hdf5_snapshot
+
+
+def test_snapshot_strain_reads_the_record_then_the_name_then_gives_nan(tmp_path):
+    from grainlab.io.hdf5 import snapshot_strain
+
+    pos, rad = np.array([[0.0, 0.0], [3e-3, 0.0]]), np.array([1e-3, 1e-3])
+    with ResultsWriter(tmp_path / "run.h5", kind="biaxial") as out:
+        # recorded 0.01512 under the rounded name strain_0.0151: the record wins
+        out.write_snapshot(snapshot_name(0.01512), Snapshot.from_geometry(pos, rad, axial_strain=0.01512))
+        out.write_snapshot(snapshot_name(0.03), Snapshot.from_geometry(pos, rad))  # no record: the name's 0.03
+        out.write_snapshot(snapshot_name(0.3, prefix="gamma"), Snapshot.from_geometry(pos, rad))  # a shear strain
+        out.write_snapshot("initial", Snapshot.from_geometry(pos, rad))
+    strains = {info.name: snapshot_strain(info) for info in read_results(tmp_path / "run.h5").snapshots}
+    assert strains["strain_0.0151"] == 0.01512
+    assert strains["strain_0.0300"] == 0.03
+    assert np.isnan(strains["gamma_0.3000"]) and np.isnan(strains["initial"])

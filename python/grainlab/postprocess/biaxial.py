@@ -27,7 +27,6 @@ Stability index
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -39,7 +38,7 @@ from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
 from grainlab.analysis.peak import nearest_snapshot, peak_is_interior, peak_record
 from grainlab.analysis.stability import StabilityIndex
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
-from grainlab.io.hdf5 import Results, read_results
+from grainlab.io.hdf5 import Results, read_results, snapshot_strain
 from grainlab.io.results import json_safe
 from grainlab.postprocess.band import BandNumbers, BandSearch
 from grainlab.postprocess.products import RunProducts
@@ -64,8 +63,6 @@ REQUIRED_COLUMNS: dict[str, str] = {
     "force_anisotropy": "a_n in Fig. 9",
     "mean_stability_index": "Fig. 14",
 }
-
-_NAME_STRAIN = re.compile(r"strain_([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)$")
 
 
 class MissingColumnError(ValueError):
@@ -263,13 +260,6 @@ class RunAnalysis:
         return None
 
 
-def _snapshot_strain(info: Any) -> float:
-    if info.axial_strain is not None and math.isfinite(info.axial_strain):
-        return float(info.axial_strain)
-    m = _NAME_STRAIN.search(info.name)
-    return float(m.group(1)) if m else math.nan
-
-
 def _timeseries(results: Results) -> dict[str, NDArray[np.float64]]:
     ts = results.timeseries
     for column, purpose in REQUIRED_COLUMNS.items():
@@ -376,7 +366,7 @@ def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> 
             "inside the record; that record stands for the peak"
         )
 
-    strains = [_snapshot_strain(info) for info in results.snapshots]
+    strains = [snapshot_strain(info) for info in results.snapshots]
     k_snap = _select_peak(results, strains, eps_peak, peak_snapshot)
     if peak_snapshot is None and math.isfinite(strains[k_snap]):
         gap = abs(strains[k_snap] - eps_peak)

@@ -52,7 +52,7 @@ from grainlab.analysis.force_chains import ForceChains
 from grainlab.analysis.shear_band import Slab
 from grainlab.analysis.stability import StabilityIndex
 from grainlab.analysis.tessellation import LocalPorosity
-from grainlab.io.hdf5 import AnalysisItem, Results, read_results, write_analysis
+from grainlab.io.hdf5 import AnalysisItem, Results, read_results, snapshot_strain, write_analysis
 from grainlab.postprocess.band import (
     BandNumbers,
     BandSearch,
@@ -67,7 +67,7 @@ from grainlab.snapshot import Snapshot
 if TYPE_CHECKING:
     from grainlab.plot.workers import FigurePool
 
-__all__ = ["PRODUCTS", "LambdaField", "RunProducts", "snapshot_strain", "store_run_products"]
+__all__ = ["PRODUCTS", "LambdaField", "RunProducts", "store_run_products"]
 
 #: The products a run stores, with the version of the rule that makes each (module docstring).
 PRODUCTS: dict[str, int] = {
@@ -96,12 +96,6 @@ class LambdaField:
     stability_index: NDArray[np.float64]
     #: (N,) contacts of each particle counted by lambda.
     n_contacts: NDArray[np.int64]
-
-
-def snapshot_strain(info: Any) -> float:
-    """A snapshot's axial strain as its record gives it, NaN when it has none."""
-    value = getattr(info, "axial_strain", None)
-    return math.nan if value is None else float(value)
 
 
 # ------------------------------------------------------------------ items of the file

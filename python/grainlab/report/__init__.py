@@ -1,10 +1,12 @@
 """``report.html``: one self-contained page describing a results folder (docs/report.md).
 
-:func:`write_report` tells a biaxial run (``run.h5``) from a packing study
-(``study.csv``), gathers what the page shows (:mod:`.biaxial`, :mod:`.study`),
-renders it (:mod:`.render`, :mod:`.html`) and writes ``DIR/report.html``
-atomically. The page embeds its figures as PNG ``data:`` URIs and has no
-scripts, fonts or links to other hosts: it opens offline from ``file://``.
+:func:`write_report` tells a run (``run.h5``, its ``kind`` naming the test)
+from a packing study (``study.csv``), looks its page up in the registry
+(:mod:`.pages`: each test's declared :class:`~.run_page.ReportPage`),
+assembles it (:mod:`.run_page`; the biaxial test's and the study's own
+layout in :mod:`.render`) and writes ``DIR/report.html`` atomically. The
+page embeds its figures as PNG ``data:`` URIs and has no scripts, fonts or
+links to other hosts: it opens offline from ``file://``.
 
 Example
 -------
@@ -17,7 +19,6 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Literal
 
 from grainlab.io.results import write_text_atomic
 from grainlab.report.angles import (
@@ -49,22 +50,23 @@ __all__ = [
 #: Name of the report in a results folder.
 REPORT_FILE = "report.html"
 
-#: What a results folder holds: a run of a protocol (its results file's ``kind``) or a study.
-Kind = Literal["biaxial", "oedometer", "cyclic", "simple_shear", "study"]
-
 
 class ReportError(ValueError):
     """The folder cannot be reported on (the message says why and what would work)."""
 
 
-def detect_kind(folder: str | os.PathLike[str]) -> tuple[Path, Kind]:
+def detect_kind(folder: str | os.PathLike[str]) -> tuple[Path, str]:
     """``(folder, kind)`` of a results folder, or :class:`ReportError`.
 
     A run's folder holds a finished ``run.h5``, whose ``kind`` attribute names
-    its test (``"biaxial"``, ``"oedometer"``, ``"cyclic"``, ``"simple_shear"``); a study folder holds
-    ``study.csv``. A path to either file stands for its folder. Nothing is
-    read beyond the folder listing and that attribute, so this fails before any work.
+    its test, one with a page in :data:`grainlab.report.pages.PAGES`
+    (``"biaxial"``, ``"oedometer"``, ``"cyclic"``, ``"simple_shear"``); a
+    study folder holds ``study.csv`` (kind ``"study"``). A path to either file
+    stands for its folder. Nothing is read beyond the folder listing and that
+    attribute, so this fails before any work.
     """
+    from grainlab.report.pages import PAGES, STUDY
+
     path = Path(folder)
     if path.is_file() and path.name in ("run.h5", "study.csv"):
         path = path.parent
@@ -76,23 +78,18 @@ def detect_kind(folder: str | os.PathLike[str]) -> tuple[Path, Kind]:
         from grainlab.io.hdf5 import results_kind
 
         kind = results_kind(path / "run.h5") or "biaxial"
-        if kind == "biaxial":
-            return path, "biaxial"
-        if kind == "oedometer":
-            return path, "oedometer"
-        if kind == "cyclic":
-            return path, "cyclic"
-        if kind == "simple_shear":
-            return path, "simple_shear"
+        if kind in PAGES:
+            return path, kind
+        covered = ", ".join(p.name for p in PAGES.values())
         raise ReportError(f"{path}: a run of kind {kind!r}, which grainlab report does not cover "
-                          "(it covers biaxial, oedometer, cyclic and simple-shear runs and the packing study)")
+                          f"(it covers the runs of {covered} and the packing study)")
     if (path / "run.h5.partial").exists():
         raise ReportError(
             f"{path}: the run has not finished (only run.h5.partial); continue it with "
             f"grainlab run KIND --out {path} --resume (grainlab biaxial for a biaxial run), then make the report"
         )
     if (path / "study.csv").exists():
-        return path, "study"
+        return path, STUDY
     if (path / "sweep.csv").exists():
         biaxial = sorted(path.glob("runs/*/biaxial/run.h5"))
         hint = (f"report a run of the sweep, e.g. grainlab report {biaxial[0].parent}" if biaxial else
@@ -120,28 +117,9 @@ def write_report(
     ``folder/report.html``. Raises :class:`ReportError` (or the reader's
     ``ValueError``) before any work when the folder is neither kind.
     """
+    from grainlab.report.pages import PAGES, STUDY_PAGE
+
     path, kind = detect_kind(folder)
     target = Path(out) if out is not None else path / REPORT_FILE
-    if kind == "biaxial":
-        from grainlab.report.biaxial import gather_biaxial
-        from grainlab.report.render import render_biaxial
-
-        text = render_biaxial(gather_biaxial(path, redraw=redraw))
-    elif kind == "oedometer":
-        from grainlab.report.oedometer import gather_oedometer, render_oedometer
-
-        text = render_oedometer(gather_oedometer(path, redraw=redraw))
-    elif kind == "cyclic":
-        from grainlab.report.cyclic import gather_cyclic, render_cyclic
-
-        text = render_cyclic(gather_cyclic(path, redraw=redraw))
-    elif kind == "simple_shear":
-        from grainlab.report.simple_shear import gather_simple_shear, render_simple_shear
-
-        text = render_simple_shear(gather_simple_shear(path, redraw=redraw))
-    else:
-        from grainlab.report.render import render_study
-        from grainlab.report.study import gather_study
-
-        text = render_study(gather_study(path, redraw=redraw))
-    return write_text_atomic(target, text)
+    page = PAGES.get(kind, STUDY_PAGE)  # detect_kind gives a registered test's kind or the study's
+    return write_text_atomic(target, page.html(path, redraw=redraw))

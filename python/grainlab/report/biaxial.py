@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 import grainlab
-from grainlab._html import EmbeddedFigure, fmt, is_usable_png
+from grainlab._html import EmbeddedFigure, fmt, is_usable_png, number
 from grainlab._mapping import flatten_keys
 from grainlab.analysis.peak import peak_record
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
@@ -351,10 +351,6 @@ def _val(d: dict[str, Any] | None, *keys: str) -> Any:
     return d
 
 
-def _num(x: Any) -> float:
-    return float(x) if isinstance(x, int | float) and not isinstance(x, bool) else math.nan
-
-
 def _band_text(band: BandNumbers | None) -> str:
     if band is None:
         return "not available (a single snapshot, or no fabric numbers)"
@@ -371,31 +367,31 @@ def _paper_rows(r: BiaxialReport) -> list[tuple[str, str, str, str]]:
     states = fab.get("states", {}) if isinstance(fab, dict) else {}
     run: dict[str, str] = {}
     run["porosity"] = (
-        f"{fmt(_num(s.get('porosity_generated')), 3)} nominal / "
-        f"{fmt(_num(s.get('porosity_generated_overlap_corrected')), 3)} overlap-corrected after generation; "
-        f"{fmt(_num(s.get('porosity_initial')), 3)} at the start of shearing"
+        f"{fmt(number(s.get('porosity_generated')), 3)} nominal / "
+        f"{fmt(number(s.get('porosity_generated_overlap_corrected')), 3)} overlap-corrected after generation; "
+        f"{fmt(number(s.get('porosity_initial')), 3)} at the start of shearing"
     )
     run["min_radius"] = f"{fmt(1e3 * float(r.diameters.min()) / 2, 3)} mm"
-    rate = _num(s.get("strain_rate"))
+    rate = number(s.get("strain_rate"))
     run["strain_rate"] = (
         f"{fmt(rate, 3)} 1/s ({fmt(6000 * rate, 3)} %/min, {fmt(rate / STRAIN_RATE_PER_S, 3)} x the paper's)"
         if math.isfinite(rate)
         else "n/a"
     )
-    p_y = _num((r.results.config.get("material") or {}).get("limiting_contact_pressure"))
-    run["density_scaling"] = f"{fmt(_num(s.get('density_scaling_factor')), 3)} " + (
+    p_y = number((r.results.config.get("material") or {}).get("limiting_contact_pressure"))
+    run["density_scaling"] = f"{fmt(number(s.get('density_scaling_factor')), 3)} " + (
         f"(Eq. 16 with p_y = {fmt(p_y / 1e6, 3)} MPa)" if math.isfinite(p_y)
         else "(Eq. 16 with p = σ₃: a run from before material.limiting_contact_pressure)"
     )
-    run["a_initial"] = fmt(_num(_val(states, "initial", "a")), 3)
-    run["a_n_initial"] = fmt(_num(_val(states, "initial", "a_n")), 3)
+    run["a_initial"] = fmt(number(_val(states, "initial", "a")), 3)
+    run["a_n_initial"] = fmt(number(_val(states, "initial", "a_n")), 3)
     eps = ts[AXIAL_STRAIN]
     if "anisotropy" in ts and np.nanmax(eps) >= 0.005:
         run["a_at_0.5"] = fmt(float(np.interp(0.005, eps, ts["anisotropy"])), 3)
     else:
         run["a_at_0.5"] = "n/a"
-    run["z_initial"] = fmt(_num(s.get("coordination_number_initial")), 3)
-    run["z_peak"] = fmt(_num(s.get("coordination_number_at_peak")), 3)
+    run["z_initial"] = fmt(number(s.get("coordination_number_initial")), 3)
+    run["z_peak"] = fmt(number(s.get("coordination_number_at_peak")), 3)
     run["strain_at_peak"] = fmt(r.peak_strain, percent=True)
     run["peak_ratio"] = fmt(r.peak_ratio, 3)
     ev = ts[VOLUMETRIC_STRAIN]
@@ -409,7 +405,7 @@ def _paper_rows(r: BiaxialReport) -> list[tuple[str, str, str, str]]:
     run["band_inclination"] = (
         f"{fmt(end.inclination_deg, 3)} deg at {end.snapshot}" if end and end.found else "n/a (no band found)"
     )
-    lam_peak = _num(_val(states, "peak", "mean_lambda"))
+    lam_peak = number(_val(states, "peak", "mean_lambda"))
     peak = r.band_peak
     if peak and peak.found:
         run["lambda_in_band"] = f"{fmt(peak.mean_lambda_inside, 3)} (band at {peak.snapshot})"
@@ -418,8 +414,8 @@ def _paper_rows(r: BiaxialReport) -> list[tuple[str, str, str, str]]:
         run["lambda_in_band"] = f"n/a (no band at the peak); all grains {fmt(lam_peak, 3)}"
         run["lambda_outside"] = f"n/a (no band at the peak); all grains {fmt(lam_peak, 3)}"
     run["lambda_trend"] = (
-        f"{fmt(_num(_val(states, 'initial', 'mean_lambda')), 3)} initial, {fmt(lam_peak, 3)} at the peak "
-        f"snapshot, {fmt(_num(_val(states, 'final', 'mean_lambda')), 3)} final (grains with 2 or more contacts)"
+        f"{fmt(number(_val(states, 'initial', 'mean_lambda')), 3)} initial, {fmt(lam_peak, 3)} at the peak "
+        f"snapshot, {fmt(number(_val(states, 'final', 'mean_lambda')), 3)} final (grains with 2 or more contacts)"
     )
     if "mean_stability_index_all" in ts:
         lam_all = np.asarray(ts["mean_stability_index_all"], dtype=np.float64)
@@ -434,7 +430,7 @@ def _caption_numbers(fab: dict[str, Any] | None) -> dict[str, str]:
     states = (fab or {}).get("states", {})
 
     def pair(key: str) -> str:
-        a, b = _num(_val(states, "initial", key)), _num(_val(states, "peak", key))
+        a, b = number(_val(states, "initial", key)), number(_val(states, "peak", key))
         return f"{fmt(a, 3)} initial, {fmt(b, 3)} at {_val(states, 'peak', 'snapshot') or 'the peak'}"
 
     return {"a": pair("a"), "a_n": pair("a_n"), "lambda": pair("mean_lambda")}
@@ -505,21 +501,16 @@ def gather_biaxial(
     return report
 
 
-def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float) -> BiaxialReport:
-    """:func:`gather_biaxial` but the claims."""
+def _draw_missing(folder: Path, results: Results, saved: dict[str, Any],
+                  redraw: bool) -> tuple[dict[str, Any] | None, str, list[str], list[str]]:
+    """The folder's figures missing (all with ``redraw``) drawn with the functions that
+    drew them with the run; ``(fabric numbers, where they come from, drawn, notes)``."""
     from grainlab.plot import biaxial_curves
     from grainlab.postprocess import FIGURES, fabric_figures, fabric_numbers
 
     ts = results.timeseries
-    summary = dict(results.summary)
-    saved = _read_summary_json(folder)
-    for key, value in saved.items():
-        summary.setdefault(key, value)
     notes: list[str] = []
     regenerated: list[str] = []
-    threads = summary.get("threads") if isinstance(summary.get("threads"), int) else None
-
-    # figures of the folder: draw the missing ones with the functions that drew them
     curves = CURVE_FIGURES + (("fig19_stress_path",) if is_constant_volume(results.config) else ())
     missing_curves = [n for n in curves if not is_usable_png(folder / f"{n}.png")]
     if redraw or missing_curves:
@@ -546,6 +537,29 @@ def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float
         fabric, fabric_source = None, "not available"
     if regenerated:
         notes.append("drawn by this report (missing from the folder or --redraw): " + ", ".join(regenerated))
+    return fabric, fabric_source, regenerated, notes
+
+
+def _wall_times(results: Results, summary: dict[str, Any]) -> tuple[list[tuple[str, str, float]], float]:
+    """Each phase's (name, what, wall time) and the run's total, s."""
+    phases = dict(results.phases) or dict(summary.get("wall_time_by_phase_s") or {})
+    wall = [(name, PHASES.get(name, ""), float(t)) for name, t in phases.items()]
+    total = number(summary.get("wall_time_s"))
+    if not math.isfinite(total):
+        total = float(sum(t for _, _, t in wall))
+    return wall, total
+
+
+def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float) -> BiaxialReport:
+    """:func:`gather_biaxial` but the claims."""
+    ts = results.timeseries
+    summary = dict(results.summary)
+    saved = _read_summary_json(folder)
+    for key, value in saved.items():
+        summary.setdefault(key, value)
+    threads = summary.get("threads") if isinstance(summary.get("threads"), int) else None
+
+    fabric, fabric_source, regenerated, notes = _draw_missing(folder, results, saved, redraw)
 
     # the macro numbers and the angles
     k = _peak_row(ts)
@@ -569,12 +583,7 @@ def _gather(folder: Path, results: Results, redraw: bool, dilation_window: float
     n_membrane = int(summary.get("n_membrane_disks") or int((~grains).sum()))
     grading, grading_name = requested_grading(results.config)
 
-    # wall times
-    phases = dict(results.phases) or dict(summary.get("wall_time_by_phase_s") or {})
-    wall = [(name, PHASES.get(name, ""), float(t)) for name, t in phases.items()]
-    total = _num(summary.get("wall_time_s"))
-    if not math.isfinite(total):
-        total = float(sum(t for _, _, t in wall))
+    wall, total = _wall_times(results, summary)
 
     figures: dict[str, EmbeddedFigure] = {}
     for key, title, caption in _figure_specs(fabric, float(eps[k])):

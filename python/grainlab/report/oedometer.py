@@ -1,22 +1,14 @@
-"""The oedometer's report page: K0 on first loading beside Jaky's 1 - sin phi',
-K against the overconsolidation ratio on unloading beside Mayne and
-Kulhawy's K0 OCR^sin phi' (when the run names phi'), the load path's records,
-the figures, the configuration and how to rerun."""
+"""The oedometer's report page, declared: K0 on first loading beside Jaky's
+1 - sin phi', K against the overconsolidation ratio on unloading beside Mayne
+and Kulhawy's K0 OCR^sin phi' (when the run names phi'), the load path's
+records and the figures (:class:`~grainlab.report.run_page.ReportPage`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
-import grainlab
-from grainlab._html import (
-    definition_table,
-    figures,
-    fmt,
-    page,
-    paragraph,
-    section,
-    table,
-)
+from grainlab._html import Markup, fmt, paragraph, table
 from grainlab.columns import (
     COORDINATION_NUMBER,
     HORIZONTAL_STRESS_PA,
@@ -27,9 +19,9 @@ from grainlab.columns import (
     VOID_RATIO,
 )
 from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA
-from grainlab.report.run_page import RunPage, gather_run_page, rerun_sections
+from grainlab.report.run_page import PageSection, ReportPage, RunPage
 
-__all__ = ["FIGURES", "OedometerReport", "gather_oedometer", "render_oedometer"]
+__all__ = ["FIGURES", "PAGE"]
 
 #: The run's figures: file stem -> (title, caption).
 FIGURES = {
@@ -38,61 +30,61 @@ FIGURES = {
     "fig02_compression": ("Compression curve", "Void ratio against the vertical stress, loading and unloading."),
 }
 
+#: The load path table's columns, those the run recorded shown.
+_PATH_COLUMNS = (TARGET_VERTICAL_STRESS_PA, VERTICAL_STRESS_PA, HORIZONTAL_STRESS_PA, LATERAL_STRESS_RATIO,
+                 OVERCONSOLIDATION_RATIO, VOID_RATIO, COORDINATION_NUMBER, "mean_stability_index", "anisotropy")
 
-#: What the oedometer page shows.
-OedometerReport = RunPage
 
-
-def gather_oedometer(folder: str | Path, *, redraw: bool = False) -> RunPage:
-    """Collects the report of the oedometer run in ``folder``; figures missing from it
-    (all of them with ``redraw``) are drawn into it first."""
+def _draw(folder: Path) -> None:
     from grainlab.protocols.oedometer.outputs import write_outputs  # draws them from run.h5
 
-    return gather_run_page(folder, FIGURES, write_outputs, redraw=redraw)
+    write_outputs(folder)
 
 
 def _kpa(x: float) -> str:
     return fmt(x / 1e3, 4, unit="kPa")
 
 
-def render_oedometer(r: RunPage) -> str:
-    """The oedometer report page."""
-    s, ts = r.summary, r.results.timeseries
-    phi = s.get("friction_angle_deg")
+def _glance(r: RunPage) -> list[tuple[str, str]]:
+    s = r.summary
     jaky = s.get("k0_jaky")
-    glance = definition_table([
+    return [
         ("grains", fmt(s["n_particles"])),
         ("porosity / void ratio at the start of loading",
          f"{fmt(s['porosity_initial'], 4)} / {fmt(s['void_ratio_initial'], 4)}"),
         ("K0 on first loading", f"{fmt(s['k0_loading'], 3)} ({s['k0_rule']})"),
         ("Jaky's K0 = 1 - sin phi'", "no phi' given (oedometer.friction_angle)" if jaky is None
-         else f"{fmt(jaky, 3)} for phi' = {fmt(phi, 3)} deg"),
+         else f"{fmt(jaky, 3)} for phi' = {fmt(s.get('friction_angle_deg'), 3)} deg"),
         ("largest vertical stress", _kpa(s["max_vertical_stress_pa"])),
         ("K at the end", f"{fmt(s['lateral_stress_ratio_final'], 3)} at OCR {fmt(s['overconsolidation_ratio_final'], 3)}"),
         ("wall time", fmt(s["wall_time_s"], 3, unit="s")),
-    ])
-    columns = (TARGET_VERTICAL_STRESS_PA, VERTICAL_STRESS_PA, HORIZONTAL_STRESS_PA, LATERAL_STRESS_RATIO,
-               OVERCONSOLIDATION_RATIO, VOID_RATIO, COORDINATION_NUMBER, "mean_stability_index", "anisotropy")
-    present = [c for c in columns if c in ts]
+    ]
+
+
+def _load_path(r: RunPage) -> list[Markup]:
+    ts = r.results.timeseries
+    present = [c for c in _PATH_COLUMNS if c in ts]
     rows = [[fmt(float(ts[c][k]) / (1e3 if c.endswith("_pa") else 1.0), 4) for c in present]
             for k in range(len(ts[VERTICAL_STRESS_PA]))]
     headers = [f"{c[:-3]} (kPa)" if c.endswith("_pa") else str(c) for c in present]
-    unloading = [(fmt(u["overconsolidation_ratio"], 3), fmt(u["lateral_stress_ratio"], 3),
-                  "n/a" if u["mayne_kulhawy"] is None else fmt(u["mayne_kulhawy"], 3)) for u in s["unloading"]]
-    sections = [
-        section("glance", "At a glance", glance),
-        section("path", "The load path", paragraph(
-            "One record per load step, at its equilibrium (the step ends with sigma_v within oedometer.tolerance "
-            "of its target and the unbalanced force ratio below consolidation.unbalanced_force_ratio); the first "
-            "is the consolidated sample with Table 1 friction on, from which strains count.", "note"),
-            table(headers, rows, numeric=range(len(headers))), figures(r.figures)),
-        section("unloading", "Unloading: K against OCR", paragraph(
-            "Mayne and Kulhawy (1982): K0 = (1 - sin phi') OCR^(sin phi'), a comparison for sands, not an oracle "
-            "for disks.", "note"), table(["OCR", "K (this run)", "Mayne-Kulhawy"], unloading, numeric=(0, 1, 2))),
-        *rerun_sections(OEDOMETER_SCHEMA.name, r.folder, r.results),
-    ]
-    header = paragraph(f"grainlab oedometer test: {r.folder.resolve().name}; run by grainlab "
-                       f"{r.results.grainlab_version}, report generated {r.generated}.")
-    return page(f"grainlab oedometer report: {r.folder.resolve().name}", header, sections,
-                f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, "
-                "no network).")
+    return [paragraph(
+        "One record per load step, at its equilibrium (the step ends with sigma_v within oedometer.tolerance "
+        "of its target and the unbalanced force ratio below consolidation.unbalanced_force_ratio); the first "
+        "is the consolidated sample with Table 1 friction on, from which strains count.", "note"),
+        table(headers, rows, numeric=range(len(headers)))]
+
+
+def _unloading(r: RunPage) -> list[Any]:
+    rows = [(fmt(u["overconsolidation_ratio"], 3), fmt(u["lateral_stress_ratio"], 3),
+             "n/a" if u["mayne_kulhawy"] is None else fmt(u["mayne_kulhawy"], 3)) for u in r.summary["unloading"]]
+    return [paragraph("Mayne and Kulhawy (1982): K0 = (1 - sin phi') OCR^(sin phi'), a comparison for sands, not "
+                      "an oracle for disks.", "note"),
+            table(["OCR", "K (this run)", "Mayne-Kulhawy"], rows, numeric=(0, 1, 2))]
+
+
+#: The oedometer test's page.
+PAGE = ReportPage(
+    OEDOMETER_SCHEMA.name, test="oedometer test", name="oedometer", figures=FIGURES, draw=_draw, glance=_glance,
+    sections=(PageSection("path", "The load path", _load_path, with_figures=True),
+              PageSection("unloading", "Unloading: K against OCR", _unloading)),
+)

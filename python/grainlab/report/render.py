@@ -17,6 +17,7 @@ from grainlab._html import (
     figure,
     figures,
     fmt,
+    number,
     page,
     paragraph,
     section,
@@ -25,6 +26,7 @@ from grainlab._html import (
 from grainlab.columns import AXIAL_STRAIN
 from grainlab.report.band import ACCEPTANCE
 from grainlab.report.biaxial import BiaxialReport
+from grainlab.report.run_page import footer
 from grainlab.report.study import StudyReport, param_unit
 
 __all__ = ["render_biaxial", "render_study"]
@@ -53,14 +55,6 @@ def _details(summary_text: str, body: Markup) -> Markup:
 def _header(title: str, lines: list[Any]) -> Markup:
     body = "".join(f"<p>{escape(line)}</p>" for line in lines)
     return Markup(f"<h1>{escape(title)}</h1>{body}")
-
-
-def _num(x: Any) -> float:
-    return float(x) if isinstance(x, int | float) and not isinstance(x, bool) else math.nan
-
-
-def _footer() -> str:
-    return f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, no network)."
 
 
 # ----------------------------------------------------------------------------- biaxial
@@ -165,13 +159,13 @@ def _fabric_states(r: BiaxialReport) -> Markup:
             (
                 role,
                 s.get("snapshot", ""),
-                fmt(_num(s.get(AXIAL_STRAIN)), percent=True),
-                fmt(_num(s.get("a")), 3),
-                fmt(_num(s.get("theta_a_deg")), 3),
-                fmt(_num(s.get("a_n")), 3),
-                fmt(_num(s.get("theta_n_deg")), 3),
-                fmt(_num(s.get("mean_lambda")), 3),
-                fmt(_num(s.get("coordination_number")), 3),
+                fmt(number(s.get(AXIAL_STRAIN)), percent=True),
+                fmt(number(s.get("a")), 3),
+                fmt(number(s.get("theta_a_deg")), 3),
+                fmt(number(s.get("a_n")), 3),
+                fmt(number(s.get("theta_n_deg")), 3),
+                fmt(number(s.get("mean_lambda")), 3),
+                fmt(number(s.get("coordination_number")), 3),
             )
         )
     if not rows:
@@ -184,12 +178,11 @@ def _fabric_states(r: BiaxialReport) -> Markup:
     )
 
 
-def render_biaxial(r: BiaxialReport) -> str:
-    """The biaxial report page."""
-    res, s = r.results, r.summary
-    figs = r.figures
+def _biaxial_header(r: BiaxialReport) -> Markup:
+    """The head of the page: the run, when it ran, this report, the folder."""
+    res = r.results
     finished = res.attrs.get("finished", "unknown")
-    header = _header(
+    return _header(
         f"grainlab biaxial test: {r.folder.resolve().name}",
         [
             f"Run by grainlab {res.grainlab_version}: started {res.created}, finished {finished}, status "
@@ -198,17 +191,22 @@ def render_biaxial(r: BiaxialReport) -> str:
             Markup(f"Folder: <code>{escape(str(r.folder.resolve()))}</code>"),
         ],
     )
+
+
+def _glance_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "At a glance" section: the run's headline numbers."""
+    s = r.summary
     band = r.band_end
     band_glance = (
         f"{fmt(band.inclination_deg, 3)} deg, {fmt(band.thickness_diameters, 3)} diameters"
         if band is not None and band.found
         else "not found"
     )
-    glance = _glance(
+    return section("glance", "At a glance", _glance(
         [
             ("grains", fmt(r.n_grains)),
-            ("porosity at the start of shearing", fmt(_num(s.get("porosity_initial")), 3)),
-            ("initial coordination number Z", fmt(_num(s.get("coordination_number_initial")), 3)),
+            ("porosity at the start of shearing", fmt(number(s.get("porosity_initial")), 3)),
+            ("initial coordination number Z", fmt(number(s.get("coordination_number_initial")), 3)),
             ("peak stress ratio σ₁/σ₃", fmt(r.peak_ratio, 3)),
             ("axial strain at the peak", fmt(r.peak_strain, percent=True)),
             ("friction angle φ (peak)", _deg(r.phi)),
@@ -216,9 +214,11 @@ def render_biaxial(r: BiaxialReport) -> str:
             ("shear band (inclination, thickness)", band_glance),
             ("wall time", fmt(r.wall_total, 3, unit="s")),
         ]
-    )
-    sections = [section("glance", "At a glance", glance)]
+    ))
 
+
+def _rerun_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "How to rerun" section: the command, the configuration file, the report again."""
     rerun_parts: list[Any] = [
         paragraph("The same test again (keys equal to the defaults left out):"),
         code_block(r.rerun.command),
@@ -230,10 +230,13 @@ def render_biaxial(r: BiaxialReport) -> str:
         _details("config.toml (the resolved configuration)", code_block(r.rerun.toml)),
         paragraph(f"Rebuild this report: grainlab report {shlex.quote(str(r.folder.resolve()))}", "note"),
     ]
-    sections.append(section("rerun", "How to rerun", *rerun_parts))
+    return section("rerun", "How to rerun", *rerun_parts)
 
+
+def _config_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Resolved configuration" section: every key, those that differ from the defaults highlighted."""
     rows = [(c.key, c.shown, c.unit, c.default, c.paper, c.help) for c in r.config_rows]
-    sections.append(
+    return (
         section(
             "config",
             "Resolved configuration",
@@ -251,6 +254,10 @@ def render_biaxial(r: BiaxialReport) -> str:
         )
     )
 
+
+def _sample_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Sample" section: the grains, the porosities and Z, the rates, the grading curve."""
+    s, res = r.summary, r.results
     d = r.diameters
     sample_items = [
         ("grains", fmt(r.n_grains)),
@@ -259,13 +266,13 @@ def render_biaxial(r: BiaxialReport) -> str:
          f"{fmt(1e3 * float(d.min()), 3)} to {fmt(1e3 * float(d.max()), 3)} mm, mean {fmt(1e3 * float(d.mean()), 3)} mm"),
         ("requested grading", r.grading_name),
         ("porosity after generation, nominal / overlap-corrected",
-         f"{fmt(_num(s.get('porosity_generated')), 4)} / {fmt(_num(s.get('porosity_generated_overlap_corrected')), 4)}"),
-        ("stress locked in by the generation", fmt(_num(s.get("generation_stress_pa")) / 1e3, 4, unit="kPa")),
+         f"{fmt(number(s.get('porosity_generated')), 4)} / {fmt(number(s.get('porosity_generated_overlap_corrected')), 4)}"),
+        ("stress locked in by the generation", fmt(number(s.get("generation_stress_pa")) / 1e3, 4, unit="kPa")),
         ("porosity after consolidation (rigid box), nominal / overlap-corrected",
-         f"{fmt(_num(s.get('porosity_after_consolidation')), 4)} / "
-         f"{fmt(_num(s.get('porosity_after_consolidation_overlap_corrected')), 4)}"),
-        ("porosity at the start of shearing (membrane), nominal", fmt(_num(s.get("porosity_initial")), 4)),
-        ("coordination number Z at the start of shearing", fmt(_num(s.get("coordination_number_initial")), 4)),
+         f"{fmt(number(s.get('porosity_after_consolidation')), 4)} / "
+         f"{fmt(number(s.get('porosity_after_consolidation_overlap_corrected')), 4)}"),
+        ("porosity at the start of shearing (membrane), nominal", fmt(number(s.get("porosity_initial")), 4)),
+        ("coordination number Z at the start of shearing", fmt(number(s.get("coordination_number_initial")), 4)),
     ]
     ts = r.timeseries
     if "mechanical_coordination_number" in ts:
@@ -274,11 +281,11 @@ def render_biaxial(r: BiaxialReport) -> str:
              fmt(float(ts["mechanical_coordination_number"][0]), 4))
         )
     sample_items += [
-        ("strain rate", fmt(_num(s.get("strain_rate")), 4, unit="1/s")),
+        ("strain rate", fmt(number(s.get("strain_rate")), 4, unit="1/s")),
         ("inertial number (heaviest grain, damped) / mean diameter",
-         f"{fmt(_num(s.get('inertial_number')), 3)} / {fmt(_num(s.get('inertial_number_mean_diameter')), 3)}"),
-        ("density scaling factor I (Eq. 16 with p_y)", fmt(_num(s.get("density_scaling_factor")), 3)),
-        ("time step", fmt(_num(s.get("time_step_s")), 4, unit="s")),
+         f"{fmt(number(s.get('inertial_number')), 3)} / {fmt(number(s.get('inertial_number_mean_diameter')), 3)}"),
+        ("density scaling factor I (Eq. 16 with p_y)", fmt(number(s.get("density_scaling_factor")), 3)),
+        ("time step", fmt(number(s.get("time_step_s")), 4, unit="s")),
         ("records", fmt(len(ts[AXIAL_STRAIN]))),
         ("snapshots", ", ".join(res.snapshot_names)),
     ]
@@ -290,7 +297,7 @@ def render_biaxial(r: BiaxialReport) -> str:
         r.grading_png,
         "drawn by the report",
     )
-    sections.append(
+    return (
         section(
             "sample",
             "Sample",
@@ -304,6 +311,10 @@ def render_biaxial(r: BiaxialReport) -> str:
         )
     )
 
+
+def _macro_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Macro curves" section: the stress ratio and the volumetric strain."""
+    figs = r.figures
     macro_fig = EmbeddedFigure(
         "macro",
         "Stress ratio and volumetric strain, with the peak and the dilation fit",
@@ -314,8 +325,12 @@ def render_biaxial(r: BiaxialReport) -> str:
     )
     macro_figs = [macro_fig] + [figs[k] for k in ("fig08_stress_ratio", "fig10_volumetric_strain", "fig19_stress_path")
                                 if k in figs]
-    sections.append(section("macro", "Macro curves", figures(macro_figs)))
+    return section("macro", "Macro curves", figures(macro_figs))
 
+
+def _fabric_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Fabric figures" section: the fabric at the snapshots and Figs. 6-14."""
+    figs = r.figures
     fabric_parts: list[Any] = [
         paragraph(f"Fabric numbers from {r.fabric_source}.", "note"),
         _fabric_states(r),
@@ -323,14 +338,17 @@ def render_biaxial(r: BiaxialReport) -> str:
     order = ("fig06_contact_normals", "fig07_normal_forces", "fig09_anisotropy", "fig18_coordination_number",
              "fig11_displacement", "fig12_stability_index", "fig13_contact_count", "fig14_mean_stability_index")
     fabric_parts.append(figures(figs[k] for k in order if k in figs))
-    sections.append(section("fabric", "Fabric figures (Figs. 6-14)", *fabric_parts))
+    return section("fabric", "Fabric figures (Figs. 6-14)", *fabric_parts)
 
+
+def _angle_formulas(r: BiaxialReport) -> Markup:
+    """How phi and psi are computed from this run's records, and the classical inclinations."""
     dl = r.dilation
 
     def pct(x: float) -> Markup:
         return escape(fmt(x, percent=True))
 
-    formulas = Markup(
+    return Markup(
         '<p class="formula">Friction angle at the peak record (row '
         f"{r.peak_row}, ε<sub>1</sub> = {pct(r.peak_strain)}, R = σ<sub>1</sub>/σ<sub>3</sub> = "
         f"{escape(fmt(r.peak_ratio, 4))}): sin φ = (σ<sub>1</sub> − σ<sub>3</sub>)/(σ<sub>1</sub> + "
@@ -344,6 +362,11 @@ def render_biaxial(r: BiaxialReport) -> str:
         '<p class="formula">Inclination to the σ<sub>3</sub> (horizontal) direction: Mohr–Coulomb '
         "45° + φ/2, Roscoe 45° + ψ/2, Arthur 45° + (φ + ψ)/4.</p>"
     )
+
+
+def _band_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Shear band and classical angles" section: the band, the formulas, the angles beside it."""
+    band = r.band_end
     band_parts: list[Any] = [
         paragraph(
             "The band is located by grainlab.analysis.ShearBand in the excess local shear strain of the grains "
@@ -360,7 +383,7 @@ def render_biaxial(r: BiaxialReport) -> str:
             "'grainlab report --redraw' recomputes them with the installed grainlab.",
             "note",
         ),
-        formulas,
+        _angle_formulas(r),
         _classical_table(r),
     ]
     if not (band is not None and band.found):
@@ -375,9 +398,12 @@ def render_biaxial(r: BiaxialReport) -> str:
         closest = r.angles.closest(math.radians(band.inclination_deg))
         if closest:
             band_parts.append(paragraph(f"The band's inclination is closest to the {closest} angle."))
-    sections.append(section("band", "Shear band and classical angles", *band_parts))
+    return section("band", "Shear band and classical angles", *band_parts)
 
-    sections.append(
+
+def _paper_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "The paper beside this run" section: its stated values and the claims on this run."""
+    return (
         section(
             "paper",
             "The paper beside this run",
@@ -390,6 +416,9 @@ def render_biaxial(r: BiaxialReport) -> str:
         )
     )
 
+
+def _time_section(r: BiaxialReport) -> tuple[str, str, Markup]:
+    """The "Wall time" section: each phase's share of the run."""
     total = r.wall_total
     time_rows = [
         (name, what, fmt(t, 4), fmt(t / total, percent=True) if total > 0 else "n/a") for name, what, t in r.wall_times
@@ -398,7 +427,7 @@ def render_biaxial(r: BiaxialReport) -> str:
     if other > 1e-3:
         time_rows.append(("other", "records, files", fmt(other, 3), fmt(other / total, percent=True)))
     time_rows.append(("total", "generation to the end of shearing, as recorded", fmt(total, 4), "100.00 %"))
-    sections.append(
+    return (
         section(
             "time",
             "Wall time",
@@ -415,13 +444,14 @@ def render_biaxial(r: BiaxialReport) -> str:
             ),
         )
     )
-    sections.append(section("notes", "Notes", _notes(r.notes)))
-    return page(
-        f"grainlab biaxial report: {r.folder.resolve().name}",
-        header,
-        sections,
-        _footer(),
-    )
+
+
+def render_biaxial(r: BiaxialReport) -> str:
+    """The biaxial report page: its sections in the page's order."""
+    sections = [_glance_section(r), _rerun_section(r), _config_section(r), _sample_section(r), _macro_section(r),
+                _fabric_section(r), _band_section(r), _paper_section(r), _time_section(r),
+                section("notes", "Notes", _notes(r.notes))]
+    return page(f"grainlab biaxial report: {r.folder.resolve().name}", _biaxial_header(r), sections, footer())
 
 
 # ----------------------------------------------------------------------------- study
@@ -443,6 +473,67 @@ def _trend(value: Any) -> str:
     return fmt(value, 4)
 
 
+def _study_table_section(r: StudyReport) -> tuple[str, str, Markup]:
+    """The "study.csv" section: one row per packing, free text below the table."""
+    # the free-text columns go below the table, one line per packing that has any,
+    # so that the table keeps one line per row
+    texts = [c for c in r.columns if c in ("note", "error")]
+    columns = [c for c in r.columns if c not in texts]
+    rows = [[_cell(c, row.get(c, "")) for c in columns] for row in r.rows]
+    numeric = [k for k, c in enumerate(columns) if c not in ("kind", "status", "name")]
+    remarks = [
+        (str(row.get("name", "")), c, str(row.get(c, "")))
+        for row in r.rows
+        for c in texts
+        if str(row.get(c, "")).strip()
+    ]
+    table_parts: list[Any] = [
+        paragraph("One row per packing, as written (numbers to 4 significant digits).", "note"),
+        table(columns, rows, numeric=numeric, css_class="wide"),
+    ]
+    if remarks:
+        table_parts.append(table(["packing", "column", "text"], remarks, cell_classes={2: "note"}))
+    return section("table", "study.csv", *table_parts)
+
+
+def _study_figures_section(r: StudyReport) -> tuple[str, str, Markup]:
+    """The "Figures 15-17 and fits" section."""
+    s = r.summary
+    fit = s.get("fig17_fit") or {}
+    fig_parts: list[Any] = [figures(r.figures.values())]
+    trends = s.get("trends") or {}
+    if fit or trends:
+        fit_rows = [("Fig. 17: λ = slope a + intercept (all packings)",
+                     f"slope {fmt(number(fit.get('slope')), 4)}, intercept {fmt(number(fit.get('intercept')), 4)}, "
+                     f"R² {fmt(number(fit.get('r2')), 4)}, n = {fit.get('n', 'n/a')}")]
+        fit_rows += [(k.replace("_", " "), _trend(v)) for k, v in trends.items()]
+        fig_parts.append(Markup("<h3>Fits</h3>"))
+        fig_parts.append(definition_table(fit_rows))
+    return section("figures", "Figures 15-17 and fits", *fig_parts)
+
+
+def _study_time_section(r: StudyReport) -> tuple[str, str, Markup]:
+    """The "Wall time" section: the campaign's and each run's."""
+    s = r.summary
+    time_rows = [
+        ("campaign (all runs, figures, table)", fmt(number(s.get("campaign_wall_time_s")), 4)),
+        ("sum of the runs' own wall times", fmt(number(s.get("runs_wall_time_s_sum")), 4)),
+    ]
+    per_run = [
+        (row.get("name") or f"{row.get('kind')}_{row.get('porosity_target')}", row.get("status", ""),
+         _cell("wall_time_s", row.get("wall_time_s", "")))
+        for row in r.rows
+    ]
+    return (
+        section(
+            "time",
+            "Wall time",
+            definition_table(time_rows),
+            table(["run", "status", "wall time (s)"], per_run, numeric=(2,)),
+        )
+    )
+
+
 def render_study(r: StudyReport) -> str:
     """The study report page."""
     s = r.summary
@@ -458,8 +549,8 @@ def render_study(r: StudyReport) -> str:
         [
             ("packings", fmt(len(r.rows))),
             ("statuses", ", ".join(f"{k} {v}" for k, v in r.statuses.items())),
-            ("Fig. 17 fit R² (all packings)", fmt(_num(fit.get("r2")), 3)),
-            ("campaign wall time", fmt(_num(s.get("campaign_wall_time_s")), 3, unit="s")),
+            ("Fig. 17 fit R² (all packings)", fmt(number(fit.get("r2")), 3)),
+            ("campaign wall time", fmt(number(s.get("campaign_wall_time_s")), 3, unit="s")),
         ]
     )
     sections = [section("glance", "At a glance", glance)]
@@ -485,35 +576,8 @@ def render_study(r: StudyReport) -> str:
             table(["parameter", "value", "SI unit"], params, numeric=(1,)),
         )
     )
-    # the free-text columns go below the table, one line per packing that has any,
-    # so that the table keeps one line per row
-    texts = [c for c in r.columns if c in ("note", "error")]
-    columns = [c for c in r.columns if c not in texts]
-    rows = [[_cell(c, row.get(c, "")) for c in columns] for row in r.rows]
-    numeric = [k for k, c in enumerate(columns) if c not in ("kind", "status", "name")]
-    remarks = [
-        (str(row.get("name", "")), c, str(row.get(c, "")))
-        for row in r.rows
-        for c in texts
-        if str(row.get(c, "")).strip()
-    ]
-    table_parts: list[Any] = [
-        paragraph("One row per packing, as written (numbers to 4 significant digits).", "note"),
-        table(columns, rows, numeric=numeric, css_class="wide"),
-    ]
-    if remarks:
-        table_parts.append(table(["packing", "column", "text"], remarks, cell_classes={2: "note"}))
-    sections.append(section("table", "study.csv", *table_parts))
-    fig_parts: list[Any] = [figures(r.figures.values())]
-    trends = s.get("trends") or {}
-    if fit or trends:
-        fit_rows = [("Fig. 17: λ = slope a + intercept (all packings)",
-                     f"slope {fmt(_num(fit.get('slope')), 4)}, intercept {fmt(_num(fit.get('intercept')), 4)}, "
-                     f"R² {fmt(_num(fit.get('r2')), 4)}, n = {fit.get('n', 'n/a')}")]
-        fit_rows += [(k.replace("_", " "), _trend(v)) for k, v in trends.items()]
-        fig_parts.append(Markup("<h3>Fits</h3>"))
-        fig_parts.append(definition_table(fit_rows))
-    sections.append(section("figures", "Figures 15-17 and fits", *fig_parts))
+    sections.append(_study_table_section(r))
+    sections.append(_study_figures_section(r))
     sections.append(
         section(
             "paper",
@@ -521,27 +585,11 @@ def render_study(r: StudyReport) -> str:
             table(["claim", "paper", "this study", "where in the paper"], r.claims, cell_classes={2: "note"}),
         )
     )
-    time_rows = [
-        ("campaign (all runs, figures, table)", fmt(_num(s.get("campaign_wall_time_s")), 4)),
-        ("sum of the runs' own wall times", fmt(_num(s.get("runs_wall_time_s_sum")), 4)),
-    ]
-    per_run = [
-        (row.get("name") or f"{row.get('kind')}_{row.get('porosity_target')}", row.get("status", ""),
-         _cell("wall_time_s", row.get("wall_time_s", "")))
-        for row in r.rows
-    ]
-    sections.append(
-        section(
-            "time",
-            "Wall time",
-            definition_table(time_rows),
-            table(["run", "status", "wall time (s)"], per_run, numeric=(2,)),
-        )
-    )
+    sections.append(_study_time_section(r))
     sections.append(section("notes", "Notes", _notes(r.notes)))
     return page(
         f"grainlab study report: {r.folder.resolve().name}",
         header,
         sections,
-        _footer(),
+        footer(),
     )

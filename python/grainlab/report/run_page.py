@@ -1,24 +1,41 @@
-"""What the report pages of the protocols' runs share: the gathered page
+"""A test's report page, declared (:class:`ReportPage`) and assembled here once.
+
+A declaration names its protocol (the results file's ``kind``), its figures,
+its summary numbers ("At a glance") and its own sections; this module writes
+what every run's page shares: the head line, the gathered run
 (:class:`RunPage`: the run, its summary and its figures, drawn first when
-missing), how to rerun the run (``grainlab run KIND`` with the keys that differ
-from the defaults) and its resolved configuration, as page sections."""
+missing), the figures grid, how to rerun the run (``grainlab run KIND`` with
+the keys that differ from the defaults), its resolved configuration and the
+footer. A test whose page is laid out by its own module (the biaxial test's,
+the packing study's) declares that module's ``render`` instead.
+"""
 
 from __future__ import annotations
 
 import datetime
 import shlex
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from grainlab._html import EmbeddedFigure, Markup, code_block, paragraph, section, table
+import grainlab
+from grainlab._html import (
+    EmbeddedFigure,
+    Markup,
+    code_block,
+    definition_table,
+    figures,
+    page,
+    paragraph,
+    section,
+    table,
+)
 from grainlab._mapping import flatten_keys
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.protocols.config import SCHEMAS
-from grainlab.report.figures import embedded_png
 
-__all__ = ["RunPage", "gather_run_page", "rerun_sections"]
+__all__ = ["PageSection", "ReportPage", "RunPage", "footer", "gather_run_page", "rerun_sections"]
 
 
 @dataclass
@@ -32,11 +49,73 @@ class RunPage:
     generated: str
 
 
+@dataclass(frozen=True)
+class PageSection:
+    """One section of a declared page: its anchor, its title and its parts (notes,
+    tables) from the gathered run; ``with_figures`` ends it with the figures grid."""
+
+    anchor: str
+    title: str
+    parts: Callable[[RunPage], Sequence[Any]]
+    with_figures: bool = False
+
+
+@dataclass(frozen=True)
+class ReportPage:
+    """A test's report page, declared: what ``report.html`` shows for a run of ``protocol``.
+
+    ``test`` names the test in the page's head line ("oedometer test") and
+    ``name`` in its title ("grainlab oedometer report"); ``figures`` maps each
+    figure's file stem to (title, caption), drawn by ``draw(folder)`` (the
+    protocol's outputs) when one is missing; ``glance`` gives the summary
+    numbers as (label, value) pairs; ``sections`` follow them, before "How to
+    rerun" and "Resolved configuration". A page laid out by a module of its own
+    sets ``render(folder, redraw)`` instead, and the rest is not used.
+    """
+
+    protocol: str
+    test: str = ""
+    name: str = ""
+    figures: Mapping[str, tuple[str, str]] = field(default_factory=dict)
+    draw: Callable[[Path], Any] | None = None
+    glance: Callable[[RunPage], Sequence[tuple[str, str]]] | None = None
+    sections: Sequence[PageSection] = ()
+    render: Callable[[Path, bool], str] | None = None
+
+    def __post_init__(self) -> None:
+        if self.render is None and (self.draw is None or self.glance is None):
+            raise ValueError(f"{self.protocol}: a report page declares draw and glance, or its own render")
+
+    def html(self, folder: Path, *, redraw: bool = False) -> str:
+        """The page of the run in ``folder`` (figures missing from it, all of them with
+        ``redraw``, are drawn into it first)."""
+        if self.render is not None:
+            return self.render(folder, redraw)
+        if self.draw is None or self.glance is None:  # refused by __post_init__; this narrows the types
+            raise ValueError(f"{self.protocol}: a report page declares draw and glance, or its own render")
+        r = gather_run_page(folder, self.figures, self.draw, redraw=redraw)
+        parts = [section("glance", "At a glance", definition_table(list(self.glance(r))))]
+        parts += [section(s.anchor, s.title, *s.parts(r), *([figures(r.figures)] if s.with_figures else []))
+                  for s in self.sections]
+        parts += rerun_sections(self.protocol, r.folder, r.results)
+        title = r.folder.resolve().name
+        header = paragraph(f"grainlab {self.test}: {title}; run by grainlab {r.results.grainlab_version}, "
+                           f"report generated {r.generated}.")
+        return page(f"grainlab {self.name} report: {title}", header, parts, footer())
+
+
+def footer() -> str:
+    """The line at the foot of every report page."""
+    return f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, no network)."
+
+
 def gather_run_page(folder: str | Path, figures: Mapping[str, tuple[str, str]],
                     write_outputs: Callable[[Path], Any], *, redraw: bool = False) -> RunPage:
     """The page of the run in ``folder``: ``figures`` (file stem -> (title, caption)),
     drawn first by the protocol's ``write_outputs`` when one is missing (all of them
     with ``redraw``)."""
+    from grainlab.report.figures import embedded_png  # matplotlib: only when a page is made
+
     folder = Path(folder)
     results = read_results(folder / "run.h5")
     if redraw or any(not (folder / f"{stem}.png").exists() for stem in figures):

@@ -1,18 +1,18 @@
-"""The periodic simple-shear test's report page: the effective friction at its
-peak and in the steady state, the dilatancy, the fabric, the
-Rothenburg-Bathurst residual over every record, the figures, the
-configuration and how to rerun."""
+"""The periodic simple-shear test's report page, declared: the effective friction
+at its peak and in the steady state, the dilatancy, the fabric, the
+Rothenburg-Bathurst residual over every record and the figures
+(:class:`~grainlab.report.run_page.ReportPage`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
-import grainlab
-from grainlab._html import definition_table, figures, fmt, page, paragraph, section
+from grainlab._html import fmt, paragraph
 from grainlab.protocols.simple_shear.config import SIMPLE_SHEAR_SCHEMA
-from grainlab.report.run_page import RunPage, gather_run_page, rerun_sections
+from grainlab.report.run_page import PageSection, ReportPage, RunPage
 
-__all__ = ["FIGURES", "SimpleShearReport", "gather_simple_shear", "render_simple_shear"]
+__all__ = ["FIGURES", "PAGE"]
 
 #: The run's figures: file stem -> (title, caption).
 FIGURES = {
@@ -28,27 +28,25 @@ FIGURES = {
                           "the undrained test's path."),
 }
 
-#: What the simple-shear page shows.
-SimpleShearReport = RunPage
 
-
-def gather_simple_shear(folder: str | Path, *, redraw: bool = False) -> RunPage:
-    """Collects the report of the simple-shear run in ``folder``; figures missing from it
-    (all of them with ``redraw``) are drawn into it first."""
+def _draw(folder: Path) -> None:
     from grainlab.protocols.simple_shear.outputs import write_outputs  # draws them from run.h5
 
-    return gather_run_page(folder, FIGURES, write_outputs, redraw=redraw)
+    write_outputs(folder)
 
 
-def render_simple_shear(r: RunPage) -> str:
-    """The simple-shear report page."""
-    s = r.summary
-    held = ("sigma_n held at " + fmt(s["normal_stress_set_pa"] / 1e3, 4, unit="kPa") if s["volume"] == "free"
-            else "the cell's area held; sigma_n from " + fmt(s["normal_stress_set_pa"] / 1e3, 4, unit="kPa") + " to "
+def _held(s: dict[str, Any]) -> str:
+    if s["volume"] == "free":
+        return "sigma_n held at " + fmt(s["normal_stress_set_pa"] / 1e3, 4, unit="kPa")
+    return ("the cell's area held; sigma_n from " + fmt(s["normal_stress_set_pa"] / 1e3, 4, unit="kPa") + " to "
             + fmt(s["normal_stress_final_pa"] / 1e3, 4, unit="kPa"))
-    glance = definition_table([
+
+
+def _glance(r: RunPage) -> list[tuple[str, str]]:
+    s = r.summary
+    return [
         ("grains", fmt(s["n_particles"])),
-        ("boundary", f"periodic cell {fmt(1e3 * s['cell_width_m'], 4, unit='mm')} wide; {held}"),
+        ("boundary", f"periodic cell {fmt(1e3 * s['cell_width_m'], 4, unit='mm')} wide; {_held(s)}"),
         ("shear rate", f"{fmt(s['shear_rate_per_s'], 4, unit='1/s')} (I = {fmt(s['inertial_number_set'], 3)} set, "
                        f"{fmt(s['inertial_number_steady'], 3)} in the steady state)"),
         ("porosity at the start / steady", f"{fmt(s['porosity_initial'], 4)} / {fmt(s['porosity_steady'], 4)}"),
@@ -65,17 +63,18 @@ def render_simple_shear(r: RunPage) -> str:
         ("Rothenburg-Bathurst residual", f"mean |r| {fmt(s['rb_residual_mean_abs'], 3)}, largest "
                                          f"{fmt(s['rb_residual_max_abs'], 3)} over {s['records']} records"),
         ("wall time", fmt(s["wall_time_s"], 3, unit="s")),
-    ])
-    sections = [
-        section("glance", "At a glance", glance),
-        section("shear", "Shearing", paragraph(
-            "The cell's stress is the contacts' Love-Weber sum and the grains' kinetic part over the cell's area; "
-            "the shear strain is the imposed rate integrated over time (docs/protocols.md, \"Periodic simple "
-            "shear\").", "note"), figures(r.figures)),
-        *rerun_sections(SIMPLE_SHEAR_SCHEMA.name, r.folder, r.results),
     ]
-    header = paragraph(f"grainlab periodic simple-shear test: {r.folder.resolve().name}; run by grainlab "
-                       f"{r.results.grainlab_version}, report generated {r.generated}.")
-    return page(f"grainlab simple-shear report: {r.folder.resolve().name}", header, sections,
-                f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, "
-                "no network).")
+
+
+def _shearing(r: RunPage) -> list[Any]:
+    return [paragraph(
+        "The cell's stress is the contacts' Love-Weber sum and the grains' kinetic part over the cell's area; "
+        "the shear strain is the imposed rate integrated over time (docs/protocols.md, \"Periodic simple "
+        "shear\").", "note")]
+
+
+#: The periodic simple-shear test's page.
+PAGE = ReportPage(
+    SIMPLE_SHEAR_SCHEMA.name, test="periodic simple-shear test", name="simple-shear", figures=FIGURES, draw=_draw,
+    glance=_glance, sections=(PageSection("shear", "Shearing", _shearing, with_figures=True),),
+)

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from grainlab import paper
+from grainlab._html import number
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
 from grainlab.reproduction.measures import END_WINDOW, relative_slope
 from grainlab.reproduction.verdicts import ProportionRule, SideRule, ValueRule
@@ -128,10 +129,6 @@ def single_run_rows(measures: Measures, claims: Sequence[Claim] = ()) -> list[di
 
 
 # ----------------------------------------------------------------------------- biaxial helpers
-def _num(value: Any) -> float:
-    return math.nan if value is None else float(value)
-
-
 def _snaps(m: Measures) -> list[Mapping[str, Any]]:
     snapshots: list[Mapping[str, Any]] = m["snapshots"]
     return snapshots
@@ -152,8 +149,8 @@ def _peak(m: Measures) -> Mapping[str, Any]:
 def _at(m: Measures, strain: float, tolerance: float = 0.001) -> Mapping[str, Any]:
     """The snapshot within ``tolerance`` of ``strain`` (KeyError when there is none)."""
     rows = _snaps(m)
-    best = min(rows, key=lambda r: abs(_num(r[AXIAL_STRAIN]) - strain))
-    if abs(_num(best[AXIAL_STRAIN]) - strain) > tolerance:
+    best = min(rows, key=lambda r: abs(number(r[AXIAL_STRAIN]) - strain))
+    if abs(number(best[AXIAL_STRAIN]) - strain) > tolerance:
         raise KeyError(f"no snapshot at {strain}")
     return best
 
@@ -162,7 +159,7 @@ def band_measure(row: Mapping[str, Any], key: str) -> float:
     """A band measure of a snapshot: the band's grains (the band accepted at the
     snapshot, or else the first accepted after it, matched by id) against the
     rest; NaN when no band is accepted at or after the snapshot."""
-    return _num(row.get(key)) if row.get("band_members_known", row.get("band_found")) else math.nan
+    return number(row.get(key)) if row.get("band_members_known", row.get("band_found")) else math.nan
 
 
 def _band_share(row: Mapping[str, Any]) -> float:
@@ -170,18 +167,18 @@ def _band_share(row: Mapping[str, Any]) -> float:
     when none is)."""
     if not row.get("band_found"):
         return math.nan
-    inside, outside = _num(row.get("inside_n_grains")), _num(row.get("outside_n_grains"))
+    inside, outside = number(row.get("inside_n_grains")), number(row.get("outside_n_grains"))
     return inside / (inside + outside)
 
 
 def _series(m: Measures, key: str) -> tuple[np.ndarray, np.ndarray]:
     rows = _snaps(m)
-    return (np.array([_num(r[AXIAL_STRAIN]) for r in rows]), np.array([_num(r.get(key)) for r in rows]))
+    return (np.array([number(r[AXIAL_STRAIN]) for r in rows]), np.array([number(r.get(key)) for r in rows]))
 
 
 def _end_slope(m: Measures, key: str) -> float:
     eps, y = _series(m, key)
-    start = max(_num(_peak(m)[AXIAL_STRAIN]), (1.0 - END_WINDOW) * float(np.nanmax(eps)))
+    start = max(number(_peak(m)[AXIAL_STRAIN]), (1.0 - END_WINDOW) * float(np.nanmax(eps)))
     use = eps >= start - 1e-9
     return relative_slope(eps[use], y[use]) if use.sum() >= 2 else math.nan
 
@@ -310,10 +307,10 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
           "band of the strain field: the figures show one band", "Sec. 6, Figs. 11-12", None,
           "Jaccard overlap |A & B| / |A | B| of the reading's band grains with the local-strain band's at the "
           "peak snapshot (a band: reading's variant; none for the strain reading itself); most shared: above 0.5",
-          SideRule(+1, 0.5), lambda m: _num(_peak(m).get("band_overlap_with_strain"))),
+          SideRule(+1, 0.5), lambda m: number(_peak(m).get("band_overlap_with_strain"))),
     Claim("band_readings_agree_at_end", "the same at the end of the test (10 %)", "Sec. 6, Figs. 11-12", None,
           "the same overlap at the last snapshot", SideRule(+1, 0.5),
-          lambda m: _num(_final(m).get("band_overlap_with_strain"))),
+          lambda m: number(_final(m).get("band_overlap_with_strain"))),
     Claim("band_lambda_above_rest", "mean lambda in the shear zone at the peak (0.34) above the rest (0.31)",
           "Sec. 6, Fig. 13", 0.03, f"band minus rest at the peak snapshot, paired per seed; {_LAMBDA_BAND}",
           SideRule(+1), lambda m: band_measure(_peak(m), "inside_mean_lambda") - band_measure(_peak(m), "outside_mean_lambda")),
@@ -377,11 +374,11 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
     Claim("lambda_marks_band_at_0.5", "at 0.5 % lambda already shows a discontinuity surrounded by more "
           "stable grains", "Sec. 6, Fig. 12b", None,
           "ROC AUC of per-grain lambda at the 0.5 % snapshot for the grains of the band found at the peak",
-          SideRule(+1, 0.5), lambda m: _num(_at(m, 0.005)["auc_lambda_peak_band"])),
+          SideRule(+1, 0.5), lambda m: number(_at(m, 0.005)["auc_lambda_peak_band"])),
     Claim("initial_lambda_random", "the sample starts with randomly distributed stability indices, no "
           "discontinuity", "Sec. 6, Fig. 12a", 0.5,
           "ROC AUC of per-grain lambda at 0 % for the grains of the band found at the peak",
-          ValueRule(0.4, 0.6), lambda m: _num(_initial(m)["auc_lambda_peak_band"])),
+          ValueRule(0.4, 0.6), lambda m: number(_initial(m)["auc_lambda_peak_band"])),
     Claim("initial_lambda_above_zero", "an irregular packing starts with a mean lambda above zero", "Sec. 8", None,
           f"mean lambda at 0 %; {_LAMBDA_BAND}", SideRule(+1), lambda m: _initial(m)["mean_lambda"]),
     Claim("lambda_rises_to_peak", "mean lambda increases up to the peak stress ratio", "Sec. 6, Fig. 14; Sec. 8",
@@ -414,7 +411,7 @@ BIAXIAL_CLAIMS: tuple[Claim, ...] = (
 
 # ----------------------------------------------------------------------------- the packing study
 def _fit(s: Measures, name: str, key: str) -> float:
-    return _num(s[name][key])
+    return number(s[name][key])
 
 
 #: The claims of the packing study (Sec. 7, Figs. 15-17), one value per seed's 19 packings.

@@ -24,6 +24,7 @@ from matplotlib.figure import Figure
 
 from grainlab import plot
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
+from grainlab.io.hdf5 import snapshot_strain
 from grainlab.reproduction.runs import ReproductionPlan, rate_family, variant_folder
 from grainlab.reproduction.verdicts import t_interval
 
@@ -265,13 +266,10 @@ def band_readings_figure(run_dir: str | Path, title: str = "") -> Figure:
     products = RunProducts(run_dir)
     results = products.results
 
-    def strain(info: Any) -> float:
-        return math.nan if info.axial_strain is None else float(info.axial_strain)
-
     by_name = {info.name: info for info in results.snapshots}
     infos = [by_name[name] for name in products.names_by_strain]
     peak = macro_measures(results.timeseries)["peak_axial_strain"]
-    chosen = [min(infos[1:], key=lambda i: abs(strain(i) - peak)), infos[-1]]
+    chosen = [min(infos[1:], key=lambda i: abs(snapshot_strain(i) - peak)), infos[-1]]
     with plot.paper_style():
         fig = Figure(figsize=(8.0, 7.0), layout="constrained")
         axes = fig.subplots(1, 2)
@@ -295,7 +293,7 @@ def band_readings_figure(run_dir: str | Path, title: str = "") -> Figure:
                 for k, seg in enumerate(field.band.outline()):
                     ax.plot(seg[:, 0], seg[:, 1], color="C0", linestyle=":", linewidth=1.4,
                             label=r"$\lambda > 0.5$ zone (accepted)" if k == 0 else None)
-            ax.set_title(f"{100 * strain(info):.2f} % axial strain"
+            ax.set_title(f"{100 * snapshot_strain(info):.2f} % axial strain"
                          + ("" if strain_band.band is not None else "; no strain band accepted"), fontsize=8)
             ax.legend(frameon=True, framealpha=0.85, fontsize=6, loc="upper left")
             ax.set_aspect("equal")

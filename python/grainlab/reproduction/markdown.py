@@ -9,12 +9,14 @@ convergence, the paired comparisons of variants and the wall times.
 
 from __future__ import annotations
 
+import functools
 import json
-import math
 import re
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
+
+from grainlab._html import fmt
 
 __all__ = ["CLAIM_SETS", "SENSITIVITY_CLAIMS", "claims_markdown", "generated_blocks", "named_sensitivity_markdown",
            "sensitivity_blocks", "sensitivity_markdown", "update_generated_blocks"]
@@ -30,14 +32,8 @@ QUANTITY_LABELS = {
 SHORT = {"reproduced": "yes", "not reproduced": "**no**", "inconclusive": "?"}
 
 
-def _num(x: Any, digits: int = 3) -> str:
-    if x is None or (isinstance(x, float) and not math.isfinite(x)):
-        return "n/a"
-    if isinstance(x, bool):
-        return "yes" if x else "no"
-    if isinstance(x, int):
-        return str(x)
-    return f"{float(x):.{digits}g}"
+#: A number in a table: :func:`grainlab._html.fmt` without trailing zeros (``4.6``, ``n/a``).
+_num = functools.partial(fmt, trailing_zeros=False)
 
 
 def _interval(ci: Sequence[Any]) -> str:

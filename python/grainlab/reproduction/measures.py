@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 
 from grainlab.analysis.peak import nearest_snapshot, peak_is_interior, peak_record
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
+from grainlab.io.hdf5 import snapshot_strain
 
 if TYPE_CHECKING:
     from grainlab.analysis.stability import StabilityIndex
@@ -117,11 +118,6 @@ def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
     }
 
 
-def _snapshot_strain(info: Any) -> float:
-    """The axial strain a biaxial snapshot was written at (NaN when not recorded)."""
-    return _finite(info.axial_strain)
-
-
 def _fabric_of(snap: Any, options: Mapping[str, Any]) -> dict[str, Any]:
     from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
 
@@ -165,7 +161,7 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
     ts = results.timeseries
     macro = macro_measures(ts)
     infos = list(results.snapshots)
-    strains = [_snapshot_strain(info) for info in infos]
+    strains = [snapshot_strain(info) for info in infos]
     position = {info.name: k for k, info in enumerate(infos)}
     order = [position[name] for name in products.names_by_strain]
     names = products.names_by_strain

@@ -86,7 +86,7 @@ from grainlab.io.hdf5.errors import (
     UnsupportedVersionError,
 )
 from grainlab.io.hdf5.reader import Results, read_hdf5_snapshot, read_results, results_kind
-from grainlab.io.hdf5.snapshot import SnapshotInfo, snapshot_name
+from grainlab.io.hdf5.snapshot import SnapshotInfo, snapshot_name, snapshot_strain
 from grainlab.io.hdf5.writer import ResultsWriter
 
 __all__ = [
@@ -112,6 +112,7 @@ __all__ = [
     "read_results",
     "results_kind",
     "snapshot_name",
+    "snapshot_strain",
     "write_analysis",
     "write_checkpoint",
 ]

@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,7 +21,7 @@ from grainlab.io.hdf5._layout import _check_name, _dumps, _read_text, _write_tex
 from grainlab.io.hdf5.errors import ResultsFileError
 from grainlab.snapshot import Snapshot
 
-__all__ = ["SnapshotInfo", "snapshot_name"]
+__all__ = ["SnapshotInfo", "snapshot_name", "snapshot_strain"]
 
 # Units of the snapshot datasets and of well-known per-particle / per-contact fields.
 _SNAPSHOT_UNITS = {
@@ -197,6 +198,33 @@ def _read_snapshot_group_v1(group: h5py.Group, path: Path) -> Snapshot:
         raise ResultsFileError(path, f"{group.name}: missing dataset ({error})") from None
     except ValueError as error:
         raise ResultsFileError(path, f"{group.name}: invalid snapshot ({error})") from None
+
+
+#: A name :func:`snapshot_name` wrote with its default prefix: ``strain_<axial strain>``.
+_AXIAL_STRAIN_NAME = re.compile(r"^strain_([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)$")
+
+
+def snapshot_strain(info: Any) -> float:
+    """The axial strain (a fraction, compression positive) a snapshot was written at.
+
+    ``info`` is a :class:`SnapshotInfo` or a :class:`~grainlab.snapshot.Snapshot`
+    listing (anything with ``axial_strain`` and ``name``). The one fallback
+    rule: the recorded ``axial_strain`` when it is finite; else the strain in
+    a name :func:`snapshot_name` wrote with its default prefix
+    (``strain_0.0150`` gives 0.015); else NaN (a simple-shear ``gamma_*``
+    snapshot has no axial strain).
+
+    >>> from types import SimpleNamespace as S
+    >>> snapshot_strain(S(axial_strain=0.0151, name="strain_0.0150")), snapshot_strain(S(axial_strain=None, name="strain_0.0150"))
+    (0.0151, 0.015)
+    >>> snapshot_strain(S(axial_strain=None, name="gamma_0.3000"))
+    nan
+    """
+    value = getattr(info, "axial_strain", None)
+    if value is not None and math.isfinite(value):
+        return float(value)
+    match = _AXIAL_STRAIN_NAME.match(str(getattr(info, "name", "")))
+    return float(match.group(1)) if match else math.nan
 
 
 @dataclass(frozen=True)
