@@ -2,6 +2,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{require_non_negative, require_positive, EngineError, Result};
+use crate::law::hertz::HertzConstants;
 use crate::state::MAX_GROUPS;
 
 /// Which contact law a pair of material groups follows (docs/contact-law.md).
@@ -157,20 +158,20 @@ impl ContactModel {
         let nu = self.poisson_ratio;
         if !(nu > -1.0 && nu < 0.5) {
             return Err(EngineError::invalid(
-                &format!("{field}.poisson_ratio"),
+                format!("{field}.poisson_ratio"),
                 format!("{nu} is outside (-1, 0.5)"),
             ));
         }
         let e = self.restitution;
         if !(e > 0.0 && e <= 1.0) {
             return Err(EngineError::invalid(
-                &format!("{field}.restitution"),
+                format!("{field}.restitution"),
                 format!("{e} is outside (0, 1]"),
             ));
         }
         if self.normal_damping_ratio != 0.0 || self.shear_damping_ratio != 0.0 {
             return Err(EngineError::invalid(
-                &format!("{field}.normal_damping_ratio"),
+                format!("{field}.normal_damping_ratio"),
                 "Hertz-Mindlin is damped by its restitution, not by damping ratios (give 0)",
             ));
         }
@@ -182,9 +183,21 @@ impl ContactModel {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct MaterialTable {
     models: Vec<ContactModel>,
+    /// Each Hertz-Mindlin model's constants, at its index (default for a linear one).
+    hertz: Vec<HertzConstants>,
     /// What the force kernels ask of the whole table at every step, kept with
     /// it (a scan of every pair's model each step cost the step a few percent).
     summary: TableSummary,
+}
+
+impl HertzConstants {
+    /// The constants of a Hertz-Mindlin `model`; zero for a linear one.
+    fn of_model(model: &ContactModel) -> Self {
+        match model.law {
+            ContactLaw::HertzMindlin => HertzConstants::of(model),
+            ContactLaw::Linear => HertzConstants::default(),
+        }
+    }
 }
 
 /// The table's answers to the force kernels' questions, made anew at every change.
@@ -222,7 +235,12 @@ impl MaterialTable {
         model.validate("contact_model")?;
         let models = vec![model; MAX_GROUPS * MAX_GROUPS];
         let summary = TableSummary::of(&models);
-        Ok(MaterialTable { models, summary })
+        let hertz = models.iter().map(HertzConstants::of_model).collect();
+        Ok(MaterialTable {
+            models,
+            hertz,
+            summary,
+        })
     }
 
     /// Checks that `a` and `b` name material groups.
@@ -244,6 +262,8 @@ impl MaterialTable {
         model.validate("contact_model")?;
         self.models[a * MAX_GROUPS + b] = model;
         self.models[b * MAX_GROUPS + a] = model;
+        self.hertz[a * MAX_GROUPS + b] = HertzConstants::of_model(&model);
+        self.hertz[b * MAX_GROUPS + a] = HertzConstants::of_model(&model);
         self.summary = TableSummary::of(&self.models);
         Ok(())
     }
@@ -279,6 +299,12 @@ impl MaterialTable {
     #[inline(always)]
     pub fn by_index(&self, index: u16) -> &ContactModel {
         &self.models[index as usize]
+    }
+
+    /// The Hertz-Mindlin constants of the model stored at `index` (zero for a linear one).
+    #[inline(always)]
+    pub fn hertz_constants(&self, index: u16) -> &HertzConstants {
+        &self.hertz[index as usize]
     }
 
     /// The model every pair of groups uses, if they all use one and it has no

@@ -36,13 +36,44 @@ pub fn effective_moduli(model: &ContactModel) -> (f64, f64) {
     )
 }
 
-/// The tangent stiffnesses `(S_n, k_t) = (2 E* a, 8 G* a)` (N/m) at `overlap`
-/// (m) between bodies of effective radius `r_star` (m), `a = sqrt(R* delta)`.
+/// What a Hertz-Mindlin model's contacts share: `E*`, `G*` and the damping
+/// factor `d(e)`, computed once per model (the material table keeps them for
+/// the pair kernel) instead of once per contact and step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct HertzConstants {
+    /// `E*` (Pa).
+    pub e_star: f64,
+    /// `G*` (Pa).
+    pub g_star: f64,
+    /// `d(e)` ([`damping_factor`]).
+    pub damping: f64,
+}
+
+impl HertzConstants {
+    /// The constants of `model`.
+    pub fn of(model: &ContactModel) -> Self {
+        let (e_star, g_star) = effective_moduli(model);
+        HertzConstants {
+            e_star,
+            g_star,
+            damping: damping_factor(model.restitution),
+        }
+    }
+
+    /// The tangent stiffnesses `(S_n, k_t) = (2 E* a, 8 G* a)` (N/m) at
+    /// `overlap` (m) between bodies of effective radius `r_star` (m), `a = sqrt(R* delta)`.
+    #[inline(always)]
+    pub fn tangent_stiffness(&self, overlap: f64, r_star: f64) -> (f64, f64) {
+        let a = (r_star * overlap.max(0.0)).sqrt();
+        (2.0 * self.e_star * a, 8.0 * self.g_star * a)
+    }
+}
+
+/// The tangent stiffnesses `(S_n, k_t) = (2 E* a, 8 G* a)` (N/m) of `model` at
+/// `overlap` (m) between bodies of effective radius `r_star` (m).
 #[inline(always)]
 pub fn tangent_stiffness(model: &ContactModel, overlap: f64, r_star: f64) -> (f64, f64) {
-    let (e_star, g_star) = effective_moduli(model);
-    let a = (r_star * overlap.max(0.0)).sqrt();
-    (2.0 * e_star * a, 8.0 * g_star * a)
+    HertzConstants::of(model).tangent_stiffness(overlap, r_star)
 }
 
 /// The damping factor `d(e) = -sqrt(5) ln e / sqrt(pi^2 + ln^2 e)` of a
@@ -84,13 +115,28 @@ pub fn contact_law(
     increment_time: f64,
     record: &mut ContactRecord,
 ) -> ContactForce {
+    let constants = HertzConstants::of(model);
+    contact_law_with(&constants, model, kinematics, dt, increment_time, record)
+}
+
+/// [`contact_law`] with the model's `constants` computed beforehand (the pair
+/// kernel's: the same values, so the same bits).
+#[inline]
+pub fn contact_law_with(
+    constants: &HertzConstants,
+    model: &ContactModel,
+    kinematics: &ContactKinematics,
+    dt: f64,
+    increment_time: f64,
+    record: &mut ContactRecord,
+) -> ContactForce {
     let mut dissipation = ContactDissipation::default();
     let overlap = kinematics.overlap;
     let r_star = RollingSpring::effective_radius(kinematics);
-    let (normal_stiffness, shear_stiffness) = tangent_stiffness(model, overlap, r_star);
+    let (normal_stiffness, shear_stiffness) = constants.tangent_stiffness(overlap, r_star);
     let elastic_normal = (2.0 / 3.0) * normal_stiffness * overlap;
     let normal = damped_normal(
-        model,
+        constants.damping,
         kinematics,
         elastic_normal,
         normal_stiffness,
@@ -141,14 +187,13 @@ pub fn contact_law(
 /// of a density-scaled sample then never settles.
 #[inline(always)]
 fn damped_normal(
-    model: &ContactModel,
+    factor: f64,
     kinematics: &ContactKinematics,
     elastic_normal: f64,
     normal_stiffness: f64,
     dt: f64,
     dissipation: &mut ContactDissipation,
 ) -> f64 {
-    let factor = damping_factor(model.restitution);
     if factor == 0.0 {
         return elastic_normal;
     }

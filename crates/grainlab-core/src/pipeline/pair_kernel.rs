@@ -7,7 +7,9 @@ use crate::cell::PeriodicCell;
 use crate::contact::ContactGeometry;
 use crate::diagnostics::ContactDissipation;
 use crate::law::history::{forget, HistoryRun};
-use crate::law::{contact_law, ContactForce, ContactKinematics, ContactRecord, HISTORY_WIDTH};
+use crate::law::{
+    contact_law, hertz, ContactForce, ContactKinematics, ContactRecord, HISTORY_WIDTH,
+};
 use crate::material::{ContactLaw, ContactModel, MaterialTable};
 use crate::parallel::DisjointWriter;
 use crate::state::ParticleMotion;
@@ -641,6 +643,10 @@ impl PairKernel<'_> {
         let (dt, increment_time) = (self.dt, self.increment_time);
         let c = if !DASHPOTS {
             contact_law::<false>(model, &kinematics, dt, increment_time, record)
+        } else if model.law == ContactLaw::HertzMindlin {
+            // (a table with Hertz-Mindlin is never `SINGLE`: the pair's own model index)
+            let constants = self.materials.hertz_constants(columns.model[k]);
+            hertz::contact_law_with(constants, model, &kinematics, dt, increment_time, record)
         } else {
             contact_law::<true>(model, &kinematics, dt, increment_time, record)
         };
