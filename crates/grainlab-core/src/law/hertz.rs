@@ -3,16 +3,18 @@
 //!
 //! The sphere law applied to disks, as LAMMPS's `pair granular hertz/material E
 //! damping nu tangential mindlin NULL 0 mu` with `damping coeff_restitution`
-//! and `limit_damping` computes it (docs/contact-law.md, "Hertz-Mindlin"):
+//! computes it (docs/contact-law.md, "Hertz-Mindlin"):
 //! with `E* = E / (2 (1 - nu^2))`, `G* = E / (4 (2 - nu) (1 + nu))` (two grains
 //! of one material, or a grain and a wall of it), `R*` the effective radius
 //! and `a = sqrt(R* delta)` the contact radius,
 //! - normal: `F_ne = 4/3 E* a delta`, tangent stiffness `S_n = 2 E* a`;
 //! - damping: `-eta_n v_n` with `eta_n = d(e) sqrt(m* F_ne / delta)`,
-//!   `d(e) = -sqrt(5) ln e / sqrt(pi^2 + ln^2 e)`, the total never pulling;
+//!   `d(e) = -sqrt(5) ln e / sqrt(pi^2 + ln^2 e)`, not clipped (LAMMPS's default);
 //! - tangential: the tangential displacement `xi` is the history (m), the
-//!   elastic force `-k_t xi` with `k_t = 8 G* a`, capped at `mu F_ne`, `xi`
-//!   rescaled to the cap when the contact slides; no tangential dashpot;
+//!   elastic force `-k_t xi` with `k_t = 8 G* a`, capped at `mu |F_n|` (the
+//!   normal force with its dashpot), `xi` rescaled to the cap when the contact
+//!   slides; no tangential dashpot; the torques' lever arms `r - delta/2`
+//!   between grains, `r` against a wall, as LAMMPS takes them;
 //! - rolling: the rolling sub-model as for the linear law, its stiffness rule
 //!   from the tangent normal stiffness `S_n`.
 use std::f64::consts::PI;
@@ -145,20 +147,31 @@ pub fn contact_law_with(
     );
     let (spring, sliding) = mindlin(
         model,
-        elastic_normal,
+        normal,
         shear_stiffness,
         kinematics.tangential_velocity * increment_time,
         &mut record[TANGENTIAL_HISTORY.start],
         &mut dissipation,
     );
+    // LAMMPS's lever arms: to the middle of the overlap between two grains
+    // (`r - delta/2`, `pair granular`), the grain's radius against a wall
+    // (`fix wall/gran`; a wall, body i, has none)
+    let (arm_i, arm_j) = if kinematics.radius_i > 0.0 {
+        (
+            kinematics.radius_i - 0.5 * overlap,
+            kinematics.radius_j - 0.5 * overlap,
+        )
+    } else {
+        (0.0, kinematics.radius_j)
+    };
     let mut force = ContactForce {
         normal,
         elastic_normal,
         shear: spring,
         shear_spring: spring,
         sliding,
-        torque_i: -kinematics.radius_i * spring,
-        torque_j: -kinematics.radius_j * spring,
+        torque_i: -arm_i * spring,
+        torque_j: -arm_j * spring,
         rolling_spring: 0.0,
         rolling_moment: 0.0,
         rolling_energy: 0.0,
@@ -177,14 +190,10 @@ pub fn contact_law_with(
     force
 }
 
-/// The normal force with the restitution's dashpot, clipped so that it never
-/// pulls (LAMMPS's `limit_damping`; the linear law's dashpot does the same);
-/// the dashpot's work over `dt` goes to `dissipation.viscous`. Unclipped, the
-/// rebound's coefficient of restitution would be `e` exactly; clipped, the
-/// contact ends a little early and a little livelier (`e = 0.3` rebounds at
-/// 0.397, 0.5 at 0.550, 0.9 at 0.902). An unclipped dashpot glues grains to a
-/// wall that moves away from them, faster the heavier they are: a servo wall
-/// of a density-scaled sample then never settles.
+/// The normal force with the restitution's dashpot, as LAMMPS computes it by
+/// default (without `limit_damping`): not clipped, so that the rebound's
+/// coefficient of restitution is `e` exactly; the dashpot pulls a little as a
+/// contact opens. Its work over `dt` goes to `dissipation.viscous`.
 #[inline(always)]
 fn damped_normal(
     factor: f64,
@@ -200,20 +209,21 @@ fn damped_normal(
     // m* F_ne / delta = m* (2/3) S_n
     let eta = factor * (kinematics.reduced_mass * (2.0 / 3.0) * normal_stiffness).sqrt();
     let vn = kinematics.normal_velocity;
-    let damped = (elastic_normal - eta * vn).max(0.0);
+    let damped = elastic_normal - eta * vn;
     dissipation.viscous += (elastic_normal - damped) * vn * dt;
     damped
 }
 
 /// Mindlin's tangential spring: the displacement `xi` moved by `displacement`,
-/// the force `-k_t xi` capped at `mu F_ne` (the contact slides when it ends at
-/// the cap, and `xi` is rescaled to it); the slip's work (the mean force over
+/// the force `-k_t xi` capped at `mu |F_n|`, the normal force with its dashpot,
+/// as LAMMPS caps it (the contact slides when it ends at the cap, and `xi` is
+/// rescaled to it); the slip's work (the mean force over
 /// the slip at the current `k_t`) goes to `dissipation.friction`. Returns the
 /// elastic shear force and whether the contact slides.
 #[inline(always)]
 fn mindlin(
     model: &ContactModel,
-    elastic_normal: f64,
+    normal: f64,
     shear_stiffness: f64,
     displacement: f64,
     xi: &mut f64,
@@ -222,8 +232,8 @@ fn mindlin(
     let before = -shear_stiffness * *xi;
     *xi += displacement;
     let trial = -shear_stiffness * *xi;
-    let cap = model.friction * elastic_normal;
-    if trial.abs() < cap {
+    let cap = model.friction * normal.abs();
+    if trial.abs() <= cap {
         return (trial, false);
     }
     let capped = cap.copysign(trial);
@@ -309,17 +319,16 @@ mod tests {
     }
 
     #[test]
-    fn the_restitutions_dashpot_opposes_the_normal_velocity_and_never_pulls() {
+    fn the_restitutions_dashpot_opposes_the_normal_velocity() {
         let mut m = steel();
         m.restitution = 0.5;
         let mut record = [0.0; HISTORY_WIDTH];
         let approach = contact_law(&m, &kinematics(1.0e-6, -1.0, 0.0), 1e-7, 1e-7, &mut record);
         assert!(approach.normal > approach.elastic_normal);
         assert!(approach.dissipation.viscous > 0.0);
-        // opening fast at a small overlap, the dashpot would pull: clipped at zero
+        // opening fast at a small overlap, the dashpot pulls (LAMMPS's default)
         let apart = contact_law(&m, &kinematics(1.0e-9, 100.0, 0.0), 1e-7, 1e-7, &mut record);
-        assert_eq!(apart.normal, 0.0);
-        assert!(apart.dissipation.viscous > 0.0);
+        assert!(apart.normal < 0.0 && apart.dissipation.viscous > 0.0);
         assert_eq!(damping_factor(1.0), 0.0);
         // LAMMPS's factor at e = 0.5: sqrt(5) ln 2 / sqrt(pi^2 + ln^2 2)
         let ln2 = 2.0f64.ln();
