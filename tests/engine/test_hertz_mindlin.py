@@ -109,6 +109,6 @@ def test_a_biaxial_run_with_hertz_mindlin_consolidates_and_shears(tmp_path):
     result = biaxial.run_biaxial(config, tmp_path / "run", progress=False)
     summary = result.summary
     # consolidated to sigma_0 (a dashpot at the servo platens never let it settle) and
-    # sheared to 1 %: the deviator rose (1.45 here), every record finite
+    # sheared to 1 %: the deviator rose, every record finite
     assert summary["peak_stress_ratio"] > 1.2
     assert np.isfinite(summary["final_stress_ratio"])
