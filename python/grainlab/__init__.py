@@ -4,6 +4,7 @@ The engine is Rust (:mod:`grainlab._core`); :class:`Simulation` drives it from N
 """
 
 from grainlab._core import SimulationUnstableError, __version__, density_scaling_factor
+from grainlab.bodies import ClumpMassProperties, clump_mass_properties
 from grainlab.simulation import (
     FIX_ROTATION,
     FIX_X,
@@ -23,6 +24,7 @@ __all__ = [
     "FIX_ROTATION",
     "FIX_X",
     "FIX_Y",
+    "ClumpMassProperties",
     "ContactModel",
     "Contacts",
     "Energy",
@@ -34,5 +36,6 @@ __all__ = [
     "WallContacts",
     "WallState",
     "__version__",
+    "clump_mass_properties",
     "density_scaling_factor",
 ]

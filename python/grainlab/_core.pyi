@@ -26,6 +26,7 @@ __all__ = [
     "fourier_moment",
     "fabric_tensor",
     "rattlers",
+    "clump_mass_properties",
 ]
 
 __version__: str
@@ -378,3 +379,11 @@ def rattlers(
     threads: int,
 ) -> NDArray[np.bool_]:
     """``(N,)`` bool mask of the rattlers, removed iteratively."""
+
+# bodies (crates/grainlab-py/src/body.rs)
+
+def clump_mass_properties(
+    offsets: NDArray[np.float64], radii: NDArray[np.float64], density: float
+) -> tuple[float, float, tuple[float, float], float, NDArray[np.float64]]:
+    """The clump's union area (m^2), mass (kg per m), centroid (m), moment of
+    inertia about it (kg m^2 per m) and its pebbles' offsets from the centroid."""

@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod body;
 pub mod bond;
 pub mod boundary;
 pub mod cell;

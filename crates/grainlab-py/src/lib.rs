@@ -6,6 +6,7 @@
 use pyo3::prelude::*;
 
 mod analysis;
+mod body;
 mod convert;
 mod simulation;
 
@@ -34,5 +35,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<simulation::Engine>()?;
     m.add_function(wrap_pyfunction!(density_scaling_factor, m)?)?;
     analysis::register(m)?;
+    body::register(m)?;
     Ok(())
 }
