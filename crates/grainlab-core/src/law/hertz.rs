@@ -20,10 +20,7 @@
 use std::f64::consts::PI;
 
 use super::rolling::RollingSpring;
-use super::{
-    ContactForce, ContactKinematics, ContactRecord, Rolling, RollingModel, ROLLING_HISTORY,
-    TANGENTIAL_HISTORY,
-};
+use super::{with_rolling, ContactForce, ContactKinematics, ContactRecord, TANGENTIAL_HISTORY};
 use crate::diagnostics::ContactDissipation;
 use crate::material::ContactModel;
 
@@ -164,7 +161,7 @@ pub fn contact_law_with(
     } else {
         (0.0, kinematics.radius_j)
     };
-    let mut force = ContactForce {
+    let force = ContactForce {
         normal,
         elastic_normal,
         shear: spring,
@@ -179,15 +176,7 @@ pub fn contact_law_with(
         shear_stiffness,
         dissipation,
     };
-    Rolling::apply(
-        model,
-        kinematics,
-        dt,
-        increment_time,
-        &mut record[ROLLING_HISTORY],
-        &mut force,
-    );
-    force
+    with_rolling(model, kinematics, dt, increment_time, record, force)
 }
 
 /// The normal force with the restitution's dashpot, as LAMMPS computes it by

@@ -273,7 +273,7 @@ pub fn contact_law<const DASHPOTS: bool>(
         dt,
         &mut dissipation,
     );
-    let mut force = ContactForce {
+    let force = ContactForce {
         normal,
         elastic_normal,
         shear,
@@ -288,6 +288,20 @@ pub fn contact_law<const DASHPOTS: bool>(
         shear_stiffness: model.shear_stiffness,
         dissipation,
     };
+    with_rolling(model, kinematics, dt, increment_time, record, force)
+}
+
+/// `force` with the rolling sub-model's torques and dissipation added, from and
+/// into its slot of `record` (the last sub-model of either law).
+#[inline(always)]
+pub(crate) fn with_rolling(
+    model: &ContactModel,
+    kinematics: &ContactKinematics,
+    dt: f64,
+    increment_time: f64,
+    record: &mut ContactRecord,
+    mut force: ContactForce,
+) -> ContactForce {
     Rolling::apply(
         model,
         kinematics,
