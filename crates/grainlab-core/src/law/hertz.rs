@@ -105,8 +105,9 @@ pub fn stored_energy(force: &ContactForce) -> f64 {
 
 /// The law for one touching contact (conventions and arguments as
 /// [`super::contact_law`]); the record's tangential slot holds the tangential
-/// displacement `xi` (m).
-#[inline]
+/// displacement `xi` (m). Not inlined: its code kept out of the linear law's
+/// loops, which test for it on every pair (the four-pair loop's tail among them).
+#[inline(never)]
 pub fn contact_law(
     model: &ContactModel,
     kinematics: &ContactKinematics,
@@ -119,8 +120,8 @@ pub fn contact_law(
 }
 
 /// [`contact_law`] with the model's `constants` computed beforehand (the pair
-/// kernel's: the same values, so the same bits).
-#[inline]
+/// kernel's: the same values, so the same bits); not inlined, as [`contact_law`].
+#[inline(never)]
 pub fn contact_law_with(
     constants: &HertzConstants,
     model: &ContactModel,
