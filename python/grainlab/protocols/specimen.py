@@ -3,8 +3,10 @@ state's common part (:class:`SpecimenRun`), the sample's generation by radius
 expansion (:func:`generate`, the ``sample.*`` keys) and the isotropic
 consolidation in four servo-controlled walls (:func:`consolidate`, the
 ``consolidation.*`` keys), and the outputs written from a finished ``run.h5``
-(:func:`write_run_outputs`). The biaxial test, the oedometer and the cyclic test
-start with them."""
+(:func:`write_run_outputs`), and the grains' contact law (:func:`contact_law`,
+:func:`grain_model`). The biaxial test, the oedometer and the cyclic test start
+with the generation and the consolidation; simple shear generates its sample
+through :class:`SpecimenProtocol` and consolidates it in its periodic cell."""
 
 from __future__ import annotations
 
