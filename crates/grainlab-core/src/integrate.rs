@@ -7,7 +7,7 @@
 //! velocity. On the first step after velocities were set (full-step values
 //! `v(n)`), the kick is `dt/2`, so that `v(1/2) = v(0) + dt/2 a(0)`; this makes
 //! leapfrog positions equal velocity-Verlet ones (docs/contact-law.md).
-use crate::state::{FIX_ROTATION, FIX_X, FIX_Y};
+use crate::state::{FIX_ROTATION, FIX_X, FIX_Y, PEBBLE};
 use crate::vec2::{mat_vec, sub, Mat2, Vec2};
 
 /// Read-only inputs of the integration of one stripe of particles.
@@ -299,6 +299,10 @@ impl<'a> StripeKernel<'a> {
             (w, fd[2]) =
                 kick::<DAMPED>(w_old, self.torque[k], self.inv_inertia[k], alpha, step.kick);
         } else {
+            if fix & PEBBLE != 0 {
+                // moved with its clump (`body::clumps`)
+                return;
+            }
             if fix & FIX_X == 0 {
                 (v[0], fd[0]) = kick::<DAMPED>(v_old[0], f[0], inv_m, alpha, step.kick);
             }

@@ -28,7 +28,7 @@ pub mod wall;
 pub use cell::PeriodicCell;
 pub use error::{EngineError, Result};
 pub use material::{ContactLaw, ContactModel};
-pub use pipeline::{Simulation, StepParameters};
+pub use pipeline::{BodySpec, Simulation, StepParameters};
 pub use state::Particles;
 pub use wall::{ServoControl, Wall, WallControl, WallShape};
 

@@ -27,7 +27,7 @@ use crate::error::{EngineError, Result};
 use crate::law::history::ContactHistory;
 use crate::material::MaterialTable;
 use crate::parallel::stripe_count;
-use crate::state::Particles;
+use crate::state::{Particles, NO_CLUMP};
 use crate::vec2::{add, distance_from_identity, dot, sub, Mat2, Vec2, IDENTITY};
 use crate::wall::Wall;
 
@@ -382,6 +382,7 @@ impl NeighborList {
         let positions = &particles.position;
         let radii = &particles.radius;
         let groups = &particles.group;
+        let clump = &particles.clump;
         let skin = self.skin;
         for bx in 0..grid.n[0] {
             for by in 0..grid.n[1] {
@@ -408,7 +409,9 @@ impl NeighborList {
                                 let j = pj as usize;
                                 let d = sub(add(positions[j], offset), xi);
                                 let reach = ri + radii[j] + skin;
+                                // two pebbles of one clump are never a pair
                                 if dot(d, d) < reach * reach
+                                    && (clump[i] == NO_CLUMP || clump[i] != clump[j])
                                     && !bonds.contains(pi, pj)
                                     && materials.interacts(groups[i], groups[j])
                                 {

@@ -16,6 +16,14 @@ pub const FIX_Y: u8 = 2;
 /// Bit in [`Particles::fixity`]: the angular velocity is prescribed.
 pub const FIX_ROTATION: u8 = 4;
 
+/// Bit in [`Particles::fixity`], set by the engine only: the particle is a
+/// pebble of a clump, moved rigidly with its body (`body::clumps`), not by the
+/// particles' integration.
+pub const PEBBLE: u8 = 8;
+
+/// [`Particles::clump`] of a particle that is a body of its own (a plain disk).
+pub const NO_CLUMP: u32 = u32::MAX;
+
 /// Number of material groups; contact models are set per pair of groups.
 pub const MAX_GROUPS: usize = 16;
 
@@ -54,6 +62,10 @@ pub struct Particles {
     pub force: Vec<Vec2>,
     /// Resultant torque of the last step, before damping (N m).
     pub torque: Vec<f64>,
+    /// The clump each particle is a pebble of, or [`NO_CLUMP`]. A pebble's
+    /// `mass` and `inertia` are its body's (the contact laws' damping sees the
+    /// body), its velocity the body's rigid motion at its centre.
+    pub clump: Vec<u32>,
 }
 
 impl Particles {
@@ -100,6 +112,7 @@ impl Particles {
             external_torque: vec![0.0; n],
             force: vec![[0.0; 2]; n],
             torque: vec![0.0; n],
+            clump: vec![NO_CLUMP; n],
             position,
             radius,
             density,
@@ -127,6 +140,7 @@ impl Particles {
             external_torque,
             force,
             torque,
+            clump,
         } = other;
         self.position.extend(position);
         self.velocity.extend(velocity);
@@ -144,6 +158,7 @@ impl Particles {
         self.external_torque.extend(external_torque);
         self.force.extend(force);
         self.torque.extend(torque);
+        self.clump.extend(clump);
     }
 
     /// Number of disks.
@@ -156,9 +171,14 @@ impl Particles {
         self.position.is_empty()
     }
 
-    /// Recomputes mass and inertia from radius and density (after either changed).
+    /// Recomputes mass and inertia from radius and density (after either
+    /// changed), for the particles that are bodies of their own (a pebble's
+    /// are its clump's).
     pub fn update_mass_properties(&mut self) {
         for k in 0..self.len() {
+            if self.clump[k] != NO_CLUMP {
+                continue;
+            }
             let r = self.radius[k];
             let m = self.density[k] * std::f64::consts::PI * r * r;
             let inertia = 0.5 * m * r * r;
@@ -190,6 +210,7 @@ impl Particles {
         gather(&mut self.external_torque, perm);
         gather(&mut self.force, perm);
         gather(&mut self.torque, perm);
+        gather(&mut self.clump, perm);
     }
 
     /// Checks that `index` names a particle.

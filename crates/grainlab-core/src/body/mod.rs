@@ -10,8 +10,10 @@
 //! Per unit thickness, as the engine's disks (`Particles`, thickness 1 m):
 //! mass `density * area` (kg per m), moment of inertia `density * J` about the
 //! centroid (kg m^2 per m), `J = int |x - centroid|^2 dA` (m^4).
+mod clumps;
 mod union;
 
+pub use clumps::{Clumps, NewClump};
 pub use union::{union_area_properties, AreaProperties};
 
 use crate::error::{require_finite_points, require_positive, EngineError, Result};

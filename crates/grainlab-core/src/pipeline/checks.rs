@@ -109,6 +109,7 @@ impl Simulation {
             || scalars.iter().any(|a| a.len() != n)
             || p.group.len() != n
             || p.fixity.len() != n
+            || p.clump.len() != n
             || (p.density.len() != n && p.density.len() != 1)
         {
             return bad("particle arrays of different lengths");
@@ -138,6 +139,7 @@ impl Simulation {
         {
             return bad("a bond or pressure chain names a particle that does not exist");
         }
+        self.clumps.check_consistent(p)?;
         self.neighbors
             .check_consistent(n, self.walls.len(), self.materials.len())
     }

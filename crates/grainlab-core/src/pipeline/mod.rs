@@ -33,6 +33,7 @@
 //! stripe by stripe; `checks.rs` the consistency checks and the errors
 //! of an unstable run. The bond law is in [`crate::bond`], the nearest image
 //! in [`crate::cell`].
+mod bodies;
 mod checks;
 mod deferred;
 mod pair_kernel;
@@ -40,4 +41,5 @@ mod pair_lanes;
 pub mod simulation;
 mod step;
 
+pub use bodies::BodySpec;
 pub use simulation::{Simulation, StepParameters};

@@ -12,7 +12,7 @@ use crate::law::{
 };
 use crate::material::{ContactLaw, ContactModel, MaterialTable};
 use crate::parallel::DisjointWriter;
-use crate::state::ParticleMotion;
+use crate::state::{ParticleMotion, PEBBLE};
 use crate::vec2::{add, dot, mat_vec, perp, scale, sub, Mat2, Vec2};
 use crate::wall::Wall;
 
@@ -275,6 +275,9 @@ pub(crate) struct ResetKernel<'a> {
     pub(crate) external_torque: &'a [f64],
     pub(crate) mass: &'a [f64],
     pub(crate) gravity: Vec2,
+    /// The particles' fixity when there are clumps: a pebble gets no weight
+    /// here (its clump gets its own, `body::clumps`).
+    pub(crate) pebble_fixity: Option<&'a [u8]>,
     /// No pressure chain, gravity or external force or torque: every external
     /// force is +-0, so `f_e + m g` is +0 whatever its sign, and the torques
     /// (+-0) are copied as they are.
@@ -306,8 +309,12 @@ impl ResetKernel<'_> {
         let loads = self.boundary_load.map(|load| &*load.range(lo, hi));
         let (external, mass) = (&self.external_force[lo..hi], &self.mass[lo..hi]);
         let g = self.gravity;
+        let pebbles = self.pebble_fixity.map(|fixity| &fixity[lo..hi]);
         for (q, f) in forces.iter_mut().enumerate() {
-            let (fe, m) = (external[q], mass[q]);
+            let (fe, mut m) = (external[q], mass[q]);
+            if pebbles.is_some_and(|fixity| fixity[q] & PEBBLE != 0) {
+                m = 0.0;
+            }
             *f = [fe[0] + m * g[0], fe[1] + m * g[1]];
             if let Some(loads) = loads {
                 *f = add(*f, loads[q]);

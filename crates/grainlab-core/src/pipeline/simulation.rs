@@ -6,6 +6,7 @@ use super::deferred::{DeferredIndex, WallSlot};
 use super::pair_kernel::{
     pair_kernel, wall_contact, NullSink, PairForce, PairKernel, PairRecord, RecordSink,
 };
+use crate::body::Clumps;
 use crate::bond::{bond_force, Bond, BondForce, BondSlot, Bonds};
 use crate::boundary::{ChainStripes, PressureChain};
 use crate::cell::{minimum_image, PeriodicCell};
@@ -21,13 +22,13 @@ use crate::law::ContactForce;
 use crate::material::{ContactModel, MaterialTable};
 use crate::neighbor::NeighborList;
 use crate::parallel::Pacer;
-use crate::state::{ParticleMotion, Particles};
+use crate::state::{ParticleMotion, Particles, NO_CLUMP};
 use crate::vec2::{add, norm, sub, Mat2, Vec2};
 use crate::wall::{Wall, WallControl};
 
 /// The first bytes of [`Simulation::to_bytes`]: the layout of the state that
 /// follows (bincode of [`Simulation`]); a new field makes a new tag.
-const STATE_TAG: &[u8; 8] = b"GLSTATE5";
+const STATE_TAG: &[u8; 8] = b"GLSTATE6";
 
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -62,8 +63,10 @@ impl StepParameters {
 /// A 2D disk DEM simulation: particles, walls, bonds, an optional periodic cell.
 #[derive(Serialize, Deserialize)]
 pub struct Simulation {
-    /// The disks.
+    /// The disks (a clump's pebbles among them).
     pub(crate) particles: Particles,
+    /// Bodies of two or more pebbles.
+    pub(crate) clumps: Clumps,
     /// Contact models per pair of groups.
     pub(crate) materials: MaterialTable,
     /// Rigid walls.
@@ -166,6 +169,7 @@ impl Simulation {
         let identity: Vec<u32> = (0..particles.len() as u32).collect();
         let mut sim = Simulation {
             particles,
+            clumps: Clumps::default(),
             materials: MaterialTable::uniform(model)?,
             walls: Vec::new(),
             bonds: Bonds::default(),
@@ -302,7 +306,9 @@ impl Simulation {
     /// Sets the rotations (rad, finite, external order).
     pub fn set_rotations(&mut self, rotations: &[f64]) -> Result<()> {
         require_finite_values("rotations", rotations)?;
-        self.particles.rotation = self.internal_array("rotations", rotations)?;
+        let rotation = self.internal_array("rotations", rotations)?;
+        self.check_pebbles_kept("rotations", &self.particles.rotation, &rotation)?;
+        self.particles.rotation = rotation;
         Ok(())
     }
 
@@ -314,6 +320,7 @@ impl Simulation {
             require_positive(&format!("radii[{k}]"), r)?;
         }
         let radius = self.internal_array("radii", radii)?;
+        self.check_pebbles_kept("radii", &self.particles.radius, &radius)?;
         self.modify_motion(|s| {
             s.particles.radius = radius;
             s.particles.update_mass_properties();
@@ -328,7 +335,14 @@ impl Simulation {
         for (k, &d) in densities.iter().enumerate() {
             require_positive(&format!("densities[{k}]"), d)?;
         }
-        self.particles.density = self.internal_array("densities", densities)?;
+        let density = self.internal_array("densities", densities)?;
+        if self.particles.density.len() == density.len() {
+            self.check_pebbles_kept("densities", &self.particles.density, &density)?;
+        } else {
+            let current = vec![self.particles.density[0]; density.len()];
+            self.check_pebbles_kept("densities", &current, &density)?;
+        }
+        self.particles.density = density;
         self.particles.update_mass_properties();
         Ok(())
     }
@@ -364,7 +378,8 @@ impl Simulation {
                 format!("{f} is not a combination of 1 (x), 2 (y), 4 (rotation)"),
             ));
         }
-        self.particles.fixity = self.internal_array("fixity", fixity)?;
+        let fixity = self.internal_array("fixity", fixity)?;
+        self.particles.fixity = self.fixity_with_clumps(fixity)?;
         Ok(())
     }
 
@@ -547,6 +562,17 @@ impl Simulation {
                 format!("cannot bond particle {i} to itself"),
             ));
         }
+        let clump = self.particles.clump[i];
+        if clump != NO_CLUMP && clump == self.particles.clump[j] {
+            return Err(EngineError::invalid(
+                "bond",
+                format!(
+                    "particles {} and {} are pebbles of one clump and cannot be bonded",
+                    self.external_index(i),
+                    self.external_index(j)
+                ),
+            ));
+        }
         if self.bonds.contains(i as u32, j as u32) {
             return Err(EngineError::invalid(
                 "bond",
@@ -675,6 +701,12 @@ impl Simulation {
         }
         for (k, &q) in particles.iter().enumerate() {
             self.particles.check_index(&format!("particles[{k}]"), q)?;
+            if self.particles.clump[self.internal_index(q)] != NO_CLUMP {
+                return Err(EngineError::invalid(
+                    format!("particles[{k}]"),
+                    format!("particle {q} is a pebble of a clump; a chain's particles are bodies of their own"),
+                ));
+            }
         }
         for (name, w) in [("start_wall", start_wall), ("end_wall", end_wall)] {
             if let Some(w) = w {
@@ -726,6 +758,7 @@ impl Simulation {
     pub fn set_positions(&mut self, positions: &[Vec2]) -> Result<()> {
         require_finite_points("positions", positions)?;
         let position = self.internal_array("positions", positions)?;
+        self.check_pebbles_kept("positions", &self.particles.position, &position)?;
         self.modify_motion(|s| {
             s.particles.position = position;
             s.neighbors.invalidate();
@@ -740,6 +773,7 @@ impl Simulation {
     pub fn set_velocities(&mut self, velocities: &[Vec2]) -> Result<()> {
         require_finite_points("velocities", velocities)?;
         let velocity = self.internal_array("velocities", velocities)?;
+        self.check_pebbles_kept("velocities", &self.particles.velocity, &velocity)?;
         self.modify_motion(|s| {
             s.particles.velocity = velocity;
             s.half_kick_pending = true;
@@ -752,6 +786,11 @@ impl Simulation {
     pub fn set_angular_velocities(&mut self, angular_velocities: &[f64]) -> Result<()> {
         require_finite_values("angular_velocities", angular_velocities)?;
         let omega = self.internal_array("angular_velocities", angular_velocities)?;
+        self.check_pebbles_kept(
+            "angular_velocities",
+            &self.particles.angular_velocity,
+            &omega,
+        )?;
         self.modify_motion(|s| {
             s.particles.angular_velocity = omega;
             s.half_kick_pending = true;
@@ -784,7 +823,7 @@ impl Simulation {
     /// checks its input before, so that a refused change leaves the springs as
     /// they were; the test below refuses a setter that writes those fields
     /// outside of it.
-    fn modify_motion<R>(&mut self, change: impl FnOnce(&mut Self) -> R) -> R {
+    pub(crate) fn modify_motion<R>(&mut self, change: impl FnOnce(&mut Self) -> R) -> R {
         self.catch_up_shear_springs();
         change(self)
     }
@@ -979,13 +1018,16 @@ impl Simulation {
                 ks[q] += b.shear_stiffness;
             }
         }
-        let mut dt = f64::INFINITY;
-        for q in 0..n {
-            let fallback = self.materials.max_stiffness_for_group(
+        let fallback = |q: usize| {
+            self.materials.max_stiffness_for_group(
                 p.group[q],
                 p.radius[q],
                 self.params.max_overlap_ratio,
-            );
+            )
+        };
+        let mut dt = self.clump_time_step([&kn, &ks, &kr], fallback);
+        for q in (0..n).filter(|&q| p.clump[q] == NO_CLUMP) {
+            let fallback = fallback(q);
             let kn_q = if kn[q] > 0.0 { kn[q] } else { fallback };
             let ks_q = if ks[q] > 0.0 { ks[q] } else { fallback };
             let r = p.radius[q];
@@ -1041,6 +1083,8 @@ impl Simulation {
         for chain in self.chains.iter_mut() {
             chain.remap(&new_of_old);
         }
+        self.clumps.remap(&new_of_old);
+        self.clumps.rewrap(&self.particles, self.cell.as_ref());
         self.index_stripes();
         for (k, &e) in self.order.iter().enumerate() {
             self.rank[e as usize] = k as u32;

@@ -119,9 +119,10 @@ impl Simulation {
         }
         let contacts = merge_tallies(&stripes, &bonds);
         self.servo_walls();
-        let motion = self.integrate::<MEASURE>(team, defer);
+        let (mut motion, integration) = self.integrate::<MEASURE>(team, defer);
         self.move_walls();
         self.deform_cell();
+        self.move_clumps::<MEASURE>(&integration, &mut motion);
         self.track_displacements(&motion);
         self.book_energy(&contacts, &walls, wall_work, &motion);
         if MEASURE {
@@ -164,6 +165,28 @@ impl Simulation {
                 cell.deform(&m);
             }
         }
+    }
+
+    /// Step 8b': the clumps take their step from their pebbles' resultants,
+    /// and put their pebbles in place (`body::clumps`), after the cell's
+    /// deformation so that the pebbles' images are of the deformed cell.
+    fn move_clumps<const MEASURE: bool>(
+        &mut self,
+        integration: &IntegrationStep,
+        motion: &mut IntegrationTally,
+    ) {
+        if self.clumps.is_empty() {
+            return;
+        }
+        let gradient = self.deforming_gradient();
+        let tally = self.clumps.integrate::<MEASURE>(
+            &mut self.particles,
+            self.neighbors.reference().reference,
+            integration,
+            self.cell.as_ref(),
+            gradient.as_ref(),
+        );
+        motion.merge(&tally);
     }
 
     /// Step 8c: the largest displacements since the last build, for the
@@ -319,6 +342,7 @@ impl Simulation {
             external_torque: &p.external_torque,
             mass: &p.mass,
             gravity: self.params.gravity,
+            pebble_fixity: (!self.clumps.is_empty()).then_some(p.fixity.as_slice()),
             no_loads: self.chains.is_empty()
                 && !self.external_loads
                 && self.params.gravity == [0.0, 0.0],
@@ -598,7 +622,7 @@ impl Simulation {
         &mut self,
         team: Option<&Team>,
         defer: bool,
-    ) -> IntegrationTally {
+    ) -> (IntegrationTally, IntegrationStep) {
         // with a team the cross-stripe forces wait in the buffer (else they are applied)
         let buffered = team.is_some();
         let dt = self.params.time_step;
@@ -728,7 +752,7 @@ impl Simulation {
         for t in &tallies {
             total.merge(t);
         }
-        total
+        (total, step)
     }
 }
 

@@ -1,0 +1,485 @@
+//! The clumps of a simulation: bodies of two or more pebbles, moved rigidly.
+//!
+//! The pebbles stay particles (`Particles`): the neighbour lists, the contact
+//! laws, the walls and the bonds see them as disks, except that two pebbles of
+//! one clump are never a pair. What a clump adds is its motion. After the
+//! particles' integration, each clump sums its pebbles' resultants (contacts,
+//! bonds, walls and external loads) into a force and a torque about its
+//! centroid, in member order (the same bits on any number of threads), adds
+//! its weight, and takes the particles' leapfrog step with PFC's local damping
+//! on each of its three degrees of freedom (`F_d = -alpha |F| sign(v)` on the
+//! body's resultant, as PFC2D damps a clump). Its pebbles are then put back in
+//! place from the centroid and the angle, `x = X + R(theta) o + image`, so a
+//! clump never drifts out of shape, with the rigid velocity at their centres
+//! (`V + w x r`, less the imposed flow's `L r` in a deforming cell, whose
+//! velocities are relative to that flow).
+//!
+//! A body of one disk is not a clump: it is integrated as the particles are,
+//! bit for bit what it was before bodies existed.
+use serde::{Deserialize, Serialize};
+
+use crate::cell::PeriodicCell;
+use crate::error::{EngineError, Result};
+use crate::integrate::{kick, running_max, IntegrationStep, IntegrationTally};
+use crate::state::{Particles, FIX_ROTATION, FIX_X, FIX_Y, NO_CLUMP, PEBBLE};
+use crate::vec2::{add, cross, mat_vec, sub, Mat2, Vec2};
+
+use super::{ClumpTemplate, GivenMass};
+
+/// Rigid clumps of pebbles: per clump its motion and mass, and its members
+/// (internal particle indices, in the order their resultants are summed).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct Clumps {
+    /// Centroids (m).
+    pub centroid: Vec<Vec2>,
+    /// Angles from the body frame to the world, counter-clockwise (rad).
+    pub angle: Vec<f64>,
+    /// Velocities of the centroids (m/s), leapfrog half-step values as the particles'.
+    pub velocity: Vec<Vec2>,
+    /// Angular velocities (rad/s).
+    pub angular_velocity: Vec<f64>,
+    /// Masses per unit thickness (kg per m).
+    pub mass: Vec<f64>,
+    /// Moments of inertia about the centroid per unit thickness (kg m^2 per m).
+    pub inertia: Vec<f64>,
+    /// Prescribed degrees of freedom (`FIX_X`, `FIX_Y`, `FIX_ROTATION`).
+    pub fixity: Vec<u8>,
+    /// Resultant force of the last step, weight included, before damping (N).
+    pub force: Vec<Vec2>,
+    /// Resultant torque about the centroid of the last step, before damping (N m).
+    pub torque: Vec<f64>,
+    /// Clump `c`'s members are `pebble[start[c]..start[c + 1]]`.
+    pub start: Vec<u32>,
+    /// The members' internal particle indices.
+    pub pebble: Vec<u32>,
+    /// The members' centres in the body frame, from the centroid (m).
+    pub offset: Vec<Vec2>,
+    /// The periodic image each member is kept in (cell vectors `a`, `b`).
+    pub image: Vec<[i32; 2]>,
+}
+
+/// A new clump: its members (internal indices) and how its mass is known.
+pub struct NewClump<'a> {
+    /// Internal particle indices of the pebbles (two or more).
+    pub members: &'a [usize],
+    /// The body frame's angle in the world (rad): the offsets are stored
+    /// rotated back by it.
+    pub angle: f64,
+    /// Mass properties given by the user, else those of the pebbles' union
+    /// at their (common) density.
+    pub given: Option<GivenMass>,
+}
+
+/// `R(angle) o`, with the angle's sine and cosine.
+#[inline(always)]
+fn rotate((s, c): (f64, f64), o: Vec2) -> Vec2 {
+    [c * o[0] - s * o[1], s * o[0] + c * o[1]]
+}
+
+/// `w x r` in the plane.
+#[inline(always)]
+fn spin(w: f64, r: Vec2) -> Vec2 {
+    [-w * r[1], w * r[0]]
+}
+
+/// `s0 a + s1 b` of the cell (zero without one).
+fn image_offset(cell: Option<&PeriodicCell>, s: [i32; 2]) -> Vec2 {
+    match cell {
+        Some(c) if s != [0, 0] => [
+            s[0] as f64 * c.a[0] + s[1] as f64 * c.b[0],
+            s[0] as f64 * c.a[1] + s[1] as f64 * c.b[1],
+        ],
+        _ => [0.0; 2],
+    }
+}
+
+/// The whole cell vectors between `x` and `y` (`x - y` rounded in the cell's
+/// frame; zero without a cell).
+fn image_between(cell: Option<&PeriodicCell>, x: Vec2, y: Vec2) -> [i32; 2] {
+    match cell {
+        Some(c) => {
+            let f = c.fractional(add(c.origin, sub(x, y)));
+            [f[0].round() as i32, f[1].round() as i32]
+        }
+        None => [0, 0],
+    }
+}
+
+impl Clumps {
+    /// Number of clumps.
+    pub fn len(&self) -> usize {
+        self.mass.len()
+    }
+
+    /// True when no body has more than one pebble.
+    pub fn is_empty(&self) -> bool {
+        self.mass.is_empty()
+    }
+
+    /// The member range of clump `c` in `pebble`, `offset` and `image`.
+    pub fn members(&self, c: usize) -> std::ops::Range<usize> {
+        self.start[c] as usize..self.start[c + 1] as usize
+    }
+
+    /// Makes clumps of existing particles: mass properties from the union of
+    /// each clump's pebbles (their density must then be one) or as given,
+    /// velocity and angular velocity those that keep the pebbles' momentum and
+    /// angular momentum, pebbles put in rigid motion. The caller has checked
+    /// that the members exist, are plain disks and are in one clump each.
+    pub(crate) fn add(
+        &mut self,
+        particles: &mut Particles,
+        cell: Option<&PeriodicCell>,
+        clumps: &[NewClump<'_>],
+    ) -> Result<()> {
+        if self.start.is_empty() {
+            self.start.push(0);
+        }
+        for (k, new) in clumps.iter().enumerate() {
+            self.add_one(particles, cell, k, new)?;
+        }
+        self.assign_pebble_masses(particles);
+        self.place_pebbles(particles, cell, None);
+        Ok(())
+    }
+
+    fn add_one(
+        &mut self,
+        particles: &mut Particles,
+        cell: Option<&PeriodicCell>,
+        k: usize,
+        new: &NewClump<'_>,
+    ) -> Result<()> {
+        let p = &*particles;
+        let first = p.position[new.members[0]];
+        // the pebbles as one piece: each at its image nearest the first
+        let centres: Vec<Vec2> = new
+            .members
+            .iter()
+            .map(|&q| {
+                let x = p.position[q];
+                sub(x, image_offset(cell, image_between(cell, x, first)))
+            })
+            .collect();
+        let radii: Vec<f64> = new.members.iter().map(|&q| p.radius[q]).collect();
+        let (template, placement) = match new.given {
+            Some(given) => ClumpTemplate::with_mass(&centres, &radii, given),
+            None => {
+                let density = p.density[new.members[0]];
+                if let Some(&q) = new.members.iter().find(|&&q| p.density[q] != density) {
+                    return Err(EngineError::invalid(
+                        format!("bodies[{k}]"),
+                        format!(
+                            "pebbles {} and {q} have different densities: give the body's mass",
+                            new.members[0]
+                        ),
+                    ));
+                }
+                ClumpTemplate::from_pebbles(&centres, &radii, density)
+            }
+        }
+        .map_err(|e| match e {
+            EngineError::InvalidInput { field, message } => {
+                EngineError::invalid(format!("bodies[{k}].{field}"), message)
+            }
+            other => other,
+        })?;
+        let (mass, inertia) = (template.mass(), template.moment_of_inertia());
+        // the rigid motion with the pebbles' momentum and angular momentum
+        // about the centroid, the pebbles taken as disks of their own
+        let (mut momentum, mut disk_mass) = ([0.0; 2], 0.0);
+        for &q in new.members {
+            let (m, v) = (p.mass[q], p.velocity[q]);
+            momentum = add(momentum, [m * v[0], m * v[1]]);
+            disk_mass += m;
+        }
+        let mean = [momentum[0] / disk_mass, momentum[1] / disk_mass];
+        let (mut spin_momentum, mut spin_inertia) = (0.0, 0.0);
+        for (&q, &x) in new.members.iter().zip(&centres) {
+            let r = sub(x, placement.centroid);
+            let m = p.mass[q];
+            spin_momentum +=
+                m * cross(r, sub(p.velocity[q], mean)) + p.inertia[q] * p.angular_velocity[q];
+            spin_inertia += m * (r[0] * r[0] + r[1] * r[1]) + p.inertia[q];
+        }
+        let velocity = mean;
+        let angular_velocity = spin_momentum / spin_inertia;
+        let c = self.len() as u32;
+        let back = (-new.angle).sin_cos();
+        for ((&q, &o), &x) in new.members.iter().zip(template.offsets()).zip(&centres) {
+            self.pebble.push(q as u32);
+            self.offset.push(rotate(back, o));
+            self.image.push(image_between(cell, p.position[q], x));
+        }
+        let fixity = p.fixity[new.members[0]] & !PEBBLE;
+        for &q in new.members {
+            particles.clump[q] = c;
+        }
+        // the body's fixity is its pebbles' (the caller checked they agree)
+        self.fixity.push(fixity);
+        self.centroid.push(placement.centroid);
+        self.angle.push(new.angle);
+        self.velocity.push(velocity);
+        self.angular_velocity.push(angular_velocity);
+        self.mass.push(mass);
+        self.inertia.push(inertia);
+        self.force.push([0.0; 2]);
+        self.torque.push(0.0);
+        self.start.push(self.pebble.len() as u32);
+        Ok(())
+    }
+
+    /// Gives every pebble its clump's mass and inertia and the `PEBBLE` bit.
+    pub(crate) fn assign_pebble_masses(&self, particles: &mut Particles) {
+        for c in 0..self.len() {
+            let (m, i) = (self.mass[c], self.inertia[c]);
+            for &q in &self.pebble[self.members(c)] {
+                let q = q as usize;
+                particles.mass[q] = m;
+                particles.inertia[q] = i;
+                particles.inv_mass[q] = 1.0 / m;
+                particles.inv_inertia[q] = 1.0 / i;
+                particles.fixity[q] = self.fixity[c] | PEBBLE;
+            }
+        }
+    }
+
+    /// Follows a renumbering of the particles (`new_of_old[old] = new`).
+    pub(crate) fn remap(&mut self, new_of_old: &[u32]) {
+        for q in self.pebble.iter_mut() {
+            *q = new_of_old[*q as usize];
+        }
+    }
+
+    /// After the neighbour-list build wrapped the particles: the centroids
+    /// wrapped too, and each pebble's image read again from where it is.
+    pub(crate) fn rewrap(&mut self, particles: &Particles, cell: Option<&PeriodicCell>) {
+        let Some(cell) = cell else { return };
+        for c in 0..self.len() {
+            cell.wrap(&mut self.centroid[c]);
+            let turn = self.angle[c].sin_cos();
+            for m in self.members(c) {
+                let rigid = add(self.centroid[c], rotate(turn, self.offset[m]));
+                let x = particles.position[self.pebble[m] as usize];
+                self.image[m] = image_between(Some(cell), x, rigid);
+            }
+        }
+    }
+
+    /// Puts every pebble at its rigid place and velocity, with the clump's
+    /// angle, angular velocity and fixity; `gradient` is the deforming cell's
+    /// velocity gradient, if any.
+    pub(crate) fn place_pebbles(
+        &self,
+        particles: &mut Particles,
+        cell: Option<&PeriodicCell>,
+        gradient: Option<&Mat2>,
+    ) {
+        for c in 0..self.len() {
+            let turn = self.angle[c].sin_cos();
+            for m in self.members(c) {
+                let q = self.pebble[m] as usize;
+                let r = rotate(turn, self.offset[m]);
+                particles.position[q] =
+                    add(add(self.centroid[c], r), image_offset(cell, self.image[m]));
+                particles.velocity[q] = self.pebble_velocity(c, r, gradient);
+                particles.angular_velocity[q] = self.angular_velocity[c];
+                particles.rotation[q] = self.angle[c];
+            }
+        }
+    }
+
+    /// The rigid velocity of clump `c` at arm `r` from its centroid, relative
+    /// to the imposed flow `L x` when there is one.
+    #[inline(always)]
+    fn pebble_velocity(&self, c: usize, r: Vec2, gradient: Option<&Mat2>) -> Vec2 {
+        let v = add(self.velocity[c], spin(self.angular_velocity[c], r));
+        match gradient {
+            Some(l) => sub(v, mat_vec(l, r)),
+            None => v,
+        }
+    }
+
+    /// One leapfrog step of every clump, after the particles' (their pebbles'
+    /// resultants complete): see the module documentation. `cell` is the cell
+    /// after this step's deformation, `gradient` its velocity gradient when
+    /// it deforms, `reference` the positions at the last neighbour-list build.
+    pub(crate) fn integrate<const MEASURE: bool>(
+        &mut self,
+        particles: &mut Particles,
+        reference: &[Vec2],
+        step: &IntegrationStep,
+        cell: Option<&PeriodicCell>,
+        gradient: Option<&Mat2>,
+    ) -> IntegrationTally {
+        let mut sums = ClumpSums::default();
+        for c in 0..self.len() {
+            self.step_one::<MEASURE>(c, particles, step, &mut sums);
+        }
+        self.place_pebbles(particles, cell, gradient);
+        sums.track(self, particles, reference, step);
+        sums.tally.damping_dissipated = -sums.damping_work * step.kick;
+        sums.tally
+    }
+
+    /// The kick and drift of clump `c` (its pebbles not yet moved).
+    #[inline(always)]
+    fn step_one<const MEASURE: bool>(
+        &mut self,
+        c: usize,
+        particles: &Particles,
+        step: &IntegrationStep,
+        sums: &mut ClumpSums,
+    ) {
+        let turn = self.angle[c].sin_cos();
+        let (mut f, mut t) = ([0.0; 2], 0.0);
+        let (mut fe, mut te) = ([0.0; 2], 0.0);
+        for m in self.members(c) {
+            let q = self.pebble[m] as usize;
+            let r = rotate(turn, self.offset[m]);
+            let fq = particles.force[q];
+            f = add(f, fq);
+            t += particles.torque[q] + cross(r, fq);
+            if step.has_external {
+                let e = particles.external_force[q];
+                fe = add(fe, e);
+                te += particles.external_torque[q] + cross(r, e);
+            }
+        }
+        let mass = self.mass[c];
+        let weight = [mass * step.gravity[0], mass * step.gravity[1]];
+        f = add(f, weight);
+        fe = add(fe, weight);
+        self.force[c] = f;
+        self.torque[c] = t;
+        let fix = self.fixity[c];
+        let (v_old, w_old) = (self.velocity[c], self.angular_velocity[c]);
+        let (mut v, mut w, mut fd) = (v_old, w_old, [0.0; 3]);
+        let (alpha, inv_m) = (step.alpha, 1.0 / mass);
+        if fix & FIX_X == 0 {
+            (v[0], fd[0]) = kick::<true>(v_old[0], f[0], inv_m, alpha, step.kick);
+        }
+        if fix & FIX_Y == 0 {
+            (v[1], fd[1]) = kick::<true>(v_old[1], f[1], inv_m, alpha, step.kick);
+        }
+        if fix & FIX_ROTATION == 0 {
+            (w, fd[2]) = kick::<true>(w_old, t, 1.0 / self.inertia[c], alpha, step.kick);
+        }
+        // the same energy identities as the particles' (`StripeKernel::book`)
+        let v_full = [0.5 * (v_old[0] + v[0]), 0.5 * (v_old[1] + v[1])];
+        let w_full = 0.5 * (w_old + w);
+        sums.damping_work += fd[0] * v_full[0] + fd[1] * v_full[1] + fd[2] * w_full;
+        if step.has_external {
+            let free = |bit: u8, x: f64| if fix & bit == 0 { x } else { 0.0 };
+            sums.tally.external_work += (free(FIX_X, fe[0]) * v_full[0]
+                + free(FIX_Y, fe[1]) * v_full[1]
+                + free(FIX_ROTATION, te) * w_full)
+                * step.kick;
+        }
+        if MEASURE {
+            let (vk, wk) = if step.half_kick {
+                (v_old, w_old)
+            } else {
+                (v, w)
+            };
+            sums.tally.kinetic += 0.5 * mass * (v_old[0] * vk[0] + v_old[1] * vk[1])
+                + 0.5 * self.inertia[c] * w_old * wk;
+            if fix == 0 {
+                sums.tally.unbalanced_force_sum += (f[0] * f[0] + f[1] * f[1]).sqrt();
+                sums.tally.free_count += 1;
+            }
+        }
+        let mut x = self.centroid[c];
+        x[0] += step.dt * v[0];
+        x[1] += step.dt * v[1];
+        if let Some((origin, map)) = &step.step_map {
+            x = add(*origin, mat_vec(map, sub(x, *origin)));
+        }
+        sums.tally.non_finite |= !(x[0].is_finite() & x[1].is_finite() & w.is_finite());
+        self.centroid[c] = x;
+        self.velocity[c] = v;
+        self.angular_velocity[c] = w;
+        self.angle[c] += step.dt * w;
+    }
+
+    /// The members of every clump in order, with the index of their clump.
+    pub fn member_clumps(&self) -> impl Iterator<Item = (usize, u32)> + '_ {
+        (0..self.len()).flat_map(move |c| self.members(c).map(move |m| (c, self.pebble[m])))
+    }
+
+    /// Checks the clumps against the particles (after loading a state).
+    pub(crate) fn check_consistent(&self, particles: &Particles) -> Result<()> {
+        let n_clumps = self.len();
+        let per_clump = [
+            self.angle.len(),
+            self.angular_velocity.len(),
+            self.inertia.len(),
+            self.fixity.len(),
+            self.torque.len(),
+            self.velocity.len(),
+            self.centroid.len(),
+            self.force.len(),
+        ];
+        let members = self.pebble.len();
+        let bad = per_clump.iter().any(|&l| l != n_clumps)
+            || (n_clumps > 0 && self.start.len() != n_clumps + 1)
+            || self.offset.len() != members
+            || self.image.len() != members
+            || self.start.windows(2).any(|w| w[1] < w[0] + 2)
+            || self.start.last().is_some_and(|&s| s as usize != members)
+            || self.pebble.iter().any(|&q| q as usize >= particles.len())
+            || self
+                .member_clumps()
+                .any(|(c, q)| particles.clump[q as usize] != c as u32)
+            || particles.clump.iter().filter(|&&c| c != NO_CLUMP).count() != members;
+        if bad {
+            return Err(EngineError::invalid(
+                "state",
+                "inconsistent state: the clumps and their pebbles disagree",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The running sums of the clumps' step.
+#[derive(Default)]
+struct ClumpSums {
+    tally: IntegrationTally,
+    damping_work: f64,
+}
+
+impl ClumpSums {
+    /// The pebbles' largest displacements since the last build (for the
+    /// rebuild criterion), as the particles' integration measures them.
+    fn track(
+        &mut self,
+        clumps: &Clumps,
+        particles: &Particles,
+        reference: &[Vec2],
+        step: &IntegrationStep,
+    ) {
+        let acc = step.accumulated_map;
+        let acc_shift = match &step.step_map {
+            Some((origin, _)) => sub(*origin, mat_vec(&acc, *origin)),
+            None => [0.0; 2],
+        };
+        let (mut fluctuation, mut displacement) = (0.0f64, 0.0f64);
+        for &q in &clumps.pebble {
+            let q = q as usize;
+            let (x, r) = (particles.position[q], reference[q]);
+            let d = sub(x, r);
+            displacement = running_max(displacement, d[0] * d[0] + d[1] * d[1]);
+            if step.step_map.is_some() {
+                let u = sub(x, add(acc_shift, mat_vec(&acc, r)));
+                fluctuation = running_max(fluctuation, u[0] * u[0] + u[1] * u[1]);
+            }
+        }
+        self.tally.max_displacement_sq = displacement;
+        self.tally.max_fluctuation_sq = if step.step_map.is_some() {
+            fluctuation
+        } else {
+            displacement
+        };
+    }
+}
