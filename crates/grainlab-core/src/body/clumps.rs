@@ -21,6 +21,7 @@ use serde::{Deserialize, Serialize};
 use crate::cell::PeriodicCell;
 use crate::error::{EngineError, Result};
 use crate::integrate::{kick, running_max, IntegrationStep, IntegrationTally};
+use crate::parallel::{even_bounds, map_stripes, DisjointWriter, Team};
 use crate::state::{Particles, FIX_ROTATION, FIX_X, FIX_Y, NO_CLUMP, PEBBLE};
 use crate::vec2::{add, cross, mat_vec, sub, Mat2, Vec2};
 
@@ -56,6 +57,13 @@ pub struct Clumps {
     pub offset: Vec<Vec2>,
     /// The periodic image each member is kept in (cell vectors `a`, `b`).
     pub image: Vec<[i32; 2]>,
+    /// The members' arms from the centroid in the world, `R(angle) offset`,
+    /// as last placed (m).
+    pub arm: Vec<Vec2>,
+    /// Each clump's id, the order it was made in: the clumps are kept in the
+    /// order of their first pebble's place in the particles' spatial order,
+    /// so that the clumps' step walks the particles' arrays in order.
+    pub id: Vec<u32>,
 }
 
 /// A new clump: its members (internal indices) and how its mass is known.
@@ -80,6 +88,17 @@ fn rotate((s, c): (f64, f64), o: Vec2) -> Vec2 {
 #[inline(always)]
 fn spin(w: f64, r: Vec2) -> Vec2 {
     [-w * r[1], w * r[0]]
+}
+
+/// The rigid velocity `v + w x r` at arm `r` from the centroid, relative to
+/// the imposed flow `L x` when there is one (`gradient`).
+#[inline(always)]
+fn rigid_velocity(v: Vec2, w: f64, r: Vec2, gradient: Option<&Mat2>) -> Vec2 {
+    let v = add(v, spin(w, r));
+    match gradient {
+        Some(l) => sub(v, mat_vec(l, r)),
+        None => v,
+    }
 }
 
 /// `s0 a + s1 b` of the cell (zero without one).
@@ -210,6 +229,7 @@ impl Clumps {
             self.pebble.push(q as u32);
             self.offset.push(rotate(back, o));
             self.image.push(image_between(cell, p.position[q], x));
+            self.arm.push([0.0; 2]);
         }
         let fixity = p.fixity[new.members[0]] & !PEBBLE;
         for &q in new.members {
@@ -226,6 +246,7 @@ impl Clumps {
         self.force.push([0.0; 2]);
         self.torque.push(0.0);
         self.start.push(self.pebble.len() as u32);
+        self.id.push(c);
         Ok(())
     }
 
@@ -244,11 +265,61 @@ impl Clumps {
         }
     }
 
-    /// Follows a renumbering of the particles (`new_of_old[old] = new`).
-    pub(crate) fn remap(&mut self, new_of_old: &[u32]) {
+    /// Follows a renumbering of the particles (`new_of_old[old] = new`),
+    /// and puts the clumps in the order of their first pebbles.
+    pub(crate) fn remap(&mut self, new_of_old: &[u32], particles: &mut Particles) {
         for q in self.pebble.iter_mut() {
             *q = new_of_old[*q as usize];
         }
+        let mut order: Vec<usize> = (0..self.len()).collect();
+        order.sort_by_key(|&c| self.pebble[self.start[c] as usize]);
+        fn gather<T: Copy>(v: &mut Vec<T>, order: &[usize]) {
+            *v = order.iter().map(|&o| v[o]).collect();
+        }
+        fn gather_members<T: Copy>(v: &mut Vec<T>, order: &[usize], start: &[u32]) {
+            *v = order
+                .iter()
+                .flat_map(|&o| v[start[o] as usize..start[o + 1] as usize].to_vec())
+                .collect();
+        }
+        let start = self.start.clone();
+        gather_members(&mut self.pebble, &order, &start);
+        gather_members(&mut self.offset, &order, &start);
+        gather_members(&mut self.image, &order, &start);
+        gather_members(&mut self.arm, &order, &start);
+        for v in [&mut self.centroid, &mut self.velocity, &mut self.force] {
+            gather(v, &order);
+        }
+        for v in [
+            &mut self.angle,
+            &mut self.angular_velocity,
+            &mut self.mass,
+            &mut self.inertia,
+            &mut self.torque,
+        ] {
+            gather(v, &order);
+        }
+        gather(&mut self.fixity, &order);
+        gather(&mut self.id, &order);
+        let mut next = 0u32;
+        self.start = std::iter::once(0)
+            .chain(order.iter().map(|&o| {
+                next += start[o + 1] - start[o];
+                next
+            }))
+            .collect();
+        for (c, q) in self.member_clumps().collect::<Vec<_>>() {
+            particles.clump[q as usize] = c as u32;
+        }
+    }
+
+    /// The clumps' values in id order, from values in the clumps' order.
+    pub fn in_id_order<T: Copy + Default>(&self, values: &[T]) -> Vec<T> {
+        let mut out = vec![T::default(); values.len()];
+        for (c, &id) in self.id.iter().enumerate() {
+            out[id as usize] = values[c];
+        }
+        out
     }
 
     /// After the neighbour-list build wrapped the particles: the centroids
@@ -257,9 +328,8 @@ impl Clumps {
         let Some(cell) = cell else { return };
         for c in 0..self.len() {
             cell.wrap(&mut self.centroid[c]);
-            let turn = self.angle[c].sin_cos();
             for m in self.members(c) {
-                let rigid = add(self.centroid[c], rotate(turn, self.offset[m]));
+                let rigid = add(self.centroid[c], self.arm[m]);
                 let x = particles.position[self.pebble[m] as usize];
                 self.image[m] = image_between(Some(cell), x, rigid);
             }
@@ -270,7 +340,7 @@ impl Clumps {
     /// angle, angular velocity and fixity; `gradient` is the deforming cell's
     /// velocity gradient, if any.
     pub(crate) fn place_pebbles(
-        &self,
+        &mut self,
         particles: &mut Particles,
         cell: Option<&PeriodicCell>,
         gradient: Option<&Mat2>,
@@ -280,126 +350,45 @@ impl Clumps {
             for m in self.members(c) {
                 let q = self.pebble[m] as usize;
                 let r = rotate(turn, self.offset[m]);
+                self.arm[m] = r;
                 particles.position[q] =
                     add(add(self.centroid[c], r), image_offset(cell, self.image[m]));
-                particles.velocity[q] = self.pebble_velocity(c, r, gradient);
+                let (v, w) = (self.velocity[c], self.angular_velocity[c]);
+                particles.velocity[q] = rigid_velocity(v, w, r, gradient);
                 particles.angular_velocity[q] = self.angular_velocity[c];
                 particles.rotation[q] = self.angle[c];
             }
         }
     }
 
-    /// The rigid velocity of clump `c` at arm `r` from its centroid, relative
-    /// to the imposed flow `L x` when there is one.
-    #[inline(always)]
-    fn pebble_velocity(&self, c: usize, r: Vec2, gradient: Option<&Mat2>) -> Vec2 {
-        let v = add(self.velocity[c], spin(self.angular_velocity[c], r));
-        match gradient {
-            Some(l) => sub(v, mat_vec(l, r)),
-            None => v,
-        }
-    }
-
     /// One leapfrog step of every clump, after the particles' (their pebbles'
-    /// resultants complete): see the module documentation. `cell` is the cell
-    /// after this step's deformation, `gradient` its velocity gradient when
-    /// it deforms, `reference` the positions at the last neighbour-list build.
+    /// resultants complete): see the module documentation. The clumps go in
+    /// `chunks` contiguous shares (a number that depends on the system only,
+    /// so that the sums come out the same on any team), on the team if any.
     pub(crate) fn integrate<const MEASURE: bool>(
         &mut self,
         particles: &mut Particles,
-        reference: &[Vec2],
-        step: &IntegrationStep,
-        cell: Option<&PeriodicCell>,
-        gradient: Option<&Mat2>,
+        frame: &ClumpFrame<'_>,
+        chunks: usize,
+        team: Option<&Team>,
     ) -> IntegrationTally {
-        let mut sums = ClumpSums::default();
-        for c in 0..self.len() {
-            self.step_one::<MEASURE>(c, particles, step, &mut sums);
-        }
-        self.place_pebbles(particles, cell, gradient);
-        sums.track(self, particles, reference, step);
-        sums.tally.damping_dissipated = -sums.damping_work * step.kick;
-        sums.tally
-    }
-
-    /// The kick and drift of clump `c` (its pebbles not yet moved).
-    #[inline(always)]
-    fn step_one<const MEASURE: bool>(
-        &mut self,
-        c: usize,
-        particles: &Particles,
-        step: &IntegrationStep,
-        sums: &mut ClumpSums,
-    ) {
-        let turn = self.angle[c].sin_cos();
-        let (mut f, mut t) = ([0.0; 2], 0.0);
-        let (mut fe, mut te) = ([0.0; 2], 0.0);
-        for m in self.members(c) {
-            let q = self.pebble[m] as usize;
-            let r = rotate(turn, self.offset[m]);
-            let fq = particles.force[q];
-            f = add(f, fq);
-            t += particles.torque[q] + cross(r, fq);
-            if step.has_external {
-                let e = particles.external_force[q];
-                fe = add(fe, e);
-                te += particles.external_torque[q] + cross(r, e);
+        let shares = even_bounds(self.len(), chunks);
+        let pass = ClumpPass::new(self, particles, frame);
+        let tallies = map_stripes(team, shares, |(lo, hi)| {
+            let mut sums = ClumpSums::default();
+            for c in lo..hi {
+                // SAFETY: each clump is in one share, and its pebbles are its own
+                unsafe { pass.step_one::<MEASURE>(c, &mut sums) };
             }
+            sums
+        });
+        let mut total = IntegrationTally::default();
+        for sums in &tallies {
+            let mut tally = sums.tally;
+            tally.damping_dissipated = -sums.damping_work * frame.step.kick;
+            total.merge(&tally);
         }
-        let mass = self.mass[c];
-        let weight = [mass * step.gravity[0], mass * step.gravity[1]];
-        f = add(f, weight);
-        fe = add(fe, weight);
-        self.force[c] = f;
-        self.torque[c] = t;
-        let fix = self.fixity[c];
-        let (v_old, w_old) = (self.velocity[c], self.angular_velocity[c]);
-        let (mut v, mut w, mut fd) = (v_old, w_old, [0.0; 3]);
-        let (alpha, inv_m) = (step.alpha, 1.0 / mass);
-        if fix & FIX_X == 0 {
-            (v[0], fd[0]) = kick::<true>(v_old[0], f[0], inv_m, alpha, step.kick);
-        }
-        if fix & FIX_Y == 0 {
-            (v[1], fd[1]) = kick::<true>(v_old[1], f[1], inv_m, alpha, step.kick);
-        }
-        if fix & FIX_ROTATION == 0 {
-            (w, fd[2]) = kick::<true>(w_old, t, 1.0 / self.inertia[c], alpha, step.kick);
-        }
-        // the same energy identities as the particles' (`StripeKernel::book`)
-        let v_full = [0.5 * (v_old[0] + v[0]), 0.5 * (v_old[1] + v[1])];
-        let w_full = 0.5 * (w_old + w);
-        sums.damping_work += fd[0] * v_full[0] + fd[1] * v_full[1] + fd[2] * w_full;
-        if step.has_external {
-            let free = |bit: u8, x: f64| if fix & bit == 0 { x } else { 0.0 };
-            sums.tally.external_work += (free(FIX_X, fe[0]) * v_full[0]
-                + free(FIX_Y, fe[1]) * v_full[1]
-                + free(FIX_ROTATION, te) * w_full)
-                * step.kick;
-        }
-        if MEASURE {
-            let (vk, wk) = if step.half_kick {
-                (v_old, w_old)
-            } else {
-                (v, w)
-            };
-            sums.tally.kinetic += 0.5 * mass * (v_old[0] * vk[0] + v_old[1] * vk[1])
-                + 0.5 * self.inertia[c] * w_old * wk;
-            if fix == 0 {
-                sums.tally.unbalanced_force_sum += (f[0] * f[0] + f[1] * f[1]).sqrt();
-                sums.tally.free_count += 1;
-            }
-        }
-        let mut x = self.centroid[c];
-        x[0] += step.dt * v[0];
-        x[1] += step.dt * v[1];
-        if let Some((origin, map)) = &step.step_map {
-            x = add(*origin, mat_vec(map, sub(x, *origin)));
-        }
-        sums.tally.non_finite |= !(x[0].is_finite() & x[1].is_finite() & w.is_finite());
-        self.centroid[c] = x;
-        self.velocity[c] = v;
-        self.angular_velocity[c] = w;
-        self.angle[c] += step.dt * w;
+        total
     }
 
     /// The members of every clump in order, with the index of their clump.
@@ -425,6 +414,18 @@ impl Clumps {
             || (n_clumps > 0 && self.start.len() != n_clumps + 1)
             || self.offset.len() != members
             || self.image.len() != members
+            || self.arm.len() != members
+            || self.id.len() != n_clumps
+            || {
+                let mut seen = vec![false; n_clumps];
+                self.id.iter().any(|&i| {
+                    let repeated = (i as usize) >= n_clumps || seen[i as usize];
+                    if !repeated {
+                        seen[i as usize] = true;
+                    }
+                    repeated
+                })
+            }
             || self.start.windows(2).any(|w| w[1] < w[0] + 2)
             || self.start.last().is_some_and(|&s| s as usize != members)
             || self.pebble.iter().any(|&q| q as usize >= particles.len())
@@ -442,44 +443,231 @@ impl Clumps {
     }
 }
 
-/// The running sums of the clumps' step.
+/// Where the clumps' step happens: the step's constants, the cell after this
+/// step's deformation, its velocity gradient when it deforms, and the
+/// positions at the last neighbour-list build.
+pub(crate) struct ClumpFrame<'a> {
+    pub(crate) step: &'a IntegrationStep,
+    pub(crate) cell: Option<&'a PeriodicCell>,
+    pub(crate) gradient: Option<&'a Mat2>,
+    pub(crate) reference: &'a [Vec2],
+}
+
+impl ClumpFrame<'_> {
+    /// `origin - M_acc origin`: the accumulated map's image of a reference
+    /// point `r` is `shift + M_acc r` (zero without a deforming cell).
+    fn accumulated_shift(&self) -> Vec2 {
+        match &self.step.step_map {
+            Some((origin, _)) => sub(*origin, mat_vec(&self.step.accumulated_map, *origin)),
+            None => [0.0; 2],
+        }
+    }
+}
+
+/// The running sums of one share of the clumps' step.
 #[derive(Default)]
 struct ClumpSums {
     tally: IntegrationTally,
     damping_work: f64,
 }
 
-impl ClumpSums {
-    /// The pebbles' largest displacements since the last build (for the
-    /// rebuild criterion), as the particles' integration measures them.
-    fn track(
-        &mut self,
-        clumps: &Clumps,
-        particles: &Particles,
-        reference: &[Vec2],
-        step: &IntegrationStep,
-    ) {
-        let acc = step.accumulated_map;
-        let acc_shift = match &step.step_map {
-            Some((origin, _)) => sub(*origin, mat_vec(&acc, *origin)),
-            None => [0.0; 2],
+/// The clumps' and the particles' arrays as one share of the clumps' step
+/// reads and writes them: each clump writes only its own entries and its
+/// own pebbles'.
+struct ClumpPass<'a> {
+    frame: &'a ClumpFrame<'a>,
+    accumulated_shift: Vec2,
+    clumps: ClumpColumns,
+    members: (&'a [u32], &'a [u32], &'a [Vec2], &'a [[i32; 2]]),
+    mass: (&'a [f64], &'a [f64], &'a [u8]),
+    arm: DisjointWriter<Vec2>,
+    load: (&'a [Vec2], &'a [f64], &'a [Vec2], &'a [f64]),
+    position: DisjointWriter<Vec2>,
+    velocity: DisjointWriter<Vec2>,
+    angular_velocity: DisjointWriter<f64>,
+    rotation: DisjointWriter<f64>,
+}
+
+/// The clumps' per-clump motion, written clump by clump.
+struct ClumpColumns {
+    centroid: DisjointWriter<Vec2>,
+    angle: DisjointWriter<f64>,
+    velocity: DisjointWriter<Vec2>,
+    angular_velocity: DisjointWriter<f64>,
+    force: DisjointWriter<Vec2>,
+    torque: DisjointWriter<f64>,
+}
+
+// SAFETY: the writers are used for disjoint elements only (`ClumpPass`).
+unsafe impl Sync for ClumpPass<'_> {}
+
+impl<'a> ClumpPass<'a> {
+    fn new(
+        clumps: &'a mut Clumps,
+        particles: &'a mut Particles,
+        frame: &'a ClumpFrame<'a>,
+    ) -> Self {
+        let columns = ClumpColumns {
+            centroid: DisjointWriter::new(&mut clumps.centroid),
+            angle: DisjointWriter::new(&mut clumps.angle),
+            velocity: DisjointWriter::new(&mut clumps.velocity),
+            angular_velocity: DisjointWriter::new(&mut clumps.angular_velocity),
+            force: DisjointWriter::new(&mut clumps.force),
+            torque: DisjointWriter::new(&mut clumps.torque),
         };
-        let (mut fluctuation, mut displacement) = (0.0f64, 0.0f64);
-        for &q in &clumps.pebble {
-            let q = q as usize;
-            let (x, r) = (particles.position[q], reference[q]);
-            let d = sub(x, r);
-            displacement = running_max(displacement, d[0] * d[0] + d[1] * d[1]);
-            if step.step_map.is_some() {
-                let u = sub(x, add(acc_shift, mat_vec(&acc, r)));
-                fluctuation = running_max(fluctuation, u[0] * u[0] + u[1] * u[1]);
+        let arm = DisjointWriter::new(&mut clumps.arm);
+        let p = particles;
+        ClumpPass {
+            frame,
+            accumulated_shift: frame.accumulated_shift(),
+            clumps: columns,
+            members: (&clumps.start, &clumps.pebble, &clumps.offset, &clumps.image),
+            mass: (&clumps.mass, &clumps.inertia, &clumps.fixity),
+            arm,
+            position: DisjointWriter::new(&mut p.position),
+            velocity: DisjointWriter::new(&mut p.velocity),
+            angular_velocity: DisjointWriter::new(&mut p.angular_velocity),
+            rotation: DisjointWriter::new(&mut p.rotation),
+            load: (&p.force, &p.torque, &p.external_force, &p.external_torque),
+        }
+    }
+
+    /// Clump `c`'s step: its resultant about the centroid from its pebbles'
+    /// (their arms from the last placement), the kick with local damping per
+    /// degree of freedom, the drift, and its pebbles put in place.
+    ///
+    /// # Safety
+    /// No other task steps clump `c` at the same time.
+    #[inline(always)]
+    unsafe fn step_one<const MEASURE: bool>(&self, c: usize, sums: &mut ClumpSums) {
+        let step = self.frame.step;
+        let (start, pebble, _, _) = self.members;
+        let members = start[c] as usize..start[c + 1] as usize;
+        let (force, torque, external_force, external_torque) = self.load;
+        let (mut f, mut t) = ([0.0; 2], 0.0);
+        let (mut fe, mut te) = ([0.0; 2], 0.0);
+        for m in members.clone() {
+            let q = pebble[m] as usize;
+            let r = *self.arm.get(m);
+            let fq = force[q];
+            f = add(f, fq);
+            t += torque[q] + cross(r, fq);
+            if step.has_external {
+                let e = external_force[q];
+                fe = add(fe, e);
+                te += external_torque[q] + cross(r, e);
             }
         }
-        self.tally.max_displacement_sq = displacement;
-        self.tally.max_fluctuation_sq = if step.step_map.is_some() {
-            fluctuation
-        } else {
-            displacement
+        let (masses, inertias, fixities) = self.mass;
+        let mass = masses[c];
+        let weight = [mass * step.gravity[0], mass * step.gravity[1]];
+        f = add(f, weight);
+        fe = add(fe, weight);
+        let cc = &self.clumps;
+        *cc.force.get(c) = f;
+        *cc.torque.get(c) = t;
+        let fix = fixities[c];
+        let (v_old, w_old) = (*cc.velocity.get(c), *cc.angular_velocity.get(c));
+        let (mut v, mut w, mut fd) = (v_old, w_old, [0.0; 3]);
+        let (alpha, inv_m) = (step.alpha, 1.0 / mass);
+        if fix & FIX_X == 0 {
+            (v[0], fd[0]) = kick::<true>(v_old[0], f[0], inv_m, alpha, step.kick);
+        }
+        if fix & FIX_Y == 0 {
+            (v[1], fd[1]) = kick::<true>(v_old[1], f[1], inv_m, alpha, step.kick);
+        }
+        if fix & FIX_ROTATION == 0 {
+            (w, fd[2]) = kick::<true>(w_old, t, 1.0 / inertias[c], alpha, step.kick);
+        }
+        // the same energy identities as the particles' (`StripeKernel::book`)
+        let v_full = [0.5 * (v_old[0] + v[0]), 0.5 * (v_old[1] + v[1])];
+        let w_full = 0.5 * (w_old + w);
+        sums.damping_work += fd[0] * v_full[0] + fd[1] * v_full[1] + fd[2] * w_full;
+        if step.has_external {
+            let free = |bit: u8, x: f64| if fix & bit == 0 { x } else { 0.0 };
+            sums.tally.external_work += (free(FIX_X, fe[0]) * v_full[0]
+                + free(FIX_Y, fe[1]) * v_full[1]
+                + free(FIX_ROTATION, te) * w_full)
+                * step.kick;
+        }
+        if MEASURE {
+            let (vk, wk) = if step.half_kick {
+                (v_old, w_old)
+            } else {
+                (v, w)
+            };
+            sums.tally.kinetic +=
+                0.5 * mass * (v_old[0] * vk[0] + v_old[1] * vk[1]) + 0.5 * inertias[c] * w_old * wk;
+            if fix == 0 {
+                sums.tally.unbalanced_force_sum += (f[0] * f[0] + f[1] * f[1]).sqrt();
+                sums.tally.free_count += 1;
+            }
+        }
+        let mut x = *cc.centroid.get(c);
+        x[0] += step.dt * v[0];
+        x[1] += step.dt * v[1];
+        if let Some((origin, map)) = &step.step_map {
+            x = add(*origin, mat_vec(map, sub(x, *origin)));
+        }
+        sums.tally.non_finite |= !(x[0].is_finite() & x[1].is_finite() & w.is_finite());
+        let angle = *cc.angle.get(c) + step.dt * w;
+        *cc.centroid.get(c) = x;
+        *cc.velocity.get(c) = v;
+        *cc.angular_velocity.get(c) = w;
+        *cc.angle.get(c) = angle;
+        self.place::<true>(members, [x, v], [angle, w], sums);
+    }
+
+    /// Puts the pebbles `members` of a clump at centroid `x`, velocity `v`,
+    /// angle and angular velocity `[angle, w]`, and (`TRACK`) measures their
+    /// displacements since the last build for the rebuild criterion, as the
+    /// particles' integration does.
+    ///
+    /// # Safety
+    /// As [`ClumpPass::step_one`], for the clump of `members`.
+    #[inline(always)]
+    unsafe fn place<const TRACK: bool>(
+        &self,
+        members: std::ops::Range<usize>,
+        [x, v]: [Vec2; 2],
+        [angle, w]: [f64; 2],
+        sums: &mut ClumpSums,
+    ) {
+        let frame = self.frame;
+        let (_, pebble, offset, image) = self.members;
+        let turn = angle.sin_cos();
+        for m in members {
+            let q = pebble[m] as usize;
+            let r = rotate(turn, offset[m]);
+            *self.arm.get(m) = r;
+            let xq = add(add(x, r), image_offset(frame.cell, image[m]));
+            *self.position.get(q) = xq;
+            *self.velocity.get(q) = rigid_velocity(v, w, r, frame.gradient);
+            *self.angular_velocity.get(q) = w;
+            *self.rotation.get(q) = angle;
+            if TRACK {
+                sums.track(xq, frame.reference[q], frame.step, self.accumulated_shift);
+            }
+        }
+    }
+}
+
+impl ClumpSums {
+    /// A pebble's displacement from its place `r` at the last build, and its
+    /// fluctuation about the accumulated affine map in a deforming cell
+    /// (`shift`: [`ClumpFrame::accumulated_shift`]).
+    #[inline(always)]
+    fn track(&mut self, x: Vec2, r: Vec2, step: &IntegrationStep, shift: Vec2) {
+        let d = sub(x, r);
+        let d2 = d[0] * d[0] + d[1] * d[1];
+        let t = &mut self.tally;
+        t.max_displacement_sq = running_max(t.max_displacement_sq, d2);
+        t.max_fluctuation_sq = match &step.step_map {
+            Some(_) => {
+                let u = sub(x, add(shift, mat_vec(&step.accumulated_map, r)));
+                running_max(t.max_fluctuation_sq, u[0] * u[0] + u[1] * u[1])
+            }
+            None => t.max_displacement_sq,
         };
     }
 }

@@ -13,6 +13,7 @@
 mod clumps;
 mod union;
 
+pub(crate) use clumps::ClumpFrame;
 pub use clumps::{Clumps, NewClump};
 pub use union::{union_area_properties, AreaProperties};
 

@@ -145,12 +145,13 @@ impl Simulation {
                     next += 1;
                     next - 1
                 }
-                c => c,
+                c => self.clumps.id[c as usize],
             })
             .collect()
     }
 
-    /// Sets every clump's velocity (m/s) and angular velocity (rad/s), as
+    /// Sets every clump's velocity (m/s) and angular velocity (rad/s), in id
+    /// order (the order they were made in), as
     /// full-step values (the next step starts with a half kick, as after
     /// [`Simulation::set_velocities`]); the pebbles follow.
     pub fn set_clump_velocities(
@@ -173,8 +174,12 @@ impl Simulation {
         require_finite_points("clump_velocities", velocities)?;
         require_finite_values("clump_angular_velocities", angular_velocities)?;
         self.modify_motion(|s| {
-            s.clumps.velocity = velocities.to_vec();
-            s.clumps.angular_velocity = angular_velocities.to_vec();
+            let ids = &s.clumps.id;
+            s.clumps.velocity = ids.iter().map(|&i| velocities[i as usize]).collect();
+            s.clumps.angular_velocity = ids
+                .iter()
+                .map(|&i| angular_velocities[i as usize])
+                .collect();
             let gradient = s.deforming_gradient();
             s.clumps
                 .place_pebbles(&mut s.particles, s.cell.as_ref(), gradient.as_ref());
@@ -202,7 +207,7 @@ impl Simulation {
                     "particle {} is a pebble of clump {}: it moves, turns and is sized \
                      with its body (set_clump_velocities)",
                     self.external_index(q),
-                    self.particles.clump[q]
+                    self.clumps.id[self.particles.clump[q] as usize]
                 ),
             )),
             None => Ok(()),
@@ -219,10 +224,11 @@ impl Simulation {
                 return Err(EngineError::invalid(
                     format!("fixity[{}]", self.external_index(q as usize)),
                     format!(
-                        "particles {} and {} are pebbles of clump {c} with different fixity; \
+                        "particles {} and {} are pebbles of clump {} with different fixity; \
                          a body's degrees of freedom are fixed as one",
                         self.external_index(members[0] as usize),
-                        self.external_index(q as usize)
+                        self.external_index(q as usize),
+                        self.clumps.id[c]
                     ),
                 ));
             }

@@ -1083,7 +1083,7 @@ impl Simulation {
         for chain in self.chains.iter_mut() {
             chain.remap(&new_of_old);
         }
-        self.clumps.remap(&new_of_old);
+        self.clumps.remap(&new_of_old, &mut self.particles);
         self.clumps.rewrap(&self.particles, self.cell.as_ref());
         self.index_stripes();
         for (k, &e) in self.order.iter().enumerate() {

@@ -8,6 +8,7 @@ use super::pair_kernel::{
     PairKernel, ResetKernel, StripeWork,
 };
 use super::Simulation;
+use crate::body::ClumpFrame;
 use crate::bond::{bond_slot, BondSlot};
 use crate::diagnostics::Measurements;
 use crate::error::Result;
@@ -122,7 +123,7 @@ impl Simulation {
         let (mut motion, integration) = self.integrate::<MEASURE>(team, defer);
         self.move_walls();
         self.deform_cell();
-        self.move_clumps::<MEASURE>(&integration, &mut motion);
+        self.move_clumps::<MEASURE>(team, &integration, &mut motion);
         self.track_displacements(&motion);
         self.book_energy(&contacts, &walls, wall_work, &motion);
         if MEASURE {
@@ -172,6 +173,7 @@ impl Simulation {
     /// deformation so that the pebbles' images are of the deformed cell.
     fn move_clumps<const MEASURE: bool>(
         &mut self,
+        team: Option<&Team>,
         integration: &IntegrationStep,
         motion: &mut IntegrationTally,
     ) {
@@ -179,13 +181,17 @@ impl Simulation {
             return;
         }
         let gradient = self.deforming_gradient();
-        let tally = self.clumps.integrate::<MEASURE>(
-            &mut self.particles,
-            self.neighbors.reference().reference,
-            integration,
-            self.cell.as_ref(),
-            gradient.as_ref(),
-        );
+        let frame = ClumpFrame {
+            step: integration,
+            cell: self.cell.as_ref(),
+            gradient: gradient.as_ref(),
+            reference: self.neighbors.reference().reference,
+        };
+        // as many shares as stripes: a number that depends on the system only
+        let chunks = self.neighbors.stripe_ranges.len();
+        let tally = self
+            .clumps
+            .integrate::<MEASURE>(&mut self.particles, &frame, chunks, team);
         motion.merge(&tally);
     }
 
