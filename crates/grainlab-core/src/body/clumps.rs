@@ -478,7 +478,7 @@ struct ClumpPass<'a> {
     frame: &'a ClumpFrame<'a>,
     accumulated_shift: Vec2,
     clumps: ClumpColumns,
-    members: (&'a [u32], &'a [u32], &'a [Vec2], &'a [[i32; 2]]),
+    members: MemberColumns<'a>,
     mass: (&'a [f64], &'a [f64], &'a [u8]),
     arm: DisjointWriter<Vec2>,
     load: (&'a [Vec2], &'a [f64], &'a [Vec2], &'a [f64]),
@@ -486,6 +486,14 @@ struct ClumpPass<'a> {
     velocity: DisjointWriter<Vec2>,
     angular_velocity: DisjointWriter<f64>,
     rotation: DisjointWriter<f64>,
+}
+
+/// The clumps' members: `start` (CSR), pebble, body-frame offset, image.
+struct MemberColumns<'a> {
+    start: &'a [u32],
+    pebble: &'a [u32],
+    offset: &'a [Vec2],
+    image: &'a [[i32; 2]],
 }
 
 /// The clumps' per-clump motion, written clump by clump.
@@ -521,7 +529,12 @@ impl<'a> ClumpPass<'a> {
             frame,
             accumulated_shift: frame.accumulated_shift(),
             clumps: columns,
-            members: (&clumps.start, &clumps.pebble, &clumps.offset, &clumps.image),
+            members: MemberColumns {
+                start: &clumps.start,
+                pebble: &clumps.pebble,
+                offset: &clumps.offset,
+                image: &clumps.image,
+            },
             mass: (&clumps.mass, &clumps.inertia, &clumps.fixity),
             arm,
             position: DisjointWriter::new(&mut p.position),
@@ -541,7 +554,7 @@ impl<'a> ClumpPass<'a> {
     #[inline(always)]
     unsafe fn step_one<const MEASURE: bool>(&self, c: usize, sums: &mut ClumpSums) {
         let step = self.frame.step;
-        let (start, pebble, _, _) = self.members;
+        let (start, pebble) = (self.members.start, self.members.pebble);
         let members = start[c] as usize..start[c + 1] as usize;
         let (force, torque, external_force, external_torque) = self.load;
         let (mut f, mut t) = ([0.0; 2], 0.0);
@@ -634,7 +647,12 @@ impl<'a> ClumpPass<'a> {
         sums: &mut ClumpSums,
     ) {
         let frame = self.frame;
-        let (_, pebble, offset, image) = self.members;
+        let MemberColumns {
+            pebble,
+            offset,
+            image,
+            ..
+        } = self.members;
         let turn = angle.sin_cos();
         for m in members {
             let q = pebble[m] as usize;
