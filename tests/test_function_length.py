@@ -46,7 +46,6 @@ TO_SPLIT: dict[str, int] = {
     "python/grainlab/snapshot.py:Snapshot.__init__": 169,
     "python/grainlab/snapshot.py:Snapshot.from_engine_arrays": 97,
     "python/grainlab/study/packing.py:_irregular": 95,
-    "crates/grainlab-core/src/neighbor.rs:build": 188,
     "crates/grainlab-core/src/pipeline/step.rs:integrate": 136,
     "crates/grainlab-core/src/pipeline/step.rs:particle_contacts": 191,
 }

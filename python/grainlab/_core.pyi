@@ -7,7 +7,7 @@ dtype given (float64, uint8, int64, bool). Units are SI (docs/conventions.md).
 """
 
 from collections.abc import Sequence
-from typing import Literal, TypedDict, final
+from typing import Any, Literal, TypedDict, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -296,6 +296,21 @@ class Engine:
     ) -> None: ...
     @property
     def n_bonds(self) -> int: ...
+
+    # bodies
+    def add_bodies(
+        self,
+        pebbles: list[list[int]],
+        angles: list[float],
+        masses: list[tuple[float, float, float, float] | None],
+    ) -> None: ...
+    @property
+    def body_of_particles(self) -> NDArray[np.uint32]: ...
+    @property
+    def clumps(self) -> dict[str, NDArray[Any]]: ...
+    def set_clump_velocities(
+        self, velocities: NDArray[np.float64], angular_velocities: NDArray[np.float64]
+    ) -> None: ...
 
     # contacts and diagnostics
     def contacts(self) -> _Contacts: ...

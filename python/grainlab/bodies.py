@@ -26,13 +26,14 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core
 
-__all__ = ["ClumpMassProperties", "clump_mass_properties"]
+__all__ = ["ClumpMassProperties", "ClumpState", "clump_mass_properties"]
 
 
 @dataclass(frozen=True)
@@ -85,3 +86,51 @@ def clump_mass_properties(
     centre.flags.writeable = False
     body.flags.writeable = False
     return ClumpMassProperties(area, mass, centre, inertia, body)
+
+
+@dataclass(frozen=True)
+class ClumpState:
+    """The clumps of a :class:`grainlab.Simulation` (bodies of two or more
+    pebbles), in the order they were made (arrays read-only; docs/bodies.md)."""
+
+    #: (C, 2) centroids (m).
+    centroid_m: NDArray[np.float64]
+    #: (C,) angles of the body frames, counter-clockwise (rad).
+    angle_rad: NDArray[np.float64]
+    #: (C, 2) centroid velocities (m/s), leapfrog half-step values as the particles'.
+    velocity_m_per_s: NDArray[np.float64]
+    #: (C,) angular velocities (rad/s).
+    angular_velocity_rad_per_s: NDArray[np.float64]
+    #: (C,) masses (kg per m of thickness).
+    mass_kg: NDArray[np.float64]
+    #: (C,) moments of inertia about the centroid (kg m^2 per m).
+    moment_of_inertia_kg_m2: NDArray[np.float64]
+    #: (C,) prescribed degrees of freedom (1 x, 2 y, 4 rotation).
+    fixity: NDArray[np.uint8]
+    #: (C, 2) resultant force of the last step, weight included, before damping (N).
+    force_n: NDArray[np.float64]
+    #: (C,) resultant torque about the centroid of the last step (N m).
+    torque_n_m: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return len(self.mass_kg)
+
+    @classmethod
+    def _from_engine(cls, d: dict[str, NDArray[Any]]) -> ClumpState:
+        names = {
+            "centroid": "centroid_m",
+            "angle": "angle_rad",
+            "velocity": "velocity_m_per_s",
+            "angular_velocity": "angular_velocity_rad_per_s",
+            "mass": "mass_kg",
+            "moment_of_inertia": "moment_of_inertia_kg_m2",
+            "fixity": "fixity",
+            "force": "force_n",
+            "torque": "torque_n_m",
+        }
+        fields = {}
+        for key, name in names.items():
+            array = np.asarray(d[key])
+            array.flags.writeable = False
+            fields[name] = array
+        return cls(**fields)

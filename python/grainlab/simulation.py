@@ -20,7 +20,7 @@ True
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Generic, Literal, TypeVar, overload
@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, paper
+from grainlab.bodies import ClumpState, clump_mass_properties
 from grainlab.snapshot import Snapshot
 
 #: Table 1 of the paper (:mod:`grainlab.paper`): contact stiffnesses (N/m), particle
@@ -955,6 +956,101 @@ class Simulation:
     @property
     def n_bonds(self) -> int:
         return int(self._engine.n_bonds)
+
+    # ---- bodies (docs/bodies.md) ----
+
+    def add_bodies(
+        self,
+        pebbles: Sequence[Sequence[int]],
+        *,
+        angles: ArrayLike | None = None,
+        masses: Sequence[tuple[float, float, ArrayLike] | None] | None = None,
+    ) -> None:
+        """Makes rigid bodies of existing particles: ``pebbles[b]`` the particle
+        indices of body ``b`` (one index leaves a disk as it is; two or more make
+        a clump, moved as one rigid body with no contact between its pebbles).
+
+        angles : (B,) each body frame's angle in the world (rad, default 0)
+        masses : per body None (the exact union's mass and moment of inertia at
+            the pebbles' common density) or ``(mass kg/m, moment of inertia
+            kg m^2/m, centroid (2,) m)``
+
+        A clump starts with the rigid motion of its pebbles' momentum and angular
+        momentum. Refused, before any change: a body with no pebble, a pebble in
+        two bodies or already in one, a pebble of a pressure chain, two bonded
+        pebbles of one body, pebbles of one body with different fixity or (mass
+        not given) densities, a zero or negative mass.
+        """
+        lists = [[int(q) for q in body] for body in pebbles]
+        for b, body in enumerate(lists):
+            bad = [q for q in body if not 0 <= q < self.n_particles]
+            if bad:
+                raise ValueError(
+                    f"bodies[{b}].pebbles: particle index {bad[0]} out of range 0..{self.n_particles - 1}"
+                )
+        n = len(lists)
+        turns = [0.0] * n if angles is None else [float(a) for a in _values("angles", angles, n)]
+        given: list[tuple[float, float, float, float] | None] = []
+        for b, mass in enumerate([None] * n if masses is None else list(masses)):
+            if mass is None:
+                given.append(None)
+                continue
+            m, inertia, centroid = mass
+            x, y = _vector(f"masses[{b}].centroid", centroid)
+            given.append((float(m), float(inertia), x, y))
+        if len(given) != n:
+            raise ValueError(f"masses: expected {n} entries, one per body, got {len(given)}")
+        self._engine.add_bodies(lists, turns, given)
+
+    def add_clumps(
+        self,
+        offsets: ArrayLike,
+        radii: ArrayLike,
+        *,
+        positions: ArrayLike,
+        angles: ArrayLike,
+        density: float,
+    ) -> NDArray[np.int64]:
+        """Appends one clump of a template per placement: the template's pebbles
+        (``offsets`` (K, 2) m in its own frame, ``radii`` (K,) m) at
+        ``positions[c] + R(angles[c]) offsets`` (positions (C, 2) m, angles (C,)
+        rad), each clump's frame turned by its angle. Returns the new particles'
+        indices, K per clump in order."""
+        template = _points("offsets", offsets)
+        k = len(template)
+        sizes = _values("radii", radii, k)
+        where = _points("positions", positions)
+        turns = _values("angles", angles, len(where))
+        clump_mass_properties(template, sizes, density=density)  # refuses a bad template first
+        c, s = np.cos(turns), np.sin(turns)
+        world = np.empty((len(where), k, 2))
+        world[..., 0] = where[:, None, 0] + c[:, None] * template[:, 0] - s[:, None] * template[:, 1]
+        world[..., 1] = where[:, None, 1] + s[:, None] * template[:, 0] + c[:, None] * template[:, 1]
+        first = self.n_particles
+        count = k * len(where)
+        added = self.add_particles(world.reshape(-1, 2), np.tile(sizes, len(where)), np.full(count, float(density)))
+        self.add_bodies([list(range(first + k * b, first + k * (b + 1))) for b in range(len(where))], angles=turns)
+        return added
+
+    @property
+    def body_of_particles(self) -> NDArray[np.int64]:
+        """The body of every particle: the clumps are bodies ``0..len(clumps)`` in
+        the order they were made, then every disk is a body of its own."""
+        return _readonly(np.asarray(self._engine.body_of_particles, dtype=np.int64))
+
+    @property
+    def clumps(self) -> ClumpState:
+        """The clumps' centroids, angles, velocities, masses and last resultants."""
+        return ClumpState._from_engine(self._engine.clumps)
+
+    def set_clump_velocities(self, velocities: ArrayLike, angular_velocities: ArrayLike) -> None:
+        """Sets every clump's velocity (C, 2) m/s and angular velocity (C,) rad/s
+        (full-step values, as :attr:`velocities`); its pebbles follow."""
+        n = len(self.clumps)
+        v = _points("velocities", velocities)
+        if len(v) != n:
+            raise ValueError(f"velocities: has {len(v)} rows but there are {n} clumps")
+        self._engine.set_clump_velocities(v, _values("angular_velocities", angular_velocities, n))
 
     # ---- contacts and diagnostics ----
 

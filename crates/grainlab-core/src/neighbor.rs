@@ -349,82 +349,24 @@ impl NeighborList {
         for q in self.wall_pairs.particle.iter_mut() {
             *q = new_of_old[*q as usize];
         }
-        let bin_members: Vec<u32> = (0..n as u32).collect();
 
         // 3. stripes: contiguous ranges of bin columns with balanced particle counts
-        let mut column_counts = vec![0usize; grid.n[0]];
-        for &b in &bins {
-            column_counts[b as usize / grid.n[1]] += 1;
-        }
-        let mut stripe_of_column = vec![0u8; grid.n[0]];
-        let mut seen = 0usize;
-        for (c, count) in column_counts.iter().enumerate() {
-            let stripe = ((seen * n_stripes) / n.max(1)).min(n_stripes - 1);
-            stripe_of_column[c] = stripe as u8;
-            seen += count;
-        }
-        let stripe_of = |p: usize| stripe_of_column[bins[p] as usize / grid.n[1]];
-        // stripes are contiguous in the spatial order
-        let mut stripe_ranges = vec![(0usize, 0usize); n_stripes];
-        let mut start = 0usize;
-        for (b, range) in stripe_ranges.iter_mut().enumerate() {
-            let mut end = start;
-            while end < n && stripe_of(end) as usize == b {
-                end += 1;
-            }
-            *range = (start, end);
-            start = end;
-        }
-        debug_assert_eq!(start, n);
+        let (stripe_of, stripe_ranges) = stripes(&grid, &bins, n_stripes);
 
         // 4. pairs, in bin order for locality, sorted into stripes
-        let mut per_stripe: Vec<Vec<(u32, u32, [i8; 2])>> = vec![Vec::new(); n_stripes + 1];
-        let positions = &particles.position;
-        let radii = &particles.radius;
-        let groups = &particles.group;
-        let clump = &particles.clump;
-        let skin = self.skin;
-        for bx in 0..grid.n[0] {
-            for by in 0..grid.n[1] {
-                let home = bx * grid.n[1] + by;
-                for &pi in &bin_members[bin_start[home]..bin_start[home + 1]] {
-                    let i = pi as usize;
-                    let xi = positions[i];
-                    let ri = radii[i];
-                    for dx in -1i64..=1 {
-                        let Some((nx, sx)) = grid.neighbor(0, bx as i64 + dx) else {
-                            continue;
-                        };
-                        for dy in -1i64..=1 {
-                            let Some((ny, sy)) = grid.neighbor(1, by as i64 + dy) else {
-                                continue;
-                            };
-                            let shift = [sx, sy];
-                            let offset = cell.map_or([0.0; 2], |c| c.image_offset(shift));
-                            let other = nx * grid.n[1] + ny;
-                            for &pj in &bin_members[bin_start[other]..bin_start[other + 1]] {
-                                if pj <= pi {
-                                    continue;
-                                }
-                                let j = pj as usize;
-                                let d = sub(add(positions[j], offset), xi);
-                                let reach = ri + radii[j] + skin;
-                                // two pebbles of one clump are never a pair
-                                if dot(d, d) < reach * reach
-                                    && (clump[i] == NO_CLUMP || clump[i] != clump[j])
-                                    && !bonds.contains(pi, pj)
-                                    && materials.interacts(groups[i], groups[j])
-                                {
-                                    let (bi, bj) = (stripe_of(i), stripe_of(j));
-                                    let slot = if bi == bj { bi as usize } else { n_stripes };
-                                    per_stripe[slot].push((pi, pj, shift));
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let per_stripe = candidate_pairs(
+            &grid,
+            &bin_start,
+            particles,
+            &PairRules {
+                cell,
+                bonds,
+                materials,
+                skin: self.skin,
+            },
+            &stripe_of,
+            n_stripes,
+        );
 
         // 5. carry the history of touching pairs over, correcting shifts for the wraps
         let history = PairHistory::new(&self.pairs, &wraps, n);
@@ -446,30 +388,7 @@ impl NeighborList {
         }
 
         // 6. wall pairs
-        let mut wall_history: PairMap<(u32, u32), usize> = PairMap::default();
-        let old = &self.wall_pairs;
-        for k in 0..old.wall.len() {
-            if old.history.touched(k) {
-                wall_history.insert((old.wall[k], old.particle[k]), k);
-            }
-        }
-        let mut wall_pairs = WallPairList::default();
-        for (w, wall) in walls.iter().enumerate().filter(|(_, w)| w.active) {
-            for p in 0..n {
-                let g = wall.disk_contact(positions[p], radii[p]);
-                if g.overlap > -skin && materials.interacts(wall.group, particles.group[p]) {
-                    match wall_history.get(&(w as u32, p as u32)) {
-                        Some(&k) => wall_pairs.history.push_from(&old.history, k),
-                        None => wall_pairs.history.push_untouched(),
-                    }
-                    wall_pairs.wall.push(w as u32);
-                    wall_pairs.particle.push(p as u32);
-                    wall_pairs
-                        .model
-                        .push(MaterialTable::index(wall.group, particles.group[p]));
-                }
-            }
-        }
+        let wall_pairs = wall_pairs(&self.wall_pairs, walls, particles, materials, self.skin);
 
         self.pairs = pairs;
         self.wall_pairs = wall_pairs;
@@ -478,8 +397,8 @@ impl NeighborList {
         let mut touches: Vec<Vec<u32>> = vec![Vec::new(); n_stripes];
         for c in 0..self.pairs.len() - cross_first {
             let k = cross_first + c;
-            touches[stripe_of(self.pairs.i[k] as usize) as usize].push((c as u32) << 1);
-            touches[stripe_of(self.pairs.j[k] as usize) as usize].push(((c as u32) << 1) | 1);
+            touches[stripe_of[self.pairs.i[k] as usize] as usize].push((c as u32) << 1);
+            touches[stripe_of[self.pairs.j[k] as usize] as usize].push(((c as u32) << 1) | 1);
         }
         self.cross_touch_start = std::iter::once(0)
             .chain(touches.iter().scan(0usize, |acc, t| {
@@ -499,6 +418,139 @@ impl NeighborList {
         self.build_count += 1;
         Ok(new_of_old)
     }
+}
+
+/// The stripe of every particle (in spatial order, `bins` its bin) and each
+/// stripe's contiguous range: whole bin columns, with balanced particle counts.
+fn stripes(grid: &BinGrid, bins: &[u32], n_stripes: usize) -> (Vec<u8>, Vec<(usize, usize)>) {
+    let n = bins.len();
+    let mut column_counts = vec![0usize; grid.n[0]];
+    for &b in bins {
+        column_counts[b as usize / grid.n[1]] += 1;
+    }
+    let mut stripe_of_column = vec![0u8; grid.n[0]];
+    let mut seen = 0usize;
+    for (c, count) in column_counts.iter().enumerate() {
+        let stripe = ((seen * n_stripes) / n.max(1)).min(n_stripes - 1);
+        stripe_of_column[c] = stripe as u8;
+        seen += count;
+    }
+    let stripe_of: Vec<u8> = bins
+        .iter()
+        .map(|&b| stripe_of_column[b as usize / grid.n[1]])
+        .collect();
+    // stripes are contiguous in the spatial order
+    let mut stripe_ranges = vec![(0usize, 0usize); n_stripes];
+    let mut start = 0usize;
+    for (b, range) in stripe_ranges.iter_mut().enumerate() {
+        let mut end = start;
+        while end < n && stripe_of[end] as usize == b {
+            end += 1;
+        }
+        *range = (start, end);
+        start = end;
+    }
+    debug_assert_eq!(start, n);
+    (stripe_of, stripe_ranges)
+}
+
+/// What makes two particles a candidate pair besides their bins.
+struct PairRules<'a> {
+    cell: Option<&'a PeriodicCell>,
+    bonds: &'a Bonds,
+    materials: &'a MaterialTable,
+    skin: f64,
+}
+
+/// The pairs closer than the sum of their radii and the skin, neither bonded
+/// nor two pebbles of one clump, between groups that interact, in bin order;
+/// per stripe of both particles, the pairs across stripes last.
+fn candidate_pairs(
+    grid: &BinGrid,
+    bin_start: &[usize],
+    particles: &Particles,
+    rules: &PairRules<'_>,
+    stripe_of: &[u8],
+    n_stripes: usize,
+) -> Vec<Vec<(u32, u32, [i8; 2])>> {
+    let mut per_stripe: Vec<Vec<(u32, u32, [i8; 2])>> = vec![Vec::new(); n_stripes + 1];
+    let (positions, radii) = (&particles.position, &particles.radius);
+    let (groups, clump) = (&particles.group, &particles.clump);
+    for bx in 0..grid.n[0] {
+        for by in 0..grid.n[1] {
+            let home = bx * grid.n[1] + by;
+            for pi in bin_start[home] as u32..bin_start[home + 1] as u32 {
+                let i = pi as usize;
+                let (xi, ri) = (positions[i], radii[i]);
+                for dx in -1i64..=1 {
+                    let Some((nx, sx)) = grid.neighbor(0, bx as i64 + dx) else {
+                        continue;
+                    };
+                    for dy in -1i64..=1 {
+                        let Some((ny, sy)) = grid.neighbor(1, by as i64 + dy) else {
+                            continue;
+                        };
+                        let shift = [sx, sy];
+                        let offset = rules.cell.map_or([0.0; 2], |c| c.image_offset(shift));
+                        let other = nx * grid.n[1] + ny;
+                        for pj in bin_start[other] as u32..bin_start[other + 1] as u32 {
+                            if pj <= pi {
+                                continue;
+                            }
+                            let j = pj as usize;
+                            let d = sub(add(positions[j], offset), xi);
+                            let reach = ri + radii[j] + rules.skin;
+                            if dot(d, d) < reach * reach
+                                && (clump[i] == NO_CLUMP || clump[i] != clump[j])
+                                && !rules.bonds.contains(pi, pj)
+                                && rules.materials.interacts(groups[i], groups[j])
+                            {
+                                let (bi, bj) = (stripe_of[i], stripe_of[j]);
+                                let slot = if bi == bj { bi as usize } else { n_stripes };
+                                per_stripe[slot].push((pi, pj, shift));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    per_stripe
+}
+
+/// The particle-wall pairs within the skin of the active walls, with the
+/// history of the `old` ones that touched.
+fn wall_pairs(
+    old: &WallPairList,
+    walls: &[Wall],
+    particles: &Particles,
+    materials: &MaterialTable,
+    skin: f64,
+) -> WallPairList {
+    let mut wall_history: PairMap<(u32, u32), usize> = PairMap::default();
+    for k in 0..old.wall.len() {
+        if old.history.touched(k) {
+            wall_history.insert((old.wall[k], old.particle[k]), k);
+        }
+    }
+    let mut pairs = WallPairList::default();
+    for (w, wall) in walls.iter().enumerate().filter(|(_, w)| w.active) {
+        for p in 0..particles.len() {
+            let g = wall.disk_contact(particles.position[p], particles.radius[p]);
+            if g.overlap > -skin && materials.interacts(wall.group, particles.group[p]) {
+                match wall_history.get(&(w as u32, p as u32)) {
+                    Some(&k) => pairs.history.push_from(&old.history, k),
+                    None => pairs.history.push_untouched(),
+                }
+                pairs.wall.push(w as u32);
+                pairs.particle.push(p as u32);
+                pairs
+                    .model
+                    .push(MaterialTable::index(wall.group, particles.group[p]));
+            }
+        }
+    }
+    pairs
 }
 
 /// Uniform bins over fractional coordinates, at least `cutoff` wide.

@@ -1,7 +1,9 @@
 //! `grainlab._core.Engine`: the engine's simulation, method for method.
+use grainlab_core::body::GivenMass;
+use grainlab_core::state::PEBBLE;
 use grainlab_core::{
-    ContactLaw, ContactModel, Particles, PeriodicCell, ServoControl, Simulation, Wall, WallControl,
-    WallShape,
+    BodySpec, ContactLaw, ContactModel, Particles, PeriodicCell, ServoControl, Simulation, Wall,
+    WallControl, WallShape,
 };
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -301,7 +303,15 @@ impl Engine {
     }
     #[getter]
     fn fixity<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        particle_array!(self, py, values fixity)
+        // the engine's own pebble bit is not the user's
+        let fixity: Vec<u8> = self
+            .sim
+            .particles()
+            .fixity
+            .iter()
+            .map(|f| f & !PEBBLE)
+            .collect();
+        values_to_py(py, &self.sim.to_external(&fixity))
     }
 
     // The engine validates the values (naming the field and the index); the
@@ -594,6 +604,72 @@ impl Engine {
     #[getter]
     fn n_bonds(&self) -> usize {
         self.sim.bonds().len()
+    }
+
+    // ---- bodies ----
+
+    /// Bodies of particles: `pebbles[b]` the particle indices of body `b`,
+    /// `angles[b]` its frame's angle, `masses[b]` None or (mass, moment of
+    /// inertia, centroid x, centroid y).
+    fn add_bodies(
+        &mut self,
+        pebbles: Vec<Vec<usize>>,
+        angles: Vec<f64>,
+        masses: Vec<Option<(f64, f64, f64, f64)>>,
+    ) -> PyResult<()> {
+        same_length("angles", angles.len(), pebbles.len())?;
+        same_length("masses", masses.len(), pebbles.len())?;
+        let bodies: Vec<BodySpec> = pebbles
+            .into_iter()
+            .zip(angles.into_iter().zip(masses))
+            .map(|(pebbles, (angle, mass))| BodySpec {
+                pebbles,
+                angle,
+                given: mass.map(|(mass, moment_of_inertia, x, y)| GivenMass {
+                    mass,
+                    moment_of_inertia,
+                    centroid: [x, y],
+                }),
+            })
+            .collect();
+        self.sim.add_bodies(&bodies).map_err(to_py_err)
+    }
+
+    #[getter]
+    fn body_of_particles<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        values_to_py(py, &self.sim.body_of_particles())
+    }
+
+    /// The clumps' state in id order.
+    #[getter]
+    fn clumps<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = self.sim.clumps();
+        let d = PyDict::new(py);
+        d.set_item("centroid", points_to_py(py, &c.in_id_order(&c.centroid))?)?;
+        d.set_item("velocity", points_to_py(py, &c.in_id_order(&c.velocity))?)?;
+        d.set_item("force", points_to_py(py, &c.in_id_order(&c.force))?)?;
+        for (name, v) in [
+            ("angle", &c.angle),
+            ("angular_velocity", &c.angular_velocity),
+            ("mass", &c.mass),
+            ("moment_of_inertia", &c.inertia),
+            ("torque", &c.torque),
+        ] {
+            d.set_item(name, values_to_py(py, &c.in_id_order(v)))?;
+        }
+        d.set_item("fixity", values_to_py(py, &c.in_id_order(&c.fixity)))?;
+        Ok(d)
+    }
+
+    fn set_clump_velocities(
+        &mut self,
+        velocities: PyReadonlyArray2<'_, f64>,
+        angular_velocities: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<()> {
+        let v = points("clump_velocities", &velocities)?;
+        self.sim
+            .set_clump_velocities(&v, &values(&angular_velocities))
+            .map_err(to_py_err)
     }
 
     // ---- contacts and diagnostics ----

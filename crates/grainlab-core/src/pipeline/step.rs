@@ -293,7 +293,8 @@ impl Simulation {
         team: Option<&Team>,
         defer: bool,
     ) -> Vec<ContactTally> {
-        let increment_time = self.increment_time();
+        let (increment_time, velocity_gradient) =
+            (self.increment_time(), self.deforming_gradient());
         let buffer_cross = team.is_some();
         let n_stripes = self.neighbors.stripe_ranges.len();
         let pairs = &mut self.neighbors.pairs;
@@ -324,11 +325,6 @@ impl Simulation {
         self.bond_slots.resize(n_bonds, BondSlot::default());
         let bond_parts = split_ranges(&mut self.bonds.list, &bond_ranges);
         let bond_slot_parts = split_ranges(&mut self.bond_slots, &bond_ranges);
-        let velocity_gradient = self
-            .cell
-            .as_ref()
-            .filter(|c| c.is_deforming())
-            .map(|c| c.velocity_gradient);
 
         // the chains' follower loads, each stripe its own particles' (step 2a)
         let has_chains = !self.chains.is_empty();

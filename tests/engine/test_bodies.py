@@ -1,0 +1,141 @@
+"""Rigid bodies from Python: clumps placed from a template, their mass from the
+exact union, their motion (momentum of colliding clumps, a pile at rest), the
+body of every particle, save and load, and bad input refused before any change."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from grainlab import ContactModel, Simulation
+from grainlab.bodies import clump_mass_properties
+
+TRIMER = np.array([[0.0, 0.7e-3], [-0.6e-3, -0.35e-3], [0.6e-3, -0.35e-3]])
+RADII = np.full(3, 1.0e-3)
+DENSITY = 2.0e8
+KN = 8.45e7
+
+
+def _two_trimers(**kwargs: object) -> Simulation:
+    sim = Simulation(
+        np.empty((0, 2)), np.empty(0), DENSITY, contact_model=ContactModel(KN, KN, 0.0), time_step=1e-4
+    )
+    sim.add_clumps(TRIMER, RADII, positions=[[0.0, 0.0], [4.2e-3, 0.8e-3]], angles=[0.0, 0.7], density=DENSITY)
+    return sim
+
+
+def test_clumps_are_placed_from_their_template_with_the_unions_mass():
+    sim = _two_trimers()
+    union = clump_mass_properties(TRIMER, RADII, density=DENSITY)
+    clumps = sim.clumps
+    assert len(clumps) == 2 and sim.n_particles == 6
+    # (the turned clump's union is computed from its turned pebbles: round-off apart)
+    np.testing.assert_allclose(clumps.mass_kg, [union.mass_kg] * 2, rtol=1e-14)
+    np.testing.assert_allclose(clumps.moment_of_inertia_kg_m2, [union.moment_of_inertia_kg_m2] * 2, rtol=1e-14)
+    np.testing.assert_array_equal(clumps.angle_rad, [0.0, 0.7])
+    # the second clump's pebbles are the template turned by 0.7 about its origin
+    c, s = np.cos(0.7), np.sin(0.7)
+    turned = TRIMER @ np.array([[c, s], [-s, c]]) + [4.2e-3, 0.8e-3]
+    np.testing.assert_allclose(sim.positions[3:], turned, rtol=0, atol=1e-18)
+    centroid = union.centroid_m @ np.array([[c, s], [-s, c]]) + [4.2e-3, 0.8e-3]
+    np.testing.assert_allclose(clumps.centroid_m[1], centroid, rtol=0, atol=1e-18)
+    np.testing.assert_array_equal(sim.body_of_particles, [0, 0, 0, 1, 1, 1])
+    # the pebbles carry the body's mass (what the contact laws' damping sees)
+    np.testing.assert_array_equal(sim.masses, np.repeat(clumps.mass_kg, 3))
+    assert sim.fixity.max() == 0
+
+
+def test_colliding_clumps_keep_their_momentum_and_exchange_spin():
+    sim = _two_trimers()
+    sim.set_clump_velocities([[0.01, 0.0], [-0.01, 0.0]], [0.0, 0.0])
+    mass = sim.clumps.mass_kg
+
+    def momentum() -> np.ndarray:
+        return (mass[:, None] * sim.clumps.velocity_m_per_s).sum(0)
+
+    p0 = momentum()
+    touched = False
+    for _ in range(200):
+        sim.run(10)
+        touched |= sim.contact_count > 0
+        np.testing.assert_allclose(momentum(), p0, rtol=0, atol=1e-15 * np.abs(mass * 0.01).sum())
+    assert touched
+    # the off-centre hit turned them (frictionless: through the pebbles' centres)
+    assert np.abs(sim.clumps.angular_velocity_rad_per_s).min() > 1e-3
+
+
+def test_a_pile_of_clumps_comes_to_rest_on_a_floor_without_inner_contacts():
+    sim = Simulation(
+        np.empty((0, 2)),
+        np.empty(0),
+        2650.0,
+        contact_model=ContactModel(KN, KN, 0.5),
+        time_step=1e-4,
+        local_damping=0.7,
+        gravity=(0.0, -9.81),
+    )
+    sim.add_line_wall((0.0, 0.0), (0.0, 1.0))
+    sim.add_line_wall((0.0, 0.0), (1.0, 0.0))
+    sim.add_line_wall((12e-3, 0.0), (-1.0, 0.0))
+    rng = np.random.default_rng(4)
+    centres = [[2.2e-3 + 3.5e-3 * (k % 3), 2.2e-3 + 3.5e-3 * (k // 3)] for k in range(6)]
+    sim.add_clumps(TRIMER, RADII, positions=centres, angles=rng.uniform(0, 2 * np.pi, 6), density=2650.0)
+    sim.time_step = sim.critical_time_step(0.5)
+    sim.run(80_000)
+    body = sim.body_of_particles
+    contacts = sim.contacts()
+    assert len(contacts) >= 3  # every clump of the second row rests on the first
+    assert not np.any(body[contacts.i] == body[contacts.j])
+    # at rest: the floor and, by friction, the side walls carry the clumps' weight
+    carried = sum(sim.wall(k).force[1] for k in range(3))
+    assert carried == pytest.approx(-9.81 * sim.clumps.mass_kg.sum(), rel=1e-6)
+    assert np.abs(sim.clumps.velocity_m_per_s).max() < 1e-9
+
+
+def test_save_and_load_keep_the_clumps_to_the_bit(tmp_path):
+    sim = _two_trimers()
+    sim.set_clump_velocities([[0.01, 0.0], [-0.01, 0.0]], [0.0, 3.0])
+    sim.run(50)
+    sim.save(tmp_path / "state.bin")
+    sim.run(100)
+    again = Simulation.load(tmp_path / "state.bin")
+    again.run(100)
+    np.testing.assert_array_equal(again.positions, sim.positions)
+    np.testing.assert_array_equal(again.clumps.angle_rad, sim.clumps.angle_rad)
+    np.testing.assert_array_equal(again.body_of_particles, sim.body_of_particles)
+
+
+@pytest.mark.parametrize(
+    ("pebbles", "kwargs", "message"),
+    [
+        ([[0, 1], [1, 2]], {}, r"bodies\[1\]: particle 1 is also a pebble of body 0"),
+        ([[0, 1], []], {}, r"bodies\[1\]: a body needs at least one pebble"),
+        ([[0, 7]], {}, r"bodies\[0\].pebbles: particle index 7 out of range 0..2"),
+        ([[0, -1]], {}, r"bodies\[0\].pebbles: particle index -1 out of range"),
+        ([[0, 1]], {"masses": [(0.0, 1.0, (0.0, 0.0))]}, r"bodies\[0\].mass"),
+        ([[0, 1]], {"masses": [(1.0, -1.0, (0.0, 0.0))]}, r"bodies\[0\].moment_of_inertia"),
+        ([[0, 1]], {"angles": [np.nan]}, r"angles\[0\]: must be finite"),
+        ([[0, 1]], {"masses": []}, r"masses: expected 1 entries"),
+    ],
+)
+def test_bad_bodies_are_refused_with_the_field_before_any_change(pebbles, kwargs, message):
+    sim = Simulation([[0.0, 0.0], [1.5e-3, 0.0], [3.0e-3, 0.0]], [1e-3] * 3, DENSITY, time_step=1e-5)
+    with pytest.raises(ValueError, match=message):
+        sim.add_bodies(pebbles, **kwargs)
+    assert len(sim.clumps) == 0
+    np.testing.assert_array_equal(sim.body_of_particles, [0, 1, 2])
+
+
+def test_a_pebble_moves_only_with_its_body():
+    sim = _two_trimers()
+    moved = sim.positions.copy()
+    moved[4, 0] += 1e-3
+    with pytest.raises(ValueError, match=r"positions\[4\]: particle 4 is a pebble of clump 1"):
+        sim.positions = moved
+    with pytest.raises(ValueError, match=r"different fixity"):
+        sim.fixity = [7, 0, 0, 0, 0, 0]
+    sim.fixity = [7, 7, 7, 0, 0, 0]
+    np.testing.assert_array_equal(sim.clumps.fixity, [7, 0])
+    np.testing.assert_array_equal(sim.fixity, [7, 7, 7, 0, 0, 0])
+    with pytest.raises(ValueError, match=r"velocities: has 1 rows but there are 2 clumps"):
+        sim.set_clump_velocities([[0.0, 0.0]], [0.0])
