@@ -20,7 +20,12 @@ Instruction counts are steadier than times on a loaded machine: ``--count``
 also runs each build once under ``valgrind --tool=callgrind`` (1,000 steps,
 one thread) and prints the instructions executed. ``--rolling-friction MU``
 gives both builds' contact model rolling resistance (the example's
-``--rolling-friction=MU``; both builds must know it).
+``--rolling-friction=MU``; both builds must know it). ``--b-option OPT`` adds
+an option of the example to B's runs only: one build against itself with and
+without it, e.g. the cost of rigid trimers per pebble-step against disks::
+
+    python benchmarks/engine_versions.py target/release/examples/throughput \
+        target/release/examples/throughput --b-option=--trimers --repeat 5
 
 The last line printed is one JSON object with the medians and ratios.
 """
@@ -50,10 +55,12 @@ def options(rolling_friction: float) -> list[str]:
     return [f"--rolling-friction={rolling_friction!r}"] if rolling_friction > 0.0 else []
 
 
-def run_once(binary: str, threads: int, steps: int, rolling_friction: float = 0.0) -> float:
-    """Particle-steps per second of one run of ``binary``."""
+def run_once(
+    binary: str, threads: int, steps: int, rolling_friction: float = 0.0, extra: tuple[str, ...] = ()
+) -> float:
+    """Particle-steps per second of one run of ``binary`` (``extra``: more options)."""
     out = subprocess.run(
-        [binary, str(threads), str(steps), *options(rolling_friction)],
+        [binary, str(threads), str(steps), *options(rolling_friction), *extra],
         check=True,
         capture_output=True,
         text=True,
@@ -92,6 +99,10 @@ def main(argv: list[str] | None = None) -> int:
         "--rolling-friction", type=float, default=0.0, metavar="MU",
         help="rolling resistance mu_r of both builds' contact model (0: none)",
     )
+    parser.add_argument(
+        "--b-option", action="append", default=[], metavar="OPT",
+        help="an option of the example for B's runs only (repeatable), e.g. --trimers",
+    )
     args = parser.parse_args(argv)
     for name in (args.a, args.b):
         if not Path(name).is_file():
@@ -104,13 +115,13 @@ def main(argv: list[str] | None = None) -> int:
     runs: dict[str, list[float]] = {}
     for _ in range(args.repeat):
         for threads in args.threads:
-            for label, binary in (("a", args.a), ("b", args.b)):
+            for label, binary, extra in (("a", args.a, ()), ("b", args.b, tuple(args.b_option))):
                 hog = None
                 if args.busy:
                     hog = multiprocessing.Process(target=spin, args=(time.time() + 600,))
                     hog.start()
                 try:
-                    speed = run_once(binary, threads, args.steps, args.rolling_friction)
+                    speed = run_once(binary, threads, args.steps, args.rolling_friction, extra)
                 finally:
                     if hog is not None:
                         hog.terminate()
