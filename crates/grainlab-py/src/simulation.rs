@@ -42,6 +42,36 @@ fn point(field: &str, v: Vec<f64>) -> PyResult<[f64; 2]> {
     }
 }
 
+/// A setter of the engine that takes one value per particle.
+type Setter<T> = fn(&mut Simulation, &[T]) -> grainlab_core::Result<()>;
+
+impl Engine {
+    /// The one way a per-particle `(N, 2)` array is set: its shape and length
+    /// checked here, its values by the engine (naming the field and the index).
+    fn set_points(
+        &mut self,
+        field: &str,
+        array: &PyReadonlyArray2<'_, f64>,
+        set: Setter<[f64; 2]>,
+    ) -> PyResult<()> {
+        let v = points(field, array)?;
+        same_length(field, v.len(), self.sim.particles().len())?;
+        set(&mut self.sim, &v).map_err(to_py_err)
+    }
+
+    /// The one way a per-particle `(N,)` array is set (as [`Engine::set_points`]).
+    fn set_values<T: numpy::Element + Copy>(
+        &mut self,
+        field: &str,
+        array: &PyReadonlyArray1<'_, T>,
+        set: Setter<T>,
+    ) -> PyResult<()> {
+        let v = values(array);
+        same_length(field, v.len(), self.sim.particles().len())?;
+        set(&mut self.sim, &v).map_err(to_py_err)
+    }
+}
+
 #[pymethods]
 impl Engine {
     #[new]
@@ -314,67 +344,63 @@ impl Engine {
         values_to_py(py, &self.sim.to_external(&fixity))
     }
 
-    // The engine validates the values (naming the field and the index); the
-    // glue checks the shapes and the lengths.
-
+    // (each through `set_points` / `set_values`)
     fn set_positions(&mut self, positions: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
-        let v = points("positions", &positions)?;
-        same_length("positions", v.len(), self.sim.particles().len())?;
-        self.sim.set_positions(&v).map_err(to_py_err)
+        self.set_points("positions", &positions, Simulation::set_positions)
     }
 
     fn set_velocities(&mut self, velocities: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
-        let v = points("velocities", &velocities)?;
-        same_length("velocities", v.len(), self.sim.particles().len())?;
-        self.sim.set_velocities(&v).map_err(to_py_err)
+        self.set_points("velocities", &velocities, Simulation::set_velocities)
     }
 
-    fn set_external_forces(&mut self, forces: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
-        let v = points("external_forces", &forces)?;
-        same_length("external_forces", v.len(), self.sim.particles().len())?;
-        self.sim.set_external_forces(&v).map_err(to_py_err)
+    fn set_external_forces(&mut self, external_forces: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        self.set_points(
+            "external_forces",
+            &external_forces,
+            Simulation::set_external_forces,
+        )
     }
 
     fn set_rotations(&mut self, rotations: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
-        let v = values(&rotations);
-        same_length("rotations", v.len(), self.sim.particles().len())?;
-        self.sim.set_rotations(&v).map_err(to_py_err)
+        self.set_values("rotations", &rotations, Simulation::set_rotations)
     }
 
-    fn set_angular_velocities(&mut self, omega: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
-        let v = values(&omega);
-        same_length("angular_velocities", v.len(), self.sim.particles().len())?;
-        self.sim.set_angular_velocities(&v).map_err(to_py_err)
+    fn set_angular_velocities(
+        &mut self,
+        angular_velocities: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<()> {
+        self.set_values(
+            "angular_velocities",
+            &angular_velocities,
+            Simulation::set_angular_velocities,
+        )
     }
 
-    fn set_external_torques(&mut self, torques: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
-        let v = values(&torques);
-        same_length("external_torques", v.len(), self.sim.particles().len())?;
-        self.sim.set_external_torques(&v).map_err(to_py_err)
+    fn set_external_torques(
+        &mut self,
+        external_torques: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<()> {
+        self.set_values(
+            "external_torques",
+            &external_torques,
+            Simulation::set_external_torques,
+        )
     }
 
     fn set_radii(&mut self, radii: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
-        let v = values(&radii);
-        same_length("radii", v.len(), self.sim.particles().len())?;
-        self.sim.set_radii(&v).map_err(to_py_err)
+        self.set_values("radii", &radii, Simulation::set_radii)
     }
 
     fn set_densities(&mut self, densities: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
-        let v = values(&densities);
-        same_length("densities", v.len(), self.sim.particles().len())?;
-        self.sim.set_densities(&v).map_err(to_py_err)
+        self.set_values("densities", &densities, Simulation::set_densities)
     }
 
     fn set_groups(&mut self, groups: PyReadonlyArray1<'_, u8>) -> PyResult<()> {
-        let v = values(&groups);
-        same_length("groups", v.len(), self.sim.particles().len())?;
-        self.sim.set_groups(&v).map_err(to_py_err)
+        self.set_values("groups", &groups, Simulation::set_groups)
     }
 
     fn set_fixity(&mut self, fixity: PyReadonlyArray1<'_, u8>) -> PyResult<()> {
-        let v = values(&fixity);
-        same_length("fixity", v.len(), self.sim.particles().len())?;
-        self.sim.set_fixity(&v).map_err(to_py_err)
+        self.set_values("fixity", &fixity, Simulation::set_fixity)
     }
 
     // ---- periodic cell ----
