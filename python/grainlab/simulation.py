@@ -1052,6 +1052,13 @@ class Simulation:
             raise ValueError(f"velocities: has {len(v)} rows but there are {n} clumps")
         self._engine.set_clump_velocities(v, _values("angular_velocities", angular_velocities, n))
 
+    def scale_clumps(self, factors: ArrayLike) -> None:
+        """Grows every clump by ``factors`` (C,) about its centroid: a similar body
+        of the same density (pebble radii and offsets times the factor, mass times
+        its square, moment of inertia times its fourth power), as radius expansion
+        grows the disks (:attr:`radii`)."""
+        self._engine.scale_clumps(_values("factors", factors, len(self.clumps)))
+
     # ---- contacts and diagnostics ----
 
     def contacts(self) -> Contacts:

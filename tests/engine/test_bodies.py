@@ -126,6 +126,20 @@ def test_bad_bodies_are_refused_with_the_field_before_any_change(pebbles, kwargs
     np.testing.assert_array_equal(sim.body_of_particles, [0, 1, 2])
 
 
+def test_scaled_clumps_are_similar_clumps_of_the_same_density():
+    sim = _two_trimers()
+    before = sim.clumps
+    sim.scale_clumps([2.0, 0.5])
+    after = sim.clumps
+    np.testing.assert_allclose(after.mass_kg, before.mass_kg * [4.0, 0.25], rtol=1e-15)
+    np.testing.assert_allclose(after.moment_of_inertia_kg_m2, before.moment_of_inertia_kg_m2 * [16.0, 1 / 16], rtol=1e-15)
+    np.testing.assert_array_equal(sim.radii, [2e-3] * 3 + [0.5e-3] * 3)
+    union = clump_mass_properties(sim.positions[:3], sim.radii[:3], density=DENSITY)
+    assert after.mass_kg[0] == pytest.approx(union.mass_kg, rel=1e-13)
+    with pytest.raises(ValueError, match=r"factors\[1\]"):
+        sim.scale_clumps([1.0, 0.0])
+
+
 def test_a_pebble_moves_only_with_its_body():
     sim = _two_trimers()
     moved = sim.positions.copy()

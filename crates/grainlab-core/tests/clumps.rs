@@ -578,3 +578,42 @@ fn the_energy_ledger_balances_with_clumps_friction_damping_and_gravity() {
     let drift = (e.balance() - b0) / turnover;
     assert!(drift.abs() < 2e-3, "balance drift {drift} of {turnover} J");
 }
+
+#[test]
+fn a_scaled_clump_is_the_similar_clump_of_the_same_density() {
+    use grainlab_core::body::ClumpTemplate;
+    let r = 1.0e-3;
+    let mut centres = trimer([0.0, 0.0], r, 0.2);
+    centres.extend(trimer([6.0 * r, 0.0], r, 1.1));
+    let particles = Particles::new(centres, vec![r; 6], vec![DENSITY]).unwrap();
+    let mut sim = Simulation::new(particles, ContactModel::linear(KN, KN, 0.5), 1e-7, 1).unwrap();
+    sim.add_bodies(&triples(2)).unwrap();
+    let before = sim.to_external(&sim.particles().position);
+    let centroids = sim.clumps().centroid.clone();
+    let factors = [1.5, 0.8];
+    sim.scale_clumps(&factors).unwrap();
+    let x = sim.to_external(&sim.particles().position);
+    let radii = sim.to_external(&sim.particles().radius);
+    for b in 0..2 {
+        let (f, c) = (factors[b], centroids[b]);
+        let pebbles = &x[3 * b..3 * b + 3];
+        for (p, q) in pebbles.iter().zip(&before[3 * b..3 * b + 3]) {
+            let expected = [c[0] + f * (q[0] - c[0]), c[1] + f * (q[1] - c[1])];
+            assert!(distance(*p, expected) < 1e-15, "{p:?} vs {expected:?}");
+        }
+        assert_eq!(radii[3 * b], f * r);
+        let (similar, at) =
+            ClumpTemplate::from_pebbles(pebbles, &radii[3 * b..3 * b + 3], DENSITY).unwrap();
+        let clumps = sim.clumps();
+        assert!((clumps.mass[b] / similar.mass() - 1.0).abs() < 1e-13);
+        assert!((clumps.inertia[b] / similar.moment_of_inertia() - 1.0).abs() < 1e-13);
+        assert!(distance(clumps.centroid[b], at.centroid) < 1e-15);
+    }
+    for bad in [[0.0, 1.0], [1.0, f64::NAN], [-1.0, 1.0]] {
+        assert!(matches!(
+            sim.scale_clumps(&bad),
+            Err(EngineError::InvalidInput { .. })
+        ));
+    }
+    assert_eq!(refusal(sim.scale_clumps(&[1.0])).0, "factors");
+}

@@ -698,6 +698,10 @@ impl Engine {
             .map_err(to_py_err)
     }
 
+    fn scale_clumps(&mut self, factors: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        self.sim.scale_clumps(&values(&factors)).map_err(to_py_err)
+    }
+
     // ---- contacts and diagnostics ----
 
     fn contacts<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {

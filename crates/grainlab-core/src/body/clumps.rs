@@ -250,6 +250,21 @@ impl Clumps {
         Ok(())
     }
 
+    /// Grows clump `c` (in the clumps' order) by `factor` about its centroid:
+    /// pebble radii and offsets times `factor`, mass times `factor^2` and
+    /// moment of inertia times `factor^4` (a similar body of the same
+    /// density); the caller puts the pebbles in place.
+    pub(crate) fn scale(&mut self, c: usize, factor: f64, particles: &mut Particles) {
+        for m in self.members(c) {
+            let q = self.pebble[m] as usize;
+            particles.radius[q] *= factor;
+            self.offset[m] = [self.offset[m][0] * factor, self.offset[m][1] * factor];
+        }
+        let area_factor = factor * factor;
+        self.mass[c] *= area_factor;
+        self.inertia[c] *= area_factor * area_factor;
+    }
+
     /// Gives every pebble its clump's mass and inertia and the `PEBBLE` bit.
     pub(crate) fn assign_pebble_masses(&self, particles: &mut Particles) {
         for c in 0..self.len() {

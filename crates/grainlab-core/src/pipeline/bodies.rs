@@ -2,7 +2,9 @@
 //! outside, and what the rest of the simulation asks of them (`body::clumps`).
 use super::Simulation;
 use crate::body::{Clumps, GivenMass, NewClump};
-use crate::error::{require_finite_points, require_finite_values, EngineError, Result};
+use crate::error::{
+    require_finite_points, require_finite_values, require_positive, EngineError, Result,
+};
 use crate::state::{NO_CLUMP, PEBBLE};
 use crate::vec2::{norm, Vec2};
 
@@ -184,6 +186,36 @@ impl Simulation {
             s.clumps
                 .place_pebbles(&mut s.particles, s.cell.as_ref(), gradient.as_ref());
             s.half_kick_pending = true;
+        });
+        Ok(())
+    }
+
+    /// Grows every clump by `factors` (in id order, finite and > 0) about its
+    /// centroid: its pebbles' radii and offsets scale by the factor, its mass
+    /// by its square and its moment of inertia by its fourth power (a similar
+    /// body of the same density); velocities are kept. For samples made by
+    /// radius expansion ([`Simulation::set_radii`] grows the disks).
+    pub fn scale_clumps(&mut self, factors: &[f64]) -> Result<()> {
+        let n = self.clumps.len();
+        if factors.len() != n {
+            return Err(EngineError::invalid(
+                "factors",
+                format!("expected {n} values, one per clump, got {}", factors.len()),
+            ));
+        }
+        for (k, &f) in factors.iter().enumerate() {
+            require_positive(&format!("factors[{k}]"), f)?;
+        }
+        self.modify_motion(|s| {
+            for c in 0..n {
+                let factor = factors[s.clumps.id[c] as usize];
+                s.clumps.scale(c, factor, &mut s.particles);
+            }
+            s.clumps.assign_pebble_masses(&mut s.particles);
+            let gradient = s.deforming_gradient();
+            s.clumps
+                .place_pebbles(&mut s.particles, s.cell.as_ref(), gradient.as_ref());
+            s.neighbors.invalidate();
         });
         Ok(())
     }
