@@ -46,8 +46,7 @@ TO_SPLIT: dict[str, int] = {
     "python/grainlab/snapshot.py:Snapshot.__init__": 169,
     "python/grainlab/snapshot.py:Snapshot.from_engine_arrays": 97,
     "python/grainlab/study/packing.py:_irregular": 95,
-    "crates/grainlab-core/src/pipeline/step.rs:integrate": 136,
-    "crates/grainlab-core/src/pipeline/step.rs:particle_contacts": 191,
+    "crates/grainlab-core/src/pipeline/step.rs:particle_contacts": 165,
 }
 
 

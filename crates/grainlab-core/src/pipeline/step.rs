@@ -391,7 +391,14 @@ impl Simulation {
             slots: DisjointWriter::new(&mut self.wall_slots),
         };
         let (materials, deferred_index) = (&self.materials, &self.deferred_index);
-        let (dt, max_overlap_ratio) = (self.params.time_step, self.params.max_overlap_ratio);
+        let wall_step = WallStep {
+            walls,
+            materials,
+            motion: &motion,
+            dt: self.params.time_step,
+            increment_time,
+            max_overlap_ratio: self.params.max_overlap_ratio,
+        };
         let tallies = map_stripes(team, stripes, |work| {
             let b = work.stripe;
             let mut direct = DirectSink {
@@ -437,37 +444,7 @@ impl Simulation {
                 }
                 if defer {
                     // SAFETY: each wall pair is in the list of one stripe only
-                    for &k in deferred_index.walls_of_stripe(b) {
-                        let k = k as usize;
-                        let wall = &walls[wall_pairs.wall[k] as usize];
-                        let model = materials.by_index(wall_pairs.model[k]);
-                        let q = wall_pairs.particle[k] as usize;
-                        let record = wall_pairs.records.get(k);
-                        let contact =
-                            wall_contact(wall, model, &motion, q, dt, increment_time, record);
-                        let slot = wall_pairs.slots.get(k);
-                        let Some((g, c)) = contact else {
-                            *wall_pairs.sliding.get(k) = false;
-                            slot.active = false;
-                            continue;
-                        };
-                        *wall_pairs.sliding.get(k) = c.sliding;
-                        let r = motion.radius[q];
-                        let n = g.normal;
-                        *slot = WallSlot {
-                            force: add(scale(n, c.normal), scale(perp(n), c.shear)),
-                            torque: c.torque_j,
-                            dissipation: c.dissipation,
-                            stiffness: c.normal_stiffness,
-                            overlap_violation: g.overlap > max_overlap_ratio * r,
-                            active: true,
-                            ..WallSlot::default()
-                        };
-                        if MEASURE {
-                            slot.elastic = c.stored_energy(model);
-                            slot.force_norm = (c.normal * c.normal + c.shear * c.shear).sqrt();
-                        }
-                    }
+                    wall_pairs.evaluate::<MEASURE>(deferred_index.walls_of_stripe(b), &wall_step);
                 }
                 tally
             }
@@ -617,16 +594,9 @@ impl Simulation {
         (tally, work)
     }
 
-    /// Step 7: leapfrog with local damping stripe by stripe in parallel; with a team each
-    /// stripe first adds its particles' deferred bond and wall forces (`defer`),
-    /// then their cross-stripe pairs.
-    fn integrate<const MEASURE: bool>(
-        &mut self,
-        team: Option<&Team>,
-        defer: bool,
-    ) -> (IntegrationTally, IntegrationStep) {
-        // with a team the cross-stripe forces wait in the buffer (else they are applied)
-        let buffered = team.is_some();
+    /// The constants of this step's integration; in a deforming cell the
+    /// accumulated map since the last build takes this step's.
+    fn integration_step(&mut self) -> IntegrationStep {
         let dt = self.params.time_step;
         let step_map = self
             .cell
@@ -637,19 +607,31 @@ impl Simulation {
             Some((_, m)) => self.neighbors.advance_map(m).accumulated_map,
             None => self.neighbors.reference().accumulated_map,
         };
-        let p = &mut self.particles;
-        let has_external = self.params.gravity != [0.0, 0.0] || self.external_loads;
-        let step = IntegrationStep {
+        IntegrationStep {
             dt,
             kick: if self.half_kick_pending { 0.5 * dt } else { dt },
             half_kick: self.half_kick_pending,
             alpha: self.params.local_damping,
             gravity: self.params.gravity,
-            has_external,
+            has_external: self.params.gravity != [0.0, 0.0] || self.external_loads,
             step_map,
             accumulated_map,
             vector: self.simd,
-        };
+        }
+    }
+
+    /// Step 7: leapfrog with local damping stripe by stripe in parallel; with a team each
+    /// stripe first adds its particles' deferred bond and wall forces (`defer`),
+    /// then their cross-stripe pairs.
+    fn integrate<const MEASURE: bool>(
+        &mut self,
+        team: Option<&Team>,
+        defer: bool,
+    ) -> (IntegrationTally, IntegrationStep) {
+        // with a team the cross-stripe forces wait in the buffer (else they are applied)
+        let buffered = team.is_some();
+        let step = self.integration_step();
+        let p = &mut self.particles;
         let inputs = IntegrationInputs {
             inv_mass: &p.inv_mass,
             inv_inertia: &p.inv_inertia,
@@ -685,76 +667,98 @@ impl Simulation {
             wall_particles: &self.neighbors.wall_pairs.particle,
             wall_slots: &self.wall_slots,
         };
-        type Work<'w> = (
-            usize,
-            usize,
-            &'w mut [Vec2],
-            &'w mut [Vec2],
-            &'w mut [f64],
-            &'w mut [f64],
-            &'w mut [Vec2],
-            &'w mut [f64],
-        );
-        let stripes: Vec<Work<'_>> = split_ranges(&mut p.position, &bounds)
-            .into_iter()
-            .zip(split_ranges(&mut p.velocity, &bounds))
-            .zip(split_ranges(&mut p.rotation, &bounds))
-            .zip(split_ranges(&mut p.angular_velocity, &bounds))
-            .zip(split_ranges(&mut p.force, &bounds))
-            .zip(split_ranges(&mut p.torque, &bounds))
-            .zip(&bounds)
-            .enumerate()
-            .map(
-                |(
-                    b,
-                    (
-                        (((((position, velocity), rotation), angular_velocity), force), torque),
-                        &(lo, _),
-                    ),
-                )| {
-                    (
-                        b,
-                        lo,
-                        position,
-                        velocity,
-                        rotation,
-                        angular_velocity,
-                        force,
-                        torque,
-                    )
-                },
-            )
-            .collect();
-        let tallies = map_stripes(
-            team,
-            stripes,
-            |(b, lo, position, velocity, rotation, angular_velocity, force, torque)| {
-                if defer {
-                    // the bonds, then the wall contacts, as their serial passes add them
-                    deferred.apply(b, lo, force, torque);
-                }
-                if buffered {
-                    // the cross-stripe pairs touching this stripe, in pair order, as a
-                    // sequential pass over all of them adds them
-                    cross.apply(b, lo, force, torque);
-                }
-                let stripe = MotionStripe {
-                    lo,
-                    position,
-                    velocity,
-                    rotation,
-                    angular_velocity,
-                    force,
-                    torque,
-                };
-                integrate_stripe::<MEASURE>(stripe, &inputs, &step)
-            },
-        );
+        let whole = OpenStripe {
+            lo: 0,
+            position: &mut p.position,
+            velocity: &mut p.velocity,
+            rotation: &mut p.rotation,
+            angular_velocity: &mut p.angular_velocity,
+            force: &mut p.force,
+            torque: &mut p.torque,
+        };
+        let stripes = MotionWork::split(whole, &bounds);
+        let tallies = map_stripes(team, stripes, |work| {
+            let MotionWork { stripe: b, motion } = work;
+            if defer {
+                // the bonds, then the wall contacts, as their serial passes add them
+                deferred.apply(b, motion.lo, motion.force, motion.torque);
+            }
+            if buffered {
+                // the cross-stripe pairs touching this stripe, in pair order, as a
+                // sequential pass over all of them adds them
+                cross.apply(b, motion.lo, motion.force, motion.torque);
+            }
+            integrate_stripe::<MEASURE>(motion.into_stripe(), &inputs, &step)
+        });
         let mut total = IntegrationTally::default();
         for t in &tallies {
             total.merge(t);
         }
         (total, step)
+    }
+}
+
+/// One stripe's share of the particles' motion in the integration: its
+/// forces still open to the deferred and cross-stripe additions.
+struct MotionWork<'w> {
+    stripe: usize,
+    motion: OpenStripe<'w>,
+}
+
+/// A stripe's motion arrays with its resultants writable.
+struct OpenStripe<'w> {
+    lo: usize,
+    position: &'w mut [Vec2],
+    velocity: &'w mut [Vec2],
+    rotation: &'w mut [f64],
+    angular_velocity: &'w mut [f64],
+    force: &'w mut [Vec2],
+    torque: &'w mut [f64],
+}
+
+impl<'w> OpenStripe<'w> {
+    /// The stripe as the integration reads it, its resultants complete.
+    fn into_stripe(self) -> MotionStripe<'w> {
+        MotionStripe {
+            lo: self.lo,
+            position: self.position,
+            velocity: self.velocity,
+            rotation: self.rotation,
+            angular_velocity: self.angular_velocity,
+            force: self.force,
+            torque: self.torque,
+        }
+    }
+}
+
+impl<'w> MotionWork<'w> {
+    /// The particles' whole arrays (`p`, from index 0) cut into the stripes `bounds`.
+    fn split(p: OpenStripe<'w>, bounds: &[(usize, usize)]) -> Vec<MotionWork<'w>> {
+        let mut position = split_ranges(p.position, bounds).into_iter();
+        let mut velocity = split_ranges(p.velocity, bounds).into_iter();
+        let mut rotation = split_ranges(p.rotation, bounds).into_iter();
+        let mut angular_velocity = split_ranges(p.angular_velocity, bounds).into_iter();
+        let mut force = split_ranges(p.force, bounds).into_iter();
+        let mut torque = split_ranges(p.torque, bounds).into_iter();
+        let mut next = move |stripe: usize, lo: usize| -> Option<MotionWork<'w>> {
+            Some(MotionWork {
+                stripe,
+                motion: OpenStripe {
+                    lo,
+                    position: position.next()?,
+                    velocity: velocity.next()?,
+                    rotation: rotation.next()?,
+                    angular_velocity: angular_velocity.next()?,
+                    force: force.next()?,
+                    torque: torque.next()?,
+                },
+            })
+        };
+        bounds
+            .iter()
+            .enumerate()
+            .map_while(|(b, &(lo, _))| next(b, lo))
+            .collect()
     }
 }
 
@@ -782,4 +786,55 @@ struct WallPairWork<'a> {
     records: DisjointWriter<ContactRecord>,
     sliding: DisjointWriter<bool>,
     slots: DisjointWriter<WallSlot>,
+}
+
+/// What a wall pair's evaluation reads besides the pair: the walls, the
+/// models, the particles' motion and the step's constants.
+struct WallStep<'a> {
+    walls: &'a [crate::wall::Wall],
+    materials: &'a crate::material::MaterialTable,
+    motion: &'a ParticleMotion<'a>,
+    dt: f64,
+    increment_time: f64,
+    max_overlap_ratio: f64,
+}
+
+impl WallPairWork<'_> {
+    /// The wall pairs `pairs` (of one stripe's particles): each pair's law,
+    /// its spring and sliding flag updated, its force in its slot.
+    ///
+    /// # Safety
+    /// No other task evaluates any of `pairs` at the same time.
+    unsafe fn evaluate<const MEASURE: bool>(&self, pairs: &[u32], at: &WallStep<'_>) {
+        for &k in pairs {
+            let k = k as usize;
+            let wall = &at.walls[self.wall[k] as usize];
+            let model = at.materials.by_index(self.model[k]);
+            let q = self.particle[k] as usize;
+            let record = self.records.get(k);
+            let contact = wall_contact(wall, model, at.motion, q, at.dt, at.increment_time, record);
+            let slot = self.slots.get(k);
+            let Some((g, c)) = contact else {
+                *self.sliding.get(k) = false;
+                slot.active = false;
+                continue;
+            };
+            *self.sliding.get(k) = c.sliding;
+            let r = at.motion.radius[q];
+            let n = g.normal;
+            *slot = WallSlot {
+                force: add(scale(n, c.normal), scale(perp(n), c.shear)),
+                torque: c.torque_j,
+                dissipation: c.dissipation,
+                stiffness: c.normal_stiffness,
+                overlap_violation: g.overlap > at.max_overlap_ratio * r,
+                active: true,
+                ..WallSlot::default()
+            };
+            if MEASURE {
+                slot.elastic = c.stored_energy(model);
+                slot.force_norm = (c.normal * c.normal + c.shear * c.shear).sqrt();
+            }
+        }
+    }
 }
