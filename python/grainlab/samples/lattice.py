@@ -126,17 +126,16 @@ def _check_rng(rng: np.random.Generator | int | None) -> np.random.Generator:
     return np.random.default_rng(0 if rng is None else rng)
 
 
-def _make(
-    kind: str,
+def _checked(
     diameter: float,
     porosity: float | None,
     box: ArrayLike | None,
     n_rows: int | None,
     n_cols: int | None,
     boundary: str,
-    rng: np.random.Generator | int | None,
-) -> Lattice:
-    row, offset, contact = _GEOMETRY[kind]
+    offset: float,
+) -> tuple[float, float | None, int | None, int | None]:
+    """The diameter, porosity and row and column counts, checked (bad input names its field)."""
     d = float(diameter)
     if not (math.isfinite(d) and d > 0):
         raise ValueError(f"diameter: must be a finite diameter > 0 (m), got {diameter}")
@@ -156,73 +155,100 @@ def _make(
             raise ValueError(f"n_rows, n_cols: must be >= 1, got {n_rows}, {n_cols}")
         if boundary == "periodic" and offset and n_rows % 2:
             raise ValueError(f"n_rows: a periodic hexagonal lattice needs an even number of rows, got {n_rows}")
+    return d, porosity, n_rows, n_cols
+
+
+#: A lattice's sites before vacancies: sites, cell, spacing, note, contact porosity.
+_Sites = tuple[NDArray[np.float64], tuple[float, float, float, float], float, str, float]
+
+
+def _periodic_sites(
+    kind: str, d: float, porosity: float | None, box: ArrayLike | None, n_rows: int | None, n_cols: int | None
+) -> _Sites:
+    """The sites of a periodic cell of whole lattice periods (compressed to the porosity)."""
+    row, offset, contact = _GEOMETRY[kind]
+    if porosity is None or porosity >= contact:
+        a = d
+    else:
+        a = d * math.sqrt((1.0 - contact) / (1.0 - porosity))
+    if box is None:
+        x0 = y0 = 0.0
+    else:
+        bx = check_box(box)
+        x0, y0 = bx[0], bx[1]
+        n_cols = max(1, round((bx[2] - bx[0]) / a))
+        periods = (bx[3] - bx[1]) / (row * a)
+        # hexagonal rows repeat every two rows
+        n_rows = max(2, 2 * round(periods / 2)) if offset else max(1, round(periods))
+    assert n_rows is not None and n_cols is not None
+    cell = (x0, y0, x0 + n_cols * a, y0 + n_rows * row * a)
+    j, i = np.meshgrid(np.arange(n_rows), np.arange(n_cols), indexing="ij")
+    sites = np.column_stack(
+        [(x0 + (i + 0.5 + offset * (j % 2)) * a).ravel(), (y0 + (j + 0.5) * row * a).ravel()]
+    )
+    note = f"{kind} lattice of {d * 1e3:g} mm disks, periodic cell of {n_cols} x {n_rows} sites"
+    note += f" ({cell[2] - x0:.6g} x {cell[3] - y0:.6g} m)"
+    if box is not None and not np.allclose(cell, check_box(box), rtol=0.0, atol=1e-12 * d):
+        note += ", the box rounded to whole lattice periods"
+    return sites, cell, a, note, contact
+
+
+def _walled_sites(
+    kind: str, d: float, porosity: float | None, box: ArrayLike | None, n_rows: int | None, n_cols: int | None
+) -> _Sites:
+    """The sites in a walled box, given or fitted around the rows (compressed to the porosity)."""
+    row, offset, contact = _GEOMETRY[kind]
+    r = 0.5 * d
+    disk = math.pi * r * r
+    what = f"{kind} lattice of {d * 1e3:g} mm disks"
+    if box is None:
+        assert n_rows is not None and n_cols is not None
+        nr, nc = n_rows, n_cols
+        n_sites = nc * nr - (nr // 2 if offset else 0)
+
+        def box_porosity(a: float) -> float:
+            return 1.0 - n_sites * disk / (((nc - 1) * a + d) * ((nr - 1) * row * a + d))
+
+        full_contact = box_porosity(d)
+        a = d if porosity is None or porosity >= full_contact else _bisect(box_porosity, porosity, d)
+        cell = (0.0, 0.0, (nc - 1) * a + d, (nr - 1) * row * a + d)
+        note = f"{what} in a walled box fitted around {nc} x {nr} rows"
+    else:
+        cell = check_box(box)
+        area = (cell[2] - cell[0]) * (cell[3] - cell[1])
+
+        def fitted_porosity(a: float) -> float:
+            return 1.0 - len(_sites_in_box(kind, a, r, cell)) * disk / area
+
+        full_contact = fitted_porosity(d)
+        if len(_sites_in_box(kind, d, r, cell)) == 0:
+            raise ValueError(f"box: a {d:g} m disk does not fit in {cell}")
+        if porosity is None or porosity >= full_contact:
+            a = d
+        else:
+            a = _largest_spacing_at_most(fitted_porosity, porosity, d)
+        note = f"{what} in a walled box"
+    if kind == "hexagonal":
+        note += f"; this box's contact porosity is {full_contact:.4f} (the infinite lattice's {contact:.4f})"
+    return _sites_in_box(kind, a, r, cell), cell, a, note, full_contact
+
+
+def _make(
+    kind: str,
+    diameter: float,
+    porosity: float | None,
+    box: ArrayLike | None,
+    n_rows: int | None,
+    n_cols: int | None,
+    boundary: str,
+    rng: np.random.Generator | int | None,
+) -> Lattice:
+    d, porosity, n_rows, n_cols = _checked(diameter, porosity, box, n_rows, n_cols, boundary, _GEOMETRY[kind][1])
     r = 0.5 * d
     disk = math.pi * r * r
     rng = _check_rng(rng)
-    what = f"{kind} lattice of {d * 1e3:g} mm disks"
-
-    if boundary == "periodic":
-        if porosity is None or porosity >= contact:
-            a = d
-        else:
-            a = d * math.sqrt((1.0 - contact) / (1.0 - porosity))
-        if box is None:
-            x0 = y0 = 0.0
-        else:
-            bx = check_box(box)
-            x0, y0 = bx[0], bx[1]
-            n_cols = max(1, round((bx[2] - bx[0]) / a))
-            periods = (bx[3] - bx[1]) / (row * a)
-            # hexagonal rows repeat every two rows
-            n_rows = max(2, 2 * round(periods / 2)) if offset else max(1, round(periods))
-        assert n_rows is not None and n_cols is not None
-        cell = (x0, y0, x0 + n_cols * a, y0 + n_rows * row * a)
-        j, i = np.meshgrid(np.arange(n_rows), np.arange(n_cols), indexing="ij")
-        sites = np.column_stack(
-            [(x0 + (i + 0.5 + offset * (j % 2)) * a).ravel(), (y0 + (j + 0.5) * row * a).ravel()]
-        )
-        note = f"{what}, periodic cell of {n_cols} x {n_rows} sites ({cell[2] - x0:.6g} x {cell[3] - y0:.6g} m)"
-        if box is not None and not np.allclose(cell, check_box(box), rtol=0.0, atol=1e-12 * d):
-            note += ", the box rounded to whole lattice periods"
-        full_contact = contact
-    else:
-        if box is None:
-            assert n_rows is not None and n_cols is not None
-            nr, nc = n_rows, n_cols
-            n_sites = nc * nr - (nr // 2 if offset else 0)
-
-            def box_porosity(a: float) -> float:
-                width = (nc - 1) * a + d
-                height = (nr - 1) * row * a + d
-                return 1.0 - n_sites * disk / (width * height)
-
-            full_contact = box_porosity(d)
-            if porosity is None or porosity >= full_contact:
-                a = d
-            else:
-                a = _bisect(box_porosity, porosity, d)
-            cell = (0.0, 0.0, (nc - 1) * a + d, (nr - 1) * row * a + d)
-            sites = _sites_in_box(kind, a, r, cell)
-            note = f"{what} in a walled box fitted around {nc} x {nr} rows"
-        else:
-            cell = check_box(box)
-            area = (cell[2] - cell[0]) * (cell[3] - cell[1])
-
-            def box_porosity(a: float) -> float:
-                return 1.0 - len(_sites_in_box(kind, a, r, cell)) * disk / area
-
-            full_contact = box_porosity(d)
-            if len(_sites_in_box(kind, d, r, cell)) == 0:
-                raise ValueError(f"box: a {d:g} m disk does not fit in {cell}")
-            if porosity is None or porosity >= full_contact:
-                a = d
-            else:
-                a = _largest_spacing_at_most(box_porosity, porosity, d)
-            sites = _sites_in_box(kind, a, r, cell)
-            note = f"{what} in a walled box"
-        if kind == "hexagonal":
-            note += f"; this box's contact porosity is {full_contact:.4f} (the infinite lattice's {contact:.4f})"
-
+    layout = _periodic_sites if boundary == "periodic" else _walled_sites
+    sites, cell, a, note, full_contact = layout(kind, d, porosity, box, n_rows, n_cols)
     area = (cell[2] - cell[0]) * (cell[3] - cell[1])
     n_sites = len(sites)
     n_vac = 0
