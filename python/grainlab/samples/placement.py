@@ -70,17 +70,7 @@ def random_placement(
         placed and the solid fraction they covered.
     """
     x0, y0, x1, y1 = check_box(box)
-    d = np.asarray(diameters, dtype=np.float64)
-    if d.ndim != 1:
-        raise ValueError(f"diameters: expected a 1-D array, got shape {d.shape}")
-    if not np.all(np.isfinite(d)) or np.any(d <= 0):
-        k = int(np.argmax(~np.isfinite(d) | (d <= 0)))
-        raise ValueError(f"diameters[{k}]: must be a finite diameter > 0 (m), got {d[k]}")
-    scale = float(scale)
-    if not (0.0 < scale <= 1.0):
-        raise ValueError(f"scale: must be in (0, 1], got {scale}")
-    if int(batch) < 1 or int(tries) < 1:
-        raise ValueError(f"batch and tries: must be >= 1, got batch={batch}, tries={tries}")
+    d, scale = _checked(diameters, scale, batch, tries)
     n = len(d)
     radii = 0.5 * scale * d
     positions = np.zeros((n, 2))
@@ -100,35 +90,9 @@ def random_placement(
     tree: cKDTree | None = None
     while len(queue):
         todo = queue[:batch]
-        r = radii[todo]
         m = len(todo)
-        u = rng.random((m, tries, 2))
-        cx = x0 + r[:, None] + u[..., 0] * ((x1 - x0) - 2.0 * r[:, None])
-        cy = y0 + r[:, None] + u[..., 1] * ((y1 - y0) - 2.0 * r[:, None])
-        cand = np.stack([cx, cy], axis=-1).reshape(-1, 2)
-        owner = np.repeat(np.arange(m), tries)
-        rc = r[owner]
-        ok = np.ones(len(cand), dtype=bool)
-        if len(placed):
-            ok = _clear_of(cand, rc, tree, positions[placed], radii[placed])
-        # per disk, the first candidate clear of the placed set
-        ok2 = ok.reshape(m, tries)
-        has = ok2.any(axis=1)
-        first = np.argmax(ok2, axis=1)
-        chosen = np.flatnonzero(has)
-        cpos = cand.reshape(m, tries, 2)[chosen, first[chosen]]
-        crad = r[chosen]
-        # conflicts inside the round: the later (smaller) disk of a clashing pair waits
-        if len(chosen) > 1:
-            ctree = cKDTree(cpos)
-            pairs = ctree.query_pairs(2.0 * float(crad.max()), output_type="ndarray")
-            if len(pairs):
-                a, b = pairs.min(axis=1), pairs.max(axis=1)
-                dist = np.hypot(*(cpos[a] - cpos[b]).T)
-                clash = dist < crad[a] + crad[b]
-                keep = np.ones(len(chosen), dtype=bool)
-                keep[b[clash]] = False
-                chosen, cpos = chosen[keep], cpos[keep]
+        existing = (tree, positions[placed], radii[placed]) if len(placed) else None
+        chosen, cpos = _one_round(radii[todo], (x0, y0, x1, y1), rng, tries, existing)
         accepted = todo[chosen]
         positions[accepted] = cpos
         if len(accepted):
@@ -149,6 +113,59 @@ def random_placement(
         done[chosen] = True
         queue = np.concatenate([todo[~done], queue[batch:]])
     return positions, radii
+
+
+def _checked(diameters: ArrayLike, scale: float, batch: int, tries: int) -> tuple[NDArray[np.float64], float]:
+    """The diameters and the scale, checked (bad input names its field)."""
+    d = np.asarray(diameters, dtype=np.float64)
+    if d.ndim != 1:
+        raise ValueError(f"diameters: expected a 1-D array, got shape {d.shape}")
+    if not np.all(np.isfinite(d)) or np.any(d <= 0):
+        k = int(np.argmax(~np.isfinite(d) | (d <= 0)))
+        raise ValueError(f"diameters[{k}]: must be a finite diameter > 0 (m), got {d[k]}")
+    scale = float(scale)
+    if not (0.0 < scale <= 1.0):
+        raise ValueError(f"scale: must be in (0, 1], got {scale}")
+    if int(batch) < 1 or int(tries) < 1:
+        raise ValueError(f"batch and tries: must be >= 1, got batch={batch}, tries={tries}")
+    return d, scale
+
+
+def _one_round(
+    r: NDArray[np.float64],
+    box: tuple[float, float, float, float],
+    rng: np.random.Generator,
+    tries: int,
+    existing: tuple[cKDTree, NDArray[np.float64], NDArray[np.float64]] | None,
+) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+    """One round of placement for disks of radii ``r``: ``tries`` random centres
+    each, the first one clear of the ``existing`` disks (their tree, centres and
+    radii) kept, then of a clashing pair of this round the later disk left to
+    wait. Returns which disks were placed (indices into ``r``) and where."""
+    x0, y0, x1, y1 = box
+    m = len(r)
+    u = rng.random((m, tries, 2))
+    cx = x0 + r[:, None] + u[..., 0] * ((x1 - x0) - 2.0 * r[:, None])
+    cy = y0 + r[:, None] + u[..., 1] * ((y1 - y0) - 2.0 * r[:, None])
+    cand = np.stack([cx, cy], axis=-1).reshape(-1, 2)
+    rc = r[np.repeat(np.arange(m), tries)]
+    ok = np.ones(len(cand), dtype=bool) if existing is None else _clear_of(cand, rc, *existing)
+    # per disk, the first candidate clear of the placed set
+    ok2 = ok.reshape(m, tries)
+    first = np.argmax(ok2, axis=1)
+    chosen = np.flatnonzero(ok2.any(axis=1))
+    cpos = cand.reshape(m, tries, 2)[chosen, first[chosen]]
+    crad = r[chosen]
+    # conflicts inside the round: the later (smaller) disk of a clashing pair waits
+    if len(chosen) > 1:
+        pairs = cKDTree(cpos).query_pairs(2.0 * float(crad.max()), output_type="ndarray")
+        if len(pairs):
+            a, b = pairs.min(axis=1), pairs.max(axis=1)
+            clash = np.hypot(*(cpos[a] - cpos[b]).T) < crad[a] + crad[b]
+            keep = np.ones(len(chosen), dtype=bool)
+            keep[b[clash]] = False
+            chosen, cpos = chosen[keep], cpos[keep]
+    return chosen, cpos
 
 
 def _clear_of(
