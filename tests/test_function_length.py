@@ -40,7 +40,6 @@ TO_SPLIT: dict[str, int] = {
     "python/grainlab/protocols/biaxial/phases.py:shear": 135,
     "python/grainlab/reproduction/initial_state.py:snapshot_initial_state": 119,
     "python/grainlab/samples/expansion.py:expand_to_porosity": 100,
-    "python/grainlab/samples/friction_search.py:expand_with_friction_search": 137,
     "python/grainlab/snapshot.py:Snapshot.__init__": 169,
     "python/grainlab/snapshot.py:Snapshot.from_engine_arrays": 97,
     "python/grainlab/study/packing.py:_irregular": 95,

@@ -65,7 +65,7 @@ import json
 import math
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -236,6 +236,115 @@ def _pair(name: str, value: Any, minimum: float, strict_minimum: bool) -> tuple[
     return low, high
 
 
+def _checked_limits(
+    stress_high: float, max_stress_pa: float, friction_tolerance: float, min_mechanical_coordination: float
+) -> tuple[float, float]:
+    """The band's upper end against the stress bound, the tolerance and the least ``Z_m``, checked."""
+    if stress_high > max_stress_pa:
+        raise ValueError(
+            f"stress_band_pa: the band's upper end {stress_high:.4g} Pa exceeds max_stress_pa = "
+            f"{max_stress_pa:.4g} Pa, beyond which the expansion stops; lower the band or raise max_stress_pa"
+        )
+    friction_tolerance = float(friction_tolerance)
+    if not (math.isfinite(friction_tolerance) and friction_tolerance > 0.0):
+        raise ValueError(f"friction_tolerance: must be a finite number > 0, got {friction_tolerance!r}")
+    min_mechanical_coordination = float(min_mechanical_coordination)
+    if not (math.isfinite(min_mechanical_coordination) and min_mechanical_coordination >= 0.0):
+        raise ValueError(
+            f"min_mechanical_coordination: must be a finite number >= 0, got {min_mechanical_coordination!r}")
+    return friction_tolerance, min_mechanical_coordination
+
+
+class _Search:
+    """The search's trials: one radius expansion per friction (``expand``), each
+    judged against the stress band and the least mechanical coordination number."""
+
+    def __init__(
+        self, expand: Callable[[float], Sample], band: tuple[float, float], min_mechanical_coordination: float
+    ) -> None:
+        self.expand = expand
+        self.band = band
+        self.min_mechanical_coordination = min_mechanical_coordination
+        self.trials: list[FrictionTrial] = []
+
+    def trial(self, friction: float) -> tuple[FrictionTrial, Sample | None]:
+        """The expansion with ``friction``, its outcome recorded; the sample unless it stopped."""
+        started = time.perf_counter()
+        try:
+            with warnings.catch_warnings():
+                # an unsettled trial is an outcome of the search, not a warning to the caller
+                warnings.filterwarnings("ignore", message="expand_to_porosity: unbalanced force ratio",
+                                        category=RuntimeWarning)
+                sample = self.expand(friction)
+        except ExpansionError as error:
+            if not self.trials:
+                raise  # too dense for the stress bound even with the least friction
+            done = FrictionTrial(friction, "stopped", error.stress_pa, math.nan, math.nan, error.steps,
+                                 time.perf_counter() - started, str(error))
+            self.trials.append(done)
+            return done, None
+        done = FrictionTrial(friction, self.outcome(sample), sample.mean_wall_stress_pa,
+                             sample.mechanical_coordination_number, sample.coordination_number, sample.steps,
+                             sample.wall_time_s)
+        self.trials.append(done)
+        return done, sample
+
+    def bisect(self, low: float, high: float, tolerance: float, best: Sample | None) -> Sample | None:
+        """Bisects the friction between a loose ``low`` and a dense ``high`` until a
+        trial lands in the band or the bracket is narrower than ``tolerance``: that
+        sample, else the stress-bearing one of least friction (``best`` so far), else None."""
+        while high - low > tolerance:
+            middle = 0.5 * (low + high)
+            done, sample = self.trial(middle)
+            if done.outcome == "in_band":
+                return sample
+            if done.rank == 0:
+                low = middle
+            else:
+                high = middle
+                if done.stress_bearing:
+                    best = sample
+        return best
+
+    def too_loose(self, porosity: float, last: FrictionTrial) -> FrictionSearchError:
+        """The error of a target still loose at the largest friction (``last``)."""
+        return FrictionSearchError(
+            f"porosity: nominal porosity {porosity:.4f} is looser than radius expansion jams even with the "
+            f"largest generation friction allowed: with friction {last.friction:g} the packing ends "
+            f"{last.outcome} (mean wall stress {last.mean_wall_stress_pa:.3g} Pa, Z_m "
+            f"{last.mechanical_coordination_number:.2f}; a stress-bearing packing needs at least "
+            f"{self.band[0]:.3g} Pa and Z_m >= {self.min_mechanical_coordination:g}). Aim for a denser target "
+            "or raise friction_range's upper end.",
+            target=porosity, trials=self.trials,
+        )
+
+    def nothing_bears(
+        self, porosity: float, friction_range: tuple[float, float], max_stress_pa: float
+    ) -> FrictionSearchError:
+        """The error when no friction of the range gives a stress-bearing packing."""
+        loose = max((t for t in self.trials if t.rank == 0), key=lambda t: t.friction)
+        dense = min((t for t in self.trials if t.rank > 0), key=lambda t: t.friction)
+        return FrictionSearchError(
+            f"porosity: no generation friction in [{friction_range[0]:g}, {friction_range[1]:g}] makes nominal "
+            f"porosity {porosity:.4f} stress-bearing within max_stress_pa = {max_stress_pa / 1e6:.3g} MPa: at "
+            f"friction {loose.friction:.4g} the packing ends {loose.outcome}, at {dense.friction:.4g} the "
+            f"expansion stopped ({dense.message}). Widen stress_band_pa or raise max_stress_pa.",
+            target=porosity, trials=self.trials,
+        )
+
+    def outcome(self, sample: Sample) -> str:
+        """Where a settled or unsettled packing stands against the band."""
+        stress, z_m = sample.mean_wall_stress_pa, sample.mechanical_coordination_number
+        low, high = self.band
+        if not sample.equilibrium_reached:
+            return "unsettled"
+        if not sample.jammed:
+            return "stress_free"
+        if stress < low or not z_m >= self.min_mechanical_coordination:
+            return "below_band"
+        return "in_band" if stress <= high else "above_band"
+
+
 def expand_with_friction_search(
     box: ArrayLike = (0.0, 0.0, 0.075, 0.15),
     porosity: float = 0.12,
@@ -285,50 +394,18 @@ def expand_with_friction_search(
     mu_min, mu_max = _pair("friction_range", friction_range, 0.0, strict_minimum=False)
     stress_low, stress_high = _pair("stress_band_pa", stress_band_pa, 0.0, strict_minimum=True)
     max_stress_pa = float(expansion.get("max_stress_pa", MAX_STRESS_PA))
-    if stress_high > max_stress_pa:
-        raise ValueError(
-            f"stress_band_pa: the band's upper end {stress_high:.4g} Pa exceeds max_stress_pa = "
-            f"{max_stress_pa:.4g} Pa, beyond which the expansion stops; lower the band or raise max_stress_pa"
-        )
-    friction_tolerance = float(friction_tolerance)
-    if not (math.isfinite(friction_tolerance) and friction_tolerance > 0.0):
-        raise ValueError(f"friction_tolerance: must be a finite number > 0, got {friction_tolerance!r}")
-    min_mechanical_coordination = float(min_mechanical_coordination)
-    if not (math.isfinite(min_mechanical_coordination) and min_mechanical_coordination >= 0.0):
-        raise ValueError(
-            f"min_mechanical_coordination: must be a finite number >= 0, got {min_mechanical_coordination!r}")
-
-    trials: list[FrictionTrial] = []
-
-    def trial(friction: float) -> tuple[FrictionTrial, Sample | None]:
-        started = time.perf_counter()
-        try:
-            with warnings.catch_warnings():
-                # an unsettled trial is an outcome of the search, not a warning to the caller
-                warnings.filterwarnings("ignore", message="expand_to_porosity: unbalanced force ratio",
-                                        category=RuntimeWarning)
-                sample = expand_to_porosity(box, porosity, grading, friction=friction, progress=progress,
-                                            keep_simulation=keep_simulation, **expansion)
-        except ExpansionError as error:
-            if not trials:
-                raise  # too dense for the stress bound even with the least friction
-            done = FrictionTrial(friction, "stopped", error.stress_pa, math.nan, math.nan, error.steps,
-                                 time.perf_counter() - started, str(error))
-            trials.append(done)
-            return done, None
-        stress, z_m = sample.mean_wall_stress_pa, sample.mechanical_coordination_number
-        if not sample.equilibrium_reached:
-            outcome = "unsettled"
-        elif not sample.jammed:
-            outcome = "stress_free"
-        elif stress < stress_low or not z_m >= min_mechanical_coordination:
-            outcome = "below_band"
-        else:
-            outcome = "in_band" if stress <= stress_high else "above_band"
-        done = FrictionTrial(friction, outcome, stress, z_m, sample.coordination_number, sample.steps,
-                             sample.wall_time_s)
-        trials.append(done)
-        return done, sample
+    friction_tolerance, min_mechanical_coordination = _checked_limits(
+        stress_high, max_stress_pa, friction_tolerance, min_mechanical_coordination
+    )
+    search = _Search(
+        lambda friction: expand_to_porosity(
+            box, porosity, grading, friction=friction, progress=progress,
+            keep_simulation=keep_simulation, **expansion,
+        ),
+        (stress_low, stress_high),
+        min_mechanical_coordination,
+    )
+    trial, trials = search.trial, search.trials
 
     def result(sample: Sample) -> FrictionSearch:
         return FrictionSearch(sample, tuple(trials), (mu_min, mu_max), (stress_low, stress_high),
@@ -339,37 +416,10 @@ def expand_with_friction_search(
         return result(sample)  # type: ignore[arg-type]
     last, sample = trial(mu_max)
     if last.rank == 0:
-        raise FrictionSearchError(
-            f"porosity: nominal porosity {porosity:.4f} is looser than radius expansion jams even with the "
-            f"largest generation friction allowed: with friction {mu_max:g} the packing ends {last.outcome} "
-            f"(mean wall stress {last.mean_wall_stress_pa:.3g} Pa, Z_m {last.mechanical_coordination_number:.2f}; "
-            f"a stress-bearing packing needs at least {stress_low:.3g} Pa and Z_m >= "
-            f"{min_mechanical_coordination:g}). Aim for a denser target or raise friction_range's upper end.",
-            target=porosity, trials=trials,
-        )
+        raise search.too_loose(porosity, last)
     if last.outcome == "in_band":
         return result(sample)  # type: ignore[arg-type]
-    best = sample if last.stress_bearing else None
-    low, high = mu_min, mu_max
-    while high - low > friction_tolerance:
-        middle = 0.5 * (low + high)
-        done, sample = trial(middle)
-        if done.outcome == "in_band":
-            return result(sample)  # type: ignore[arg-type]
-        if done.rank == 0:
-            low = middle
-        else:
-            high = middle
-            if done.stress_bearing:
-                best = sample
+    best = search.bisect(mu_min, mu_max, friction_tolerance, sample if last.stress_bearing else None)
     if best is None:
-        loose = max((t for t in trials if t.rank == 0), key=lambda t: t.friction)
-        dense = min((t for t in trials if t.rank > 0), key=lambda t: t.friction)
-        raise FrictionSearchError(
-            f"porosity: no generation friction in [{mu_min:g}, {mu_max:g}] makes nominal porosity "
-            f"{porosity:.4f} stress-bearing within max_stress_pa = {max_stress_pa / 1e6:.3g} MPa: at friction "
-            f"{loose.friction:.4g} the packing ends {loose.outcome}, at {dense.friction:.4g} the expansion "
-            f"stopped ({dense.message}). Widen stress_band_pa or raise max_stress_pa.",
-            target=porosity, trials=trials,
-        )
+        raise search.nothing_bears(porosity, (mu_min, mu_max), max_stress_pa)
     return result(best)
