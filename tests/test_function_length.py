@@ -42,7 +42,6 @@ TO_SPLIT: dict[str, int] = {
     "python/grainlab/samples/expansion.py:expand_to_porosity": 100,
     "python/grainlab/snapshot.py:Snapshot.__init__": 169,
     "python/grainlab/snapshot.py:Snapshot.from_engine_arrays": 97,
-    "python/grainlab/study/packing.py:_irregular": 95,
     "crates/grainlab-core/src/pipeline/step.rs:particle_contacts": 165,
 }
 

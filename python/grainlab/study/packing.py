@@ -230,7 +230,11 @@ class _ExpansionOptions(TypedDict, total=False):
     density_scaling: bool
 
 
-def _irregular(p: PackingParams) -> tuple[dict[str, Any], Snapshot]:
+def _expanded(p: PackingParams) -> tuple[Any, Any, str, list[str], int]:
+    """The irregular packing by radius expansion (with the friction search if asked):
+    ``(sample, search or None, status, notes, expansions run)``; once more with the
+    real masses after a stop at the engine's overlap limit, and the densest packing
+    the stress bound allows when the target is beyond it."""
     from grainlab.samples import (
         ExpansionError,
         UniformByNumber,
@@ -296,6 +300,11 @@ def _irregular(p: PackingParams) -> tuple[dict[str, Any], Snapshot]:
             f"({error}); measured instead the packing expanded to {fallback:.4f} with generation friction "
             f"{friction:g}, just above the densest one reached ({error.porosity:.4f})"
         )
+    return sample, search, status, notes, expansions
+
+
+def _irregular(p: PackingParams) -> tuple[dict[str, Any], Snapshot]:
+    sample, search, status, notes, expansions = _expanded(p)
     if search is not None:
         expansions += len(search.trials) - 1
     sim = sample.simulation
