@@ -339,6 +339,88 @@ def gap_for_coordination_number(
     return float(max(gap[needed - 1], 0.0))
 
 
+def _measures(
+    snapshot: Snapshot,
+) -> tuple[CoordinationNumber, float, ContactAnisotropy, StabilityIndex, ContactAnisotropy | None]:
+    """Z (without and with the boundary), the contact normals' and (where there
+    are forces) the normal forces' anisotropy, and lambda, on one thread."""
+    with _kernels.kernel_threads(1):
+        z = CoordinationNumber().compute(snapshot)
+        z_boundary = CoordinationNumber(include_boundary=True).compute(snapshot).coordination_number
+        normals = ContactAnisotropy().compute(snapshot)
+        lam = StabilityIndex().compute(snapshot)
+        forces = (
+            ContactAnisotropy(weight="normal_force").compute(snapshot)
+            if snapshot.normal_force is not None and float(np.sum(snapshot.normal_force)) > 0
+            else None
+        )
+    return z, z_boundary, normals, lam, forces
+
+
+def _interior(
+    snapshot: Snapshot,
+    grain_grain: NDArray[np.bool_],
+    bounds: tuple[NDArray[np.float64], NDArray[np.float64]],
+    inset: float,
+) -> NDArray[np.bool_]:
+    """Which grain-grain contacts have their midpoint ``inset`` inside the bounding box."""
+    lo, hi = bounds
+    ci, cj = np.asarray(snapshot.contact_i), np.asarray(snapshot.contact_j)
+    all_pos = np.asarray(snapshot.positions)
+    mid = 0.5 * (all_pos[ci[grain_grain]] + all_pos[cj[grain_grain]])
+    return np.asarray(np.all((mid > lo + inset) & (mid < hi - inset), axis=1), dtype=bool)
+
+
+def _interior_anisotropy(
+    snapshot: Snapshot, grain_grain: NDArray[np.bool_], interior: NDArray[np.bool_]
+) -> tuple[float, float, Any]:
+    """The anisotropy and direction of the interior grain-grain contacts' normals
+    (on one thread) and the isotropic noise floor at their count."""
+    angles = np.asarray(snapshot.contact_angles())[grain_grain][interior]
+    with _kernels.kernel_threads(1):
+        a_int, t_int = anisotropy_fourier(angles) if angles.size else (math.nan, math.nan)
+    return float(a_int), float(t_int), isotropic_noise_floor(max(int(interior.sum()), 1))
+
+
+def _force_noise(
+    snapshot: Snapshot, forces: ContactAnisotropy | None, grain_grain: NDArray[np.bool_]
+) -> tuple[float, float, float, float]:
+    """The force anisotropy a_n, the force-weighted effective contact count and
+    the noise floor's mean and probability of the paper's a_n at that count
+    (NaN where there are no forces)."""
+    a_n = n_eff = force_floor_mean = force_p = math.nan
+    if forces is not None and snapshot.normal_force is not None:
+        a_n = forces.anisotropy
+        f = np.asarray(snapshot.normal_force)[grain_grain]
+        if f.size and float(np.sum(f * f)) > 0:
+            n_eff = float(np.sum(f) ** 2 / np.sum(f * f))
+            force_floor = isotropic_noise_floor(max(n_eff, 1.0))
+            force_floor_mean, force_p = force_floor.mean, force_floor.probability_at_most(PAPER_A_N)
+    return a_n, n_eff, force_floor_mean, force_p
+
+
+def _circles(
+    pos: NDArray[np.float64],
+    rad: NDArray[np.float64],
+    grain_counts: NDArray[np.int64],
+    bounds: tuple[NDArray[np.float64], NDArray[np.float64]],
+    radius: float,
+) -> tuple[list[float], list[float], list[float]]:
+    """Nominal and overlap-corrected porosity and mean contact count in the
+    measurement circles of ``radius`` at :data:`CIRCLE_HEIGHTS` of the grains'
+    bounding box ``bounds`` (lower and upper corners)."""
+    lo, hi = bounds
+    height = float(hi[1] - lo[1])
+    nominal, corrected, circle_z = [], [], []
+    for h in CIRCLE_HEIGHTS:
+        centre = (0.5 * (lo[0] + hi[0]), lo[1] + h * height)
+        nominal.append(measurement_circle_porosity(pos, rad, centre, radius))
+        corrected.append(measurement_circle_porosity(pos, rad, centre, radius, overlap_corrected=True))
+        inside = np.hypot(pos[:, 0] - centre[0], pos[:, 1] - centre[1]) < radius
+        circle_z.append(float(grain_counts[inside].mean()) if inside.any() else math.nan)
+    return nominal, corrected, circle_z
+
+
 def snapshot_initial_state(
     snapshot: Snapshot,
     *,
@@ -355,16 +437,7 @@ def snapshot_initial_state(
     """
     if not 0.0 < circle_radius_fraction <= 0.5:
         raise ValueError(f"circle_radius_fraction: must be in (0, 0.5], got {circle_radius_fraction!r}")
-    with _kernels.kernel_threads(1):
-        z = CoordinationNumber().compute(snapshot)
-        z_boundary = CoordinationNumber(include_boundary=True).compute(snapshot).coordination_number
-        normals = ContactAnisotropy().compute(snapshot)
-        lam = StabilityIndex().compute(snapshot)
-        forces = (
-            ContactAnisotropy(weight="normal_force").compute(snapshot)
-            if snapshot.normal_force is not None and float(np.sum(snapshot.normal_force)) > 0
-            else None
-        )
+    z, z_boundary, normals, lam, forces = _measures(snapshot)
     sample = snapshot.is_sample
     n_grains = int(sample.sum())
     ci, cj = np.asarray(snapshot.contact_i), np.asarray(snapshot.contact_j)
@@ -373,47 +446,17 @@ def snapshot_initial_state(
     counts = np.bincount(ci[grain_grain], minlength=snapshot.n_particles)
     counts += np.bincount(cj[grain_grain], minlength=snapshot.n_particles)
     floor = isotropic_noise_floor(max(n_c, 1))
-
-    a_n = math.nan
-    n_eff = math.nan
-    force_floor_mean = math.nan
-    force_p = math.nan
-    if forces is not None and snapshot.normal_force is not None:
-        a_n = forces.anisotropy
-        f = np.asarray(snapshot.normal_force)[grain_grain]
-        if f.size and float(np.sum(f * f)) > 0:
-            n_eff = float(np.sum(f) ** 2 / np.sum(f * f))
-            force_floor = isotropic_noise_floor(max(n_eff, 1.0))
-            force_floor_mean, force_p = force_floor.mean, force_floor.probability_at_most(PAPER_A_N)
-
+    a_n, n_eff, force_floor_mean, force_p = _force_noise(snapshot, forces, grain_grain)
     pos = np.asarray(snapshot.positions)[sample]
     rad = np.asarray(snapshot.radii)[sample]
-    lo = (pos - rad[:, None]).min(axis=0)
-    hi = (pos + rad[:, None]).max(axis=0)
+    lo, hi = (pos - rad[:, None]).min(axis=0), (pos + rad[:, None]).max(axis=0)
     width, height = float(hi[0] - lo[0]), float(hi[1] - lo[1])
     radius = circle_radius_fraction * min(width, 0.5 * height)
-    nominal, corrected, circle_z = [], [], []
     grain_counts = counts[sample]
-    for h in CIRCLE_HEIGHTS:
-        centre = (0.5 * (lo[0] + hi[0]), lo[1] + h * height)
-        nominal.append(measurement_circle_porosity(pos, rad, centre, radius))
-        corrected.append(measurement_circle_porosity(pos, rad, centre, radius, overlap_corrected=True))
-        inside = np.hypot(pos[:, 0] - centre[0], pos[:, 1] - centre[1]) < radius
-        circle_z.append(float(grain_counts[inside].mean()) if inside.any() else math.nan)
-
-    porosity = math.nan
-    if area is not None:
-        porosity = float(1.0 - math.pi * float(np.sum(rad * rad)) / float(area))
-    ends_i = ci[grain_grain]
-    ends_j = cj[grain_grain]
-    all_pos = np.asarray(snapshot.positions)
-    mid = 0.5 * (all_pos[ends_i] + all_pos[ends_j])
-    inset = 2.0 * float(2.0 * rad.max())
-    interior = np.all((mid > lo + inset) & (mid < hi - inset), axis=1)
-    angles = np.asarray(snapshot.contact_angles())[grain_grain][interior]
-    with _kernels.kernel_threads(1):
-        a_int, t_int = anisotropy_fourier(angles) if angles.size else (math.nan, math.nan)
-    floor_int = isotropic_noise_floor(max(int(interior.sum()), 1))
+    nominal, corrected, circle_z = _circles(pos, rad, grain_counts, (lo, hi), radius)
+    porosity = math.nan if area is None else float(1.0 - math.pi * float(np.sum(rad * rad)) / float(area))
+    interior = _interior(snapshot, grain_grain, (lo, hi), 2.0 * float(2.0 * rad.max()))
+    a_int, t_int, floor_int = _interior_anisotropy(snapshot, grain_grain, interior)
     rattler = np.asarray(z.rattlers)
     lam_grains = sample & (np.asarray(lam.n_contacts) >= 2)
     gap = gap_for_coordination_number(pos, rad, PAPER_Z)
