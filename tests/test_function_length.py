@@ -29,7 +29,6 @@ HOT_KERNEL = "// hot kernel:"
 TO_SPLIT: dict[str, int] = {
     "python/grainlab/commands/analyze.py:register": 102,
     "python/grainlab/commands/analyze.py:run": 108,
-    "python/grainlab/demo.py:compress": 90,
     "python/grainlab/io/csv.py:read_particles_csv": 108,
     "python/grainlab/io/lammps_dump.py:_frame_index": 138,
     "python/grainlab/io/lammps_dump.py:attach_lammps_contacts": 87,

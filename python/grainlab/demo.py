@@ -13,6 +13,7 @@ import io
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -32,6 +33,7 @@ from grainlab.simulation import (
     WALL_GROUP,
     ContactModel,
     Simulation,
+    Wall,
 )
 
 #: What the demo writes into its folder; a folder already holding one is refused.
@@ -70,6 +72,39 @@ def random_disks(
     return centres, diameters / 2
 
 
+def _boxed_disks(n_side: int, seed: int, threads: int | None) -> tuple[Simulation, dict[str, Wall]]:
+    """``n_side**2`` random disks on a grid (Table 1's contacts, no platen
+    friction) in a box of four segment walls, named as :data:`BOX_WALLS`."""
+    spacing = 3.2e-3
+    positions, radii = random_disks(n_side, spacing, 0.5e-3, 3.0e-3, seed)
+    box = n_side * spacing
+    sim = Simulation(
+        positions,
+        radii,
+        TABLE1_DENSITY_KG_PER_M3,
+        contact_model=ContactModel(TABLE1_STIFFNESS_N_PER_M, TABLE1_STIFFNESS_N_PER_M, TABLE1_FRICTION),
+        local_damping=TABLE1_LOCAL_DAMPING,
+        threads=threads,
+    )
+    # Table 1: particle-platen friction 0
+    sim.set_contact_model(0, WALL_GROUP, ContactModel(friction=0.0))
+    corners = [(0.0, 0.0), (box, 0.0), (box, box), (0.0, box)]
+    walls = dict(zip(BOX_WALLS, (sim.add_segment_wall(corners[k], corners[(k + 1) % 4]) for k in range(4)),
+                     strict=True))
+    return sim, walls
+
+
+def _write(out: Path, rows: list[dict[str, Any]], result: CompressionResult, sim: Simulation) -> None:
+    """The demo's ``timeseries.csv``, ``summary.json`` and ``state.bin`` in ``out``."""
+    table = io.StringIO()
+    writer = csv.DictWriter(table, fieldnames=list(rows[0]), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    write_text_atomic(out / "timeseries.csv", table.getvalue())
+    write_json_atomic(out / "summary.json", asdict(result))
+    sim.save(out / "state.bin")
+
+
 def compress(
     out_dir: str | Path | None = None,
     *,
@@ -95,22 +130,7 @@ def compress(
     if out_dir is not None:
         ensure_output_folder(out_dir)
         refuse_overwrite(out_dir, DEMO_FILES, why="grainlab demo writes its own")
-    spacing = 3.2e-3
-    positions, radii = random_disks(n_side, spacing, 0.5e-3, 3.0e-3, seed)
-    box = n_side * spacing
-    sim = Simulation(
-        positions,
-        radii,
-        TABLE1_DENSITY_KG_PER_M3,
-        contact_model=ContactModel(TABLE1_STIFFNESS_N_PER_M, TABLE1_STIFFNESS_N_PER_M, TABLE1_FRICTION),
-        local_damping=TABLE1_LOCAL_DAMPING,
-        threads=threads,
-    )
-    # Table 1: particle-platen friction 0
-    sim.set_contact_model(0, WALL_GROUP, ContactModel(friction=0.0))
-    corners = [(0.0, 0.0), (box, 0.0), (box, box), (0.0, box)]
-    walls = dict(zip(BOX_WALLS, (sim.add_segment_wall(corners[k], corners[(k + 1) % 4]) for k in range(4)),
-                     strict=True))
+    sim, walls = _boxed_disks(n_side, seed, threads)
     rows = []
     start = time.perf_counter()
     bar = progress_bar(max_steps, "compressing", enabled=progress, unit="step")
@@ -151,12 +171,5 @@ def compress(
         particle_steps_per_s=sim.n_particles * steps / wall_time,
     )
     if out_dir is not None:
-        out = Path(out_dir)
-        table = io.StringIO()
-        writer = csv.DictWriter(table, fieldnames=list(rows[0]), lineterminator="\n")
-        writer.writeheader()
-        writer.writerows(rows)
-        write_text_atomic(out / "timeseries.csv", table.getvalue())
-        write_json_atomic(out / "summary.json", asdict(result))
-        sim.save(out / "state.bin")
+        _write(Path(out_dir), rows, result, sim)
     return result
