@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, paper
 from grainlab.bodies import ClumpState, clump_mass_properties
-from grainlab.snapshot import Snapshot
+from grainlab.snapshot import GRAIN_ANGLE_FIELD, GRAIN_CENTROID_FIELD, GRAIN_FIELD, Snapshot
 
 #: Table 1 of the paper (:mod:`grainlab.paper`): contact stiffnesses (N/m), particle
 #: friction, density (kg/m^3), local damping.
@@ -1147,9 +1147,25 @@ class Simulation:
             particle_fields={
                 "velocity": self.velocities,
                 "angular_velocity": self.angular_velocities,
+                **self._grain_fields(),
             },
             metadata=metadata,
         )
+
+    def _grain_fields(self) -> dict[str, NDArray[Any]]:
+        """The snapshot's grain fields (:data:`~grainlab.snapshot.GRAIN_FIELD`): every
+        particle's body, and its body's centroid and angle (a disk's own centre and
+        rotation); none without clumps, so that a disks' snapshot is as before."""
+        clumps = self.clumps
+        if not len(clumps):
+            return {}
+        body = self.body_of_particles
+        pebble = body < len(clumps)
+        centroid = np.array(self.positions)
+        angle = np.array(self.rotations)
+        centroid[pebble] = clumps.centroid_m[body[pebble]]
+        angle[pebble] = clumps.angle_rad[body[pebble]]
+        return {GRAIN_FIELD: body, GRAIN_CENTROID_FIELD: centroid, GRAIN_ANGLE_FIELD: angle}
 
     # ---- state ----
 

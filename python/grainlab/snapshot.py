@@ -33,6 +33,14 @@ Conventions (docs/conventions.md):
   found from the geometry (:meth:`Snapshot.boundary_bodies`). Stability index
   and contact counts count each boundary body once per particle by default
   (docs/fabric.md, "Boundary contacts").
+* A *grain* is a rigid body of the sample: one disk, or a clump of disks
+  (pebbles) moved as one (docs/bodies.md). ``particle_fields["grain"]``
+  (:data:`GRAIN_FIELD`) labels the grain of each particle (an integer >= 0;
+  pebbles of one clump share it), and ``"grain_centroid"`` (N, 2) and
+  ``"grain_angle"`` (N,) carry each particle's grain's centroid and angle;
+  without them every particle is a grain of its own, at its centre, turned by
+  its rotation (:meth:`Snapshot.grains`). A simulation's snapshot has them when
+  it has clumps.
 
 Example
 -------
@@ -65,6 +73,9 @@ from grainlab import _core, _kernels
 
 __all__ = [
     "BODY_FIELD",
+    "GRAIN_ANGLE_FIELD",
+    "GRAIN_CENTROID_FIELD",
+    "GRAIN_FIELD",
     "ParticleKind",
     "Snapshot",
     "detect_contacts",
@@ -75,6 +86,12 @@ TWO_PI = 2.0 * np.pi
 
 #: Name of the per-particle field that labels each membrane particle's chain.
 BODY_FIELD = "body"
+
+#: Names of the per-particle fields of the grain (rigid body) of each particle:
+#: its label, its centroid (N, 2) and its angle (N,).
+GRAIN_FIELD = "grain"
+GRAIN_CENTROID_FIELD = "grain_centroid"
+GRAIN_ANGLE_FIELD = "grain_angle"
 
 #: Ways of counting a particle's contacts with boundary bodies (see
 #: :meth:`Snapshot.contact_counts`): ``"body"`` once per body, ``"each"`` every contact.
@@ -139,6 +156,31 @@ def _as_int(name: str, value: ArrayLike, shape: tuple[int | None, ...]) -> NDArr
     a = a.astype(np.int64, copy=False)
     _check_shape(name, a, shape)
     return a
+
+
+def _labels(name: str, value: ArrayLike, n: int, least: int) -> NDArray[np.int64]:
+    """(n,) integer labels, each >= ``least``."""
+    labels = _as_int(f"particle_fields[{name!r}]", value, (n,))
+    if labels.size and labels.min() < least:
+        k = int(np.argmin(labels))
+        what = "body labels must be >= 0 (or -1 for none)" if least < 0 else "grain labels must be >= 0"
+        raise ValueError(f"particle_fields[{name!r}]: {what}, got {int(labels[k])} at index {k}")
+    return _readonly(labels)
+
+
+def _labelled_fields(fields: dict[str, NDArray[Any]], n: int) -> dict[str, NDArray[Any]]:
+    """The per-particle fields with the boundary body and grain labels checked
+    (:data:`BODY_FIELD`, :data:`GRAIN_FIELD` and the grain's centroid and angle)."""
+    if BODY_FIELD in fields:
+        fields[BODY_FIELD] = _labels(BODY_FIELD, fields[BODY_FIELD], n, -1)
+    if GRAIN_FIELD in fields:
+        fields[GRAIN_FIELD] = _labels(GRAIN_FIELD, fields[GRAIN_FIELD], n, 0)
+    for name, shape in ((GRAIN_CENTROID_FIELD, (n, 2)), (GRAIN_ANGLE_FIELD, (n,))):
+        if name in fields:
+            if GRAIN_FIELD not in fields:
+                raise ValueError(f"particle_fields[{name!r}]: given without particle_fields[{GRAIN_FIELD!r}]")
+            fields[name] = _readonly(_as_float(f"particle_fields[{name!r}]", fields[name], shape))
+    return fields
 
 
 def _check_shape(name: str, a: NDArray[Any], shape: tuple[int | None, ...]) -> None:
@@ -367,16 +409,7 @@ class Snapshot:
             k: _readonly(self._field(k, v, n, "particle_fields"))
             for k, v in dict(particle_fields or {}).items()
         }
-        if BODY_FIELD in per_particle:
-            body = _as_int(f"particle_fields[{BODY_FIELD!r}]", per_particle[BODY_FIELD], (n,))
-            if body.size and body.min() < -1:
-                k = int(np.argmin(body))
-                raise ValueError(
-                    f"particle_fields[{BODY_FIELD!r}]: body labels must be >= 0 (or -1 for none), "
-                    f"got {int(body[k])} at index {k}"
-                )
-            per_particle[BODY_FIELD] = _readonly(body)
-        put("particle_fields", per_particle)
+        put("particle_fields", _labelled_fields(per_particle, n))
 
         flags = tuple(bool(p) for p in periodic)
         if len(flags) != 2:
@@ -621,6 +654,20 @@ class Snapshot:
     def is_sample(self) -> NDArray[np.bool_]:
         """(N,) mask of the particles that belong to the sample (kind != MEMBRANE)."""
         return np.asarray(self.kind != ParticleKind.MEMBRANE, dtype=np.bool_)
+
+    def grains(self) -> NDArray[np.int64]:
+        """(N,) the grain (rigid body) of each particle, labels 0, 1, ...: pebbles of
+        one clump share theirs (:data:`GRAIN_FIELD`); without the field every
+        particle is a grain of its own (``arange(N)``)."""
+        if GRAIN_FIELD not in self.particle_fields:
+            return _readonly(np.arange(self.n_particles, dtype=np.int64))
+        return _readonly(np.asarray(self.particle_fields[GRAIN_FIELD], dtype=np.int64))
+
+    @property
+    def n_grains(self) -> int:
+        """Number of grains (rigid bodies) of all kinds: :meth:`grains` labels."""
+        labels = self.grains()
+        return int(np.unique(labels).size)
 
     @property
     def is_wall_contact(self) -> NDArray[np.bool_]:

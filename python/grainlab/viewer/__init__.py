@@ -56,6 +56,7 @@ _BODY = """<!DOCTYPE html>
       <option value="strain">local shear strain</option>
       <option value="porosity">local porosity</option>
       <option value="chains">force chains</option>
+      <option value="grains">grain (a clump's pebbles alike)</option>
     </select>
   </label>
   <label><input type="checkbox" id="show-contacts"> contact network</label>

@@ -9,8 +9,9 @@ the rotation since the first snapshot, the local shear strain since it and
 the shear band labels; the particle–particle contacts with their normal
 forces; the accepted bands' outlines (the run's stored band searches, against its
 first snapshot);
-the walls when the file stores them; and the stress–strain curve of the
-time series.
+the walls when the file stores them; each particle's grain (the pebbles of a
+clump share theirs, :meth:`~grainlab.snapshot.Snapshot.grains`), for the page's
+colour per grain; and the stress–strain curve of the time series.
 
 Arrays are quantised for the page: coordinates, radii and values as
 float32 (about 7 significant digits: a grain's lambda shows to 1e-6), codes
@@ -111,6 +112,7 @@ def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str, pr
             "rotation": encode(rotation, "f4"),
             "strain": encode(arrays["local_shear_strain"], "f4"),
             "in_band": encode(arrays["in_shear_band"], "u1"),
+            "grain": encode(snap.grains(), "u4"),
             "ci": encode(lines[:, 0], index_dtype),
             "cj": encode(lines[:, 1], index_dtype),
             "fn": encode(force, "f4"),

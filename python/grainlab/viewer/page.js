@@ -7,7 +7,7 @@
   const FIELDS = {
     x: "f4", y: "f4", r: "f4", id: "u4", kind: "u1", lambda: "f4", contacts: "u1", dx: "f4",
     dy: "f4", rotation: "f4", strain: "f4", in_band: "u1", ci: D.index_dtype, cj: D.index_dtype, fn: "f4",
-    porosity: "f4", chain: "u1",
+    porosity: "f4", chain: "u1", grain: "u4",
   };
   const MEMBRANE = 1;
 
@@ -23,6 +23,9 @@
     for (const key in FIELDS) a[key] = decode(s.arrays[key], FIELDS[key]);
     a.disp = new Float32Array(s.n);
     for (let i = 0; i < s.n; i++) a.disp[i] = Math.hypot(a.dx[i], a.dy[i]);
+    // a shade per grain, spread by the golden ratio so that neighbouring labels differ
+    a.grainShade = new Float32Array(s.n);
+    for (let i = 0; i < s.n; i++) a.grainShade[i] = (a.grain[i] * 0.6180339887) % 1;
     return { meta: s, a: a };
   });
 
@@ -66,6 +69,7 @@
     porosity: { label: "local porosity (power cell)", key: "porosity", lo: 0, hi: percentile("porosity", 0.98),
                 stops: SEQ },
     chains: { label: "in a force chain (0 no, 1 yes)", key: "chain", lo: 0, hi: 1, stops: [[200, 200, 210], [150, 20, 30]] },
+    grains: { label: "grain (one colour per rigid body)", key: "grainShade", lo: 0, hi: 1, stops: DIV },
   };
 
   // ---------------------------------------------------------------- elements
