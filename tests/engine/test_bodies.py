@@ -7,6 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from clump_factories import trimer_pile
+
 from grainlab import ContactModel, Simulation
 from grainlab.bodies import clump_mass_properties
 
@@ -65,22 +67,7 @@ def test_colliding_clumps_keep_their_momentum_and_exchange_spin():
 
 
 def test_a_pile_of_clumps_comes_to_rest_on_a_floor_without_inner_contacts():
-    sim = Simulation(
-        np.empty((0, 2)),
-        np.empty(0),
-        2650.0,
-        contact_model=ContactModel(KN, KN, 0.5),
-        time_step=1e-4,
-        local_damping=0.7,
-        gravity=(0.0, -9.81),
-    )
-    sim.add_line_wall((0.0, 0.0), (0.0, 1.0))
-    sim.add_line_wall((0.0, 0.0), (1.0, 0.0))
-    sim.add_line_wall((12e-3, 0.0), (-1.0, 0.0))
-    rng = np.random.default_rng(4)
-    centres = [[2.2e-3 + 3.5e-3 * (k % 3), 2.2e-3 + 3.5e-3 * (k // 3)] for k in range(6)]
-    sim.add_clumps(TRIMER, RADII, positions=centres, angles=rng.uniform(0, 2 * np.pi, 6), density=2650.0)
-    sim.time_step = sim.critical_time_step(0.5)
+    sim = trimer_pile(np.random.default_rng(4).uniform(0, 2 * np.pi, 6))
     sim.run(80_000)
     body = sim.body_of_particles
     contacts = sim.contacts()

@@ -11,34 +11,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from grainlab import ContactModel, Simulation
+from clump_factories import trimer_pile
+
+from grainlab import Simulation
 from grainlab.io.hdf5 import ResultsWriter, read_results
 from grainlab.postprocess.vtk import export_vtk
 from grainlab.snapshot import GRAIN_ANGLE_FIELD, GRAIN_CENTROID_FIELD, GRAIN_FIELD, Snapshot
 from grainlab.viewer.data import viewer_data
 
-TRIMER = np.array([[0.0, 0.7e-3], [-0.6e-3, -0.35e-3], [0.6e-3, -0.35e-3]])
-
-
 def _settling_clumps() -> Simulation:
     """Six trimers and one disk falling into a box."""
-    sim = Simulation(
-        np.empty((0, 2)),
-        np.empty(0),
-        2650.0,
-        contact_model=ContactModel(8.45e7, 8.45e7, 0.5),
-        time_step=1e-4,
-        local_damping=0.7,
-        gravity=(0.0, -9.81),
-    )
-    sim.add_line_wall((0.0, 0.0), (0.0, 1.0))
-    sim.add_line_wall((0.0, 0.0), (1.0, 0.0))
-    sim.add_line_wall((12e-3, 0.0), (-1.0, 0.0))
-    sim.add_particles([[10e-3, 9e-3]], [0.8e-3], 2650.0)
-    centres = [[2.2e-3 + 3.5e-3 * (k % 3), 2.2e-3 + 3.5e-3 * (k // 3)] for k in range(6)]
-    sim.add_clumps(TRIMER, np.full(3, 1e-3), positions=centres, angles=np.linspace(0.0, 2.0, 6), density=2650.0)
-    sim.time_step = sim.critical_time_step(0.5)
-    return sim
+    return trimer_pile(np.linspace(0.0, 2.0, 6), with_disk=True)
 
 
 @pytest.fixture(scope="module")
