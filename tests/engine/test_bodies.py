@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from clump_factories import trimer_pile
 
 from grainlab import ContactModel, Simulation

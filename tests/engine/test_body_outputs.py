@@ -10,7 +10,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from clump_factories import trimer_pile
 
 from grainlab import Simulation
@@ -18,6 +17,7 @@ from grainlab.io.hdf5 import ResultsWriter, read_results
 from grainlab.postprocess.vtk import export_vtk
 from grainlab.snapshot import GRAIN_ANGLE_FIELD, GRAIN_CENTROID_FIELD, GRAIN_FIELD, Snapshot
 from grainlab.viewer.data import viewer_data
+
 
 def _settling_clumps() -> Simulation:
     """Six trimers and one disk falling into a box."""
