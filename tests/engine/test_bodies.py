@@ -128,10 +128,18 @@ def test_scaled_clumps_are_similar_clumps_of_the_same_density():
 
 def test_a_pebble_moves_only_with_its_body():
     sim = _two_trimers()
-    moved = sim.positions.copy()
-    moved[4, 0] += 1e-3
-    with pytest.raises(ValueError, match=r"positions\[4\]: particle 4 is a pebble of clump 1"):
-        sim.positions = moved
+    # the whole assembly shifted: each clump follows rigidly, to round-off
+    centroids = sim.clumps.centroid_m
+    sim.positions = sim.positions + [1e-3, 2e-3]
+    np.testing.assert_allclose(sim.clumps.centroid_m, centroids + [1e-3, 2e-3], rtol=0, atol=1e-15)
+    # zeros stop the clumps; a radius of one pebble cannot change alone
+    sim.set_clump_velocities([[0.01, 0.0], [0.0, 0.02]], [3.0, -1.0])
+    sim.velocities = np.zeros((6, 2))
+    sim.angular_velocities = np.zeros(6)
+    assert not sim.clumps.velocity_m_per_s.any() and not sim.clumps.angular_velocity_rad_per_s.any()
+    assert not sim.velocities.any()
+    with pytest.raises(ValueError, match=r"radii\[4\]: particle 4 is a pebble of clump 1"):
+        sim.radii = [1e-3] * 4 + [2e-3, 1e-3]
     with pytest.raises(ValueError, match=r"different fixity"):
         sim.fixity = [7, 0, 0, 0, 0, 0]
     sim.fixity = [7, 7, 7, 0, 0, 0]

@@ -351,6 +351,104 @@ impl Clumps {
         }
     }
 
+    /// The clumps with a member whose entry of `new` (a per-particle array)
+    /// differs from `current`'s.
+    pub(crate) fn changed<T: PartialEq>(&self, current: &[T], new: &[T]) -> Vec<usize> {
+        (0..self.len())
+            .filter(|&c| {
+                self.pebble[self.members(c)]
+                    .iter()
+                    .any(|&q| current[q as usize] != new[q as usize])
+            })
+            .collect()
+    }
+
+    /// Clump `c` placed where its pebbles' `positions` put it: the rotation and
+    /// translation of its body frame closest to them in least squares (exact
+    /// for a rigidly moved clump), each pebble taken at its image nearest the
+    /// first; the images read again.
+    pub(crate) fn fit_placement(
+        &mut self,
+        c: usize,
+        positions: &[Vec2],
+        cell: Option<&PeriodicCell>,
+    ) {
+        let members = self.members(c);
+        let first = positions[self.pebble[members.start] as usize];
+        let world: Vec<Vec2> = self.pebble[members.clone()]
+            .iter()
+            .map(|&q| {
+                let x = positions[q as usize];
+                sub(x, image_offset(cell, image_between(cell, x, first)))
+            })
+            .collect();
+        let n = world.len() as f64;
+        let mean = |points: &mut dyn Iterator<Item = Vec2>| {
+            let s = points.fold([0.0; 2], add);
+            [s[0] / n, s[1] / n]
+        };
+        let offsets = &self.offset[members.clone()];
+        let (body_mean, world_mean) = (
+            mean(&mut offsets.iter().copied()),
+            mean(&mut world.iter().copied()),
+        );
+        let (mut along, mut across) = (0.0, 0.0);
+        for (&o, &p) in offsets.iter().zip(&world) {
+            let (o, p) = (sub(o, body_mean), sub(p, world_mean));
+            along += o[0] * p[0] + o[1] * p[1];
+            across += cross(o, p);
+        }
+        let angle = across.atan2(along);
+        self.angle[c] = angle;
+        self.centroid[c] = sub(world_mean, rotate(angle.sin_cos(), body_mean));
+        for (m, &x) in members.zip(&world) {
+            let q = self.pebble[m] as usize;
+            self.image[m] = image_between(cell, positions[q], x);
+        }
+    }
+
+    /// Clump `c`'s velocity and angular velocity fitted to its pebbles'
+    /// `velocity` (relative to the imposed flow when `gradient`): the rigid
+    /// motion `V + w x r` closest to them in least squares (exact for a rigid
+    /// one), at the pebbles' current arms.
+    pub(crate) fn fit_velocity(&mut self, c: usize, velocity: &[Vec2], gradient: Option<&Mat2>) {
+        let members = self.members(c);
+        let n = members.len() as f64;
+        let absolute = |m: usize| {
+            let v = velocity[self.pebble[m] as usize];
+            match gradient {
+                Some(l) => add(v, mat_vec(l, self.arm[m])),
+                None => v,
+            }
+        };
+        let (mut r_sum, mut v_sum) = ([0.0; 2], [0.0; 2]);
+        for m in members.clone() {
+            r_sum = add(r_sum, self.arm[m]);
+            v_sum = add(v_sum, absolute(m));
+        }
+        let (r_mean, v_mean) = ([r_sum[0] / n, r_sum[1] / n], [v_sum[0] / n, v_sum[1] / n]);
+        let (mut turn, mut spread) = (0.0, 0.0);
+        for m in members {
+            let (r, v) = (sub(self.arm[m], r_mean), sub(absolute(m), v_mean));
+            turn += cross(r, v);
+            spread += r[0] * r[0] + r[1] * r[1];
+        }
+        let w = if spread > 0.0 { turn / spread } else { 0.0 };
+        self.angular_velocity[c] = w;
+        self.velocity[c] = sub(v_mean, spin(w, r_mean));
+    }
+
+    /// Clump `c`'s angular velocity: the mean of its pebbles' `angular_velocity`.
+    pub(crate) fn fit_angular_velocity(&mut self, c: usize, angular_velocity: &[f64]) {
+        let members = self.members(c);
+        let n = members.len() as f64;
+        let sum: f64 = self.pebble[members]
+            .iter()
+            .map(|&q| angular_velocity[q as usize])
+            .sum();
+        self.angular_velocity[c] = sum / n;
+    }
+
     /// Puts every pebble at its rigid place and velocity, with the clump's
     /// angle, angular velocity and fixity; `gradient` is the deforming cell's
     /// velocity gradient, if any.
@@ -361,6 +459,19 @@ impl Clumps {
         gradient: Option<&Mat2>,
     ) {
         for c in 0..self.len() {
+            self.place_clump(c, particles, cell, gradient);
+        }
+    }
+
+    /// [`Clumps::place_pebbles`] for clump `c` alone.
+    pub(crate) fn place_clump(
+        &mut self,
+        c: usize,
+        particles: &mut Particles,
+        cell: Option<&PeriodicCell>,
+        gradient: Option<&Mat2>,
+    ) {
+        {
             let turn = self.angle[c].sin_cos();
             for m in self.members(c) {
                 let q = self.pebble[m] as usize;

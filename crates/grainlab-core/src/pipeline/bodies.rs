@@ -236,8 +236,8 @@ impl Simulation {
             Some(q) => Err(EngineError::invalid(
                 format!("{field}[{}]", self.external_index(q)),
                 format!(
-                    "particle {} is a pebble of clump {}: it moves, turns and is sized \
-                     with its body (set_clump_velocities)",
+                    "particle {} is a pebble of clump {}: it turns and is sized with its \
+                     body (scale_clumps)",
                     self.external_index(q),
                     self.clumps.id[self.particles.clump[q] as usize]
                 ),

@@ -755,12 +755,21 @@ impl Simulation {
     /// Sets the positions (m, finite, external order): a jump, not a
     /// displacement, so the springs are caught up first and the jump adds
     /// nothing to them; the neighbour lists are rebuilt at the next step or query.
+    /// A clump whose pebbles moved goes where they put it (the rigid placement
+    /// closest to them in least squares), its pebbles back in its shape.
     pub fn set_positions(&mut self, positions: &[Vec2]) -> Result<()> {
         require_finite_points("positions", positions)?;
         let position = self.internal_array("positions", positions)?;
-        self.check_pebbles_kept("positions", &self.particles.position, &position)?;
+        let moved = self.clumps.changed(&self.particles.position, &position);
         self.modify_motion(|s| {
             s.particles.position = position;
+            let gradient = s.deforming_gradient();
+            for c in moved {
+                let cell = s.cell.as_ref();
+                s.clumps.fit_placement(c, &s.particles.position, cell);
+                s.clumps
+                    .place_clump(c, &mut s.particles, cell, gradient.as_ref());
+            }
             s.neighbors.invalidate();
         });
         Ok(())
@@ -770,29 +779,44 @@ impl Simulation {
     /// values: the next step starts with a half kick and adds no shear
     /// increment, and the displacement of the last step, made at the old
     /// half-step velocities, is first added to the springs, so it is counted once.
+    /// A clump whose pebbles' velocities changed takes the rigid motion closest
+    /// to them in least squares (zero for zeros), its pebbles its rigid velocity.
     pub fn set_velocities(&mut self, velocities: &[Vec2]) -> Result<()> {
         require_finite_points("velocities", velocities)?;
         let velocity = self.internal_array("velocities", velocities)?;
-        self.check_pebbles_kept("velocities", &self.particles.velocity, &velocity)?;
+        let changed = self.clumps.changed(&self.particles.velocity, &velocity);
         self.modify_motion(|s| {
             s.particles.velocity = velocity;
+            let gradient = s.deforming_gradient();
+            for c in changed {
+                s.clumps
+                    .fit_velocity(c, &s.particles.velocity, gradient.as_ref());
+                s.clumps
+                    .place_clump(c, &mut s.particles, s.cell.as_ref(), gradient.as_ref());
+            }
             s.half_kick_pending = true;
         });
         Ok(())
     }
 
     /// Sets the angular velocities (rad/s, finite, external order), full-step
-    /// values as in [`Simulation::set_velocities`].
+    /// values as in [`Simulation::set_velocities`]; a clump whose pebbles'
+    /// changed takes their mean.
     pub fn set_angular_velocities(&mut self, angular_velocities: &[f64]) -> Result<()> {
         require_finite_values("angular_velocities", angular_velocities)?;
         let omega = self.internal_array("angular_velocities", angular_velocities)?;
-        self.check_pebbles_kept(
-            "angular_velocities",
-            &self.particles.angular_velocity,
-            &omega,
-        )?;
+        let changed = self
+            .clumps
+            .changed(&self.particles.angular_velocity, &omega);
         self.modify_motion(|s| {
             s.particles.angular_velocity = omega;
+            let gradient = s.deforming_gradient();
+            for c in changed {
+                s.clumps
+                    .fit_angular_velocity(c, &s.particles.angular_velocity);
+                s.clumps
+                    .place_clump(c, &mut s.particles, s.cell.as_ref(), gradient.as_ref());
+            }
             s.half_kick_pending = true;
         });
         Ok(())
