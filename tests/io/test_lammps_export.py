@@ -98,6 +98,10 @@ def test_export_refuses_what_it_cannot_carry(tmp_path):
         write_lammps_shear(walled, tmp_path, LammpsShear(1.0, 0.1))
     with pytest.raises(ValueError, match="rolling"):
         write_lammps_shear(small_cell(rolling_friction=0.1), tmp_path, LammpsShear(1.0, 0.1))
+    clumped = small_cell()
+    clumped.add_bodies([[0, 1]])
+    with pytest.raises(ValueError, match=r"1 clump\(s\) cannot be exported"):
+        write_lammps_shear(clumped, tmp_path, LammpsShear(1.0, 0.1))
     with pytest.raises(ValueError, match="final_strain"):
         LammpsShear(1.0, -0.1)
     assert not any(tmp_path.iterdir())  # refused before anything was written

@@ -203,6 +203,10 @@ def _checked_state(sim: Simulation) -> ContactModel:
         raise ValueError(f"sim: {len(active)} active wall(s); the periodic simple shear has none")
     if sim.n_bonds:
         raise ValueError(f"sim: {sim.n_bonds} bond(s) cannot be exported")
+    if len(sim.clumps):
+        raise ValueError(
+            f"sim: {len(sim.clumps)} clump(s) cannot be exported: the deck's atoms would move as free disks"
+        )
     if np.any(sim.fixity != 0):
         raise ValueError("sim: fixed degrees of freedom (Simulation.fixity) cannot be exported")
     if np.any(sim.external_forces != 0.0) or np.any(sim.external_torques != 0.0):
