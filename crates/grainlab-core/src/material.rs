@@ -207,6 +207,7 @@ struct TableSummary {
     undamped: bool,
     rolling: bool,
     rolling_damped: bool,
+    all_hertz: bool,
 }
 
 impl TableSummary {
@@ -225,6 +226,7 @@ impl TableSummary {
             rolling_damped: models
                 .iter()
                 .any(|m| m.rolling_friction != 0.0 && m.rolling_damping_ratio > 0.0),
+            all_hertz: models.iter().all(|m| m.law == ContactLaw::HertzMindlin),
         }
     }
 }
@@ -319,6 +321,12 @@ impl MaterialTable {
     /// evaluate the linear law only; a Hertz-Mindlin pair runs the law itself).
     pub fn undamped(&self) -> bool {
         self.summary.undamped
+    }
+
+    /// Whether every pair of groups uses Hertz-Mindlin (the pair loop then
+    /// runs that law inlined, the linear loops keep theirs without it).
+    pub fn all_hertz(&self) -> bool {
+        self.summary.all_hertz
     }
 
     /// Whether any model of the table has rolling resistance (`rolling_friction`

@@ -130,6 +130,20 @@ pub fn contact_law_with(
     increment_time: f64,
     record: &mut ContactRecord,
 ) -> ContactForce {
+    law(constants, model, kinematics, dt, increment_time, record)
+}
+
+/// The law itself, inlined where it is called: into [`contact_law_with`],
+/// and into the pair loop of a table whose every model is Hertz-Mindlin.
+#[inline(always)]
+pub(crate) fn law(
+    constants: &HertzConstants,
+    model: &ContactModel,
+    kinematics: &ContactKinematics,
+    dt: f64,
+    increment_time: f64,
+    record: &mut ContactRecord,
+) -> ContactForce {
     let mut dissipation = ContactDissipation::default();
     let overlap = kinematics.overlap;
     let r_star = RollingSpring::effective_radius(kinematics);

@@ -354,6 +354,7 @@ macro_rules! pair_kernel {
             max_overlap_ratio: $sim.params.max_overlap_ratio,
             single_model: $sim.materials.single_undamped_model(),
             undamped: $sim.materials.undamped(),
+            all_hertz: $sim.materials.all_hertz(),
             rolling,
             // (the table scanned again only when it has rolling resistance)
             rolling_damped: rolling && $sim.materials.rolling_damped(),
@@ -386,6 +387,8 @@ pub(crate) struct PairKernel<'a> {
     pub(crate) single_model: Option<ContactModel>,
     /// No model has a dashpot.
     pub(crate) undamped: bool,
+    /// Every model is Hertz-Mindlin.
+    pub(crate) all_hertz: bool,
     /// Some model has rolling resistance (the four-pair loop then evaluates it).
     pub(crate) rolling: bool,
     /// Some model with rolling resistance has a rolling dashpot.
@@ -408,6 +411,13 @@ impl PairKernel<'_> {
         sink: &mut S,
     ) -> ContactTally {
         let (records, sliding) = (history.records, history.sliding);
+        if self.all_hertz {
+            return if self.velocity_gradient.is_some() {
+                self.hertz_pairs::<MEASURE, true, S>(first, records, sliding, sink)
+            } else {
+                self.hertz_pairs::<MEASURE, false, S>(first, records, sliding, sink)
+            };
+        }
         // the loop specialised on what is fixed for the whole call: the same
         // arithmetic in every variant, minus the tests whose outcome is known
         match (
@@ -481,7 +491,30 @@ impl PairKernel<'_> {
         let fixed = self.loop_constants();
         let columns = self.columns(first, records.len().min(sliding.len()));
         let all = 0..columns.len();
-        self.pairs_one_at_a_time::<MEASURE, DEFORMING, SINGLE, DASHPOTS, S>(
+        self.pairs_one_at_a_time::<MEASURE, DEFORMING, SINGLE, DASHPOTS, false, S>(
+            &fixed, &columns, all, records, sliding, sink, &mut tally,
+        );
+        tally
+    }
+
+    /// The loop of a table whose every model is Hertz-Mindlin, with the law
+    /// inlined (the same bits as through [`hertz::contact_law_with`]).
+    ///
+    /// # Safety
+    /// As [`PairKernel::run`].
+    #[inline(never)]
+    unsafe fn hertz_pairs<const MEASURE: bool, const DEFORMING: bool, S: ForceSink>(
+        &self,
+        first: usize,
+        records: &mut [ContactRecord],
+        sliding: &mut [bool],
+        sink: &mut S,
+    ) -> ContactTally {
+        let mut tally = ContactTally::default();
+        let fixed = self.loop_constants();
+        let columns = self.columns(first, records.len().min(sliding.len()));
+        let all = 0..columns.len();
+        self.pairs_one_at_a_time::<MEASURE, DEFORMING, false, true, true, S>(
             &fixed, &columns, all, records, sliding, sink, &mut tally,
         );
         tally
@@ -498,6 +531,7 @@ impl PairKernel<'_> {
         const DEFORMING: bool,
         const SINGLE: bool,
         const DASHPOTS: bool,
+        const HERTZ: bool,
         S: ForceSink,
     >(
         &self,
@@ -510,7 +544,7 @@ impl PairKernel<'_> {
         tally: &mut ContactTally,
     ) {
         for k in range {
-            self.one_pair::<MEASURE, DEFORMING, SINGLE, DASHPOTS, S>(
+            self.one_pair::<MEASURE, DEFORMING, SINGLE, DASHPOTS, HERTZ, S>(
                 fixed,
                 columns,
                 k,
@@ -570,6 +604,7 @@ impl PairKernel<'_> {
         const DEFORMING: bool,
         const SINGLE: bool,
         const DASHPOTS: bool,
+        const HERTZ: bool,
         S: ForceSink,
     >(
         &self,
@@ -648,7 +683,11 @@ impl PairKernel<'_> {
             },
         };
         let (dt, increment_time) = (self.dt, self.increment_time);
-        let c = if !DASHPOTS {
+        let c = if HERTZ {
+            // (a table of Hertz-Mindlin alone: `hertz_pairs`)
+            let constants = self.materials.hertz_constants(columns.model[k]);
+            hertz::law(constants, model, &kinematics, dt, increment_time, record)
+        } else if !DASHPOTS {
             contact_law::<false>(model, &kinematics, dt, increment_time, record)
         } else if model.law == ContactLaw::HertzMindlin {
             // (a table with Hertz-Mindlin is never `SINGLE`: the pair's own model index)

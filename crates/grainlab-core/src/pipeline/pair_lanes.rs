@@ -468,7 +468,7 @@ impl PairKernel<'_> {
             }
             k0 += 4;
         }
-        self.pairs_one_at_a_time::<MEASURE, DEFORMING, SINGLE, false, S>(
+        self.pairs_one_at_a_time::<MEASURE, DEFORMING, SINGLE, false, false, S>(
             &fixed,
             &columns,
             k0..n,
