@@ -487,14 +487,9 @@ impl PairKernel<'_> {
                 ),
             };
         }
-        let mut tally = ContactTally::default();
-        let fixed = self.loop_constants();
-        let columns = self.columns(first, records.len().min(sliding.len()));
-        let all = 0..columns.len();
-        self.pairs_one_at_a_time::<MEASURE, DEFORMING, SINGLE, DASHPOTS, false, S>(
-            &fixed, &columns, all, records, sliding, sink, &mut tally,
-        );
-        tally
+        self.whole_run::<MEASURE, DEFORMING, SINGLE, DASHPOTS, false, S>(
+            first, records, sliding, sink,
+        )
     }
 
     /// The loop of a table whose every model is Hertz-Mindlin, with the law
@@ -510,11 +505,33 @@ impl PairKernel<'_> {
         sliding: &mut [bool],
         sink: &mut S,
     ) -> ContactTally {
+        self.whole_run::<MEASURE, DEFORMING, false, true, true, S>(first, records, sliding, sink)
+    }
+
+    /// Every pair of the run from `first`, one at a time, and their tally.
+    ///
+    /// # Safety
+    /// As [`PairKernel::run`].
+    #[inline(always)]
+    unsafe fn whole_run<
+        const MEASURE: bool,
+        const DEFORMING: bool,
+        const SINGLE: bool,
+        const DASHPOTS: bool,
+        const HERTZ: bool,
+        S: ForceSink,
+    >(
+        &self,
+        first: usize,
+        records: &mut [ContactRecord],
+        sliding: &mut [bool],
+        sink: &mut S,
+    ) -> ContactTally {
         let mut tally = ContactTally::default();
         let fixed = self.loop_constants();
         let columns = self.columns(first, records.len().min(sliding.len()));
         let all = 0..columns.len();
-        self.pairs_one_at_a_time::<MEASURE, DEFORMING, false, true, true, S>(
+        self.pairs_one_at_a_time::<MEASURE, DEFORMING, SINGLE, DASHPOTS, HERTZ, S>(
             &fixed, &columns, all, records, sliding, sink, &mut tally,
         );
         tally
