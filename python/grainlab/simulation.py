@@ -959,6 +959,25 @@ class Simulation:
 
     # ---- bodies (docs/bodies.md) ----
 
+    def add_bodies_by_label(self, labels: ArrayLike) -> list[int]:
+        """Makes rigid bodies of the particles that share a label: ``labels`` (N,)
+        integers, one per particle, -1 for a particle left as it is (as a file's
+        body or molecule column gives them). The bodies are made in the order of
+        their labels (:meth:`add_bodies`, frames at angle 0); returns the labels
+        of the clumps made, in that order."""
+        tags = np.asarray(labels)
+        if tags.shape != (self.n_particles,) or tags.dtype.kind not in "iu":
+            raise ValueError(
+                f"labels: expected {self.n_particles} integers, one per particle, got {tags.dtype} {tags.shape}"
+            )
+        if tags.size and tags.min() < -1:
+            k = int(np.argmin(tags))
+            raise ValueError(f"labels[{k}]: a body label is >= 0 (or -1 for none), got {int(tags[k])}")
+        names = [int(t) for t in np.unique(tags[tags >= 0])]
+        groups = [np.flatnonzero(tags == t).tolist() for t in names]
+        self.add_bodies(groups)
+        return [t for t, g in zip(names, groups, strict=True) if len(g) > 1]
+
     def add_bodies(
         self,
         pebbles: Sequence[Sequence[int]],

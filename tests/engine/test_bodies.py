@@ -147,3 +147,15 @@ def test_a_pebble_moves_only_with_its_body():
     np.testing.assert_array_equal(sim.fixity, [7, 7, 7, 0, 0, 0])
     with pytest.raises(ValueError, match=r"velocities: has 1 rows but there are 2 clumps"):
         sim.set_clump_velocities([[0.0, 0.0]], [0.0])
+
+
+def test_bodies_by_label_group_the_particles_that_share_one():
+    sim = Simulation([[0.0, 0.0], [1.5e-3, 0.0], [9e-3, 0.0], [20e-3, 0.0], [21.5e-3, 0.0]], [1e-3] * 5, DENSITY,
+                     time_step=1e-6)
+    assert sim.add_bodies_by_label([7, 7, -1, 3, 3]) == [3, 7]
+    # clumps in label order: label 3 (particles 3, 4) is clump 0, label 7 clump 1
+    np.testing.assert_array_equal(sim.body_of_particles, [1, 1, 2, 0, 0])
+    with pytest.raises(ValueError, match=r"labels\[1\]: a body label is >= 0"):
+        Simulation([[0.0, 0.0], [3e-3, 0.0]], [1e-3] * 2, DENSITY, time_step=1e-6).add_bodies_by_label([0, -2])
+    with pytest.raises(ValueError, match=r"labels: expected 2 integers"):
+        Simulation([[0.0, 0.0], [3e-3, 0.0]], [1e-3] * 2, DENSITY, time_step=1e-6).add_bodies_by_label([0.5, 1.0])
