@@ -8,12 +8,13 @@ from __future__ import annotations
 import base64
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 from clump_factories import trimer_pile
 
 from grainlab import Simulation
-from grainlab.io.hdf5 import ResultsWriter, read_results
+from grainlab.io.hdf5 import FORMAT_VERSION, ResultsFileError, ResultsWriter, read_results
 from grainlab.postprocess.vtk import export_vtk
 from grainlab.snapshot import GRAIN_ANGLE_FIELD, GRAIN_CENTROID_FIELD, GRAIN_FIELD, Snapshot
 from grainlab.viewer.data import viewer_data
@@ -62,6 +63,61 @@ def test_run_h5_keeps_the_grains_to_the_bit(clump_run):
         np.testing.assert_array_equal(back.grains(), snap.grains())
         for name in (GRAIN_CENTROID_FIELD, GRAIN_ANGLE_FIELD):
             np.testing.assert_array_equal(back.particle_fields[name], snap.particle_fields[name])
+
+
+def test_run_h5_stores_one_row_per_grain(clump_run):
+    """Layout 3: ``grain`` per particle, ``grains/label, centroid, angle`` per grain."""
+    folder, snaps = clump_run
+    snap = snaps[-1]
+    with h5py.File(folder / "run.h5") as f:
+        assert f.attrs["format_version"] == FORMAT_VERSION == 3
+        group = f["snapshots/s2"]
+        np.testing.assert_array_equal(group["grain"][()], snap.grains())
+        np.testing.assert_array_equal(group["grains/label"][()], np.arange(7))
+        rows = {name: group[f"grains/{name}"][()] for name in ("centroid", "angle")}
+        units = {name: group[f"grains/{name}"].attrs["units"] for name in ("centroid", "angle")}
+        assert set(group["particle_fields"]) == {"velocity", "angular_velocity"}
+    # the clumps (grains 0-5) as the engine has them, the disk (grain 6) at its centre
+    centroid = np.asarray(snap.particle_fields[GRAIN_CENTROID_FIELD])
+    angle = np.asarray(snap.particle_fields[GRAIN_ANGLE_FIELD])
+    assert rows["centroid"].tobytes() == np.r_[centroid[1::3], centroid[:1]].tobytes()
+    assert rows["angle"].tobytes() == np.r_[angle[1::3], angle[:1]].tobytes()
+    assert units == {"centroid": "m", "angle": "rad"}
+
+
+def test_a_layout_2_file_with_grain_fields_reads_them(clump_run, tmp_path):
+    """Layout 2 kept the grains as three per-particle fields; such a file reads as it was."""
+    _, snaps = clump_run
+    with ResultsWriter(tmp_path / "run.h5", kind="biaxial") as writer:
+        writer.write_snapshot("s", snaps[0])
+    with h5py.File(tmp_path / "run.h5", "r+") as f:
+        f.attrs["format_version"] = 2
+        group = f["snapshots/s"]
+        for name in ("grain", "grains"):
+            del group[name]
+        for name in (GRAIN_FIELD, GRAIN_CENTROID_FIELD, GRAIN_ANGLE_FIELD):
+            group["particle_fields"].create_dataset(name, data=snaps[0].particle_fields[name])
+    back = read_results(tmp_path / "run.h5").snapshot("s")
+    for name in (GRAIN_FIELD, GRAIN_CENTROID_FIELD, GRAIN_ANGLE_FIELD):
+        np.testing.assert_array_equal(back.particle_fields[name], snaps[0].particle_fields[name])
+
+
+@pytest.mark.parametrize(
+    ("damage", "message"),
+    [
+        (lambda g: g["grains/label"].__setitem__(6, 9), r"/grain: particle 0's grain 6 is not in grains/label"),
+        (lambda g: g["grains/label"].__setitem__(0, 3), r"grains/label: the labels do not increase"),
+        (lambda g: g.__delitem__("grains"), r"a 'grain' dataset without 'grains/label'"),
+    ],
+)
+def test_a_damaged_grains_group_is_refused(clump_run, tmp_path, damage, message):
+    _, snaps = clump_run
+    with ResultsWriter(tmp_path / "run.h5", kind="biaxial") as writer:
+        writer.write_snapshot("s", snaps[0])
+    with h5py.File(tmp_path / "run.h5", "r+") as f:
+        damage(f["snapshots/s"])
+    with pytest.raises(ResultsFileError, match=message):
+        read_results(tmp_path / "run.h5").snapshot("s")
 
 
 def test_the_vtk_export_and_the_viewer_carry_the_grains(clump_run):
