@@ -15,6 +15,7 @@ from clump_factories import trimer_pile
 
 from grainlab import Simulation
 from grainlab.io.hdf5 import FORMAT_VERSION, ResultsFileError, ResultsWriter, read_results
+from grainlab.io.vtk import clump_points, write_clumps_vtp
 from grainlab.postprocess.vtk import export_vtk
 from grainlab.snapshot import GRAIN_ANGLE_FIELD, GRAIN_CENTROID_FIELD, GRAIN_FIELD, Snapshot
 from grainlab.viewer.data import viewer_data
@@ -137,6 +138,44 @@ def test_the_vtk_export_and_the_viewer_carry_the_grains(clump_run):
     data = viewer_data(folder)
     grain = np.frombuffer(base64.b64decode(data["snapshots"][-1]["arrays"]["grain"]), dtype="<u4")
     np.testing.assert_array_equal(grain, snaps[-1].grains())
+
+
+def test_the_vtk_export_writes_the_clumps_centroids_and_angles(clump_run):
+    pytest.importorskip("vtkmodules.vtkIOXML")
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+
+    folder, snaps = clump_run
+    export = export_vtk(folder, folder / "vtk_clumps")
+    assert [f.name for f in export.clump_files] == ["clumps_0000.vtp", "clumps_0001.vtp", "clumps_0002.vtp"]
+    assert export.clumps_pvd is not None and "clumps_0002.vtp" in export.clumps_pvd.read_text()
+    reader = vtkXMLPolyDataReader()
+    reader.SetFileName(str(export.clump_files[-1]))
+    reader.Update()
+    out = reader.GetOutput()
+    points, data = vtk_to_numpy(out.GetPoints().GetData()), out.GetPointData()
+    centroid = np.asarray(snaps[-1].particle_fields[GRAIN_CENTROID_FIELD])[1::3]  # pebbles 1-3 are clump 0, ...
+    angle = np.asarray(snaps[-1].particle_fields[GRAIN_ANGLE_FIELD])[1::3]
+    assert points[:, :2].tobytes() == centroid.tobytes() and not points[:, 2].any()
+    assert vtk_to_numpy(data.GetArray("angle")).tobytes() == angle.tobytes()
+    np.testing.assert_array_equal(vtk_to_numpy(data.GetArray("grain")), np.arange(6))
+    np.testing.assert_array_equal(vtk_to_numpy(data.GetArray("n_pebbles")), np.full(6, 3))
+    np.testing.assert_allclose(vtk_to_numpy(data.GetArray("orientation"))[:, :2], np.c_[np.cos(angle), np.sin(angle)])
+    assert vtk_to_numpy(out.GetFieldData().GetArray("n_clumps")).tolist() == [6]
+    assert out.GetNumberOfVerts() == 6
+
+
+def test_no_clumps_file_without_clumps_or_their_centroids(tmp_path):
+    disks = Snapshot([[0.0, 0.0], [3.0, 0.0]], [1.0, 1.0], rotations=[0.0, 1.0])
+    labelled = Snapshot([[0.0, 0.0], [1.5, 0.0]], [1.0, 1.0], particle_fields={GRAIN_FIELD: [5, 5]})
+    singles = Snapshot(
+        [[0.0, 0.0], [3.0, 0.0]], [1.0, 1.0],
+        particle_fields={GRAIN_FIELD: [0, 1], GRAIN_CENTROID_FIELD: [[0.0, 0.0], [3.0, 0.0]], GRAIN_ANGLE_FIELD: [0, 0]},
+    )  # fmt: skip
+    for snap in (disks, labelled, singles):
+        assert clump_points(snap) is None
+        assert write_clumps_vtp(tmp_path / "clumps.vtp", snap) is None
+    assert not (tmp_path / "clumps.vtp").exists()
 
 
 def test_a_snapshot_without_grains_makes_every_particle_its_own():
