@@ -138,6 +138,19 @@ def test_the_vtk_export_and_the_viewer_carry_the_grains(clump_run):
     data = viewer_data(folder)
     grain = np.frombuffer(base64.b64decode(data["snapshots"][-1]["arrays"]["grain"]), dtype="<u4")
     np.testing.assert_array_equal(grain, snaps[-1].grains())
+    # the page opens coloured by grain and outlines the clumps of 19 particles in 7 grains
+    assert data["clumps"] is True
+    assert [(s["n"], s["n_grains"]) for s in data["snapshots"]] == [(19, 7)] * 3
+
+
+def test_the_viewer_of_a_run_of_disks_has_no_clumps(tmp_path):
+    sim = Simulation([[1e-3, 1e-3], [3.5e-3, 1e-3], [6e-3, 1e-3]], np.full(3, 1e-3), 2650.0, time_step=1e-6)
+    with ResultsWriter(tmp_path / "run.h5", kind="biaxial") as writer:
+        writer.write_snapshot("s0", sim.snapshot(axial_strain=0.0))
+    data = viewer_data(tmp_path)
+    assert data["clumps"] is False and data["snapshots"][0]["n_grains"] == 3
+    grain = np.frombuffer(base64.b64decode(data["snapshots"][0]["arrays"]["grain"]), dtype="<u4")
+    np.testing.assert_array_equal(grain, [0, 1, 2])
 
 
 def test_the_vtk_export_writes_the_clumps_centroids_and_angles(clump_run):

@@ -1,6 +1,7 @@
 """``grainlab view``: the self-contained viewer page, its data, and the page in headless chromium
 (Playwright, as the reports' test_browser.py): offline, the slider and the colour change the
-picture, hovering a grain shows the run's lambda of that grain."""
+picture, hovering a grain shows the run's lambda of that grain, a clump's pebbles share one
+colour and the clump one outline."""
 
 from __future__ import annotations
 
@@ -149,3 +150,66 @@ def test_walls_stored_with_a_snapshot_are_drawn(tmp_path):
     assert data["snapshots"][1]["walls"] is None
     dy = _decode(data["snapshots"][1]["arrays"]["dy"], "f4")
     np.testing.assert_allclose(dy, (pos[:, 1] * -0.01).astype(np.float32), rtol=1e-5, atol=1e-12)
+
+
+def _clump_run(folder) -> tuple[np.ndarray, np.ndarray]:
+    """Three trimers (grains 0-2, pebbles of radius 1 mm) and a disk (grain 3) in a row,
+    settling by 10 um between two snapshots; returns the pebbles' positions and radii."""
+    from grainlab.io.hdf5 import ResultsWriter
+    from grainlab.snapshot import Snapshot
+
+    offsets = np.array([[0.0, 0.7], [-0.6, -0.35], [0.6, -0.35]]) * 1e-3
+    centres = np.array([[2e-3, 2e-3], [6e-3, 2e-3], [10e-3, 2e-3], [14e-3, 2e-3]])
+    positions = np.r_[(centres[:3, None, :] + offsets).reshape(-1, 2), centres[3:]]
+    radii = np.full(10, 1e-3)
+    centroid = np.r_[np.repeat(centres[:3], 3, axis=0), centres[3:]]
+    grain = {"grain": np.r_[np.repeat([0, 1, 2], 3), 3], "grain_angle": np.zeros(10)}
+    with ResultsWriter(folder / "run.h5", kind="biaxial") as out:
+        for k in range(2):
+            down = [0.0, -1e-5 * k]
+            fields = grain | {"grain_centroid": centroid + down}
+            snap = Snapshot.from_geometry(
+                positions + down, radii, tolerance=1e-9, axial_strain=1e-3 * k, particle_fields=fields
+            )
+            out.write_snapshot(f"strain_{k}", snap)
+    return positions + down, radii
+
+
+def test_clumps_are_drawn_one_colour_each_and_outlined(tmp_path):
+    from playwright.sync_api import sync_playwright
+
+    chromium = chromium_or_skip()
+    positions, radii = _clump_run(tmp_path)
+    page_file = write_viewer(tmp_path)
+    pixels = """(points) => {
+        const c = document.getElementById('grains'), r = c.getBoundingClientRect();
+        const image = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        return points.map(([x, y]) => {
+            const k = 4 * (Math.floor((y - r.top) * c.height / r.height) * c.width + Math.floor((x - r.left) * c.width / r.width));
+            return [image[k], image[k + 1], image[k + 2]];
+        });
+    }"""
+    problems: list[str] = []
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=chromium, args=["--no-sandbox"])
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 1000})
+            page.on("console", lambda m: problems.append(m.text) if m.type in ("error", "warning") else None)
+            page.on("pageerror", lambda e: problems.append(str(e)))
+            page.goto(page_file.resolve().as_uri(), wait_until="load")
+            mode = page.eval_on_selector("#mode", "el => el.value")
+            page.uncheck("#show-band")
+            centre = [page.evaluate(f"grainlabViewer.clientPosition({i})") for i in range(10)]
+            # client pixels per metre, from the disk and the first pebble
+            per_m = (centre[9][0] - centre[0][0]) / (positions[9, 0] - positions[0, 0])
+            tops = [[centre[i][0], centre[i][1] - radii[i] * per_m - 1.0] for i in (0, 3, 9)]
+            colour = page.evaluate(pixels, centre + tops)
+        finally:
+            browser.close()
+    colour, above = colour[:10], colour[10:]
+    assert problems == []
+    assert mode == "grains"  # a run with clumps opens coloured by grain
+    assert colour[0] == colour[1] == colour[2] and colour[3] == colour[4] == colour[5]
+    assert len({tuple(colour[0]), tuple(colour[3]), tuple(colour[6]), tuple(colour[9])}) == 4
+    assert all(sum(rgb) < 300 for rgb in above[:2]), above  # the trimers' outlines, just above their top pebbles
+    assert sum(above[2]) == 3 * 255, above  # no outline round the disk: the white page
