@@ -252,7 +252,9 @@ class Snapshot:
     contact_fields : mapping of str to (Nc, ...) arrays, optional
         Further per-contact data, e.g. ``overlap``, ``sliding``, ``bonded``.
     particle_fields : mapping of str to (N, ...) arrays, optional
-        Further per-particle data, e.g. ``velocity`` (N, 2), ``force`` (N, 2).
+        Further per-particle data, e.g. ``velocity`` (N, 2), ``force`` (N, 2);
+        ``body`` (membrane chains) and ``grain``, ``grain_centroid``,
+        ``grain_angle`` (rigid bodies) are checked as the module docstring says.
     box : (2, 2) float, m, optional
         ``[[xlo, xhi], [ylo, yhi]]`` of the simulation box.
     periodic : (bool, bool)
