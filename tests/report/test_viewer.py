@@ -6,8 +6,12 @@ colour and the clump one outline."""
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
 import re
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -84,17 +88,13 @@ def _pixels(page) -> str:
     return page.evaluate("document.getElementById('grains').toDataURL()")
 
 
-def test_the_page_in_chromium(viewer_page, synthetic_results):
+@contextlib.contextmanager
+def _in_chromium(page_file: Path, problems: list[str], requests: list[str]) -> Iterator[Any]:
+    """The page open in headless chromium; console errors and warnings and page errors go to
+    ``problems``, the URLs it requests to ``requests`` (skips without chromium)."""
     from playwright.sync_api import sync_playwright
 
     chromium = chromium_or_skip()
-    results = read_results(synthetic_results / "run.h5")
-    last = results.snapshot(-1)
-    lam = StabilityIndex().compute(last).stability_index
-    grains = np.flatnonzero((last.kind == 0) & (last.contact_counts() >= 3))
-    k = int(grains[np.argmax(lam[grains])])  # a grain with a distinctive lambda
-    problems: list[str] = []
-    requests: list[str] = []
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=chromium, args=["--no-sandbox"])
         try:
@@ -102,27 +102,40 @@ def test_the_page_in_chromium(viewer_page, synthetic_results):
             page.on("console", lambda m: problems.append(m.text) if m.type in ("error", "warning") else None)
             page.on("pageerror", lambda e: problems.append(str(e)))
             page.on("request", lambda r: requests.append(r.url))
-            page.goto(viewer_page.resolve().as_uri(), wait_until="load")
-            assert page.evaluate("grainlabViewer.snapshotCount") == 3
-            assert page.evaluate("grainlabViewer.current()") == 2  # opens on the last snapshot
-            last_picture = _pixels(page)
-            page.locator("#snapshot").fill("0")  # the slider: the first snapshot
-            assert page.evaluate("grainlabViewer.current()") == 0
-            first_picture = _pixels(page)
-            assert first_picture != last_picture
-            assert "0.00 %" in page.inner_text("#strain-label")
-            page.locator("#snapshot").fill("2")
-            assert _pixels(page) == last_picture  # the same snapshot, the same picture
-            page.select_option("#mode", "strain")
-            assert _pixels(page) != last_picture
-            page.select_option("#mode", "lambda")
-            x, y = page.evaluate(f"grainlabViewer.clientPosition({k})")
-            page.mouse.move(x, y)
-            assert page.is_visible("#tip")
-            shown = page.inner_text("#tip td[data-key='λ']")
-            particle = page.inner_text("#tip td[data-key='particle id']")
+            page.goto(page_file.resolve().as_uri(), wait_until="load")
+            yield page
         finally:
             browser.close()
+
+
+def test_the_page_in_chromium(viewer_page, synthetic_results):
+    chromium_or_skip()
+    results = read_results(synthetic_results / "run.h5")
+    last = results.snapshot(-1)
+    lam = StabilityIndex().compute(last).stability_index
+    grains = np.flatnonzero((last.kind == 0) & (last.contact_counts() >= 3))
+    k = int(grains[np.argmax(lam[grains])])  # a grain with a distinctive lambda
+    problems: list[str] = []
+    requests: list[str] = []
+    with _in_chromium(viewer_page, problems, requests) as page:
+        assert page.evaluate("grainlabViewer.snapshotCount") == 3
+        assert page.evaluate("grainlabViewer.current()") == 2  # opens on the last snapshot
+        last_picture = _pixels(page)
+        page.locator("#snapshot").fill("0")  # the slider: the first snapshot
+        assert page.evaluate("grainlabViewer.current()") == 0
+        first_picture = _pixels(page)
+        assert first_picture != last_picture
+        assert "0.00 %" in page.inner_text("#strain-label")
+        page.locator("#snapshot").fill("2")
+        assert _pixels(page) == last_picture  # the same snapshot, the same picture
+        page.select_option("#mode", "strain")
+        assert _pixels(page) != last_picture
+        page.select_option("#mode", "lambda")
+        x, y = page.evaluate(f"grainlabViewer.clientPosition({k})")
+        page.mouse.move(x, y)
+        assert page.is_visible("#tip")
+        shown = page.inner_text("#tip td[data-key='λ']")
+        particle = page.inner_text("#tip td[data-key='particle id']")
     assert problems == []
     assert all(url.startswith(("file:", "data:")) for url in requests), requests
     assert int(particle) == int(last.ids[k])
@@ -176,9 +189,7 @@ def _clump_run(folder) -> tuple[np.ndarray, np.ndarray]:
 
 
 def test_clumps_are_drawn_one_colour_each_and_outlined(tmp_path):
-    from playwright.sync_api import sync_playwright
-
-    chromium = chromium_or_skip()
+    chromium_or_skip()
     positions, radii = _clump_run(tmp_path)
     page_file = write_viewer(tmp_path)
     pixels = """(points) => {
@@ -190,24 +201,17 @@ def test_clumps_are_drawn_one_colour_each_and_outlined(tmp_path):
         });
     }"""
     problems: list[str] = []
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=chromium, args=["--no-sandbox"])
-        try:
-            page = browser.new_page(viewport={"width": 1280, "height": 1000})
-            page.on("console", lambda m: problems.append(m.text) if m.type in ("error", "warning") else None)
-            page.on("pageerror", lambda e: problems.append(str(e)))
-            page.goto(page_file.resolve().as_uri(), wait_until="load")
-            mode = page.eval_on_selector("#mode", "el => el.value")
-            page.uncheck("#show-band")
-            centre = [page.evaluate(f"grainlabViewer.clientPosition({i})") for i in range(10)]
-            # client pixels per metre, from the disk and the first pebble
-            per_m = (centre[9][0] - centre[0][0]) / (positions[9, 0] - positions[0, 0])
-            tops = [[centre[i][0], centre[i][1] - radii[i] * per_m - 1.0] for i in (0, 3, 9)]
-            colour = page.evaluate(pixels, centre + tops)
-        finally:
-            browser.close()
+    requests: list[str] = []
+    with _in_chromium(page_file, problems, requests) as page:
+        mode = page.eval_on_selector("#mode", "el => el.value")
+        page.uncheck("#show-band")
+        centre = [page.evaluate(f"grainlabViewer.clientPosition({i})") for i in range(10)]
+        # client pixels per metre, from the disk and the first pebble
+        per_m = (centre[9][0] - centre[0][0]) / (positions[9, 0] - positions[0, 0])
+        tops = [[centre[i][0], centre[i][1] - radii[i] * per_m - 1.0] for i in (0, 3, 9)]
+        colour = page.evaluate(pixels, centre + tops)
     colour, above = colour[:10], colour[10:]
-    assert problems == []
+    assert problems == [] and all(url.startswith(("file:", "data:")) for url in requests), (problems, requests)
     assert mode == "grains"  # a run with clumps opens coloured by grain
     assert colour[0] == colour[1] == colour[2] and colour[3] == colour[4] == colour[5]
     assert len({tuple(colour[0]), tuple(colour[3]), tuple(colour[6]), tuple(colour[9])}) == 4
