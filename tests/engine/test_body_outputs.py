@@ -14,6 +14,7 @@ import pytest
 from clump_factories import trimer_pile
 
 from grainlab import Simulation
+from grainlab.cli import main
 from grainlab.io.hdf5 import FORMAT_VERSION, ResultsFileError, ResultsWriter, read_results
 from grainlab.io.vtk import clump_points, write_clumps_vtp
 from grainlab.postprocess.vtk import export_vtk
@@ -176,6 +177,13 @@ def test_the_vtk_export_writes_the_clumps_centroids_and_angles(clump_run):
     np.testing.assert_allclose(vtk_to_numpy(data.GetArray("orientation"))[:, :2], np.c_[np.cos(angle), np.sin(angle)])
     assert vtk_to_numpy(out.GetFieldData().GetArray("n_clumps")).tolist() == [6]
     assert out.GetNumberOfVerts() == 6
+
+
+def test_grainlab_export_names_the_clumps_files(clump_run, capsys):
+    folder, _ = clump_run
+    assert main(["export", str(folder), "--vtk", "--out", str(folder / "vtk_cli")]) == 0
+    said = capsys.readouterr().out
+    assert f"grainlab export: the clumps of 3 snapshot(s) -> {folder / 'vtk_cli' / 'clumps.pvd'}" in said
 
 
 def test_no_clumps_file_without_clumps_or_their_centroids(tmp_path):
