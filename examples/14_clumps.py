@@ -7,7 +7,8 @@ joins two pebbles of one clump, and the snapshot (and ParaView file) carries
 every pebble's grain with its centroid and angle (docs/bodies.md).
 
 Usage: ``python examples/14_clumps.py [n_clumps] [eta]`` (default 12 trimers,
-eta 0.3); with ``--vtk DIR`` it writes the settled pile as ``DIR/pile.vtp``.
+eta 0.3); with ``--vtk DIR`` it writes the settled pile as ``DIR/pile.vtp`` (the
+pebbles) and ``DIR/pile_clumps.vtp`` (one point per clump at its centroid, with its angle).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import grainlab
-from grainlab.io.vtk import write_vtp
+from grainlab.io.vtk import write_clumps_vtp, write_vtp
 from grainlab.postprocess.vtk import snapshot_arrays
 from grainlab.shapes import shape_template
 
@@ -27,7 +28,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("n_clumps", nargs="?", type=int, default=12)
     parser.add_argument("eta", nargs="?", type=float, default=0.3)
-    parser.add_argument("--vtk", type=Path, default=None, help="write the settled pile to DIR/pile.vtp")
+    parser.add_argument("--vtk", type=Path, default=None, help="write the settled pile to DIR/pile.vtp, pile_clumps.vtp")
     args = parser.parse_args()
 
     radius = 1.5e-3  # circumscribed radius of each trimer (m)
@@ -71,7 +72,8 @@ def main() -> None:
         args.vtk.mkdir(parents=True, exist_ok=True)
         path = write_vtp(args.vtk / "pile.vtp", np.c_[snap.positions, np.zeros(snap.n_particles)],
                          point_data=snapshot_arrays(snap))
-        print(f"wrote {path} (point data 'grain', 'grain_centroid', 'grain_angle')")
+        clumps = write_clumps_vtp(args.vtk / "pile_clumps.vtp", snap)
+        print(f"wrote {path} (point data 'grain', 'grain_centroid', 'grain_angle') and {clumps} (one point per clump)")
 
 
 if __name__ == "__main__":

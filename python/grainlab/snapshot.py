@@ -37,10 +37,12 @@ Conventions (docs/conventions.md):
   (pebbles) moved as one (docs/bodies.md). ``particle_fields["grain"]``
   (:data:`GRAIN_FIELD`) labels the grain of each particle (an integer >= 0;
   pebbles of one clump share it), and ``"grain_centroid"`` (N, 2) and
-  ``"grain_angle"`` (N,) carry each particle's grain's centroid and angle;
-  without them every particle is a grain of its own, at its centre, turned by
-  its rotation (:meth:`Snapshot.grains`). A simulation's snapshot has them when
-  it has clumps.
+  ``"grain_angle"`` (N,) carry each particle's grain's centroid and angle (the
+  same bits on every particle of one grain); without them every particle is a
+  grain of its own, at its centre, turned by its rotation
+  (:meth:`Snapshot.grains`, :meth:`Snapshot.grain_centroids`,
+  :meth:`Snapshot.grain_angles`). A simulation's snapshot has them when it has
+  clumps.
 
 Example
 -------
@@ -179,8 +181,27 @@ def _labelled_fields(fields: dict[str, NDArray[Any]], n: int) -> dict[str, NDArr
         if name in fields:
             if GRAIN_FIELD not in fields:
                 raise ValueError(f"particle_fields[{name!r}]: given without particle_fields[{GRAIN_FIELD!r}]")
-            fields[name] = _readonly(_as_float(f"particle_fields[{name!r}]", fields[name], shape))
+            values = _as_float(f"particle_fields[{name!r}]", fields[name], shape)
+            _check_one_value_per_grain(name, values, fields[GRAIN_FIELD])
+            fields[name] = _readonly(values)
     return fields
+
+
+def _check_one_value_per_grain(name: str, values: NDArray[np.float64], grain: NDArray[np.int64]) -> None:
+    """Every particle of a grain carries the same bits of ``values`` (its grain's centroid
+    or angle), so that one row per grain (``run.h5``) keeps them all."""
+    order = np.argsort(grain, kind="stable")
+    bits = values.view(np.uint64).reshape(len(grain), -1)[order]
+    same_grain = grain[order][1:] == grain[order][:-1]
+    differ = same_grain & np.any(bits[1:] != bits[:-1], axis=1)
+    if differ.any():
+        k = int(np.argmax(differ))
+        first, second = sorted((int(order[k]), int(order[k + 1])))
+        raise ValueError(
+            f"particle_fields[{name!r}]: particles {first} and {second} are of grain {int(grain[first])} "
+            f"but carry different values ({values[first].tolist()} and {values[second].tolist()}): "
+            "a rigid grain has one centroid and one angle"
+        )
 
 
 def _check_shape(name: str, a: NDArray[Any], shape: tuple[int | None, ...]) -> None:
@@ -231,7 +252,9 @@ class Snapshot:
     contact_fields : mapping of str to (Nc, ...) arrays, optional
         Further per-contact data, e.g. ``overlap``, ``sliding``, ``bonded``.
     particle_fields : mapping of str to (N, ...) arrays, optional
-        Further per-particle data, e.g. ``velocity`` (N, 2), ``force`` (N, 2).
+        Further per-particle data, e.g. ``velocity`` (N, 2), ``force`` (N, 2);
+        ``body`` (membrane chains) and ``grain``, ``grain_centroid``,
+        ``grain_angle`` (rigid bodies) are checked as the module docstring says.
     box : (2, 2) float, m, optional
         ``[[xlo, xhi], [ylo, yhi]]`` of the simulation box.
     periodic : (bool, bool)
@@ -668,6 +691,39 @@ class Snapshot:
         """Number of grains (rigid bodies) of all kinds: :meth:`grains` labels."""
         labels = self.grains()
         return int(np.unique(labels).size)
+
+    def grain_centroids(self) -> NDArray[np.float64]:
+        """(N, 2) m: the centroid of each particle's grain (:data:`GRAIN_CENTROID_FIELD`;
+        the pebbles of a clump share their clump's). Without the field, a snapshot whose
+        grains are single disks gives each disk's centre.
+
+        Raises ValueError for a snapshot that labels clumps (grains of more than one
+        particle) without their centroids, such as a file read with grain labels only.
+        """
+        return self._of_grains(GRAIN_CENTROID_FIELD, self.positions, "centroids")
+
+    def grain_angles(self) -> NDArray[np.float64]:
+        """(N,) rad: the angle of each particle's grain, CCW positive
+        (:data:`GRAIN_ANGLE_FIELD`; a clump's angle turns its pebbles' offsets from the
+        body frame). Without the field, a snapshot whose grains are single disks gives
+        each disk's rotation.
+
+        Raises ValueError for a snapshot that labels clumps without their angles, or
+        whose disks carry no rotations.
+        """
+        return self._of_grains(GRAIN_ANGLE_FIELD, self.rotations, "angles")
+
+    def _of_grains(self, name: str, own: NDArray[np.float64] | None, what: str) -> NDArray[np.float64]:
+        if name in self.particle_fields:
+            return _readonly(np.asarray(self.particle_fields[name], dtype=np.float64))
+        if self.n_grains != self.n_particles:
+            raise ValueError(
+                f"grain {what}: the snapshot labels clumps (particle_fields[{GRAIN_FIELD!r}]) "
+                f"without particle_fields[{name!r}]"
+            )
+        if own is None:
+            raise ValueError(f"grain {what}: the snapshot has no rotations, so its disks' angles are unknown")
+        return own
 
     @property
     def is_wall_contact(self) -> NDArray[np.bool_]:

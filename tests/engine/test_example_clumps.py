@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "14_clumps.py"
@@ -20,3 +21,5 @@ def test_the_clumps_example_settles_a_pile_of_trimers(tmp_path):
     assert re.search(r"contacts between clumps, 0 inside one", out), out
     assert "the snapshot has 8 grains; grain of pebbles 0-5: [0, 0, 0, 1, 1, 1]" in out
     assert (tmp_path / "pile.vtp").is_file()
+    clumps = ET.parse(tmp_path / "pile_clumps.vtp").getroot().find("PolyData/Piece")
+    assert clumps is not None and clumps.get("NumberOfPoints") == "8"  # one point per trimer

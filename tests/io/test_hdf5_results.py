@@ -163,7 +163,7 @@ def test_round_trip_is_exact(tmp_path):
         out.write_phases({"generation": 12.5, "consolidation": 3.0, "shearing": 40.25})
     res = read_results(tmp_path / "run.h5")
 
-    assert res.format_version == FORMAT_VERSION == 2
+    assert res.format_version == FORMAT_VERSION == 3
     assert res.kind == "biaxial" and res.status == "complete"
     assert res.grainlab_version and res.created.endswith("+00:00")
     assert same_config(res.config, CONFIG)
@@ -406,6 +406,20 @@ def test_a_version_1_file_written_from_the_docs_is_read(tmp_path):
     np.testing.assert_allclose(snap.contact_normals(), [[1.0, 0.0], [1.0, 0.0]])
 
 
+def test_a_version_2_file_reads_with_every_particle_a_grain_of_its_own(tmp_path):
+    """Files written before grains (layout 2, the same snapshot groups as layout 1)."""
+    path = tmp_path / "run.h5"
+    write_v1_by_hand(path)
+    with h5py.File(path, "r+") as f:
+        f.attrs["format_version"] = 2
+        f["snapshots/strain_0.0010"].create_dataset("rotations", data=[0.25, -1.5])
+    snap = read_results(path).snapshot("strain_0.0010")
+    assert snap.grains().tolist() == [0, 1] and snap.n_grains == 2
+    assert snap.grain_centroids().tolist() == [[0.0, 0.0], [2e-3, 0.0]]
+    assert snap.grain_angles().tolist() == [0.25, -1.5]
+    assert "grain" not in snap.particle_fields
+
+
 def test_future_version_is_refused_naming_the_version(tmp_path):
     path = tmp_path / "run.h5"
     write_v1_by_hand(path)
@@ -418,7 +432,7 @@ def test_future_version_is_refused_naming_the_version(tmp_path):
     with h5py.File(path, "r+") as f:
         f.attrs["format_version"] = 0
     with pytest.raises(
-        ResultsFileError, match=r"format_version 0 is unknown \(known versions: 1, 2\)"
+        ResultsFileError, match=r"format_version 0 is unknown \(known versions: 1, 2, 3\)"
     ):
         read_results(path)
 

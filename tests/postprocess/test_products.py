@@ -75,7 +75,7 @@ def assert_same_search(a, b):
 def test_stored_products_are_the_products_made_anew(fresh_run, counted):
     stored = store_run_products(fresh_run)
     assert stored.analysis_versions == PRODUCTS
-    assert stored.attrs["format_version"] == 2
+    assert stored.attrs["format_version"] == 3
     searched = len(counted)
     assert searched >= 20 * (len(stored.snapshot_names) - 1)  # every band and its permutation test
     products = RunProducts(fresh_run)
@@ -151,7 +151,7 @@ def test_a_file_without_products_is_read_and_its_products_made_anew(run_dir, tmp
         os.chmod(tmp_path, 0o755)
     assert read_results(path).attrs["format_version"] == 1  # untouched
     store_run_products(path)
-    assert read_results(path).attrs["format_version"] == 2
+    assert read_results(path).attrs["format_version"] == 3
 
 
 def test_a_product_of_another_rule_version_is_made_again(fresh_run, counted, monkeypatch):

@@ -1,12 +1,17 @@
 """``grainlab view``: the self-contained viewer page, its data, and the page in headless chromium
 (Playwright, as the reports' test_browser.py): offline, the slider and the colour change the
-picture, hovering a grain shows the run's lambda of that grain."""
+picture, hovering a grain shows the run's lambda of that grain, a clump's pebbles share one
+colour and the clump one outline."""
 
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
 import re
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -83,17 +88,13 @@ def _pixels(page) -> str:
     return page.evaluate("document.getElementById('grains').toDataURL()")
 
 
-def test_the_page_in_chromium(viewer_page, synthetic_results):
+@contextlib.contextmanager
+def _in_chromium(page_file: Path, problems: list[str], requests: list[str]) -> Iterator[Any]:
+    """The page open in headless chromium; console errors and warnings and page errors go to
+    ``problems``, the URLs it requests to ``requests`` (skips without chromium)."""
     from playwright.sync_api import sync_playwright
 
     chromium = chromium_or_skip()
-    results = read_results(synthetic_results / "run.h5")
-    last = results.snapshot(-1)
-    lam = StabilityIndex().compute(last).stability_index
-    grains = np.flatnonzero((last.kind == 0) & (last.contact_counts() >= 3))
-    k = int(grains[np.argmax(lam[grains])])  # a grain with a distinctive lambda
-    problems: list[str] = []
-    requests: list[str] = []
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=chromium, args=["--no-sandbox"])
         try:
@@ -101,27 +102,40 @@ def test_the_page_in_chromium(viewer_page, synthetic_results):
             page.on("console", lambda m: problems.append(m.text) if m.type in ("error", "warning") else None)
             page.on("pageerror", lambda e: problems.append(str(e)))
             page.on("request", lambda r: requests.append(r.url))
-            page.goto(viewer_page.resolve().as_uri(), wait_until="load")
-            assert page.evaluate("grainlabViewer.snapshotCount") == 3
-            assert page.evaluate("grainlabViewer.current()") == 2  # opens on the last snapshot
-            last_picture = _pixels(page)
-            page.locator("#snapshot").fill("0")  # the slider: the first snapshot
-            assert page.evaluate("grainlabViewer.current()") == 0
-            first_picture = _pixels(page)
-            assert first_picture != last_picture
-            assert "0.00 %" in page.inner_text("#strain-label")
-            page.locator("#snapshot").fill("2")
-            assert _pixels(page) == last_picture  # the same snapshot, the same picture
-            page.select_option("#mode", "strain")
-            assert _pixels(page) != last_picture
-            page.select_option("#mode", "lambda")
-            x, y = page.evaluate(f"grainlabViewer.clientPosition({k})")
-            page.mouse.move(x, y)
-            assert page.is_visible("#tip")
-            shown = page.inner_text("#tip td[data-key='λ']")
-            particle = page.inner_text("#tip td[data-key='particle id']")
+            page.goto(page_file.resolve().as_uri(), wait_until="load")
+            yield page
         finally:
             browser.close()
+
+
+def test_the_page_in_chromium(viewer_page, synthetic_results):
+    chromium_or_skip()
+    results = read_results(synthetic_results / "run.h5")
+    last = results.snapshot(-1)
+    lam = StabilityIndex().compute(last).stability_index
+    grains = np.flatnonzero((last.kind == 0) & (last.contact_counts() >= 3))
+    k = int(grains[np.argmax(lam[grains])])  # a grain with a distinctive lambda
+    problems: list[str] = []
+    requests: list[str] = []
+    with _in_chromium(viewer_page, problems, requests) as page:
+        assert page.evaluate("grainlabViewer.snapshotCount") == 3
+        assert page.evaluate("grainlabViewer.current()") == 2  # opens on the last snapshot
+        last_picture = _pixels(page)
+        page.locator("#snapshot").fill("0")  # the slider: the first snapshot
+        assert page.evaluate("grainlabViewer.current()") == 0
+        first_picture = _pixels(page)
+        assert first_picture != last_picture
+        assert "0.00 %" in page.inner_text("#strain-label")
+        page.locator("#snapshot").fill("2")
+        assert _pixels(page) == last_picture  # the same snapshot, the same picture
+        page.select_option("#mode", "strain")
+        assert _pixels(page) != last_picture
+        page.select_option("#mode", "lambda")
+        x, y = page.evaluate(f"grainlabViewer.clientPosition({k})")
+        page.mouse.move(x, y)
+        assert page.is_visible("#tip")
+        shown = page.inner_text("#tip td[data-key='λ']")
+        particle = page.inner_text("#tip td[data-key='particle id']")
     assert problems == []
     assert all(url.startswith(("file:", "data:")) for url in requests), requests
     assert int(particle) == int(last.ids[k])
@@ -149,3 +163,57 @@ def test_walls_stored_with_a_snapshot_are_drawn(tmp_path):
     assert data["snapshots"][1]["walls"] is None
     dy = _decode(data["snapshots"][1]["arrays"]["dy"], "f4")
     np.testing.assert_allclose(dy, (pos[:, 1] * -0.01).astype(np.float32), rtol=1e-5, atol=1e-12)
+
+
+def _clump_run(folder) -> tuple[np.ndarray, np.ndarray]:
+    """Three trimers (grains 0-2, pebbles of radius 1 mm) and a disk (grain 3) in a row,
+    settling by 10 um between two snapshots; returns the pebbles' positions and radii."""
+    from grainlab.io.hdf5 import ResultsWriter
+    from grainlab.snapshot import Snapshot
+
+    offsets = np.array([[0.0, 0.7], [-0.6, -0.35], [0.6, -0.35]]) * 1e-3
+    centres = np.array([[2e-3, 2e-3], [6e-3, 2e-3], [10e-3, 2e-3], [14e-3, 2e-3]])
+    positions = np.r_[(centres[:3, None, :] + offsets).reshape(-1, 2), centres[3:]]
+    radii = np.full(10, 1e-3)
+    centroid = np.r_[np.repeat(centres[:3], 3, axis=0), centres[3:]]
+    grain = {"grain": np.r_[np.repeat([0, 1, 2], 3), 3], "grain_angle": np.zeros(10)}
+    with ResultsWriter(folder / "run.h5", kind="biaxial") as out:
+        for k in range(2):
+            down = [0.0, -1e-5 * k]
+            fields = grain | {"grain_centroid": centroid + down}
+            snap = Snapshot.from_geometry(
+                positions + down, radii, tolerance=1e-9, axial_strain=1e-3 * k, particle_fields=fields
+            )
+            out.write_snapshot(f"strain_{k}", snap)
+    return positions + down, radii
+
+
+def test_clumps_are_drawn_one_colour_each_and_outlined(tmp_path):
+    chromium_or_skip()
+    positions, radii = _clump_run(tmp_path)
+    page_file = write_viewer(tmp_path)
+    pixels = """(points) => {
+        const c = document.getElementById('grains'), r = c.getBoundingClientRect();
+        const image = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        return points.map(([x, y]) => {
+            const k = 4 * (Math.floor((y - r.top) * c.height / r.height) * c.width + Math.floor((x - r.left) * c.width / r.width));
+            return [image[k], image[k + 1], image[k + 2]];
+        });
+    }"""
+    problems: list[str] = []
+    requests: list[str] = []
+    with _in_chromium(page_file, problems, requests) as page:
+        mode = page.eval_on_selector("#mode", "el => el.value")
+        page.uncheck("#show-band")
+        centre = [page.evaluate(f"grainlabViewer.clientPosition({i})") for i in range(10)]
+        # client pixels per metre, from the disk and the first pebble
+        per_m = (centre[9][0] - centre[0][0]) / (positions[9, 0] - positions[0, 0])
+        tops = [[centre[i][0], centre[i][1] - radii[i] * per_m - 1.0] for i in (0, 3, 9)]
+        colour = page.evaluate(pixels, centre + tops)
+    colour, above = colour[:10], colour[10:]
+    assert problems == [] and all(url.startswith(("file:", "data:")) for url in requests), (problems, requests)
+    assert mode == "grains"  # a run with clumps opens coloured by grain
+    assert colour[0] == colour[1] == colour[2] and colour[3] == colour[4] == colour[5]
+    assert len({tuple(colour[0]), tuple(colour[3]), tuple(colour[6]), tuple(colour[9])}) == 4
+    assert all(sum(rgb) < 300 for rgb in above[:2]), above  # the trimers' outlines, just above their top pebbles
+    assert sum(above[2]) == 3 * 255, above  # no outline round the disk: the white page

@@ -90,6 +90,8 @@ def run(args: argparse.Namespace) -> int:
         f"grainlab export: {len(done.files)} snapshot(s) -> {done.pvd} "
         f"(time = {done.time_quantity}); open it in ParaView"
     )
+    if done.clumps_pvd is not None:
+        print(f"grainlab export: the clumps of {len(done.clump_files)} snapshot(s) -> {done.clumps_pvd}")
     return 0
 
 

@@ -131,6 +131,21 @@ def integral_column(
     return values.astype(np.int64)
 
 
+def label_column(
+    path: str | Path, values: NDArray[np.float64], line_numbers: NDArray[np.int64], name: str, what: str, least: int
+) -> NDArray[np.int64]:
+    """An integer column of ``what`` labels (``"body"``, ``"grain"``), each >= ``least``; the
+    error names the line of the first that is not."""
+    labels = integral_column(path, values, line_numbers, name)
+    bad = labels < least
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise FileFormatError(
+            path, int(line_numbers[k]), f"column {name!r}: {int(labels[k])} is not a {what} label (>= {least})"
+        )
+    return labels
+
+
 def check_unique_ids(
     path: str | Path, ids: NDArray[np.int64], line_numbers: NDArray[np.int64]
 ) -> None:

@@ -3,10 +3,13 @@
 Particles CSV
     A header line, then one row per particle, comma separated. Required
     columns ``id,x,y,radius`` (SI units: m); optional ``rotation`` (rad),
-    ``kind`` (:class:`~grainlab.snapshot.ParticleKind` code) and ``body``
+    ``kind`` (:class:`~grainlab.snapshot.ParticleKind` code), ``body``
     (integer: the membrane chain of each membrane particle, -1 for none;
-    :meth:`Snapshot.boundary_bodies`); any other numeric column is kept in
-    :attr:`Snapshot.particle_fields`. Column order
+    :meth:`Snapshot.boundary_bodies`), ``grain`` (integer >= 0: the rigid
+    body of each particle, the pebbles of a clump alike;
+    :meth:`Snapshot.grains`) with, optionally, its grain's centroid
+    ``grain_x,grain_y`` (m) and angle ``grain_angle`` (rad); any other numeric
+    column is kept in :attr:`Snapshot.particle_fields`. Column order
     is free, names are case-insensitive; blank lines and lines starting with
     ``#`` are skipped. A ``z`` column makes the file 3D when it is not
     constant (within 1e-3 of the smallest radius): such a file is refused
@@ -48,14 +51,23 @@ from grainlab.io._table import (
     check_geometry,
     check_unique_ids,
     integral_column,
+    label_column,
     parse_float_table,
     plain,
     read_lines,
 )
-from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
+from grainlab.snapshot import (
+    BODY_FIELD,
+    GRAIN_ANGLE_FIELD,
+    GRAIN_CENTROID_FIELD,
+    GRAIN_FIELD,
+    ParticleKind,
+    Snapshot,
+)
 
 __all__ = [
     "CONTACT_ROLES",
+    "GRAIN_CENTROID_COLUMNS",
     "PARTICLE_ROLES",
     "MissingKindWarning",
     "check_column_map",
@@ -67,8 +79,12 @@ __all__ = [
 
 PARTICLE_COLUMNS = ("id", "x", "y", "radius")
 CONTACT_COLUMNS = ("i", "j")
+#: The columns of a grain's centroid, x and y (m).
+GRAIN_CENTROID_COLUMNS = ("grain_x", "grain_y")
 #: Roles a ``columns`` mapping may give to a particles file's columns.
-PARTICLE_ROLES = ("id", "x", "y", "z", "radius", "rotation", "kind", BODY_FIELD)
+PARTICLE_ROLES = (
+    "id", "x", "y", "z", "radius", "rotation", "kind", BODY_FIELD, GRAIN_FIELD, *GRAIN_CENTROID_COLUMNS, GRAIN_ANGLE_FIELD
+)
 #: Roles a ``columns`` mapping may give to a contacts file's columns.
 CONTACT_ROLES = ("i", "j", "normal_force", "shear_force")
 
@@ -247,18 +263,7 @@ def read_particles_csv(
             raise FileFormatError(
                 path, int(numbers[k]), f"column 'kind': unknown code {int(kind[k])}"
             )
-    extra: dict[str, NDArray[Any]] = {
-        n: v for n, v in col.items() if n not in PARTICLE_COLUMNS + ("rotation", "kind")
-    }
-    if BODY_FIELD in col:
-        body = integral_column(path, col[BODY_FIELD], numbers, BODY_FIELD)
-        bad = body < -1
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise FileFormatError(
-                path, int(numbers[k]), f"column {BODY_FIELD!r}: {int(body[k])} is not a body label (>= -1)"
-            )
-        extra[BODY_FIELD] = body
+    extra = _label_fields(path, col, numbers)
     positions = np.c_[col["x"], col["y"]]
     metadata: dict[str, Any] = {"source": str(path), "format": format_name}
     if column_map:
@@ -288,6 +293,30 @@ def read_particles_csv(
     if detect:
         return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **kwargs)
     return Snapshot(positions, radius, **kwargs)
+
+
+def _label_fields(
+    path: str | Path, col: Mapping[str, NDArray[np.float64]], numbers: NDArray[np.int64]
+) -> dict[str, NDArray[Any]]:
+    """The particles' fields: every column but the core ones, with the membrane chain
+    (``body``) and the grain (``grain``; ``grain_x, grain_y`` as the field
+    ``grain_centroid``) read as labels and checked, naming the line."""
+    extra: dict[str, NDArray[Any]] = {
+        n: v for n, v in col.items() if n not in PARTICLE_COLUMNS + ("rotation", "kind", *GRAIN_CENTROID_COLUMNS)
+    }
+    if BODY_FIELD in col:
+        extra[BODY_FIELD] = label_column(path, col[BODY_FIELD], numbers, BODY_FIELD, "body", -1)
+    if GRAIN_FIELD in col:
+        extra[GRAIN_FIELD] = label_column(path, col[GRAIN_FIELD], numbers, GRAIN_FIELD, "grain", 0)
+    given = [n for n in (*GRAIN_CENTROID_COLUMNS, GRAIN_ANGLE_FIELD) if n in col]
+    if given and GRAIN_FIELD not in col:
+        raise FileFormatError(path, None, f"column {given[0]!r}: a grain's value without a {GRAIN_FIELD!r} column")
+    x, y = (col.get(n) for n in GRAIN_CENTROID_COLUMNS)
+    if (x is None) != (y is None):
+        raise FileFormatError(path, None, "columns 'grain_x', 'grain_y': a grain's centroid needs both")
+    if x is not None and y is not None:
+        extra[GRAIN_CENTROID_FIELD] = np.c_[x, y]
+    return extra
 
 
 def read_contacts_csv(
@@ -355,7 +384,10 @@ def write_particles_csv(
     *,
     float_format: str = "%.17g",
 ) -> Path:
-    """Write ``id,x,y,radius`` (+ rotation when set, kind, body when set, + ``columns``) as CSV.
+    """Write ``id,x,y,radius`` (+ rotation when set, kind, body and grain when set, + ``columns``) as CSV.
+
+    A snapshot with grains (:data:`~grainlab.snapshot.GRAIN_FIELD`) writes
+    ``grain`` and, when it has them, ``grain_x, grain_y`` and ``grain_angle``.
 
     ``kind`` is always written, so that reading the file back does not warn
     (:class:`MissingKindWarning`).
@@ -372,8 +404,15 @@ def write_particles_csv(
     if snapshot.rotations is not None:
         cols["rotation"] = np.asarray(snapshot.rotations)
     cols["kind"] = np.asarray(snapshot.kind)
-    if BODY_FIELD in snapshot.particle_fields:
-        cols[BODY_FIELD] = np.asarray(snapshot.particle_fields[BODY_FIELD])
+    fields = snapshot.particle_fields
+    for name in (BODY_FIELD, GRAIN_FIELD):
+        if name in fields:
+            cols[name] = np.asarray(fields[name])
+    if GRAIN_CENTROID_FIELD in fields:
+        centroid = np.asarray(fields[GRAIN_CENTROID_FIELD])
+        cols.update(zip(GRAIN_CENTROID_COLUMNS, centroid.T, strict=True))
+    if GRAIN_ANGLE_FIELD in fields:
+        cols[GRAIN_ANGLE_FIELD] = np.asarray(fields[GRAIN_ANGLE_FIELD])
     for name, values in (columns or {}).items():
         v = np.asarray(values)
         if v.shape != (snapshot.n_particles,):

@@ -68,11 +68,12 @@ from grainlab.io._table import (
     check_geometry,
     check_unique_ids,
     integral_column,
+    label_column,
     parse_float_table,
     plain,
     read_lines,
 )
-from grainlab.snapshot import BODY_FIELD, ParticleKind, Snapshot
+from grainlab.snapshot import BODY_FIELD, GRAIN_FIELD, ParticleKind, Snapshot
 
 __all__ = [
     "DumpFrame",
@@ -323,6 +324,7 @@ def read_lammps_dump(
     body_column: str | None = None,
     z_policy: str = "refuse",
     z0: float | None = None,
+    grain_column: str | None = None,
 ) -> Snapshot:
     """Read one frame of a LAMMPS atoms dump (and its contacts) into a :class:`Snapshot`.
 
@@ -336,6 +338,11 @@ def read_lammps_dump(
     a bonded chain) that says which boundary body each boundary atom belongs
     to (:data:`~grainlab.snapshot.BODY_FIELD`); without it, boundary atoms
     that touch one another form one body (:meth:`Snapshot.boundary_bodies`).
+    ``grain_column`` names an integer column (>= 0) that says which rigid body
+    each atom belongs to (:data:`~grainlab.snapshot.GRAIN_FIELD`): ``mol``, the
+    molecule id, for the bodies of ``fix rigid/small ... molecule``; atoms of
+    one value are the pebbles of one grain (:meth:`Snapshot.grains`), whose
+    centroid and angle a dump does not carry.
 
     3D data (the ``z`` column, or ``zu`` / ``zs`` / ``zsu`` beside the chosen
     x and y, spreading over more than ``PLANAR_TOLERANCE`` = 1e-3 of the
@@ -430,18 +437,7 @@ def read_lammps_dump(
     for name, values in col.items():
         if name not in used:
             fields[name] = values
-    if body_column is not None:
-        if body_column not in col:
-            raise FileFormatError(
-                path, where, f"no column {body_column!r} for body_column (columns: {' '.join(frame.columns)})"
-            )
-        body = integral_column(path, col[body_column], numbers, body_column)
-        if np.any(body < -1):
-            k = int(np.argmax(body < -1))
-            raise FileFormatError(
-                path, int(numbers[k]), f"column {body_column!r}: {int(body[k])} is not a body label (>= -1)"
-            )
-        fields[BODY_FIELD] = body
+    fields |= _label_fields(path, frame, {"body_column": body_column, "grain_column": grain_column})
     kind = None
     if len(boundary_types):
         if "type" not in col:
@@ -496,6 +492,27 @@ def read_lammps_dump(
     if detect:
         return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **snap_kwargs)
     return Snapshot(positions, radius, **snap_kwargs)
+
+
+#: The label fields a dump's columns may give: argument -> (field, what, least label).
+_LABELS = {"body_column": (BODY_FIELD, "body", -1), "grain_column": (GRAIN_FIELD, "grain", 0)}
+
+
+def _label_fields(path: str | Path, frame: DumpFrame, columns: Mapping[str, str | None]) -> dict[str, NDArray[Any]]:
+    """The boundary body and grain labels of the atoms from the columns ``columns`` names
+    (``{"body_column": "mol", "grain_column": None}``), checked, naming the line."""
+    fields: dict[str, NDArray[Any]] = {}
+    for argument, name in columns.items():
+        if name is None:
+            continue
+        field, what, least = _LABELS[argument]
+        if name not in frame.columns:
+            raise FileFormatError(
+                path, frame.header_line, f"no column {name!r} for {argument} (columns: {' '.join(frame.columns)})"
+            )
+        values = frame.data[:, frame.columns.index(name)]
+        fields[field] = label_column(path, values, frame.line_numbers, name, what, least)
+    return fields
 
 
 _ID_NAMES = (("patom1", "patom2"), ("id1", "id2"), ("atom1", "atom2"), ("i", "j"))

@@ -21,6 +21,13 @@ vertex, 1 contact line) and fills the contact arrays on the vertex cells with
 NaN (floating point) or -1 (integers and flags), so that a *Threshold* on
 ``cell_kind`` or on a force keeps only the contacts.
 
+A snapshot with clumps (grains of several pebbles, :meth:`Snapshot.grains
+<grainlab.snapshot.Snapshot.grains>`) has a second PolyData beside it
+(:func:`write_clumps_vtp`, :func:`clump_points`): one vertex per clump at its
+centroid, carrying its ``grain`` label, ``angle``, ``orientation`` (the body
+frame's x axis, for a glyph) and ``n_pebbles``; the pebbles' own points carry
+``grain``, ``grain_centroid`` and ``grain_angle`` as any per-particle field.
+
 Contacts that cannot be drawn as a line between two centres are left out of
 the lines (they still count in ``n_contacts`` and the stability index), and
 their numbers are stored in the file's field data: wall contacts
@@ -57,9 +64,11 @@ __all__ = [
     "CELL_CONTACT",
     "CELL_PARTICLE",
     "as_vector3",
+    "clump_points",
     "contact_lines",
     "exportable",
     "CELL_WALL",
+    "write_clumps_vtp",
     "write_pvd",
     "write_vtp",
     "write_vtu",
@@ -208,6 +217,45 @@ def write_walls_vtp(path: str | os.PathLike[str], segments: ArrayLike, *, binary
         "PolyData", path, seg.reshape(-1, 2), np.arange(2 * k).reshape(k, 2),
         None, {"wall_index": np.arange(k, dtype=np.int32)}, field, binary, verts=False,
     )
+
+
+def clump_points(snap: Any) -> tuple[NDArray[np.float64], dict[str, NDArray[Any]]] | None:
+    """The clumps of a snapshot as points: ``(centroids (C, 2), point_data)``, or None.
+
+    One point per grain of more than one particle (a clump; :meth:`Snapshot.grains
+    <grainlab.snapshot.Snapshot.grains>`), in increasing grain label, at its centroid, m.
+    Point data: ``grain`` (Int64, the label), ``angle`` (rad, CCW positive),
+    ``orientation`` (cos, sin, 0 of the angle: the body frame's x axis, the
+    orientation array of a glyph) and ``n_pebbles`` (Int32). None when the
+    snapshot has no clumps, or does not know their centroids and angles (a file
+    that labels grains only).
+    """
+    fields = snap.particle_fields
+    if "grain_centroid" not in fields or "grain_angle" not in fields:
+        return None
+    label, first, count = np.unique(snap.grains(), return_index=True, return_counts=True)
+    clump = count > 1
+    if not clump.any():
+        return None
+    rows = first[clump]
+    angle = np.asarray(fields["grain_angle"], np.float64)[rows]
+    data: dict[str, NDArray[Any]] = {
+        "grain": label[clump].astype(np.int64),
+        "angle": angle,
+        "orientation": np.c_[np.cos(angle), np.sin(angle), np.zeros(len(rows))],
+        "n_pebbles": count[clump].astype(np.int32),
+    }
+    return np.asarray(fields["grain_centroid"], np.float64)[rows], data
+
+
+def write_clumps_vtp(path: str | os.PathLike[str], snap: Any, *, binary: bool = True) -> Path | None:
+    """The clumps of ``snap`` as one vertex each at its centroid (:func:`clump_points`), with
+    the field data ``n_clumps``; writes nothing and returns None when :func:`clump_points` is None."""
+    clumps = clump_points(snap)
+    if clumps is None:
+        return None
+    centroids, data = clumps
+    return write_vtp(path, centroids, point_data=data, field_data={"n_clumps": [len(centroids)]}, binary=binary)
 
 
 def _write_xml(

@@ -28,6 +28,7 @@ from grainlab.io.vtk import (
     as_vector3,
     contact_lines,
     exportable,
+    write_clumps_vtp,
     write_pvd,
     write_vtp,
     write_vtu,
@@ -114,6 +115,9 @@ class VtkExport:
     #: The walls of each snapshot that stores them (``walls_0000.vtp``, ...) and their ``walls.pvd``.
     wall_files: tuple[Path, ...] = ()
     walls_pvd: Path | None = None
+    #: The clumps of each snapshot that has them (``clumps_0000.vtp``, ...) and their ``clumps.pvd``.
+    clump_files: tuple[Path, ...] = ()
+    clumps_pvd: Path | None = None
 
 
 def export_vtk(
@@ -131,7 +135,9 @@ def export_vtk(
     UnstructuredGrid ``snapshot_0000.vtu`` (:func:`grainlab.io.vtk.write_vtu`,
     for meshio); when ``run.h5`` stores a snapshot's walls, its active walls
     as lines in ``walls_0000.vtp`` (infinite walls clipped to the particles'
-    extent) and a ``walls.pvd`` collection on the same time axis. Raises
+    extent) and a ``walls.pvd`` collection on the same time axis; for the
+    snapshots with clumps, their centroids and angles in ``clumps_0000.vtp``
+    (:func:`grainlab.io.vtk.write_clumps_vtp`) and a ``clumps.pvd``. Raises
     ValueError when the run has no snapshots.
     """
     path = Path(run)
@@ -143,7 +149,7 @@ def export_vtk(
         raise ValueError(f"{h5}: the run has no snapshots to export")
     snaps = [results.snapshot(name) for name in names]
     quantity, times = _time_axis(snaps)
-    files, grids, walls_written = [], [], []
+    files, grids, walls_written, clumps_written = [], [], [], []
     for k, (name, snap) in enumerate(zip(names, snaps, strict=True)):
         lines, line_data, left_out = contact_lines(snap)
         field_data: dict[str, ArrayLike] = {
@@ -167,8 +173,17 @@ def export_vtk(
             extent = np.array([(snap.positions - r).min(axis=0), (snap.positions + r).max(axis=0)])
             segments = walls.segments(extent)
             walls_written.append((times[k], write_walls_vtp(folder / f"walls_{k:04d}.vtp", segments, binary=binary)))
+        clumps = write_clumps_vtp(folder / f"clumps_{k:04d}.vtp", snap, binary=binary)
+        if clumps is not None:
+            clumps_written.append((times[k], clumps))
     pvd = write_pvd(folder / "run.pvd", [(t, f.name) for t, f in zip(times, files, strict=True)])
-    walls_pvd = write_pvd(folder / "walls.pvd", [(t, f.name) for t, f in walls_written]) if walls_written else None
     return VtkExport(
-        pvd, tuple(files), tuple(times), quantity, tuple(grids), tuple(f for _, f in walls_written), walls_pvd
+        pvd, tuple(files), tuple(times), quantity, tuple(grids), tuple(f for _, f in walls_written),
+        _collection(folder / "walls.pvd", walls_written), tuple(f for _, f in clumps_written),
+        _collection(folder / "clumps.pvd", clumps_written),
     )
+
+
+def _collection(pvd: Path, written: Sequence[tuple[float, Path]]) -> Path | None:
+    """The ``.pvd`` of the files ``written`` (time, file), or None without any."""
+    return write_pvd(pvd, [(t, f.name) for t, f in written]) if written else None

@@ -10,8 +10,10 @@ the shear band labels; the particle–particle contacts with their normal
 forces; the accepted bands' outlines (the run's stored band searches, against its
 first snapshot);
 the walls when the file stores them; each particle's grain (the pebbles of a
-clump share theirs, :meth:`~grainlab.snapshot.Snapshot.grains`), for the page's
-colour per grain; and the stress–strain curve of the time series.
+clump share theirs, :meth:`~grainlab.snapshot.Snapshot.grains`) and each
+snapshot's number of grains, for the page's colour per grain and its outlines
+of the clumps (``clumps`` says whether the run has any: the page then opens
+coloured by grain); and the stress–strain curve of the time series.
 
 Arrays are quantised for the page: coordinates, radii and values as
 float32 (about 7 significant digits: a grain's lambda shows to 1e-6), codes
@@ -94,6 +96,7 @@ def _snapshot(name: str, snap: Any, first: Any, walls: Any, index_dtype: str, pr
         "axial_strain": snap.axial_strain if snap.axial_strain is not None else snap.scalars.get(SHEAR_STRAIN),
         "time_s": snap.time,
         "n": n,
+        "n_grains": snap.n_grains,
         "n_contacts": int(len(lines)),
         "band": outline,
         "walls": None if walls is None else walls.segments(_bounds(snap)).tolist(),
@@ -154,6 +157,7 @@ def viewer_data(run: str | Path) -> dict[str, Any]:
             break
     bounds = np.array([_bounds(s) for s in snaps])
     return {
+        "clumps": any(s.n_grains < s.n_particles for s in snaps),
         "title": f"{results.kind} run {h5.parent.name}",
         "source": str(h5),
         "index_dtype": index_dtype,

@@ -26,6 +26,11 @@
     // a shade per grain, spread by the golden ratio so that neighbouring labels differ
     a.grainShade = new Float32Array(s.n);
     for (let i = 0; i < s.n; i++) a.grainShade[i] = (a.grain[i] * 0.6180339887) % 1;
+    // the pebbles of clumps (grains of more than one particle), outlined as one body
+    const size = new Map();
+    for (let i = 0; i < s.n; i++) size.set(a.grain[i], (size.get(a.grain[i]) || 0) + 1);
+    a.pebbles = new Uint8Array(s.n);
+    for (let i = 0; i < s.n; i++) a.pebbles[i] = Math.min(255, size.get(a.grain[i]));
     return { meta: s, a: a };
   });
 
@@ -86,6 +91,7 @@
   const legend = document.getElementById("legend");
   slider.max = String(snaps.length - 1);
   slider.value = String(snaps.length - 1);
+  if (D.clumps) mode.value = "grains";  // a run with clumps opens on its bodies
 
   const lo = D.bounds[0], hi = D.bounds[1];
   const PAD = 12;
@@ -122,6 +128,16 @@
     ctx.clearRect(0, 0, canvas.width, canvas.height);
     ctx.fillStyle = "#ffffff";
     ctx.fillRect(0, 0, canvas.width, canvas.height);
+    // a clump's outline: its pebbles stroked wide, then filled over, so that only the
+    // boundary of their union stays dark
+    ctx.strokeStyle = "#202020";
+    ctx.lineWidth = 2.5;
+    for (let i = 0; i < s.meta.n; i++) {
+      if (a.pebbles[i] < 2) continue;
+      ctx.beginPath();
+      ctx.arc(sx(a.x[i]), sy(a.y[i]), Math.max(0.5, a.r[i] * scale), 0, 2 * Math.PI);
+      ctx.stroke();
+    }
     for (let i = 0; i < s.meta.n; i++) {
       ctx.beginPath();
       ctx.arc(sx(a.x[i]), sy(a.y[i]), Math.max(0.5, a.r[i] * scale), 0, 2 * Math.PI);
@@ -177,7 +193,8 @@
       ctx.stroke();
     }
     strainLabel.textContent = D.strain_label + " " + strainText(s) + " (" + s.meta.name + ", " + s.meta.n +
-      " particles, " + s.meta.n_contacts + " contacts drawn)";
+      " particles" + (s.meta.n_grains !== s.meta.n ? " in " + s.meta.n_grains + " grains" : "") + ", " +
+      s.meta.n_contacts + " contacts drawn)";
     legend.innerHTML = "";
     const bar = document.createElement("span");
     bar.className = "bar";
@@ -305,6 +322,7 @@
     const rows = [
       ["particle id", String(a.id[i])],
       ["kind", a.kind[i] === MEMBRANE ? "membrane" : a.kind[i] === 2 ? "boundary grain" : "grain"],
+      ["grain", String(a.grain[i]) + (a.pebbles[i] > 1 ? " (a clump of " + a.pebbles[i] + ")" : "")],
       ["\u03bb", a.lambda[i].toFixed(6)],
       ["contacts", String(a.contacts[i])],
       ["radius (m)", a.r[i].toExponential(3)],

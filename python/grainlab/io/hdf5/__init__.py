@@ -3,14 +3,16 @@
 The layouts are specified, group by group and attribute by attribute, in
 ``docs/file-formats.md``; this module is their reference implementation.
 
-Results file (``format = "grainlab-results"``, ``format_version = 2``)
+Results file (``format = "grainlab-results"``, ``format_version = 3``)
     :class:`ResultsWriter` creates it while a run goes on; :func:`read_results`
     loads it as a :class:`Results`. It holds the resolved configuration,
     the time series (one appendable float64 column per measurement), full
     :class:`~grainlab.snapshot.Snapshot` objects, a summary and wall time per
     phase. Version 2 adds the analysis group (:mod:`grainlab.io.hdf5.analysis`):
     products of the analysis stored with the run, added to a complete file by
-    :func:`write_analysis`.
+    :func:`write_analysis`. Version 3 stores each snapshot's grains (rigid
+    bodies: the grain of every particle, each grain's centroid and angle) one
+    row per grain (:mod:`grainlab.io.hdf5.snapshot`).
 
 Crash safety
     The writer works on ``run.h5.partial`` with root attribute

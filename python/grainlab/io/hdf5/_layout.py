@@ -21,8 +21,9 @@ from grainlab.io.results import RESULTS_FILE, json_safe
 
 #: Root attribute ``format`` of a results file.
 FORMAT = "grainlab-results"
-#: Layout version written by this grainlab: 2 adds the analysis group to version 1's layout.
-FORMAT_VERSION = 2
+#: Layout version written by this grainlab: 2 adds the analysis group to version 1's layout,
+#: 3 stores the snapshots' grains (rigid bodies) one row per grain.
+FORMAT_VERSION = 3
 #: Root attribute ``format`` of a checkpoint file.
 CHECKPOINT_FORMAT = "grainlab-checkpoint"
 #: Checkpoint layout version written by this grainlab.

@@ -9,7 +9,8 @@ arrays, each product with the version of the rule that made it
 A product is added to a complete ``run.h5`` by :func:`write_analysis`, which
 works on a copy of the file and renames it over the original: an interrupted
 write leaves the file as it was. Files of layout version 1 have no analysis
-group; a product written into one makes it a version-2 file.
+group; a product written into an older file makes it a file of the current
+version (whose readers read the older snapshots as they were).
 """
 
 from __future__ import annotations

@@ -27,7 +27,12 @@ from grainlab.io.hdf5._layout import (
 )
 from grainlab.io.hdf5.analysis import AnalysisItem, read_analysis_item, read_analysis_versions
 from grainlab.io.hdf5.errors import IncompleteResultsError, ResultsFileError
-from grainlab.io.hdf5.snapshot import SnapshotInfo, _read_snapshot_group_v1, _snapshot_infos_v1
+from grainlab.io.hdf5.snapshot import (
+    SnapshotInfo,
+    _read_snapshot_group_v1,
+    _read_snapshot_group_v3,
+    _snapshot_infos_v1,
+)
 from grainlab.io.walls import WallGeometry, read_wall_group
 from grainlab.snapshot import Snapshot
 
@@ -178,11 +183,19 @@ def _read_results_v1(f: h5py.File, path: Path, allow_incomplete: bool) -> Result
     )
 
 
-def _read_snapshot_v1(f: h5py.File, name: str, path: Path) -> Snapshot:
+def _snapshot_group(f: h5py.File, name: str, path: Path) -> h5py.Group:
     group = f.get("snapshots")
     if group is None or name not in group:
         raise ResultsFileError(path, f"no snapshot named {name!r}")
-    return _read_snapshot_group_v1(group[name], path)
+    return group[name]
+
+
+def _read_snapshot_v1(f: h5py.File, name: str, path: Path) -> Snapshot:
+    return _read_snapshot_group_v1(_snapshot_group(f, name, path), path)
+
+
+def _read_snapshot_v3(f: h5py.File, name: str, path: Path) -> Snapshot:
+    return _read_snapshot_group_v3(_snapshot_group(f, name, path), path)
 
 
 #: Reader of each results layout version. A new layout adds an entry; old ones stay.
@@ -190,6 +203,8 @@ _READERS_BY_VERSION: dict[int, _LayoutReader] = {
     1: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_v1),
     # version 2 is version 1 and the analysis group, which version 1 files do not have
     2: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_v1),
+    # version 3 is version 2 with the snapshots' grains one row per grain
+    3: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_v3),
 }
 
 

@@ -1,6 +1,12 @@
 """One snapshot as an HDF5 group (``/snapshots/<name>`` of a results file): its
 name, its datasets and attributes written and read, and what the group says
-about it without loading it (:class:`SnapshotInfo`)."""
+about it without loading it (:class:`SnapshotInfo`).
+
+Layout version 3 stores a snapshot's grains (rigid bodies: a clump's pebbles
+share one) as the dataset ``grain`` (N,) and the group ``grains`` of one row per
+grain (``label``, ``centroid``, ``angle``) instead of three per-particle fields;
+versions 1 and 2 have neither, and their snapshots read with every particle a
+grain of its own unless their ``particle_fields`` say otherwise."""
 
 from __future__ import annotations
 
@@ -19,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from grainlab.io.hdf5._layout import _check_name, _dumps, _read_text, _write_text
 from grainlab.io.hdf5.errors import ResultsFileError
-from grainlab.snapshot import Snapshot
+from grainlab.snapshot import GRAIN_ANGLE_FIELD, GRAIN_CENTROID_FIELD, GRAIN_FIELD, Snapshot
 
 __all__ = ["SnapshotInfo", "snapshot_name", "snapshot_strain"]
 
@@ -128,6 +134,8 @@ def _write_snapshot_group(
     for owner in ("contact_fields", "particle_fields"):
         sub = group.create_group(owner, track_order=True)
         for key, value in getattr(snapshot, owner).items():
+            if owner == "particle_fields" and key in _GRAIN_FIELDS:
+                continue  # one row per grain, in the grain datasets below
             _check_name(f"snapshot.{owner}", key)
             _write_array(
                 sub,
@@ -137,6 +145,7 @@ def _write_snapshot_group(
                 compression=compression,
                 where=f"snapshot.{owner}[{key!r}]",
             )
+    _write_grains(group, snapshot.particle_fields, compression)
     _write_text(group, "metadata", metadata)
     group.attrs["n_particles"] = np.int64(snapshot.n_particles)
     group.attrs["n_contacts"] = np.int64(snapshot.n_contacts)
@@ -156,7 +165,67 @@ def _write_snapshot_group(
         group.attrs["step"] = np.int64(step)
 
 
-def _read_snapshot_group_v1(group: h5py.Group, path: Path) -> Snapshot:
+#: The per-particle fields of the grains, stored one row per grain (version 3).
+_GRAIN_FIELDS = (GRAIN_FIELD, GRAIN_CENTROID_FIELD, GRAIN_ANGLE_FIELD)
+#: Each per-grain dataset of the ``grains`` group: its per-particle field, units and width.
+_GRAIN_ROWS = {"centroid": (GRAIN_CENTROID_FIELD, "m", (2,)), "angle": (GRAIN_ANGLE_FIELD, "rad", ())}
+
+
+def _write_grains(group: h5py.Group, fields: Mapping[str, NDArray[Any]], compression: str | None) -> None:
+    """The grain of every particle as ``grain`` (N,) and one row per grain, in increasing
+    label, as ``grains/label``, ``grains/centroid``, ``grains/angle`` (the Snapshot has checked
+    that a grain's particles agree, so the rows keep every particle's value to the bit)."""
+    if GRAIN_FIELD not in fields:
+        return
+    grain = np.asarray(fields[GRAIN_FIELD], dtype=np.int64)
+    label, first = np.unique(grain, return_index=True)
+    _write_array(group, "grain", grain, units="", compression=compression, where="snapshot.grain")
+    rows = group.create_group("grains", track_order=True)
+    _write_array(rows, "label", label, units="", compression=compression, where="snapshot.grains.label")
+    for name, (field, units, _) in _GRAIN_ROWS.items():
+        if field in fields:
+            values = np.asarray(fields[field])[first]
+            _write_array(rows, name, values, units=units, compression=compression, where=f"snapshot.grains.{name}")
+
+
+def _read_grains(group: h5py.Group, path: Path) -> dict[str, NDArray[Any]]:
+    """The grain fields of a version-3 snapshot group, one value per particle (none when
+    the snapshot has no grains)."""
+    if "grain" not in group:
+        return {}
+    grain = np.asarray(group["grain"][()], dtype=np.int64)
+    rows = group.get("grains")
+    if rows is None or "label" not in rows:
+        raise ResultsFileError(path, f"{group.name}: a 'grain' dataset without 'grains/label'")
+    label = np.asarray(rows["label"][()], dtype=np.int64)
+    if np.any(np.diff(label) <= 0):
+        raise ResultsFileError(path, f"{group.name}/grains/label: the labels do not increase")
+    row = np.searchsorted(label, grain)
+    found = row < len(label)
+    found[found] = label[row[found]] == grain[found]
+    if not found.all():
+        k = int(np.argmin(found))
+        raise ResultsFileError(path, f"{group.name}/grain: particle {k}'s grain {int(grain[k])} is not in grains/label")
+    fields: dict[str, NDArray[Any]] = {GRAIN_FIELD: grain}
+    for name, (field, _, width) in _GRAIN_ROWS.items():
+        if name in rows:
+            values = rows[name][()]
+            if values.shape != (len(label), *width):
+                raise ResultsFileError(
+                    path, f"{group.name}/grains/{name}: shape {values.shape}, expected {(len(label), *width)}"
+                )
+            fields[field] = values[row]
+    return fields
+
+
+def _read_snapshot_group_v3(group: h5py.Group, path: Path) -> Snapshot:
+    """Version 3: version 1's group and its grains (:func:`_read_grains`)."""
+    return _read_snapshot_group_v1(group, path, _read_grains(group, path))
+
+
+def _read_snapshot_group_v1(
+    group: h5py.Group, path: Path, grains: Mapping[str, NDArray[Any]] | None = None
+) -> Snapshot:
     def get(name: str) -> NDArray[Any] | None:
         return group[name][()] if name in group else None
 
@@ -186,7 +255,7 @@ def _read_snapshot_group_v1(group: h5py.Group, path: Path) -> Snapshot:
             contact_normal=get("contact_normal"),
             contact_point=get("contact_point"),
             contact_fields=fields("contact_fields"),
-            particle_fields=fields("particle_fields"),
+            particle_fields=fields("particle_fields") | dict(grains or {}),
             box=get("box"),
             periodic=periodic,  # type: ignore[arg-type]
             tilt=float(attrs.get("tilt", 0.0)),
