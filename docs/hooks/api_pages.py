@@ -122,9 +122,9 @@ def api_nav(pages: list[ApiPage]) -> list[object]:
 
     def entry(page: ApiPage) -> object:
         children = sorted(by_parent.get(page.module, []), key=lambda c: (c.module in by_parent, c.module))
-        title = page.module if "." not in page.module else page.module.rpartition(".")[2]
+        # the full name: the page's title in the search results too
         if not children:
-            return {title: page.src_uri}
-        return {title: [{page.module: page.src_uri}, *(entry(child) for child in children)]}
+            return {page.module: page.src_uri}
+        return {page.module: [{page.module: page.src_uri}, *(entry(child) for child in children)]}
 
     return [entry(page) for page in by_parent[""]]
