@@ -7,8 +7,8 @@ build:  ## install grainlab (release build of the Rust engine)
 dev:  ## editable install: Python edits are live; rerun after Rust edits
 	pip install -e .
 
-wheel:  ## the release artifacts in dist/: the abi3 wheel for manylinux2014 (glibc 2.17+, linked by zig) and the sdist
-	python -m maturin build --release --zig --compatibility manylinux2014 --out dist
+wheel:  ## the release artifacts in dist/: the abi3 wheel for manylinux2014 (glibc 2.17+, linked by zig; its own cargo folder target/wheel) and the sdist
+	CARGO_TARGET_DIR=target/wheel python -m maturin build --release --zig --compatibility manylinux2014 --out dist
 	python -m maturin sdist --out dist
 
 # NO_MKDOCS_2_WARNING=1: Material for MkDocs 9.x prints a notice of its own end of life (May 2027)

@@ -28,6 +28,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+import yaml
 
 import grainlab
 
@@ -183,3 +184,20 @@ def test_without_qemu_the_test_skips_unless_ci_requires_it(monkeypatch):
     monkeypatch.setenv("GRAINLAB_REQUIRE_QEMU", "1")
     with pytest.raises(pytest.fail.Exception, match="GRAINLAB_REQUIRE_QEMU"):
         _qemu_or_skip()
+
+
+def test_the_release_workflow_builds_every_platform_and_the_sdist_on_a_tag():
+    workflow = yaml.safe_load((ROOT / ".github" / "workflows" / "release.yml").read_text(encoding="utf-8"))
+    assert workflow[True]["push"]["tags"] == ["v*"]  # YAML reads the key "on" as True
+    jobs = workflow["jobs"]
+    assert {m["target"] for m in jobs["linux"]["strategy"]["matrix"]["include"]} == {"x86_64", "aarch64"}
+    assert {m["target"] for m in jobs["macos"]["strategy"]["matrix"]["include"]} == {"x86_64", "aarch64"}
+    builds = {name: next(s for s in job["steps"] if str(s.get("uses", "")).startswith("PyO3/maturin-action"))
+              for name, job in jobs.items() if name != "release"}
+    assert builds["linux"]["with"]["manylinux"] == "2014"  # the glibc of make wheel and the test above
+    assert builds["windows"]["with"]["target"] == "x64" and builds["sdist"]["with"]["command"] == "sdist"
+    for name in ("linux", "macos", "windows"):
+        assert "--release" in builds[name]["with"]["args"]
+        run = "\n".join(s.get("run", "") for s in jobs[name]["steps"])
+        assert "grainlab --version" in run and "tests/packaging/same_bits.py" in run, name
+    assert set(jobs["release"]["needs"]) == {"linux", "macos", "windows", "sdist"}
