@@ -22,6 +22,7 @@ lint:  ## formatting and lints, Rust and Python, types (mypy strict, the compile
 	cargo clippy --release -p grainlab-core -p grainlab-py -- -D warnings
 	ruff check python tests benchmarks examples docs/hooks
 	python -m mypy python/grainlab
+	python -m mypy docs/hooks
 	python -m mypy.stubtest grainlab._core
 	python -m pytest -q -p no:cacheprovider tests/test_layers.py tests/test_function_length.py
 

@@ -41,17 +41,19 @@ def page_uri(module: str) -> str:
 def load_package(source: Path) -> griffe.Module:
     """The ``grainlab`` package read from ``source`` (the folder holding it)."""
     extensions = griffe.load_extensions(GrainlabDocstrings())
-    return griffe.load(
+    package = griffe.load(
         "grainlab", search_paths=[str(source)], extensions=extensions, resolve_aliases=True, resolve_external=False
     )
+    assert isinstance(package, griffe.Module)
+    return package
 
 
 def public_modules(package: griffe.Module) -> list[griffe.Module]:
     """The package and every public module under it, parents before children."""
     found = [package]
     for member in package.modules.values():
-        if not member.is_alias and is_public(member.path):
-            found += public_modules(member)  # type: ignore[arg-type]
+        if isinstance(member, griffe.Module) and is_public(member.path):
+            found += public_modules(member)
     return found
 
 
@@ -84,7 +86,7 @@ def _split(module: griffe.Module, public: set[str]) -> tuple[list[str], list[tup
         member = module.members.get(name)
         if member is None or member.is_module:
             continue
-        if member.is_alias:
+        if isinstance(member, griffe.Alias):
             target = member.final_target
             if _documented_at_home(target, public) and target.module.path != module.path:
                 elsewhere.append((name, target.path, _summary(target)))
