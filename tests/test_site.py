@@ -18,7 +18,7 @@ from types import ModuleType
 
 import pytest
 import yaml
-from browser_helpers import chromium_or_skip, served
+from external_tools import chromium_or_skip, served
 
 from grainlab.cli import build_parser
 

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from external_tools import tool_or_skip
 
 import grainlab
 
@@ -130,12 +131,7 @@ def test_the_wheel_runs_the_quick_biaxial_test_with_no_rust_on_path(venv, tmp_pa
 def _qemu_or_skip() -> str:
     if platform.machine() != "x86_64":
         pytest.skip("the AVX2 kernels are x86_64's")
-    path = shutil.which("qemu-x86_64")
-    if path is None:
-        if os.environ.get("GRAINLAB_REQUIRE_QEMU") == "1":
-            pytest.fail("GRAINLAB_REQUIRE_QEMU=1 but no qemu-x86_64 on PATH (apt-get install qemu-user)")
-        pytest.skip("no qemu-x86_64 on PATH (Debian: apt-get install qemu-user)")
-    return path
+    return tool_or_skip("qemu-x86_64", "GRAINLAB_REQUIRE_QEMU", "apt-get install qemu-user")
 
 
 def _engine_ymm_instructions(log: Path, maps: str) -> tuple[int, int]:
@@ -172,18 +168,6 @@ def test_without_avx2_the_wheel_runs_the_scalar_path_to_the_same_bits(venv, tmp_
     assert with_avx2[1][1] > 0, "with AVX2 the engine ran no AVX2 kernel"
     assert without_avx2[1][0] > 10_000 and without_avx2[1][1] == 0, without_avx2
     assert native.stdout.splitlines()[0] == with_avx2[0] == without_avx2[0]
-
-
-def test_without_qemu_the_test_skips_unless_ci_requires_it(monkeypatch):
-    if platform.machine() != "x86_64":
-        pytest.skip("the AVX2 kernels are x86_64's")
-    monkeypatch.setattr(shutil, "which", lambda name: None)
-    monkeypatch.delenv("GRAINLAB_REQUIRE_QEMU", raising=False)
-    with pytest.raises(pytest.skip.Exception, match="qemu"):
-        _qemu_or_skip()
-    monkeypatch.setenv("GRAINLAB_REQUIRE_QEMU", "1")
-    with pytest.raises(pytest.fail.Exception, match="GRAINLAB_REQUIRE_QEMU"):
-        _qemu_or_skip()
 
 
 def test_the_release_workflow_builds_every_platform_and_the_sdist_on_a_tag():

@@ -8,7 +8,7 @@ import xml.etree.ElementTree as ET
 from html.parser import HTMLParser
 from pathlib import Path
 
-from browser_helpers import chromium_or_skip
+from external_tools import chromium_or_skip
 
 __all__ = ["chromium_or_skip", "check_self_contained", "open_in_browser", "parse"]
 

@@ -1,8 +1,8 @@
-"""A real browser for the tests that open pages: Debian's chromium driven by Playwright
-(which downloads no browser of its own), and a folder served on the loopback address.
-
-The skip rule of every browser test: skipped when chromium or Playwright is missing,
-failed instead when GRAINLAB_REQUIRE_BROWSER=1 (as .ci/run sets it)."""
+"""The programs some tests need beyond Python's packages, and the one skip rule for them:
+a test skips when its program is missing, and fails instead when the environment variable
+that requires the program is 1 (as .ci/run sets them). Debian's chromium (driven by
+Playwright, which downloads no browser of its own) for the tests that open pages, with a
+folder served on the loopback address; qemu-user for the wheel's test without AVX2."""
 
 from __future__ import annotations
 
@@ -18,21 +18,26 @@ from pathlib import Path
 import pytest
 
 
+def tool_or_skip(command: str, required_by: str, install: str) -> str:
+    """The path of ``command``; else skip the test, or fail it when the environment
+    variable ``required_by`` is 1 (CI)."""
+    path = shutil.which(command)
+    if path is None:
+        if os.environ.get(required_by) == "1":
+            pytest.fail(f"{required_by}=1 but no {command} on PATH ({install})")
+        pytest.skip(f"no {command} on PATH (Debian: {install})")
+    return path
+
+
 def chromium_or_skip() -> str:
     """Debian's chromium, or skip (fail when GRAINLAB_REQUIRE_BROWSER=1, as in CI)."""
-    required = os.environ.get("GRAINLAB_REQUIRE_BROWSER") == "1"
     try:
         import playwright.sync_api  # noqa: F401
     except ImportError:
-        if required:
+        if os.environ.get("GRAINLAB_REQUIRE_BROWSER") == "1":
             pytest.fail("GRAINLAB_REQUIRE_BROWSER=1 but Playwright is not installed (pip install '.[test]')")
         pytest.skip("Playwright is not installed")
-    path = shutil.which("chromium")
-    if path is None:
-        if required:
-            pytest.fail("GRAINLAB_REQUIRE_BROWSER=1 but no chromium on PATH (apt-get install chromium)")
-        pytest.skip("no chromium on PATH (Debian: apt-get install chromium)")
-    return path
+    return tool_or_skip("chromium", "GRAINLAB_REQUIRE_BROWSER", "apt-get install chromium")
 
 
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):
