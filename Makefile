@@ -1,5 +1,5 @@
 # One command per developer task; CI runs the same test command (.ci/run).
-.PHONY: build dev lint test test-fast bench bench-engine
+.PHONY: build dev lint test test-fast bench bench-engine docs wheel
 
 build:  ## install grainlab (release build of the Rust engine)
 	pip install .
@@ -7,11 +7,22 @@ build:  ## install grainlab (release build of the Rust engine)
 dev:  ## editable install: Python edits are live; rerun after Rust edits
 	pip install -e .
 
+wheel:  ## the release artifacts in dist/: the abi3 wheel for manylinux2014 (glibc 2.17+, linked by zig; its own cargo folder target/wheel) and the sdist
+	CARGO_TARGET_DIR=target/wheel python -m maturin build --release --zig --compatibility manylinux2014 --out dist
+	python -m maturin sdist --out dist
+
+# NO_MKDOCS_2_WARNING=1: Material for MkDocs 9.x prints a notice of its own end of life (May 2027)
+# on every build; it says nothing of this site, whose warnings all fail the strict build.
+docs:  ## the documentation site in site/ (mkdocs build --strict: any warning, a broken link or reference, fails it); installs grainlab and the docs' packages first when they are missing
+	@python -c "import grainlab, material, mkdocstrings_handlers.python" 2>/dev/null || pip install -e ".[test]"
+	NO_MKDOCS_2_WARNING=1 python -m mkdocs build --strict
+
 lint:  ## formatting and lints, Rust and Python, types (mypy strict, the compiled module's stub), the import-layer contract and the function-length rule (ARCHITECTURE.md)
 	cargo fmt --all -- --check
 	cargo clippy --release -p grainlab-core -p grainlab-py -- -D warnings
-	ruff check python tests benchmarks examples
+	ruff check python tests benchmarks examples docs/hooks
 	python -m mypy python/grainlab
+	python -m mypy docs/hooks
 	python -m mypy.stubtest grainlab._core
 	python -m pytest -q -p no:cacheprovider tests/test_layers.py tests/test_function_length.py
 

@@ -34,6 +34,7 @@ LAYERS: dict[str, int] = {
     "grainlab._html": 0,
     "grainlab.columns": 0,
     "grainlab.paper": 0,
+    "grainlab.citation": 0,  # the citation: the version (_core) and the article
     # 1: the engine API and the snapshot data model
     "grainlab": 1,
     "grainlab.bodies": 1,

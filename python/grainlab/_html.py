@@ -17,6 +17,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from grainlab._core import __version__
+from grainlab.citation import how_to_cite
+
 __all__ = [
     "CSS",
     "EmbeddedFigure",
@@ -27,6 +30,7 @@ __all__ = [
     "figure",
     "figures",
     "fmt",
+    "footer",
     "number",
     "page",
     "paragraph",
@@ -279,6 +283,15 @@ tr.verdict-not-reproduced td.verdict { background: #fbe4e2; }
 tr.verdict-inconclusive td.verdict { background: #f3f0e0; }
 footer { color: #7b8794; font-size: .85em; text-align: center; padding: 1em; }
 """
+
+
+def footer() -> str:
+    """The line at the foot of every self-contained page: the version that wrote it, what
+    the file holds, and how to cite grainlab and the article it reproduces."""
+    return (
+        f"grainlab {__version__}: this file is self-contained (figures embedded, no scripts, no network). "
+        f"{how_to_cite()}"
+    )
 
 
 def page(title: str, header: Markup, sections: Sequence[tuple[str, str, Markup]], footer: str) -> str:

@@ -35,13 +35,28 @@ def build_parser() -> argparse.ArgumentParser:
         prog="grainlab",
         description="2D discrete element laboratory for granular soils.",
     )
-    parser.add_argument("--version", action="version", version=f"grainlab {grainlab.__version__}")
+    parser.add_argument("--version", action=_Version)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
         importlib.import_module(name).register(subparsers)
     for command in subparsers.choices.values():
         add_output_options(command)
     return parser
+
+
+class _Version(argparse.Action):
+    """``--version``: the version on the first line, then how to cite grainlab (CITATION.cff)."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str = argparse.SUPPRESS) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS,
+                         help="print the version and how to cite grainlab, and exit")
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: object, option_string: str | None = None) -> None:
+        from grainlab.citation import how_to_cite
+
+        print(f"grainlab {grainlab.__version__}\n{how_to_cite()}")
+        parser.exit()
 
 
 def add_output_options(parser: argparse.ArgumentParser) -> None:

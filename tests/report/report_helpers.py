@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import base64
 import io
-import os
-import shutil
 import xml.etree.ElementTree as ET
 from html.parser import HTMLParser
 from pathlib import Path
 
-import pytest
+from external_tools import chromium_or_skip
+
+__all__ = ["chromium_or_skip", "check_self_contained", "open_in_browser", "parse"]
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -95,23 +95,6 @@ def check_self_contained(path: Path) -> list[str]:
         ET.fromstring(text[start:end])  # inline SVG parses
         start = text.find("<svg", end)
     return kinds
-
-
-def chromium_or_skip() -> str:
-    """Debian's chromium, or skip (fail when GRAINLAB_REQUIRE_BROWSER=1, as in CI)."""
-    required = os.environ.get("GRAINLAB_REQUIRE_BROWSER") == "1"
-    try:
-        import playwright.sync_api  # noqa: F401
-    except ImportError:
-        if required:
-            pytest.fail("GRAINLAB_REQUIRE_BROWSER=1 but Playwright is not installed (pip install '.[test]')")
-        pytest.skip("Playwright is not installed")
-    path = shutil.which("chromium")
-    if path is None:
-        if required:
-            pytest.fail("GRAINLAB_REQUIRE_BROWSER=1 but no chromium on PATH (apt-get install chromium)")
-        pytest.skip("no chromium on PATH (Debian: apt-get install chromium)")
-    return path
 
 
 def open_in_browser(chromium: str, report: Path) -> dict:

@@ -49,9 +49,9 @@ def test_quick_run_report_in_chromium(quick_biaxial_run):
 
 
 def test_without_chromium_the_test_skips_unless_ci_requires_it(monkeypatch):
-    import report_helpers
+    import external_tools
 
-    monkeypatch.setattr(report_helpers.shutil, "which", lambda name: None)
+    monkeypatch.setattr(external_tools.shutil, "which", lambda name: None)
     monkeypatch.delenv("GRAINLAB_REQUIRE_BROWSER", raising=False)
     with pytest.raises(pytest.skip.Exception, match="chromium"):
         chromium_or_skip()

@@ -387,6 +387,7 @@ class ShearBand(SlabBand):
     r"""Locate the dominant shear band (and a second one) in a per-particle strain field.
 
     The method, its thresholds and how to read the angle: docs/fabric.md, "Shear band".
+    :meth:`summary` gives the scalars (and the second band's) as a JSON-ready dict.
 
     Parameters
     ----------
@@ -405,8 +406,6 @@ class ShearBand(SlabBand):
         Least :attr:`prominence` of an accepted band.
     second : bool, default True
         Also look for a second (conjugate) band, :attr:`second`.
-
-    :meth:`summary` gives the scalars (and the second band's) as a JSON-ready dict.
 
     Example
     -------

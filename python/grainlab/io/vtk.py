@@ -156,6 +156,8 @@ def write_vtp(
 ) -> Path:
     """Write points, one vertex cell per point, and lines to a VTK XML PolyData file.
 
+    Booleans are stored as Int32 0 / 1. Returns the path.
+
     Parameters
     ----------
     path : path of the ``.vtp`` file (parent folders are created).
@@ -173,8 +175,6 @@ def write_vtp(
         Whole-file values (any length, flattened to one component).
     binary : bool, default True
         Base64 raw arrays with UInt64 headers; False writes ASCII (no ``-inf``).
-
-    Booleans are stored as Int32 0 / 1. Returns the path.
 
     Raises
     ------

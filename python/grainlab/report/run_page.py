@@ -19,13 +19,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import grainlab
 from grainlab._html import (
     EmbeddedFigure,
     Markup,
     code_block,
     definition_table,
     figures,
+    footer,
     page,
     paragraph,
     section,
@@ -102,11 +102,6 @@ class ReportPage:
         header = paragraph(f"grainlab {self.test}: {title}; run by grainlab {r.results.grainlab_version}, "
                            f"report generated {r.generated}.")
         return page(f"grainlab {self.name} report: {title}", header, parts, footer())
-
-
-def footer() -> str:
-    """The line at the foot of every report page."""
-    return f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, no network)."
 
 
 def gather_run_page(folder: str | Path, figures: Mapping[str, tuple[str, str]],

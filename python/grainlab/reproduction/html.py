@@ -17,6 +17,7 @@ from grainlab._html import (
     escape,
     figures,
     fmt,
+    footer,
     page,
     paragraph,
     section,
@@ -168,7 +169,5 @@ def write_html(path: str | Path, plan: ReproductionPlan, document: Mapping[str, 
         ("claims", "claims.json, claims.csv (one row per variant and claim); measures.json (every number measured)"),
         ("notes", "; ".join(document.get("notes", [])) or "none"),
     ]), code_block(f"grainlab reproduce --out {out_dir} --claims-only   # recompute from the runs")))
-    text = page("grainlab reproduce: does the paper's finding hold?", header, sections,
-                f"grainlab {grainlab.__version__}: this file is self-contained (figures embedded, no scripts, "
-                "no network).")
+    text = page("grainlab reproduce: does the paper's finding hold?", header, sections, footer())
     return write_text_atomic(path, text)
