@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
-from grainlab.samples.porosity import check_box
+from grainlab.samples.porosity import check_box, positive_lengths
 
 __all__ = ["PlacementError", "random_placement"]
 
@@ -117,12 +117,7 @@ def random_placement(
 
 def _checked(diameters: ArrayLike, scale: float, batch: int, tries: int) -> tuple[NDArray[np.float64], float]:
     """The diameters and the scale, checked (bad input names its field)."""
-    d = np.asarray(diameters, dtype=np.float64)
-    if d.ndim != 1:
-        raise ValueError(f"diameters: expected a 1-D array, got shape {d.shape}")
-    if not np.all(np.isfinite(d)) or np.any(d <= 0):
-        k = int(np.argmax(~np.isfinite(d) | (d <= 0)))
-        raise ValueError(f"diameters[{k}]: must be a finite diameter > 0 (m), got {d[k]}")
+    d = positive_lengths("diameters", diameters, "diameter")
     scale = float(scale)
     if not (0.0 < scale <= 1.0):
         raise ValueError(f"scale: must be in (0, 1], got {scale}")

@@ -68,14 +68,19 @@ def box_area(box: ArrayLike) -> float:
     return (x1 - x0) * (y1 - y0)
 
 
-def _radii(radii: ArrayLike) -> NDArray[np.float64]:
-    r = np.asarray(radii, dtype=np.float64)
+def positive_lengths(name: str, values: ArrayLike, what: str) -> NDArray[np.float64]:
+    """``values`` as a 1-D array of finite lengths > 0 (m), else one line naming ``name[k]``."""
+    r = np.asarray(values, dtype=np.float64)
     if r.ndim != 1:
-        raise ValueError(f"radii: expected a 1-D array, got shape {r.shape}")
+        raise ValueError(f"{name}: expected a 1-D array, got shape {r.shape}")
     if not np.all(np.isfinite(r)) or np.any(r <= 0):
         k = int(np.argmax(~np.isfinite(r) | (r <= 0)))
-        raise ValueError(f"radii[{k}]: must be a finite radius > 0 (m), got {r[k]}")
+        raise ValueError(f"{name}[{k}]: must be a finite {what} > 0 (m), got {r[k]}")
     return r
+
+
+def _radii(radii: ArrayLike) -> NDArray[np.float64]:
+    return positive_lengths("radii", radii, "radius")
 
 
 def nominal_porosity(radii: ArrayLike, area: float) -> float:
