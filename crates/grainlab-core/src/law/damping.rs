@@ -8,7 +8,8 @@ use crate::material::ContactModel;
 /// force, clipped so that it never pulls, and `c_s = 2 beta_s sqrt(m* ks)` on
 /// the shear force while the contact sticks (not stored in the spring, not in
 /// the Coulomb cap). No history; their work is the ledger's `viscous` entry.
-/// The four-pair lanes evaluate only models without dashpots.
+/// The four-pair lanes evaluate only models without dashpots (so the
+/// dashpots' one form is this scalar one).
 #[derive(Debug, Clone, Copy)]
 pub struct ViscousDashpots;
 

@@ -20,7 +20,9 @@
 use std::f64::consts::PI;
 
 use super::rolling::RollingSpring;
-use super::{with_rolling, ContactForce, ContactKinematics, ContactRecord, TANGENTIAL_HISTORY};
+use super::{
+    shear_torques, with_rolling, ContactForce, ContactKinematics, ContactRecord, TANGENTIAL_HISTORY,
+};
 use crate::diagnostics::ContactDissipation;
 use crate::material::ContactModel;
 
@@ -176,14 +178,15 @@ pub(crate) fn law(
     } else {
         (0.0, kinematics.radius_j)
     };
+    let (torque_i, torque_j) = shear_torques(arm_i, arm_j, spring);
     let force = ContactForce {
         normal,
         elastic_normal,
         shear: spring,
         shear_spring: spring,
         sliding,
-        torque_i: -arm_i * spring,
-        torque_j: -arm_j * spring,
+        torque_i,
+        torque_j,
         rolling_spring: 0.0,
         rolling_moment: 0.0,
         rolling_energy: 0.0,

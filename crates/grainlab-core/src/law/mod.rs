@@ -10,9 +10,10 @@
 //! contact (and hands a Hertz-Mindlin one to [`hertz::contact_law`]) and
 //! returns its forces, its torques on both bodies and each sub-model's
 //! dissipation; the pair kernel, the wall contacts, the springs' catch-up and
-//! the contact queries call it. The AVX2 lanes (`pipeline/pair_lanes.rs`,
-//! `law_by_four`) write the linear law's operations again, four pairs at a time,
-//! and their tests hold them to its bits, rolling resistance included.
+//! the contact queries call it. The sub-models' arithmetic is written once,
+//! generic over [`real::Real`]: `f64` here, four AVX2 lanes in the four-pair
+//! loop (`pipeline/pair_lanes.rs`, `law_by_four`), whose tests hold the two to
+//! the same bits, rolling resistance included.
 //!
 //! Each sub-model declares the history it carries per contact
 //! ([`SubModel::HISTORY`] values); one contact's history is one
@@ -38,11 +39,13 @@ use std::ops::Range;
 
 use crate::diagnostics::ContactDissipation;
 use crate::material::{ContactLaw, ContactModel};
+use real::Real;
 
 pub mod damping;
 pub mod hertz;
 pub mod history;
 pub mod normal;
+pub mod real;
 pub mod rolling;
 pub mod tangential;
 
@@ -53,9 +56,11 @@ pub trait SubModel {
     /// How many values of history it carries per contact (its slot in the
     /// [`ContactRecord`]).
     const HISTORY: usize;
-    /// Whether `pipeline/pair_lanes.rs` evaluates it four pairs at a time (with
-    /// [`contact_law`]'s bits, which its test checks on random inputs); the
-    /// four-pair loop runs only while every sub-model of the law says so.
+    /// Whether `pipeline/pair_lanes.rs` evaluates it four pairs at a time (its
+    /// arithmetic generic over [`real::Real`], called there with four lanes;
+    /// the same bits as [`contact_law`], which its test checks on random
+    /// inputs); the four-pair loop runs only while every sub-model of the law
+    /// says so.
     const LANES: bool;
 }
 
@@ -273,14 +278,15 @@ pub fn contact_law<const DASHPOTS: bool>(
         dt,
         &mut dissipation,
     );
+    let (torque_i, torque_j) = shear_torques(kinematics.radius_i, kinematics.radius_j, shear);
     let force = ContactForce {
         normal,
         elastic_normal,
         shear,
         shear_spring: state.spring,
         sliding: state.sliding,
-        torque_i: -kinematics.radius_i * shear,
-        torque_j: -kinematics.radius_j * shear,
+        torque_i,
+        torque_j,
         rolling_spring: 0.0,
         rolling_moment: 0.0,
         rolling_energy: 0.0,
@@ -289,6 +295,13 @@ pub fn contact_law<const DASHPOTS: bool>(
         dissipation,
     };
     with_rolling(model, kinematics, dt, increment_time, record, force)
+}
+
+/// The torques `(-r_i F_s, -r_j F_s)` of the shear force `shear` on both
+/// bodies, of one contact or four lanes.
+#[inline(always)]
+pub fn shear_torques<R: Real>(radius_i: R, radius_j: R, shear: R) -> (R, R) {
+    (-radius_i * shear, -radius_j * shear)
 }
 
 /// `force` with the rolling sub-model's torques and dissipation added, from and

@@ -1,4 +1,5 @@
 //! Normal sub-models: the elastic normal force.
+use super::real::Real;
 use super::{NormalModel, SubModel};
 use crate::material::ContactModel;
 
@@ -13,9 +14,17 @@ impl SubModel for LinearSpring {
     const LANES: bool = true;
 }
 
+impl LinearSpring {
+    /// `kn * overlap` (N), of one contact or of four lanes.
+    #[inline(always)]
+    pub fn force<R: Real>(normal_stiffness: R, overlap: R) -> R {
+        normal_stiffness * overlap
+    }
+}
+
 impl NormalModel for LinearSpring {
     #[inline(always)]
     fn elastic_force(model: &ContactModel, overlap: f64, _history: &mut [f64]) -> f64 {
-        model.normal_stiffness * overlap
+        Self::force(model.normal_stiffness, overlap)
     }
 }

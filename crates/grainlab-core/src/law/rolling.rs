@@ -1,4 +1,6 @@
 //! Rolling sub-models: a torque resisting the relative rolling of the two bodies.
+use super::real::Real;
+use super::tangential::CappedUpdate;
 use super::{ContactForce, ContactKinematics, RollingModel, SubModel};
 use crate::material::ContactModel;
 
@@ -32,17 +34,41 @@ impl SubModel for RollingSpring {
     const LANES: bool = true;
 }
 
+/// One update of the rolling sub-model, for one contact or four lanes
+/// ([`RollingSpring::advance`]).
+#[derive(Debug, Clone, Copy)]
+pub struct RollingUpdate<R: Real> {
+    /// The rolling stiffness `k_r` (N m/rad).
+    pub stiffness: R,
+    /// The rolling spring's update and cap (N m).
+    pub spring: CappedUpdate<R>,
+    /// The spring's elastic energy `M_r^2 / (2 k_r)` (J).
+    pub energy: R,
+    /// The moment on `j`: the spring, with the dashpot on top where it acts (N m).
+    pub moment: R,
+    /// Where the dashpot acts: below the cap, `eta_r > 0`.
+    pub damped: R::Mask,
+    /// The dashpot's power `c_r w^2 dt` where it acts (J; +0 elsewhere, and
+    /// everywhere without `DASHPOT`).
+    pub power: R,
+}
+
 impl RollingSpring {
     /// The contact's effective radius `R*` (m): `r_i r_j / (r_i + r_j)`, or
     /// `r_j` against a wall (`r_i` = 0).
     #[inline(always)]
     pub fn effective_radius(kinematics: &ContactKinematics) -> f64 {
-        let (ri, rj) = (kinematics.radius_i, kinematics.radius_j);
-        if ri == 0.0 {
-            rj
-        } else {
-            ri * rj / (ri + rj)
-        }
+        Self::effective_radius_of(kinematics.radius_i, kinematics.radius_j)
+    }
+
+    /// [`RollingSpring::effective_radius`] of the radii, for one contact or four lanes.
+    #[inline(always)]
+    pub fn effective_radius_of<R: Real>(radius_i: R, radius_j: R) -> R {
+        R::select(
+            radius_i.eq(R::splat(0.0)),
+            radius_j,
+            radius_i * radius_j / (radius_i + radius_j),
+        )
     }
 
     /// The rolling stiffness `k_r` (N m/rad) of `model` at a contact of
@@ -50,12 +76,20 @@ impl RollingSpring {
     /// (the law's `k_n`): the given one, or the rule `2.25 k_n mu_r^2 R*^2`.
     #[inline(always)]
     pub fn stiffness(model: &ContactModel, normal_stiffness: f64, r_star: f64) -> f64 {
-        if model.rolling_stiffness > 0.0 {
-            model.rolling_stiffness
-        } else {
-            let mu_r = model.rolling_friction;
-            2.25 * normal_stiffness * mu_r * mu_r * r_star * r_star
-        }
+        Self::stiffness_of(
+            model.rolling_stiffness,
+            model.rolling_friction,
+            normal_stiffness,
+            r_star,
+        )
+    }
+
+    /// [`RollingSpring::stiffness`] from the `given` stiffness (0: the rule)
+    /// and `mu_r`, for one contact or four lanes.
+    #[inline(always)]
+    pub fn stiffness_of<R: Real>(given: R, mu_r: R, normal_stiffness: R, r_star: R) -> R {
+        let rule = R::splat(2.25) * normal_stiffness * mu_r * mu_r * r_star * r_star;
+        R::select(given.gt(R::splat(0.0)), given, rule)
     }
 
     /// The energy dissipated by a plastic update from the spring `before`
@@ -65,6 +99,59 @@ impl RollingSpring {
     #[inline(always)]
     pub fn plastic_work(stiffness: f64, before: f64, trial: f64, capped: f64) -> f64 {
         0.5 * (before + capped) * (trial - capped) / stiffness
+    }
+
+    /// The sub-model's update, for one contact or four lanes: `k_r`, the spring
+    /// `spring - k_r w increment_time` capped at `mu_r R* F_n`, its energy and,
+    /// with `DASHPOT` (compiled out without), the dashpot below the cap. The
+    /// contact's `mu_r` is not 0 (the scalar law returns before; the lanes
+    /// mask such pairs out).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub fn advance<R: Real, const DASHPOT: bool>(
+        mu_r: R,
+        given_stiffness: R,
+        damping_ratio: R,
+        normal_stiffness: R,
+        r_star: R,
+        elastic_normal: R,
+        rolling_velocity: R,
+        rolling_inertia: R,
+        increment_time: R,
+        dt: R,
+        spring: R,
+    ) -> RollingUpdate<R> {
+        let k_r = Self::stiffness_of(given_stiffness, mu_r, normal_stiffness, r_star);
+        let w = rolling_velocity;
+        let update = CappedUpdate::of(
+            spring,
+            k_r * w * increment_time,
+            mu_r * r_star * elastic_normal,
+        );
+        let energy = R::splat(0.5) * update.spring * update.spring / k_r;
+        let damped = R::and(R::not(update.at_cap), damping_ratio.gt(R::splat(0.0)));
+        let (mut moment, mut power) = (update.spring, R::splat(0.0));
+        if DASHPOT {
+            let c_r = R::splat(2.0) * damping_ratio * (rolling_inertia * k_r).sqrt();
+            let c_r_w = c_r * w;
+            moment = R::select(damped, moment - c_r_w, moment);
+            power = R::select(damped, c_r_w * w * dt, power);
+        }
+        RollingUpdate {
+            stiffness: k_r,
+            spring: update,
+            energy,
+            moment,
+            damped,
+            power,
+        }
+    }
+
+    /// The torques on `i` and `j` with the rolling `moment` on `j` (and its
+    /// opposite on `i`) added.
+    #[inline(always)]
+    pub fn with_moment<R: Real>(torque_i: R, torque_j: R, moment: R) -> (R, R) {
+        (torque_i - moment, torque_j + moment)
     }
 }
 
@@ -78,34 +165,45 @@ impl RollingModel for RollingSpring {
         history: &mut [f64],
         force: &mut ContactForce,
     ) {
-        let mu_r = model.rolling_friction;
-        if mu_r == 0.0 {
+        if model.rolling_friction == 0.0 {
             return;
         }
         let r_star = Self::effective_radius(kinematics);
-        let k_r = Self::stiffness(model, force.normal_stiffness, r_star);
-        let w = kinematics.rolling_velocity;
-        let spring = &mut history[0];
-        let trial = *spring - k_r * w * increment_time;
-        let cap = mu_r * r_star * force.elastic_normal;
-        let plastic = trial.abs() >= cap;
-        let mut moment = if plastic {
-            let capped = cap.copysign(trial);
-            force.dissipation.rolling += Self::plastic_work(k_r, *spring, trial, capped);
-            capped
-        } else {
-            trial
-        };
-        *spring = moment;
-        force.rolling_spring = moment;
-        force.rolling_energy = 0.5 * moment * moment / k_r;
-        if !plastic && model.rolling_damping_ratio > 0.0 {
-            let c_r = 2.0 * model.rolling_damping_ratio * (kinematics.rolling_inertia * k_r).sqrt();
-            moment -= c_r * w;
-            force.dissipation.rolling += c_r * w * w * dt;
+        // the dashpot's terms compiled in only for a model that has one
+        macro_rules! advance {
+            ($dashpot:literal) => {
+                Self::advance::<f64, $dashpot>(
+                    model.rolling_friction,
+                    model.rolling_stiffness,
+                    model.rolling_damping_ratio,
+                    force.normal_stiffness,
+                    r_star,
+                    force.elastic_normal,
+                    kinematics.rolling_velocity,
+                    kinematics.rolling_inertia,
+                    increment_time,
+                    dt,
+                    history[0],
+                )
+            };
         }
-        force.rolling_moment = moment;
-        force.torque_i -= moment;
-        force.torque_j += moment;
+        let update = if model.rolling_damping_ratio > 0.0 {
+            advance!(true)
+        } else {
+            advance!(false)
+        };
+        let spring = update.spring;
+        if spring.at_cap {
+            force.dissipation.rolling +=
+                Self::plastic_work(update.stiffness, history[0], spring.trial, spring.capped);
+        } else if update.damped {
+            force.dissipation.rolling += update.power;
+        }
+        history[0] = spring.spring;
+        force.rolling_spring = spring.spring;
+        force.rolling_energy = update.energy;
+        force.rolling_moment = update.moment;
+        (force.torque_i, force.torque_j) =
+            Self::with_moment(force.torque_i, force.torque_j, update.moment);
     }
 }

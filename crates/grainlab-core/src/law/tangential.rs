@@ -1,4 +1,5 @@
 //! Tangential sub-models: the shear force's history and its Coulomb cap.
+use super::real::Real;
 use super::{ShearState, SubModel, TangentialModel};
 use crate::diagnostics::ContactDissipation;
 use crate::material::ContactModel;
@@ -17,7 +18,55 @@ impl SubModel for ShearSpring {
     const LANES: bool = true;
 }
 
+/// One update of a spring with a cap (the shear spring's, the rolling
+/// spring's), for one contact or four lanes.
+#[derive(Debug, Clone, Copy)]
+pub struct CappedUpdate<R: Real> {
+    /// The spring plus its increment, before the cap.
+    pub trial: R,
+    /// The cap with the trial's sign.
+    pub capped: R,
+    /// Where the trial reaches the cap, `|trial| >= cap`: the spring ends there.
+    pub at_cap: R::Mask,
+    /// The spring after the update: `capped` at the cap, else `trial`.
+    pub spring: R,
+}
+
+impl<R: Real> CappedUpdate<R> {
+    /// The spring `before` plus `increment`, capped at `cap`.
+    #[inline(always)]
+    pub fn of(before: R, increment: R, cap: R) -> Self {
+        let trial = before - increment;
+        let at_cap = trial.abs().ge(cap);
+        let capped = cap.copysign(trial);
+        CappedUpdate {
+            trial,
+            capped,
+            at_cap,
+            spring: R::select(at_cap, capped, trial),
+        }
+    }
+}
+
 impl ShearSpring {
+    /// The spring's update, of one contact or four lanes: `spring - ks v_t
+    /// increment_time`, capped at `mu * elastic_normal`.
+    #[inline(always)]
+    pub fn advance<R: Real>(
+        shear_stiffness: R,
+        friction: R,
+        elastic_normal: R,
+        tangential_velocity: R,
+        increment_time: R,
+        spring: R,
+    ) -> CappedUpdate<R> {
+        CappedUpdate::of(
+            spring,
+            shear_stiffness * tangential_velocity * increment_time,
+            friction * elastic_normal,
+        )
+    }
+
     /// The energy dissipated by a slip from the spring `before` through the
     /// uncapped `trial` to the `capped` spring: the work of the mean shear
     /// force over the slip minus the spring's energy change, the exact
@@ -40,19 +89,21 @@ impl TangentialModel for ShearSpring {
         dissipation: &mut ContactDissipation,
     ) -> ShearState {
         let spring = &mut history[0];
-        let trial = *spring - model.shear_stiffness * tangential_velocity * increment_time;
-        let cap = model.friction * elastic_normal;
-        let sliding = trial.abs() >= cap;
-        if sliding {
-            let capped = cap.copysign(trial);
-            dissipation.friction += Self::slip_work(model, *spring, trial, capped);
-            *spring = capped;
-        } else {
-            *spring = trial;
+        let update = Self::advance(
+            model.shear_stiffness,
+            model.friction,
+            elastic_normal,
+            tangential_velocity,
+            increment_time,
+            *spring,
+        );
+        if update.at_cap {
+            dissipation.friction += Self::slip_work(model, *spring, update.trial, update.capped);
         }
+        *spring = update.spring;
         ShearState {
-            spring: *spring,
-            sliding,
+            spring: update.spring,
+            sliding: update.at_cap,
         }
     }
 }

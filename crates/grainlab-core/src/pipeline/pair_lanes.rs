@@ -4,10 +4,11 @@
 //! The law of four pairs is [`law_by_four`]: the sub-models of
 //! [`crate::law::contact_law`] without the normal and shear dashpots (normal
 //! spring, shear spring with its cap and, compiled in only for a table with
-//! rolling resistance, the rolling spring with its cap and its dashpot), lane
-//! by lane; its test gives both the same random contacts and requires the
-//! same bits. The loop runs only while every sub-model of the law has lanes
-//! ([`crate::law::LANES`]).
+//! rolling resistance, the rolling spring with its cap and its dashpot),
+//! their own code called with four lanes (the laws are written once over
+//! [`crate::law::real::Real`]); its test gives both the same random contacts
+//! and requires the same bits. The loop runs only while every sub-model of
+//! the law has lanes ([`crate::law::LANES`]).
 //!
 //! Why the bits are the same: every pair's law is computed lane by lane with
 //! the operations of the scalar code in its order (IEEE additions,
@@ -30,12 +31,13 @@ use std::arch::x86_64::*;
 
 use super::pair_kernel::{no_contact, ContactTally, ForceSink, PairKernel};
 use crate::diagnostics::ContactDissipation;
+use crate::law::normal::LinearSpring;
 use crate::law::rolling::RollingSpring;
 use crate::law::tangential::ShearSpring;
 use crate::law::{
-    elastic_energy, ContactForce, ContactRecord, ROLLING_HISTORY, TANGENTIAL_HISTORY,
+    elastic_energy, shear_torques, ContactForce, ContactRecord, ROLLING_HISTORY, TANGENTIAL_HISTORY,
 };
-use crate::simd::spill;
+use crate::simd::{spill, F64x4};
 
 /// `_mm256_permute4x64_pd`'s selector that swaps lanes 1 and 2: pairs in
 /// memory order into register order and back.
@@ -577,19 +579,17 @@ pub(super) struct FourLaws {
     pub(super) rolling_power: __m256d,
 }
 
-// hot kernel: the law of four pairs in AVX2 registers, inlined into the pair loop; split, the lanes would go through memory
-/// The contact law of four pairs without normal and shear dashpots, lane by
-/// lane with the scalar operations of [`crate::law::contact_law`] in their
-/// order: the normal spring, the shear spring's increment and Coulomb cap
-/// (branches as selects of the value the branch keeps), the torques; with
-/// `ROLLING`, the rolling law of [`crate::law::rolling::RollingSpring`] from
-/// `rolling` (its stiffness rule, increment, cap, plastic work, energy, and,
-/// with `DASHPOT` (some lane may have one), its dashpot) for pairs of
-/// particles (`r_i > 0`: `R* = r_i r_j / (r_i + r_j)`); and, for
-/// a pair that does not touch, the record [`crate::law::history::forget`]
-/// leaves. Every operation is a correctly rounded IEEE one (no fused
-/// multiply-add), so each lane has the scalar law's bits (the test below
-/// checks it on random contacts).
+/// The contact law of four pairs without normal and shear dashpots: the
+/// sub-models' own code, written once over [`crate::law::real::Real`], called
+/// with four lanes ([`F64x4`]): the normal spring
+/// ([`LinearSpring::force`]), the shear spring's increment and Coulomb cap
+/// ([`ShearSpring::advance`]), the torques ([`shear_torques`]); with
+/// `ROLLING`, the rolling sub-model ([`RollingSpring::advance`], with
+/// `DASHPOT` (some lane may have one) its dashpot compiled in) where the pair
+/// touches and its `mu_r` is not 0; and, for a pair that does not touch, the
+/// record [`crate::law::history::forget`] leaves. What is left here is the
+/// loop's part: which lanes touch, roll or forget. The test below holds each
+/// lane to the scalar law's bits on random contacts.
 #[inline]
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
@@ -598,26 +598,19 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
     increment_time: __m256d,
     dt: __m256d,
 ) -> FourLaws {
-    let sign_bit = _mm256_set1_pd(-0.0);
+    let x = |v: __m256d| F64x4::from(v);
     let zero = _mm256_setzero_pd();
-    // normal: the linear spring
-    let elastic_normal = _mm256_mul_pd(c.kn, c.overlap);
-    // tangential: the shear spring's increment, then its cap
-    let trial = _mm256_sub_pd(
-        c.spring,
-        _mm256_mul_pd(_mm256_mul_pd(c.ks, c.tangential_velocity), increment_time),
+    let (increment_time, dt) = (x(increment_time), x(dt));
+    let elastic_normal = LinearSpring::force(x(c.kn), x(c.overlap));
+    let shear = ShearSpring::advance(
+        x(c.ks),
+        x(c.mu),
+        elastic_normal,
+        x(c.tangential_velocity),
+        increment_time,
+        x(c.spring),
     );
-    let cap = _mm256_mul_pd(c.mu, elastic_normal);
-    let slides = _mm256_and_pd(
-        c.touching,
-        _mm256_cmp_pd::<_CMP_GE_OQ>(_mm256_andnot_pd(sign_bit, trial), cap),
-    );
-    // cap.copysign(trial)
-    let capped = _mm256_or_pd(
-        _mm256_andnot_pd(sign_bit, cap),
-        _mm256_and_pd(sign_bit, trial),
-    );
-    let law_spring = _mm256_blendv_pd(trial, capped, slides);
+    let slides = _mm256_and_pd(c.touching, shear.at_cap.0);
     // a pair out of contact keeps its record if it is all +-0 and it did not
     // slide, else gets +0 (with the rolling law the record is two wide)
     let mut keeps = _mm256_andnot_pd(c.slid_before, _mm256_cmp_pd::<_CMP_EQ_OQ>(c.spring, zero));
@@ -625,18 +618,17 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
         keeps = _mm256_and_pd(keeps, _mm256_cmp_pd::<_CMP_EQ_OQ>(rolling.spring, zero));
     }
     let idle_spring = _mm256_and_pd(keeps, c.spring);
-    let spring = _mm256_blendv_pd(idle_spring, law_spring, c.touching);
+    let spring = _mm256_blendv_pd(idle_spring, shear.spring.0, c.touching);
     // (no normal or shear dashpot:) the torques of the shear force
-    let mut torque_i = _mm256_mul_pd(_mm256_xor_pd(c.radius_i, sign_bit), spring);
-    let mut torque_j = _mm256_mul_pd(_mm256_xor_pd(c.radius_j, sign_bit), spring);
+    let (torque_i, torque_j) = shear_torques(x(c.radius_i), x(c.radius_j), x(spring));
     let mut laws = FourLaws {
-        elastic_normal,
-        trial,
-        capped,
+        elastic_normal: elastic_normal.0,
+        trial: shear.trial.0,
+        capped: shear.capped.0,
         slides,
         spring,
-        torque_i,
-        torque_j,
+        torque_i: torque_i.0,
+        torque_j: torque_j.0,
         rolling_record: zero,
         rolling_spring: zero,
         rolling_moment: zero,
@@ -654,77 +646,41 @@ pub(super) unsafe fn law_by_four<const ROLLING: bool, const DASHPOT: bool>(
     // scalar law returns at once for mu_r == 0: slot, torques as they are)
     let r = rolling;
     let on = _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(r.mu_r, zero), c.touching);
-    // R* = r_i r_j / (r_i + r_j) (two particles: never the wall's r_j)
-    let r_star = _mm256_div_pd(
-        _mm256_mul_pd(c.radius_i, c.radius_j),
-        _mm256_add_pd(c.radius_i, c.radius_j),
-    );
-    // k_r: the given one when > 0, else 2.25 k_n mu_r^2 R*^2 (left to right)
-    let rule = _mm256_mul_pd(
-        _mm256_mul_pd(
-            _mm256_mul_pd(
-                _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(2.25), c.kn), r.mu_r),
-                r.mu_r,
-            ),
-            r_star,
-        ),
+    let r_star = RollingSpring::effective_radius_of(x(c.radius_i), x(c.radius_j));
+    let update = RollingSpring::advance::<F64x4, DASHPOT>(
+        x(r.mu_r),
+        x(r.k_r),
+        x(r.eta_r),
+        x(c.kn),
         r_star,
+        elastic_normal,
+        x(r.rolling_velocity),
+        x(r.rolling_inertia),
+        increment_time,
+        dt,
+        x(r.spring),
     );
-    let k_r = _mm256_blendv_pd(rule, r.k_r, _mm256_cmp_pd::<_CMP_GT_OQ>(r.k_r, zero));
-    let w = r.rolling_velocity;
-    let rolling_trial = _mm256_sub_pd(
-        r.spring,
-        _mm256_mul_pd(_mm256_mul_pd(k_r, w), increment_time),
-    );
-    let rolling_cap = _mm256_mul_pd(_mm256_mul_pd(r.mu_r, r_star), elastic_normal);
-    let plastic = _mm256_and_pd(
-        on,
-        _mm256_cmp_pd::<_CMP_GE_OQ>(_mm256_andnot_pd(sign_bit, rolling_trial), rolling_cap),
-    );
-    let rolling_capped = _mm256_or_pd(
-        _mm256_andnot_pd(sign_bit, rolling_cap),
-        _mm256_and_pd(sign_bit, rolling_trial),
-    );
-    let moment_spring = _mm256_blendv_pd(rolling_trial, rolling_capped, plastic);
     // (the plastic work, a division, is booked by the loop for the few
     // contacts at the cap, from `rolling_trial` and `rolling_capped`, as the
     // slip's work is)
-    let half = _mm256_set1_pd(0.5);
-    let energy = _mm256_div_pd(
-        _mm256_mul_pd(_mm256_mul_pd(half, moment_spring), moment_spring),
-        k_r,
-    );
-    let mut moment = moment_spring;
-    if DASHPOT {
-        // below the cap, with eta_r > 0: -2 eta_r sqrt(I_r k_r) w on top, its
-        // power c_r w^2 dt dissipated
-        let damped = _mm256_andnot_pd(
-            plastic,
-            _mm256_and_pd(on, _mm256_cmp_pd::<_CMP_GT_OQ>(r.eta_r, zero)),
-        );
-        let c_r = _mm256_mul_pd(
-            _mm256_mul_pd(_mm256_set1_pd(2.0), r.eta_r),
-            _mm256_sqrt_pd(_mm256_mul_pd(r.rolling_inertia, k_r)),
-        );
-        let c_r_w = _mm256_mul_pd(c_r, w);
-        moment = _mm256_blendv_pd(moment, _mm256_sub_pd(moment, c_r_w), damped);
-        let power = _mm256_mul_pd(_mm256_mul_pd(c_r_w, w), dt);
-        laws.rolling_power = _mm256_and_pd(damped, power);
-    }
-    torque_i = _mm256_blendv_pd(torque_i, _mm256_sub_pd(torque_i, moment), on);
-    torque_j = _mm256_blendv_pd(torque_j, _mm256_add_pd(torque_j, moment), on);
+    let moment = update.moment.0;
+    let (rolled_i, rolled_j) = RollingSpring::with_moment(torque_i, torque_j, update.moment);
+    laws.torque_i = _mm256_blendv_pd(torque_i.0, rolled_i.0, on);
+    laws.torque_j = _mm256_blendv_pd(torque_j.0, rolled_j.0, on);
+    let moment_spring = update.spring.spring.0;
     let idle_rolling = _mm256_and_pd(keeps, r.spring);
     let touching_rolling = _mm256_blendv_pd(r.spring, moment_spring, on);
-    laws.torque_i = torque_i;
-    laws.torque_j = torque_j;
     laws.rolling_record = _mm256_blendv_pd(idle_rolling, touching_rolling, c.touching);
     laws.rolling_spring = _mm256_and_pd(on, moment_spring);
     laws.rolling_moment = _mm256_and_pd(on, moment);
-    laws.rolling_energy = _mm256_and_pd(on, energy);
-    laws.rolling_stiffness = k_r;
-    laws.rolling_trial = rolling_trial;
-    laws.rolling_capped = rolling_capped;
-    laws.rolling_plastic = plastic;
+    laws.rolling_energy = _mm256_and_pd(on, update.energy.0);
+    laws.rolling_stiffness = update.stiffness.0;
+    laws.rolling_trial = update.spring.trial.0;
+    laws.rolling_capped = update.spring.capped.0;
+    laws.rolling_plastic = _mm256_and_pd(on, update.spring.at_cap.0);
+    if DASHPOT {
+        laws.rolling_power = _mm256_and_pd(on, update.power.0);
+    }
     laws
 }
 
