@@ -105,6 +105,7 @@ class _ContactArrays(TypedDict):
     shear_force: NDArray[np.float64]
     sliding: NDArray[np.bool_]
     rolling_moment: NDArray[np.float64]
+    normal_stiffness: NDArray[np.float64]
 
 class _Contacts(_ContactArrays):
     i: NDArray[np.uint32]

@@ -146,7 +146,10 @@ class Contacts:
     Forces and moments are the elastic parts (no dashpot forces or moments);
     see docs/contact-law.md. The torque of a contact on ``i`` is
     ``r_i * shear_force + rolling_moment``, on ``j`` ``r_j * shear_force -
-    rolling_moment``.
+    rolling_moment``. ``normal_stiffness`` is the normal force's tangent
+    stiffness ``dF_n / d(overlap)`` at the current overlap (N/m): ``kn`` for the
+    linear law, ``2 E* a`` for Hertz-Mindlin (docs/contact-law.md), the bond's
+    ``kn`` for a bond.
 
     Two touching disks held in place, ``i`` turning against ``j``: the rolling
     moment on ``i`` is ``-k_r dtheta`` while below its cap
@@ -174,6 +177,7 @@ class Contacts:
     sliding: NDArray[np.bool_]
     bonded: NDArray[np.bool_]
     rolling_moment: NDArray[np.float64]
+    normal_stiffness: NDArray[np.float64]
 
     def __len__(self) -> int:
         return len(self.i)
@@ -191,7 +195,9 @@ class WallContacts:
     to the wall, ``normal_force`` is compression positive, ``shear_force`` acts
     on the particle along ``(-n_y, n_x)`` and ``rolling_moment`` (N m,
     counter-clockwise positive, 0 without rolling resistance) on the particle;
-    the contact's torque on the particle is ``r * shear_force + rolling_moment``."""
+    the contact's torque on the particle is ``r * shear_force + rolling_moment``;
+    ``normal_stiffness`` is the normal force's tangent stiffness (N/m), as
+    :class:`Contacts`'s."""
 
     wall: NDArray[np.uint32]
     particle: NDArray[np.uint32]
@@ -202,6 +208,7 @@ class WallContacts:
     shear_force: NDArray[np.float64]
     sliding: NDArray[np.bool_]
     rolling_moment: NDArray[np.float64]
+    normal_stiffness: NDArray[np.float64]
 
     def __len__(self) -> int:
         return len(self.wall)

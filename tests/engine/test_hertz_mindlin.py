@@ -40,6 +40,21 @@ def test_the_contact_force_is_hertzs_and_the_time_step_takes_the_tangent_stiffne
     assert sim.contact_model(0, 0) == ContactModel.hertz_mindlin(E, NU, 0.5, 0.4)
 
 
+def test_each_contact_reports_its_laws_tangent_normal_stiffness():
+    """``Contacts.normal_stiffness`` is dF_n/d(overlap) at the overlap: Hertz's 2 E* a
+    (the slope of 4/3 E* sqrt(R*) overlap^1.5), and kn for the linear law."""
+    r, overlap = 1e-3, 2e-6
+    hertz = two_disks(overlap, ContactModel.hertz_mindlin(E, NU, 0.5, 0.4), r).contacts()
+    assert hertz.normal_stiffness[0] == pytest.approx(2 * E_STAR * math.sqrt(r / 2 * overlap), rel=1e-12)
+    # the slope of the reported force between two overlaps
+    step = 1e-10
+    forces = [two_disks(d, ContactModel.hertz_mindlin(E, NU, 0.5, 0.4), r).contacts().normal_force[0]
+              for d in (overlap - step, overlap + step)]
+    assert (forces[1] - forces[0]) / (2 * step) == pytest.approx(hertz.normal_stiffness[0], rel=1e-6)
+    linear = two_disks(overlap, ContactModel(8.45e7, 2.0e7, 0.5), r).contacts()
+    assert linear.normal_stiffness.tolist() == [8.45e7]
+
+
 def test_a_free_disk_counts_one_hertz_contact_at_the_largest_overlap_allowed():
     r = 1e-3
     # every pair of groups Hertz-Mindlin (the fallback takes the stiffest model of any group pair)
@@ -83,7 +98,7 @@ def test_bad_law_parameters_are_refused_with_one_line(fields, message):
         ("biaxial", "material.restitution=0", "material.restitution"),
         ("biaxial", "material.contact_law=hooke", "material.contact_law"),
         ("biaxial", "material.contact_damping=0.1", "hertz_mindlin is damped by material.restitution"),
-        ("simple_shear", "material.youngs_modulus=70e9", "not available in simple shear yet"),
+        ("simple_shear", "material.restitution=1.5", "material.restitution"),
     ],
 )
 def test_bad_law_settings_are_one_line_before_any_folder(tmp_path, capsys, command, setting, message):
@@ -112,3 +127,19 @@ def test_a_biaxial_run_with_hertz_mindlin_consolidates_and_shears(tmp_path):
     # sheared to 1 %: the deviator rose, every record finite
     assert summary["peak_stress_ratio"] > 1.2
     assert np.isfinite(summary["final_stress_ratio"])
+
+
+@pytest.mark.slow
+def test_simple_shear_with_hertz_mindlin_holds_its_normal_stress(tmp_path):
+    """The cell's stress control reads each contact's tangent stiffness (2 E* a), so a
+    Hertz-Mindlin packing in simple shear holds sigma_yy at its target as a linear one does."""
+    out = tmp_path / "run"
+    assert cli.main(["run", "simple_shear", "--quick", "--out", str(out), "--set",
+                     "material.contact_law=hertz_mindlin"]) == 0
+    series = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
+    sheared = series[series["shear_strain"] >= 0.1]
+    target = 100.0e3  # simple_shear.normal_stress auto: consolidation.pressure, 100 kPa
+    assert len(sheared) > 10
+    assert np.all(np.abs(sheared["normal_stress_pa"] / target - 1.0) < 0.05)
+    assert abs(float(np.mean(sheared["normal_stress_pa"])) / target - 1.0) < 0.01
+    assert float(np.mean(sheared["friction_coefficient"])) > 0.1

@@ -5,7 +5,7 @@ use crate::pipeline::Simulation;
 use crate::vec2::{scale, Vec2};
 
 /// One row of the contact table while it is assembled.
-type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool, f64);
+type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool, f64, f64);
 
 /// Particle-particle contacts and bonds, sorted by `(i, j)` with `i < j`,
 /// in external (user) particle indices.
@@ -19,7 +19,9 @@ type ContactRow = (u32, u32, Vec2, Vec2, f64, f64, f64, bool, bool, f64);
 /// (N, along `perp(normal)`) are the forces on `j`, and `rolling_moment` (N m,
 /// counter-clockwise positive) the rolling resistance's moment on `j` (its
 /// opposite acts on `i`), elastic parts only (the optional viscous dashpots,
-/// the rolling one too, are not included).
+/// the rolling one too, are not included). `normal_stiffness` is the normal
+/// force's tangent stiffness at the overlap, `dF_n / d(overlap)`: what a
+/// stiffness estimate (a servo's gain, say) reads instead of assuming a law.
 #[derive(Debug, Clone, Default)]
 pub struct ContactList {
     /// First particle.
@@ -43,6 +45,9 @@ pub struct ContactList {
     /// Rolling moment on `j` (N m), the rolling spring `M_r`: 0 without rolling
     /// resistance and for bonds.
     pub rolling_moment: Vec<f64>,
+    /// The normal force's tangent stiffness (N/m): `kn` for the linear law,
+    /// `2 E* a` for Hertz-Mindlin, the bond's `kn` for a bond.
+    pub normal_stiffness: Vec<f64>,
 }
 
 /// Particle-wall contacts, sorted by `(wall, particle)` (external particle
@@ -69,6 +74,8 @@ pub struct WallContactList {
     /// Rolling moment on the particle (N m, the rolling spring `M_r`; 0
     /// without rolling resistance).
     pub rolling_moment: Vec<f64>,
+    /// The normal force's tangent stiffness (N/m), as [`ContactList`]'s.
+    pub normal_stiffness: Vec<f64>,
 }
 
 impl Simulation {
@@ -94,6 +101,7 @@ impl Simulation {
                     c.sliding,
                     false,
                     c.rolling_spring,
+                    c.normal_stiffness,
                 ));
             }
         }
@@ -112,6 +120,7 @@ impl Simulation {
                 false,
                 true,
                 0.0,
+                b.normal_stiffness,
             ));
         }
         // external indices, i < j: swapping a pair flips its normal and the
@@ -145,6 +154,7 @@ impl Simulation {
             out.sliding.push(r.7);
             out.bonded.push(r.8);
             out.rolling_moment.push(r.9);
+            out.normal_stiffness.push(r.10);
         }
         Ok(out)
     }
@@ -172,6 +182,7 @@ impl Simulation {
                 out.shear_force.push(c.shear_spring);
                 out.sliding.push(c.sliding);
                 out.rolling_moment.push(c.rolling_spring);
+                out.normal_stiffness.push(c.normal_stiffness);
             }
         }
         let mut idx: Vec<usize> = (0..out.wall.len()).collect();
@@ -186,6 +197,7 @@ impl Simulation {
             shear_force: idx.iter().map(|&k| out.shear_force[k]).collect(),
             sliding: idx.iter().map(|&k| out.sliding[k]).collect(),
             rolling_moment: idx.iter().map(|&k| out.rolling_moment[k]).collect(),
+            normal_stiffness: idx.iter().map(|&k| out.normal_stiffness[k]).collect(),
         })
     }
 }

@@ -717,6 +717,7 @@ impl Engine {
         d.set_item("sliding", values_to_py(py, &c.sliding))?;
         d.set_item("bonded", values_to_py(py, &c.bonded))?;
         d.set_item("rolling_moment", values_to_py(py, &c.rolling_moment))?;
+        d.set_item("normal_stiffness", values_to_py(py, &c.normal_stiffness))?;
         Ok(d)
     }
 
@@ -732,6 +733,7 @@ impl Engine {
         d.set_item("shear_force", values_to_py(py, &c.shear_force))?;
         d.set_item("sliding", values_to_py(py, &c.sliding))?;
         d.set_item("rolling_moment", values_to_py(py, &c.rolling_moment))?;
+        d.set_item("normal_stiffness", values_to_py(py, &c.normal_stiffness))?;
         Ok(d)
     }
 

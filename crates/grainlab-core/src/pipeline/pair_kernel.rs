@@ -119,6 +119,8 @@ pub(crate) struct PairRecord {
     /// The rolling spring after the update, the moment on `j` (N m; 0 without
     /// rolling resistance).
     pub(crate) rolling_spring: f64,
+    /// The normal force's tangent stiffness at this overlap (N/m).
+    pub(crate) normal_stiffness: f64,
 }
 
 /// Keeps every contact's record, in pair order (`None`: not in contact).
@@ -139,6 +141,7 @@ impl ForceSink for RecordSink {
             shear_spring: c.shear_spring,
             sliding: c.sliding,
             rolling_spring: c.rolling_spring,
+            normal_stiffness: c.normal_stiffness,
         });
     }
 }

@@ -16,7 +16,9 @@ The control sets the rate of the cell's side k, ``L_kk``, once every
 ``e = sigma_kk - target``: ``L_kk = K e + J``, ``J <- J + INTEGRAL_SHARE K e``.
 The proportional part alone would close :data:`RELAXATION` of the gap over
 one interval at the packing's stiffness, estimated from above by the affine
-(Voigt) sum ``E_kk = (1/A) sum_c k_n |l_c|^2 n_k^4``, so ``K = RELAXATION /
+(Voigt) sum ``E_kk = (1/A) sum_c k_n |l_c|^2 n_k^4`` with each contact's
+tangent normal stiffness ``k_n`` (the contact law's: ``kn`` for the linear
+law, ``2 E* a`` for Hertz-Mindlin), so ``K = RELAXATION /
 (E_kk dt_interval)``; the integral part ``J`` learns the steady rate that
 shearing asks for (a dilating sample's), which a proportional control alone
 would only give at a standing stress error. With the true stiffness any
@@ -63,6 +65,14 @@ class CellStress:
         return np.asarray(self.contact + self.kinetic, dtype=np.float64)
 
 
+def _stiffness_sum(normal_stiffness: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    """``sum_c k_c a_c b_c`` over the contacts; a stiffness the same for every
+    contact (the linear law's ``kn``) is factored out of the sum."""
+    if normal_stiffness.size and bool(np.all(normal_stiffness == normal_stiffness[0])):
+        return float(normal_stiffness[0]) * float(a @ b)
+    return float((normal_stiffness * a) @ b)
+
+
 def _cell_contacts(sim: Simulation, caller: str) -> tuple[float, Contacts, NDArray[np.float64]]:
     """The cell's area, the contacts and each contact's branch length ``r_i + r_j - delta``."""
     cell = sim.cell
@@ -73,7 +83,7 @@ def _cell_contacts(sim: Simulation, caller: str) -> tuple[float, Contacts, NDArr
     return float(cell.area), c, radii[c.i] + radii[c.j] - c.overlap
 
 
-def cell_stress(sim: Simulation, normal_stiffness: float) -> CellStress:
+def cell_stress(sim: Simulation) -> CellStress:
     """The stress of the periodic cell of ``sim`` (:class:`CellStress`)."""
     area, c, length = _cell_contacts(sim, "cell_stress")
     branch = length[:, None] * c.normal
@@ -84,11 +94,11 @@ def cell_stress(sim: Simulation, normal_stiffness: float) -> CellStress:
     masses = sim.masses
     kinetic = (masses[:, None] * v).T @ v / area
     n4 = c.normal**4
-    stiffness = normal_stiffness * (length**2) @ n4 / area
+    stiffness = c.normal_stiffness * (length**2) @ n4 / area
     return CellStress(contact, kinetic, (float(stiffness[0]), float(stiffness[1])), area)
 
 
-def side_stresses(sim: Simulation, normal_stiffness: float, sides: Sequence[int]) -> list[tuple[float, float]]:
+def side_stresses(sim: Simulation, sides: Sequence[int]) -> list[tuple[float, float]]:
     """``(sigma_kk, E_kk)`` of each side ``k`` of ``sides`` (0: x, 1: y) alone, as
     :func:`cell_stress` gives them (to rounding) at a fraction of its cost, from one
     read of the contacts: what the control reads every 100 steps."""
@@ -102,7 +112,7 @@ def side_stresses(sim: Simulation, normal_stiffness: float, sides: Sequence[int]
         lever = length * n_k
         v = sim.velocities[:, side]
         stress = (float(lever @ on_j) + float(sim.masses @ (v * v))) / area
-        stiffness = normal_stiffness * float((lever * lever) @ (n_k * n_k)) / area
+        stiffness = _stiffness_sum(c.normal_stiffness, lever * lever, n_k * n_k) / area
         out.append((stress, stiffness))
     return out
 

@@ -66,11 +66,6 @@ SIMPLE_SHEAR_QUICK: dict[str, Any] = {"sample.width": 0.03, "sample.height": 0.0
 
 def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
     check_sample(values, given)
-    if values["material.contact_law"] != "linear":
-        raise ConfigError(
-            f"material.contact_law: {values['material.contact_law']!r} is not available in simple shear yet "
-            "(its cell control reads the linear contact stiffness; the biaxial, cyclic and oedometer tests take it)"
-        )
     final, interval = values["simple_shear.final_strain"], values["simple_shear.record_interval"]
     if interval > final:
         raise ConfigError(

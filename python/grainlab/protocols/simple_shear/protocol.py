@@ -39,11 +39,12 @@ from grainlab.protocols.specimen import (
     OUTPUT_FILES,
     SpecimenError,
     SpecimenProtocol,
+    contact_law,
     damped_time_step_factor,
     grain_model,
 )
 from grainlab.protocols.triggers import At, Every, WallClock, schedule_steps
-from grainlab.simulation import ContactModel, Simulation
+from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind
 
 __all__ = ["SimpleShearProtocol", "SimpleShearRun", "record_steps", "run_simple_shear", "snapshot_name_of"]
@@ -79,7 +80,6 @@ def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int,
              shear_rate: float) -> None:
     """Runs to ``to_step``, the cell's side rates set every CONTROL_STEPS steps (counted from
     ``run.start_step``) to hold ``targets`` (sigma_xx, sigma_yy; None: that side's rate 0)."""
-    kn = config["material.normal_stiffness"]
     if targets == (None, None):  # nothing to hold: the gradient is set once
         wanted = ((0.0, shear_rate), (0.0, 0.0))
         cell = sim.cell
@@ -94,7 +94,7 @@ def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int,
             interval = CONTROL_STEPS * sim.time_step
             cap = _max_rate(sim, config, shear_rate)
             held = [(k, target) for k, target in enumerate(targets) if target is not None]
-            measured = side_stresses(sim, kn, [k for k, _ in held])
+            measured = side_stresses(sim, [k for k, _ in held])
             for (k, target), (stress, stiffness) in zip(held, measured, strict=True):
                 rates[k], run.cell_rate_integral[k] = servo_rate(
                     stress, target, stiffness, interval, cap, run.cell_rate_integral[k])
@@ -128,7 +128,7 @@ def _equilibrate(sim: Simulation, run: SimpleShearRun, config: Config, progress:
     while True:
         _advance(sim, run, config, sim.step_count + CHUNK_STEPS, (target, target), 0.0)
         steps += CHUNK_STEPS
-        stress = cell_stress(sim, config["material.normal_stiffness"]).total
+        stress = cell_stress(sim).total
         bar.update(CHUNK_STEPS)
         bar.set_postfix_str(f"sxx {stress[0, 0] / 1e3:.1f} kPa, syy {stress[1, 1] / 1e3:.1f} kPa, "
                             f"unbalanced {sim.unbalanced_force_ratio:.1e}")
@@ -153,14 +153,13 @@ def _consolidate(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
     start = time.perf_counter()
     _to_periodic(context)
-    sim.set_contact_model(0, 0, ContactModel(config["material.normal_stiffness"], config["material.shear_stiffness"],
-                                             config["consolidation.friction"]))
+    sim.set_contact_model(0, 0, contact_law(config, config["consolidation.friction"]))
     sim.local_damping = config["material.local_damping"]
     sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0) * damped_time_step_factor(config)
     steps = _equilibrate(sim, run, config, context.progress, "consolidating")
     cell = sim.cell
     assert cell is not None
-    stress = cell_stress(sim, config["material.normal_stiffness"]).total
+    stress = cell_stress(sim).total
     radii = sim.radii[: run.n_grains]
     run.consolidation = {
         "steps": steps, "stress_xx_pa": float(stress[0, 0]), "stress_yy_pa": float(stress[1, 1]),
@@ -180,7 +179,7 @@ def _settle(context: Context) -> None:
     _equilibrate(sim, run, config, context.progress, "settling with friction")
     cell = sim.cell
     assert cell is not None
-    stress = cell_stress(sim, config["material.normal_stiffness"]).total
+    stress = cell_stress(sim).total
     held = config["simple_shear.normal_stress"]
     run.normal_stress_pa = float(stress[1, 1]) if config["simple_shear.volume"] == "constant" or held == "auto" \
         else float(held)
@@ -248,7 +247,7 @@ def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, f
     """One record, in :data:`grainlab.columns.SIMPLE_SHEAR`'s order."""
     cell = sim.cell
     assert cell is not None
-    stress = cell_stress(sim, config["material.normal_stiffness"])
+    stress = cell_stress(sim)
     total = stress.total
     n = run.n_grains
     area = float(cell.area)
