@@ -344,6 +344,7 @@ impl PairKernel<'_> {
             // with `ROLLING`, the records [shear, rolling] of pairs 0 and 1,
             // then 2 and 3, from the lanes (the inverse of `unpack`)
             let (overlap, new_spring) = (in_order(overlap), in_order(new_spring));
+            let elastic_normal = in_order(law.elastic_normal);
             let rolling_record = if ROLLING {
                 in_order(law.rolling_record)
             } else {
@@ -401,10 +402,9 @@ impl PairKernel<'_> {
                 let [i, j] = ij[l];
                 let model = self.model_of::<SINGLE>(&fixed, &columns, k);
                 let slid = sliding_bits & (1 << l) != 0;
-                let elastic_normal = model.normal_stiffness * overlap[l];
                 let c = ContactForce {
-                    normal: elastic_normal,
-                    elastic_normal,
+                    normal: elastic_normal[l],
+                    elastic_normal: elastic_normal[l],
                     shear: new_spring[l],
                     shear_spring: new_spring[l],
                     sliding: slid,
@@ -431,7 +431,7 @@ impl PairKernel<'_> {
                         ShearSpring::slip_work(model, before, trial[l], capped[l]);
                 }
                 if MEASURE {
-                    let (en, fs) = (elastic_normal, new_spring[l]);
+                    let (en, fs) = (elastic_normal[l], new_spring[l]);
                     tally.elastic += elastic_energy(model, en, fs);
                     if ROLLING && rolling_energy[l] != 0.0 {
                         tally.elastic += rolling_energy[l];

@@ -12,6 +12,8 @@ import grainlab
 from grainlab.io.hdf5 import snapshot_name
 from grainlab.paper import DENSITY_SCALING_LIMIT
 from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.specimen import contact_law
+from grainlab.simulation import Simulation
 
 __all__ = [
     "DENSITY_SCALING_LIMIT",
@@ -122,9 +124,12 @@ def check_strain_rate(config: BiaxialConfig) -> None:
     if config["boundary.kind"] == "membrane":
         diameter = min(diameter, config["boundary.membrane_diameter"])
     radius = 0.5 * diameter
-    mass = config["material.density"] * math.pi * radius**2
-    stiffness = max(config["material.normal_stiffness"], 2.0 * config["material.shear_stiffness"])
-    time_step = 0.1 * config["run.time_step_safety"] * math.sqrt(mass / stiffness)
+    # the critical time step of the smallest grain with the grains' law (its stiffest
+    # contact: the law's tangent stiffnesses at the largest overlap allowed), as the
+    # engine computes it
+    smallest = Simulation([[0.0, 0.0]], [radius], config["material.density"],
+                          contact_model=contact_law(config, config["material.friction"]))
+    time_step = 0.1 * config["run.time_step_safety"] * smallest.critical_time_step(1.0)
     problem = strain_rate_problem(rate, time_step, config["sample.height"], radius, config["shear.record_interval"])
     if problem is not None:
         raise ValueError(
