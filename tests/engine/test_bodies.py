@@ -126,6 +126,28 @@ def test_scaled_clumps_are_similar_clumps_of_the_same_density():
         sim.scale_clumps([1.0, 0.0])
 
 
+def test_a_clumps_new_density_scales_its_mass_and_inertia():
+    """All pebbles of a clump given one new density: the body's mass and moment of
+    inertia scale by the density ratio (density scaling of a clump sample); pebbles
+    of one clump that disagree are refused before any change."""
+    sim = _two_trimers()
+    before = sim.clumps
+    sim.densities = [3 * DENSITY] * 3 + [DENSITY] * 3
+    after = sim.clumps
+    np.testing.assert_allclose(after.mass_kg, before.mass_kg * [3.0, 1.0], rtol=1e-15)
+    np.testing.assert_allclose(after.moment_of_inertia_kg_m2, before.moment_of_inertia_kg_m2 * [3.0, 1.0],
+                               rtol=1e-15)
+    np.testing.assert_array_equal(sim.masses, np.repeat(after.mass_kg, 3))
+    union = clump_mass_properties(sim.positions[:3], sim.radii[:3], density=3 * DENSITY)
+    assert after.mass_kg[0] == pytest.approx(union.mass_kg, rel=1e-13)
+    with pytest.raises(ValueError, match=r"densities\[4\]: particles 3 and 4 are pebbles of clump 1 with different"):
+        sim.densities = [DENSITY] * 4 + [2 * DENSITY, DENSITY]
+    np.testing.assert_array_equal(sim.clumps.mass_kg, after.mass_kg)
+    # and back: the clump's own mass again
+    sim.densities = [DENSITY] * 6
+    np.testing.assert_allclose(sim.clumps.mass_kg, before.mass_kg, rtol=1e-15)
+
+
 def test_a_pebble_moves_only_with_its_body():
     sim = _two_trimers()
     # the whole assembly shifted: each clump follows rigidly, to round-off

@@ -265,6 +265,20 @@ impl Clumps {
         self.inertia[c] *= area_factor * area_factor;
     }
 
+    /// Gives clump `c` the density `density` (its pebbles', which agree): its
+    /// mass and moment of inertia times the ratio to the pebbles' old density
+    /// (`particles.density`, not yet changed), exact for a body of uniform
+    /// density, given or computed; the pebbles' masses follow
+    /// ([`Clumps::assign_pebble_masses`]).
+    pub(crate) fn rescale_density(&mut self, c: usize, density: f64, particles: &Particles) {
+        let old = particles.density[self.pebble[self.start[c] as usize] as usize];
+        if density != old {
+            let ratio = density / old;
+            self.mass[c] *= ratio;
+            self.inertia[c] *= ratio;
+        }
+    }
+
     /// Gives every pebble its clump's mass and inertia and the `PEBBLE` bit.
     pub(crate) fn assign_pebble_masses(&self, particles: &mut Particles) {
         for c in 0..self.len() {

@@ -246,25 +246,42 @@ impl Simulation {
         }
     }
 
-    /// A user's fixity (internal order) with each clump's pebbles agreeing,
-    /// the clumps' fixity taken from it and the pebble bit kept.
-    pub(crate) fn fixity_with_clumps(&mut self, mut fixity: Vec<u8>) -> Result<Vec<u8>> {
+    /// Refuses a per-particle array (internal order) in which two pebbles of
+    /// one clump differ, the value being the body's (`why` says so).
+    pub(crate) fn check_clumps_agree<T: PartialEq + Copy + std::fmt::Debug>(
+        &self,
+        field: &str,
+        values: &[T],
+        why: &str,
+    ) -> Result<()> {
         for c in 0..self.clumps.len() {
             let members = &self.clumps.pebble[self.clumps.members(c)];
-            let first = fixity[members[0] as usize];
-            if let Some(&q) = members.iter().find(|&&q| fixity[q as usize] != first) {
+            let first = values[members[0] as usize];
+            if let Some(&q) = members.iter().find(|&&q| values[q as usize] != first) {
                 return Err(EngineError::invalid(
-                    format!("fixity[{}]", self.external_index(q as usize)),
+                    format!("{field}[{}]", self.external_index(q as usize)),
                     format!(
-                        "particles {} and {} are pebbles of clump {} with different fixity; \
-                         a body's degrees of freedom are fixed as one",
+                        "particles {} and {} are pebbles of clump {} with different {field} \
+                         ({first:?} and {:?}); {why}",
                         self.external_index(members[0] as usize),
                         self.external_index(q as usize),
-                        self.clumps.id[c]
+                        self.clumps.id[c],
+                        values[q as usize]
                     ),
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// A user's fixity (internal order) with each clump's pebbles agreeing,
+    /// the clumps' fixity taken from it and the pebble bit kept.
+    pub(crate) fn fixity_with_clumps(&mut self, mut fixity: Vec<u8>) -> Result<Vec<u8>> {
+        self.check_clumps_agree(
+            "fixity",
+            &fixity,
+            "a body's degrees of freedom are fixed as one",
+        )?;
         for c in 0..self.clumps.len() {
             let first = self.clumps.pebble[self.clumps.start[c] as usize] as usize;
             self.clumps.fixity[c] = fixity[first];

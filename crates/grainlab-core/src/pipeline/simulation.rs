@@ -336,14 +336,15 @@ impl Simulation {
             require_positive(&format!("densities[{k}]"), d)?;
         }
         let density = self.internal_array("densities", densities)?;
-        if self.particles.density.len() == density.len() {
-            self.check_pebbles_kept("densities", &self.particles.density, &density)?;
-        } else {
-            let current = vec![self.particles.density[0]; density.len()];
-            self.check_pebbles_kept("densities", &current, &density)?;
+        self.check_clumps_agree("densities", &density, "a clump has one density")?;
+        for c in 0..self.clumps.len() {
+            let first = self.clumps.pebble[self.clumps.start[c] as usize] as usize;
+            self.clumps
+                .rescale_density(c, density[first], &self.particles);
         }
         self.particles.density = density;
         self.particles.update_mass_properties();
+        self.clumps.assign_pebble_masses(&mut self.particles);
         Ok(())
     }
 
