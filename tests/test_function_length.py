@@ -37,7 +37,6 @@ TO_SPLIT: dict[str, int] = {
     "python/grainlab/postprocess/biaxial.py:analyse_run": 89,
     "python/grainlab/protocols/biaxial/phases.py:install_boundary": 94,
     "python/grainlab/protocols/biaxial/phases.py:shear": 135,
-    "python/grainlab/samples/expansion.py:expand_to_porosity": 100,
     "python/grainlab/snapshot.py:Snapshot.__init__": 169,
     "python/grainlab/snapshot.py:Snapshot.from_engine_arrays": 97,
     "crates/grainlab-core/src/pipeline/step.rs:particle_contacts": 165,

@@ -32,6 +32,7 @@ from grainlab.samples.placement import PlacementError, random_placement
 from grainlab.samples.porosity import (
     box_area,
     disk_area_in_box,
+    grain_overlap_area,
     lens_area,
     measurement_circle_porosity,
     nominal_porosity,
@@ -59,6 +60,7 @@ __all__ = [
     "disk_area_in_box",
     "expand_to_porosity",
     "expand_with_friction_search",
+    "grain_overlap_area",
     "hexagonal_lattice",
     "lens_area",
     "measurement_circle_porosity",

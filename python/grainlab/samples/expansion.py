@@ -54,7 +54,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import paper
-from grainlab.analysis.fabric import CoordinationNumber
+from grainlab.analysis.fabric import CoordinationNumber, rattlers
 from grainlab.samples.grading import PAPER_GRADING, Grading
 from grainlab.samples.placement import random_placement
 from grainlab.samples.porosity import (
@@ -63,6 +63,7 @@ from grainlab.samples.porosity import (
     overlap_corrected_porosity,
     particle_count,
 )
+from grainlab.shapes import ShapeTemplate
 from grainlab.simulation import DEFAULT_TIME_STEP_SAFETY
 
 __all__ = ["WALL_NAMES", "ExpansionError", "Sample", "expand_to_porosity"]
@@ -140,10 +141,12 @@ class Sample:
     mean_wall_stress_pa: float
     """Mean of :attr:`wall_stresses_pa`, Pa: the stress locked in by the expansion."""
     coordination_number: float
-    """``2 Nc / N`` (particle-particle contacts, rattlers included)."""
+    """``2 Nc / N`` (particle-particle contacts, rattlers included); for clumps
+    per grain, ``2 Nc / N_grains`` (CEGEO's Z_c: a pair of grains touching at two
+    pebbles counts twice)."""
     mechanical_coordination_number: float
-    """``Z_m``: ``2 Nc / N`` over the particles left once rattlers (fewer than 2
-    particle-particle contacts) are removed iteratively
+    """``Z_m``: ``2 Nc / N`` over the particles (grains) left once rattlers (fewer
+    than 2 contacts) are removed iteratively
     (:class:`grainlab.analysis.CoordinationNumber`); NaN when none is left."""
     mean_overlap_ratio: float
     """Mean contact overlap over the smallest radius."""
@@ -171,6 +174,12 @@ class Sample:
     steps: int
     """DEM steps run (growth and equilibrium)."""
     wall_time_s: float
+    shape: str = "disk"
+    """The grains' shape (:func:`grainlab.shapes.shape_template`'s name, "disk" for disks)."""
+    shape_parameter: float = 0.0
+    """Its eta (0 for disks)."""
+    grain: NDArray[np.int64] | None = None
+    """(N,) each particle's grain (body), for a sample of clumps; None for disks."""
     simulation: Any = field(default=None, repr=False, compare=False)
     """The live :class:`grainlab.Simulation` when asked for (``keep_simulation=True``)."""
 
@@ -178,10 +187,17 @@ class Sample:
     def n_particles(self) -> int:
         return len(self.radii)
 
+    @property
+    def n_grains(self) -> int:
+        """Grains (bodies): the disks, or the clumps."""
+        return self.n_particles if self.grain is None else int(self.grain.max()) + 1
+
     def summary(self) -> str:
         """One line: where the sample is."""
+        grains = (f"{self.n_particles} disks" if self.grain is None else
+                  f"{self.n_grains} {self.shape}s (eta {self.shape_parameter:g}, {self.n_particles} pebbles)")
         return (
-            f"{self.n_particles} disks, porosity {self.porosity:.4f} nominal / "
+            f"{grains}, porosity {self.porosity:.4f} nominal / "
             f"{self.porosity_overlap_corrected:.4f} overlap-corrected (target {self.porosity_target:.4f}), "
             f"wall stress {self.mean_wall_stress_pa / 1e3:.1f} kPa, Z {self.coordination_number:.2f}, "
             f"mean overlap {100 * self.mean_overlap_ratio:.1f}% of r_min, "
@@ -191,8 +207,12 @@ class Sample:
 
     def to_dict(self) -> dict[str, Any]:
         """The scalar results (JSON-ready), without positions, radii or the simulation."""
+        grains = {} if self.grain is None else {
+            "n_grains": self.n_grains, "shape": self.shape, "shape_parameter": self.shape_parameter,
+        }
         return {
             "n_particles": self.n_particles,
+            **grains,
             "box": list(self.box),
             "porosity_target": self.porosity_target,
             "porosity": self.porosity,
@@ -256,6 +276,8 @@ class _Box:
         self.area = (x1 - x0) * (y1 - y0)
         self.lengths = (x1 - x0, y1 - y0, x1 - x0, y1 - y0)
         self.walls = [sim.add_segment_wall(a, b) for a, b in _wall_points(box)]
+        #: Each particle's grain when the grains are clumps (porosities by grain), else None.
+        self.grain: NDArray[np.int64] | None = None
 
     def wall_stresses(self) -> NDArray[np.float64]:
         return np.array([w.normal_stress(length) for w, length in zip(self.walls, self.lengths, strict=True)])
@@ -264,37 +286,24 @@ class _Box:
         return float(self.wall_stresses().mean())
 
     def porosities(self) -> tuple[float, float]:
-        r = self.sim.radii
-        return nominal_porosity(r, self.area), overlap_corrected_porosity(self.sim.positions, r, self.box)
+        r, p, g = self.sim.radii, self.sim.positions, self.grain
+        if g is None:
+            return nominal_porosity(r, self.area), overlap_corrected_porosity(p, r, self.box)
+        return (nominal_porosity(r, self.area, positions=p, grain=g),
+                overlap_corrected_porosity(p, r, self.box, grain=g))
 
 
 def expand_to_porosity(
-    box: ArrayLike = (0.0, 0.0, 0.075, 0.15),
-    porosity: float = 0.12,
-    grading: Grading = PAPER_GRADING,
-    *,
-    seed: int | None = 0,
-    n_particles: int | None = None,
-    diameters: ArrayLike | None = None,
-    friction: float = 0.0,
-    wall_friction: float = 0.0,
-    normal_stiffness: float = _KN,
-    shear_stiffness: float = _KN,
-    density: float = _DENSITY,
-    local_damping: float = _DAMPING,
-    initial_scale: float = 0.5,
-    growth_per_increment: float = 1.0e-2,
-    steps_per_increment: int = 50,
-    growth_stress_scale_pa: float = 1.0e5,
-    equilibrium_ratio: float = 1.0e-4,
-    stress_free_overlap: float = 1.0e-5,
-    max_equilibrium_steps: int = 300_000,
-    max_stress_pa: float = MAX_STRESS_PA,
-    time_step_safety: float = DEFAULT_TIME_STEP_SAFETY,
-    density_scaling: bool = True,
-    threads: int = 1,
-    progress: bool = False,
-    keep_simulation: bool = False,
+    box: ArrayLike = (0.0, 0.0, 0.075, 0.15), porosity: float = 0.12, grading: Grading = PAPER_GRADING, *,
+    seed: int | None = 0, n_particles: int | None = None, diameters: ArrayLike | None = None,
+    friction: float = 0.0, wall_friction: float = 0.0,
+    normal_stiffness: float = _KN, shear_stiffness: float = _KN, density: float = _DENSITY,
+    local_damping: float = _DAMPING, initial_scale: float = 0.5,
+    growth_per_increment: float = 1.0e-2, steps_per_increment: int = 50, growth_stress_scale_pa: float = 1.0e5,
+    equilibrium_ratio: float = 1.0e-4, stress_free_overlap: float = 1.0e-5, max_equilibrium_steps: int = 300_000,
+    max_stress_pa: float = MAX_STRESS_PA, time_step_safety: float = DEFAULT_TIME_STEP_SAFETY,
+    density_scaling: bool = True, threads: int = 1, progress: bool = False, keep_simulation: bool = False,
+    shape: ShapeTemplate | None = None,
 ) -> Sample:
     """Generates a sample by radius expansion inside rigid walls to a target nominal porosity.
 
@@ -313,33 +322,28 @@ def expand_to_porosity(
     normal_stiffness, shear_stiffness : contact kn, ks (N/m; Table 1: 8.45e7)
     density : kg/m^3 (Table 1: 2e8); local_damping : alpha (Table 1: 0.8)
     initial_scale : placed radius over final radius (the paper halves: 0.5)
-    growth_per_increment : largest increment of ``ln r`` per growth step
-    steps_per_increment : DEM steps after each growth increment
-    growth_stress_scale_pa : the increment is divided by ``1 + sigma / this``
-    equilibrium_ratio : stop cycling when the mean unbalanced force ratio is below this
-    stress_free_overlap : also stop (an unjammed, stress-free packing) when the rms
-        contact overlap falls below this fraction of the smallest radius
-    max_equilibrium_steps : give up cycling to equilibrium after this many steps
-        (the sample is returned with ``equilibrium_reached = False`` and a warning)
+    growth_per_increment, steps_per_increment, growth_stress_scale_pa : the
+        growth (module docstring, steps 3); equilibrium_ratio, stress_free_overlap,
+        max_equilibrium_steps : the end (step 4; past the last, the sample comes
+        with ``equilibrium_reached = False`` and a warning)
     max_stress_pa : stress bound (mean wall stress in equilibrium), Pa
     time_step_safety : time step = this x the critical step, re-evaluated every increment
     density_scaling : give every disk the largest disk's mass while generating
     threads : engine worker threads (the sample does not depend on them)
     progress : show the progress on stderr (off by default)
-    keep_simulation : return the live simulation in :attr:`Sample.simulation`
-        (walls 0..3 are bottom, right, top, left; particle-particle friction is
-        still the generation friction: set the test's own contact models)
+    keep_simulation : return the live simulation in :attr:`Sample.simulation` (walls 0..3:
+        bottom, right, top, left; the generation friction still on: set the test's own)
+    shape : each grain's shape (:func:`grainlab.shapes.shape_template`): clumps at random
+        angles, the grading giving their circumscribed diameters, the porosity their
+        unions (docs/samples.md, "Samples of shaped grains"); None: disks
 
     Raises
     ------
     ValueError
-        bad input, naming the field, before any work.
-    PlacementError
-        (a ValueError) random placement at ``initial_scale`` could not fit the disks.
-    ExpansionError
-        (a ValueError) the target needs a mean wall stress above
-        ``max_stress_pa`` (or overlaps beyond the engine's limit): the message
-        gives the densest nominal porosity reached and the stress it needed.
+        bad input, naming the field, before any work; :class:`PlacementError` when
+        placement at ``initial_scale`` cannot fit the grains; :class:`ExpansionError`
+        when the target needs a mean wall stress above ``max_stress_pa`` (or overlaps
+        beyond the engine's limit), with the densest porosity reached and its stress.
     """
     started = time.perf_counter()
     settings = _Settings.checked(
@@ -351,13 +355,14 @@ def expand_to_porosity(
         max_equilibrium_steps=max_equilibrium_steps, max_stress_pa=max_stress_pa,
         time_step_safety=time_step_safety, threads=threads,
     )
+    clumps = _clump_shape(shape)
     rng = np.random.default_rng(seed)
     d = _diameters(settings, grading, diameters, n_particles, rng)
-    expansion = _Expansion.placed(settings, d, rng, density_scaling, progress)
+    expansion = _Expansion.placed(settings, d, rng, density_scaling, progress, clumps)
     expansion.grow()
-    sample = expansion.finish(settings, density_scaling)
     return Sample(
-        **sample,
+        **expansion.finish(settings, density_scaling),
+        **_grains_of(clumps, expansion.walls.grain),
         radius_factor=expansion.radius_factor,
         seed=seed,
         grading=grading.name,
@@ -368,6 +373,20 @@ def expand_to_porosity(
         wall_time_s=time.perf_counter() - started,
         simulation=expansion.sim if keep_simulation else None,
     )
+
+
+def _clump_shape(shape: ShapeTemplate | None) -> ShapeTemplate | None:
+    """The template of clumps to grow (None for disks: no shape, or one of one disk)."""
+    if shape is not None and not isinstance(shape, ShapeTemplate):
+        raise TypeError(f"shape: expected a ShapeTemplate (grainlab.shapes.shape_template) or None, got {shape!r}")
+    return shape if shape is not None and shape.n_pebbles > 1 else None
+
+
+def _grains_of(clumps: ShapeTemplate | None, grain: NDArray[np.int64] | None) -> dict[str, Any]:
+    """A :class:`Sample`'s shape fields."""
+    if clumps is None:
+        return {"shape": "disk", "shape_parameter": 0.0, "grain": None}
+    return {"shape": clumps.name, "shape_parameter": clumps.eta, "grain": grain}
 
 
 @dataclass(frozen=True)
@@ -465,6 +484,30 @@ def _diameters(
     return grading.sample(n, rng)
 
 
+def _clump_pebbles(shape: ShapeTemplate, centres: NDArray[np.float64], sizes: NDArray[np.float64],
+                   angles: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The pebbles (centres (N K, 2), radii (N K,)) of clumps of ``shape`` with
+    circumscribed radii ``sizes`` at ``centres``, each turned by its angle."""
+    c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+    ox, oy = shape.offsets[:, 0][None, :], shape.offsets[:, 1][None, :]
+    world = np.empty((len(centres), shape.n_pebbles, 2))
+    world[..., 0] = centres[:, None, 0] + sizes[:, None] * (c * ox - s * oy)
+    world[..., 1] = centres[:, None, 1] + sizes[:, None] * (s * ox + c * oy)
+    return world.reshape(-1, 2), (sizes[:, None] * shape.radii[None, :]).reshape(-1)
+
+
+def _grain_coordination(grain: NDArray[np.int64], i: NDArray[np.uint32], j: NDArray[np.uint32]) -> tuple[float, float]:
+    """``(Z_c, Z_m)`` per grain from the pebbles' contacts: contacts per grain
+    (two at two pebbles of one pair of grains), and the same over the grains left
+    once rattlers (fewer than 2 contacts) are removed iteratively."""
+    n = int(grain.max()) + 1
+    a, b = grain[np.asarray(i, dtype=np.int64)], grain[np.asarray(j, dtype=np.int64)]
+    core = ~rattlers(a, b, n)
+    alive = int((core[a] & core[b]).sum())
+    n_core = int(core.sum())
+    return 2.0 * len(a) / n, (2.0 * alive / n_core if n_core else float("nan"))
+
+
 class _Expansion:
     """The disks placed at ``initial_scale`` in the box, the simulation that grows
     them, and the growth itself: :meth:`grow`, then :meth:`finish`."""
@@ -490,15 +533,18 @@ class _Expansion:
 
     @classmethod
     def placed(cls, settings: _Settings, d: NDArray[np.float64], rng: np.random.Generator, density_scaling: bool,
-               progress: bool) -> _Expansion:
+               progress: bool, clumps: ShapeTemplate | None = None) -> _Expansion:
         """Final radii scaled by one common factor so that the final nominal porosity is
-        exactly the target; the disks placed at random at ``initial_scale`` of them."""
+        exactly the target; the disks (or the clumps' circumscribed disks, the clumps
+        at random angles) placed at random at ``initial_scale`` of them."""
         import grainlab
         from grainlab.simulation import WALL_GROUP
 
         s = settings
         x0, y0, x1, y1 = s.box
-        radius_factor = math.sqrt((1.0 - s.porosity) * s.area / (math.pi * float(np.sum((0.5 * d) ** 2))))
+        # a grain's area over its circumscribed radius squared: pi, or the clump template's
+        shape_area = math.pi if clumps is None else clumps.area
+        radius_factor = math.sqrt((1.0 - s.porosity) * s.area / (shape_area * float(np.sum((0.5 * d) ** 2))))
         final_radii = radius_factor * 0.5 * d
         if 2.0 * final_radii.max() > min(x1 - x0, y1 - y0):
             raise ValueError(
@@ -507,14 +553,34 @@ class _Expansion:
             )
         positions, _ = random_placement(s.box, 2.0 * final_radii, rng, scale=s.initial_scale)
         model = grainlab.ContactModel(s.normal_stiffness, s.shear_stiffness, s.friction)
-        sim = grainlab.Simulation(positions, s.initial_scale * final_radii, density=s.density, contact_model=model,
+        if clumps is None:
+            pebbles, sizes = positions, s.initial_scale * final_radii
+        else:
+            angles = rng.uniform(0.0, 2.0 * math.pi, len(d))
+            pebbles, sizes = _clump_pebbles(clumps, positions, s.initial_scale * final_radii, angles)
+        sim = grainlab.Simulation(pebbles, sizes, density=s.density, contact_model=model,
                                   threads=s.threads, local_damping=s.local_damping)
         sim.set_contact_model(0, WALL_GROUP, grainlab.ContactModel(s.normal_stiffness, s.shear_stiffness,
                                                                    s.wall_friction))
         expansion = cls(s, sim, final_radii, radius_factor, progress)
+        per_grain = 1
+        if clumps is not None:
+            per_grain = clumps.n_pebbles
+            sim.add_bodies(np.arange(len(sizes)).reshape(len(d), per_grain).tolist(), angles=angles)
+            expansion.walls.grain = np.repeat(np.arange(len(d)), per_grain)
         if density_scaling:
-            sim.densities = s.density * (final_radii.max() / final_radii) ** 2
+            # every grain the largest one's mass (a clump's density is its pebbles')
+            sim.densities = np.repeat(s.density * (final_radii.max() / final_radii) ** 2, per_grain)
         return expansion
+
+    def resize(self, scale: float) -> None:
+        """The grains at ``scale`` of their final size: the disks' radii, or each clump
+        grown about its centroid by the ratio to the current scale (``scale_clumps``)."""
+        if self.walls.grain is None:
+            self.sim.radii = self.final_radii if scale == 1.0 else scale * self.final_radii
+        else:
+            self.sim.scale_clumps(np.full(len(self.final_radii), scale / self.scale))
+        self.scale = scale
 
     def relax(self, limit: int) -> tuple[str, int]:
         """Cycles at fixed radii until equilibrium (``"equilibrium"``), until the contacts
@@ -586,8 +652,7 @@ class _Expansion:
             stress = 0.0
             while self.scale < 1.0:
                 growth = s.growth_per_increment / (1.0 + max(stress, 0.0) / s.growth_stress_scale_pa)
-                self.scale = min(1.0, self.scale * math.exp(growth))
-                sim.radii = self.final_radii if self.scale == 1.0 else self.scale * self.final_radii
+                self.resize(min(1.0, self.scale * math.exp(growth)))
                 sim.time_step = sim.critical_time_step(s.time_step_safety)
                 sim.run(s.steps_per_increment)
                 self.steps += s.steps_per_increment
@@ -635,8 +700,11 @@ class _Expansion:
         else:
             mean_overlap = max_overlap = 0.0
         n_nom, n_cor = self.walls.porosities()
-        coordination = sim.coordination_number
-        mechanical = CoordinationNumber().compute(sim.snapshot()).mechanical_coordination_number
+        if self.walls.grain is None:
+            coordination = sim.coordination_number
+            mechanical = CoordinationNumber().compute(sim.snapshot()).mechanical_coordination_number
+        else:
+            coordination, mechanical = _grain_coordination(self.walls.grain, contacts.i, contacts.j)
         if density_scaling:
             sim.densities = np.full(len(radii), settings.density)
         sim.velocities = np.zeros((len(radii), 2))
