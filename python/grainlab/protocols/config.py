@@ -27,6 +27,9 @@ from typing import Any, TypedDict
 
 from grainlab import paper
 from grainlab._mapping import flatten_keys
+from grainlab.io._table import FileFormatError
+from grainlab.io.shape_file import read_shape_template
+from grainlab.shapes import SHAPES, ShapeTemplate, shape_template
 from grainlab.simulation import DEFAULT_TIME_STEP_SAFETY
 
 
@@ -62,6 +65,8 @@ class Field:
     allow_auto: bool = False
 
     def describe_range(self) -> str:
+        if self.kind == "text":
+            return "a text" + (" (" + ", ".join(self.choices) + ", or a file)" if self.choices else "")
         if self.choices:
             return "one of " + ", ".join(repr(c) for c in self.choices)
         lo = "(" if self.exclusive_minimum else "["
@@ -112,6 +117,17 @@ SHARED_FIELDS: dict[str, Field] = {
         "percent passing by mass at each sieve size of a 'curve' grading (0 first, 100 last)",
     ),
     "sample.seed": Field("integer", 1, "random seed of the sample", minimum=0),
+    "sample.shape": Field(
+        "text", "disk",
+        "grain shape (docs/bodies.md, 'Shapes'): rigid clumps of disks, the grading giving each grain's "
+        "circumscribed diameter; a file lists a template's pebbles (x, y, r per line)",
+        choices=SHAPES,
+    ),
+    "sample.shape_parameter": Field(
+        "number", 0.0, "CEGEO's eta = 1 - inscribed / circumscribed radius of dimers, trimers and rods (0: disks)",
+        minimum=0.0, maximum=1.0, exclusive_maximum=True,
+    ),
+    "sample.rod_pebbles": Field("integer", 3, "pebbles of a rod (sample.shape = rod)", minimum=2),
     "sample.generation_friction": Field("number", 0.0, "particle friction during radius expansion", minimum=0.0),
     "sample.max_generation_stress": Field(
         "stress", 5.0e6, "stress bound of the radius expansion", **_POSITIVE
@@ -288,6 +304,10 @@ def coerce_field(fields: Mapping[str, Field], key: str, value: Any) -> Any:
     field = fields[key]
     if field.allow_auto and value == "auto":
         return "auto"
+    if field.kind == "text":
+        if not isinstance(value, str) or not value.strip():
+            raise ConfigError(f"{key}: expected {field.describe_range()}, got {value!r}")
+        return value.strip()
     if field.kind == "choice":
         if value not in field.choices:
             raise ConfigError(f"{key}: {value!r} is not {field.describe_range()}")
@@ -464,11 +484,36 @@ def _grading_curve(v: dict[str, Any], given: AbstractSet[str]) -> None:
     v["sample.d_min"], v["sample.d_max"] = sizes[0], sizes[-1]
 
 
+def grain_shape(v: Mapping[str, Any]) -> ShapeTemplate | None:
+    """The grains' clump template of ``sample.shape`` (None for disks, and for any
+    shape at eta 0), or a :class:`ConfigError` saying what is wrong."""
+    shape, eta = v["sample.shape"], v["sample.shape_parameter"]
+    if v["sample.rod_pebbles"] != SHARED_FIELDS["sample.rod_pebbles"].default and shape != "rod":
+        raise ConfigError(f"sample.rod_pebbles: only a rod takes it, got sample.shape = {shape!r}")
+    if shape == "disk" and eta > 0.0:
+        raise ConfigError(f"sample.shape_parameter: a disk has eta 0, got {eta:g} (choose dimer, trimer or rod)")
+    if shape in SHAPES:
+        try:
+            template = shape_template(shape, eta, n_pebbles=v["sample.rod_pebbles"] if shape == "rod" else None)
+        except ValueError as error:
+            raise ConfigError(f"sample.{error}") from None
+    elif eta > 0.0:
+        raise ConfigError(f"sample.shape_parameter: the template file {shape!r} gives its own eta; leave it out")
+    else:
+        try:
+            template = read_shape_template(shape)
+        except FileFormatError as error:
+            reason = str(error) if Path(shape).is_file() else "no such file"
+            raise ConfigError(f"sample.shape: {shape!r} is not {', '.join(SHAPES)} or a template file ({reason})") from None
+    return template if template.n_pebbles > 1 else None
+
+
 def check_sample(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
     """The checks of :data:`SHARED_FIELDS` that span several keys (the grading, the
-    sample's size against its grains, Hertz-Mindlin without contact dashpots); a
-    'curve' grading sets ``sample.d_min/d_max``."""
+    grains' shape, the sample's size against its grains, Hertz-Mindlin without
+    contact dashpots); a 'curve' grading sets ``sample.d_min/d_max``."""
     _grading_curve(v, given)
+    grain_shape(v)
     if v["material.contact_law"] == "hertz_mindlin" and v["material.contact_damping"] > 0:
         raise ConfigError(
             "material.contact_damping: hertz_mindlin is damped by material.restitution, "
@@ -487,7 +532,13 @@ def check_sample(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> No
 
 def check_boundary(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
     """A constant-volume test needs the rigid side walls: they are its boundary unless
-    another was asked for, which is refused."""
+    another was asked for, which is refused; clumps cannot form the outermost grains'
+    chain."""
+    if v["boundary.kind"] == "outer_particles" and v["sample.shape"] != "disk" and grain_shape(v) is not None:
+        raise ConfigError(
+            f"boundary.kind: 'outer_particles' bonds the outermost grains into a chain, which the pebbles of "
+            f"sample.shape = {v['sample.shape']!r} cannot join (they move with their clump); use 'membrane' or 'walls'"
+        )
     if v["shear.volume"] != "constant":
         return
     if "boundary.kind" not in given:

@@ -24,7 +24,7 @@ from grainlab._cores import available_cores
 from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
 from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
-from grainlab.protocols.config import Config
+from grainlab.protocols.config import Config, grain_shape
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
 from grainlab.protocols.runner import Protocol, ProtocolError, RunResult
 from grainlab.samples import (
@@ -33,6 +33,7 @@ from grainlab.samples import (
     UniformByMass,
     UniformByNumber,
     expand_to_porosity,
+    nominal_porosity,
     overlap_corrected_porosity,
 )
 from grainlab.simulation import ContactModel, Simulation
@@ -202,6 +203,7 @@ def generate(config: Config, threads: int, progress: bool, state: type[R], phase
         threads=threads,
         progress=progress,
         keep_simulation=True,
+        shape=grain_shape(config.values),
     )
     sim = sample.simulation
     n = sim.n_particles
@@ -267,15 +269,19 @@ def consolidate(
     radii = sim.radii[grains]
     area = width * height
     box = (float(sim.wall(run.walls["left"]).points[0, 0]), float(sim.wall(run.walls["bottom"]).points[0, 1]))
+    # clumps: each one's union once (docs/samples.md, "Porosity: two readings")
+    grain = sim.body_of_particles[grains] if len(sim.clumps) else None
     run.consolidation = {
         "steps": steps,
         "stress_xx_pa": sxx,
         "stress_yy_pa": syy,
         "width_m": width,
         "height_m": height,
-        "porosity": 1.0 - float(np.pi * np.sum(radii**2)) / area,
+        "porosity": 1.0 - float(np.pi * np.sum(radii**2)) / area if grain is None else nominal_porosity(
+            radii, area, positions=sim.positions[grains], grain=grain
+        ),
         "porosity_overlap_corrected": overlap_corrected_porosity(
-            sim.positions[grains], radii, (box[0], box[1], box[0] + width, box[1] + height)
+            sim.positions[grains], radii, (box[0], box[1], box[0] + width, box[1] + height), grain=grain
         ),
         "coordination_number": sim.coordination_number,
         "unbalanced_force_ratio": sim.unbalanced_force_ratio,
