@@ -282,3 +282,30 @@ def test_the_controls_side_stress_is_the_cells_stress(free):
         assert stress == pytest.approx(float(full.total[k, k]), rel=1e-12)
         assert stiffness == pytest.approx(full.stiffness_pa[k], rel=1e-12)
     assert full.total[1, 1] > 0 and full.stiffness_pa[1] > 0
+
+
+def test_a_clump_chains_cell_stress_takes_branches_between_centroids():
+    """Oracle: three dimers end to end along x fill a periodic cell of length L, each
+    contact at overlap delta, so each carries kn delta along a branch of L / 3 from
+    centroid to centroid: sigma_xx = L kn delta / A exactly (the pebbles' own branch,
+    2 r - delta, would give less); nothing along y, and no kinetic part at rest."""
+    from grainlab import ContactModel, Simulation
+    from grainlab.protocols.simple_shear.cell import cell_stress, side_stresses
+
+    r, arm, delta, kn = 1e-3, 0.5e-3, 2e-6, 1e7
+    pitch = 2 * arm + 2 * r - delta  # centroid to centroid
+    length, height = 3 * pitch, 10 * r
+    centres = [(k * pitch + side * arm, 5 * r) for k in range(3) for side in (-1, 1)]
+    sim = Simulation(np.array(centres) + [pitch / 2, 0.0], [r] * 6, 2650.0,
+                     contact_model=ContactModel(kn, kn, 0.5))
+    sim.add_bodies([[0, 1], [2, 3], [4, 5]])
+    sim.set_periodic_cell((0.0, 0.0), (length, height))
+    stress = cell_stress(sim)
+    area = length * height
+    assert stress.contact[0, 0] == pytest.approx(length * kn * delta / area, rel=1e-9)
+    assert abs(stress.contact[1, 1]) < 1e-12 * stress.contact[0, 0]
+    assert not stress.kinetic.any()
+    (sigma_xx, stiffness_xx), = side_stresses(sim, (0,))
+    assert sigma_xx == pytest.approx(stress.total[0, 0], rel=1e-12)
+    # the affine stiffness estimate with the same branches: sum kn (L/3)^2 / A
+    assert stiffness_xx == pytest.approx(3 * kn * pitch**2 / area, rel=1e-9)

@@ -7,9 +7,10 @@ The stress of the cell (compression positive) is
 
     sigma = (1/A) [ sum_c l_c (x) f_c + sum_p m_p v_p (x) v_p ],
 
-``l_c = (r_i + r_j - delta) n`` the branch vector of contact c from i to j,
+``l_c = (r_i + r_j - delta) n`` the branch vector of contact c from i to j
+(for a clump's pebble, from the clump's centroid: the pebbles' arms added),
 ``f_c`` the contact force on j, ``v_p`` each grain's velocity about the
-imposed flow and ``A`` the cell's area.
+imposed flow (a clump's, with its mass) and ``A`` the cell's area.
 
 The control sets the rate of the cell's side k, ``L_kk``, once every
 :data:`CONTROL_STEPS` steps, proportional and integral in the stress gap
@@ -73,28 +74,63 @@ def _stiffness_sum(normal_stiffness: NDArray[np.float64], a: NDArray[np.float64]
     return float((normal_stiffness * a) @ b)
 
 
-def _cell_contacts(sim: Simulation, caller: str) -> tuple[float, Contacts, NDArray[np.float64]]:
-    """The cell's area, the contacts and each contact's branch length ``r_i + r_j - delta``."""
+@dataclass(frozen=True)
+class _CellContacts:
+    """What the cell's stress reads: its area, the contacts, each contact's branch
+    vector from ``i``'s grain to ``j``'s (``(r_i + r_j - delta) n`` between disks,
+    from centroid to centroid for clumps, ``length`` its disks' part) and each
+    grain's mass and velocity (the clumps', not their pebbles')."""
+
+    area: float
+    contacts: Contacts
+    length: NDArray[np.float64]
+    branch: NDArray[np.float64]
+    clumps: bool
+    masses: NDArray[np.float64]
+    velocities: NDArray[np.float64]
+
+
+def _cell_contacts(sim: Simulation, caller: str) -> _CellContacts:
     cell = sim.cell
     if cell is None:
         raise ValueError(f"{caller}: the simulation has no periodic cell")
     c = sim.contacts()
     radii = sim.radii
-    return float(cell.area), c, radii[c.i] + radii[c.j] - c.overlap
+    length = radii[c.i] + radii[c.j] - c.overlap
+    branch = length[:, None] * c.normal
+    if not len(sim.clumps):
+        return _CellContacts(float(cell.area), c, length, branch, False, sim.masses, sim.velocities)
+    clumps = sim.clumps
+    body = sim.body_of_particles
+    pebble = body < len(clumps)
+    # each pebble's arm from its clump's centroid, at its nearest image in the cell
+    arm = np.zeros((sim.n_particles, 2))
+    arm[pebble] = sim.positions[pebble] - clumps.centroid_m[body[pebble]]
+    lattice = np.array([cell.a, cell.b]).T
+    fractions = np.linalg.solve(lattice, arm.T)
+    arm = np.asarray((lattice @ (fractions - np.round(fractions))).T, dtype=np.float64)
+    branch = branch + arm[c.i] - arm[c.j]
+    masses = np.concatenate([sim.masses[~pebble], clumps.mass_kg])
+    velocities = np.concatenate([sim.velocities[~pebble], clumps.velocity_m_per_s])
+    return _CellContacts(float(cell.area), c, length, branch, True, masses, velocities)
 
 
 def cell_stress(sim: Simulation) -> CellStress:
-    """The stress of the periodic cell of ``sim`` (:class:`CellStress`)."""
-    area, c, length = _cell_contacts(sim, "cell_stress")
-    branch = length[:, None] * c.normal
+    """The stress of the periodic cell of ``sim`` (:class:`CellStress`); with clumps,
+    branch vectors between their centroids and their own kinetic part."""
+    g = _cell_contacts(sim, "cell_stress")
+    c, area = g.contacts, g.area
     on_j = -c.force_on_i
-    contact = branch.T @ on_j / area
+    contact = g.branch.T @ on_j / area
     contact = 0.5 * (contact + contact.T)
-    v = sim.velocities
-    masses = sim.masses
-    kinetic = (masses[:, None] * v).T @ v / area
+    v = g.velocities
+    kinetic = (g.masses[:, None] * v).T @ v / area
     n4 = c.normal**4
-    stiffness = c.normal_stiffness * (length**2) @ n4 / area
+    if g.clumps:
+        stiffness = np.array([float((c.normal_stiffness * g.branch[:, k] ** 2) @ (c.normal[:, k] ** 2))
+                              for k in (0, 1)]) / area
+    else:
+        stiffness = c.normal_stiffness * (g.length**2) @ n4 / area
     return CellStress(contact, kinetic, (float(stiffness[0]), float(stiffness[1])), area)
 
 
@@ -102,16 +138,17 @@ def side_stresses(sim: Simulation, sides: Sequence[int]) -> list[tuple[float, fl
     """``(sigma_kk, E_kk)`` of each side ``k`` of ``sides`` (0: x, 1: y) alone, as
     :func:`cell_stress` gives them (to rounding) at a fraction of its cost, from one
     read of the contacts: what the control reads every 100 steps."""
-    area, c, length = _cell_contacts(sim, "side_stresses")
+    g = _cell_contacts(sim, "side_stresses")
+    c, area = g.contacts, g.area
     out = []
     for side in sides:
         n_k = c.normal[:, side]
         # the force on j along k: normal_force n_k - shear_force (on i) t_k, t = (-n_y, n_x)
         tangent_k = -c.normal[:, 1] if side == 0 else c.normal[:, 0]
         on_j = c.normal_force * n_k - c.shear_force * tangent_k
-        lever = length * n_k
-        v = sim.velocities[:, side]
-        stress = (float(lever @ on_j) + float(sim.masses @ (v * v))) / area
+        lever = g.branch[:, side] if g.clumps else g.length * n_k
+        v = g.velocities[:, side]
+        stress = (float(lever @ on_j) + float(g.masses @ (v * v))) / area
         stiffness = _stiffness_sum(c.normal_stiffness, lever * lever, n_k * n_k) / area
         out.append((stress, stiffness))
     return out
