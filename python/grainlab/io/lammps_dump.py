@@ -111,122 +111,25 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
     = (line, problem), so that the frames before it stay readable; a
     timestep given twice is refused.
     """
+    walk = _HeaderWalk(path, lines)
     frames = []
     k = 0
-    n_lines = len(lines)
-    while k < n_lines:
+    while k < len(lines):
         if not lines[k].strip():
             k += 1
             continue
-        frame: dict[str, Any] = {
-            "box": None, "tilt": 0.0, "boundary": [], "time": None, "count": None, "line": k + 1
-        }  # fmt: skip
-        if lines[k].startswith("ITEM: TIME") and not lines[k].startswith("ITEM: TIMESTEP"):
-            # `dump_modify time yes` puts the time first
-            try:
-                frame["time"] = float(lines[k + 1].split()[0])
-            except (IndexError, ValueError):
-                raise FileFormatError(path, k + 2, "expected the simulation time") from None
-            k += 2
-        if k >= n_lines or not lines[k].startswith("ITEM: TIMESTEP"):
-            found = lines[k][:60] if k < n_lines else "the end of the file"
-            raise FileFormatError(path, k + 1, f"expected 'ITEM: TIMESTEP', found {found!r}")
-        if k + 1 >= n_lines:
-            frames.append({**frame, "truncated": (n_lines, "file ends after 'ITEM: TIMESTEP'")})
-            break
-        try:
-            frame["timestep"] = int(lines[k + 1].split()[0])
-        except (IndexError, ValueError):
-            raise FileFormatError(path, k + 2, "expected the timestep number") from None
-        k += 2
-        while True:
-            if k >= n_lines:
-                frame["truncated"] = (k, "file ends inside a frame header (no ITEM: ATOMS / ENTRIES)")
-                break
-            item = lines[k]
-            if not item.startswith("ITEM:"):
-                raise FileFormatError(path, k + 1, f"expected an 'ITEM:' line, found {item[:60]!r}")
-            if item.startswith("ITEM: NUMBER OF") or item.startswith("ITEM: TIME"):
-                if k + 1 >= n_lines:
-                    frame["truncated"] = (n_lines, "file ends inside a frame header")
-                    break
-            if item.startswith("ITEM: NUMBER OF"):
-                try:
-                    frame["count"] = int(lines[k + 1].split()[0])
-                except (IndexError, ValueError):
-                    raise FileFormatError(
-                        path, k + 2, "expected the number of atoms / entries"
-                    ) from None
-                k += 2
-            elif item.startswith("ITEM: BOX BOUNDS"):
-                flags = item.split()[3:]
-                triclinic = flags[:3] == ["xy", "xz", "yz"]
-                if triclinic:
-                    flags = flags[3:]
-                if len(flags) != 3 or not all(_BOUNDARY_FLAG.match(f) for f in flags):
-                    raise FileFormatError(
-                        path,
-                        k + 1,
-                        "expected three boundary flags after 'ITEM: BOX BOUNDS' (x y z, each pp for "
-                        f"periodic or two of f, s, m, e.g. 'pp ff pp'), found {' '.join(flags) or 'none'!r}: "
-                        "cannot tell which directions are periodic",
-                    )
-                if k + 3 >= n_lines:
-                    frame["truncated"] = (n_lines, "file ends inside the box bounds")
-                    break
-                try:
-                    frame["box"], frame["tilt"] = _box_bounds(lines[k + 1 : k + 4], triclinic)
-                except (IndexError, ValueError):
-                    raise FileFormatError(
-                        path,
-                        k + 2,
-                        "expected three lines of box bounds 'lo hi'" + (" tilt" if triclinic else ""),
-                    ) from None
-                except _TiltOutOfPlane as error:
-                    raise FileFormatError(path, k + 3, str(error)) from None
-                for axis, name in ((0, "x"), (1, "y")):
-                    lo, hi = frame["box"][axis]
-                    if not -MAX_LENGTH_M <= lo < hi <= MAX_LENGTH_M:
-                        raise FileFormatError(
-                            path,
-                            k + 2 + axis,
-                            f"box bounds: {name}lo {plain(lo)} and {name}hi {plain(hi)} are not a finite "
-                            f"range with {name}lo < {name}hi",
-                        )
-                frame["boundary"] = flags
-                k += 4
-            elif item.startswith("ITEM: TIME"):
-                try:
-                    frame["time"] = float(lines[k + 1].split()[0])
-                except (IndexError, ValueError):
-                    raise FileFormatError(path, k + 2, "expected the simulation time") from None
-                k += 2
-            elif item.startswith("ITEM: UNITS"):
-                frame["units"] = lines[k + 1].strip() if k + 1 < n_lines else ""
-                k += 2
-            elif item.startswith("ITEM: ATOMS") or item.startswith("ITEM: ENTRIES"):
-                kind = item.split()[1]
-                if frame["count"] is None:
-                    raise FileFormatError(
-                        path, k + 1, f"'ITEM: {kind}' before 'ITEM: NUMBER OF ...'"
-                    )
-                frame["kind"] = kind
-                frame["columns"] = item.split()[2:]
-                frame["header_line"] = k + 1
-                frame["first"] = k + 1
-                k += 1 + frame["count"]
-                if k > n_lines:
-                    frame["truncated"] = (
-                        n_lines,
-                        f"file ends inside a frame: expected {frame['count']} rows "
-                        f"after line {frame['header_line']}",
-                    )
-                break
-            else:
-                raise FileFormatError(path, k + 1, f"unknown dump item {item[:60]!r}")
+        frame, k = walk.start(k)
+        if "truncated" not in frame:
+            k = walk.items(frame, k)
         frames.append(frame)
         if "truncated" in frame:
             break
+    _check_frames(path, frames)
+    return frames
+
+
+def _check_frames(path: str | Path, frames: list[dict[str, Any]]) -> None:
+    """Refuses an empty file, a first frame cut short and a timestep given twice."""
     if not frames:
         raise FileFormatError(path, None, "empty file: no 'ITEM: TIMESTEP' frame")
     if "truncated" in frames[0]:
@@ -241,7 +144,126 @@ def _frame_index(path: str | Path, lines: list[str]) -> list[dict[str, Any]]:
                 f"{first_line[frame['timestep']]}): which frame is meant is ambiguous",
             )
         first_line[frame["timestep"]] = frame["line"]
-    return frames
+
+
+class _HeaderWalk:
+    """The header items of a dump's frames, line by line (:func:`_frame_index`);
+    each method takes the line index ``k`` of an item and returns the next one."""
+
+    def __init__(self, path: str | Path, lines: list[str]) -> None:
+        self.path, self.lines, self.n = path, lines, len(lines)
+
+    def value(self, k: int, cast: type[int] | type[float], what: str) -> Any:
+        """The first word of line ``k + 1`` as ``cast``, or a clear error naming it."""
+        try:
+            return cast(self.lines[k + 1].split()[0])
+        except (IndexError, ValueError):
+            raise FileFormatError(self.path, k + 2, f"expected {what}") from None
+
+    def start(self, k: int) -> tuple[dict[str, Any], int]:
+        """A new frame from its (optional ``ITEM: TIME`` and) ``ITEM: TIMESTEP`` lines."""
+        lines, n = self.lines, self.n
+        frame: dict[str, Any] = {
+            "box": None, "tilt": 0.0, "boundary": [], "time": None, "count": None, "line": k + 1
+        }  # fmt: skip
+        if lines[k].startswith("ITEM: TIME") and not lines[k].startswith("ITEM: TIMESTEP"):
+            # `dump_modify time yes` puts the time first
+            frame["time"] = self.value(k, float, "the simulation time")
+            k += 2
+        if k >= n or not lines[k].startswith("ITEM: TIMESTEP"):
+            found = lines[k][:60] if k < n else "the end of the file"
+            raise FileFormatError(self.path, k + 1, f"expected 'ITEM: TIMESTEP', found {found!r}")
+        if k + 1 >= n:
+            frame["truncated"] = (n, "file ends after 'ITEM: TIMESTEP'")
+            return frame, n
+        frame["timestep"] = self.value(k, int, "the timestep number")
+        return frame, k + 2
+
+    def items(self, frame: dict[str, Any], k: int) -> int:
+        """The frame's header items up to and over its table (``ATOMS`` / ``ENTRIES``)."""
+        lines, n = self.lines, self.n
+        while True:
+            if k >= n:
+                frame["truncated"] = (k, "file ends inside a frame header (no ITEM: ATOMS / ENTRIES)")
+                return k
+            item = lines[k]
+            if not item.startswith("ITEM:"):
+                raise FileFormatError(self.path, k + 1, f"expected an 'ITEM:' line, found {item[:60]!r}")
+            if (item.startswith("ITEM: NUMBER OF") or item.startswith("ITEM: TIME")) and k + 1 >= n:
+                frame["truncated"] = (n, "file ends inside a frame header")
+                return k
+            if item.startswith("ITEM: NUMBER OF"):
+                frame["count"] = self.value(k, int, "the number of atoms / entries")
+                k += 2
+            elif item.startswith("ITEM: BOX BOUNDS"):
+                k = self.box(frame, k, item)
+                if "truncated" in frame:
+                    return k
+            elif item.startswith("ITEM: TIME"):
+                frame["time"] = self.value(k, float, "the simulation time")
+                k += 2
+            elif item.startswith("ITEM: UNITS"):
+                frame["units"] = lines[k + 1].strip() if k + 1 < n else ""
+                k += 2
+            elif item.startswith("ITEM: ATOMS") or item.startswith("ITEM: ENTRIES"):
+                return self.table(frame, k, item)
+            else:
+                raise FileFormatError(self.path, k + 1, f"unknown dump item {item[:60]!r}")
+
+    def box(self, frame: dict[str, Any], k: int, item: str) -> int:
+        """``ITEM: BOX BOUNDS`` with its boundary flags and three lines of bounds."""
+        path = self.path
+        flags = item.split()[3:]
+        triclinic = flags[:3] == ["xy", "xz", "yz"]
+        if triclinic:
+            flags = flags[3:]
+        if len(flags) != 3 or not all(_BOUNDARY_FLAG.match(f) for f in flags):
+            raise FileFormatError(
+                path,
+                k + 1,
+                "expected three boundary flags after 'ITEM: BOX BOUNDS' (x y z, each pp for "
+                f"periodic or two of f, s, m, e.g. 'pp ff pp'), found {' '.join(flags) or 'none'!r}: "
+                "cannot tell which directions are periodic",
+            )
+        if k + 3 >= self.n:
+            frame["truncated"] = (self.n, "file ends inside the box bounds")
+            return k
+        try:
+            frame["box"], frame["tilt"] = _box_bounds(self.lines[k + 1 : k + 4], triclinic)
+        except (IndexError, ValueError):
+            raise FileFormatError(
+                path, k + 2, "expected three lines of box bounds 'lo hi'" + (" tilt" if triclinic else "")
+            ) from None
+        except _TiltOutOfPlane as error:
+            raise FileFormatError(path, k + 3, str(error)) from None
+        for axis, name in ((0, "x"), (1, "y")):
+            lo, hi = frame["box"][axis]
+            if not -MAX_LENGTH_M <= lo < hi <= MAX_LENGTH_M:
+                raise FileFormatError(
+                    path,
+                    k + 2 + axis,
+                    f"box bounds: {name}lo {plain(lo)} and {name}hi {plain(hi)} are not a finite "
+                    f"range with {name}lo < {name}hi",
+                )
+        frame["boundary"] = flags
+        return k + 4
+
+    def table(self, frame: dict[str, Any], k: int, item: str) -> int:
+        """``ITEM: ATOMS`` / ``ENTRIES``: the columns, and past the table's rows."""
+        kind = item.split()[1]
+        if frame["count"] is None:
+            raise FileFormatError(self.path, k + 1, f"'ITEM: {kind}' before 'ITEM: NUMBER OF ...'")
+        frame["kind"] = kind
+        frame["columns"] = item.split()[2:]
+        frame["header_line"] = k + 1
+        frame["first"] = k + 1
+        k += 1 + frame["count"]
+        if k > self.n:
+            frame["truncated"] = (
+                self.n,
+                f"file ends inside a frame: expected {frame['count']} rows after line {frame['header_line']}",
+            )
+        return k
 
 
 class _TiltOutOfPlane(Exception):
@@ -359,69 +381,16 @@ def read_lammps_dump(
         raise ValueError(
             "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
         )
-    frame = read_dump_frames(path, timestep)
-    if frame.kind != "ATOMS":
-        raise FileFormatError(
-            path,
-            frame.header_line,
-            f"expected an atoms dump ('ITEM: ATOMS'), found 'ITEM: {frame.kind}'",
-        )
+    frame = _atoms_frame(path, timestep)
     col = {name: frame.data[:, k] for k, name in enumerate(frame.columns)}
-    where = frame.header_line
-    if "id" not in col:
-        raise FileFormatError(
-            path, where, f"missing column 'id' (columns: {' '.join(frame.columns)})"
-        )
-    numbers = frame.line_numbers
-    if frame.data.shape[0] == 0:
-        raise FileFormatError(path, where, "the frame has no atoms")
+    where, numbers = frame.header_line, frame.line_numbers
     ids = integral_column(path, col["id"], numbers, "id")
     check_unique_ids(path, ids, numbers)
     box2 = None if frame.box is None else frame.box[:2].copy()
     used = {"id", "z", "zu", "zs", "zsu", "vz", "fz", "omegax", "omegay", "ix", "iy", "iz"}
-    for xn, yn, scaled in (
-        ("x", "y", False),
-        ("xu", "yu", False),
-        ("xs", "ys", True),
-        ("xsu", "ysu", True),
-    ):
-        if xn in col and yn in col:
-            x, y = col[xn].copy(), col[yn].copy()
-            if scaled:
-                if box2 is None:
-                    raise FileFormatError(path, where, "scaled coordinates need the box bounds")
-                x = box2[0, 0] + x * (box2[0, 1] - box2[0, 0]) + y * frame.tilt
-                y = box2[1, 0] + y * (box2[1, 1] - box2[1, 0])
-            used |= {xn, yn}
-            position_columns = f"{xn} {yn}"
-            break
-    else:
-        raise FileFormatError(
-            path,
-            where,
-            "missing position columns 'x y' (or xu yu, xs ys) "
-            f"(columns: {' '.join(frame.columns)})",
-        )
-    if "radius" in col:
-        radius = col["radius"]
-        used.add("radius")
-        rname = "radius"
-    elif "diameter" in col:
-        radius = 0.5 * col["diameter"]
-        used.add("diameter")
-        rname = "diameter"
-    else:
-        raise FileFormatError(
-            path,
-            where,
-            f"missing column 'radius' (or 'diameter') (columns: {' '.join(frame.columns)})",
-        )
-    bad = radius <= 0
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(
-            path, int(numbers[k]), f"column {rname!r}: {plain(col[rname][k])} is not > 0"
-        )
+    x, y, (xn, yn) = _dump_positions(path, frame, col, box2)
+    used |= {xn, yn}
+    radius = _dump_radii(path, frame, col, used)
     zn = {"x": "z", "xu": "zu", "xs": "zs", "xsu": "zsu"}[xn]
     z = col[zn] if zn in col else None
     if z is not None and zn in ("zs", "zsu"):
@@ -429,6 +398,117 @@ def read_lammps_dump(
         z = frame.box[2, 0] + z * (frame.box[2, 1] - frame.box[2, 0])
     plan = planar(path, where, z, radius, z_policy=z_policy, z0=z0, column=zn)
     check_geometry(path, np.c_[x, y][plan.keep], plan.radii, numbers[plan.keep], (xn, yn))
+    fields = _dump_fields(col, used)
+    fields |= _label_fields(path, frame, {"body_column": body_column, "grain_column": grain_column})
+    kind = _dump_kinds(path, frame, col, boundary_types)
+    periodic = _dump_periodic(path, frame, z_policy)
+    metadata = {"source": str(path), "format": "lammps-dump", "timestep": frame.timestep, "positions": f"{xn} {yn}"}
+    snap_kwargs: dict[str, Any] = dict(
+        ids=ids, kind=kind, particle_fields=fields, box=box2, tilt=frame.tilt, time=frame.time, metadata=metadata,
+        periodic=periodic if box2 is not None else (False, False),
+    )  # fmt: skip
+    reading = _Reading(frame, plan, contacts, columns, detect, tolerance)
+    return _dump_snapshot(path, reading, np.c_[x, y], radius, snap_kwargs)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Reading:
+    """How :func:`read_lammps_dump` was asked to make its snapshot."""
+
+    frame: DumpFrame
+    plan: Any
+    contacts: str | Path | None
+    columns: Mapping[str, str] | None
+    detect: bool
+    tolerance: float
+
+
+def _dump_snapshot(path: str | Path, reading: _Reading, positions: NDArray[np.float64],
+                   radius: NDArray[np.float64], snap_kwargs: dict[str, Any]) -> Snapshot:
+    """The snapshot of the atoms: the rows 3D data keeps, and its contacts (from a
+    contacts dump, detected in 3D or in the plane, or none)."""
+    plan, tolerance, metadata = reading.plan, reading.tolerance, snap_kwargs["metadata"]
+    if plan.z is not None:  # 3D data read as asked: keep the chosen rows, z as a field
+        keep = plan.keep
+        positions, radius = positions[keep], plan.radii
+        fields = {name: values[keep] for name, values in snap_kwargs["particle_fields"].items()} | {"z": plan.z}
+        metadata.update(plan.metadata)
+        kind = snap_kwargs["kind"]
+        snap_kwargs.update(
+            ids=snap_kwargs["ids"][keep], kind=None if kind is None else kind[keep], particle_fields=fields
+        )
+    if reading.contacts is not None:
+        snap = Snapshot(positions, radius, **snap_kwargs)
+        return attach_lammps_contacts(snap, reading.contacts, timestep=reading.frame.timestep, columns=reading.columns)
+    if reading.detect and plan.spheres and plan.z is not None:
+        i, j, normals = sphere_contacts(
+            path, positions, plan.z, radius, snap_kwargs["ids"], tolerance=tolerance,
+            box=snap_kwargs["box"], periodic=snap_kwargs["periodic"],
+        )  # fmt: skip
+        metadata["contacts"] = f"detected between the spheres in 3D (tolerance {tolerance:g} m)"
+        return Snapshot(positions, radius, contact_i=i, contact_j=j, contact_normal=normals, **snap_kwargs)
+    if reading.detect:
+        return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **snap_kwargs)
+    return Snapshot(positions, radius, **snap_kwargs)
+
+
+def _atoms_frame(path: str | Path, timestep: int | None) -> DumpFrame:
+    """The frame of an atoms dump, with an ``id`` column and at least one atom."""
+    frame = read_dump_frames(path, timestep)
+    where = frame.header_line
+    if frame.kind != "ATOMS":
+        raise FileFormatError(path, where, f"expected an atoms dump ('ITEM: ATOMS'), found 'ITEM: {frame.kind}'")
+    if "id" not in frame.columns:
+        raise FileFormatError(path, where, f"missing column 'id' (columns: {' '.join(frame.columns)})")
+    if frame.data.shape[0] == 0:
+        raise FileFormatError(path, where, "the frame has no atoms")
+    return frame
+
+
+def _dump_positions(
+    path: str | Path, frame: DumpFrame, col: Mapping[str, NDArray[np.float64]], box2: NDArray[np.float64] | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[str, str]]:
+    """The atoms' x and y (m) from the first pair of position columns found, unscaled."""
+    for xn, yn, scaled in (("x", "y", False), ("xu", "yu", False), ("xs", "ys", True), ("xsu", "ysu", True)):
+        if xn in col and yn in col:
+            x, y = col[xn].copy(), col[yn].copy()
+            if scaled:
+                if box2 is None:
+                    raise FileFormatError(path, frame.header_line, "scaled coordinates need the box bounds")
+                x = box2[0, 0] + x * (box2[0, 1] - box2[0, 0]) + y * frame.tilt
+                y = box2[1, 0] + y * (box2[1, 1] - box2[1, 0])
+            return x, y, (xn, yn)
+    raise FileFormatError(
+        path,
+        frame.header_line,
+        f"missing position columns 'x y' (or xu yu, xs ys) (columns: {' '.join(frame.columns)})",
+    )
+
+
+def _dump_radii(path: str | Path, frame: DumpFrame, col: Mapping[str, NDArray[np.float64]],
+                used: set[str]) -> NDArray[np.float64]:
+    """The atoms' radii (m) from ``radius`` or ``diameter``, each > 0; the column joins ``used``."""
+    if "radius" in col:
+        radius, rname = col["radius"], "radius"
+    elif "diameter" in col:
+        radius, rname = 0.5 * col["diameter"], "diameter"
+    else:
+        raise FileFormatError(
+            path,
+            frame.header_line,
+            f"missing column 'radius' (or 'diameter') (columns: {' '.join(frame.columns)})",
+        )
+    used.add(rname)
+    bad = radius <= 0
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise FileFormatError(path, int(frame.line_numbers[k]), f"column {rname!r}: {plain(col[rname][k])} is not > 0")
+    return radius
+
+
+def _dump_fields(col: Mapping[str, NDArray[np.float64]], used: set[str]) -> dict[str, NDArray[Any]]:
+    """The particle fields of the columns not read otherwise: velocity and force as
+    pairs, every other column as it is."""
     fields: dict[str, NDArray[Any]] = {}
     for pair, name in ((("vx", "vy"), "velocity"), (("fx", "fy"), "force")):
         if pair[0] in col and pair[1] in col:
@@ -437,61 +517,31 @@ def read_lammps_dump(
     for name, values in col.items():
         if name not in used:
             fields[name] = values
-    fields |= _label_fields(path, frame, {"body_column": body_column, "grain_column": grain_column})
-    kind = None
-    if len(boundary_types):
-        if "type" not in col:
-            raise FileFormatError(path, where, "boundary_types needs a 'type' column in the dump")
-        kind = np.where(
-            np.isin(col["type"], np.asarray(boundary_types, dtype=np.float64)),
-            ParticleKind.MEMBRANE,
-            ParticleKind.SOIL,
-        )
+    return fields
+
+
+def _dump_kinds(path: str | Path, frame: DumpFrame, col: Mapping[str, NDArray[np.float64]],
+                boundary_types: Sequence[int]) -> NDArray[Any] | None:
+    """Each atom's kind: a boundary atom (``MEMBRANE``) of a type in ``boundary_types``."""
+    if not len(boundary_types):
+        return None
+    if "type" not in col:
+        raise FileFormatError(path, frame.header_line, "boundary_types needs a 'type' column in the dump")
+    return np.where(
+        np.isin(col["type"], np.asarray(boundary_types, dtype=np.float64)), ParticleKind.MEMBRANE, ParticleKind.SOIL
+    )
+
+
+def _dump_periodic(path: str | Path, frame: DumpFrame, z_policy: str) -> tuple[bool, bool]:
+    """Which of x and y are periodic (``pp``); a tilted box needs y periodic and no 3D policy."""
     periodic = (False, False)
     if frame.boundary:
         periodic = (frame.boundary[0] == "pp", frame.boundary[1] == "pp")
     if frame.tilt != 0.0 and not periodic[1]:
-        raise FileFormatError(path, where, "a triclinic box with xy tilt needs y periodic ('pp')")
+        raise FileFormatError(path, frame.header_line, "a triclinic box with xy tilt needs y periodic ('pp')")
     if frame.tilt != 0.0 and z_policy != "refuse":
         raise ValueError(f"z_policy: {z_policy!r} is not supported in a triclinic (tilted) box")
-    metadata = {
-        "source": str(path),
-        "format": "lammps-dump",
-        "timestep": frame.timestep,
-        "positions": position_columns,
-    }
-    snap_kwargs: dict[str, Any] = dict(
-        ids=ids,
-        kind=kind,
-        particle_fields=fields,
-        box=box2,
-        periodic=periodic if box2 is not None else (False, False),
-        tilt=frame.tilt,
-        time=frame.time,
-        metadata=metadata,
-    )
-    positions = np.c_[x, y]
-    if plan.z is not None:  # 3D data read as asked: keep the chosen rows, z as a field
-        keep = plan.keep
-        positions, radius = positions[keep], plan.radii
-        fields = {name: values[keep] for name, values in fields.items()} | {"z": plan.z}
-        metadata.update(plan.metadata)
-        snap_kwargs.update(
-            ids=ids[keep], kind=None if kind is None else kind[keep], particle_fields=fields
-        )
-    if contacts is not None:
-        snap = Snapshot(positions, radius, **snap_kwargs)
-        return attach_lammps_contacts(snap, contacts, timestep=frame.timestep, columns=columns)
-    if detect and plan.spheres and plan.z is not None:
-        i, j, normals = sphere_contacts(
-            path, positions, plan.z, radius, snap_kwargs["ids"], tolerance=tolerance,
-            box=box2, periodic=snap_kwargs["periodic"],
-        )  # fmt: skip
-        metadata["contacts"] = f"detected between the spheres in 3D (tolerance {tolerance:g} m)"
-        return Snapshot(positions, radius, contact_i=i, contact_j=j, contact_normal=normals, **snap_kwargs)
-    if detect:
-        return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **snap_kwargs)
-    return Snapshot(positions, radius, **snap_kwargs)
+    return periodic
 
 
 #: The label fields a dump's columns may give: argument -> (field, what, least label).
@@ -591,6 +641,49 @@ def _guess_id_columns(frame: DumpFrame, atom_ids: NDArray[np.int64]) -> dict[str
     return {}
 
 
+def _pair_indices(snapshot: Snapshot, path: str | Path, frame: DumpFrame,
+                  roles: Mapping[str, int]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The snapshot's indices of each listed pair's atoms; an unknown id or an atom
+    paired with itself is refused, naming the line."""
+    numbers = frame.line_numbers
+    id_i = integral_column(path, frame.data[:, roles["i"]], numbers, frame.columns[roles["i"]])
+    id_j = integral_column(path, frame.data[:, roles["j"]], numbers, frame.columns[roles["j"]])
+    i = snapshot.index_of(id_i)
+    j = snapshot.index_of(id_j)
+    for role, idx, vals in (("i", i, id_i), ("j", j, id_j)):
+        bad = idx < 0
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(
+                path,
+                int(numbers[k]),
+                f"column {frame.columns[roles[role]]!r}: unknown atom id {int(vals[k])}",
+            )
+    same = i == j
+    if same.any():
+        k = int(np.argmax(same))
+        raise FileFormatError(path, int(numbers[k]), f"atom id {int(id_i[k])} paired with itself")
+    return i, j
+
+
+def _pair_forces(data: NDArray[np.float64], roles: Mapping[str, int],
+                 n_hat: NDArray[np.float64]) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
+    """Each pair's normal force (compression positive) and shear force along
+    ``(-n_y, n_x)`` from the columns there are (None where none gives it)."""
+    t_hat = np.c_[-n_hat[:, 1], n_hat[:, 0]]
+    normal_force = None
+    if "normal_force" in roles:
+        normal_force = data[:, roles["normal_force"]]
+    elif "fx" in roles and "fy" in roles:
+        normal_force = -(data[:, roles["fx"]] * n_hat[:, 0] + data[:, roles["fy"]] * n_hat[:, 1])
+    shear_force = None
+    if "shear_x" in roles and "shear_y" in roles:
+        shear_force = data[:, roles["shear_x"]] * t_hat[:, 0] + data[:, roles["shear_y"]] * t_hat[:, 1]
+    elif "shear_force" in roles:
+        shear_force = data[:, roles["shear_force"]]
+    return normal_force, shear_force
+
+
 def attach_lammps_contacts(
     snapshot: Snapshot,
     path: str | Path,
@@ -608,26 +701,9 @@ def attach_lammps_contacts(
             frame.header_line,
             f"expected a local dump ('ITEM: ENTRIES'), found 'ITEM: {frame.kind}'",
         )
-    ids = np.asarray(snapshot.ids)
-    roles = _resolve_columns(path, frame, columns, ids)
+    roles = _resolve_columns(path, frame, columns, np.asarray(snapshot.ids))
     data, numbers = frame.data, frame.line_numbers
-    id_i = integral_column(path, data[:, roles["i"]], numbers, frame.columns[roles["i"]])
-    id_j = integral_column(path, data[:, roles["j"]], numbers, frame.columns[roles["j"]])
-    i = snapshot.index_of(id_i)
-    j = snapshot.index_of(id_j)
-    for role, idx, vals in (("i", i, id_i), ("j", j, id_j)):
-        bad = idx < 0
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise FileFormatError(
-                path,
-                int(numbers[k]),
-                f"column {frame.columns[roles[role]]!r}: unknown atom id {int(vals[k])}",
-            )
-    same = i == j
-    if same.any():
-        k = int(np.argmax(same))
-        raise FileFormatError(path, int(numbers[k]), f"atom id {int(id_i[k])} paired with itself")
+    i, j = _pair_indices(snapshot, path, frame, roles)
 
     d = snapshot.minimum_image(snapshot.positions[j] - snapshot.positions[i])
     dist_geom = np.hypot(d[:, 0], d[:, 1])
@@ -641,20 +717,7 @@ def attach_lammps_contacts(
             path, int(numbers[k]), "the two atoms of this pair have the same position"
         )
     n_hat = d / dist_geom[:, None]
-    t_hat = np.c_[-n_hat[:, 1], n_hat[:, 0]]
-
-    normal_force = None
-    if "normal_force" in roles:
-        normal_force = data[:, roles["normal_force"]]
-    elif "fx" in roles and "fy" in roles:
-        normal_force = -(data[:, roles["fx"]] * n_hat[:, 0] + data[:, roles["fy"]] * n_hat[:, 1])
-    shear_force = None
-    if "shear_x" in roles and "shear_y" in roles:
-        shear_force = (
-            data[:, roles["shear_x"]] * t_hat[:, 0] + data[:, roles["shear_y"]] * t_hat[:, 1]
-        )
-    elif "shear_force" in roles:
-        shear_force = data[:, roles["shear_force"]]
+    normal_force, shear_force = _pair_forces(data, roles, n_hat)
 
     keep = touching
     metadata = dict(snapshot.metadata)
