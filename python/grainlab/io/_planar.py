@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.io._table import FileFormatError
-from grainlab.snapshot import detect_contacts
+from grainlab.snapshot import Snapshot, detect_contacts
 
 #: Largest spread of z (max - min), as a fraction of the smallest radius, read as 2D.
 PLANAR_TOLERANCE = 1e-3
@@ -133,3 +133,41 @@ def sphere_contacts(
             "above the other: their contact has no direction in the plane",
         )
     return i, j, d / length[:, None]
+
+
+def keep_planar_rows(
+    plan: Planar, positions: NDArray[np.float64], radii: NDArray[np.float64], kwargs: dict[str, Any], *,
+    z_field: bool,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A reader's positions and radii as ``plan`` keeps them: with 3D data read as
+    asked, the chosen rows, and in ``kwargs`` (the Snapshot's) the same rows of
+    ``ids``, ``kind``, ``rotations`` and every particle field (``z`` added as a field
+    when ``z_field``) and the plan's metadata; else as they are."""
+    if plan.z is None:
+        return positions, radii
+    keep = plan.keep
+    for key in ("ids", "kind", "rotations"):
+        if kwargs.get(key) is not None:
+            kwargs[key] = kwargs[key][keep]
+    fields = {name: values[keep] for name, values in kwargs["particle_fields"].items()}
+    kwargs["particle_fields"] = fields | {"z": plan.z} if z_field else fields
+    kwargs["metadata"].update(plan.metadata)
+    return positions[keep], plan.radii
+
+
+def detected_snapshot(
+    path: str | Path, plan: Planar, positions: NDArray[np.float64], radii: NDArray[np.float64],
+    kwargs: dict[str, Any], *, detect: bool, tolerance: float,
+) -> Snapshot:
+    """A reader's snapshot with its contacts detected: between the spheres in 3D
+    for projected 3D data, else in the plane; none when not ``detect``."""
+    if detect and plan.spheres and plan.z is not None:
+        i, j, normals = sphere_contacts(
+            path, positions, plan.z, radii, kwargs["ids"], tolerance=tolerance,
+            box=kwargs.get("box"), periodic=kwargs.get("periodic", (False, False)),
+        )  # fmt: skip
+        kwargs["metadata"]["contacts"] = f"detected between the spheres in 3D (tolerance {tolerance:g} m)"
+        return Snapshot(positions, radii, contact_i=i, contact_j=j, contact_normal=normals, **kwargs)
+    if detect:
+        return Snapshot.from_geometry(positions, radii, tolerance=tolerance, **kwargs)
+    return Snapshot(positions, radii, **kwargs)

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.io._planar import planar, sphere_contacts
+from grainlab.io._planar import detected_snapshot, planar
 from grainlab.io._table import FileFormatError, check_geometry, check_unique_ids, plain
 from grainlab.snapshot import ParticleKind, Snapshot
 
@@ -57,10 +57,4 @@ def snapshot_from_points(
     fields = {name: value[keep] for name, value in fields.items()}
     metadata = {**metadata, **plan.metadata}
     kwargs: dict[str, Any] = dict(ids=ids, kind=kind, particle_fields=fields, metadata=metadata)
-    if plan.spheres and plan.z is not None:
-        i, j, normals = sphere_contacts(
-            path, positions, plan.z, plan.radii, ids, tolerance=tolerance, box=None, periodic=(False, False)
-        )
-        metadata["contacts"] = f"detected between the spheres in 3D (tolerance {tolerance:g} m)"
-        return Snapshot(positions, plan.radii, contact_i=i, contact_j=j, contact_normal=normals, **kwargs)
-    return Snapshot.from_geometry(positions, plan.radii, tolerance=tolerance, **kwargs)
+    return detected_snapshot(path, plan, positions, plan.radii, kwargs, detect=True, tolerance=tolerance)

@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from grainlab.io._planar import check_z_policy, planar, sphere_contacts
+from grainlab.io._planar import check_z_policy, detected_snapshot, keep_planar_rows, planar
 from grainlab.io._table import (
     FileFormatError,
     check_geometry,
@@ -252,17 +252,7 @@ def read_particles_csv(
     if bad.any():
         k = int(np.argmax(bad))
         raise FileFormatError(path, int(numbers[k]), f"column 'radius': {plain(radius[k])} is not > 0")
-    kind = None
-    if "kind" not in col:
-        warn_missing_kind(path)
-    else:
-        kind = integral_column(path, col["kind"], numbers, "kind")
-        bad = ~np.isin(kind, [int(k) for k in ParticleKind])
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise FileFormatError(
-                path, int(numbers[k]), f"column 'kind': unknown code {int(kind[k])}"
-            )
+    kind = _kinds(path, col, numbers)
     extra = _label_fields(path, col, numbers)
     positions = np.c_[col["x"], col["y"]]
     metadata: dict[str, Any] = {"source": str(path), "format": format_name}
@@ -271,28 +261,30 @@ def read_particles_csv(
     rotations = col.get("rotation")
     plan = planar(path, None, col.get("z"), radius, z_policy=z_policy, z0=z0)
     check_geometry(path, positions[plan.keep], plan.radii, numbers[plan.keep])
-    if plan.z is not None:  # 3D data read as asked: keep the chosen rows
-        keep = plan.keep
-        positions, radius, ids = positions[keep], plan.radii, ids[keep]
-        kind = None if kind is None else kind[keep]
-        rotations = None if rotations is None else rotations[keep]
-        extra = {n: v[keep] for n, v in extra.items()}
-        metadata.update(plan.metadata)
     kwargs: dict[str, Any] = dict(
         ids=ids, rotations=rotations, kind=kind, particle_fields=extra, metadata=metadata
     )
+    positions, radius = keep_planar_rows(plan, positions, radius, kwargs, z_field=False)
     if contacts is not None:
         snap = Snapshot(positions, radius, **kwargs)
         return attach_contacts_csv(snap, contacts, columns=contact_map)
-    if detect and plan.spheres and plan.z is not None:
-        i, j, normals = sphere_contacts(
-            path, positions, plan.z, radius, ids, tolerance=tolerance, box=None, periodic=(False, False)
-        )
-        metadata["contacts"] = f"detected between the spheres in 3D (tolerance {tolerance:g} m)"
-        return Snapshot(positions, radius, contact_i=i, contact_j=j, contact_normal=normals, **kwargs)
-    if detect:
-        return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **kwargs)
-    return Snapshot(positions, radius, **kwargs)
+    return detected_snapshot(path, plan, positions, radius, kwargs, detect=detect, tolerance=tolerance)
+
+
+def _kinds(
+    path: str | Path, col: Mapping[str, NDArray[np.float64]], numbers: NDArray[np.int64]
+) -> NDArray[np.int64] | None:
+    """The particles' kinds from the ``kind`` column (known codes only), or None with
+    a :class:`MissingKindWarning` when there is none."""
+    if "kind" not in col:
+        warn_missing_kind(path)
+        return None
+    kind = integral_column(path, col["kind"], numbers, "kind")
+    bad = ~np.isin(kind, [int(k) for k in ParticleKind])
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise FileFormatError(path, int(numbers[k]), f"column 'kind': unknown code {int(kind[k])}")
+    return kind
 
 
 def _label_fields(

@@ -61,7 +61,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from grainlab.io._planar import check_z_policy, planar, sphere_contacts
+from grainlab.io._planar import check_z_policy, detected_snapshot, keep_planar_rows, planar
 from grainlab.io._table import (
     MAX_LENGTH_M,
     FileFormatError,
@@ -407,49 +407,11 @@ def read_lammps_dump(
         ids=ids, kind=kind, particle_fields=fields, box=box2, tilt=frame.tilt, time=frame.time, metadata=metadata,
         periodic=periodic if box2 is not None else (False, False),
     )  # fmt: skip
-    reading = _Reading(frame, plan, contacts, columns, detect, tolerance)
-    return _dump_snapshot(path, reading, np.c_[x, y], radius, snap_kwargs)
-
-
-@dataclasses.dataclass(frozen=True)
-class _Reading:
-    """How :func:`read_lammps_dump` was asked to make its snapshot."""
-
-    frame: DumpFrame
-    plan: Any
-    contacts: str | Path | None
-    columns: Mapping[str, str] | None
-    detect: bool
-    tolerance: float
-
-
-def _dump_snapshot(path: str | Path, reading: _Reading, positions: NDArray[np.float64],
-                   radius: NDArray[np.float64], snap_kwargs: dict[str, Any]) -> Snapshot:
-    """The snapshot of the atoms: the rows 3D data keeps, and its contacts (from a
-    contacts dump, detected in 3D or in the plane, or none)."""
-    plan, tolerance, metadata = reading.plan, reading.tolerance, snap_kwargs["metadata"]
-    if plan.z is not None:  # 3D data read as asked: keep the chosen rows, z as a field
-        keep = plan.keep
-        positions, radius = positions[keep], plan.radii
-        fields = {name: values[keep] for name, values in snap_kwargs["particle_fields"].items()} | {"z": plan.z}
-        metadata.update(plan.metadata)
-        kind = snap_kwargs["kind"]
-        snap_kwargs.update(
-            ids=snap_kwargs["ids"][keep], kind=None if kind is None else kind[keep], particle_fields=fields
-        )
-    if reading.contacts is not None:
+    positions, radius = keep_planar_rows(plan, np.c_[x, y], radius, snap_kwargs, z_field=True)
+    if contacts is not None:
         snap = Snapshot(positions, radius, **snap_kwargs)
-        return attach_lammps_contacts(snap, reading.contacts, timestep=reading.frame.timestep, columns=reading.columns)
-    if reading.detect and plan.spheres and plan.z is not None:
-        i, j, normals = sphere_contacts(
-            path, positions, plan.z, radius, snap_kwargs["ids"], tolerance=tolerance,
-            box=snap_kwargs["box"], periodic=snap_kwargs["periodic"],
-        )  # fmt: skip
-        metadata["contacts"] = f"detected between the spheres in 3D (tolerance {tolerance:g} m)"
-        return Snapshot(positions, radius, contact_i=i, contact_j=j, contact_normal=normals, **snap_kwargs)
-    if reading.detect:
-        return Snapshot.from_geometry(positions, radius, tolerance=tolerance, **snap_kwargs)
-    return Snapshot(positions, radius, **snap_kwargs)
+        return attach_lammps_contacts(snap, contacts, timestep=frame.timestep, columns=columns)
+    return detected_snapshot(path, plan, positions, radius, snap_kwargs, detect=detect, tolerance=tolerance)
 
 
 def _atoms_frame(path: str | Path, timestep: int | None) -> DumpFrame:
