@@ -193,22 +193,9 @@ def _read_arrays(tok: _Tokens, n: int, into: dict[str, NDArray[np.float64]] | No
             into[name] = values[:, 0] if values.shape[1] == 1 else values
 
 
-def read_legacy_vtk(
-    path: str | Path,
-    *,
-    tolerance: float = 0.0,
-    boundary_types: Sequence[int] = (),
-    radius_array: str = "radius",
-    z_policy: str = "refuse",
-    z0: float | None = None,
-) -> Snapshot:
-    """Read an ASCII legacy VTK particle file (LIGGGHTS / LAMMPS ``dump custom/vtk``).
-
-    The particles are the points, with the radius array ``radius_array``;
-    see the module documentation for ids, kinds, fields and z.
-    """
-    check_z_policy(z_policy, z0)
-    p = Path(path)
+def _vtk_header(p: Path) -> tuple[float, _Tokens]:
+    """A legacy VTK file's version and its tokens from the ``DATASET`` line on,
+    checked: ASCII, and a dataset of points (POLYDATA or UNSTRUCTURED_GRID)."""
     lines = read_lines(p)
     if len(lines) < 4 or not is_legacy_vtk(lines[0]):
         raise FileFormatError(p, 1, "not a legacy VTK file (first line '# vtk DataFile Version x.y')")
@@ -228,7 +215,16 @@ def read_legacy_vtk(
     dataset = tok.word("dataset type").upper()
     if dataset not in ("POLYDATA", "UNSTRUCTURED_GRID"):
         raise FileFormatError(p, tok.line[1], f"DATASET {dataset}: particles are POLYDATA or UNSTRUCTURED_GRID")
+    return version, tok
+
+
+def _vtk_sections(
+    p: Path, tok: _Tokens, version: float
+) -> tuple[NDArray[np.float64] | None, NDArray[np.int64], int | None, dict[str, NDArray[np.float64]]]:
+    """The points (N, 3), each point's file line, the POINTS line and the point
+    arrays of the sections after ``DATASET`` (cells and field data skipped)."""
     points: NDArray[np.float64] | None = None
+    point_lines = np.zeros(0, dtype=np.int64)
     points_line = None
     arrays: dict[str, NDArray[np.float64]] = {}
     while not tok.done():
@@ -253,15 +249,55 @@ def read_legacy_vtk(
                 raise FileFormatError(p, line, f"POINT_DATA {n} does not match the POINTS count")
             _read_arrays(tok, n, arrays if key == "POINT_DATA" else None)
         elif key == "FIELD":  # dataset-level field data (TIME, CYCLE): not per particle
-            tok.word("FIELD name")
-            for _ in range(tok.integer("FIELD array count")):
-                name = tok.word("FIELD array name")
-                ncomp, ntuples = tok.integer(f"{name} components"), tok.integer(f"{name} tuples")
-                tok.word(f"{name} type")
-                tok.numbers(ncomp * ntuples, f"array {name}")
-                tok.skip_metadata()
+            _skip_field_data(tok)
         else:
             raise FileFormatError(p, line, f"unexpected section {key!r}")
+    return points, point_lines, points_line, arrays
+
+
+def _skip_field_data(tok: _Tokens) -> None:
+    """A ``FIELD`` section's arrays, read past."""
+    tok.word("FIELD name")
+    for _ in range(tok.integer("FIELD array count")):
+        name = tok.word("FIELD array name")
+        ncomp, ntuples = tok.integer(f"{name} components"), tok.integer(f"{name} tuples")
+        tok.word(f"{name} type")
+        tok.numbers(ncomp * ntuples, f"array {name}")
+        tok.skip_metadata()
+
+
+def _point_fields(p: Path, arrays: dict[str, NDArray[np.float64]], numbers: NDArray[np.int64],
+                  radius_array: str) -> dict[str, NDArray[Any]]:
+    """The particle fields of the point arrays but ``id`` and the radius: vectors in
+    the plane, ``type`` as integers."""
+    fields: dict[str, NDArray[Any]] = {}
+    for name, values in arrays.items():
+        if name in ("id", radius_array):
+            continue
+        fields[name] = values[:, :2].copy() if values.ndim == 2 and values.shape[1] == 3 else values
+    if "type" in fields:
+        fields["type"] = integral_column(p, arrays["type"], numbers, "type")
+    return fields
+
+
+def read_legacy_vtk(
+    path: str | Path,
+    *,
+    tolerance: float = 0.0,
+    boundary_types: Sequence[int] = (),
+    radius_array: str = "radius",
+    z_policy: str = "refuse",
+    z0: float | None = None,
+) -> Snapshot:
+    """Read an ASCII legacy VTK particle file (LIGGGHTS / LAMMPS ``dump custom/vtk``).
+
+    The particles are the points, with the radius array ``radius_array``;
+    see the module documentation for ids, kinds, fields and z.
+    """
+    check_z_policy(z_policy, z0)
+    p = Path(path)
+    version, tok = _vtk_header(p)
+    points, point_lines, points_line, arrays = _vtk_sections(p, tok, version)
     if points is None:
         raise FileFormatError(p, None, "no POINTS section")
     if radius_array not in arrays:
@@ -280,13 +316,7 @@ def read_legacy_vtk(
         if "type" not in arrays:
             raise FileFormatError(p, None, "boundary_types needs a point array 'type'")
         kind = boundary_kind(arrays["type"], boundary_types)
-    fields: dict[str, NDArray[Any]] = {}
-    for name, values in arrays.items():
-        if name in ("id", radius_array):
-            continue
-        fields[name] = values[:, :2].copy() if values.ndim == 2 and values.shape[1] == 3 else values
-    if "type" in fields:
-        fields["type"] = integral_column(p, arrays["type"], numbers, "type")
+    fields = _point_fields(p, arrays, numbers, radius_array)
     return snapshot_from_points(
         p,
         numbers,
