@@ -34,7 +34,6 @@ TO_SPLIT: dict[str, int] = {
     "python/grainlab/protocols/biaxial/phases.py:shear": 135,
     "python/grainlab/snapshot.py:Snapshot.__init__": 169,
     "python/grainlab/snapshot.py:Snapshot.from_engine_arrays": 97,
-    "crates/grainlab-core/src/pipeline/step.rs:particle_contacts": 165,
 }
 
 

@@ -9,13 +9,15 @@ use super::pair_kernel::{
 };
 use super::Simulation;
 use crate::body::ClumpFrame;
-use crate::bond::{bond_slot, BondSlot};
+use crate::bond::{bond_slot, Bond, BondSlot};
 use crate::diagnostics::Measurements;
 use crate::error::Result;
 use crate::integrate::{
     integrate_stripe, IntegrationInputs, IntegrationStep, IntegrationTally, MotionStripe,
 };
+use crate::law::history::ContactHistory;
 use crate::law::ContactRecord;
+use crate::neighbor::WallPairList;
 use crate::parallel::{
     even_bounds, map_stripes, split_ranges, DisjointWriter, Team, PARALLEL_MIN_PARTICLES,
 };
@@ -298,33 +300,15 @@ impl Simulation {
         let buffer_cross = team.is_some();
         let n_stripes = self.neighbors.stripe_ranges.len();
         let pairs = &mut self.neighbors.pairs;
-        let starts = &pairs.stripe_start;
-        // interior pairs of each stripe, then the cross-stripe pairs shared out evenly
-        let cross_start = starts[n_stripes];
-        let n_pairs = pairs.len();
-        let cross_ranges: Vec<(usize, usize)> = even_bounds(n_pairs - cross_start, n_stripes)
-            .into_iter()
-            .map(|(lo, hi)| (cross_start + lo, cross_start + hi))
-            .collect();
-        let mut ranges: Vec<(usize, usize)> =
-            (0..n_stripes).map(|b| (starts[b], starts[b + 1])).collect();
-        ranges.extend(&cross_ranges);
-        let mut history_parts = pairs.history.split(&ranges);
-        let cross_history = history_parts.split_off(n_stripes);
-        // every slot is rewritten by the kernel (a force or `skip`), so no clearing
-        self.cross_forces
-            .resize(n_pairs - cross_start, PairForce::NONE);
-        let local: Vec<(usize, usize)> = cross_ranges
-            .iter()
-            .map(|&(lo, hi)| (lo - cross_start, hi - cross_start))
-            .collect();
-        let cross_buffers = split_ranges(&mut self.cross_forces, &local);
-        // the bonds shared out evenly too; their forces wait in slots
-        let n_bonds = self.bonds.list.len();
-        let bond_ranges = even_bounds(n_bonds, n_stripes);
-        self.bond_slots.resize(n_bonds, BondSlot::default());
-        let bond_parts = split_ranges(&mut self.bonds.list, &bond_ranges);
-        let bond_slot_parts = split_ranges(&mut self.bond_slots, &bond_ranges);
+        let (ranges, stripes) = stripe_shares(
+            &mut pairs.history,
+            &pairs.stripe_start,
+            pairs.i.len(),
+            &mut self.cross_forces,
+            &mut self.bonds.list,
+            &mut self.bond_slots,
+            n_stripes,
+        );
 
         // the chains' follower loads, each stripe its own particles' (step 2a)
         let has_chains = !self.chains.is_empty();
@@ -349,23 +333,6 @@ impl Simulation {
                 && !self.external_loads
                 && self.params.gravity == [0.0, 0.0],
         };
-        let stripes: Vec<StripeWork<'_>> = history_parts
-            .into_iter()
-            .zip(cross_history)
-            .zip(cross_buffers)
-            .zip(bond_parts.into_iter().zip(bond_slot_parts))
-            .enumerate()
-            .map(
-                |(b, (((history, cross_history), cross_forces), (bonds, bond_slots)))| StripeWork {
-                    stripe: b,
-                    history,
-                    cross_history,
-                    cross_forces,
-                    bonds,
-                    bond_slots,
-                },
-            )
-            .collect();
         // what the bond and wall laws read (not the resultants the stripes write)
         let motion = ParticleMotion {
             position: &p.position,
@@ -378,18 +345,8 @@ impl Simulation {
         let cell = self.cell.as_ref();
         let stripe_ranges = &self.neighbors.stripe_ranges;
         // the wall pairs, each evaluated by the stripe of its particle (`defer`)
-        let wp = &mut self.neighbors.wall_pairs;
-        if defer {
-            self.wall_slots.resize(wp.wall.len(), WallSlot::default());
-        }
-        let wall_pairs = WallPairWork {
-            wall: &wp.wall,
-            particle: &wp.particle,
-            model: &wp.model,
-            records: DisjointWriter::new(&mut wp.history.records),
-            sliding: DisjointWriter::new(&mut wp.history.sliding),
-            slots: DisjointWriter::new(&mut self.wall_slots),
-        };
+        let wall_pairs =
+            WallPairWork::of(&mut self.neighbors.wall_pairs, &mut self.wall_slots, defer);
         let (materials, deferred_index) = (&self.materials, &self.deferred_index);
         let wall_step = WallStep {
             walls,
@@ -788,6 +745,24 @@ struct WallPairWork<'a> {
     slots: DisjointWriter<WallSlot>,
 }
 
+impl<'a> WallPairWork<'a> {
+    /// The work of the wall pairs `wp`, their results going to `slots` (sized to
+    /// the pairs when the stripes evaluate them, `defer`).
+    fn of(wp: &'a mut WallPairList, slots: &'a mut Vec<WallSlot>, defer: bool) -> Self {
+        if defer {
+            slots.resize(wp.wall.len(), WallSlot::default());
+        }
+        WallPairWork {
+            wall: &wp.wall,
+            particle: &wp.particle,
+            model: &wp.model,
+            records: DisjointWriter::new(&mut wp.history.records),
+            sliding: DisjointWriter::new(&mut wp.history.sliding),
+            slots: DisjointWriter::new(slots),
+        }
+    }
+}
+
 /// What a wall pair's evaluation reads besides the pair: the walls, the
 /// models, the particles' motion and the step's constants.
 struct WallStep<'a> {
@@ -837,4 +812,59 @@ impl WallPairWork<'_> {
             }
         }
     }
+}
+
+/// The shares of one force evaluation, one per stripe (step 5): the ranges of
+/// the pair list (each stripe's interior pairs, then the cross-stripe pairs
+/// shared out evenly, one range each) and each stripe's work: its interior
+/// pairs' history, its share of the cross pairs' history and of their force
+/// buffer (every slot rewritten by the kernel, so not cleared), its share of
+/// the bonds and of their force slots.
+fn stripe_shares<'a>(
+    history: &'a mut ContactHistory,
+    starts: &[usize],
+    n_pairs: usize,
+    cross_forces: &'a mut Vec<PairForce>,
+    bonds: &'a mut [Bond],
+    bond_slots: &'a mut Vec<BondSlot>,
+    n_stripes: usize,
+) -> (Vec<(usize, usize)>, Vec<StripeWork<'a>>) {
+    let cross_start = starts[n_stripes];
+    let cross_ranges: Vec<(usize, usize)> = even_bounds(n_pairs - cross_start, n_stripes)
+        .into_iter()
+        .map(|(lo, hi)| (cross_start + lo, cross_start + hi))
+        .collect();
+    let mut ranges: Vec<(usize, usize)> =
+        (0..n_stripes).map(|b| (starts[b], starts[b + 1])).collect();
+    ranges.extend(&cross_ranges);
+    let mut history_parts = history.split(&ranges);
+    let cross_history = history_parts.split_off(n_stripes);
+    cross_forces.resize(n_pairs - cross_start, PairForce::NONE);
+    let local: Vec<(usize, usize)> = cross_ranges
+        .iter()
+        .map(|&(lo, hi)| (lo - cross_start, hi - cross_start))
+        .collect();
+    let cross_buffers = split_ranges(cross_forces, &local);
+    let bond_ranges = even_bounds(bonds.len(), n_stripes);
+    bond_slots.resize(bonds.len(), BondSlot::default());
+    let bond_parts = split_ranges(bonds, &bond_ranges);
+    let bond_slot_parts = split_ranges(bond_slots, &bond_ranges);
+    let stripes = history_parts
+        .into_iter()
+        .zip(cross_history)
+        .zip(cross_buffers)
+        .zip(bond_parts.into_iter().zip(bond_slot_parts))
+        .enumerate()
+        .map(
+            |(b, (((history, cross_history), cross_forces), (bonds, bond_slots)))| StripeWork {
+                stripe: b,
+                history,
+                cross_history,
+                cross_forces,
+                bonds,
+                bond_slots,
+            },
+        )
+        .collect();
+    (ranges, stripes)
 }
