@@ -334,6 +334,28 @@ def _select_peak(
     return nearest_snapshot(strains, eps_peak)
 
 
+def _bands(products: RunProducts, states: dict[str, RunState], k_snap: int, last: int,
+           notes: list[str]) -> dict[str, BandSearch]:
+    """The shear bands from the initial state to the peak and to the final state
+    (snapshots ``k_snap`` and ``last``), where those differ from it; what is
+    missing goes to ``notes``."""
+    bands: dict[str, BandSearch] = {}
+    if k_snap == 0 and last == 0:
+        notes.append("only one snapshot: no displacements and no shear band")
+        return bands
+    if k_snap != 0:
+        bands["peak"] = _band(products, states["initial"], states["peak"])
+    if last not in (0, k_snap):
+        bands["final"] = _band(products, states["initial"], states["final"])
+    for key, b in bands.items():
+        if not b.numbers.found:
+            notes.append(
+                f"no shear band found at {b.numbers.snapshot} ({key} state): its maps have no "
+                "outline (BandNumbers.reason says why)"
+            )
+    return bands
+
+
 def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> RunAnalysis:
     """Read ``run.h5`` of ``run_dir`` and measure its states and bands (module docstring).
 
@@ -393,21 +415,7 @@ def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> 
     if states["peak"].snap.normal_force is None:
         notes.append(f"{names[k_snap]} has no contact forces: no normal-force diagram data")
 
-    bands: dict[str, BandSearch] = {}
-    if k_snap == 0 and last == 0:
-        notes.append("only one snapshot: no displacements and no shear band")
-    else:
-        if k_snap != 0:
-            bands["peak"] = _band(products, states["initial"], states["peak"])
-        if last not in (0, k_snap):
-            bands["final"] = _band(products, states["initial"], states["final"])
-    for key, b in bands.items():
-        if not b.numbers.found:
-            notes.append(
-                f"no shear band found at {b.numbers.snapshot} ({key} state): its maps have no "
-                "outline (BandNumbers.reason says why)"
-            )
-
+    bands = _bands(products, states, k_snap, last, notes)
     numbers = FabricNumbers(
         results_path=results.path,
         peak_row=k_peak,
