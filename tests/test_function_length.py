@@ -31,8 +31,6 @@ TO_SPLIT: dict[str, int] = {
     "python/grainlab/commands/analyze.py:run": 108,
     "python/grainlab/protocols/biaxial/phases.py:install_boundary": 94,
     "python/grainlab/protocols/biaxial/phases.py:shear": 135,
-    "python/grainlab/snapshot.py:Snapshot.__init__": 169,
-    "python/grainlab/snapshot.py:Snapshot.from_engine_arrays": 97,
 }
 
 
@@ -124,7 +122,7 @@ def test_the_rule_counts_what_it_says():
 
 
 def test_the_ratchet_refuses_growth_newcomers_and_stale_entries():
-    name = "python/grainlab/snapshot.py:Snapshot.__init__"
+    name = next(n for n in TO_SPLIT if n.startswith("python/"))  # any entry still listed
     listed = [(n, lines) for n, lines in TO_SPLIT.items() if n.startswith("python/")]
     others = [(n, lines) for n, lines in listed if n != name]
     assert _over_the_limit(listed, PYTHON_LIMIT) == []

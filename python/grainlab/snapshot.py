@@ -218,6 +218,163 @@ def _check_shape(name: str, a: NDArray[Any], shape: tuple[int | None, ...]) -> N
         raise ValueError(f"{name}: expected shape {want}, got {a.shape}")
 
 
+
+def _wall_pairs(wall_i: ArrayLike | None, wall_id: ArrayLike | None) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The wall contacts' particles and their ``contact_j`` codes (``-1 - wall_id``)."""
+    if wall_i is None:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    if wall_id is None:
+        raise ValueError("wall_id: required with wall_i")
+    wi = np.asarray(wall_i, dtype=np.int64).reshape(-1)
+    wj = wall_code(np.asarray(wall_id, dtype=np.int64).reshape(-1))
+    if wj.shape != wi.shape:
+        raise ValueError(f"wall_id: expected shape {wi.shape}, got {wj.shape}")
+    return wi, wj
+
+
+class _ContactJoin:
+    """Joins a per-contact array of the particle contacts and one of the ``n_wall``
+    wall contacts (:meth:`Snapshot.from_engine_arrays`)."""
+
+    def __init__(self, n_wall: int) -> None:
+        self.n_wall = n_wall
+
+    def __call__(
+        self, name: str, particle: ArrayLike | None, wall: ArrayLike | None, width: int | None, fill: Any
+    ) -> NDArray[Any] | None:
+        """Both joined, particle contacts first; None when neither is given; a missing
+        wall array filled with ``fill`` (refused when ``fill`` is None)."""
+        if particle is None and wall is None:
+            return None
+        if particle is None:
+            raise ValueError(f"{name}: wall values given but no particle-contact values")
+        p = np.asarray(particle)
+        nw = self.n_wall
+        if wall is None:
+            if nw and fill is None:
+                raise ValueError(f"{name}: needs the wall-contact values too (wall_*)")
+            shape = (nw,) if width is None else (nw, width)
+            w = np.full(shape, fill, dtype=p.dtype)
+        else:
+            w = np.asarray(wall, dtype=p.dtype)
+        return np.concatenate([p, w])
+
+
+def _checked_particles(
+    positions: ArrayLike, radii: ArrayLike, ids: ArrayLike | None, rotations: ArrayLike | None,
+    kind: ArrayLike | None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64], NDArray[np.float64] | None,
+           NDArray[np.int8]]:
+    """A snapshot's particles checked: positions (N, 2), radii > 0, unique ids
+    (default 0..N-1), rotations and known kind codes (default grains)."""
+    pos = _as_float("positions", positions, (None, 2))
+    n = pos.shape[0]
+    rad = _as_float("radii", radii, (n,))
+    if np.any(rad <= 0.0):
+        k = int(np.argmax(rad <= 0.0))
+        raise ValueError(f"radii: must be > 0, got {rad[k]!r} at index {k}")
+    labels = np.arange(n, dtype=np.int64) if ids is None else _as_int("ids", ids, (n,))
+    if n > 1:
+        order = np.argsort(labels, kind="stable")
+        dup = labels[order[1:]] == labels[order[:-1]]
+        if dup.any():
+            raise ValueError(f"ids: duplicate id {int(labels[order[1:]][dup][0])}")
+    turns = None if rotations is None else _as_float("rotations", rotations, (n,))
+    if kind is None:
+        codes = np.zeros(n, dtype=np.int8)
+    else:
+        given = _as_int("kind", kind, (n,))
+        allowed = [int(k) for k in ParticleKind]
+        bad = ~np.isin(given, allowed)
+        if bad.any():
+            raise ValueError(f"kind: unknown code {int(given[bad][0])} (allowed {allowed})")
+        codes = given.astype(np.int8)
+    return pos, rad, labels, turns, codes
+
+
+def _checked_pairs(
+    contact_i: ArrayLike | None, contact_j: ArrayLike | None, n: int
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """A snapshot's contact pairs checked: both or neither, indices in range (j < 0:
+    a wall), no particle with itself."""
+    if (contact_i is None) != (contact_j is None):
+        raise ValueError("contact_i / contact_j: give both or neither")
+    ci = np.zeros(0, np.int64) if contact_i is None else _as_int("contact_i", contact_i, (None,))
+    nc = ci.shape[0]
+    cj = np.zeros(0, np.int64) if contact_j is None else _as_int("contact_j", contact_j, (nc,))
+    if nc:
+        if ci.min() < 0 or ci.max() >= n:
+            k = int(np.argmax((ci < 0) | (ci >= n)))
+            raise ValueError(f"contact_i: index {int(ci[k])} out of range [0, {n}) at contact {k}")
+        if cj.max() >= n:
+            k = int(np.argmax(cj >= n))
+            raise ValueError(f"contact_j: index {int(cj[k])} out of range [0, {n}) at contact {k}")
+        if np.any(ci == cj):
+            k = int(np.argmax(ci == cj))
+            raise ValueError(f"contact_j: particle {int(ci[k])} in contact with itself at contact {k}")
+    return ci, cj
+
+
+def _checked_normals(
+    contact_normal: ArrayLike | None, cj: NDArray[np.int64], has_points: bool
+) -> NDArray[np.float64] | None:
+    """The contact normals checked to be unit vectors; without them, wall contacts
+    need the contact points."""
+    nc = cj.shape[0]
+    if contact_normal is None:
+        if nc and np.any(cj < 0) and not has_points:
+            raise ValueError(
+                "contact_normal: wall contacts (contact_j < 0) need contact_normal or contact_point"
+            )
+        return None
+    normal = _as_float("contact_normal", contact_normal, (nc, 2))
+    length = np.hypot(normal[:, 0], normal[:, 1])
+    bad = np.abs(length - 1.0) > 1e-6
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ValueError(f"contact_normal: not a unit vector at contact {k} (length {length[k]:.6g})")
+    return normal
+
+
+def _checked_cell(
+    box: ArrayLike | None, periodic: tuple[bool, bool], tilt: float
+) -> tuple[NDArray[np.float64] | None, tuple[bool, bool], float]:
+    """The box bounds, periodic flags and tilt checked against one another."""
+    flags = tuple(bool(p) for p in periodic)
+    if len(flags) != 2:
+        raise ValueError(f"periodic: expected two flags (x, y), got {periodic!r}")
+    bounds = None
+    if box is not None:
+        bounds = _as_float("box", box, (2, 2))
+        if np.any(bounds[:, 1] <= bounds[:, 0]):
+            raise ValueError(f"box: need xlo < xhi and ylo < yhi, got {bounds.tolist()}")
+    elif any(flags):
+        raise ValueError("box: a periodic direction needs the box bounds")
+    lean = float(tilt)
+    if not np.isfinite(lean):
+        raise ValueError(f"tilt: must be finite, got {tilt!r}")
+    if lean != 0.0 and not flags[1]:
+        raise ValueError(f"tilt: a leaning cell ({lean!r} m) needs y periodic")
+    return bounds, (flags[0], flags[1]), lean
+
+
+def _checked_scalars(scalars: Mapping[str, float] | None, axial_strain: float | None) -> dict[str, float]:
+    """The named scalars (``axial_strain`` among them when given), finite."""
+    values = dict(scalars or {})
+    if axial_strain is not None:
+        if "axial_strain" in values and values["axial_strain"] != axial_strain:
+            raise ValueError("axial_strain: given twice, as axial_strain and in scalars, with other values")
+        values["axial_strain"] = axial_strain
+    checked: dict[str, float] = {}
+    for name, scalar in values.items():
+        if not isinstance(name, str) or not name:
+            raise ValueError(f"scalars: names must be non-empty strings, got {name!r}")
+        number = float(scalar)
+        if not np.isfinite(number):
+            raise ValueError(f"scalars[{name!r}]: must be finite, got {number}")
+        checked[name] = number
+    return checked
+
 @dataclass(frozen=True, eq=False, init=False)
 class Snapshot:
     """One state of a 2D disk assembly: particles and their contacts.
@@ -342,85 +499,25 @@ class Snapshot:
             object.__setattr__(self, name, value)
 
         put("_cache", {})
-        pos = _as_float("positions", positions, (None, 2))
+        pos, rad, labels, turns, codes = _checked_particles(positions, radii, ids, rotations, kind)
         n = pos.shape[0]
-        rad = _as_float("radii", radii, (n,))
-        if np.any(rad <= 0.0):
-            k = int(np.argmax(rad <= 0.0))
-            raise ValueError(f"radii: must be > 0, got {rad[k]!r} at index {k}")
-        labels = np.arange(n, dtype=np.int64) if ids is None else _as_int("ids", ids, (n,))
-        if n > 1:
-            order = np.argsort(labels, kind="stable")
-            dup = labels[order[1:]] == labels[order[:-1]]
-            if dup.any():
-                raise ValueError(f"ids: duplicate id {int(labels[order[1:]][dup][0])}")
         put("positions", _readonly(pos))
         put("radii", _readonly(rad))
         put("ids", _readonly(labels))
-
-        turns = None if rotations is None else _as_float("rotations", rotations, (n,))
         put("rotations", None if turns is None else _readonly(turns))
-        if kind is None:
-            codes = np.zeros(n, dtype=np.int8)
-        else:
-            given = _as_int("kind", kind, (n,))
-            allowed = [int(k) for k in ParticleKind]
-            bad = ~np.isin(given, allowed)
-            if bad.any():
-                raise ValueError(f"kind: unknown code {int(given[bad][0])} (allowed {allowed})")
-            codes = given.astype(np.int8)
         put("kind", _readonly(codes))
-
-        if (contact_i is None) != (contact_j is None):
-            raise ValueError("contact_i / contact_j: give both or neither")
-        ci = (
-            np.zeros(0, np.int64) if contact_i is None else _as_int("contact_i", contact_i, (None,))
-        )
+        ci, cj = _checked_pairs(contact_i, contact_j, n)
         nc = ci.shape[0]
-        cj = np.zeros(0, np.int64) if contact_j is None else _as_int("contact_j", contact_j, (nc,))
-        if nc:
-            if ci.min() < 0 or ci.max() >= n:
-                k = int(np.argmax((ci < 0) | (ci >= n)))
-                raise ValueError(
-                    f"contact_i: index {int(ci[k])} out of range [0, {n}) at contact {k}"
-                )
-            if cj.max() >= n:
-                k = int(np.argmax(cj >= n))
-                raise ValueError(
-                    f"contact_j: index {int(cj[k])} out of range [0, {n}) at contact {k}"
-                )
-            if np.any(ci == cj):
-                k = int(np.argmax(ci == cj))
-                raise ValueError(
-                    f"contact_j: particle {int(ci[k])} in contact with itself at contact {k}"
-                )
         put("contact_i", _readonly(ci))
         put("contact_j", _readonly(cj))
-
         for name, value in (("normal_force", normal_force), ("shear_force", shear_force)):
             put(name, None if value is None else _readonly(_as_float(name, value, (nc,))))
         point = (
             None if contact_point is None else _as_float("contact_point", contact_point, (nc, 2))
         )
         put("contact_point", None if point is None else _readonly(point))
-        if contact_normal is not None:
-            normal = _as_float("contact_normal", contact_normal, (nc, 2))
-            length = np.hypot(normal[:, 0], normal[:, 1])
-            bad = np.abs(length - 1.0) > 1e-6
-            if bad.any():
-                k = int(np.argmax(bad))
-                raise ValueError(
-                    f"contact_normal: not a unit vector at contact {k} (length {length[k]:.6g})"
-                )
-            put("contact_normal", _readonly(normal))
-        else:
-            put("contact_normal", None)
-            if nc and np.any(cj < 0) and contact_point is None:
-                raise ValueError(
-                    "contact_normal: wall contacts (contact_j < 0) need contact_normal or "
-                    "contact_point"
-                )
-
+        normal = _checked_normals(contact_normal, cj, point is not None)
+        put("contact_normal", None if normal is None else _readonly(normal))
         put(
             "contact_fields",
             {
@@ -433,45 +530,16 @@ class Snapshot:
             for k, v in dict(particle_fields or {}).items()
         }
         put("particle_fields", _labelled_fields(per_particle, n))
-
-        flags = tuple(bool(p) for p in periodic)
-        if len(flags) != 2:
-            raise ValueError(f"periodic: expected two flags (x, y), got {periodic!r}")
-        put("periodic", (flags[0], flags[1]))
-        if box is not None:
-            bounds = _as_float("box", box, (2, 2))
-            if np.any(bounds[:, 1] <= bounds[:, 0]):
-                raise ValueError(f"box: need xlo < xhi and ylo < yhi, got {bounds.tolist()}")
-            put("box", _readonly(bounds))
-        elif any(flags):
-            raise ValueError("box: a periodic direction needs the box bounds")
-        else:
-            put("box", None)
-        lean = float(tilt)
-        if not np.isfinite(lean):
-            raise ValueError(f"tilt: must be finite, got {tilt!r}")
-        if lean != 0.0 and not flags[1]:
-            raise ValueError(f"tilt: a leaning cell ({lean!r} m) needs y periodic")
+        bounds, flags, lean = _checked_cell(box, periodic, tilt)
+        put("periodic", flags)
+        put("box", None if bounds is None else _readonly(bounds))
         put("tilt", lean)
         if time is not None:
             time = float(time)
             if not np.isfinite(time):
                 raise ValueError(f"time: must be finite, got {time}")
         put("time", time)
-        values = dict(scalars or {})
-        if axial_strain is not None:
-            if "axial_strain" in values and values["axial_strain"] != axial_strain:
-                raise ValueError("axial_strain: given twice, as axial_strain and in scalars, with other values")
-            values["axial_strain"] = axial_strain
-        checked: dict[str, float] = {}
-        for name, scalar in values.items():
-            if not isinstance(name, str) or not name:
-                raise ValueError(f"scalars: names must be non-empty strings, got {name!r}")
-            number = float(scalar)
-            if not np.isfinite(number):
-                raise ValueError(f"scalars[{name!r}]: must be finite, got {number}")
-            checked[name] = number
-        put("scalars", checked)
+        put("scalars", _checked_scalars(scalars, axial_strain))
         put("metadata", dict(metadata or {}))
 
     @staticmethod
@@ -556,39 +624,8 @@ class Snapshot:
         """
         ci = np.asarray(contact_i, dtype=np.int64).reshape(-1)
         cj = np.asarray(contact_j, dtype=np.int64).reshape(-1)
-        if wall_i is None:
-            wi = np.zeros(0, np.int64)
-            wj = np.zeros(0, np.int64)
-        else:
-            if wall_id is None:
-                raise ValueError("wall_id: required with wall_i")
-            wi = np.asarray(wall_i, dtype=np.int64).reshape(-1)
-            wj = wall_code(np.asarray(wall_id, dtype=np.int64).reshape(-1))
-            if wj.shape != wi.shape:
-                raise ValueError(f"wall_id: expected shape {wi.shape}, got {wj.shape}")
-        nw = wi.shape[0]
-
-        def join(
-            name: str,
-            particle: ArrayLike | None,
-            wall: ArrayLike | None,
-            width: int | None,
-            fill: Any,
-        ) -> NDArray[Any] | None:
-            if particle is None and wall is None:
-                return None
-            if particle is None:
-                raise ValueError(f"{name}: wall values given but no particle-contact values")
-            p = np.asarray(particle)
-            if wall is None:
-                if nw and fill is None:
-                    raise ValueError(f"{name}: needs the wall-contact values too (wall_*)")
-                shape = (nw,) if width is None else (nw, width)
-                w = np.full(shape, fill, dtype=p.dtype)
-            else:
-                w = np.asarray(wall, dtype=p.dtype)
-            return np.concatenate([p, w])
-
+        wi, wj = _wall_pairs(wall_i, wall_id)
+        join = _ContactJoin(wi.shape[0])
         normals = join("contact_normal", contact_normal, wall_normal, 2, None)
         points = join("contact_point", contact_point, wall_point, 2, None)
         fields = dict(kwargs.pop("contact_fields", {}) or {})
