@@ -26,6 +26,7 @@ from grainlab._progress import progress_bar
 from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
 from grainlab.protocols.config import Config, grain_shape
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
+from grainlab.protocols.grains import grain_coordination, grain_porosity
 from grainlab.protocols.runner import Protocol, ProtocolError, RunResult
 from grainlab.samples import (
     PAPER_GRADING,
@@ -33,7 +34,6 @@ from grainlab.samples import (
     UniformByMass,
     UniformByNumber,
     expand_to_porosity,
-    nominal_porosity,
     overlap_corrected_porosity,
 )
 from grainlab.simulation import ContactModel, Simulation
@@ -277,13 +277,11 @@ def consolidate(
         "stress_yy_pa": syy,
         "width_m": width,
         "height_m": height,
-        "porosity": 1.0 - float(np.pi * np.sum(radii**2)) / area if grain is None else nominal_porosity(
-            radii, area, positions=sim.positions[grains], grain=grain
-        ),
+        "porosity": grain_porosity(sim, run.n_grains, area),
         "porosity_overlap_corrected": overlap_corrected_porosity(
             sim.positions[grains], radii, (box[0], box[1], box[0] + width, box[1] + height), grain=grain
         ),
-        "coordination_number": sim.coordination_number,
+        "coordination_number": grain_coordination(sim),
         "unbalanced_force_ratio": sim.unbalanced_force_ratio,
         "time_step_s": sim.time_step,
     }

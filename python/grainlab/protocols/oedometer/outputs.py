@@ -28,6 +28,7 @@ from grainlab.columns import (
     VERTICAL_STRESS_PA,
 )
 from grainlab.protocols.config import Config
+from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.oedometer.state import OedometerRun
 from grainlab.protocols.runner import RunResult
 from grainlab.protocols.specimen import write_run_outputs
@@ -46,7 +47,7 @@ class OedometerResult(RunResult):
         s = self.summary
         jaky = "" if s["k0_jaky"] is None else f" (Jaky {s['k0_jaky']:.3f})"
         return (
-            f"grainlab oedometer: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}; K0 "
+            f"grainlab oedometer: {s.get('n_grains', s['n_particles'])} grains, porosity {s['porosity_initial']:.3f}; K0 "
             f"{s['k0_loading']:.3f}{jaky} on loading to {s['max_vertical_stress_pa'] / 1e3:.0f} kPa; "
             f"K {s['lateral_stress_ratio_final']:.3f} at OCR {s['overconsolidation_ratio_final']:.2f}; "
             f"{s['wall_time_s']:.1f} s -> {self.out_dir}"
@@ -89,6 +90,7 @@ def summarise(run: OedometerRun, config: Config, timeseries: dict[str, np.ndarra
     ]
     return {
         "n_particles": run.n_grains,
+        **clump_summary(run.sample),
         "porosity_initial": float(timeseries["porosity"][0]),
         "void_ratio_initial": float(timeseries["void_ratio"][0]),
         "porosity_after_consolidation": run.consolidation["porosity"],

@@ -20,6 +20,7 @@ from grainlab.columns import OEDOMETER
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import BOX_WALLS, box_state
+from grainlab.protocols.grains import grain_count, grain_porosity
 from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA  # noqa: F401 - registers the schema
 from grainlab.protocols.oedometer.outputs import OedometerResult, summarise, write_outputs
 from grainlab.protocols.oedometer.state import OedometerRun
@@ -120,7 +121,7 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
     box = box_state({name: sim.wall(run.walls[name]) for name in BOX_WALLS})
     area = box.width_m * box.height_m
     n = run.n_grains
-    porosity = 1.0 - float(np.pi * np.sum(sim.radii[:n] ** 2)) / area
+    porosity = grain_porosity(sim, n, area)
     c, w = sim.contacts(), sim.wall_contacts()
     lw = love_weber_stress(sim.positions, c.i, c.j, c.point, -c.force_on_i, area, np.ones(sim.n_particles, bool),
                            wall_particle=w.particle, wall_point=w.point, wall_force_on_particle=w.force_on_particle)
@@ -137,7 +138,7 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
         "volumetric_strain": (run.area0 - area) / run.area0,
         "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "height_m": box.height_m, "area_m2": area,
         "love_weber_xx_pa": float(lw[0, 0]), "love_weber_yy_pa": float(lw[1, 1]), "love_weber_xy_pa": float(lw[0, 1]),
-        "coordination_number": 2.0 * int(np.count_nonzero((c.i < n) & (c.j < n))) / n,
+        "coordination_number": 2.0 * int(np.count_nonzero((c.i < n) & (c.j < n))) / grain_count(sim, n),
         "unbalanced_force_ratio": sim.unbalanced_force_ratio,
         "kinetic_energy_j": energy.kinetic, "elastic_energy_j": energy.elastic,
         "friction_dissipated_j": energy.friction_dissipated, "damping_dissipated_j": energy.damping_dissipated,

@@ -29,6 +29,7 @@ from grainlab.columns import (
     VOLUMETRIC_STRAIN,
 )
 from grainlab.protocols.config import Config
+from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.runner import RunResult
 from grainlab.protocols.simple_shear.state import SimpleShearRun
 from grainlab.protocols.specimen import write_run_outputs
@@ -46,7 +47,7 @@ class SimpleShearResult(RunResult):
     def one_line(self) -> str:
         s = self.summary
         return (
-            f"grainlab simple_shear ({s['volume']} volume): {s['n_particles']} grains, I {s['inertial_number_set']:.1e}; "
+            f"grainlab simple_shear ({s['volume']} volume): {s.get('n_grains', s['n_particles'])} grains, I {s['inertial_number_set']:.1e}; "
             f"peak mu {s['friction_coefficient_peak']:.3f} at {100 * s['shear_strain_at_peak']:.1f} %, steady mu "
             f"{s['friction_coefficient_steady']:.3f}, porosity {s['porosity_steady']:.4f}, Z "
             f"{s['coordination_number_steady']:.2f} at gamma >= {100 * s['steady_from_strain']:.0f} %; "
@@ -79,6 +80,7 @@ def summarise(run: SimpleShearRun, config: Config, timeseries: dict[str, np.ndar
                VOLUMETRIC_STRAIN, "kinetic_stress_share")}
     return {
         "n_particles": run.n_grains,
+        **clump_summary(run.sample),
         "volume": config["simple_shear.volume"],
         "inertial_number_set": config["simple_shear.inertial_number"],
         "shear_rate_per_s": run.shear_rate_per_s,

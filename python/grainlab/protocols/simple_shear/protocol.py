@@ -24,6 +24,7 @@ from grainlab.columns import SIMPLE_SHEAR
 from grainlab.io.hdf5.snapshot import snapshot_name
 from grainlab.io.results import SHEAR_START_FILE
 from grainlab.protocols.config import Config
+from grainlab.protocols.grains import grain_coordination, grain_count, grain_porosity
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.simple_shear.cell import (
     CONTROL_STEPS,
@@ -160,12 +161,11 @@ def _consolidate(context: Context) -> None:
     cell = sim.cell
     assert cell is not None
     stress = cell_stress(sim).total
-    radii = sim.radii[: run.n_grains]
     run.consolidation = {
         "steps": steps, "stress_xx_pa": float(stress[0, 0]), "stress_yy_pa": float(stress[1, 1]),
         "width_m": float(cell.a[0]), "height_m": float(cell.b[1]),
-        "porosity": 1.0 - float(np.pi * np.sum(radii**2)) / cell.area,
-        "coordination_number": sim.coordination_number, "unbalanced_force_ratio": sim.unbalanced_force_ratio,
+        "porosity": grain_porosity(sim, run.n_grains, cell.area),
+        "coordination_number": grain_coordination(sim), "unbalanced_force_ratio": sim.unbalanced_force_ratio,
         "time_step_s": sim.time_step,
     }
     run.wall_time["consolidate"] = time.perf_counter() - start
@@ -251,12 +251,14 @@ def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, f
     total = stress.total
     n = run.n_grains
     area = float(cell.area)
-    porosity = 1.0 - float(np.pi * np.sum(sim.radii[:n] ** 2)) / area
+    porosity = grain_porosity(sim, n, area)
     normal = float(total[1, 1])
     tau = -float(total[0, 1])
     snap = sim.snapshot(kind=np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8))
     fabric = fabric_summary(snap)
     z = fabric.pop("coordination_number")
+    if len(sim.clumps):  # contacts per grain (CEGEO's Z_c), not per pebble
+        z = 2.0 * snap.n_contacts / grain_count(sim, n)
     rb = StressForceFabric().compute(snap)
     energy = sim.energy
     strain = (sim.step_count - run.start_step) * sim.time_step * run.shear_rate_per_s
