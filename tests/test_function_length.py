@@ -35,8 +35,6 @@ TO_SPLIT: dict[str, int] = {
     "python/grainlab/io/lammps_dump.py:read_lammps_dump": 185,
     "python/grainlab/io/vtk_read.py:read_legacy_vtk": 108,
     "python/grainlab/postprocess/biaxial.py:analyse_run": 89,
-    "python/grainlab/protocols/biaxial/phases.py:install_boundary": 94,
-    "python/grainlab/protocols/biaxial/phases.py:shear": 135,
     "python/grainlab/samples/expansion.py:expand_to_porosity": 100,
     "python/grainlab/snapshot.py:Snapshot.__init__": 169,
     "python/grainlab/snapshot.py:Snapshot.from_engine_arrays": 97,
