@@ -38,7 +38,7 @@ import time
 from pathlib import Path
 
 from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary, start_shear
-from grainlab.protocols.biaxial.state import _Run
+from grainlab.protocols.biaxial.state import BiaxialRun
 from grainlab.protocols.config import resolve
 from grainlab.protocols.specimen import consolidate, engine_threads, generate
 from grainlab.simulation import Simulation
@@ -47,7 +47,7 @@ from grainlab.simulation import Simulation
 def build_state(path: Path, quick: bool) -> None:
     """Runs the biaxial protocol to the start of shear and writes the engine state."""
     config = resolve(quick=quick)
-    sim, run = generate(config, engine_threads(config), False, _Run, "consolidate")
+    sim, run = generate(config, engine_threads(config), False, BiaxialRun, "consolidate")
     consolidate(sim, run, config, progress=False)
     install_boundary(sim, run, config, progress=False)
     start_shear(sim, run, config)

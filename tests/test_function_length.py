@@ -29,8 +29,6 @@ HOT_KERNEL = "// hot kernel:"
 TO_SPLIT: dict[str, int] = {
     "python/grainlab/commands/analyze.py:register": 102,
     "python/grainlab/commands/analyze.py:run": 108,
-    "python/grainlab/protocols/biaxial/phases.py:install_boundary": 94,
-    "python/grainlab/protocols/biaxial/phases.py:shear": 135,
 }
 
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import grainlab.protocols.biaxial as biaxial
-import grainlab.protocols.biaxial.phases as phases
 import grainlab.protocols.biaxial.protocol as protocol
+import grainlab.protocols.biaxial.records as records
 import grainlab.protocols.specimen as specimen
 from grainlab.analysis import StabilityIndex
 from grainlab.cli import main
@@ -93,7 +93,7 @@ def test_resumed_run_ends_with_the_same_results(tmp_path, monkeypatch):
     config = resolve(overrides=overrides, quick=True)
     straight = biaxial.run_biaxial(config, tmp_path / "straight", progress=False)
 
-    real_measure = phases._measure
+    real_measure = records.measure
     calls = {"n": 0}
 
     def dying_measure(*args, **kwargs):
@@ -102,14 +102,14 @@ def test_resumed_run_ends_with_the_same_results(tmp_path, monkeypatch):
             raise KeyboardInterrupt("simulated kill during shearing")
         return real_measure(*args, **kwargs)
 
-    monkeypatch.setattr(phases, "_measure", dying_measure)
+    monkeypatch.setattr(records, "measure", dying_measure)
     killed = tmp_path / "killed"
     with pytest.raises(KeyboardInterrupt):
         biaxial.run_biaxial(config, killed, progress=False)
     # a killed run leaves nothing that looks complete
     assert not (killed / "run.h5").exists() and not (killed / "summary.json").exists()
     assert (killed / "checkpoint.h5").exists()
-    monkeypatch.setattr(phases, "_measure", real_measure)
+    monkeypatch.setattr(records, "measure", real_measure)
     resumed = biaxial.run_biaxial(config, killed, resume=True, progress=False)
 
     a = read_results(straight.out_dir / "run.h5")
@@ -228,7 +228,7 @@ def test_snapshot_arrays_are_stored_compressed(quick_run):
 
 
 def test_the_shear_plan_is_typed_and_keeps_the_checkpoints_layout():
-    from grainlab.protocols.biaxial.state import ShearPlan, _Run
+    from grainlab.protocols.biaxial.state import BiaxialRun, ShearPlan
 
     saved = {"strain_rate": 3.3e-4, "platen_speed_m_per_s": 1.2e-5, "height0": 0.15, "area0": 0.011,
              "start_step": 1234, "record_steps": [10, 20, 30], "snapshot_steps": {"0": 0.0, "20": 0.001},
@@ -237,6 +237,6 @@ def test_the_shear_plan_is_typed_and_keeps_the_checkpoints_layout():
     plan = ShearPlan.from_dict(saved)  # as a checkpoint (of this or an earlier grainlab) stores it
     assert plan.next_record == 2 and plan.record_steps == [10, 20, 30]
     assert plan.to_dict() == saved
-    run = _Run.from_dict({"phase": "shear", "n_grains": 3, "grain_density": 2e8, "walls": {}, "wall_time": {},
+    run = BiaxialRun.from_dict({"phase": "shear", "n_grains": 3, "grain_density": 2e8, "walls": {}, "wall_time": {},
                           "sample": {}, "consolidation": {}, "shear": saved})
     assert run.shear_plan() == plan and run.to_dict()["shear"] == saved

@@ -92,12 +92,12 @@ sys.path.insert(0, {tests!r})
 import reliability_factories as stand_ins
 import grainlab.postprocess.figures as figures
 import grainlab.protocols.biaxial.outputs as outputs
-import grainlab.protocols.biaxial.phases as phases
+import grainlab.protocols.biaxial.records as records
 from grainlab.cli import main
 
 outputs._figures = stand_ins.fake_curves
 figures.fabric_figures = stand_ins.fake_fabric_figures
-measure, calls = phases._measure, []
+measure, calls = records.measure, []
 
 def filling_measure(*args, **kwargs):
     calls.append(1)
@@ -110,7 +110,7 @@ def filling_measure(*args, **kwargs):
             os.close(fd)
     return measure(*args, **kwargs)
 
-phases._measure = filling_measure
+records.measure = filling_measure
 sys.exit(main(sys.argv[1:]))
 """
 

@@ -12,7 +12,7 @@ from reliability_factories import TINY_TOML, tiny_config
 
 import grainlab
 import grainlab.protocols.biaxial as biaxial
-import grainlab.protocols.biaxial.phases as phases
+import grainlab.protocols.biaxial.records as records
 from grainlab.cli import main
 from grainlab.io.hdf5 import read_results
 from grainlab.protocols.config import resolve
@@ -68,7 +68,7 @@ def test_a_rate_too_fast_for_the_runs_own_time_step_stops_before_the_first_recor
 def test_a_run_that_blows_up_is_marked_failed_with_its_error(tmp_path, monkeypatch, capsys, fast_figures):
     (tmp_path / "tiny.toml").write_text(TINY_TOML)
     out = tmp_path / "run"
-    measure, calls = phases._measure, []
+    measure, calls = records.measure, []
 
     def unstable(*args, **kwargs):
         calls.append(1)
@@ -76,7 +76,7 @@ def test_a_run_that_blows_up_is_marked_failed_with_its_error(tmp_path, monkeypat
             raise grainlab.SimulationUnstableError("particles 3 and 7 overlap by 60 % of the smaller radius")
         return measure(*args, **kwargs)
 
-    monkeypatch.setattr(phases, "_measure", unstable)
+    monkeypatch.setattr(records, "measure", unstable)
     assert main(["biaxial", "--config", str(tmp_path / "tiny.toml"), "--out", str(out), "--no-progress"]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "run stopped: particles 3 and 7 overlap" in err

@@ -18,7 +18,7 @@ from reliability_factories import TINY_TOML, assert_same_run, tiny_config
 import grainlab.postprocess.figures as figures
 import grainlab.protocols.biaxial as biaxial
 import grainlab.protocols.biaxial.outputs as outputs
-import grainlab.protocols.biaxial.phases as phases
+import grainlab.protocols.biaxial.records as records
 import grainlab.protocols.runner as runner
 import grainlab.protocols.specimen as specimen
 from grainlab.cli import main
@@ -62,7 +62,7 @@ def _stop_at(monkeypatch, where: str) -> None:
     elif where.startswith("checkpoint "):  # 1 generated, 2 consolidated, 3 boundary installed, 4 sheared
         monkeypatch.setattr(runner, "write_checkpoint", _after(write_checkpoint, int(where.split()[1])))
     elif where == "shearing":
-        monkeypatch.setattr(phases, "_measure", _before(phases._measure, 3))
+        monkeypatch.setattr(records, "measure", _before(records.measure, 3))
     elif where == "summary":
         monkeypatch.setattr(ResultsWriter, "write_summary", _before(ResultsWriter.write_summary))
     elif where == "finalized":

@@ -10,7 +10,7 @@ import shutil
 import pytest
 
 import grainlab.plot.workers as workers
-from grainlab.protocols.biaxial.outputs import _write_outputs
+from grainlab.protocols.biaxial.outputs import write_outputs
 from grainlab.report import write_report
 
 pytestmark = pytest.mark.slow
@@ -34,7 +34,7 @@ def test_the_quick_run_drawn_in_one_process_gives_the_same_files(quick_biaxial_r
     folder.mkdir()
     shutil.copy2(quick_biaxial_run / "run.h5", folder / "run.h5")
     monkeypatch.setattr(workers, "available_cores", lambda: 1)  # no workers: the serial path
-    _write_outputs(folder)
+    write_outputs(folder)
     write_report(folder)
     names = sorted(p.name for p in quick_biaxial_run.iterdir())
     assert sorted(p.name for p in folder.iterdir()) == names

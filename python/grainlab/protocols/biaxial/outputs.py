@@ -16,7 +16,7 @@ from grainlab.analysis.peak import peak_record
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
 from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
-from grainlab.protocols.biaxial.state import _Run
+from grainlab.protocols.biaxial.state import BiaxialRun
 from grainlab.protocols.config import BiaxialConfig
 from grainlab.protocols.runner import RunResult
 
@@ -50,7 +50,7 @@ class BiaxialResult(RunResult):
                 "the end; ")
 
 
-def _summary(run: _Run, config: BiaxialConfig, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
+def summarise(run: BiaxialRun, config: BiaxialConfig, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
     shear = run.shear_plan()
     first = {k: float(v[0]) for k, v in timeseries.items()}
     last = {k: float(v[-1]) for k, v in timeseries.items()}
@@ -127,7 +127,7 @@ def _figures(timeseries: dict[str, np.ndarray], out: Path, constant_volume: bool
         pool.draw(curve_tasks(timeseries, stress_path=constant_volume), out)
 
 
-def _write_outputs(out: Path) -> dict[str, Any]:
+def write_outputs(out: Path) -> dict[str, Any]:
     """``timeseries.csv``, the figures and ``summary.json``, all from the finished
     ``run.h5``: a run stopped while they were written finishes them with ``--resume``.
     The figures are drawn side by side in worker processes, with their copies

@@ -1,65 +1,53 @@
-"""The biaxial test's own phases: install the boundary, start and run the
-shearing (the sample's generation and consolidation are every test's,
-:mod:`grainlab.protocols.specimen`). Each takes the simulation, the run state
-and the configuration; :mod:`grainlab.protocols.biaxial.protocol` lists them as
-the protocol's stages, and the runner moves the run from one to the next."""
+"""The biaxial test's own stage before shearing: the flexible boundary
+installed and the shearing planned (the sample's generation and consolidation
+are every test's, :mod:`grainlab.protocols.specimen`; the shearing is
+:mod:`grainlab.protocols.biaxial.shearing`). The cyclic test installs its
+boundary and plans its loading with the same functions."""
 
 from __future__ import annotations
 
 import math
 import time
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
 import grainlab
-from grainlab._interrupt import raise_if_interrupted
-from grainlab._progress import progress_bar
-from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
-from grainlab.io.hdf5 import ResultsWriter, snapshot_name
 from grainlab.protocols.biaxial.rates import (
     default_strain_rate,
     inertial_number,
     strain_rate_problem,
 )
-from grainlab.protocols.biaxial.records import (
-    TIMESERIES_UNITS,
-    _area,
-    _measure,
-    _platens,
-    _snapshot,
-    _walls,
-)
+from grainlab.protocols.biaxial.records import enclosed_area, platen_state
 from grainlab.protocols.biaxial.state import (
     CHUNK_STEPS,
     BiaxialError,
+    BiaxialRun,
     Boundary,
     ShearPlan,
-    _boundary,
-    _Run,
 )
 from grainlab.protocols.boundary import (
-    GrainBoundary,
     Membrane,
     WallBoundary,
     install_grain_boundary,
     install_membrane,
-    membrane_breach,
     set_platen_velocity,
 )
-from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import servo_box
 from grainlab.protocols.specimen import grain_model, platen_model
-from grainlab.protocols.triggers import At, Every, WallClock, schedule_steps
+from grainlab.protocols.triggers import At, Every, schedule_steps
 from grainlab.simulation import Simulation, Wall
 
-#: Steps between two settings of rigid side walls' motion while shearing (variant C).
-WALL_CONTROL_STEPS = 100
+__all__ = ["check_shear_plan", "drive_platens", "install_boundary", "start_platens", "start_shear"]
 
 
-def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress: bool) -> None:
+def install_boundary(sim: Simulation, run: BiaxialRun, config: Config, progress: bool) -> None:
+    """The box's walls replaced by platens three sample widths long and the lateral
+    boundary of ``boundary.kind`` (the membrane, the outer grains or rigid side walls),
+    Table 1 friction on, the sample re-equilibrated under sigma_0."""
     start = time.perf_counter()
     walls = run.walls
     left_x = float(sim.wall(walls["left"]).points[0, 0])
@@ -76,86 +64,86 @@ def install_boundary(sim: Simulation, run: _Run, config: BiaxialConfig, progress
     walls["bottom"], walls["top"] = bottom.id, top.id
     sim.set_contact_model(0, 0, grain_model(config))  # Table 1 friction from here on
     sim.set_contact_model(0, 1, platen_model(config))
-    limit = config["consolidation.unbalanced_force_ratio"]
-    steps = 0
     if config["boundary.kind"] == "walls":
         steps = _install_walls(sim, run, config, left_x, right_x, bottom, top)
     elif config["boundary.kind"] == "membrane":
-        membrane = install_membrane(
-            sim,
-            left_x=left_x,
-            right_x=right_x,
-            bottom=bottom,
-            top=top,
-            diameter=config["boundary.membrane_diameter"],
-            overlap=config["boundary.membrane_overlap"],
-            bond_stiffness=config["boundary.membrane_stiffness"],
-            friction=config["boundary.membrane_friction"],
-            grain_model=grain_model(config),
-            density=config["material.density"],
-            pressure=config["consolidation.pressure"],
-        )
-        run.consolidation["membrane_disks"] = len(membrane.left) + len(membrane.right)
-        run.membrane = membrane.to_dict()
-        sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
-        # The platens hold sigma_0 while the membrane takes over and friction
-        # switches on, so that shearing starts from an isotropic state: they
-        # stand still while their stress stays within the tolerance of sigma_0,
-        # and are servo-controlled to it (the engine's servo, as in the
-        # consolidation) from the first chunk that ends outside it until the
-        # sample is in equilibrium. The membrane's end disks keep their place: the
-        # platens move by micrometres.
-        target = config["consolidation.pressure"]
-        tolerance = config["consolidation.tolerance"]
-        max_speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)
-        servo = False
-        while True:
-            sim.run(CHUNK_STEPS)
-            steps += CHUNK_STEPS
-            platens = _platens(sim, membrane)
-            sigma_1 = platens.axial_stress_pa
-            settled = abs(sigma_1 / target - 1.0) < tolerance
-            if not settled or servo:
-                servo = True
-                for platen in (bottom, top):
-                    platen.servo(target, platens.width_m, relaxation=0.5, max_speed_m_per_s=max_speed)
-            if settled and sim.unbalanced_force_ratio < limit:
-                break
-            if steps >= config["consolidation.max_steps"]:
-                break
-        if servo:
-            bottom.velocity = (0.0, 0.0)
-            top.velocity = (0.0, 0.0)
-        if not settled:
-            warnings.warn(
-                f"boundary phase: consolidation.max_steps reached with the platens at {sigma_1 / 1e3:.1f} kPa "
-                f"(sigma_0 {target / 1e3:.1f} kPa +- {tolerance:.0%}): shearing starts from there",
-                RuntimeWarning,
-                stacklevel=2,
-            )
-        run.consolidation["platen_stress_pa"] = sigma_1
+        steps = _install_membrane(sim, run, config, left_x, right_x, bottom, top)
     else:
-        radii = sim.radii[: run.n_grains]
-        grains = install_grain_boundary(
-            sim,
-            n_grains=run.n_grains,
-            bottom=bottom,
-            top=top,
-            pressure=config["consolidation.pressure"],
-            bin_height=float(2 * radii.mean()),
-        )
-        while True:
-            sim.run(CHUNK_STEPS)
-            steps += CHUNK_STEPS
-            grains = grains.identify(sim)
-            if sim.unbalanced_force_ratio < limit or steps >= config["consolidation.max_steps"]:
-                break
-        run.membrane = grains.to_dict()
+        steps = _install_outer_grains(sim, run, config, bottom, top)
     run.consolidation["boundary_steps"] = steps
     run.wall_time["boundary"] = time.perf_counter() - start
 
 
-def _install_walls(sim: Simulation, run: _Run, config: Any, left_x: float, right_x: float, bottom: Wall,
+def _unsettled(where: str) -> None:
+    """Warns that the boundary stage ends out of equilibrium, with ``where`` the boundary stood."""
+    warnings.warn(f"boundary phase: consolidation.max_steps reached with {where}: shearing starts from there",
+                  RuntimeWarning, stacklevel=4)
+
+
+def _install_membrane(sim: Simulation, run: BiaxialRun, config: Config, left_x: float, right_x: float,
+                      bottom: Wall, top: Wall) -> int:
+    """Variant A: the membrane chains; the sample re-equilibrated. The platens hold
+    sigma_0 while the membrane takes over and friction switches on, so that shearing
+    starts from an isotropic state: they stand still while their stress stays within
+    the tolerance of sigma_0, and are servo-controlled to it (the engine's servo, as in
+    the consolidation) from the first chunk that ends outside it until the sample is in
+    equilibrium. The membrane's end disks keep their place: the platens move by
+    micrometres. Returns the steps it took."""
+    membrane = install_membrane(
+        sim, left_x=left_x, right_x=right_x, bottom=bottom, top=top, diameter=config["boundary.membrane_diameter"],
+        overlap=config["boundary.membrane_overlap"], bond_stiffness=config["boundary.membrane_stiffness"],
+        friction=config["boundary.membrane_friction"], grain_model=grain_model(config),
+        density=config["material.density"], pressure=config["consolidation.pressure"],
+    )
+    run.consolidation["membrane_disks"] = len(membrane.left) + len(membrane.right)
+    run.boundary = membrane
+    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0)
+    target, tolerance = config["consolidation.pressure"], config["consolidation.tolerance"]
+    limit = config["consolidation.unbalanced_force_ratio"]
+    max_speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)
+    servo, steps = False, 0
+    while True:
+        sim.run(CHUNK_STEPS)
+        steps += CHUNK_STEPS
+        platens = platen_state(sim, membrane)
+        sigma_1 = platens.axial_stress_pa
+        settled = abs(sigma_1 / target - 1.0) < tolerance
+        if not settled or servo:
+            servo = True
+            for platen in (bottom, top):
+                platen.servo(target, platens.width_m, relaxation=0.5, max_speed_m_per_s=max_speed)
+        if settled and sim.unbalanced_force_ratio < limit:
+            break
+        if steps >= config["consolidation.max_steps"]:
+            break
+    if servo:
+        bottom.velocity = (0.0, 0.0)
+        top.velocity = (0.0, 0.0)
+    if not settled:
+        _unsettled(f"the platens at {sigma_1 / 1e3:.1f} kPa (sigma_0 {target / 1e3:.1f} kPa +- {tolerance:.0%})")
+    run.consolidation["platen_stress_pa"] = sigma_1
+    return steps
+
+
+def _install_outer_grains(sim: Simulation, run: BiaxialRun, config: Config, bottom: Wall, top: Wall) -> int:
+    """Variant B: the follower loads on the outermost grains, re-identified every chunk
+    until equilibrium; returns the steps it took."""
+    radii = sim.radii[: run.n_grains]
+    grains = install_grain_boundary(sim, n_grains=run.n_grains, bottom=bottom, top=top,
+                                    pressure=config["consolidation.pressure"], bin_height=float(2 * radii.mean()))
+    steps = 0
+    while True:
+        sim.run(CHUNK_STEPS)
+        steps += CHUNK_STEPS
+        grains = grains.identify(sim)
+        if sim.unbalanced_force_ratio < config["consolidation.unbalanced_force_ratio"] or \
+                steps >= config["consolidation.max_steps"]:
+            break
+    run.boundary = grains
+    return steps
+
+
+def _install_walls(sim: Simulation, run: BiaxialRun, config: Config, left_x: float, right_x: float, bottom: Wall,
                    top: Wall) -> int:
     """Variant C: rigid side walls three sample heights long where the box's were, the
     four walls servo-controlled to sigma_0 with friction on until equilibrium, then
@@ -176,19 +164,14 @@ def _install_walls(sim: Simulation, run: _Run, config: Any, left_x: float, right
     for wall in box.values():
         wall.velocity = (0.0, 0.0)
     if not settled:
-        warnings.warn(
-            f"boundary phase: consolidation.max_steps reached with the walls at {state.stress_xx_pa / 1e3:.1f} and "
-            f"{state.stress_yy_pa / 1e3:.1f} kPa (sigma_0 {target / 1e3:.1f} kPa): shearing starts from there",
-            RuntimeWarning,
-            stacklevel=3,
-        )
+        _unsettled(f"the walls at {state.stress_xx_pa / 1e3:.1f} and {state.stress_yy_pa / 1e3:.1f} kPa "
+                   f"(sigma_0 {target / 1e3:.1f} kPa)")
     run.consolidation["platen_stress_pa"] = state.stress_yy_pa
-    run.membrane = WallBoundary(left.id, right.id, bottom.id, top.id, target,
-                                config["shear.volume"] == "constant").to_dict()
+    run.boundary = WallBoundary(left.id, right.id, bottom.id, top.id, target, config["shear.volume"] == "constant")
     return steps
 
 
-def start_shear(sim: Simulation, run: _Run, config: BiaxialConfig) -> None:
+def start_shear(sim: Simulation, run: BiaxialRun, config: Config) -> None:
     """The platens set moving at the axial strain rate, the shearing planned to
     ``shear.final_strain`` (records ``Every(shear.record_interval)``, snapshots
     ``At(shear.snapshot_strains)``)."""
@@ -207,14 +190,14 @@ def drive_platens(sim: Simulation, boundary: Boundary, speed: float) -> None:
         sim.wall(boundary.top_wall).velocity = (0.0, -speed)
 
 
-def start_platens(sim: Simulation, run: _Run, config: Any, *, final: float, records: Sequence[Any],
+def start_platens(sim: Simulation, run: BiaxialRun, config: Config, *, final: float, records: Sequence[Any],
                   snapshots: Sequence[float], turns: Sequence[float] = ()) -> None:
     """The platens set approaching each other at ``shear.strain_rate`` and the loading
     planned over ``final`` of *strain path* (the axial strain travelled, whatever its
     direction): records on the ``records`` triggers, snapshots at the path strains
     ``snapshots``, the platens' direction reversed at the path strains ``turns``
     (:class:`ShearPlan`; a monotonic test has none)."""
-    boundary = _boundary(run)
+    boundary = run.lateral_boundary()
     grains = np.arange(run.n_grains)
     radii = sim.radii[grains]
     rate = config["shear.strain_rate"]
@@ -223,7 +206,7 @@ def start_platens(sim: Simulation, run: _Run, config: Any, *, final: float, reco
         rate = default_strain_rate(config, config["sample.d_max"], 0.5 * config["sample.d_min"])
     bottom, top = sim.wall(boundary.bottom_wall), sim.wall(boundary.top_wall)
     height0 = float(top.points[0, 1] - bottom.points[0, 1])
-    area0 = _area(sim, boundary)
+    area0 = enclosed_area(sim, boundary)
     speed = 0.5 * rate * height0
     drive_platens(sim, boundary, speed)
     dt = sim.time_step
@@ -248,151 +231,7 @@ def start_platens(sim: Simulation, run: _Run, config: Any, *, final: float, reco
     )
 
 
-def shear(
-    sim: Simulation,
-    run: _Run,
-    config: Any,
-    writer: ResultsWriter,
-    save: Callable[[], None],
-    progress: bool,
-    *,
-    final: float | None = None,
-    snapshot_name_of: Callable[[float], str] = snapshot_name,
-    extra: Callable[[int], dict[str, float]] | None = None,
-    units: Mapping[str, str] = TIMESERIES_UNITS,
-    rule: Callable[[Simulation, _Run], str] | None = None,
-    event_snapshot: Callable[[int], str | None] | None = None,
-) -> None:
-    """Runs the planned loading (:func:`start_platens`) to its end: the platens reversed
-    at the plan's turns, a record (with ``extra(steps since the start)``'s columns, in
-    ``units``) on each record step, a snapshot named ``snapshot_name_of(path strain)``
-    on each snapshot step, a checkpoint on the wall clock; ``final`` (default
-    ``shear.final_strain``) is the path strain the progress counts to.
-
-    A ``rule(sim, run)`` (a stress-controlled cyclic test's) is asked every
-    WALL_CONTROL_STEPS steps between records; it answers ``""``, ``"turn"`` (the
-    platens reverse there), ``"mark"`` or ``"end"`` (the loading stops there). Each
-    answer but ``""`` is an event: counted in the plan, recorded, and stored as a
-    snapshot when ``event_snapshot(events so far)`` names one."""
-    start = time.perf_counter() - run.wall_time.get("shear", 0.0)
-    plan = run.shear_plan()
-    steps = plan.record_steps
-    snap_steps = plan.snapshot_steps
-    final = config["shear.final_strain"] if final is None else final
-
-    def record() -> dict[str, float]:
-        values = _measure(sim, run, config)
-        if extra is not None:
-            values.update(extra(sim.step_count - plan.start_step))
-        return values
-
-    boundary = _boundary(run)
-    walls = boundary if isinstance(boundary, WallBoundary) else None
-    wall_speed = 0.05 * float(sim.radii[: run.n_grains].min()) / (50 * sim.time_step)
-
-    last_event: dict[str, Any] = {"step": -1, "values": {}}
-
-    def on_event(answer: str) -> None:
-        """An event of the rule: counted, recorded and (when named) stored; the
-        platens reversed at a turn; the loading ended at the end."""
-        plan.events += 1
-        if answer == "turn":
-            plan.turn_steps.append(sim.step_count - plan.start_step)
-            _reverse(sim, run, plan)
-        values = record()
-        writer.append_timeseries(values, units=units)
-        last_event.update(step=sim.step_count, values=values)
-        name = None if event_snapshot is None else event_snapshot(plan.events)
-        if name is not None:
-            writer.write_snapshot(name, _snapshot(sim, run, values[AXIAL_STRAIN]), step=sim.step_count,
-                                  walls=_walls(sim, run))
-        if answer == "end":
-            plan.next_record = len(steps)
-
-    def advance(to_step: int) -> bool:
-        """Runs to ``to_step``; rigid side walls are controlled, and the rule asked,
-        every WALL_CONTROL_STEPS. False when the rule ended the loading on the way."""
-        if walls is None and rule is None:
-            sim.run(to_step - sim.step_count)
-            return True
-        while sim.step_count < to_step:
-            n = min(WALL_CONTROL_STEPS, to_step - sim.step_count)
-            if walls is not None:
-                walls.control(sim, n, plan.area0, wall_speed)
-            sim.run(n)
-            answer = "" if rule is None else rule(sim, run)
-            if answer:
-                on_event(answer)
-                if answer == "end":
-                    return False
-        return True
-
-    if plan.next_record == 0 and "0" in snap_steps and writer.n_rows == 0:
-        first = record()
-        writer.append_timeseries(first, units=units)
-        writer.write_snapshot(snapshot_name_of(0.0), _snapshot(sim, run, 0.0), step=sim.step_count,
-                              walls=_walls(sim, run))
-    checkpoint_due = WallClock(config["run.checkpoint_interval"])
-    done = 100 * final * steps[plan.next_record - 1] / steps[-1] if plan.next_record and steps[-1] else 0.0
-    bar = progress_bar(
-        round(100 * final, 3),
-        "shearing",
-        enabled=progress,
-        unit="% strain",
-        initial=done,
-        bar_format="{l_bar}{bar}| {n:.2f}/{total:.1f} % [{elapsed}<{remaining}{postfix}]",
-    )
-    while plan.next_record < len(steps):
-        target = plan.start_step + steps[plan.next_record]
-        turn = plan.start_step + plan.turn_steps[plan.next_turn] if plan.next_turn < len(plan.turn_steps) else None
-        if turn is not None and turn < target:
-            advance(turn)
-            _reverse(sim, run, plan)
-            continue
-        if not advance(target):
-            break
-        if last_event["step"] == sim.step_count:  # an event's record is this step's
-            values = last_event["values"]
-        else:
-            values = record()
-            writer.append_timeseries(values, units=units)
-        key = str(steps[plan.next_record])
-        if key in snap_steps:
-            writer.write_snapshot(snapshot_name_of(snap_steps[key]), _snapshot(sim, run, values[AXIAL_STRAIN]),
-                                  step=sim.step_count, walls=_walls(sim, run))
-        boundary = _boundary(run)
-        if isinstance(boundary, GrainBoundary):
-            run.membrane = boundary.identify(sim).to_dict()
-        elif isinstance(boundary, Membrane):
-            breach = membrane_breach(sim, boundary)
-            if breach is not None:
-                bar.close()
-                raise BiaxialError(
-                    f"shearing stopped at {100 * values[AXIAL_STRAIN]:.2f} % axial strain: {breach}"
-                )
-        plan.next_record += 1
-        if turn == target:  # a turning point recorded: reversed after its record
-            _reverse(sim, run, plan)
-        raise_if_interrupted()
-        path = 100 * final * steps[plan.next_record - 1] / steps[-1]
-        bar.update(path - done)
-        done = path
-        bar.set_postfix_str(f"ratio {values[STRESS_RATIO]:.2f}")
-        if checkpoint_due():
-            run.wall_time["shear"] = time.perf_counter() - start
-            save()
-    bar.close()
-    run.wall_time["shear"] = time.perf_counter() - start
-
-
-def _reverse(sim: Simulation, run: _Run, plan: ShearPlan) -> None:
-    """The platens reversed at the plan's next turn: compression after an even number of
-    turns, extension after an odd one."""
-    plan.next_turn += 1
-    drive_platens(sim, _boundary(run), plan.platen_speed_m_per_s * (-1.0) ** plan.next_turn)
-
-
-def check_shear_plan(sim: Simulation, run: _Run, config: Any, snapshots: Sequence[float] | None = None,
+def check_shear_plan(sim: Simulation, run: BiaxialRun, config: Config, snapshots: Sequence[float] | None = None,
                      key: str = "shear.snapshot_strains") -> None:
     """The shearing phase's records and snapshots (path strains ``snapshots``, default
     ``shear.snapshot_strains`` up to ``shear.final_strain``; ``key`` names them in the

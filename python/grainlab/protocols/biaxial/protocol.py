@@ -8,10 +8,13 @@ import os
 from pathlib import Path
 from typing import Any, ClassVar
 
-from grainlab.protocols.biaxial.outputs import BiaxialResult, _summary, _write_outputs
-from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary, shear, start_shear
+from grainlab.io.hdf5 import snapshot_name
+from grainlab.protocols.biaxial import records as biaxial_records
+from grainlab.protocols.biaxial.outputs import BiaxialResult, summarise, write_outputs
+from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary, start_shear
 from grainlab.protocols.biaxial.rates import check_density_scaling, check_strain_rate
-from grainlab.protocols.biaxial.state import _Run
+from grainlab.protocols.biaxial.shearing import shear, shear_records, shear_snapshots
+from grainlab.protocols.biaxial.state import BiaxialRun
 from grainlab.protocols.config import BiaxialConfig
 from grainlab.protocols.runner import RUN_FILES, Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import OUTPUT_FILES, SpecimenProtocol, consolidate
@@ -19,7 +22,7 @@ from grainlab.protocols.specimen import OUTPUT_FILES, SpecimenProtocol, consolid
 __all__ = ["OUTPUT_FILES", "RUN_FILES", "BiaxialProtocol", "run_biaxial"]
 
 
-Context = StageContext[BiaxialConfig, _Run]
+Context = StageContext[BiaxialConfig, BiaxialRun]
 
 
 def _consolidate(context: Context) -> None:
@@ -34,10 +37,12 @@ def _boundary(context: Context) -> None:
 
 
 def _shear(context: Context) -> None:
-    shear(context.sim, context.state, context.config, context.writer, context.save, context.progress)
+    sim, run, config = context.sim, context.state, context.config
+    records = shear_records(context, lambda: biaxial_records.measure(sim, run, config), biaxial_records.TIMESERIES_UNITS)
+    shear(context, records, shear_snapshots(context, records, snapshot_name), final=config["shear.final_strain"])
 
 
-class BiaxialProtocol(SpecimenProtocol[_Run, BiaxialResult]):
+class BiaxialProtocol(SpecimenProtocol[BiaxialRun, BiaxialResult]):
     """The paper's biaxial test (Sec. 6, Table 1); the sample is generated when the run starts."""
 
     name = "biaxial"
@@ -48,22 +53,22 @@ class BiaxialProtocol(SpecimenProtocol[_Run, BiaxialResult]):
         Stage("shear", _shear, "the platens at a constant axial strain rate to the final strain; records "
                                "and snapshots on their triggers, checkpoints on the wall clock"),
     )
-    state_type = _Run
+    state_type = BiaxialRun
 
     def check(self) -> None:
         check_strain_rate(self.config)  # a rate refused needs no warning about its inertia
         check_density_scaling(self.config)
 
-    def state_from_dict(self, saved: Any) -> _Run:
+    def state_from_dict(self, saved: Any) -> BiaxialRun:
         # "peak": the peak so far, which checkpoints of earlier grainlab versions carry; the
         # summary takes it from the records (grainlab.analysis.peak)
-        return _Run.from_dict({k: v for k, v in saved.items() if k not in ("config", "elapsed_s", "peak")})
+        return BiaxialRun.from_dict({k: v for k, v in saved.items() if k not in ("config", "elapsed_s", "peak")})
 
     def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
-        return _summary(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
+        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
 
     def write_outputs(self, out: Path) -> dict[str, Any]:
-        return _write_outputs(out)
+        return write_outputs(out)
 
     def result(self, out: Path, summary: dict[str, Any]) -> BiaxialResult:
         return BiaxialResult(out, summary)

@@ -11,19 +11,21 @@ from grainlab.analysis import fabric_summary
 from grainlab.analysis.stress import love_weber_stress
 from grainlab.columns import BIAXIAL
 from grainlab.io.walls import WallGeometry
-from grainlab.protocols.biaxial.state import Boundary, _boundary, _Run
+from grainlab.protocols.biaxial.state import BiaxialRun, Boundary
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, sample_area
 from grainlab.protocols.config import BiaxialConfig
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind, Snapshot
 
+__all__ = ["TIMESERIES_UNITS", "PlatenState", "deviator_stress", "enclosed_area", "measure", "platen_state",
+           "take_snapshot", "wall_geometry"]
+
 #: Column -> unit of the shearing's records (:data:`grainlab.columns.BIAXIAL`).
 TIMESERIES_UNITS = BIAXIAL.units()
 
 
-
 @dataclass(frozen=True)
-class _Platens:
+class PlatenState:
     """The platens' state: sample height and area, and the mean axial stress
     of the two platens over the sample's mean width (area over height)."""
 
@@ -33,31 +35,32 @@ class _Platens:
     axial_stress_pa: float
 
 
-def _platens(sim: Simulation, boundary: Boundary) -> _Platens:
+def platen_state(sim: Simulation, boundary: Boundary) -> PlatenState:
+    """The platens' state now."""
     bottom, top = sim.wall(boundary.bottom_wall), sim.wall(boundary.top_wall)
     height = float(top.points[0, 1] - bottom.points[0, 1])
-    area = _area(sim, boundary)
+    area = enclosed_area(sim, boundary)
     width = area / height
     axial_force = 0.5 * (float(top.force[1]) - float(bottom.force[1]))
-    return _Platens(height, area, width, axial_force / width)
+    return PlatenState(height, area, width, axial_force / width)
 
 
-def deviator_stress(sim: Simulation, run: _Run, config: BiaxialConfig) -> float:
+def deviator_stress(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> float:
     """q = sigma_1 - sigma_3' from the platens' and the lateral boundary's forces alone
     (cheap enough for every 100 steps): sigma_3' is the confining pressure held, or the
     side walls' stress at constant volume."""
-    boundary = _boundary(run)
-    sigma_1 = _platens(sim, boundary).axial_stress_pa
+    boundary = run.lateral_boundary()
+    sigma_1 = platen_state(sim, boundary).axial_stress_pa
     if isinstance(boundary, WallBoundary) and boundary.constant_volume:
         return sigma_1 - boundary.lateral_stress(sim)
     return sigma_1 - float(config["consolidation.pressure"])
 
 
-def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, float]:
+def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str, float]:
     """One record of the shearing phase."""
-    boundary = _boundary(run)
+    boundary = run.lateral_boundary()
     shear = run.shear_plan()
-    platens = _platens(sim, boundary)
+    platens = platen_state(sim, boundary)
     height, area, sigma_1 = platens.height_m, platens.area_m2, platens.axial_stress_pa
     sigma_3 = config["consolidation.pressure"]  # the confining pressure held (a cell pressure)
 
@@ -130,35 +133,36 @@ def _measure(sim: Simulation, run: _Run, config: BiaxialConfig) -> dict[str, flo
     }
 
 
-def _fabric(sim: Simulation, run: _Run) -> dict[str, float]:
+def _fabric(sim: Simulation, run: BiaxialRun) -> dict[str, float]:
     """Fabric measures of the grains (membrane disks excluded as particles):
     anisotropy of contact normals and normal forces (the exact estimate, and
     Eq. 7-8 on the histogram as ``*_binned``), the mean stability index (Sec. 5)
     and the mechanical coordination number."""
-    summary = fabric_summary(_snapshot(sim, run, 0.0))
+    summary = fabric_summary(take_snapshot(sim, run, 0.0))
     summary.pop("coordination_number")  # the record's own, grain-grain contacts
     return summary
 
 
-def _area(sim: Simulation, boundary: Boundary) -> float:
+def enclosed_area(sim: Simulation, boundary: Boundary) -> float:
+    """The area inside the lateral boundary and the platens, m^2."""
     return sample_area(sim, boundary) if isinstance(boundary, Membrane) else boundary.area(sim)
 
 
-def _snapshot(sim: Simulation, run: _Run, strain: float) -> Snapshot:
+def take_snapshot(sim: Simulation, run: BiaxialRun, strain: float) -> Snapshot:
     """The state as a snapshot: grains, membrane disks labelled by chain (left 0, right 1)."""
     kind = np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8)
     kind[run.n_grains :] = int(ParticleKind.MEMBRANE)
     body = np.full(sim.n_particles, -1, dtype=np.int64)
-    if run.membrane is not None and run.membrane.get("kind") == GrainBoundary.kind:
-        kind[run.membrane["left"] + run.membrane["right"]] = int(ParticleKind.BOUNDARY)
-    elif run.membrane is not None and run.membrane.get("kind") != WallBoundary.kind:
-        body[run.membrane["left"]] = 0
-        body[run.membrane["right"]] = 1
+    if isinstance(run.boundary, GrainBoundary):
+        kind[run.boundary.left + run.boundary.right] = int(ParticleKind.BOUNDARY)
+    elif isinstance(run.boundary, Membrane):
+        body[run.boundary.left] = 0
+        body[run.boundary.right] = 1
     snap = sim.snapshot(kind=kind, axial_strain=strain, step=sim.step_count)
     return snap.with_boundary_bodies(body)
 
 
-def _walls(sim: Simulation, run: _Run) -> WallGeometry:
+def wall_geometry(sim: Simulation, run: BiaxialRun) -> WallGeometry:
     """The walls now (the platens active, the consolidation box's sides not), named
     as the run names them, for the snapshot."""
     return WallGeometry.from_simulation(sim, names={wall_id: name for name, wall_id in run.walls.items()})

@@ -1,5 +1,5 @@
-"""What a biaxial run carries from phase to phase (saved in every checkpoint),
-its boundary, and the error a run stops with."""
+"""What a biaxial or cyclic run carries from stage to stage (saved in every
+checkpoint), its lateral boundary, and the error a run stops with."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from typing import Any
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary
 from grainlab.protocols.specimen import CHUNK_STEPS, SpecimenError, SpecimenRun
 
-__all__ = ["CHUNK_STEPS", "BiaxialError", "ShearPlan"]
+__all__ = ["CHUNK_STEPS", "BiaxialError", "BiaxialRun", "Boundary", "ShearPlan", "boundary_from_dict"]
 
 
 class BiaxialError(SpecimenError):
@@ -61,50 +61,55 @@ class ShearPlan:
         return cls(**values)
 
 
-@dataclass
-class _Run(SpecimenRun):
-    """What a biaxial run carries from phase to phase, saved in every checkpoint:
-    :class:`SpecimenRun`'s fields, the lateral boundary, the shearing's plan."""
+#: A biaxial run's lateral boundary.
+Boundary = Membrane | GrainBoundary | WallBoundary
 
-    membrane: dict[str, Any] | None = None
+
+def boundary_from_dict(saved: dict[str, Any]) -> Boundary:
+    """The lateral boundary a checkpoint stored (its ``to_dict()``)."""
+    if saved.get("kind") == GrainBoundary.kind:
+        return GrainBoundary.from_dict(saved)
+    if saved.get("kind") == WallBoundary.kind:
+        return WallBoundary.from_dict(saved)
+    return Membrane.from_dict(saved)
+
+
+@dataclass
+class BiaxialRun(SpecimenRun):
+    """What a biaxial (or cyclic) run carries from stage to stage, saved in every
+    checkpoint: :class:`SpecimenRun`'s fields, the lateral boundary (set by the boundary
+    stage; checkpoints store it as ``membrane``, whichever it is) and the shearing's plan."""
+
+    boundary: Boundary | None = None
     shear: ShearPlan | None = None
     rows: int = 0
     snapshots: list[str] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         saved = dict(self.__dict__)
+        boundary = saved.pop("boundary")
+        saved["membrane"] = None if boundary is None else boundary.to_dict()
         saved["shear"] = None if self.shear is None else self.shear.to_dict()
         return saved
 
     @classmethod
-    def from_dict(cls, saved: dict[str, Any]) -> _Run:
+    def from_dict(cls, saved: dict[str, Any]) -> BiaxialRun:
         values = dict(saved)
+        boundary = values.pop("membrane", None)
+        values["boundary"] = None if boundary is None else boundary_from_dict(boundary)
         if values.get("shear") is not None:
             values["shear"] = ShearPlan.from_dict(values["shear"])
         return cls(**values)
 
-    def boundary_state(self) -> dict[str, Any]:
-        """The lateral boundary's record (:attr:`membrane`), set by the boundary phase."""
-        if self.membrane is None:
+    def lateral_boundary(self) -> Boundary:
+        """The lateral boundary (the membrane, variant B's grain chains or variant C's
+        walls), set by the boundary stage."""
+        if self.boundary is None:
             raise BiaxialError(f"the run has no lateral boundary yet (phase {self.phase!r})")
-        return self.membrane
+        return self.boundary
 
     def shear_plan(self) -> ShearPlan:
-        """The shearing phase's plan and progress (:attr:`shear`), set when shearing starts."""
+        """The shearing's plan and progress (:attr:`shear`), set when shearing starts."""
         if self.shear is None:
             raise BiaxialError(f"the run has no shearing plan yet (phase {self.phase!r})")
         return self.shear
-
-
-#: A biaxial run's lateral boundary.
-Boundary = Membrane | GrainBoundary | WallBoundary
-
-
-def _boundary(run: _Run) -> Boundary:
-    """The run's lateral boundary (the membrane, variant B's grain chains or variant C's walls)."""
-    boundary = run.boundary_state()
-    if boundary.get("kind") == GrainBoundary.kind:
-        return GrainBoundary.from_dict(boundary)
-    if boundary.get("kind") == WallBoundary.kind:
-        return WallBoundary.from_dict(boundary)
-    return Membrane.from_dict(boundary)

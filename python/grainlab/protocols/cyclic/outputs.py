@@ -25,7 +25,7 @@ from grainlab.columns import (
     STRESS_RATIO,
     VOLUMETRIC_STRAIN,
 )
-from grainlab.protocols.biaxial.state import _Run
+from grainlab.protocols.biaxial.state import BiaxialRun
 from grainlab.protocols.config import Config
 from grainlab.protocols.runner import RunResult
 from grainlab.protocols.specimen import write_run_outputs
@@ -93,7 +93,7 @@ def cycle_table(timeseries: dict[str, np.ndarray], cell_pressure_pa: float | Non
     return rows
 
 
-def summarise(run: _Run, config: Config, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
+def summarise(run: BiaxialRun, config: Config, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
     """The run's summary, as ``run.h5`` and ``summary.json`` store it."""
     plan = run.shear_plan()
     constant_volume = config["shear.volume"] == "constant"

@@ -18,28 +18,30 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from grainlab.columns import CYCLE, CYCLIC, STRAIN_PATH
-from grainlab.protocols.biaxial.phases import (
-    check_shear_plan,
-    install_boundary,
-    shear,
-    start_platens,
-)
+from grainlab.protocols.biaxial import records as biaxial_records
+from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary, start_platens
 from grainlab.protocols.biaxial.rates import check_density_scaling, check_strain_rate
-from grainlab.protocols.biaxial.records import deviator_stress
-from grainlab.protocols.biaxial.state import _boundary as _boundary_of
-from grainlab.protocols.biaxial.state import _Run
+from grainlab.protocols.biaxial.shearing import (
+    WALL_CONTROL_STEPS,
+    reverse_platens,
+    shear,
+    shear_records,
+    shear_snapshots,
+)
+from grainlab.protocols.biaxial.state import BiaxialRun
 from grainlab.protocols.config import Config
 from grainlab.protocols.cyclic.config import CYCLIC_SCHEMA  # noqa: F401 - registers the schema
 from grainlab.protocols.cyclic.outputs import CyclicResult, summarise, write_outputs
+from grainlab.protocols.operations import Loading, Operation, Records, Snapshots
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import SpecimenProtocol, consolidate
-from grainlab.protocols.triggers import At, Every
+from grainlab.protocols.triggers import At, Every, EveryStop
 from grainlab.simulation import Simulation
 
-__all__ = ["STRESS_EVENTS", "CyclicProtocol", "cycle_plan", "run_cyclic", "snapshot_name_of", "stress_path_length",
-           "stress_rule", "stress_snapshot_name"]
+__all__ = ["STRESS_EVENTS", "CyclicProtocol", "StressCycles", "cycle_plan", "event_snapshot_name", "run_cyclic",
+           "snapshot_name_of", "stress_path_length"]
 
-Context = StageContext[Config, _Run]
+Context = StageContext[Config, BiaxialRun]
 
 
 def cycle_plan(amplitude: float, cycles: int) -> tuple[float, list[float], list[float]]:
@@ -57,7 +59,7 @@ def cycle_plan(amplitude: float, cycles: int) -> tuple[float, list[float], list[
     return round(4 * a * cycles, 12), turns, sorted({0.0, *peaks, *ends})
 
 
-def snapshot_name_of(amplitude: float) -> Any:
+def snapshot_name_of(amplitude: float) -> Callable[[float], str]:
     """The snapshot name of a path strain: ``start``, ``cycle_003_compression`` (its
     compression turning point), ``cycle_003_extension``, ``cycle_003_end``."""
 
@@ -87,44 +89,61 @@ def stress_path_length(config: Config) -> float:
     return float(4 * config["cyclic.cycles"] * config["cyclic.strain_limit"])
 
 
-def stress_rule(config: Config) -> Callable[[Simulation, _Run], str]:
-    """The turning rule of a stress-controlled test: the platens load until q reaches
-    +A_q (a turn), unload through q = 0 (a mark) to -A_q (a turn) and load back to
-    q = 0 (a mark, or the end after the last cycle); the loading also ends where the
-    axial strain reaches +/- ``cyclic.strain_limit``."""
-    amplitude, cycles, limit = (config["cyclic.stress_amplitude"], config["cyclic.cycles"],
-                                config["cyclic.strain_limit"])
+def event_snapshot_name(event: int, cycles: int) -> str | None:
+    """The snapshot of a stress-controlled test's event ``event`` (1, 2, ...): the first and
+    last cycles' turning points and every cycle's end, named as the strain-controlled test's."""
+    cycle, what = (event - 1) // 4 + 1, STRESS_EVENTS[(event - 1) % 4]
+    if what == "end" or (what != "unloaded" and cycle in (1, cycles)):
+        return f"cycle_{cycle:03d}_{what}"
+    return None
 
-    def rule(sim: Simulation, run: _Run) -> str:
-        plan = run.shear_plan()
-        bottom, top = sim.wall(_boundary_of(run).bottom_wall), sim.wall(_boundary_of(run).top_wall)
-        strain = (plan.height0 - float(top.points[0, 1] - bottom.points[0, 1])) / plan.height0
-        if abs(strain) >= limit:
-            return "end"
-        q = deviator_stress(sim, run, config)
+
+class StressCycles(Operation):
+    """A stress-controlled test's cycles, every WALL_CONTROL_STEPS steps: the platens load
+    until q reaches +A_q (a turn), unload through q = 0 (an event) to -A_q (a turn) and
+    load back to q = 0 (an event, or the end after the last cycle); the loading also
+    ends where the axial strain reaches +/- ``cyclic.strain_limit``. Each event is
+    counted in the plan (``events``), recorded and stored as a snapshot when
+    :func:`event_snapshot_name` names one; the platens reverse at a turn."""
+
+    def __init__(self, config: Config, run: BiaxialRun, records: Records, snapshots: Snapshots) -> None:
+        super().__init__(EveryStop(WALL_CONTROL_STEPS))
+        self.config, self.run, self.records, self.snapshots = config, run, records, snapshots
+
+    def _event(self, sim: Simulation) -> tuple[bool, bool] | None:
+        """(whether the platens turn, whether the loading ends) at an event; None between events."""
+        plan, config = self.run.shear_plan(), self.config
+        boundary = self.run.lateral_boundary()
+        height = float(sim.wall(boundary.top_wall).points[0, 1] - sim.wall(boundary.bottom_wall).points[0, 1])
+        if abs((plan.height0 - height) / plan.height0) >= config["cyclic.strain_limit"]:
+            return False, True
+        q, amplitude = biaxial_records.deviator_stress(sim, self.run, config), config["cyclic.stress_amplitude"]
         quarter = plan.events % 4
         if quarter == 0 and q >= amplitude or quarter == 2 and q <= -amplitude:
-            return "turn"
+            return True, False
         if quarter == 1 and q <= 0.0:
-            return "mark"
+            return False, False
         if quarter == 3 and q >= 0.0:
-            return "end" if plan.events + 1 == 4 * cycles else "mark"
-        return ""
-
-    return rule
-
-
-def stress_snapshot_name(cycles: int) -> Callable[[int], str | None]:
-    """The snapshot of a stress-controlled test's event ``k`` (1, 2, ...): the first and
-    last cycles' turning points and every cycle's end, named as the strain-controlled test's."""
-
-    def name(k: int) -> str | None:
-        cycle, what = (k - 1) // 4 + 1, STRESS_EVENTS[(k - 1) % 4]
-        if what == "end" or (what != "unloaded" and cycle in (1, cycles)):
-            return f"cycle_{cycle:03d}_{what}"
+            return False, plan.events + 1 == 4 * config["cyclic.cycles"]
         return None
 
-    return name
+    def act(self, loading: Loading) -> None:
+        sim, plan = loading.sim, self.run.shear_plan()
+        event = self._event(sim)
+        if event is None:
+            return
+        turn, end = event
+        plan.events += 1
+        if turn:
+            plan.turn_steps.append(sim.step_count - plan.start_step)
+            reverse_platens(sim, self.run)
+        self.records.write(sim.step_count)
+        name = event_snapshot_name(plan.events, self.config["cyclic.cycles"])
+        if name is not None:
+            self.snapshots.store(name, sim.step_count)
+        if end:
+            plan.next_record = len(plan.record_steps)
+            loading.stop()
 
 
 def _boundary(context: Context) -> None:
@@ -143,30 +162,28 @@ def _boundary(context: Context) -> None:
 
 
 def _cycle(context: Context) -> None:
-    config = context.config
+    sim, run, config = context.sim, context.state, context.config
     amplitude = config["cyclic.strain_amplitude"]
-    plan = context.state.shear_plan()
-    strain_per_step = plan.strain_rate * context.sim.time_step
-    if config["cyclic.control"] == "stress":
+    plan = run.shear_plan()
+    strain_per_step = plan.strain_rate * sim.time_step
+    stress = config["cyclic.control"] == "stress"
 
-        def events(steps: int) -> dict[str, float]:
-            return {STRAIN_PATH: steps * strain_per_step, CYCLE: context.state.shear_plan().events / 4.0}
+    def measure() -> dict[str, float]:
+        travelled = (sim.step_count - plan.start_step) * strain_per_step
+        cycle = plan.events / 4.0 if stress else travelled / (4.0 * amplitude)
+        return {**biaxial_records.measure(sim, run, config), STRAIN_PATH: travelled, CYCLE: cycle}
 
-        shear(context.sim, context.state, config, context.writer, context.save, context.progress,
-              final=stress_path_length(config), snapshot_name_of=lambda path: "start", extra=events,
-              units=CYCLIC.units(), rule=stress_rule(config), event_snapshot=stress_snapshot_name(config["cyclic.cycles"]))
+    records = shear_records(context, measure, CYCLIC.units())
+    if stress:
+        snapshots = shear_snapshots(context, records, lambda path: "start")
+        shear(context, records, snapshots, final=stress_path_length(config),
+              first=[StressCycles(config, run, records, snapshots)])
         return
-
-    def path(steps: int) -> dict[str, float]:
-        travelled = steps * strain_per_step
-        return {STRAIN_PATH: travelled, CYCLE: travelled / (4.0 * amplitude)}
-
     final, _, _ = cycle_plan(amplitude, config["cyclic.cycles"])
-    shear(context.sim, context.state, config, context.writer, context.save, context.progress, final=final,
-          snapshot_name_of=snapshot_name_of(amplitude), extra=path, units=CYCLIC.units())
+    shear(context, records, shear_snapshots(context, records, snapshot_name_of(amplitude)), final=final)
 
 
-class CyclicProtocol(SpecimenProtocol[_Run, CyclicResult]):
+class CyclicProtocol(SpecimenProtocol[BiaxialRun, CyclicResult]):
     """The cyclic biaxial test (strain amplitude, N cycles, constant confining pressure)."""
 
     name = "cyclic"
@@ -177,14 +194,14 @@ class CyclicProtocol(SpecimenProtocol[_Run, CyclicResult]):
         Stage("shear", _cycle, "the platens between +/- the amplitude, N cycles; records and snapshots on "
                                "their triggers, checkpoints on the wall clock"),
     )
-    state_type = _Run
+    state_type = BiaxialRun
 
     def check(self) -> None:
         check_strain_rate(self.config)
         check_density_scaling(self.config)
 
-    def state_from_dict(self, saved: Any) -> _Run:
-        return _Run.from_dict({k: v for k, v in saved.items() if k not in ("config", "elapsed_s")})
+    def state_from_dict(self, saved: Any) -> BiaxialRun:
+        return BiaxialRun.from_dict({k: v for k, v in saved.items() if k not in ("config", "elapsed_s")})
 
     def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
         return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)

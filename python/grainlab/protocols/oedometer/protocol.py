@@ -6,24 +6,24 @@ snapshot at each equilibrium; :func:`run_oedometer` runs it into a folder."""
 from __future__ import annotations
 
 import os
-import time
 from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
-from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
 from grainlab.analysis import fabric_summary
 from grainlab.analysis.stress import love_weber_stress
 from grainlab.columns import OEDOMETER
 from grainlab.io.walls import WallGeometry
+from grainlab.protocols import operations
 from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import BOX_WALLS, box_state
 from grainlab.protocols.grains import grain_count, grain_porosity
 from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA  # noqa: F401 - registers the schema
 from grainlab.protocols.oedometer.outputs import OedometerResult, summarise, write_outputs
 from grainlab.protocols.oedometer.state import OedometerRun
+from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import (
     CHUNK_STEPS,
@@ -33,13 +33,11 @@ from grainlab.protocols.specimen import (
     grain_model,
     platen_model,
 )
-from grainlab.protocols.triggers import WallClock
-from grainlab.simulation import Simulation
+from grainlab.protocols.triggers import And, EveryStop, Flag, WallClock
+from grainlab.simulation import Simulation, Wall
 from grainlab.snapshot import ParticleKind
 
-__all__ = ["OedometerProtocol", "OedometerRun", "load_path", "run_oedometer"]
-
-
+__all__ = ["LoadSteps", "OedometerProtocol", "OedometerRun", "PlatenServo", "load_path", "run_oedometer"]
 
 Context = StageContext[Config, OedometerRun]
 
@@ -64,48 +62,83 @@ def _confine(context: Context) -> None:
     run.load_start_step = sim.step_count
 
 
+class PlatenServo(Operation):
+    """Controller: the top platen servo-controlled to the load step's stress
+    (``load_path(config)[run.next_load]``) over each chunk, at most ``max_speed_m_per_s``."""
+
+    acts_before_run = True
+
+    def __init__(self, walls: dict[str, Wall], stresses: list[float], run: OedometerRun, max_speed_m_per_s: float):
+        super().__init__(EveryStop(CHUNK_STEPS))
+        self.walls, self.stresses, self.run, self.max_speed = walls, stresses, run, max_speed_m_per_s
+
+    def act(self, loading: Loading) -> None:
+        box = box_state(self.walls)
+        self.walls["top"].servo(self.stresses[self.run.next_load], box.width_m, relaxation=0.5,
+                                max_speed_m_per_s=self.max_speed)
+
+
+class LoadSteps(Operation):
+    """After each chunk, whether the load step's stress is held within
+    ``oedometer.tolerance`` in equilibrium: then the platen stops, the step's target is
+    :attr:`target`, the run moves to the next step and :attr:`reached` fires (and
+    :attr:`finished` after the last step); a step that takes ``oedometer.max_steps``
+    stops the run with a :class:`SpecimenError`."""
+
+    def __init__(self, walls: dict[str, Wall], stresses: list[float], run: OedometerRun, config: Config,
+                 step: int) -> None:
+        super().__init__(EveryStop(CHUNK_STEPS))
+        self.walls, self.stresses, self.run, self.config = walls, stresses, run, config
+        self.started, self.target = step, stresses[run.next_load]
+        self.reached, self.finished = Flag(), Flag()
+        self.box = box_state(walls)
+
+    def act(self, loading: Loading) -> None:
+        sim, run, config = loading.sim, self.run, self.config
+        target, limit = self.stresses[run.next_load], config["consolidation.unbalanced_force_ratio"]
+        box = self.box = box_state(self.walls)
+        if abs(box.stress_yy_pa / target - 1.0) < config["oedometer.tolerance"] and sim.unbalanced_force_ratio < limit:
+            self.walls["top"].velocity = (0.0, 0.0)
+            if run.next_load == 0:  # sigma_0 with friction on: strains count from here
+                run.height0, run.area0 = box.height_m, box.width_m * box.height_m
+            run.max_vertical_stress_pa = max(run.max_vertical_stress_pa, box.stress_yy_pa)
+            self.target, self.started = target, sim.step_count
+            run.next_load += 1
+            self.reached.raise_at(sim.step_count)
+            if run.next_load == len(self.stresses):
+                self.finished.raise_at(sim.step_count)
+        elif sim.step_count - self.started >= config["oedometer.max_steps"]:
+            raise SpecimenError(
+                f"load step {run.next_load} ({target / 1e3:.1f} kPa) did not reach equilibrium in "
+                f"{sim.step_count - self.started} steps: sigma_v {box.stress_yy_pa / 1e3:.1f} kPa, unbalanced force "
+                f"ratio {sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise oedometer.max_steps"
+            )
+
+
 def _load(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
-    start = time.perf_counter() - run.wall_time.get("load", 0.0)
     walls = {name: sim.wall(run.walls[name]) for name in BOX_WALLS}
     stresses = load_path(config)
+    if run.next_load == len(stresses):  # stopped after the last step's checkpoint
+        return
     bar = progress_bar(len(stresses), "loading", enabled=context.progress, unit="step", initial=run.next_load)
     speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
-    tolerance, limit = config["oedometer.tolerance"], config["consolidation.unbalanced_force_ratio"]
-    checkpoint_due = WallClock(config["run.checkpoint_interval"])
-    while run.next_load < len(stresses):
-        target = stresses[run.next_load]
-        steps = 0
-        while True:
-            box = box_state(walls)
-            walls["top"].servo(target, box.width_m, relaxation=0.5, max_speed_m_per_s=speed)
-            sim.run(CHUNK_STEPS)
-            steps += CHUNK_STEPS
-            box = box_state(walls)
-            if abs(box.stress_yy_pa / target - 1.0) < tolerance and sim.unbalanced_force_ratio < limit:
-                break
-            if steps >= config["oedometer.max_steps"]:
-                bar.close()
-                raise SpecimenError(
-                    f"load step {run.next_load} ({target / 1e3:.1f} kPa) did not reach equilibrium in {steps} "
-                    f"steps: sigma_v {box.stress_yy_pa / 1e3:.1f} kPa, unbalanced force ratio "
-                    f"{sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise oedometer.max_steps"
-                )
-            raise_if_interrupted()
-        walls["top"].velocity = (0.0, 0.0)
-        if run.next_load == 0:  # sigma_0 with friction on: strains count from here
-            run.height0, run.area0 = box.height_m, box.width_m * box.height_m
-        run.max_vertical_stress_pa = max(run.max_vertical_stress_pa, box.stress_yy_pa)
-        context.writer.append_timeseries(_record(sim, run, target), units=OEDOMETER.units())
-        context.writer.write_snapshot(f"load_{run.next_load:02d}", _snapshot(sim, run), step=sim.step_count,
-                                      walls=WallGeometry.from_simulation(sim, names={i: n for n, i in run.walls.items()}))
-        run.next_load += 1
-        bar.update(1)
-        bar.set_postfix_str(f"sigma_v {box.stress_yy_pa / 1e3:.0f} kPa, K {box.stress_xx_pa / box.stress_yy_pa:.3f}")
-        run.wall_time["load"] = time.perf_counter() - start
-        if checkpoint_due():  # a stop loses at most run.checkpoint_interval of work
-            context.save()
-    bar.close()
+    steps = LoadSteps(walls, stresses, run, config, sim.step_count)
+    geometry = {i: n for n, i in run.walls.items()}
+    # a checkpoint at an equilibrium once run.checkpoint_interval has passed
+    checkpoint = operations.Checkpoint(And(steps.reached, WallClock(config["run.checkpoint_interval"])), context.save,
+                            run.wall_time, "load")
+    operations.run_loading(sim, [
+        steps,
+        operations.Records(steps.reached, context.writer, lambda: _record(sim, run, steps.target), OEDOMETER.units()),
+        operations.Snapshots(steps.reached, context.writer, lambda step: f"load_{run.next_load - 1:02d}", lambda: _snapshot(sim, run),
+                  lambda: WallGeometry.from_simulation(sim, names=geometry)),
+        operations.Progress(steps.reached, bar, lambda step: run.next_load, lambda: f"sigma_v {steps.box.stress_yy_pa / 1e3:.0f} "
+                 f"kPa, K {steps.box.stress_xx_pa / steps.box.stress_yy_pa:.3f}", run.next_load),
+        checkpoint,
+        operations.Stop(steps.finished),
+        PlatenServo(walls, stresses, run, speed),
+    ], bar, checkpoint)
 
 
 def _snapshot(sim: Simulation, run: OedometerRun) -> Any:

@@ -23,8 +23,10 @@ from grainlab.analysis import StressForceFabric, fabric_summary
 from grainlab.columns import SIMPLE_SHEAR
 from grainlab.io.hdf5.snapshot import snapshot_name
 from grainlab.io.results import SHEAR_START_FILE
+from grainlab.protocols import operations
 from grainlab.protocols.config import Config
 from grainlab.protocols.grains import grain_coordination, grain_count, grain_porosity
+from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.simple_shear.cell import (
     CONTROL_STEPS,
@@ -44,11 +46,21 @@ from grainlab.protocols.specimen import (
     damped_time_step_factor,
     grain_model,
 )
-from grainlab.protocols.triggers import At, Every, WallClock, schedule_steps
+from grainlab.protocols.triggers import (
+    And,
+    At,
+    Every,
+    EveryStop,
+    OnSteps,
+    Periodic,
+    WallClock,
+    schedule_steps,
+)
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind
 
-__all__ = ["SimpleShearProtocol", "SimpleShearRun", "record_steps", "run_simple_shear", "snapshot_name_of"]
+__all__ = ["CellControl", "SimpleShearProtocol", "SimpleShearRun", "record_steps", "run_simple_shear", "set_cell_rates",
+           "snapshot_name_of"]
 
 Context = StageContext[Config, SimpleShearRun]
 
@@ -77,29 +89,53 @@ def _max_rate(sim: Simulation, config: Config, shear_rate: float) -> float:
     return float(0.05 * config["sample.d_min"] / (100 * sim.time_step * cell.b[1]) + abs(shear_rate))
 
 
-def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int, targets: tuple[float | None, float | None],
-             shear_rate: float) -> None:
-    """Runs to ``to_step``, the cell's side rates set every CONTROL_STEPS steps (counted from
-    ``run.start_step``) to hold ``targets`` (sigma_xx, sigma_yy; None: that side's rate 0)."""
-    if targets == (None, None):  # nothing to hold: the gradient is set once
-        wanted = ((0.0, shear_rate), (0.0, 0.0))
+def set_cell_rates(sim: Simulation, run: SimpleShearRun, config: Config, targets: tuple[float | None, float | None],
+                   shear_rate: float) -> None:
+    """The cell's velocity gradient ``[[L_xx, shear_rate], [0, L_yy]]`` for the next
+    CONTROL_STEPS steps, each side's rate servo-controlled to hold its target of
+    ``targets`` (sigma_xx, sigma_yy; None: that side's rate 0)."""
+    rates = [0.0, 0.0]
+    interval = CONTROL_STEPS * sim.time_step
+    cap = _max_rate(sim, config, shear_rate)
+    held = [(k, target) for k, target in enumerate(targets) if target is not None]
+    measured = side_stresses(sim, [k for k, _ in held])
+    for (k, target), (stress, stiffness) in zip(held, measured, strict=True):
+        rates[k], run.cell_rate_integral[k] = servo_rate(
+            stress, target, stiffness, interval, cap, run.cell_rate_integral[k])
+    sim.set_velocity_gradient([[rates[0], shear_rate], [0.0, rates[1]]])
+
+
+class CellControl(Operation):
+    """Controller: the cell sheared at ``shear_rate``; a side with a target stress
+    servo-controlled to it every CONTROL_STEPS steps from ``run.start_step``
+    (:func:`set_cell_rates`), or, with no target, the gradient set at every stop."""
+
+    acts_before_run = True
+
+    def __init__(self, run: SimpleShearRun, config: Config, targets: tuple[float | None, float | None],
+                 shear_rate: float) -> None:
+        held = targets != (None, None)
+        super().__init__(Periodic(CONTROL_STEPS, run.start_step) if held else EveryStop())
+        self.run, self.config, self.targets, self.shear_rate = run, config, targets, shear_rate
+
+    def act(self, loading: Loading) -> None:
+        sim = loading.sim
+        if self.targets != (None, None):
+            set_cell_rates(sim, self.run, self.config, self.targets, self.shear_rate)
+            return
+        wanted = ((0.0, self.shear_rate), (0.0, 0.0))
         cell = sim.cell
         if cell is None or cell.velocity_gradient != wanted:
             sim.set_velocity_gradient(wanted)
-        sim.run(to_step - sim.step_count)
-        return
+
+
+def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int, target: float) -> None:
+    """Runs to ``to_step``, both sides of the cell servo-controlled to ``target`` every
+    CONTROL_STEPS steps (counted from ``run.start_step``)."""
     while sim.step_count < to_step:
         into = (sim.step_count - run.start_step) % CONTROL_STEPS
         if into == 0:
-            rates = [0.0, 0.0]
-            interval = CONTROL_STEPS * sim.time_step
-            cap = _max_rate(sim, config, shear_rate)
-            held = [(k, target) for k, target in enumerate(targets) if target is not None]
-            measured = side_stresses(sim, [k for k, _ in held])
-            for (k, target), (stress, stiffness) in zip(held, measured, strict=True):
-                rates[k], run.cell_rate_integral[k] = servo_rate(
-                    stress, target, stiffness, interval, cap, run.cell_rate_integral[k])
-            sim.set_velocity_gradient([[rates[0], shear_rate], [0.0, rates[1]]])
+            set_cell_rates(sim, run, config, (target, target), 0.0)
         sim.run(min(CONTROL_STEPS - into, to_step - sim.step_count))
 
 
@@ -127,7 +163,7 @@ def _equilibrate(sim: Simulation, run: SimpleShearRun, config: Config, progress:
     run.start_step = sim.step_count  # the control's step count starts here
     run.cell_rate_integral = [0.0, 0.0]
     while True:
-        _advance(sim, run, config, sim.step_count + CHUNK_STEPS, (target, target), 0.0)
+        _advance(sim, run, config, sim.step_count + CHUNK_STEPS, target)
         steps += CHUNK_STEPS
         stress = cell_stress(sim).total
         bar.update(CHUNK_STEPS)
@@ -200,40 +236,36 @@ def _settle(context: Context) -> None:
 
 def _shear(context: Context) -> None:
     sim, run, config, writer = context.sim, context.state, context.config, context.writer
-    start = time.perf_counter() - run.wall_time.get("shear", 0.0)
     rate = run.shear_rate_per_s
     steps_per_unit = 1.0 / (rate * sim.time_step)
     steps, snaps = record_steps(config, steps_per_unit)
-    targets = (None, run.normal_stress_pa) if config["simple_shear.volume"] == "free" else (None, None)
-    final = config["simple_shear.final_strain"]
+    records = operations.Records(OnSteps(steps, run.start_step), writer, lambda: _record(sim, run, config), SIMPLE_SHEAR.units(),
+                      count=run)
+    strains = {run.start_step + step: strain for step, strain in snaps.items()}
+    snapshots = operations.Snapshots(OnSteps(strains), writer, lambda step: snapshot_name_of(strains[step]),
+                          lambda: _snapshot(sim, run, records.values))
     if run.next_record == 0 and writer.n_rows == 0:
         sim.set_velocity_gradient([[0.0, rate], [0.0, 0.0]])
-        values = _record(sim, run, config)
-        writer.append_timeseries(values, units=SIMPLE_SHEAR.units())
+        records.write(sim.step_count)
         if 0.0 in config["simple_shear.snapshot_strains"]:
-            writer.write_snapshot(snapshot_name_of(0.0), _snapshot(sim, run, values), step=sim.step_count)
-    checkpoint_due = WallClock(config["run.checkpoint_interval"])
+            snapshots.store(snapshot_name_of(0.0), sim.step_count)
+    if run.next_record == len(steps):  # stopped after the last record's checkpoint
+        return
+    final = config["simple_shear.final_strain"]
     done = 100 * steps[run.next_record - 1] / steps_per_unit if run.next_record else 0.0
     bar = progress_bar(round(100 * final, 3), "shearing", enabled=context.progress, unit="% strain", initial=done,
                        bar_format="{l_bar}{bar}| {n:.1f}/{total:.0f} % [{elapsed}<{remaining}{postfix}]")
-    while run.next_record < len(steps):
-        _advance(sim, run, config, run.start_step + steps[run.next_record], targets, rate)
-        values = _record(sim, run, config)
-        writer.append_timeseries(values, units=SIMPLE_SHEAR.units())
-        if steps[run.next_record] in snaps:
-            writer.write_snapshot(snapshot_name_of(snaps[steps[run.next_record]]), _snapshot(sim, run, values),
-                                  step=sim.step_count)
-        run.next_record += 1
-        raise_if_interrupted()
-        reached = 100 * steps[run.next_record - 1] / steps_per_unit
-        bar.update(reached - done)
-        done = reached
-        bar.set_postfix_str(f"mu {values['friction_coefficient']:.3f}, Z {values['coordination_number']:.2f}")
-        if checkpoint_due():
-            run.wall_time["shear"] = time.perf_counter() - start
-            context.save()
-    bar.close()
-    run.wall_time["shear"] = time.perf_counter() - start
+    scheduled = records.trigger
+    checkpoint = operations.Checkpoint(And(scheduled, WallClock(config["run.checkpoint_interval"])), context.save,
+                            run.wall_time, "shear")
+    targets = (None, run.normal_stress_pa) if config["simple_shear.volume"] == "free" else (None, None)
+    operations.run_loading(sim, [
+        records, snapshots,
+        operations.Progress(scheduled, bar, lambda step: 100 * (step - run.start_step) / steps_per_unit,
+                 lambda: f"mu {records.values['friction_coefficient']:.3f}, Z {records.values['coordination_number']:.2f}",
+                 done),
+        checkpoint, operations.Stop(OnSteps(steps[-1:], run.start_step)), CellControl(run, config, targets, rate),
+    ], bar, checkpoint)
 
 
 def _snapshot(sim: Simulation, run: SimpleShearRun, values: dict[str, float]) -> Any:
