@@ -18,6 +18,7 @@ from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic,
 from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
 from grainlab.protocols.biaxial.state import BiaxialRun
 from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.runner import RunResult
 
 #: The paper's reported values, for the summary and the docs.
@@ -35,7 +36,7 @@ class BiaxialResult(RunResult):
     def one_line(self) -> str:
         s = self.summary
         return (
-            f"grainlab biaxial: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}, "
+            f"grainlab biaxial: {s.get('n_grains', s['n_particles'])} grains, porosity {s['porosity_initial']:.3f}, "
             f"Z0 {s['coordination_number_initial']:.2f}; peak sigma1/sigma3 {s['peak_stress_ratio']:.2f} "
             f"at {100 * s['axial_strain_at_peak']:.2f} % axial strain; {self._undrained()}strain rate "
             f"{s['strain_rate']:.3g} 1/s; {s['wall_time_s']:.1f} s -> {self.out_dir}"
@@ -59,6 +60,7 @@ def summarise(run: BiaxialRun, config: BiaxialConfig, timeseries: dict[str, np.n
             for name in (STRESS_RATIO, AXIAL_STRAIN, "coordination_number", VOLUMETRIC_STRAIN)}
     return {
         "n_particles": run.n_grains,
+        **clump_summary(run.sample),
         "n_membrane_disks": run.consolidation.get("membrane_disks", 0),
         "porosity_initial": shear.porosity_initial,
         "porosity_after_consolidation": run.consolidation["porosity"],

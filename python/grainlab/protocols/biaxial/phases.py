@@ -37,6 +37,7 @@ from grainlab.protocols.boundary import (
 )
 from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import servo_box
+from grainlab.protocols.grains import grain_porosity
 from grainlab.protocols.specimen import grain_model, platen_model
 from grainlab.protocols.triggers import At, Every, schedule_steps
 from grainlab.simulation import Simulation, Wall
@@ -226,7 +227,7 @@ def start_platens(sim: Simulation, run: BiaxialRun, config: Config, *, final: fl
         density_scaling_factor=grainlab.density_scaling_factor(
             rate, config["material.density"], float(radii.min()), config["material.limiting_contact_pressure"]
         ),
-        porosity_initial=1.0 - float(np.pi * np.sum(radii**2)) / area0,
+        porosity_initial=grain_porosity(sim, run.n_grains, area0),
         turn_steps=[round(t * steps_per_strain) for t in turns],
     )
 

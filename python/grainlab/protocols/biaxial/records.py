@@ -14,6 +14,7 @@ from grainlab.io.walls import WallGeometry
 from grainlab.protocols.biaxial.state import BiaxialRun, Boundary
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, sample_area
 from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.grains import grain_count
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind, Snapshot
 
@@ -121,7 +122,7 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
         "love_weber_xx_pa": float(lw[0, 0]),
         "love_weber_yy_pa": float(lw[1, 1]),
         "love_weber_xy_pa": float(lw[0, 1]),
-        "coordination_number": 2.0 * grain_contacts / n,
+        "coordination_number": 2.0 * grain_contacts / grain_count(sim, n),
         "unbalanced_force_ratio": sim.unbalanced_force_ratio,
         "kinetic_energy_j": energy.kinetic,
         "elastic_energy_j": energy.elastic,

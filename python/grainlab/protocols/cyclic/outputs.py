@@ -27,6 +27,7 @@ from grainlab.columns import (
 )
 from grainlab.protocols.biaxial.state import BiaxialRun
 from grainlab.protocols.config import Config
+from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.runner import RunResult
 from grainlab.protocols.specimen import write_run_outputs
 
@@ -43,7 +44,7 @@ class CyclicResult(RunResult):
     def one_line(self) -> str:
         s = self.summary
         if not s["cycles"]:
-            return (f"grainlab cyclic: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}; no cycle "
+            return (f"grainlab cyclic: {s.get('n_grains', s['n_particles'])} grains, porosity {s['porosity_initial']:.3f}; no cycle "
                     f"completed: the axial strain reached +/-{100 * s['strain_limit']:.1f} % in the first; "
                     f"{s['wall_time_s']:.1f} s -> {self.out_dir}")
         first, last = s["cycles"][0], s["cycles"][-1]
@@ -52,7 +53,7 @@ class CyclicResult(RunResult):
         failed = (f" (of {s['cycles_asked']}: the axial strain reached +/-{100 * s['strain_limit']:.1f} %)"
                   if s.get("stopped_at_strain_limit") else "")
         return (
-            f"grainlab cyclic: {s['n_particles']} grains, porosity {s['porosity_initial']:.3f}; "
+            f"grainlab cyclic: {s.get('n_grains', s['n_particles'])} grains, porosity {s['porosity_initial']:.3f}; "
             f"{len(s['cycles'])} cycles{failed} of {amplitude}: sigma1/sigma3 at +A "
             f"{first['stress_ratio_compression']:.2f} -> {last['stress_ratio_compression']:.2f}, volumetric strain "
             f"{100 * last[VOLUMETRIC_STRAIN]:.3f} %, Z {s['coordination_number_initial']:.2f} -> "
@@ -101,6 +102,7 @@ def summarise(run: BiaxialRun, config: Config, timeseries: dict[str, np.ndarray]
     last = cycles[-1] if cycles else {}
     return {
         "n_particles": run.n_grains,
+        **clump_summary(run.sample),
         "n_membrane_disks": run.consolidation.get("membrane_disks", 0),
         "porosity_initial": plan.porosity_initial,
         "porosity_after_consolidation": run.consolidation["porosity"],
