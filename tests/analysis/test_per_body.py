@@ -3,6 +3,8 @@ invariants on a settled pile of trimers, and today's numbers to the bit for disk
 
 from __future__ import annotations
 
+import csv
+import json
 import sys
 from pathlib import Path
 
@@ -10,7 +12,7 @@ import numpy as np
 import pytest
 from factories_analysis import grain_on_membrane, jittered_packing
 
-from grainlab import ContactModel, Simulation
+from grainlab import ContactModel, Simulation, cli
 from grainlab.analysis import (
     ContactAnisotropy,
     CoordinationNumber,
@@ -26,7 +28,7 @@ from grainlab.analysis.per_body import (
     body_view,
 )
 from grainlab.analysis.stress import contact_stress
-from grainlab.io import read_snapshot
+from grainlab.io import read_snapshot, write_particles_csv
 from grainlab.snapshot import Snapshot
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "engine"))
@@ -335,3 +337,39 @@ def test_bodies_move_and_turn_with_their_centroids_and_angles(pile):
     angle0 = np.asarray(start.particle_fields["grain_angle"])[first]
     assert np.array_equal(strain.rotation, angle - angle0)
     assert np.abs(strain.displacement[1:, 1]).min() > 1e-4  # they fell
+
+
+# ---------------------------------------------------------------- grainlab analyze
+def test_grainlab_analyze_reports_the_bodies_of_a_pile_of_trimers(pile, tmp_path, capsys):
+    start, end = pile
+    write_particles_csv(tmp_path / "start.csv", start)
+    write_particles_csv(tmp_path / "end.csv", end)
+    out = tmp_path / "out"
+    args = ["analyze", str(tmp_path / "end.csv"), "--reference", str(tmp_path / "start.csv")]
+    assert cli.main([*args, "--tolerance", "1e-12", "--out", str(out)]) == 0
+    line = capsys.readouterr().out
+    assert "; 7 bodies (6 clumps): Z = " in line
+    summary = json.loads((out / "fabric.json").read_text())
+    # read from the file, the pebbles' overlaps inside each trimer are contacts; the bodies have none
+    assert summary["n_particles"] == 19 and summary["n_contacts"] > end.n_contacts
+    engine = BodyCoordination().compute(end)
+    assert summary["body_Z"] == engine.coordination_number
+    assert summary["body_Z_c"] == engine.contact_coordination_number
+    assert summary["body_n_rattlers"] == int(engine.rattlers.sum())
+    with open(out / "bodies.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [int(r["n_pebbles"]) for r in rows] == [1, 3, 3, 3, 3, 3, 3]
+    first = np.r_[0, 1 + 3 * np.arange(6)]
+    moved = end.particle_fields["grain_centroid"][first] - start.particle_fields["grain_centroid"][first]
+    got = np.array([[float(r["displacement_x"]), float(r["displacement_y"])] for r in rows])
+    assert np.array_equal(got, moved)
+    assert (out / "map_stability_index_bodies.png").exists()
+
+
+def test_grainlab_analyze_of_disks_reports_no_bodies(tmp_path, capsys):
+    write_particles_csv(tmp_path / "disks.csv", jittered_packing(6, 6, seed=1))
+    out = tmp_path / "out"
+    assert cli.main(["analyze", str(tmp_path / "disks.csv"), "--no-figures", "--out", str(out)]) == 0
+    assert "bodies" not in capsys.readouterr().out
+    assert not any(k.startswith("body_") or k == "n_bodies" for k in json.loads((out / "fabric.json").read_text()))
+    assert not (out / "bodies.csv").exists()

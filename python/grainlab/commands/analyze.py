@@ -264,5 +264,20 @@ def run(args: argparse.Namespace) -> int:
             f"{f(s['band_thickness_diameters'], '.1f')} d, "
             f"lambda in/out {f(s['mean_lambda_in_band'])}/{f(s['mean_lambda_outside_band'])}"
         )
-    print(line + f" -> {args.out}")
+    print(line + _bodies_line(s) + f" -> {args.out}")
     return 0
+
+
+def _bodies_line(s: dict[str, Any]) -> str:
+    """The measures per body of a snapshot of clumps for the summary line ("" for disks)."""
+    if "n_bodies" not in s:
+        return ""
+
+    def f(x: float | None) -> str:
+        return "n/a" if x is None else format(x, ".3f")
+
+    return (
+        f"; {s['n_bodies']} bodies ({s['n_clumps']} clumps): Z = {f(s['body_Z'])}, "
+        f"Z_c = {f(s['body_Z_c'])}, Zm = {f(s['body_mechanical_Z'])}, a = {f(s['body_a'])}, "
+        f"mean lambda = {f(s['body_mean_lambda'])}, orientation a_p = {f(s['body_orientation_a'])}"
+    )
