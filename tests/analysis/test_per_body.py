@@ -373,3 +373,36 @@ def test_grainlab_analyze_of_disks_reports_no_bodies(tmp_path, capsys):
     assert "bodies" not in capsys.readouterr().out
     assert not any(k.startswith("body_") or k == "n_bodies" for k in json.loads((out / "fabric.json").read_text()))
     assert not (out / "bodies.csv").exists()
+
+
+def test_grainlab_analyze_reads_the_bodies_of_a_lammps_dump_by_molecule(tmp_path, capsys):
+    # the two trimers of touching pebbles (mm), molecules 7 and 3, as `fix rigid/small` writes them
+    snap = _two_trimers()
+    rows = "\n".join(
+        f"{k + 1} {7 if k < 3 else 3} 1 {float(x) * 1e-3!r} {float(y) * 1e-3!r} 0.0005"
+        for k, (x, y) in enumerate(snap.positions)
+    )
+    dump = tmp_path / "clumps.dump"
+    dump.write_text(
+        "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n6\nITEM: BOX BOUNDS ff ff pp\n"
+        "-0.002 0.002\n-0.003 0.002\n-0.0005 0.0005\nITEM: ATOMS id mol type x y radius\n" + rows + "\n"
+    )
+    out = tmp_path / "out"
+    args = ["analyze", str(dump), "--grain-column", "mol", "--tolerance", "1e-12", "--no-figures"]
+    assert cli.main([*args, "--out", str(out)]) == 0
+    assert "; 2 bodies (2 clumps): Z = 1.000, Z_c = 2.000" in capsys.readouterr().out
+    summary = json.loads((out / "fabric.json").read_text())
+    assert summary["n_contacts"] == 8 and summary["body_n_contacts"] == 2 and summary["body_n_pairs"] == 1
+    with open(out / "bodies.csv", newline="") as fh:
+        rows_read = list(csv.DictReader(fh))
+    # the centroids come from the pebbles' union (a dump carries none): each triangle's centre
+    centre = TRIANGLE.mean(axis=0) * 1e-3
+    got = np.array([[float(r["x"]), float(r["y"])] for r in rows_read])
+    np.testing.assert_allclose(got, [centre, centre * [1, -1] - [0, 1e-3]], atol=1e-15)
+    assert [int(r["grain"]) for r in rows_read] == [7, 3]
+
+
+def test_the_grain_column_is_refused_for_files_that_are_not_lammps_dumps(tmp_path):
+    write_particles_csv(tmp_path / "disks.csv", jittered_packing(3, 3, seed=1))
+    with pytest.raises(ValueError, match="grain column: only applies to LAMMPS dumps"):
+        read_snapshot(tmp_path / "disks.csv", grain_column="mol")
