@@ -3,8 +3,10 @@
 Makes trimers of CEGEO's shape parameter eta (``grainlab.shapes``), drops them
 into a box of three walls under gravity with local damping until they rest,
 and prints what it measured: the walls carry the clumps' weight, no contact
-joins two pebbles of one clump, and the snapshot (and ParaView file) carries
-every pebble's grain with its centroid and angle (docs/bodies.md).
+joins two pebbles of one clump, the snapshot (and ParaView file) carries
+every pebble's grain with its centroid and angle (docs/bodies.md), and the
+coordination numbers and lambda per body beside those of the pebbles
+(docs/fabric.md, "Measures per body").
 
 Usage: ``python examples/14_clumps.py [n_clumps] [eta]`` (default 12 trimers,
 eta 0.3); with ``--vtk DIR`` it writes the settled pile as ``DIR/pile.vtp`` (the
@@ -19,6 +21,12 @@ from pathlib import Path
 import numpy as np
 
 import grainlab
+from grainlab.analysis import (
+    BodyCoordination,
+    BodyStabilityIndex,
+    CoordinationNumber,
+    StabilityIndex,
+)
 from grainlab.io.vtk import write_clumps_vtp, write_vtp
 from grainlab.postprocess.vtk import snapshot_arrays
 from grainlab.shapes import shape_template
@@ -68,6 +76,13 @@ def main() -> None:
     print(f"walls carry {carried:.6g} N of the {weight:.6g} N weight")
     print(f"{len(contacts)} contacts between clumps, {inner} inside one")
     print(f"the snapshot has {snap.n_grains} grains; grain of pebbles 0-5: {snap.grains()[:6].tolist()}")
+    z = BodyCoordination(include_boundary=True).compute(snap)  # the walls hold the pile
+    lam = BodyStabilityIndex().compute(snap)
+    print(f"per body, walls counted: Z = {z.coordination_number:.3f} (touching pairs), "
+          f"Z_c = {z.contact_coordination_number:.3f} (contacts), rattlers: {int(z.rattlers.sum())}, "
+          f"mean lambda = {lam.mean:.3f}; read as pebbles: "
+          f"Z = {CoordinationNumber(include_boundary=True).compute(snap).coordination_number:.3f}, "
+          f"mean lambda = {StabilityIndex().compute(snap).mean:.3f}")
     if args.vtk is not None:
         args.vtk.mkdir(parents=True, exist_ok=True)
         path = write_vtp(args.vtk / "pile.vtp", np.c_[snap.positions, np.zeros(snap.n_particles)],

@@ -20,6 +20,8 @@ def test_the_clumps_example_settles_a_pile_of_trimers(tmp_path):
     assert abs(carried / weight - 1) < 1e-4, out
     assert re.search(r"contacts between clumps, 0 inside one", out), out
     assert "the snapshot has 8 grains; grain of pebbles 0-5: [0, 0, 0, 1, 1, 1]" in out
+    pairs, contacts = map(float, re.search(r"per body, walls counted: Z = (\S+) \(touching pairs\), Z_c = (\S+)", out).groups())
+    assert 0 < pairs <= contacts, out
     assert (tmp_path / "pile.vtp").is_file()
     clumps = ET.parse(tmp_path / "pile_clumps.vtp").getroot().find("PolyData/Piece")
     assert clumps is not None and clumps.get("NumberOfPoints") == "8"  # one point per trimer

@@ -1,5 +1,6 @@
 """Analysis of snapshots: fabric, stability index, strain fields, shear band, stresses,
-force networks and chains, power cells, contact loops.
+force networks and chains, power cells, contact loops; per body for clumps
+(:func:`body_view`).
 
 Every measure is a small class in the freud style (parameters in the
 constructor, ``compute(...)`` returns ``self``, results as properties that
@@ -10,6 +11,7 @@ raise until computed, ``plot(ax=None)``) backed by plain NumPy functions.
 from grainlab.analysis.analyze import AnalysisResult, analyze_snapshot, fabric_summary
 from grainlab.analysis.band_contacts import BandContacts
 from grainlab.analysis.band_readings import DisplacementBand
+from grainlab.analysis.body_analysis import BodyAnalysis, analyze_bodies
 from grainlab.analysis.fabric import (
     EDGE_TOLERANCE_RAD,
     ContactAnisotropy,
@@ -23,6 +25,13 @@ from grainlab.analysis.fabric import (
 from grainlab.analysis.force_chains import ForceChains
 from grainlab.analysis.loops import ContactLoops
 from grainlab.analysis.networks import ForceNetworks
+from grainlab.analysis.per_body import (
+    BodyCoordination,
+    BodyOrientation,
+    BodyStabilityIndex,
+    BodyView,
+    body_view,
+)
 from grainlab.analysis.shear_band import ShearBand, Slab
 from grainlab.analysis.stability import StabilityIndex, stability_index, stability_index_of_angles
 from grainlab.analysis.strain import LocalStrain, match_ids, neighbour_pairs
@@ -34,6 +43,11 @@ __all__ = [
     "EDGE_TOLERANCE_RAD",
     "AnalysisResult",
     "BandContacts",
+    "BodyAnalysis",
+    "BodyCoordination",
+    "BodyOrientation",
+    "BodyStabilityIndex",
+    "BodyView",
     "ContactAnisotropy",
     "ContactLoops",
     "CoordinationNumber",
@@ -49,10 +63,12 @@ __all__ = [
     "Slab",
     "StabilityIndex",
     "StressForceFabric",
+    "analyze_bodies",
     "analyze_snapshot",
     "angular_histogram",
     "anisotropy_eq7",
     "anisotropy_fourier",
+    "body_view",
     "fabric_summary",
     "fabric_tensor",
     "match_ids",

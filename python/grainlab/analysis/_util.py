@@ -12,9 +12,16 @@ from grainlab import _kernels
 from grainlab.analysis._compute import NotComputedError as NotComputedError  # re-exported
 from grainlab.snapshot import BOUNDARY_COUNTING, TWO_PI, Snapshot, boundary_end_groups
 
+#: The angles (rad) of each contact's end on i and on j, two (Nc,) arrays.
+EndAngles = tuple[NDArray[np.float64], NDArray[np.float64]]
+
 
 def contact_ends(
-    snapshot: Snapshot, *, include_boundary: bool, boundary: str = "each"
+    snapshot: Snapshot,
+    *,
+    include_boundary: bool,
+    boundary: str = "each",
+    end_angles: EndAngles | None = None,
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
     """Owner particle and contact angle of every contact *end* on a sample particle:
     ``owner (K,)``, ``angle (K,)`` in [0, 2 pi) and the (Nc,) mask of the contacts used.
@@ -26,25 +33,32 @@ def contact_ends(
     the normal-force-weighted mean direction (docs/fabric.md, "Boundary
     contacts"). Order: the ends on the ``i`` side of the used contacts, in list
     order, then those on the ``j`` side (:func:`contact_ends_in_list_order`: each
-    contact's two ends together).
+    contact's two ends together). ``end_angles`` ((Nc,), (Nc,)) gives the angle of
+    each contact's end on i and on j instead (a rigid body's contacts seen from its
+    centroid, docs/fabric.md, "Measures per body"); the j angles of wall contacts
+    are not read.
     """
-    owner, ends, keep, _ = _contact_ends(snapshot, include_boundary, boundary)
+    owner, ends, keep, _ = _contact_ends(snapshot, include_boundary, boundary, end_angles)
     return owner, ends, keep
 
 
 def contact_ends_in_list_order(
-    snapshot: Snapshot, *, include_boundary: bool, boundary: str = "each"
+    snapshot: Snapshot,
+    *,
+    include_boundary: bool,
+    boundary: str = "each",
+    end_angles: EndAngles | None = None,
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
     """:func:`contact_ends` (the same ends, bit for bit) in the order of the contact
     list: contact ``c`` gives its end on ``i``, then on ``j``, before contact ``c + 1``'s
     (a merged boundary end sits at the particle's first contact with that body)."""
-    owner, ends, keep, source = _contact_ends(snapshot, include_boundary, boundary)
+    owner, ends, keep, source = _contact_ends(snapshot, include_boundary, boundary, end_angles)
     order = np.argsort(source, kind="stable")  # a contact's i end before its j end
     return owner[order], ends[order], keep
 
 
 def _contact_ends(
-    snapshot: Snapshot, include_boundary: bool, boundary: str
+    snapshot: Snapshot, include_boundary: bool, boundary: str, end_angles: EndAngles | None = None
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.int64]]:
     """:func:`contact_ends`, with the (K,) index of the contact each end comes
     from (of a merged end, the smallest of its group)."""
@@ -52,11 +66,14 @@ def _contact_ends(
         raise ValueError(f"boundary: must be 'body' or 'each', got {boundary!r}")
     ci = np.asarray(snapshot.contact_i)
     cj = np.asarray(snapshot.contact_j)
-    angle = np.asarray(snapshot.contact_angles())
-    if _kernels.compiled() and not has_boundary(snapshot):
-        # no wall, no membrane: every contact gives two ends and nothing merges
+    if end_angles is None:
+        angle = np.asarray(snapshot.contact_angles())
         angle_j = angle + np.pi
         angle_j[angle_j >= TWO_PI] -= TWO_PI
+    else:
+        angle, angle_j = (np.asarray(a, dtype=np.float64) for a in end_angles)
+    if _kernels.compiled() and not has_boundary(snapshot):
+        # no wall, no membrane: every contact gives two ends and nothing merges
         owner = np.concatenate([ci, cj])
         index = np.arange(ci.size, dtype=np.int64)
         source = np.concatenate([index, index])
@@ -66,10 +83,8 @@ def _contact_ends(
     pp = keep & (cj >= 0)
     on_i = keep & sample[ci]
     on_j = pp & sample[np.where(cj >= 0, cj, 0)]
-    angle_j = angle[on_j] + np.pi
-    angle_j[angle_j >= TWO_PI] -= TWO_PI
     owner = np.concatenate([ci[on_i], cj[on_j]])
-    ends = np.concatenate([angle[on_i], angle_j])
+    ends = np.concatenate([angle[on_i], angle_j[on_j]])
     index = np.arange(ci.size, dtype=np.int64)
     source = np.concatenate([index[on_i], index[on_j]])
     if boundary == "body" and include_boundary and owner.size:

@@ -11,10 +11,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.analysis._util import json_number
+from grainlab.analysis.body_analysis import BodyAnalysis, analyze_bodies
 from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
 from grainlab.analysis.force_chains import ForceChains
 from grainlab.analysis.loops import ContactLoops
 from grainlab.analysis.networks import ForceNetworks
+from grainlab.analysis.per_body import has_clumps
 from grainlab.analysis.shear_band import ShearBand
 from grainlab.analysis.stability import DEFAULT_READING, StabilityIndex
 from grainlab.analysis.strain import LocalStrain
@@ -46,6 +48,8 @@ class AnalysisResult:
     stress_force_fabric: StressForceFabric | None = None
     grain_stress: GrainStress | None = None
     chains: ForceChains | None = None
+    #: The measures per body, for a snapshot of clumps (None for disks).
+    bodies: BodyAnalysis | None = None
 
     def summary(self) -> dict[str, Any]:
         """The scalar results, as written to ``fabric.json`` (angles in degrees)."""
@@ -120,6 +124,7 @@ class AnalysisResult:
             "timestep": self.snapshot.metadata.get("timestep"),
             "contacts": self.snapshot.metadata.get("contacts"),
             "notes": list(self.notes),
+            **(self.bodies.summary() if self.bodies is not None else {}),
         }
         return out
 
@@ -277,7 +282,9 @@ def analyze_snapshot(
     whether wall and membrane contacts count for lambda (yes) and for Z and the
     anisotropies (no); ``strain_*``: :class:`LocalStrain`'s neighbourhood;
     ``lambda_*``: :class:`StabilityIndex`'s reading of Eqs. 9-11, checked before
-    any work. What is measured, and when: docs/analysis.md, "Everything at once".
+    any work. A snapshot of clumps (bodies of several pebbles) gets the measures
+    per body too (:attr:`AnalysisResult.bodies`). What is measured, and when:
+    docs/analysis.md, "Everything at once".
     """
     stability = StabilityIndex(  # checks the reading before any work
         include_boundary=lambda_include_boundary,
@@ -313,22 +320,16 @@ def analyze_snapshot(
     strain, band = _strain_and_band(
         snapshot, reference, stability, LocalStrain(strain_neighbours, strain_cutoff), notes
     )
+    bodies = None
+    if has_clumps(snapshot):  # the same measures per body (a snapshot of disks has none)
+        bodies = analyze_bodies(
+            snapshot, reference, like=(coordination, anisotropy, stability),
+            strain=LocalStrain(strain_neighbours, strain_cutoff), notes=notes,
+        )
     return AnalysisResult(
-        snapshot,
-        coordination,
-        anisotropy,
-        force_anisotropy,
-        stability,
-        strain,
-        band,
-        notes,
-        fabric_tensor=fabric_tensor,
-        loops=loops,
-        porosity=porosity,
-        networks=networks,
-        stress_force_fabric=stress_force_fabric,
-        grain_stress=grains,
-        chains=chains,
+        snapshot, coordination, anisotropy, force_anisotropy, stability, strain, band, notes,
+        fabric_tensor=fabric_tensor, loops=loops, porosity=porosity, networks=networks,
+        stress_force_fabric=stress_force_fabric, grain_stress=grains, chains=chains, bodies=bodies,
     )
 
 

@@ -22,7 +22,7 @@ docs/fabric.md, "Geometrical stability index λ".
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from grainlab import _core, _kernels
 from grainlab.analysis._compute import Compute, Computed
 from grainlab.analysis._util import (
+    EndAngles,
     contact_ends,
     contact_ends_in_list_order,
     finite_mean,
@@ -207,6 +208,42 @@ def stability_index_of_angles(
     return float(lam[0])
 
 
+def lambda_of(
+    snapshot: Snapshot,
+    include_boundary: bool,
+    boundary: str,
+    reading: tuple[str, str, str] = (LAMBDA_SLOTS[0], LAMBDA_ANCHORS[0], LAMBDA_DEVIATIONS[0]),
+    end_angles: EndAngles | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """lambda and the contact counts of every particle of ``snapshot`` (what
+    :class:`StabilityIndex` stores), under ``reading`` (slots, anchor, deviation);
+    ``end_angles``: each contact's angle on i and on j instead of the normal's
+    (:func:`grainlab.analysis._util.contact_ends`)."""
+    slots, anchor, deviation = reading
+    if not _check_reading(slots, anchor, deviation):
+        # NumPy only; the ends in contact-list order, which "list" reads
+        owner, ends, _ = contact_ends_in_list_order(
+            snapshot, include_boundary=include_boundary, boundary=boundary, end_angles=end_angles
+        )
+        return stability_index(
+            owner, ends, snapshot.n_particles, slots=slots, anchor=anchor, deviation=deviation
+        )
+    if end_angles is None and _kernels.compiled() and not has_boundary(snapshot):
+        # no wall, no membrane: the kernel takes both ends of every contact itself
+        lam, counts = _core.stability_index_of_contacts(
+            np.ascontiguousarray(snapshot.contact_i),
+            np.ascontiguousarray(snapshot.contact_j),
+            np.ascontiguousarray(snapshot.contact_angles()),
+            snapshot.n_particles,
+            _kernels.threads(),
+        )
+        return lam, counts
+    owner, ends, _ = contact_ends(
+        snapshot, include_boundary=include_boundary, boundary=boundary, end_angles=end_angles
+    )
+    return stability_index(owner, ends, snapshot.n_particles)
+
+
 class StabilityIndex(Compute):
     r"""Geometrical stability index lambda of every particle (paper Sec. 5).
 
@@ -245,7 +282,7 @@ class StabilityIndex(Compute):
     0.333333333333
     """
 
-    _parameters = ("include_boundary", "boundary", "slots", "anchor", "deviation")
+    _parameters: ClassVar[tuple[str, ...]] = ("include_boundary", "boundary", "slots", "anchor", "deviation")
 
     def __init__(
         self,
@@ -273,33 +310,16 @@ class StabilityIndex(Compute):
 
     def compute(self, snapshot: Snapshot) -> StabilityIndex:
         """Compute lambda for every particle of ``snapshot``; returns ``self``."""
-        if not _check_reading(self.slots, self.anchor, self.deviation):
-            # NumPy only; the ends in contact-list order, which "list" reads
-            owner, ends, _ = contact_ends_in_list_order(
-                snapshot, include_boundary=self.include_boundary, boundary=self.boundary
-            )
-            lam, counts = stability_index(
-                owner,
-                ends,
-                snapshot.n_particles,
-                slots=self.slots,
-                anchor=self.anchor,
-                deviation=self.deviation,
-            )
-        elif _kernels.compiled() and not has_boundary(snapshot):
-            # no wall, no membrane: the kernel takes both ends of every contact itself
-            lam, counts = _core.stability_index_of_contacts(
-                np.ascontiguousarray(snapshot.contact_i),
-                np.ascontiguousarray(snapshot.contact_j),
-                np.ascontiguousarray(snapshot.contact_angles()),
-                snapshot.n_particles,
-                _kernels.threads(),
-            )
-        else:
-            owner, ends, _ = contact_ends(
-                snapshot, include_boundary=self.include_boundary, boundary=self.boundary
-            )
-            lam, counts = stability_index(owner, ends, snapshot.n_particles)
+        lam, counts = lambda_of(
+            snapshot, self.include_boundary, self.boundary, (self.slots, self.anchor, self.deviation)
+        )
+        return self._store_lambda(snapshot, lam, counts)
+
+    def _store_lambda(
+        self, snapshot: Snapshot, lam: NDArray[np.float64], counts: NDArray[np.int64]
+    ) -> StabilityIndex:
+        """Store lambda and the contact counts of ``snapshot``'s particles (NaN for
+        membrane particles) with their means; returns ``self``."""
         sample = snapshot.is_sample
         lam[~sample] = np.nan
         self._store(

@@ -48,8 +48,6 @@ def parse_types(text: str | None) -> tuple[int, ...]:
 
 def register(subparsers: Any) -> None:
     """Add the ``analyze`` subcommand."""
-    from grainlab.analysis.stability import LAMBDA_ANCHORS, LAMBDA_DEVIATIONS, LAMBDA_SLOTS
-
     p = subparsers.add_parser(
         "analyze",
         help="fabric, stability index, strain and shear band of a snapshot",
@@ -112,6 +110,12 @@ def register(subparsers: Any) -> None:
         help="LAMMPS atom types that bound the sample (e.g. frozen wall disks): not part of it",
     )
     p.add_argument(
+        "--grain-column",
+        metavar="COLUMN",
+        help="LAMMPS dump column naming each atom's rigid body (mol): the measures per body are "
+        "reported too (a CSV's 'grain' column and a run.h5 of clumps give them without it)",
+    )
+    p.add_argument(
         "--min-contacts", type=int, default=2, help="rattler threshold for mechanical Z (default 2)"
     )
     p.add_argument(
@@ -119,6 +123,20 @@ def register(subparsers: Any) -> None:
         action="store_true",
         help="leave wall and membrane contacts out of lambda (default: counted)",
     )
+    _add_lambda_reading(p)
+    p.add_argument(
+        "--no-figures", action="store_true", help="write only particles.csv and fabric.json"
+    )
+    p.add_argument(
+        "--out", metavar="DIR", default="analysis", help="output folder (default ./analysis)"
+    )
+    p.set_defaults(func=run)
+
+
+def _add_lambda_reading(p: Any) -> None:
+    """The options of lambda's reading of Eqs. 9-11 (docs/fabric.md, "Readings of Eqs. 9-11")."""
+    from grainlab.analysis.stability import LAMBDA_ANCHORS, LAMBDA_DEVIATIONS, LAMBDA_SLOTS
+
     p.add_argument(
         "--lambda-slots",
         choices=LAMBDA_SLOTS,
@@ -141,13 +159,6 @@ def register(subparsers: Any) -> None:
         help="reading of Eq. 9: D the sum of the deviations (Eq. 9) or per contact, "
         "divided by n - 1 (default sum)",
     )
-    p.add_argument(
-        "--no-figures", action="store_true", help="write only particles.csv and fabric.json"
-    )
-    p.add_argument(
-        "--out", metavar="DIR", default="analysis", help="output folder (default ./analysis)"
-    )
-    p.set_defaults(func=run)
 
 
 def _same_configuration(snapshot: Any, reference: Any) -> bool:
@@ -158,14 +169,50 @@ def _same_configuration(snapshot: Any, reference: Any) -> bool:
     return a.shape == b.shape and bool(np.array_equal(a, b))
 
 
-def run(args: argparse.Namespace) -> int:
-    """Entry point of ``grainlab analyze``; returns the exit code."""
-    from grainlab.analysis import analyze_snapshot
+def _read_reference(
+    args: argparse.Namespace, columns: Any, particle_columns: Any, boundary_types: tuple[int, ...]
+) -> Any:
+    """The ``--reference`` snapshot: of a LAMMPS dump its first frame and of a run.h5 its
+    first snapshot unless ``--reference-timestep`` says another."""
     from grainlab.io import (
         FileFormatError,
         MissingKindWarning,
         detect_format,
         list_timesteps,
+        read_snapshot,
+    )
+
+    ref_step = args.reference_timestep
+    try:
+        ref_format = detect_format(args.reference)
+    except FileFormatError:
+        if not particle_columns:
+            raise
+        ref_format = "particles-csv"  # its names are those --columns maps
+    if ref_step is None and ref_format == "lammps-dump":
+        ref_step = list_timesteps(args.reference)[0]
+    # a run.h5 reference without a step: its first snapshot (strain 0)
+    first = 0 if ref_step is None and ref_format == "grainlab-hdf5" else None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MissingKindWarning)  # said once, for INPUT
+        return read_snapshot(
+            args.reference,
+            contacts=args.reference_contacts,
+            timestep=ref_step,
+            tolerance=args.tolerance,
+            columns=columns if args.reference_contacts else None,
+            boundary_types=boundary_types,
+            particle_columns=particle_columns if ref_format != "grainlab-hdf5" else None,
+            snapshot=first,
+            grain_column=getattr(args, "grain_column", None) if ref_format == "lammps-dump" else None,
+        )
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry point of ``grainlab analyze``; returns the exit code."""
+    from grainlab.analysis import analyze_snapshot
+    from grainlab.io import (
+        MissingKindWarning,
         read_snapshot,
     )
     from grainlab.io.results import check_output_folder, ensure_output_folder
@@ -189,44 +236,21 @@ def run(args: argparse.Namespace) -> int:
             columns=columns,
             boundary_types=boundary_types,
             particle_columns=particle_columns,
+            grain_column=getattr(args, "grain_column", None),
         )
     for warning in caught:  # one line each, without the warnings module's source line
         if issubclass(warning.category, MissingKindWarning):
             print(f"grainlab analyze: warning: {warning.message}", file=sys.stderr)
         else:
             warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
-    reference = None
-    if args.reference:
-        ref_step = args.reference_timestep
-        try:
-            ref_format = detect_format(args.reference)
-        except FileFormatError:
-            if not particle_columns:
-                raise
-            ref_format = "particles-csv"  # its names are those --columns maps
-        if ref_step is None and ref_format == "lammps-dump":
-            ref_step = list_timesteps(args.reference)[0]
-        # a run.h5 reference without a step: its first snapshot (strain 0)
-        first = 0 if ref_step is None and ref_format == "grainlab-hdf5" else None
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", MissingKindWarning)  # said once, for INPUT
-            reference = read_snapshot(
-                args.reference,
-                contacts=args.reference_contacts,
-                timestep=ref_step,
-                tolerance=args.tolerance,
-                columns=columns if args.reference_contacts else None,
-                boundary_types=boundary_types,
-                particle_columns=particle_columns if ref_format != "grainlab-hdf5" else None,
-                snapshot=first,
-            )
-        if _same_configuration(snapshot, reference):
-            print(
-                "grainlab analyze: warning: the reference is the analysed snapshot itself (the same "
-                "positions): every displacement is 0 and no shear band can be found; choose an earlier "
-                "frame with --reference-timestep",
-                file=sys.stderr,
-            )
+    reference = _read_reference(args, columns, particle_columns, boundary_types) if args.reference else None
+    if reference is not None and _same_configuration(snapshot, reference):
+        print(
+            "grainlab analyze: warning: the reference is the analysed snapshot itself (the same "
+            "positions): every displacement is 0 and no shear band can be found; choose an earlier "
+            "frame with --reference-timestep",
+            file=sys.stderr,
+        )
     result = analyze_snapshot(
         snapshot,
         reference,
@@ -264,5 +288,20 @@ def run(args: argparse.Namespace) -> int:
             f"{f(s['band_thickness_diameters'], '.1f')} d, "
             f"lambda in/out {f(s['mean_lambda_in_band'])}/{f(s['mean_lambda_outside_band'])}"
         )
-    print(line + f" -> {args.out}")
+    print(line + _bodies_line(s) + f" -> {args.out}")
     return 0
+
+
+def _bodies_line(s: dict[str, Any]) -> str:
+    """The measures per body of a snapshot of clumps for the summary line ("" for disks)."""
+    if "n_bodies" not in s:
+        return ""
+
+    def f(x: float | None) -> str:
+        return "n/a" if x is None else format(x, ".3f")
+
+    return (
+        f"; {s['n_bodies']} bodies ({s['n_clumps']} clumps): Z = {f(s['body_Z'])}, "
+        f"Z_c = {f(s['body_Z_c'])}, Zm = {f(s['body_mechanical_Z'])}, a = {f(s['body_a'])}, "
+        f"mean lambda = {f(s['body_mean_lambda'])}, orientation a_p = {f(s['body_orientation_a'])}"
+    )

@@ -168,6 +168,7 @@ def _read_vtk(
 def _read_dump(
     path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
     columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
+    grain_column: str | None = None,
 ) -> Snapshot:
     if particle_columns:
         raise ValueError("particle columns: only apply to CSV files (a LAMMPS dump names its columns)")
@@ -178,6 +179,7 @@ def _read_dump(
         columns=columns,
         tolerance=tolerance,
         boundary_types=boundary_types,
+        grain_column=grain_column,
     )
 
 
@@ -204,6 +206,7 @@ def read_snapshot(
     format: str | None = None,
     snapshot: str | int | None = None,
     particle_columns: Mapping[str, str] | None = None,
+    grain_column: str | None = None,
 ) -> Snapshot:
     """Read a snapshot from any supported file.
 
@@ -232,6 +235,9 @@ def read_snapshot(
         other names is read as a particles CSV when this is given.
     boundary_types
         LAMMPS atom types that bound the sample (wall disks): kind MEMBRANE.
+    grain_column
+        The column of a LAMMPS dump that says which rigid body each atom is a
+        pebble of (``"mol"``; :func:`grainlab.io.lammps_dump.read_lammps_dump`).
     snapshot
         Snapshot of a grainlab results file ``run.h5``, by name
         (``"strain_0.0150"``) or position (``-1`` the last, the default);
@@ -252,6 +258,10 @@ def read_snapshot(
     if snapshot is not None and fmt != "grainlab-hdf5":
         raise ValueError(f"snapshot: only applies to grainlab HDF5 results files, not a {fmt}")
     extra: dict[str, Any] = {} if snapshot is None else {"snapshot": snapshot}
+    if grain_column is not None:
+        if fmt != "lammps-dump":
+            raise ValueError(f"grain column: only applies to LAMMPS dumps, not a {fmt} (a CSV has its 'grain' column)")
+        extra["grain_column"] = grain_column
     if particle_columns:
         if fmt == "grainlab-hdf5":
             raise ValueError("particle columns: only apply to CSV files, not to a grainlab results file")

@@ -20,12 +20,16 @@ __all__ = ["write_analysis"]
 
 
 def write_analysis(result: AnalysisResult, out_dir: str | Path, *, figures: bool = True) -> list[Path]:
-    """Write ``particles.csv``, ``fabric.json`` and (with ``figures``) the PNG + SVG
-    figures of ``result`` into ``out_dir`` (made if needed); returns the paths written."""
+    """Write ``particles.csv``, ``fabric.json``, for clumps ``bodies.csv``, and (with
+    ``figures``) the PNG + SVG figures of ``result`` into ``out_dir`` (made if needed);
+    returns the paths written."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = [write_particles_csv(out / "particles.csv", result.snapshot, result.particle_table())]
     written.append(write_json_atomic(out / "fabric.json", result.summary()))
+    bodies = result.bodies
+    if bodies is not None:
+        written.append(write_particles_csv(out / "bodies.csv", bodies.view.snapshot, bodies.table()))
     if not figures:
         return written
     snap = result.snapshot
@@ -34,6 +38,8 @@ def write_analysis(result: AnalysisResult, out_dir: str | Path, *, figures: bool
     if result.force_anisotropy is not None:
         written += plot.save_figure(result.force_anisotropy.plot(), out / "normal_forces")
     written += plot.save_figure(result.stability.plot(band=band), out / "map_stability_index")
+    if bodies is not None:
+        written += plot.save_figure(bodies.stability.plot(), out / "map_stability_index_bodies")
     ax = plot.particle_map(
         snap.positions,
         snap.radii,
