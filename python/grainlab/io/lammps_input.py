@@ -71,6 +71,7 @@ __all__ = [
     "LammpsExport",
     "LammpsFixedCell",
     "LammpsShear",
+    "check_lammps_export",
     "find_lammps",
     "lammps_pair_coeff",
     "read_lammps_run",
@@ -528,9 +529,17 @@ def write_lammps_fixed_cell(sim: Simulation, folder: str | Path, run: LammpsFixe
     return _write(sim, folder, run)
 
 
-def _write(sim: Simulation, folder: str | Path, protocol: LammpsShear | LammpsFixedCell) -> LammpsExport:
+def check_lammps_export(sim: Simulation, protocol: LammpsShear | LammpsFixedCell) -> ContactModel:
+    """Refuse, in one line, what the export of ``sim`` with ``protocol`` cannot carry
+    (walls, bonds, sheared clumps, ...: module docstring); returns the one contact
+    model it writes."""
     model = _checked_state(sim, protocol)
-    lammps_pair_coeff(model)  # refuses a law LAMMPS cannot say, before anything is written
+    lammps_pair_coeff(model)  # refuses a law LAMMPS cannot say
+    return model
+
+
+def _write(sim: Simulation, folder: str | Path, protocol: LammpsShear | LammpsFixedCell) -> LammpsExport:
+    model = check_lammps_export(sim, protocol)  # before anything is written
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
         raise ValueError(f"folder: {folder} is a file")
