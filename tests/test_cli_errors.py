@@ -119,3 +119,25 @@ def test_an_export_of_a_missing_source_says_so_before_asking_for_the_shear(tmp_p
     assert cli.main(["export", str(tmp_path), "--lammps"]) == 2
     _one_line(capsys, f"{tmp_path}: no checkpoint.h5 or shear_start.state")
     assert not (tmp_path / "lammps").exists()
+
+
+def test_an_export_of_clumps_to_a_shear_is_one_line_before_any_folder(tmp_path, capsys):
+    import numpy as np
+
+    from grainlab import Simulation
+
+    sim = Simulation(np.empty((0, 2)), np.empty(0), 2650.0, time_step=1e-7)
+    sim.add_clumps([[-0.3e-3, 0.0], [0.3e-3, 0.0]], [0.7e-3] * 2, positions=[[2e-3, 2e-3]], angles=[0.0], density=2650.0)
+    sim.set_periodic_cell((0.0, 0.0), (6e-3, 6e-3))
+    state = tmp_path / "clumps.state"
+    sim.save(state)
+    out = tmp_path / "deck"
+    assert cli.main(["export", str(state), "--lammps", "--shear-rate", "1", "--shear-strain", "0.1", "--out", str(out)]) == 2
+    _one_line(capsys, "sim: 1 clump(s) cannot be sheared in LAMMPS")
+    assert not out.exists()
+    assert cli.main(["export", str(state), "--lammps", "--steps", "10", "--shear-rate", "1", "--out", str(out)]) == 2
+    _one_line(capsys, "--steps: holds the cell fixed; give it without --shear-rate and --shear-strain")
+    assert not out.exists()
+    assert cli.main(["export", str(state), "--lammps", "--steps", "1000", "--out", str(out)]) == 0
+    assert "fix             rigid clumps rigid/small molecule infile bodies.grainlab" in (out / "in.grainlab").read_text()
+    assert (out / "bodies.grainlab").is_file()

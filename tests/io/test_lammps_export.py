@@ -57,7 +57,7 @@ def test_pair_coeff_carries_the_law_and_refuses_what_lammps_cannot_say():
     ).split()
     # tangential dashpot x * eta_n = 2 zeta_s sqrt(m* ks): x = sqrt(ks / kn) for equal ratios
     assert float(damped[6]) == pytest.approx(0.5, rel=1e-15)
-    assert damped[-2:] == ["damping", "tsuji"]
+    assert damped[-3:] == ["damping", "tsuji", "limit_damping"]
     with pytest.raises(ValueError, match="rolling"):
         lammps_pair_coeff(ContactModel(rolling_friction=0.1))
     with pytest.raises(ValueError, match="normal_damping_ratio > 0"):
@@ -100,7 +100,7 @@ def test_export_refuses_what_it_cannot_carry(tmp_path):
         write_lammps_shear(small_cell(rolling_friction=0.1), tmp_path, LammpsShear(1.0, 0.1))
     clumped = small_cell()
     clumped.add_bodies([[0, 1]])
-    with pytest.raises(ValueError, match=r"1 clump\(s\) cannot be exported"):
+    with pytest.raises(ValueError, match=r"1 clump\(s\) cannot be sheared in LAMMPS: fix rigid/small keeps"):
         write_lammps_shear(clumped, tmp_path, LammpsShear(1.0, 0.1))
     with pytest.raises(ValueError, match="final_strain"):
         LammpsShear(1.0, -0.1)

@@ -8,7 +8,10 @@ Thin wrappers around :func:`grainlab.postprocess.export_vtk` and
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from grainlab.io.lammps_input import LammpsShear
 
 __all__ = ["register", "run"]
 
@@ -37,7 +40,9 @@ def register(subparsers: Any) -> None:
             "Simulation.save, a checkpoint.h5, or a run folder holding one); writes data.grainlab, "
             "in.grainlab (periodic simple shear at --shear-rate to --shear-strain, dumps of atoms "
             "and contacts) and export.json into --out (default: DIR/lammps, or STATE.lammps next to "
-            "a state file). Run it with 'mpirun -np 2 lmp -in in.grainlab' there; "
+            "a state file); with --steps N instead, the cell held fixed for N steps, the one run a "
+            "state with clumps goes to LAMMPS with (each clump a fix rigid/small body with grainlab's "
+            "mass and moment of inertia, bodies.grainlab). Run it with 'mpirun -np 2 lmp -in in.grainlab' there; "
             "grainlab.io.lammps_input.read_lammps_run reads the dumps back as snapshots. "
             "See docs/lammps.md."
         ),
@@ -57,6 +62,10 @@ def register(subparsers: Any) -> None:
         "--shear-strain", type=float, metavar="GAMMA",
         help="--lammps: shear strain at the end (required but for a simple-shear run's folder: its own)"
     )
+    p.add_argument(
+        "--steps", type=int, metavar="N",
+        help="--lammps: hold the periodic cell fixed for N steps instead of shearing it (clumps need it)",
+    )  # fmt: skip
     p.add_argument(
         "--dump-every", type=int, default=0, metavar="STEPS",
         help="--lammps: steps between dumps (default: about 50 dumps over the run)",
@@ -98,11 +107,42 @@ def run(args: argparse.Namespace) -> int:
 def _lammps(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from grainlab.io.lammps_input import LammpsShear, simulation_to_export, write_lammps_shear
+    from grainlab.io.lammps_input import (
+        LammpsFixedCell,
+        check_lammps_export,
+        simulation_to_export,
+        write_lammps_fixed_cell,
+        write_lammps_shear,
+    )
     from grainlab.io.results import ensure_output_folder
 
+    if args.steps is not None and (args.shear_rate is not None or args.shear_strain is not None):
+        raise ValueError("--steps: holds the cell fixed; give it without --shear-rate and --shear-strain")
     source = Path(args.dir)
     sim = simulation_to_export(source)  # first: a missing or unusable source is the first thing to say
+    protocol = _shear(args, source) if args.steps is None else LammpsFixedCell(args.steps, args.dump_every, args.local_damping)
+    check_lammps_export(sim, protocol)  # before the output folder is made
+    default = source / "lammps" if source.is_dir() else source.with_name(source.name + ".lammps")
+    out = Path(args.out) if args.out is not None else default
+    ensure_output_folder(out)
+    if isinstance(protocol, LammpsFixedCell):
+        done = write_lammps_fixed_cell(sim, out, protocol)
+    else:
+        done = write_lammps_shear(sim, out, protocol)
+    clumps = f" ({len(sim.clumps)} clumps)" if len(sim.clumps) else ""
+    print(
+        f"grainlab export: {sim.n_particles} disks{clumps}, {done.steps} steps -> {done.input_file} and "
+        f"{done.data_file.name}; run 'mpirun -np 2 lmp -in {done.input_file.name}' in {out}"
+    )
+    for item in done.dropped:
+        print(f"  not carried: {item}")
+    return 0
+
+
+def _shear(args: argparse.Namespace, source: Any) -> LammpsShear:
+    """The simple shear of ``--shear-rate`` and ``--shear-strain``, or of a simple-shear run's folder."""
+    from grainlab.io.lammps_input import LammpsShear
+
     rate, strain = args.shear_rate, args.shear_strain
     planned = _simple_shear_plan(source)
     if planned is not None:  # a simple-shear run's folder: its rate and strain unless given
@@ -110,19 +150,11 @@ def _lammps(args: argparse.Namespace) -> int:
         strain = planned[1] if strain is None else strain
     for flag, value in (("--shear-rate", rate), ("--shear-strain", strain)):
         if value is None:
-            raise ValueError(f"{flag}: required with --lammps (but for a simple-shear run's folder, whose own it takes)")
-    shear = LammpsShear(rate, strain, args.dump_every, args.local_damping)
-    default = source / "lammps" if source.is_dir() else source.with_name(source.name + ".lammps")
-    out = Path(args.out) if args.out is not None else default
-    ensure_output_folder(out)
-    done = write_lammps_shear(sim, out, shear)
-    print(
-        f"grainlab export: {sim.n_particles} disks, {done.steps} steps -> {done.input_file} and {done.data_file.name}; "
-        f"run 'mpirun -np 2 lmp -in {done.input_file.name}' in {out}"
-    )
-    for item in done.dropped:
-        print(f"  not carried: {item}")
-    return 0
+            raise ValueError(
+                f"{flag}: required with --lammps but for --steps (a fixed cell) or a simple-shear run's folder, "
+                "whose own it takes"
+            )
+    return LammpsShear(rate, strain, args.dump_every, args.local_damping)
 
 
 def _simple_shear_plan(source: Any) -> tuple[float, float] | None:
