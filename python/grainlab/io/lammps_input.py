@@ -30,13 +30,26 @@ force on the first atom). The thermo output has LAMMPS's own stress of the
 contacts (``compute pressure NULL virial``: ``pxx pyy pxy``, compression
 positive) and the mean contact count.
 
+:func:`write_lammps_fixed_cell` writes the same with the cell held fixed for a
+number of steps (:class:`LammpsFixedCell`), and carries clumps: every atom has
+a molecule id (``fix property/atom mol``; grainlab's body + 1), each clump is a
+``fix rigid/small molecule`` body whose mass, centroid, moment of inertia,
+velocity and angular momentum are grainlab's (``bodies.grainlab``, read by the
+``infile`` keyword: LAMMPS's own sums over the pebbles would count their
+overlaps twice), contacts inside a clump are excluded (``neigh_modify exclude
+molecule/intra``), the disks move by ``fix nve/sphere disc``, and
+``bodies.dump`` (``compute rigid/local``: ``mol x y vx vy omegaz``) has a row per
+clump at every dump. Clumps cannot be sheared (a rigid body keeps its velocity
+across the sheared boundary, where ``remap v`` shifts an atom's): refused.
+
 What a data file cannot carry is named in :attr:`LammpsExport.dropped`: the
 contacts' shear springs (LAMMPS starts them at zero), the rotation angles (a
 LAMMPS sphere has none), grainlab's local damping when ``local_damping`` is
 ``"omit"`` (Debian's LAMMPS of 29 Sep 2021 has no ``fix damping/cundall``).
 A state that LAMMPS's law cannot reproduce (walls, bonds, fixed or loaded
-disks, gravity, rolling resistance, several contact models) is refused
-before anything is written. See docs/lammps.md.
+disks, gravity, rolling resistance, several contact models, sheared clumps) is
+refused before anything is written (:func:`check_lammps_export`). See
+docs/lammps.md.
 """
 
 from __future__ import annotations
