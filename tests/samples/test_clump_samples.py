@@ -104,3 +104,14 @@ def test_dimers_pack_at_random_angles():
 def test_a_shape_that_is_not_a_template_is_refused_before_any_work():
     with pytest.raises(TypeError, match="shape: expected a ShapeTemplate"):
         expand_to_porosity(BOX, 0.16, GRADING, shape="trimer")  # type: ignore[arg-type]
+
+
+def test_a_clump_sample_keeps_the_gradings_sizes():
+    """The default grain count fills the box with grains of the shape's area, so the
+    common growth factor stays near 1: the clumps' circumscribed diameters are the
+    grading's, not 1 / sqrt(area fraction) larger."""
+    shape = shape_template("trimer", 0.5)
+    s = expand_to_porosity(BOX, 0.16, GRADING, seed=2, shape=shape)
+    assert abs(s.radius_factor - 1.0) < 0.1  # the draw's own scatter, not 1 / sqrt(0.71) = 1.19
+    diameters = 2 * s.radii[::3] / shape.radii[0]
+    assert diameters.min() > 0.9 * GRADING.d_min and diameters.max() < 1.1 * GRADING.d_max

@@ -357,7 +357,7 @@ def expand_to_porosity(
     )
     clumps = _clump_shape(shape)
     rng = np.random.default_rng(seed)
-    d = _diameters(settings, grading, diameters, n_particles, rng)
+    d = _diameters(settings, grading, diameters, n_particles, rng, clumps)
     expansion = _Expansion.placed(settings, d, rng, density_scaling, progress, clumps)
     expansion.grow()
     return Sample(
@@ -465,9 +465,11 @@ def _diameters(
     diameters: ArrayLike | None,
     n_particles: int | None,
     rng: np.random.Generator,
+    clumps: ShapeTemplate | None = None,
 ) -> NDArray[np.float64]:
-    """The diameters given, or ``n_particles`` (default: :func:`particle_count`) drawn
-    from the grading."""
+    """The diameters given, or ``n_particles`` drawn from the grading: by default as
+    many as fill the box at the porosity, disks (:func:`particle_count`) or grains of
+    the ``clumps`` shape's area (so that the grains keep the grading's sizes)."""
     if diameters is not None:
         if n_particles is not None:
             raise ValueError("n_particles: give either n_particles or diameters, not both")
@@ -478,7 +480,12 @@ def _diameters(
             k = int(np.argmax(~np.isfinite(d) | (d <= 0)))
             raise ValueError(f"diameters[{k}]: must be a finite diameter > 0 (m), got {d[k]}")
         return d
-    n = particle_count(settings.area, settings.porosity, grading) if n_particles is None else int(n_particles)
+    if n_particles is not None:
+        n = int(n_particles)
+    elif clumps is None:
+        n = particle_count(settings.area, settings.porosity, grading)
+    else:  # grains of the shape's area, a fraction of their circumscribed disk's, fill the box
+        n = round((1.0 - settings.porosity) * settings.area / (grading.mean_disk_area() * clumps.area / math.pi))
     if n < 1:
         raise ValueError(f"n_particles: must be >= 1, got {n}")
     return grading.sample(n, rng)
