@@ -381,7 +381,7 @@ def figures(rows: list[dict], paper: dict, figure_dir: Path) -> None:
             yerr = [r[key + "_spread"] or 0.0 for r in sel]
             seeds = max(r["seeds"] for r in sel)
             ax.errorbar([r["eta"] for r in sel], [r[key] for r in sel], yerr=yerr, fmt="o-", color=colour,
-                        label=f"grainlab, ~{n} grains ({seeds} seed{'s' if seeds > 1 else ''})")
+                        label=f"grainlab, size {n} ({seeds} seed{'s' if seeds > 1 else ''})")
         ax.set_xlabel(r"$\eta$")
         ax.set_ylabel(label)
         ax.legend(fontsize=7)
