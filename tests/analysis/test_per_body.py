@@ -406,3 +406,24 @@ def test_the_grain_column_is_refused_for_files_that_are_not_lammps_dumps(tmp_pat
     write_particles_csv(tmp_path / "disks.csv", jittered_packing(3, 3, seed=1))
     with pytest.raises(ValueError, match="grain column: only applies to LAMMPS dumps"):
         read_snapshot(tmp_path / "disks.csv", grain_column="mol")
+
+
+def test_a_dimer_across_a_periodic_edge_is_one_body_seen_from_its_centroid():
+    # pebbles at x = 9.7 and 0.3 of a 10 x 10 periodic cell (0.6 apart across the edge),
+    # a disk above the second one
+    snap = Snapshot.from_geometry(
+        [[9.7, 5.0], [0.3, 5.0], [0.3, 5.95]],
+        [0.5, 0.5, 0.5],
+        box=[[0.0, 10.0], [0.0, 10.0]],
+        periodic=(True, True),
+        particle_fields={"grain": [0, 0, 1]},
+    )
+    view = body_view(snap)
+    assert view.n_bodies == 2 and view.snapshot.n_contacts == 1
+    np.testing.assert_allclose(view.snapshot.positions[0], [10.0, 5.0], atol=1e-12)
+    np.testing.assert_allclose(view.offsets[:2], [[-0.3, 0.0], [0.3, 0.0]], atol=1e-12)
+    assert BodyOrientation().compute(view).axis[0] == pytest.approx(0.0, abs=1e-12)
+    on_dimer, on_disk = view.end_angles()
+    # the contact point (0.3, 5.475) is (0.3, 0.475) from the centroid across the edge
+    assert on_dimer[0] == pytest.approx(np.arctan2(0.475, 0.3), abs=1e-12)
+    assert on_disk[0] == pytest.approx(1.5 * np.pi, abs=1e-12)  # the disk keeps its normal's angle

@@ -44,8 +44,8 @@ class BodyAnalysis:
     def summary(self) -> dict[str, Any]:
         """The scalars, as ``fabric.json`` writes them (angles in degrees)."""
         num = json_number
-        z, a, fa, lam, o = self.coordination, self.anisotropy, self.force_anisotropy, self.stability, self.orientation
-        sigma = self.stress
+        z, a, fa = self.coordination, self.anisotropy, self.force_anisotropy
+        lam, o, sigma = self.stability, self.orientation, self.stress
         return {
             "n_bodies": z.n_bodies,
             "n_clumps": int((self.view.n_pebbles[self.view.snapshot.is_sample] > 1).sum()),
@@ -109,17 +109,21 @@ def analyze_bodies(
     changes. Each measure takes the parameters of the pebbles' measure in ``like``
     (default: the defaults), ``strain`` the neighbourhood (default
     :class:`LocalStrain`'s); ``notes`` gets what could not be measured."""
-    coordination, anisotropy, stability = like or (CoordinationNumber(), ContactAnisotropy(), StabilityIndex())
+    coordination, anisotropy, stability = like or (
+        CoordinationNumber(), ContactAnisotropy(), StabilityIndex()
+    )
     view = body_view(snapshot)
     bodies = view.snapshot
     force = bodies.normal_force
     fabric = (anisotropy.include_boundary, anisotropy.edge_tolerance)
     reading = {"slots": stability.slots, "anchor": stability.anchor, "deviation": stability.deviation}
+    rule = (coordination.min_contacts, coordination.include_boundary, coordination.boundary)
+    weighted = ContactAnisotropy(anisotropy.bins, "normal_force", *fabric)
     result = BodyAnalysis(
         view,
-        BodyCoordination(coordination.min_contacts, coordination.include_boundary, coordination.boundary).compute(view),
+        BodyCoordination(*rule).compute(view),
         ContactAnisotropy(anisotropy.bins, "count", *fabric).compute(bodies),
-        ContactAnisotropy(anisotropy.bins, "normal_force", *fabric).compute(bodies) if force is not None else None,
+        None if force is None else weighted.compute(bodies),
         BodyStabilityIndex(stability.include_boundary, stability.boundary, **reading).compute(view),
         BodyOrientation().compute(view),
     )

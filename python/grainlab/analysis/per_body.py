@@ -217,7 +217,8 @@ def _body_snapshot(
     wall = cj < 0
     bi, bj = body[ci], np.where(wall, cj, body[np.where(wall, 0, cj)])
     keep = wall | (bi != bj)
-    fields = {BODY_FIELD: np.asarray(snapshot.particle_fields[BODY_FIELD])[first]} if BODY_FIELD in snapshot.particle_fields else {}
+    chains = snapshot.particle_fields.get(BODY_FIELD)  # the membrane chains
+    fields = {} if chains is None else {BODY_FIELD: np.asarray(chains)[first]}
 
     def kept(a: NDArray[Any] | None) -> NDArray[Any] | None:
         return None if a is None else np.asarray(a)[keep]
@@ -287,14 +288,15 @@ class BodyCoordination(Compute):
         :func:`body_view`); returns ``self``."""
         view = _view(snapshot)
         s = view.snapshot
-        pairs = CoordinationNumber(self.min_contacts, self.include_boundary, self.boundary).compute(view.pairs())
-        contacts = CoordinationNumber(0, self.include_boundary, self.boundary).compute(s)
+        rule = (self.include_boundary, self.boundary)
+        pairs = CoordinationNumber(self.min_contacts, *rule).compute(view.pairs())
+        contacts = CoordinationNumber(0, *rule).compute(s)
         core = s.is_sample & ~pairs.rattlers
         ci, cj = np.asarray(s.contact_i), np.asarray(s.contact_j)
         other = np.where(cj >= 0, cj, ci)
         among = core[ci] & ((cj < 0) | core[other] | ~s.is_sample[other])
         among |= ~s.is_sample[ci] & core[other]
-        kept = CoordinationNumber(0, self.include_boundary, self.boundary).compute(s.select_contacts(among))
+        kept = CoordinationNumber(0, *rule).compute(s.select_contacts(among))
         n_m = int(core.sum())
         z_cm = float(kept.n_contacts[core].sum() / n_m) if n_m else float("nan")
         self._store(

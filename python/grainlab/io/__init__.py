@@ -260,7 +260,7 @@ def read_snapshot(
     extra: dict[str, Any] = {} if snapshot is None else {"snapshot": snapshot}
     if grain_column is not None:
         if fmt != "lammps-dump":
-            raise ValueError(f"grain column: only applies to LAMMPS dumps, not a {fmt} (a CSV has its 'grain' column)")
+            raise ValueError(f"grain column: only applies to LAMMPS dumps, not a {fmt}")
         extra["grain_column"] = grain_column
     if particle_columns:
         if fmt == "grainlab-hdf5":
