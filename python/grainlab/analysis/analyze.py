@@ -16,7 +16,7 @@ from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
 from grainlab.analysis.force_chains import ForceChains
 from grainlab.analysis.loops import ContactLoops
 from grainlab.analysis.networks import ForceNetworks
-from grainlab.analysis.per_body import has_clumps
+from grainlab.analysis.per_body import BodyCoordination, BodyStabilityIndex, body_view, has_clumps
 from grainlab.analysis.shear_band import ShearBand
 from grainlab.analysis.stability import DEFAULT_READING, StabilityIndex
 from grainlab.analysis.strain import LocalStrain
@@ -237,13 +237,25 @@ def fabric_summary(snapshot: Snapshot) -> dict[str, float]:
     (the exact, unbinned estimate; ``anisotropy_fourier`` is the same value
     under its earlier name), ``anisotropy_binned`` (Eq. 7 on 18 bins),
     ``force_anisotropy`` and ``force_anisotropy_binned`` (NaN when no contact
-    carries a force)."""
-    z = CoordinationNumber().compute(snapshot)
+    carries a force). A snapshot of clumps is read per body (docs/fabric.md,
+    "Measures per body"): contacts per body (``Z_c``, and ``Z_c`` of the bodies
+    left once rattlers are removed), lambda about each body's centroid, the
+    anisotropies of the contacts between bodies."""
+    stability: StabilityIndex
+    if has_clumps(snapshot):
+        view = body_view(snapshot)
+        bodies = BodyCoordination().compute(view)
+        stability = BodyStabilityIndex().compute(view)
+        coordination = bodies.contact_coordination_number, bodies.mechanical_contact_coordination_number
+        snapshot = view.snapshot
+    else:
+        z = CoordinationNumber().compute(snapshot)
+        stability = StabilityIndex().compute(snapshot)
+        coordination = z.coordination_number, z.mechanical_coordination_number
     normals = ContactAnisotropy().compute(snapshot)
-    stability = StabilityIndex().compute(snapshot)
     out = {
-        "coordination_number": z.coordination_number,
-        "mechanical_coordination_number": z.mechanical_coordination_number,
+        "coordination_number": coordination[0],
+        "mechanical_coordination_number": coordination[1],
         "mean_stability_index": stability.mean,
         "mean_stability_index_all": stability.mean_all,
         "anisotropy": normals.anisotropy,

@@ -25,7 +25,7 @@ from grainlab.io.hdf5.snapshot import snapshot_name
 from grainlab.io.results import SHEAR_START_FILE
 from grainlab.protocols import operations
 from grainlab.protocols.config import Config
-from grainlab.protocols.grains import grain_coordination, grain_count, grain_porosity
+from grainlab.protocols.grains import grain_coordination, grain_porosity
 from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.simple_shear.cell import (
@@ -289,8 +289,6 @@ def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, f
     snap = sim.snapshot(kind=np.full(sim.n_particles, int(ParticleKind.SOIL), dtype=np.int8))
     fabric = fabric_summary(snap)
     z = fabric.pop("coordination_number")
-    if len(sim.clumps):  # contacts per grain (CEGEO's Z_c), not per pebble
-        z = 2.0 * snap.n_contacts / grain_count(sim, n)
     rb = StressForceFabric().compute(snap)
     energy = sim.energy
     strain = (sim.step_count - run.start_step) * sim.time_step * run.shear_rate_per_s
