@@ -64,56 +64,9 @@ def register(subparsers: Any) -> None:
         "input", metavar="INPUT",
         help="particles CSV, PFC ball table, LAMMPS atoms dump, YADE text export, legacy VTK file or run.h5",
     )
-    p.add_argument(
-        "--contacts", metavar="FILE",
-        help="contacts CSV (i,j by id; a PFC table's end1,end2) or LAMMPS local dump",
-    )
-    p.add_argument(
-        "--columns",
-        metavar="ROLE=COLUMN,...",
-        help="column names of a particles CSV (INPUT and --reference), e.g. id=ID,x=pos_x,y=pos_y,radius=rad",
-    )
-    p.add_argument(
-        "--reference", metavar="SNAPSHOT_FILE", help="earlier snapshot for displacement and strain"
-    )
-    p.add_argument(
-        "--reference-contacts", metavar="FILE", help="contacts file of the reference snapshot"
-    )
-    p.add_argument(
-        "--timestep", type=int, metavar="N", help="frame of a multi-frame dump (default: last)"
-    )
-    p.add_argument(
-        "--reference-timestep",
-        type=int,
-        metavar="N",
-        help="frame of the reference dump or run.h5 (default: the first; a run.h5 its strain-0 snapshot)",
-    )
+    _add_input_options(p)
     p.add_argument(
         "--bins", type=int, default=18, help=f"angular bins over 360 degrees, 2 to {MAX_BINS} (default 18)"
-    )
-    p.add_argument(
-        "--tolerance",
-        type=float,
-        default=0.0,
-        metavar="METRES",
-        help="touching tolerance (m) when contacts are detected from geometry (default 0)",
-    )
-    p.add_argument(
-        "--contact-columns",
-        metavar="ROLE=COLUMN,...",
-        help="column roles of the contacts file: a LAMMPS local dump (i=c_ids[1],j=c_ids[2],"
-        "normal_force=c_pl[2]) or a contacts CSV (i=end1,j=end2)",
-    )
-    p.add_argument(
-        "--boundary-types",
-        metavar="T1,T2",
-        help="LAMMPS atom types that bound the sample (e.g. frozen wall disks): not part of it",
-    )
-    p.add_argument(
-        "--grain-column",
-        metavar="COLUMN",
-        help="LAMMPS dump column naming each atom's rigid body (mol): the measures per body are "
-        "reported too (a CSV's 'grain' column and a run.h5 of clumps give them without it)",
     )
     p.add_argument(
         "--min-contacts", type=int, default=2, help="rattler threshold for mechanical Z (default 2)"
@@ -208,13 +161,61 @@ def _read_reference(
         )
 
 
+def _add_input_options(p: argparse.ArgumentParser) -> None:
+    """The options that say how to read the snapshot and its reference."""
+    p.add_argument(
+        "--contacts", metavar="FILE",
+        help="contacts CSV (i,j by id; a PFC table's end1,end2) or LAMMPS local dump",
+    )
+    p.add_argument(
+        "--columns",
+        metavar="ROLE=COLUMN,...",
+        help="column names of a particles CSV (INPUT and --reference), e.g. id=ID,x=pos_x,y=pos_y,radius=rad",
+    )
+    p.add_argument(
+        "--reference", metavar="SNAPSHOT_FILE", help="earlier snapshot for displacement and strain"
+    )
+    p.add_argument(
+        "--reference-contacts", metavar="FILE", help="contacts file of the reference snapshot"
+    )
+    p.add_argument(
+        "--timestep", type=int, metavar="N", help="frame of a multi-frame dump (default: last)"
+    )
+    p.add_argument(
+        "--reference-timestep",
+        type=int,
+        metavar="N",
+        help="frame of the reference dump or run.h5 (default: the first; a run.h5 its strain-0 snapshot)",
+    )
+    p.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.0,
+        metavar="METRES",
+        help="touching tolerance (m) when contacts are detected from geometry (default 0)",
+    )
+    p.add_argument(
+        "--contact-columns",
+        metavar="ROLE=COLUMN,...",
+        help="column roles of the contacts file: a LAMMPS local dump (i=c_ids[1],j=c_ids[2],"
+        "normal_force=c_pl[2]) or a contacts CSV (i=end1,j=end2)",
+    )
+    p.add_argument(
+        "--boundary-types",
+        metavar="T1,T2",
+        help="LAMMPS atom types that bound the sample (e.g. frozen wall disks): not part of it",
+    )
+    p.add_argument(
+        "--grain-column",
+        metavar="COLUMN",
+        help="LAMMPS dump column naming each atom's rigid body (mol): the measures per body are "
+        "reported too (a CSV's 'grain' column and a run.h5 of clumps give them without it)",
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``grainlab analyze``; returns the exit code."""
     from grainlab.analysis import analyze_snapshot
-    from grainlab.io import (
-        MissingKindWarning,
-        read_snapshot,
-    )
     from grainlab.io.results import check_output_folder, ensure_output_folder
     from grainlab.postprocess import write_analysis
 
@@ -226,23 +227,7 @@ def run(args: argparse.Namespace) -> int:
     particle_columns = parse_columns(getattr(args, "columns", None), "--columns")
     boundary_types = parse_types(args.boundary_types)
     check_output_folder(args.out)  # a bad --out is refused before the input is read, and nothing is created
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", MissingKindWarning)
-        snapshot = read_snapshot(
-            args.input,
-            contacts=args.contacts,
-            timestep=args.timestep,
-            tolerance=args.tolerance,
-            columns=columns,
-            boundary_types=boundary_types,
-            particle_columns=particle_columns,
-            grain_column=getattr(args, "grain_column", None),
-        )
-    for warning in caught:  # one line each, without the warnings module's source line
-        if issubclass(warning.category, MissingKindWarning):
-            print(f"grainlab analyze: warning: {warning.message}", file=sys.stderr)
-        else:
-            warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
+    snapshot = _read_input(args, columns, particle_columns, boundary_types)
     reference = _read_reference(args, columns, particle_columns, boundary_types) if args.reference else None
     if reference is not None and _same_configuration(snapshot, reference):
         print(
@@ -263,7 +248,36 @@ def run(args: argparse.Namespace) -> int:
     )
     ensure_output_folder(args.out)  # the input is accepted: the folder may now be made
     write_analysis(result, Path(args.out), figures=not args.no_figures)
-    s = result.summary()
+    print(_summary_line(result.summary()) + f" -> {args.out}")
+    return 0
+
+
+def _read_input(args: argparse.Namespace, columns: Any, particle_columns: Any, boundary_types: Any) -> Any:
+    """The snapshot to analyse; a missing ``kind`` column's warning printed in one line."""
+    from grainlab.io import MissingKindWarning, read_snapshot
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", MissingKindWarning)
+        snapshot = read_snapshot(
+            args.input,
+            contacts=args.contacts,
+            timestep=args.timestep,
+            tolerance=args.tolerance,
+            columns=columns,
+            boundary_types=boundary_types,
+            particle_columns=particle_columns,
+            grain_column=getattr(args, "grain_column", None),
+        )
+    for warning in caught:  # one line each, without the warnings module's source line
+        if issubclass(warning.category, MissingKindWarning):
+            print(f"grainlab analyze: warning: {warning.message}", file=sys.stderr)
+        else:
+            warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
+    return snapshot
+
+
+def _summary_line(s: dict[str, Any]) -> str:
+    """The printed line of ``grainlab analyze``: the fabric, and what was measured beyond it."""
 
     def f(x: float | None, fmt: str = ".3f") -> str:
         return "n/a" if x is None else format(x, fmt)
@@ -288,8 +302,7 @@ def run(args: argparse.Namespace) -> int:
             f"{f(s['band_thickness_diameters'], '.1f')} d, "
             f"lambda in/out {f(s['mean_lambda_in_band'])}/{f(s['mean_lambda_outside_band'])}"
         )
-    print(line + _bodies_line(s) + f" -> {args.out}")
-    return 0
+    return line + _bodies_line(s)
 
 
 def _bodies_line(s: dict[str, Any]) -> str:
