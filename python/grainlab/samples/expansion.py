@@ -54,7 +54,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import paper
-from grainlab.analysis.fabric import CoordinationNumber, rattlers
+from grainlab.analysis.fabric import CoordinationNumber
+from grainlab.analysis.per_body import BodyCoordination
 from grainlab.samples.grading import PAPER_GRADING, Grading
 from grainlab.samples.placement import random_placement
 from grainlab.samples.porosity import (
@@ -145,9 +146,11 @@ class Sample:
     per grain, ``2 Nc / N_grains`` (CEGEO's Z_c: a pair of grains touching at two
     pebbles counts twice)."""
     mechanical_coordination_number: float
-    """``Z_m``: ``2 Nc / N`` over the particles (grains) left once rattlers (fewer
-    than 2 contacts) are removed iteratively
-    (:class:`grainlab.analysis.CoordinationNumber`); NaN when none is left."""
+    """``Z_m``: ``2 Nc / N`` over the particles left once rattlers (fewer than 2
+    contacts) are removed iteratively (:class:`grainlab.analysis.CoordinationNumber`);
+    for clumps the contacts per grain over the grains left once rattler grains
+    (fewer than 2 touching grains) are removed
+    (:class:`grainlab.analysis.BodyCoordination`); NaN when none is left."""
     mean_overlap_ratio: float
     """Mean contact overlap over the smallest radius."""
     max_overlap_ratio: float
@@ -503,18 +506,6 @@ def _clump_pebbles(shape: ShapeTemplate, centres: NDArray[np.float64], sizes: ND
     return world.reshape(-1, 2), (sizes[:, None] * shape.radii[None, :]).reshape(-1)
 
 
-def _grain_coordination(grain: NDArray[np.int64], i: NDArray[np.uint32], j: NDArray[np.uint32]) -> tuple[float, float]:
-    """``(Z_c, Z_m)`` per grain from the pebbles' contacts: contacts per grain
-    (two at two pebbles of one pair of grains), and the same over the grains left
-    once rattlers (fewer than 2 contacts) are removed iteratively."""
-    n = int(grain.max()) + 1
-    a, b = grain[np.asarray(i, dtype=np.int64)], grain[np.asarray(j, dtype=np.int64)]
-    core = ~rattlers(a, b, n)
-    alive = int((core[a] & core[b]).sum())
-    n_core = int(core.sum())
-    return 2.0 * len(a) / n, (2.0 * alive / n_core if n_core else float("nan"))
-
-
 class _Expansion:
     """The disks placed at ``initial_scale`` in the box, the simulation that grows
     them, and the growth itself: :meth:`grow`, then :meth:`finish`."""
@@ -711,7 +702,8 @@ class _Expansion:
             coordination = sim.coordination_number
             mechanical = CoordinationNumber().compute(sim.snapshot()).mechanical_coordination_number
         else:
-            coordination, mechanical = _grain_coordination(self.walls.grain, contacts.i, contacts.j)
+            bodies = BodyCoordination().compute(sim.snapshot())
+            coordination, mechanical = bodies.contact_coordination_number, bodies.mechanical_contact_coordination_number
         if density_scaling:
             sim.densities = np.full(len(radii), settings.density)
         sim.velocities = np.zeros((len(radii), 2))
