@@ -10,12 +10,12 @@ from typing import Any, ClassVar
 
 from grainlab.io.hdf5 import snapshot_name
 from grainlab.protocols.biaxial import records as biaxial_records
+from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.outputs import BiaxialResult, summarise, write_outputs
 from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary, start_shear
 from grainlab.protocols.biaxial.rates import check_density_scaling, check_strain_rate
 from grainlab.protocols.biaxial.shearing import shear, shear_records, shear_snapshots
 from grainlab.protocols.biaxial.state import BiaxialRun
-from grainlab.protocols.config import BiaxialConfig
 from grainlab.protocols.runner import RUN_FILES, Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import OUTPUT_FILES, SpecimenProtocol, consolidate
 
@@ -39,10 +39,10 @@ def _boundary(context: Context) -> None:
 def _shear(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
     records = shear_records(context, lambda: biaxial_records.measure(sim, run, config), biaxial_records.TIMESERIES_UNITS)
-    shear(context, records, shear_snapshots(context, records, snapshot_name), final=config["shear.final_strain"])
+    shear(context, records, shear_snapshots(context, records, snapshot_name), final=config.shear.final_strain)
 
 
-class BiaxialProtocol(SpecimenProtocol[BiaxialRun, BiaxialResult]):
+class BiaxialProtocol(SpecimenProtocol[BiaxialConfig, BiaxialRun, BiaxialResult]):
     """The paper's biaxial test (Sec. 6, Table 1); the sample is generated when the run starts."""
 
     name = "biaxial"

@@ -11,7 +11,7 @@ import warnings
 import grainlab
 from grainlab.io.hdf5 import snapshot_name
 from grainlab.paper import DENSITY_SCALING_LIMIT
-from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.biaxial.config import BiaxialConfig
 
 __all__ = [
     "DENSITY_SCALING_LIMIT",
@@ -36,11 +36,11 @@ def check_density_scaling(config: BiaxialConfig) -> float | None:
     ``material.limiting_contact_pressure``), with a :class:`DensityScalingWarning`
     when it exceeds :data:`DENSITY_SCALING_LIMIT`; ``None`` for the ``auto``
     rate, which keeps the factor at or below ``shear.inertial_number``."""
-    rate = config["shear.strain_rate"]
-    if rate == "auto":
+    rate = config.shear.strain_rate
+    if isinstance(rate, str):  # "auto"
         return None
     factor = grainlab.density_scaling_factor(
-        rate, config["material.density"], 0.5 * config["sample.d_min"], config["material.limiting_contact_pressure"]
+        rate, config.material.density, 0.5 * config.sample.d_min, config.material.limiting_contact_pressure
     )
     if factor > DENSITY_SCALING_LIMIT:
         warnings.warn(
@@ -115,17 +115,17 @@ def check_strain_rate(config: BiaxialConfig) -> None:
                 "keep snapshot strains at least 0.0001 apart"
             )
         names[name] = strain
-    rate = config["shear.strain_rate"]
-    if rate == "auto":
+    rate = config.shear.strain_rate
+    if isinstance(rate, str):  # "auto"
         return  # bounded by the inertial number, far below these limits
-    diameter = config["sample.d_min"]
-    if config["boundary.kind"] == "membrane":
-        diameter = min(diameter, config["boundary.membrane_diameter"])
+    diameter = config.sample.d_min
+    if config.boundary.kind == "membrane":
+        diameter = min(diameter, config.boundary.membrane_diameter)
     radius = 0.5 * diameter
-    mass = config["material.density"] * math.pi * radius**2
-    stiffness = max(config["material.normal_stiffness"], 2.0 * config["material.shear_stiffness"])
-    time_step = 0.1 * config["run.time_step_safety"] * math.sqrt(mass / stiffness)
-    problem = strain_rate_problem(rate, time_step, config["sample.height"], radius, config["shear.record_interval"])
+    mass = config.material.density * math.pi * radius**2
+    stiffness = max(config.material.normal_stiffness, 2.0 * config.material.shear_stiffness)
+    time_step = 0.1 * config.run.time_step_safety * math.sqrt(mass / stiffness)
+    problem = strain_rate_problem(rate, time_step, config.sample.height, radius, config.shear.record_interval)
     if problem is not None:
         raise ValueError(
             f"shear.strain_rate: {rate:g} 1/s is too fast even for a time step shorter than any this sample "
@@ -150,15 +150,15 @@ def default_strain_rate(config: BiaxialConfig, max_diameter: float, min_radius: 
     p_y)`` with the limiting contact pressure ``p_y`` (Table 1: 150 MPa), far
     from binding with Table 1.
     """
-    rho, p = config["material.density"], config["consolidation.pressure"]
-    alpha = config["material.local_damping"]
-    bound = config["shear.inertial_number"]
+    rho, p = config.material.density, config.consolidation.pressure
+    alpha = config.material.local_damping
+    bound = config.shear.inertial_number
     inertial = max_diameter * math.sqrt(rho / ((1.0 - alpha) * p))
-    eq16 = min_radius * math.sqrt(rho / config["material.limiting_contact_pressure"])
+    eq16 = min_radius * math.sqrt(rho / config.material.limiting_contact_pressure)
     return float(bound) / max(inertial, eq16)
 
 
 def inertial_number(config: BiaxialConfig, rate: float, diameter: float) -> float:
     """``rate * d * sqrt(rho / ((1 - alpha) sigma_3))``."""
-    rho, p = config["material.density"], config["consolidation.pressure"]
-    return rate * diameter * math.sqrt(rho / ((1.0 - config["material.local_damping"]) * p))
+    rho, p = config.material.density, config.consolidation.pressure
+    return rate * diameter * math.sqrt(rho / ((1.0 - config.material.local_damping) * p))

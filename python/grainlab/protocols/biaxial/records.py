@@ -11,9 +11,9 @@ from grainlab.analysis import fabric_summary
 from grainlab.analysis.stress import love_weber_stress
 from grainlab.columns import BIAXIAL
 from grainlab.io.walls import WallGeometry
+from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.state import BiaxialRun, Boundary
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, sample_area
-from grainlab.protocols.config import BiaxialConfig
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind, Snapshot
 
@@ -53,7 +53,7 @@ def deviator_stress(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> 
     sigma_1 = platen_state(sim, boundary).axial_stress_pa
     if isinstance(boundary, WallBoundary) and boundary.constant_volume:
         return sigma_1 - boundary.lateral_stress(sim)
-    return sigma_1 - float(config["consolidation.pressure"])
+    return sigma_1 - float(config.consolidation.pressure)
 
 
 def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str, float]:
@@ -62,7 +62,7 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
     shear = run.shear_plan()
     platens = platen_state(sim, boundary)
     height, area, sigma_1 = platens.height_m, platens.area_m2, platens.axial_stress_pa
-    sigma_3 = config["consolidation.pressure"]  # the confining pressure held (a cell pressure)
+    sigma_3 = config.consolidation.pressure  # the confining pressure held (a cell pressure)
 
     c = sim.contacts()
     w = sim.wall_contacts()

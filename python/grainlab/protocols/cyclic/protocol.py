@@ -29,8 +29,7 @@ from grainlab.protocols.biaxial.shearing import (
     shear_snapshots,
 )
 from grainlab.protocols.biaxial.state import BiaxialRun
-from grainlab.protocols.config import Config
-from grainlab.protocols.cyclic.config import CYCLIC_SCHEMA  # noqa: F401 - registers the schema
+from grainlab.protocols.cyclic.config import CyclicConfig
 from grainlab.protocols.cyclic.outputs import CyclicResult, summarise, write_outputs
 from grainlab.protocols.operations import Loading, Operation, Records, Snapshots
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
@@ -41,7 +40,7 @@ from grainlab.simulation import Simulation
 __all__ = ["STRESS_EVENTS", "CyclicProtocol", "StressCycles", "cycle_plan", "event_snapshot_name", "run_cyclic",
            "snapshot_name_of", "stress_path_length"]
 
-Context = StageContext[Config, BiaxialRun]
+Context = StageContext[CyclicConfig, BiaxialRun]
 
 
 def cycle_plan(amplitude: float, cycles: int) -> tuple[float, list[float], list[float]]:
@@ -83,10 +82,10 @@ def _consolidate(context: Context) -> None:
 STRESS_EVENTS = ("compression", "unloaded", "extension", "end")
 
 
-def stress_path_length(config: Config) -> float:
+def stress_path_length(config: CyclicConfig) -> float:
     """The strain path a stress-controlled test may travel at most: every cycle's
     quarters at the strain limit."""
-    return float(4 * config["cyclic.cycles"] * config["cyclic.strain_limit"])
+    return float(4 * config.cyclic.cycles * config.cyclic.strain_limit)
 
 
 def event_snapshot_name(event: int, cycles: int) -> str | None:
@@ -106,7 +105,7 @@ class StressCycles(Operation):
     counted in the plan (``events``), recorded and stored as a snapshot when
     :func:`event_snapshot_name` names one; the platens reverse at a turn."""
 
-    def __init__(self, config: Config, run: BiaxialRun, records: Records, snapshots: Snapshots) -> None:
+    def __init__(self, config: CyclicConfig, run: BiaxialRun, records: Records, snapshots: Snapshots) -> None:
         super().__init__(EveryStop(WALL_CONTROL_STEPS))
         self.config, self.run, self.records, self.snapshots = config, run, records, snapshots
 
@@ -115,16 +114,16 @@ class StressCycles(Operation):
         plan, config = self.run.shear_plan(), self.config
         boundary = self.run.lateral_boundary()
         height = float(sim.wall(boundary.top_wall).points[0, 1] - sim.wall(boundary.bottom_wall).points[0, 1])
-        if abs((plan.height0 - height) / plan.height0) >= config["cyclic.strain_limit"]:
+        if abs((plan.height0 - height) / plan.height0) >= config.cyclic.strain_limit:
             return False, True
-        q, amplitude = biaxial_records.deviator_stress(sim, self.run, config), config["cyclic.stress_amplitude"]
+        q, amplitude = biaxial_records.deviator_stress(sim, self.run, config), float(config.cyclic.stress_amplitude)
         quarter = plan.events % 4
         if quarter == 0 and q >= amplitude or quarter == 2 and q <= -amplitude:
             return True, False
         if quarter == 1 and q <= 0.0:
             return False, False
         if quarter == 3 and q >= 0.0:
-            return False, plan.events + 1 == 4 * config["cyclic.cycles"]
+            return False, plan.events + 1 == 4 * config.cyclic.cycles
         return None
 
     def act(self, loading: Loading) -> None:
@@ -138,7 +137,7 @@ class StressCycles(Operation):
             plan.turn_steps.append(sim.step_count - plan.start_step)
             reverse_platens(sim, self.run)
         self.records.write(sim.step_count)
-        name = event_snapshot_name(plan.events, self.config["cyclic.cycles"])
+        name = event_snapshot_name(plan.events, self.config.cyclic.cycles)
         if name is not None:
             self.snapshots.store(name, sim.step_count)
         if end:
@@ -149,24 +148,24 @@ class StressCycles(Operation):
 def _boundary(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
     install_boundary(sim, run, config, context.progress)
-    if config["cyclic.control"] == "stress":
+    if config.cyclic.control == "stress":
         start_platens(sim, run, config, final=stress_path_length(config),
-                      records=[Every(config["shear.record_interval"])], snapshots=[0.0])
+                      records=[Every(config.shear.record_interval)], snapshots=[0.0])
         check_shear_plan(sim, run, config, [0.0], key="cyclic.stress_amplitude")
         return
-    final, turns, snapshots = cycle_plan(config["cyclic.strain_amplitude"], config["cyclic.cycles"])
+    final, turns, snapshots = cycle_plan(config.cyclic.strain_amplitude, config.cyclic.cycles)
     start_platens(sim, run, config, final=final,
-                  records=[Every(config["shear.record_interval"]), At([*turns, *snapshots])],
+                  records=[Every(config.shear.record_interval), At([*turns, *snapshots])],
                   snapshots=snapshots, turns=turns)
     check_shear_plan(sim, run, config, snapshots, key="cyclic.strain_amplitude")
 
 
 def _cycle(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
-    amplitude = config["cyclic.strain_amplitude"]
+    amplitude = config.cyclic.strain_amplitude
     plan = run.shear_plan()
     strain_per_step = plan.strain_rate * sim.time_step
-    stress = config["cyclic.control"] == "stress"
+    stress = config.cyclic.control == "stress"
 
     def measure() -> dict[str, float]:
         travelled = (sim.step_count - plan.start_step) * strain_per_step
@@ -179,11 +178,11 @@ def _cycle(context: Context) -> None:
         shear(context, records, snapshots, final=stress_path_length(config),
               first=[StressCycles(config, run, records, snapshots)])
         return
-    final, _, _ = cycle_plan(amplitude, config["cyclic.cycles"])
+    final, _, _ = cycle_plan(amplitude, config.cyclic.cycles)
     shear(context, records, shear_snapshots(context, records, snapshot_name_of(amplitude)), final=final)
 
 
-class CyclicProtocol(SpecimenProtocol[BiaxialRun, CyclicResult]):
+class CyclicProtocol(SpecimenProtocol[CyclicConfig, BiaxialRun, CyclicResult]):
     """The cyclic biaxial test (strain amplitude, N cycles, constant confining pressure)."""
 
     name = "cyclic"
@@ -213,7 +212,7 @@ class CyclicProtocol(SpecimenProtocol[BiaxialRun, CyclicResult]):
         return CyclicResult(out, summary)
 
 
-def run_cyclic(config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
+def run_cyclic(config: CyclicConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,
                progress: bool = False) -> CyclicResult:
     """Runs (or, with ``resume``, continues) the cyclic biaxial test into ``out_dir``
     (:func:`grainlab.protocols.runner.run_protocol`)."""

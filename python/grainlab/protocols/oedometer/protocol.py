@@ -17,9 +17,8 @@ from grainlab.analysis.stress import love_weber_stress
 from grainlab.columns import OEDOMETER
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols import operations
-from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import BOX_WALLS, box_state
-from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA  # noqa: F401 - registers the schema
+from grainlab.protocols.oedometer.config import OedometerConfig
 from grainlab.protocols.oedometer.outputs import OedometerResult, summarise, write_outputs
 from grainlab.protocols.oedometer.state import OedometerRun
 from grainlab.protocols.operations import Loading, Operation
@@ -38,13 +37,13 @@ from grainlab.snapshot import ParticleKind
 
 __all__ = ["LoadSteps", "OedometerProtocol", "OedometerRun", "PlatenServo", "load_path", "run_oedometer"]
 
-Context = StageContext[Config, OedometerRun]
+Context = StageContext[OedometerConfig, OedometerRun]
 
 
-def load_path(config: Config) -> list[float]:
+def load_path(config: OedometerConfig) -> list[float]:
     """The vertical stresses of the load steps: sigma_0 first (the state with
     friction on, from which strains count), then the configured ones."""
-    return [config["consolidation.pressure"], *config["oedometer.vertical_stresses"]]
+    return [config.consolidation.pressure, *config.oedometer.vertical_stresses]
 
 
 def _consolidate(context: Context) -> None:
@@ -57,7 +56,7 @@ def _confine(context: Context) -> None:
     sim.set_contact_model(0, 1, platen_model(config))
     for name in BOX_WALLS:
         sim.wall(run.walls[name]).velocity = (0.0, 0.0)  # rigid and fixed; the top is servo-loaded
-    run.max_vertical_stress_pa = config["consolidation.pressure"]
+    run.max_vertical_stress_pa = config.consolidation.pressure
     run.load_start_step = sim.step_count
 
 
@@ -84,7 +83,7 @@ class LoadSteps(Operation):
     :attr:`finished` after the last step); a step that takes ``oedometer.max_steps``
     stops the run with a :class:`SpecimenError`."""
 
-    def __init__(self, walls: dict[str, Wall], stresses: list[float], run: OedometerRun, config: Config,
+    def __init__(self, walls: dict[str, Wall], stresses: list[float], run: OedometerRun, config: OedometerConfig,
                  step: int) -> None:
         super().__init__(EveryStop(CHUNK_STEPS))
         self.walls, self.stresses, self.run, self.config = walls, stresses, run, config
@@ -94,9 +93,9 @@ class LoadSteps(Operation):
 
     def act(self, loading: Loading) -> None:
         sim, run, config = loading.sim, self.run, self.config
-        target, limit = self.stresses[run.next_load], config["consolidation.unbalanced_force_ratio"]
+        target, limit = self.stresses[run.next_load], config.consolidation.unbalanced_force_ratio
         box = self.box = box_state(self.walls)
-        if abs(box.stress_yy_pa / target - 1.0) < config["oedometer.tolerance"] and sim.unbalanced_force_ratio < limit:
+        if abs(box.stress_yy_pa / target - 1.0) < config.oedometer.tolerance and sim.unbalanced_force_ratio < limit:
             self.walls["top"].velocity = (0.0, 0.0)
             if run.next_load == 0:  # sigma_0 with friction on: strains count from here
                 run.height0, run.area0 = box.height_m, box.width_m * box.height_m
@@ -106,7 +105,7 @@ class LoadSteps(Operation):
             self.reached.raise_at(sim.step_count)
             if run.next_load == len(self.stresses):
                 self.finished.raise_at(sim.step_count)
-        elif sim.step_count - self.started >= config["oedometer.max_steps"]:
+        elif sim.step_count - self.started >= config.oedometer.max_steps:
             raise SpecimenError(
                 f"load step {run.next_load} ({target / 1e3:.1f} kPa) did not reach equilibrium in "
                 f"{sim.step_count - self.started} steps: sigma_v {box.stress_yy_pa / 1e3:.1f} kPa, unbalanced force "
@@ -121,11 +120,11 @@ def _load(context: Context) -> None:
     if run.next_load == len(stresses):  # stopped after the last step's checkpoint
         return
     bar = progress_bar(len(stresses), "loading", enabled=context.progress, unit="step", initial=run.next_load)
-    speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
+    speed = 0.05 * config.sample.d_min / (100 * sim.time_step)  # at most d_min/20 per 100 steps
     steps = LoadSteps(walls, stresses, run, config, sim.step_count)
     geometry = {i: n for n, i in run.walls.items()}
     # a checkpoint at an equilibrium once run.checkpoint_interval has passed
-    checkpoint = operations.Checkpoint(And(steps.reached, WallClock(config["run.checkpoint_interval"])), context.save,
+    checkpoint = operations.Checkpoint(And(steps.reached, WallClock(config.run.checkpoint_interval)), context.save,
                             run.wall_time, "load")
     operations.run_loading(sim, [
         steps,
@@ -180,7 +179,7 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
     return {name: values[name] for name in OEDOMETER}
 
 
-class OedometerProtocol(SpecimenProtocol[OedometerRun, OedometerResult]):
+class OedometerProtocol(SpecimenProtocol[OedometerConfig, OedometerRun, OedometerResult]):
     """Confined (K0) compression: side walls fixed, the top platen servo-loaded to each vertical stress."""
 
     name = "oedometer"
@@ -206,7 +205,7 @@ class OedometerProtocol(SpecimenProtocol[OedometerRun, OedometerResult]):
         return OedometerResult(out, summary)
 
 
-def run_oedometer(config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
+def run_oedometer(config: OedometerConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,
                   progress: bool = False) -> OedometerResult:
     """Runs (or, with ``resume``, continues) the oedometer test into ``out_dir``
     (:func:`grainlab.protocols.runner.run_protocol`)."""

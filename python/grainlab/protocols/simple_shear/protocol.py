@@ -24,7 +24,6 @@ from grainlab.columns import SIMPLE_SHEAR
 from grainlab.io.hdf5.snapshot import snapshot_name
 from grainlab.io.results import SHEAR_START_FILE
 from grainlab.protocols import operations
-from grainlab.protocols.config import Config
 from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.simple_shear.cell import (
@@ -33,7 +32,7 @@ from grainlab.protocols.simple_shear.cell import (
     servo_rate,
     side_stresses,
 )
-from grainlab.protocols.simple_shear.config import SIMPLE_SHEAR_SCHEMA  # noqa: F401 - registers the schema
+from grainlab.protocols.simple_shear.config import SimpleShearConfig
 from grainlab.protocols.simple_shear.outputs import SimpleShearResult, summarise, write_outputs
 from grainlab.protocols.simple_shear.state import SimpleShearRun
 from grainlab.protocols.specimen import (
@@ -60,7 +59,7 @@ from grainlab.snapshot import ParticleKind
 __all__ = ["CellControl", "SimpleShearProtocol", "SimpleShearRun", "record_steps", "run_simple_shear", "set_cell_rates",
            "snapshot_name_of"]
 
-Context = StageContext[Config, SimpleShearRun]
+Context = StageContext[SimpleShearConfig, SimpleShearRun]
 
 
 def snapshot_name_of(shear_strain: float) -> str:
@@ -68,26 +67,26 @@ def snapshot_name_of(shear_strain: float) -> str:
     return snapshot_name(shear_strain, prefix="gamma")
 
 
-def record_steps(config: Config, steps_per_unit: float) -> tuple[list[int], dict[int, float]]:
+def record_steps(config: SimpleShearConfig, steps_per_unit: float) -> tuple[list[int], dict[int, float]]:
     """The steps after the start of shearing that carry a record, and those that
     also carry a snapshot (step -> its shear strain)."""
-    final = config["simple_shear.final_strain"]
-    strains = [s for s in config["simple_shear.snapshot_strains"] if 0 < s <= final]
-    steps = schedule_steps([Every(config["simple_shear.record_interval"]), At(strains)], final=final,
+    final = config.simple_shear.final_strain
+    strains = [s for s in config.simple_shear.snapshot_strains if 0 < s <= final]
+    steps = schedule_steps([Every(config.simple_shear.record_interval), At(strains)], final=final,
                            steps_per_unit=steps_per_unit)
     snaps = {round(s * steps_per_unit): s for s in strains}
     return steps, snaps
 
 
-def _max_rate(sim: Simulation, config: Config, shear_rate: float) -> float:
+def _max_rate(sim: Simulation, config: SimpleShearConfig, shear_rate: float) -> float:
     """The cap on the cell's rate: a twentieth of the smallest diameter per 100 steps over the
     cell's height, plus the shear rate."""
     cell = sim.cell
     assert cell is not None
-    return float(0.05 * config["sample.d_min"] / (100 * sim.time_step * cell.b[1]) + abs(shear_rate))
+    return float(0.05 * config.sample.d_min / (100 * sim.time_step * cell.b[1]) + abs(shear_rate))
 
 
-def set_cell_rates(sim: Simulation, run: SimpleShearRun, config: Config, targets: tuple[float | None, float | None],
+def set_cell_rates(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig, targets: tuple[float | None, float | None],
                    shear_rate: float) -> None:
     """The cell's velocity gradient ``[[L_xx, shear_rate], [0, L_yy]]`` for the next
     CONTROL_STEPS steps, each side's rate servo-controlled to hold its target of
@@ -96,7 +95,7 @@ def set_cell_rates(sim: Simulation, run: SimpleShearRun, config: Config, targets
     interval = CONTROL_STEPS * sim.time_step
     cap = _max_rate(sim, config, shear_rate)
     held = [(k, target) for k, target in enumerate(targets) if target is not None]
-    measured = side_stresses(sim, config["material.normal_stiffness"], [k for k, _ in held])
+    measured = side_stresses(sim, config.material.normal_stiffness, [k for k, _ in held])
     for (k, target), (stress, stiffness) in zip(held, measured, strict=True):
         rates[k], run.cell_rate_integral[k] = servo_rate(
             stress, target, stiffness, interval, cap, run.cell_rate_integral[k])
@@ -110,7 +109,7 @@ class CellControl(Operation):
 
     acts_before_run = True
 
-    def __init__(self, run: SimpleShearRun, config: Config, targets: tuple[float | None, float | None],
+    def __init__(self, run: SimpleShearRun, config: SimpleShearConfig, targets: tuple[float | None, float | None],
                  shear_rate: float) -> None:
         held = targets != (None, None)
         super().__init__(Periodic(CONTROL_STEPS, run.start_step) if held else EveryStop())
@@ -127,7 +126,7 @@ class CellControl(Operation):
             sim.set_velocity_gradient(wanted)
 
 
-def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int, target: float) -> None:
+def _advance(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig, to_step: int, target: float) -> None:
     """Runs to ``to_step``, both sides of the cell servo-controlled to ``target`` every
     CONTROL_STEPS steps (counted from ``run.start_step``)."""
     while sim.step_count < to_step:
@@ -150,12 +149,12 @@ def _to_periodic(context: Context) -> None:
     sim.set_velocity_gradient(np.zeros((2, 2)))
 
 
-def _equilibrate(sim: Simulation, run: SimpleShearRun, config: Config, progress: bool, label: str) -> int:
+def _equilibrate(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig, progress: bool, label: str) -> int:
     """Servo-controls both sides of the cell to sigma_0 until equilibrium; returns the steps taken."""
-    target = config["consolidation.pressure"]
-    tolerance = config["consolidation.tolerance"]
-    limit = config["consolidation.unbalanced_force_ratio"]
-    max_steps = config["consolidation.max_steps"]
+    target = config.consolidation.pressure
+    tolerance = config.consolidation.tolerance
+    limit = config.consolidation.unbalanced_force_ratio
+    max_steps = config.consolidation.max_steps
     bar = progress_bar(max_steps, label, enabled=progress, unit="step")
     steps = 0
     run.start_step = sim.step_count  # the control's step count starts here
@@ -163,7 +162,7 @@ def _equilibrate(sim: Simulation, run: SimpleShearRun, config: Config, progress:
     while True:
         _advance(sim, run, config, sim.step_count + CHUNK_STEPS, target)
         steps += CHUNK_STEPS
-        stress = cell_stress(sim, config["material.normal_stiffness"]).total
+        stress = cell_stress(sim, config.material.normal_stiffness).total
         bar.update(CHUNK_STEPS)
         bar.set_postfix_str(f"sxx {stress[0, 0] / 1e3:.1f} kPa, syy {stress[1, 1] / 1e3:.1f} kPa, "
                             f"unbalanced {sim.unbalanced_force_ratio:.1e}")
@@ -188,14 +187,14 @@ def _consolidate(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
     start = time.perf_counter()
     _to_periodic(context)
-    sim.set_contact_model(0, 0, ContactModel(config["material.normal_stiffness"], config["material.shear_stiffness"],
-                                             config["consolidation.friction"]))
-    sim.local_damping = config["material.local_damping"]
-    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0) * damped_time_step_factor(config)
+    sim.set_contact_model(0, 0, ContactModel(config.material.normal_stiffness, config.material.shear_stiffness,
+                                             config.consolidation.friction))
+    sim.local_damping = config.material.local_damping
+    sim.time_step = config.run.time_step_safety * sim.critical_time_step(1.0) * damped_time_step_factor(config)
     steps = _equilibrate(sim, run, config, context.progress, "consolidating")
     cell = sim.cell
     assert cell is not None
-    stress = cell_stress(sim, config["material.normal_stiffness"]).total
+    stress = cell_stress(sim, config.material.normal_stiffness).total
     radii = sim.radii[: run.n_grains]
     run.consolidation = {
         "steps": steps, "stress_xx_pa": float(stress[0, 0]), "stress_yy_pa": float(stress[1, 1]),
@@ -215,18 +214,18 @@ def _settle(context: Context) -> None:
     _equilibrate(sim, run, config, context.progress, "settling with friction")
     cell = sim.cell
     assert cell is not None
-    stress = cell_stress(sim, config["material.normal_stiffness"]).total
-    held = config["simple_shear.normal_stress"]
-    run.normal_stress_pa = float(stress[1, 1]) if config["simple_shear.volume"] == "constant" or held == "auto" \
+    stress = cell_stress(sim, config.material.normal_stiffness).total
+    held = config.simple_shear.normal_stress
+    run.normal_stress_pa = float(stress[1, 1]) if config.simple_shear.volume == "constant" or held == "auto" \
         else float(held)
-    if config["simple_shear.volume"] == "free" and held == "auto":
-        run.normal_stress_pa = float(config["consolidation.pressure"])
+    if config.simple_shear.volume == "free" and held == "auto":
+        run.normal_stress_pa = float(config.consolidation.pressure)
     run.mean_diameter_m = float(2.0 * np.mean(sim.radii[: run.n_grains]))
-    density = config["material.density"]
-    run.shear_rate_per_s = config["simple_shear.inertial_number"] * math.sqrt(run.normal_stress_pa / density) \
+    density = config.material.density
+    run.shear_rate_per_s = config.simple_shear.inertial_number * math.sqrt(run.normal_stress_pa / density) \
         / run.mean_diameter_m
-    damping = config["simple_shear.local_damping"]
-    sim.local_damping = config["material.local_damping"] if damping == "auto" else float(damping)
+    damping = config.simple_shear.local_damping
+    sim.local_damping = config.material.local_damping if damping == "auto" else float(damping)
     run.start_step = sim.step_count
     run.cell_rate_integral = [0.0, 0.0]
     run.area0 = float(cell.area)
@@ -247,18 +246,18 @@ def _shear(context: Context) -> None:
     if run.next_record == 0 and writer.n_rows == 0:
         sim.set_velocity_gradient([[0.0, rate], [0.0, 0.0]])
         records.write(sim.step_count)
-        if 0.0 in config["simple_shear.snapshot_strains"]:
+        if 0.0 in config.simple_shear.snapshot_strains:
             snapshots.store(snapshot_name_of(0.0), sim.step_count)
     if run.next_record == len(steps):  # stopped after the last record's checkpoint
         return
-    final = config["simple_shear.final_strain"]
+    final = config.simple_shear.final_strain
     done = 100 * steps[run.next_record - 1] / steps_per_unit if run.next_record else 0.0
     bar = progress_bar(round(100 * final, 3), "shearing", enabled=context.progress, unit="% strain", initial=done,
                        bar_format="{l_bar}{bar}| {n:.1f}/{total:.0f} % [{elapsed}<{remaining}{postfix}]")
     scheduled = records.trigger
-    checkpoint = operations.Checkpoint(And(scheduled, WallClock(config["run.checkpoint_interval"])), context.save,
+    checkpoint = operations.Checkpoint(And(scheduled, WallClock(config.run.checkpoint_interval)), context.save,
                             run.wall_time, "shear")
-    targets = (None, run.normal_stress_pa) if config["simple_shear.volume"] == "free" else (None, None)
+    targets = (None, run.normal_stress_pa) if config.simple_shear.volume == "free" else (None, None)
     operations.run_loading(sim, [
         records, snapshots,
         operations.Progress(scheduled, bar, lambda step: 100 * (step - run.start_step) / steps_per_unit,
@@ -275,11 +274,11 @@ def _snapshot(sim: Simulation, run: SimpleShearRun, values: dict[str, float]) ->
     return sim.snapshot(kind=kind, scalars=scalars, step=sim.step_count)  # with the cell's box and tilt
 
 
-def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, float]:
+def _record(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig) -> dict[str, float]:
     """One record, in :data:`grainlab.columns.SIMPLE_SHEAR`'s order."""
     cell = sim.cell
     assert cell is not None
-    stress = cell_stress(sim, config["material.normal_stiffness"])
+    stress = cell_stress(sim, config.material.normal_stiffness)
     total = stress.total
     n = run.n_grains
     area = float(cell.area)
@@ -296,7 +295,7 @@ def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, f
         "step": float(sim.step_count), "time_s": sim.time, "shear_strain": strain,
         "shear_stress_pa": tau, "normal_stress_pa": normal, "lateral_stress_pa": float(total[0, 0]),
         "friction_coefficient": tau / normal if normal > 0 else math.nan,
-        "inertial_number": run.shear_rate_per_s * run.mean_diameter_m / math.sqrt(normal / config["material.density"])
+        "inertial_number": run.shear_rate_per_s * run.mean_diameter_m / math.sqrt(normal / config.material.density)
         if normal > 0 else math.nan,
         "volumetric_strain": (run.area0 - area) / run.area0 if run.area0 else 0.0,
         "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "area_m2": area,
@@ -316,7 +315,7 @@ def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, f
     return {name: values[name] for name in SIMPLE_SHEAR}
 
 
-class SimpleShearProtocol(SpecimenProtocol[SimpleShearRun, SimpleShearResult]):
+class SimpleShearProtocol(SpecimenProtocol[SimpleShearConfig, SimpleShearRun, SimpleShearResult]):
     """Periodic simple shear at constant normal stress or constant volume, to large strain."""
 
     name = "simple_shear"
@@ -347,7 +346,7 @@ class SimpleShearProtocol(SpecimenProtocol[SimpleShearRun, SimpleShearResult]):
         return SimpleShearResult(out, summary)
 
 
-def run_simple_shear(config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
+def run_simple_shear(config: SimpleShearConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,
                      progress: bool = False) -> SimpleShearResult:
     """Runs (or, with ``resume``, continues) the periodic simple-shear test into ``out_dir``
     (:func:`grainlab.protocols.runner.run_protocol`)."""
