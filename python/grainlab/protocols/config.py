@@ -28,7 +28,6 @@ import tomllib
 from collections.abc import Callable, Iterable, Mapping
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
-from functools import cached_property
 from pathlib import Path
 from typing import Any, ClassVar, Generic, TypedDict, TypeVar
 
@@ -328,6 +327,27 @@ def parse_override(text: str) -> tuple[str, Any]:
     return key, value
 
 
+S = TypeVar("S", bound=Section)
+
+
+class SectionOf(Generic[S]):
+    """A :class:`Config` attribute: the configuration's section ``kind``, read once."""
+
+    def __init__(self, kind: type[S]) -> None:
+        self.kind = kind
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, config: Config | None, owner: type | None = None) -> S:
+        if config is None:
+            raise AttributeError(f"{self.name}: a configuration's section, read on the configuration")
+        if self.name not in config.__dict__:
+            config.__dict__[self.name] = config.section(self.kind)
+        found: S = config.__dict__[self.name]
+        return found
+
+
 @dataclass(frozen=True)
 class Config:
     """A resolved, validated configuration: ``values`` maps every key of its schema
@@ -347,21 +367,10 @@ class Config:
         names = (f.name for f in dataclasses.fields(kind))
         return kind(**{name: self.values[k] for name in names if (k := f"{kind.prefix}.{name}") in self.values})
 
-    @cached_property
-    def sample(self) -> SampleSection:
-        return self.section(SampleSection)
-
-    @cached_property
-    def material(self) -> MaterialSection:
-        return self.section(MaterialSection)
-
-    @cached_property
-    def consolidation(self) -> ConsolidationSection:
-        return self.section(ConsolidationSection)
-
-    @cached_property
-    def run(self) -> RunSection:
-        return self.section(RunSection)
+    sample = SectionOf(SampleSection)
+    material = SectionOf(MaterialSection)
+    consolidation = SectionOf(ConsolidationSection)
+    run = SectionOf(RunSection)
 
     def to_dict(self) -> dict[str, Any]:
         """Nested ``{section: {name: value}}``, as written to ``run.h5`` and TOML."""
@@ -381,7 +390,6 @@ class Config:
         return config
 
 
-S = TypeVar("S", bound=Section)
 
 
 C = TypeVar("C", bound=Config)

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, Self, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,7 +26,7 @@ from grainlab._progress import progress_bar
 from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
 from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
-from grainlab.protocols.runner import Protocol, ProtocolError, RunResult
+from grainlab.protocols.runner import Protocol, ProtocolError, RunResult, Stage, StageContext
 from grainlab.samples import (
     PAPER_GRADING,
     GradingCurve,
@@ -40,7 +40,7 @@ from grainlab.simulation import ContactModel, Simulation
 if TYPE_CHECKING:
     from grainlab.plot.workers import FigureTask
 
-__all__ = ["CHUNK_STEPS", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
+__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
            "damped_time_step_factor",
            "engine_threads", "generate", "grain_model", "platen_model", "write_run_outputs"]
 
@@ -72,6 +72,11 @@ class SpecimenRun:
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
+    @classmethod
+    def from_dict(cls, saved: dict[str, Any]) -> Self:
+        """The state :meth:`to_dict` gave."""
+        return cls(**saved)
+
 
 R = TypeVar("R", bound=SpecimenRun)
 Result = TypeVar("Result", bound=RunResult)
@@ -81,10 +86,17 @@ C = TypeVar("C", bound=Config)
 class SpecimenProtocol(Protocol[C, R, Result]):
     """A protocol whose configuration is a :class:`Config` of the schema named as the
     protocol and whose run starts by making the sample (:func:`generate`) into a state
-    of type :attr:`state_type`, in the first stage's phase; it writes :data:`OUTPUT_FILES`."""
+    of type :attr:`state_type`, in the first stage's phase; it writes :data:`OUTPUT_FILES`,
+    sums up with :attr:`summarise` and returns a :attr:`result_type`."""
 
     state_type: ClassVar[type[SpecimenRun]]
     output_files: ClassVar[tuple[str, ...]] = OUTPUT_FILES
+    #: The summary of a run whose stages have all run: ``(state, config, time series, wall time)``.
+    summarise: ClassVar[Callable[[Any, Any, dict[str, NDArray[np.float64]], float], dict[str, Any]]]
+    #: The outputs written from the final ``run.h5``; returns the summary.
+    outputs: ClassVar[Callable[[Path], dict[str, Any]]]
+    #: What a run returns, from its folder and its summary.
+    result_type: ClassVar[type[RunResult]]
 
     def threads(self) -> int:
         return engine_threads(self.config)
@@ -101,6 +113,18 @@ class SpecimenProtocol(Protocol[C, R, Result]):
     def start(self, threads: int, progress: bool) -> tuple[Simulation, R]:
         sim, run = generate(self.config, threads, progress, self.state_type, self.stages[0].name)
         return sim, run  # type: ignore[return-value]  # state_type is R's class
+
+    def state_from_dict(self, saved: Mapping[str, Any]) -> R:
+        return self.state_type.from_dict(dict(saved))  # type: ignore[return-value]  # state_type is R's class
+
+    def summary(self, context: StageContext[C, R], wall_time_s: float) -> dict[str, Any]:
+        return type(self).summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
+
+    def write_outputs(self, out: Path) -> dict[str, Any]:
+        return type(self).outputs(out)
+
+    def result(self, out: Path, summary: dict[str, Any]) -> Result:
+        return type(self).result_type(out, summary)  # type: ignore[return-value]  # result_type is Result's class
 
 
 def grading(config: Config) -> UniformByNumber | UniformByMass | GradingCurve:
@@ -283,6 +307,14 @@ def consolidate(
         "time_step_s": sim.time_step,
     }
     run.wall_time["consolidate"] = time.perf_counter() - start
+
+
+def _consolidate_stage(context: StageContext[Any, Any]) -> None:
+    consolidate(context.sim, context.state, context.config, context.progress)
+
+
+#: The stage of every test that consolidates its sample in the four walls (:func:`consolidate`).
+CONSOLIDATE = Stage("consolidate", _consolidate_stage, "the four walls servo-controlled to sigma_0 until equilibrium")
 
 
 def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.float64]], dict[str, Any]],

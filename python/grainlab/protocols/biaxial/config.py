@@ -8,7 +8,6 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
-from functools import cached_property
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -21,6 +20,7 @@ from grainlab.protocols.config import (
     ConfigError,
     Field,
     Section,
+    SectionOf,
     check_sample,
     coerce_field,
     key,
@@ -97,13 +97,8 @@ class BiaxialConfig(Config):
     """The biaxial (and cyclic) test's configuration: the shared sections, its
     lateral boundary and its shearing."""
 
-    @cached_property
-    def boundary(self) -> BoundarySection:
-        return self.section(BoundarySection)
-
-    @cached_property
-    def shear(self) -> ShearSection:
-        return self.section(ShearSection)
+    boundary = SectionOf(BoundarySection)
+    shear = SectionOf(ShearSection)
 
 
 def coerce(key: str, value: Any) -> Any:

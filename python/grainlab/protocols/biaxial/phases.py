@@ -10,7 +10,6 @@ import math
 import time
 import warnings
 from collections.abc import Sequence
-from typing import Any
 
 import numpy as np
 
@@ -38,7 +37,7 @@ from grainlab.protocols.boundary import (
 )
 from grainlab.protocols.consolidate import servo_box
 from grainlab.protocols.specimen import grain_model, platen_model
-from grainlab.protocols.triggers import At, Every, schedule_steps
+from grainlab.protocols.triggers import schedule_steps
 from grainlab.simulation import Simulation, Wall
 
 __all__ = ["check_shear_plan", "drive_platens", "install_boundary", "start_platens", "start_shear"]
@@ -173,12 +172,10 @@ def _install_walls(sim: Simulation, run: BiaxialRun, config: BiaxialConfig, left
 
 def start_shear(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> None:
     """The platens set moving at the axial strain rate, the shearing planned to
-    ``shear.final_strain`` (records ``Every(shear.record_interval)``, snapshots
-    ``At(shear.snapshot_strains)``)."""
+    ``shear.final_strain`` (snapshots at ``shear.snapshot_strains``)."""
     final = config.shear.final_strain
-    snaps = [s for s in config.shear.snapshot_strains if s <= final + 1e-12]
-    start_platens(sim, run, config, final=final, records=[Every(config.shear.record_interval), At(snaps)],
-                  snapshots=snaps)
+    start_platens(sim, run, config, final=final,
+                  snapshots=[s for s in config.shear.snapshot_strains if s <= final + 1e-12])
 
 
 def drive_platens(sim: Simulation, boundary: Boundary, speed: float) -> None:
@@ -190,13 +187,13 @@ def drive_platens(sim: Simulation, boundary: Boundary, speed: float) -> None:
         sim.wall(boundary.top_wall).velocity = (0.0, -speed)
 
 
-def start_platens(sim: Simulation, run: BiaxialRun, config: BiaxialConfig, *, final: float, records: Sequence[Any],
+def start_platens(sim: Simulation, run: BiaxialRun, config: BiaxialConfig, *, final: float,
                   snapshots: Sequence[float], turns: Sequence[float] = ()) -> None:
     """The platens set approaching each other at ``shear.strain_rate`` and the loading
     planned over ``final`` of *strain path* (the axial strain travelled, whatever its
-    direction): records on the ``records`` triggers, snapshots at the path strains
-    ``snapshots``, the platens' direction reversed at the path strains ``turns``
-    (:class:`ShearPlan`; a monotonic test has none)."""
+    direction): records every ``shear.record_interval`` and at each snapshot and turn,
+    snapshots at the path strains ``snapshots``, the platens' direction reversed at the
+    path strains ``turns`` (:class:`ShearPlan`; a monotonic test has none)."""
     boundary = run.lateral_boundary()
     grains = np.arange(run.n_grains)
     radii = sim.radii[grains]
@@ -211,7 +208,8 @@ def start_platens(sim: Simulation, run: BiaxialRun, config: BiaxialConfig, *, fi
     drive_platens(sim, boundary, speed)
     dt = sim.time_step
     steps_per_strain = 1.0 / (rate * dt)
-    record_steps = schedule_steps(list(records), final=final, steps_per_unit=steps_per_strain)
+    record_steps = schedule_steps(config.shear.record_interval, [*turns, *snapshots], final=final,
+                                  steps_per_unit=steps_per_strain)
     root = math.sqrt(config.material.density / config.consolidation.pressure)
     run.shear = ShearPlan(
         strain_rate=rate,

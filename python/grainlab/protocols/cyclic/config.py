@@ -6,13 +6,13 @@ from __future__ import annotations
 
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
-from functools import cached_property
 from typing import Any, ClassVar
 
 from grainlab.protocols.biaxial.config import BIAXIAL_FIELDS, BiaxialConfig, check_boundary
 from grainlab.protocols.config import (
     ConfigError,
     Section,
+    SectionOf,
     check_sample,
     key,
     register_test,
@@ -55,9 +55,7 @@ CYCLIC_FIELDS = CyclicSection.keys()
 class CyclicConfig(BiaxialConfig):
     """The cyclic test's configuration: the biaxial test's sections and its cycles."""
 
-    @cached_property
-    def cyclic(self) -> CyclicSection:
-        return self.section(CyclicSection)
+    cyclic = SectionOf(CyclicSection)
 
 _MONOTONIC_ONLY = ("shear.final_strain", "shear.snapshot_strains")
 

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any, ClassVar
 
 from grainlab.columns import CYCLE, CYCLIC, STRAIN_PATH
@@ -33,8 +32,8 @@ from grainlab.protocols.cyclic.config import CyclicConfig
 from grainlab.protocols.cyclic.outputs import CyclicResult, summarise, write_outputs
 from grainlab.protocols.operations import Loading, Operation, Records, Snapshots
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
-from grainlab.protocols.specimen import SpecimenProtocol, consolidate
-from grainlab.protocols.triggers import At, Every, EveryStop
+from grainlab.protocols.specimen import CONSOLIDATE, SpecimenProtocol
+from grainlab.protocols.triggers import EveryStop
 from grainlab.simulation import Simulation
 
 __all__ = ["STRESS_EVENTS", "CyclicProtocol", "StressCycles", "cycle_plan", "event_snapshot_name", "run_cyclic",
@@ -73,9 +72,6 @@ def snapshot_name_of(amplitude: float) -> Callable[[float], str]:
 
     return name
 
-
-def _consolidate(context: Context) -> None:
-    consolidate(context.sim, context.state, context.config, context.progress)
 
 
 #: What each event of a stress-controlled cycle is, in order.
@@ -149,14 +145,11 @@ def _boundary(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
     install_boundary(sim, run, config, context.progress)
     if config.cyclic.control == "stress":
-        start_platens(sim, run, config, final=stress_path_length(config),
-                      records=[Every(config.shear.record_interval)], snapshots=[0.0])
+        start_platens(sim, run, config, final=stress_path_length(config), snapshots=[0.0])
         check_shear_plan(sim, run, config, [0.0], key="cyclic.stress_amplitude")
         return
     final, turns, snapshots = cycle_plan(config.cyclic.strain_amplitude, config.cyclic.cycles)
-    start_platens(sim, run, config, final=final,
-                  records=[Every(config.shear.record_interval), At([*turns, *snapshots])],
-                  snapshots=snapshots, turns=turns)
+    start_platens(sim, run, config, final=final, snapshots=snapshots, turns=turns)
     check_shear_plan(sim, run, config, snapshots, key="cyclic.strain_amplitude")
 
 
@@ -187,29 +180,20 @@ class CyclicProtocol(SpecimenProtocol[CyclicConfig, BiaxialRun, CyclicResult]):
 
     name = "cyclic"
     stages: ClassVar[tuple[Stage[Any, Any], ...]] = (
-        Stage("consolidate", _consolidate, "the four walls servo-controlled to sigma_0 until equilibrium"),
+        CONSOLIDATE,
         Stage("boundary", _boundary, "the side walls replaced by the membrane (or the outer grains) under "
                                      "sigma_0, the sample re-equilibrated, the cycles planned"),
         Stage("shear", _cycle, "the platens between +/- the amplitude, N cycles; records and snapshots on "
                                "their triggers, checkpoints on the wall clock"),
     )
     state_type = BiaxialRun
+    summarise = summarise
+    outputs = write_outputs
+    result_type = CyclicResult
 
     def check(self) -> None:
         check_strain_rate(self.config)
         check_density_scaling(self.config)
-
-    def state_from_dict(self, saved: Any) -> BiaxialRun:
-        return BiaxialRun.from_dict({k: v for k, v in saved.items() if k not in ("config", "elapsed_s")})
-
-    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
-        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
-
-    def write_outputs(self, out: Path) -> dict[str, Any]:
-        return write_outputs(out)
-
-    def result(self, out: Path, summary: dict[str, Any]) -> CyclicResult:
-        return CyclicResult(out, summary)
 
 
 def run_cyclic(config: CyclicConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
-from functools import cached_property
 from typing import Any, ClassVar
 
 from grainlab.protocols.config import (
     Config,
     ConfigError,
     Section,
+    SectionOf,
     check_sample,
     key,
     register_test,
@@ -51,9 +51,7 @@ OEDOMETER_FIELDS = OedometerSection.keys()
 class OedometerConfig(Config):
     """The oedometer's configuration: the shared sections and its load path."""
 
-    @cached_property
-    def oedometer(self) -> OedometerSection:
-        return self.section(OedometerSection)
+    oedometer = SectionOf(OedometerSection)
 
 
 def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:

@@ -6,7 +6,6 @@ snapshot at each equilibrium; :func:`run_oedometer` runs it into a folder."""
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
@@ -25,9 +24,9 @@ from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import (
     CHUNK_STEPS,
+    CONSOLIDATE,
     SpecimenError,
     SpecimenProtocol,
-    consolidate,
     grain_model,
     platen_model,
 )
@@ -45,9 +44,6 @@ def load_path(config: OedometerConfig) -> list[float]:
     friction on, from which strains count), then the configured ones."""
     return [config.consolidation.pressure, *config.oedometer.vertical_stresses]
 
-
-def _consolidate(context: Context) -> None:
-    consolidate(context.sim, context.state, context.config, context.progress)
 
 
 def _confine(context: Context) -> None:
@@ -184,25 +180,16 @@ class OedometerProtocol(SpecimenProtocol[OedometerConfig, OedometerRun, Oedomete
 
     name = "oedometer"
     stages: ClassVar[tuple[Stage[Any, Any], ...]] = (
-        Stage("consolidate", _consolidate, "the four walls servo-controlled to sigma_0 until equilibrium"),
+        CONSOLIDATE,
         Stage("confine", _confine, "Table 1 friction on; the four walls fixed"),
         Stage("load", _load, "the top platen servo-controlled to sigma_0 (strains count from there), then to "
                              "each vertical stress in turn; a record and a snapshot at each equilibrium, a checkpoint there "
                              "once run.checkpoint_interval has passed"),
     )
     state_type = OedometerRun
-
-    def state_from_dict(self, saved: Any) -> OedometerRun:
-        return OedometerRun(**{k: v for k, v in saved.items() if k not in ("config", "elapsed_s", "rows", "snapshots")})
-
-    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
-        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
-
-    def write_outputs(self, out: Path) -> dict[str, Any]:
-        return write_outputs(out)
-
-    def result(self, out: Path, summary: dict[str, Any]) -> OedometerResult:
-        return OedometerResult(out, summary)
+    summarise = summarise
+    outputs = write_outputs
+    result_type = OedometerResult
 
 
 def run_oedometer(config: OedometerConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,

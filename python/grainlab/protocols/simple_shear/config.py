@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, replace
-from functools import cached_property
 from typing import Any, ClassVar
 
 from grainlab.protocols.config import (
@@ -18,6 +17,7 @@ from grainlab.protocols.config import (
     Config,
     ConfigError,
     Section,
+    SectionOf,
     check_sample,
     key,
     register_test,
@@ -71,9 +71,7 @@ SIMPLE_SHEAR_FIELDS = SimpleShearSection.keys()
 class SimpleShearConfig(Config):
     """The simple-shear test's configuration: the shared sections and its shearing."""
 
-    @cached_property
-    def simple_shear(self) -> SimpleShearSection:
-        return self.section(SimpleShearSection)
+    simple_shear = SectionOf(SimpleShearSection)
 
 #: ``--quick``: a square cell of a few hundred disks sheared to 100 %.
 SIMPLE_SHEAR_QUICK: dict[str, Any] = {"sample.width": 0.03, "sample.height": 0.03}

@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 import os
 import time
-from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
@@ -45,8 +44,6 @@ from grainlab.protocols.specimen import (
 )
 from grainlab.protocols.triggers import (
     And,
-    At,
-    Every,
     EveryStop,
     OnSteps,
     Periodic,
@@ -72,7 +69,7 @@ def record_steps(config: SimpleShearConfig, steps_per_unit: float) -> tuple[list
     also carry a snapshot (step -> its shear strain)."""
     final = config.simple_shear.final_strain
     strains = [s for s in config.simple_shear.snapshot_strains if 0 < s <= final]
-    steps = schedule_steps([Every(config.simple_shear.record_interval), At(strains)], final=final,
+    steps = schedule_steps(config.simple_shear.record_interval, strains, final=final,
                            steps_per_unit=steps_per_unit)
     snaps = {round(s * steps_per_unit): s for s in strains}
     return steps, snaps
@@ -330,20 +327,10 @@ class SimpleShearProtocol(SpecimenProtocol[SimpleShearConfig, SimpleShearRun, Si
                                "checkpoints on the wall clock"),
     )
     state_type = SimpleShearRun
+    summarise = summarise
+    outputs = write_outputs
+    result_type = SimpleShearResult
     output_files = (*OUTPUT_FILES, SHEAR_START_FILE)
-
-    def state_from_dict(self, saved: Any) -> SimpleShearRun:
-        return SimpleShearRun(**{k: v for k, v in saved.items()
-                                 if k not in ("config", "elapsed_s", "rows", "snapshots")})
-
-    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
-        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
-
-    def write_outputs(self, out: Path) -> dict[str, Any]:
-        return write_outputs(out)
-
-    def result(self, out: Path, summary: dict[str, Any]) -> SimpleShearResult:
-        return SimpleShearResult(out, summary)
 
 
 def run_simple_shear(config: SimpleShearConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,
