@@ -157,4 +157,4 @@ def shear(context: ShearContext[BC], records: Records, snapshots: Snapshots, *, 
     if isinstance(boundary, WallBoundary):
         speed = 0.05 * float(sim.radii[: run.n_grains].min()) / (50 * sim.time_step)
         operations.append(SideWalls(boundary, plan.area0, speed))
-    run_loading(sim, operations, bar, checkpoint)
+    run_loading(sim, operations, checkpoint, bar)

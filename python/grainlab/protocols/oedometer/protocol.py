@@ -132,7 +132,7 @@ def _load(context: Context) -> None:
         checkpoint,
         operations.Stop(steps.finished),
         PlatenServo(walls, stresses, run, speed),
-    ], bar, checkpoint)
+    ], checkpoint, bar)
 
 
 def _snapshot(sim: Simulation, run: OedometerRun) -> Any:

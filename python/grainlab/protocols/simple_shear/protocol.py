@@ -261,7 +261,7 @@ def _shear(context: Context) -> None:
                  lambda: f"mu {records.values['friction_coefficient']:.3f}, Z {records.values['coordination_number']:.2f}",
                  done),
         checkpoint, operations.Stop(OnSteps(steps[-1:], run.start_step)), CellControl(run, config, targets, rate),
-    ], bar, checkpoint)
+    ], checkpoint, bar)
 
 
 def _snapshot(sim: Simulation, run: SimpleShearRun, values: dict[str, float]) -> Any:
