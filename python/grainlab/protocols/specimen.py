@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from grainlab.plot.workers import FigureTask
 
 __all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
-           "damped_time_step_factor",
+           "damped_time_step_factor", "engine_columns",
            "engine_threads", "generate", "grain_model", "platen_model", "write_run_outputs"]
 
 #: Steps per engine call while a phase waits for a condition.
@@ -307,6 +307,16 @@ def consolidate(
         "time_step_s": sim.time_step,
     }
     run.wall_time["consolidate"] = time.perf_counter() - start
+
+
+def engine_columns(sim: Simulation) -> dict[str, float]:
+    """The columns every test's records read from the engine: the unbalanced force ratio
+    and the energies (J)."""
+    energy = sim.energy
+    return {"unbalanced_force_ratio": sim.unbalanced_force_ratio, "kinetic_energy_j": energy.kinetic,
+            "elastic_energy_j": energy.elastic, "friction_dissipated_j": energy.friction_dissipated,
+            "damping_dissipated_j": energy.damping_dissipated, "boundary_work_j": energy.boundary_work,
+            "wall_work_j": energy.wall_work}
 
 
 def _consolidate_stage(context: StageContext[Any, Any]) -> None:

@@ -14,6 +14,7 @@ from grainlab.io.walls import WallGeometry
 from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.state import BiaxialRun, Boundary
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, sample_area
+from grainlab.protocols.specimen import engine_columns
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind, Snapshot
 
@@ -105,7 +106,6 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
     )
     grain_contacts = int(np.count_nonzero(grain_i & grain_j & ~c.bonded))
     fabric = _fabric(sim, run)
-    energy = sim.energy
     return {
         "step": float(sim.step_count),
         "time_s": sim.time,
@@ -122,13 +122,7 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
         "love_weber_yy_pa": float(lw[1, 1]),
         "love_weber_xy_pa": float(lw[0, 1]),
         "coordination_number": 2.0 * grain_contacts / n,
-        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
-        "kinetic_energy_j": energy.kinetic,
-        "elastic_energy_j": energy.elastic,
-        "friction_dissipated_j": energy.friction_dissipated,
-        "damping_dissipated_j": energy.damping_dissipated,
-        "boundary_work_j": energy.boundary_work,
-        "wall_work_j": energy.wall_work,
+        **engine_columns(sim),
         **fabric,
     }
 

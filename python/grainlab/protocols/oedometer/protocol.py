@@ -27,6 +27,7 @@ from grainlab.protocols.specimen import (
     CONSOLIDATE,
     SpecimenError,
     SpecimenProtocol,
+    engine_columns,
     grain_model,
     platen_model,
 )
@@ -154,7 +155,6 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
                            wall_particle=w.particle, wall_point=w.point, wall_force_on_particle=w.force_on_particle)
     fabric = fabric_summary(_snapshot(sim, run))
     fabric.pop("coordination_number")
-    energy = sim.energy
     values = {
         "step": float(sim.step_count), "time_s": sim.time, "target_vertical_stress_pa": target,
         "vertical_stress_pa": box.stress_yy_pa, "horizontal_stress_pa": box.stress_xx_pa,
@@ -166,10 +166,7 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
         "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "height_m": box.height_m, "area_m2": area,
         "love_weber_xx_pa": float(lw[0, 0]), "love_weber_yy_pa": float(lw[1, 1]), "love_weber_xy_pa": float(lw[0, 1]),
         "coordination_number": 2.0 * int(np.count_nonzero((c.i < n) & (c.j < n))) / n,
-        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
-        "kinetic_energy_j": energy.kinetic, "elastic_energy_j": energy.elastic,
-        "friction_dissipated_j": energy.friction_dissipated, "damping_dissipated_j": energy.damping_dissipated,
-        "boundary_work_j": energy.boundary_work, "wall_work_j": energy.wall_work,
+        **engine_columns(sim),
         **fabric,
     }
     return {name: values[name] for name in OEDOMETER}

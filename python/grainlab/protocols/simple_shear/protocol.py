@@ -40,6 +40,7 @@ from grainlab.protocols.specimen import (
     SpecimenError,
     SpecimenProtocol,
     damped_time_step_factor,
+    engine_columns,
     grain_model,
 )
 from grainlab.protocols.triggers import (
@@ -286,7 +287,6 @@ def _record(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig) -> 
     fabric = fabric_summary(snap)
     z = fabric.pop("coordination_number")
     rb = StressForceFabric().compute(snap)
-    energy = sim.energy
     strain = (sim.step_count - run.start_step) * sim.time_step * run.shear_rate_per_s
     values = {
         "step": float(sim.step_count), "time_s": sim.time, "shear_strain": strain,
@@ -301,10 +301,7 @@ def _record(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig) -> 
         "love_weber_xx_pa": float(stress.contact[0, 0]), "love_weber_yy_pa": float(stress.contact[1, 1]),
         "love_weber_xy_pa": float(stress.contact[0, 1]),
         "coordination_number": z,
-        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
-        "kinetic_energy_j": energy.kinetic, "elastic_energy_j": energy.elastic,
-        "friction_dissipated_j": energy.friction_dissipated, "damping_dissipated_j": energy.damping_dissipated,
-        "boundary_work_j": energy.boundary_work, "wall_work_j": energy.wall_work,
+        **engine_columns(sim),
         **fabric,
         "rb_stress_ratio": rb.stress_ratio, "rb_predicted_stress_ratio": rb.predicted_stress_ratio,
         "rb_residual": rb.residual,
