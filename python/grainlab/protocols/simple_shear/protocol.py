@@ -16,7 +16,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
 from grainlab.analysis import StressForceFabric, fabric_summary
 from grainlab.columns import SIMPLE_SHEAR
@@ -124,16 +123,6 @@ class CellControl(Operation):
             sim.set_velocity_gradient(wanted)
 
 
-def _advance(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig, to_step: int, target: float) -> None:
-    """Runs to ``to_step``, both sides of the cell servo-controlled to ``target`` every
-    CONTROL_STEPS steps (counted from ``run.start_step``)."""
-    while sim.step_count < to_step:
-        into = (sim.step_count - run.start_step) % CONTROL_STEPS
-        if into == 0:
-            set_cell_rates(sim, run, config, (target, target), 0.0)
-        sim.run(min(CONTROL_STEPS - into, to_step - sim.step_count))
-
-
 def _to_periodic(context: Context) -> None:
     """The walls give way to a periodic cell of their box; the gradient is set to 0."""
     sim, run = context.sim, context.state
@@ -147,38 +136,46 @@ def _to_periodic(context: Context) -> None:
     sim.set_velocity_gradient(np.zeros((2, 2)))
 
 
+class CellSettled(Operation):
+    """Stop rule: every CHUNK_STEPS steps from ``run.start_step``, the loading ends once both
+    sides hold sigma_0 within ``consolidation.tolerance`` in equilibrium; a loading that
+    takes ``consolidation.max_steps`` stops the run with a :class:`SpecimenError`."""
+
+    def __init__(self, run: SimpleShearRun, config: SimpleShearConfig, bar: operations.Bar, label: str) -> None:
+        super().__init__(Periodic(CHUNK_STEPS, run.start_step))
+        self.run, self.config, self.bar, self.label = run, config, bar, label
+
+    def act(self, loading: Loading) -> None:
+        sim, c = loading.sim, self.config.consolidation
+        steps, target, limit = sim.step_count - self.run.start_step, c.pressure, c.unbalanced_force_ratio
+        stress = cell_stress(sim, self.config.material.normal_stiffness).total
+        self.bar.update(CHUNK_STEPS)
+        self.bar.set_postfix_str(f"sxx {stress[0, 0] / 1e3:.1f} kPa, syy {stress[1, 1] / 1e3:.1f} kPa, "
+                                 f"unbalanced {sim.unbalanced_force_ratio:.1e}")
+        if max(abs(stress[0, 0] / target - 1.0), abs(stress[1, 1] / target - 1.0)) < c.tolerance and \
+                sim.unbalanced_force_ratio < limit:
+            loading.stop()
+        elif steps >= c.max_steps:
+            raise SpecimenError(
+                f"{self.label} in the periodic cell did not converge in {steps} steps: sigma_xx "
+                f"{stress[0, 0] / 1e3:.1f}, sigma_yy {stress[1, 1] / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa "
+                f"+- {c.tolerance:.0%}), unbalanced force ratio {sim.unbalanced_force_ratio:.2e} (limit "
+                f"{limit:.0e}); raise consolidation.max_steps"
+            )
+
+
 def _equilibrate(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig, progress: bool, label: str) -> int:
     """Servo-controls both sides of the cell to sigma_0 until equilibrium; returns the steps taken."""
     target = config.consolidation.pressure
-    tolerance = config.consolidation.tolerance
-    limit = config.consolidation.unbalanced_force_ratio
-    max_steps = config.consolidation.max_steps
-    bar = progress_bar(max_steps, label, enabled=progress, unit="step")
-    steps = 0
+    bar = progress_bar(config.consolidation.max_steps, label, enabled=progress, unit="step")
     run.start_step = sim.step_count  # the control's step count starts here
     run.cell_rate_integral = [0.0, 0.0]
-    while True:
-        _advance(sim, run, config, sim.step_count + CHUNK_STEPS, target)
-        steps += CHUNK_STEPS
-        stress = cell_stress(sim, config.material.normal_stiffness).total
-        bar.update(CHUNK_STEPS)
-        bar.set_postfix_str(f"sxx {stress[0, 0] / 1e3:.1f} kPa, syy {stress[1, 1] / 1e3:.1f} kPa, "
-                            f"unbalanced {sim.unbalanced_force_ratio:.1e}")
-        settled = max(abs(stress[0, 0] / target - 1.0), abs(stress[1, 1] / target - 1.0)) < tolerance
-        if settled and sim.unbalanced_force_ratio < limit:
-            break
-        if steps >= max_steps:
-            bar.close()
-            raise SpecimenError(
-                f"{label} in the periodic cell did not converge in {steps} steps: sigma_xx {stress[0, 0] / 1e3:.1f}, "
-                f"sigma_yy {stress[1, 1] / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa +- {tolerance:.0%}), "
-                f"unbalanced force ratio {sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise "
-                "consolidation.max_steps"
-            )
-        raise_if_interrupted()
-    bar.close()
+    try:
+        Loading(sim, [CellSettled(run, config, bar, label), CellControl(run, config, (target, target), 0.0)]).run()
+    finally:
+        bar.close()
     sim.set_velocity_gradient(np.zeros((2, 2)))
-    return steps
+    return sim.step_count - run.start_step
 
 
 def _consolidate(context: Context) -> None:
