@@ -37,9 +37,9 @@ import tempfile
 import time
 from pathlib import Path
 
+from grainlab.protocols.biaxial.config import resolve
 from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary, start_shear
 from grainlab.protocols.biaxial.state import BiaxialRun
-from grainlab.protocols.config import resolve
 from grainlab.protocols.specimen import consolidate, engine_threads, generate
 from grainlab.simulation import Simulation
 

@@ -20,7 +20,7 @@ import json
 import sys
 import time
 
-from grainlab.protocols.config import resolve
+from grainlab.protocols.biaxial.config import resolve
 from grainlab.protocols.consolidate import BoxState
 from grainlab.protocols.specimen import SpecimenRun, consolidate, engine_threads, generate
 

@@ -40,7 +40,7 @@ import numpy as np
 
 from grainlab.io.hdf5 import read_results
 from grainlab.protocols.biaxial import run_biaxial
-from grainlab.protocols.config import resolve
+from grainlab.protocols.biaxial.config import resolve
 from grainlab.samples import GradingCurve
 from grainlab.snapshot import ParticleKind
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from grainlab import cli
-from grainlab.protocols.config import FIELDS
+from grainlab.protocols.biaxial.config import FIELDS
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"

@@ -116,7 +116,7 @@ def test_bad_law_settings_are_one_line_before_any_folder(tmp_path, capsys, comma
 @pytest.mark.slow
 def test_a_biaxial_run_with_hertz_mindlin_consolidates_and_shears(tmp_path):
     from grainlab.protocols import biaxial
-    from grainlab.protocols.config import resolve
+    from grainlab.protocols.biaxial.config import resolve
 
     tiny = ["sample.grading=uniform_by_number", "sample.d_min=0.5mm", "sample.d_max=1mm", "sample.width=10mm",
             "sample.height=10mm", "shear.snapshot_strains=[0, 0.005]", "shear.strain_rate=20%/min", "run.threads=1"]

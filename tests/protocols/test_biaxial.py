@@ -16,7 +16,7 @@ import grainlab.protocols.specimen as specimen
 from grainlab.analysis import StabilityIndex
 from grainlab.cli import main
 from grainlab.io.hdf5 import read_results
-from grainlab.protocols.config import resolve
+from grainlab.protocols.biaxial.config import resolve
 
 
 @pytest.fixture(scope="module")

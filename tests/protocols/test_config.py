@@ -6,7 +6,8 @@ import re
 
 import pytest
 
-from grainlab.protocols.config import BiaxialConfig, ConfigError, resolve
+from grainlab.protocols.biaxial.config import BiaxialConfig, resolve
+from grainlab.protocols.config import ConfigError
 
 
 def test_defaults_are_table_1():
@@ -126,7 +127,7 @@ def test_a_protocol_declares_its_keys_on_the_shared_ones(monkeypatch):
     )
 
     own = {"load.pressure": Field("stress", 1e5, "the final vertical stress", minimum=0.0, exclusive_minimum=True)}
-    toy = ConfigSchema("toy", {**SHARED_FIELDS, **own, **RUN_FIELDS}, {"sample.width": 0.03}, check_sample)
+    toy = ConfigSchema("toy", {**SHARED_FIELDS, **own, **RUN_FIELDS}, {"sample.width": 0.03}, check_sample, Config)
     monkeypatch.setitem(SCHEMAS, "toy", toy)
     config = toy.resolve(overrides=["load.pressure=400 kPa", "material.friction=0.5"], quick=True)
     assert config["load.pressure"] == 4e5 and config["material.friction"] == 0.5

@@ -9,7 +9,7 @@ import warnings
 import pytest
 
 from grainlab.protocols.biaxial import DensityScalingWarning, check_density_scaling, run_biaxial
-from grainlab.protocols.config import resolve
+from grainlab.protocols.biaxial.config import resolve
 
 
 def eq16(rate: float, density: float, radius: float, pressure: float) -> float:

@@ -12,7 +12,8 @@ import pytest
 from grainlab import cli
 from grainlab.io import FileFormatError
 from grainlab.io.shape_file import read_shape_template
-from grainlab.protocols.config import grain_shape, resolve
+from grainlab.protocols.biaxial.config import resolve
+from grainlab.protocols.config import grain_shape
 from grainlab.shapes import shape_template
 
 

@@ -79,7 +79,7 @@ threads = 1
 
 
 def tiny_config(*extra: str):
-    from grainlab.protocols.config import resolve
+    from grainlab.protocols.biaxial.config import resolve
 
     return resolve(overrides=[*TINY, *extra])
 

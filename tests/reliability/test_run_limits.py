@@ -15,7 +15,7 @@ import grainlab.protocols.biaxial as biaxial
 import grainlab.protocols.biaxial.records as records
 from grainlab.cli import main
 from grainlab.io.hdf5 import read_results
-from grainlab.protocols.config import resolve
+from grainlab.protocols.biaxial.config import resolve
 
 
 @pytest.mark.parametrize("rate", ["1000", "10"])

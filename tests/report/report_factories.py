@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from grainlab.io.hdf5 import ResultsWriter, snapshot_name
-from grainlab.protocols.config import resolve
+from grainlab.protocols.biaxial.config import resolve
 from grainlab.snapshot import Snapshot
 
 D = 1.0e-3

@@ -18,7 +18,7 @@ from grainlab._html import fmt
 from grainlab.cli import build_parser, main
 from grainlab.io.hdf5 import read_results
 from grainlab.postprocess import FIGURES
-from grainlab.protocols.config import resolve
+from grainlab.protocols.biaxial.config import resolve
 from grainlab.report import write_report
 from grainlab.report.biaxial import CURVE_FIGURES, gather_biaxial
 

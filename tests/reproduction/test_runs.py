@@ -8,7 +8,7 @@ import json
 import pytest
 
 from grainlab.cli import main
-from grainlab.protocols.config import FIELDS
+from grainlab.protocols.biaxial.config import FIELDS
 from grainlab.reproduction.runs import (
     PLAN_FILE,
     ReproductionPlan,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from grainlab.protocols.biaxial import run_biaxial
-from grainlab.protocols.config import resolve
+from grainlab.protocols.biaxial.config import resolve
 
 
 def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

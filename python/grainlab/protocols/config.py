@@ -1,13 +1,18 @@
 """Configuration of the protocols: defaults from the paper's Table 1, TOML
 files, ``key=value`` overrides, units at the edge, validation before any work.
 
-Each protocol declares its keys as a :class:`ConfigSchema` (in :data:`SCHEMAS`):
-the shared keys of a sample, its material and its consolidation
-(:data:`SHARED_FIELDS`), its own (the biaxial test's :data:`BIAXIAL_FIELDS`) and
-the runner's (:data:`RUN_FIELDS`); :func:`resolve` is the biaxial test's.
+A configuration's keys come in typed sections (:class:`Section`: a frozen
+dataclass whose fields are the keys ``section.name``, each declared with
+:func:`key`: its kind, default, range and help). Every test that makes a
+sample shares :class:`SampleSection`, :class:`MaterialSection`,
+:class:`ConsolidationSection` (:data:`SHARED_FIELDS`) and the runner's
+:class:`RunSection` (:data:`RUN_FIELDS`); each test declares its own sections
+in its package (``protocols/biaxial/config.py``: ``boundary.*``, ``shear.*``)
+and its :class:`ConfigSchema` (in :data:`SCHEMAS`), whose resolved
+:class:`Config` (a subclass per test) reads each section typed
+(``config.shear.final_strain``) or by its dotted key (``config["shear.final_strain"]``).
 
-A configuration is a flat mapping of dotted keys (``sample.porosity``,
-``shear.strain_rate``, ...) to values in SI units. Files and overrides may give
+Values are in SI units. Files and overrides may give
 numbers (SI) or strings with a unit: ``"75 mm"``, ``"100 kPa"``, ``"2 %/min"``,
 ``"0.5 %"``. Every key has a kind that says which units it accepts and which
 range is allowed; a bad key or value raises :class:`ConfigError` (a
@@ -16,6 +21,7 @@ range is allowed; a bad key or value raises :class:`ConfigError` (a
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import tomllib
@@ -23,7 +29,7 @@ from collections.abc import Callable, Iterable, Mapping
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import Any, ClassVar, Generic, TypedDict, TypeVar
 
 from grainlab import paper
 from grainlab._mapping import flatten_keys
@@ -82,172 +88,171 @@ class Field:
         return text
 
 
-class _Range(TypedDict, total=False):
+class Range(TypedDict, total=False):
     """Range keywords of :class:`Field` shared by many keys."""
 
     minimum: float
     exclusive_minimum: bool
 
 
-_POSITIVE: _Range = {"minimum": 0.0, "exclusive_minimum": True}
+#: The range of a positive key (``**POSITIVE`` in a :func:`key`).
+POSITIVE: Range = {"minimum": 0.0, "exclusive_minimum": True}
 
-#: Every key, with the paper's Table 1 values as defaults.
-#: The keys of every test that makes a sample and consolidates it: the sample, its
-#: material (Table 1) and the consolidation.
-SHARED_FIELDS: dict[str, Field] = {
-    "sample.width": Field("length", paper.WIDTH_M, "sample width (Table 1: 75 mm)", **_POSITIVE),
-    "sample.height": Field("length", paper.HEIGHT_M, "sample height (Table 1: 150 mm)", **_POSITIVE),
-    "sample.porosity": Field(
+def key(kind: str, default: Any, help: str, **limits: Any) -> Any:
+    """One key of a :class:`Section`: a dataclass field with ``default`` whose metadata
+    holds the key's :class:`Field` (its kind, range and help)."""
+    spec = Field(kind, default, help, **limits)
+    if isinstance(default, list):
+        return dataclasses.field(default_factory=lambda: list(default), metadata={"key": spec})
+    return dataclasses.field(default=default, metadata={"key": spec})
+
+
+@dataclass(frozen=True)
+class Section:
+    """A typed section of a configuration: a frozen dataclass whose fields (each a
+    :func:`key`) are the keys ``prefix.field``."""
+
+    prefix: ClassVar[str]
+
+    @classmethod
+    def keys(cls) -> dict[str, Field]:
+        """The section's keys, in order: ``prefix.field`` -> :class:`Field`."""
+        return {f"{cls.prefix}.{f.name}": f.metadata["key"] for f in dataclasses.fields(cls)}
+
+
+@dataclass(frozen=True)
+class SampleSection(Section):
+    """The sample: its size, porosity, grading and seed."""
+
+    prefix: ClassVar[str] = "sample"
+    width: float = key("length", paper.WIDTH_M, "sample width (Table 1: 75 mm)", **POSITIVE)
+    height: float = key("length", paper.HEIGHT_M, "sample height (Table 1: 150 mm)", **POSITIVE)
+    porosity: float = key(
         "strain", paper.POROSITY, "target nominal porosity of the radius expansion (Table 1: 0.12)",
         minimum=0.0, maximum=1.0, exclusive_minimum=True, exclusive_maximum=True,
-    ),
-    "sample.d_min": Field("length", paper.D_MIN_M, "smallest grain diameter (Table 1: 0.5 mm)", **_POSITIVE),
-    "sample.d_max": Field("length", paper.D_MAX_M, "largest grain diameter (Table 1: 3 mm)", **_POSITIVE),
-    "sample.grading": Field(
+    )
+    d_min: float = key("length", paper.D_MIN_M, "smallest grain diameter (Table 1: 0.5 mm)", **POSITIVE)
+    d_max: float = key("length", paper.D_MAX_M, "largest grain diameter (Table 1: 3 mm)", **POSITIVE)
+    grading: str = key(
         "choice", "paper",
         "grain size distribution; 'curve' takes sample.sieve_sizes and sample.percent_passing",
         choices=("paper", "uniform_by_number", "uniform_by_mass", "curve"),
-    ),
-    "sample.sieve_sizes": Field(
+    )
+    sieve_sizes: list[float] = key(
         "length_list", [],
         "sieve sizes of a 'curve' grading, smallest first (they set d_min and d_max)",
-    ),
-    "sample.percent_passing": Field(
+    )
+    percent_passing: list[float] = key(
         "percent_list", [],
         "percent passing by mass at each sieve size of a 'curve' grading (0 first, 100 last)",
-    ),
-    "sample.seed": Field("integer", 1, "random seed of the sample", minimum=0),
-    "sample.shape": Field(
+    )
+    seed: int = key("integer", 1, "random seed of the sample", minimum=0)
+    shape: str = key(
         "text", "disk",
         "grain shape (docs/bodies.md, 'Shapes'): rigid clumps of disks, the grading giving each grain's "
         "circumscribed diameter; a file lists a template's pebbles (x, y, r per line)",
         choices=SHAPES,
-    ),
-    "sample.shape_parameter": Field(
+    )
+    shape_parameter: float = key(
         "number", 0.0, "CEGEO's eta = 1 - inscribed / circumscribed radius of dimers, trimers and rods (0: disks)",
         minimum=0.0, maximum=1.0, exclusive_maximum=True,
-    ),
-    "sample.rod_pebbles": Field("integer", 3, "pebbles of a rod (sample.shape = rod)", minimum=2),
-    "sample.generation_friction": Field("number", 0.0, "particle friction during radius expansion", minimum=0.0),
-    "sample.max_generation_stress": Field(
-        "stress", 5.0e6, "stress bound of the radius expansion", **_POSITIVE
-    ),
-    "material.normal_stiffness": Field("stiffness", paper.NORMAL_STIFFNESS_N_PER_M, "contact kn (Table 1)", **_POSITIVE),
-    "material.shear_stiffness": Field("stiffness", paper.SHEAR_STIFFNESS_N_PER_M, "contact ks (Table 1)", **_POSITIVE),
-    "material.friction": Field("number", paper.FRICTION, "particle friction (Table 1: 0.9)", minimum=0.0),
-    "material.platen_friction": Field("number", paper.PLATEN_FRICTION, "particle-platen friction (Table 1: 0)", minimum=0.0),
-    "material.rolling_friction": Field(
+    )
+    rod_pebbles: int = key("integer", 3, "pebbles of a rod (sample.shape = rod)", minimum=2)
+    generation_friction: float = key("number", 0.0, "particle friction during radius expansion", minimum=0.0)
+    max_generation_stress: float = key(
+        "stress", 5.0e6, "stress bound of the radius expansion", **POSITIVE
+    )
+
+
+@dataclass(frozen=True)
+class MaterialSection(Section):
+    """The grains' material and contact law (Table 1)."""
+
+    prefix: ClassVar[str] = "material"
+    normal_stiffness: float = key("stiffness", paper.NORMAL_STIFFNESS_N_PER_M, "contact kn (Table 1)", **POSITIVE)
+    shear_stiffness: float = key("stiffness", paper.SHEAR_STIFFNESS_N_PER_M, "contact ks (Table 1)", **POSITIVE)
+    friction: float = key("number", paper.FRICTION, "particle friction (Table 1: 0.9)", minimum=0.0)
+    platen_friction: float = key("number", paper.PLATEN_FRICTION, "particle-platen friction (Table 1: 0)", minimum=0.0)
+    rolling_friction: float = key(
         "number", 0.0, "rolling friction mu_r between grains and at the platens (0: none, the paper's law)", minimum=0.0
-    ),
-    "material.rolling_stiffness": Field(
+    )
+    rolling_stiffness: float | str = key(
         "number", "auto", "rolling stiffness k_r in N m/rad (auto: 2.25 kn mu_r^2 R*^2)",
-        **_POSITIVE, allow_auto=True,
-    ),
-    "material.rolling_damping": Field(
+        **POSITIVE, allow_auto=True,
+    )
+    rolling_damping: float = key(
         "number", 0.0, "rolling dashpot, fraction of critical 2 sqrt(I_r k_r), below the cap", minimum=0.0
-    ),
-    "material.contact_damping": Field(
+    )
+    contact_damping: float = key(
         "number", 0.0, "normal and shear contact dashpots between grains, fraction of critical "
         "(0: none, the paper's law)", minimum=0.0
-    ),
-    "material.contact_law": Field(
+    )
+    contact_law: str = key(
         "choice", "linear",
         "contact law between grains and at the platens: 'linear' (kn, ks: the paper's) or "
         "'hertz_mindlin' (material.youngs_modulus, poisson_ratio, restitution)",
         choices=("linear", "hertz_mindlin"),
-    ),
-    "material.youngs_modulus": Field(
+    )
+    youngs_modulus: float = key(
         "stress", 70.0e9, "Young's modulus E of the grains, read by hertz_mindlin (quartz: about 70 GPa)",
-        **_POSITIVE,
-    ),
-    "material.poisson_ratio": Field(
+        **POSITIVE,
+    )
+    poisson_ratio: float = key(
         "number", 0.25, "Poisson ratio of the grains, read by hertz_mindlin",
         minimum=-1.0, maximum=0.5, exclusive_minimum=True, exclusive_maximum=True,
-    ),
-    "material.restitution": Field(
+    )
+    restitution: float = key(
         "number", 0.5, "normal coefficient of restitution of hertz_mindlin's dashpot (1: elastic)",
         minimum=0.0, maximum=1.0, exclusive_minimum=True,
-    ),
-    "material.density": Field("density", paper.DENSITY_KG_PER_M3, "scaled particle density (Table 1: 2e8 kg/m^3)", **_POSITIVE),
-    "material.limiting_contact_pressure": Field(
-        "stress", paper.LIMITING_CONTACT_PRESSURE_PA, "p_y of the density scaling factor, paper Eq. 16 (Table 1: 150 MPa)", **_POSITIVE
-    ),
-    "material.local_damping": Field(
+    )
+    density: float = key("density", paper.DENSITY_KG_PER_M3, "scaled particle density (Table 1: 2e8 kg/m^3)", **POSITIVE)
+    limiting_contact_pressure: float = key(
+        "stress", paper.LIMITING_CONTACT_PRESSURE_PA, "p_y of the density scaling factor, paper Eq. 16 (Table 1: 150 MPa)", **POSITIVE
+    )
+    local_damping: float = key(
         "number", paper.LOCAL_DAMPING, "local damping alpha (Table 1: 0.8)", minimum=0.0, maximum=1.0, exclusive_maximum=True
-    ),
-    "consolidation.pressure": Field("stress", paper.CONSOLIDATION_PRESSURE_PA, "isotropic consolidation stress sigma_0 = sigma_3", **_POSITIVE),
-    "consolidation.friction": Field(
+    )
+
+
+@dataclass(frozen=True)
+class ConsolidationSection(Section):
+    """The isotropic consolidation to sigma_0."""
+
+    prefix: ClassVar[str] = "consolidation"
+    pressure: float = key("stress", paper.CONSOLIDATION_PRESSURE_PA, "isotropic consolidation stress sigma_0 = sigma_3", **POSITIVE)
+    friction: float = key(
         "number", 0.0,
         "grain friction while consolidating (the generation's; Table 1 friction acts from the membrane on)",
         minimum=0.0,
-    ),
-    "consolidation.tolerance": Field(
+    )
+    tolerance: float = key(
         "strain", 0.01, "wall stresses within this fraction of sigma_0", minimum=0.0, exclusive_minimum=True
-    ),
-    "consolidation.unbalanced_force_ratio": Field(
-        "number", 1.0e-3, "equilibrium: mean unbalanced force ratio below this", **_POSITIVE
-    ),
-    "consolidation.max_steps": Field("integer", 2_000_000, "give up consolidating after this many steps", minimum=1),
-}
+    )
+    unbalanced_force_ratio: float = key(
+        "number", 1.0e-3, "equilibrium: mean unbalanced force ratio below this", **POSITIVE
+    )
+    max_steps: int = key("integer", 2_000_000, "give up consolidating after this many steps", minimum=1)
 
-#: The biaxial test's own keys: the lateral boundary and the shearing.
-BIAXIAL_FIELDS: dict[str, Field] = {
-    "boundary.kind": Field(
-        "choice", "membrane",
-        "lateral boundary (docs/boundary.md): a bonded membrane (A), the outermost grains (B), or the "
-        "consolidation box's rigid side walls (C; the one of shear.volume = constant)",
-        choices=("membrane", "outer_particles", "walls"),
-    ),
-    "boundary.membrane_diameter": Field("length", 0.5e-3, "diameter of the membrane disks", **_POSITIVE),
-    "boundary.membrane_overlap": Field(
-        "strain", 0.5, "rest overlap of neighbouring membrane disks, fraction of their diameter",
-        minimum=0.0, maximum=0.9,
-    ),
-    "boundary.membrane_stiffness": Field(
-        "stiffness", 8.45e5, "normal and shear stiffness of the membrane bonds", **_POSITIVE
-    ),
-    "boundary.membrane_friction": Field("number", 0.0, "friction between grains and membrane disks", minimum=0.0),
-    "shear.strain_rate": Field(
-        "strain_rate", paper.STRAIN_RATE_PER_S,
-        "axial strain rate (Table 1: 2 %/min); auto = the fastest with the heaviest grain's inertial "
-        "number <= shear.inertial_number (2 %/min with Table 1: no faster rate passed the rate study)",
-        **_POSITIVE, allow_auto=True,
-    ),
-    "shear.volume": Field(
-        "choice", "free",
-        "free: the confining pressure held (drained); constant: the sample's area held by the rigid side walls, "
-        "the undrained test's analogue (needs boundary.kind = walls, its default then)",
-        choices=("free", "constant"),
-    ),
-    "shear.final_strain": Field("strain", 0.10, "final axial strain", minimum=0.0, maximum=0.5, exclusive_minimum=True),
-    "shear.record_interval": Field(
-        "strain", 0.0005, "axial strain between two records (<= 0.05 %)", minimum=0.0, maximum=0.0005,
-        exclusive_minimum=True,
-    ),
-    "shear.snapshot_strains": Field(
-        "strain_list", list(paper.SNAPSHOT_STRAINS),
-        "axial strains of the full snapshots (the paper's 0, 0.5, 0.7, 0.9, 1.5 and 10 %)",
-    ),
-    "shear.inertial_number": Field(
-        "number", 1.0e-4,
-        "bound on the inertial number (and Eq. 16 factor) for the auto strain rate: its value at the rate study's "
-        "fastest converged rate, 2 %/min with Table 1", **_POSITIVE
-    ),
-}
 
-#: How a run executes (the runner's keys, in every test's configuration).
-RUN_FIELDS: dict[str, Field] = {
-    "run.threads": Field("integer", "auto", "engine threads (auto: all cores)", minimum=1, allow_auto=True),
-    "run.time_step_safety": Field(
+@dataclass(frozen=True)
+class RunSection(Section):
+    """How a run executes (the runner's keys, in every test's configuration)."""
+
+    prefix: ClassVar[str] = "run"
+    threads: int | str = key("integer", "auto", "engine threads (auto: all cores)", minimum=1, allow_auto=True)
+    time_step_safety: float = key(
         "number", DEFAULT_TIME_STEP_SAFETY, "time step = this x the critical time step (0.8, as PFC)", minimum=0.0,
         maximum=1.0,
         exclusive_minimum=True,
-    ),
-    "run.checkpoint_interval": Field("time", 30.0, "wall-clock time between checkpoints", **_POSITIVE),
-}
+    )
+    checkpoint_interval: float = key("time", 30.0, "wall-clock time between checkpoints", **POSITIVE)
 
-#: Every key of the biaxial test, in the order files and tables list them.
-FIELDS: dict[str, Field] = {**SHARED_FIELDS, **BIAXIAL_FIELDS, **RUN_FIELDS}
+
+#: The keys of every test that makes a sample and consolidates it: the sample, its
+#: material (Table 1) and the consolidation.
+SHARED_FIELDS: dict[str, Field] = {**SampleSection.keys(), **MaterialSection.keys(), **ConsolidationSection.keys()}
+#: How a run executes (the runner's keys, in every test's configuration).
+RUN_FIELDS: dict[str, Field] = RunSection.keys()
 
 #: Item kind and range of each list kind.
 _LIST_ITEMS: dict[str, tuple[str, Field]] = {
@@ -331,7 +336,7 @@ def coerce_field(fields: Mapping[str, Field], key: str, value: Any) -> Any:
     return _check_range(key, field, _parse_quantity(key, field, value))
 
 
-def _parse_override(text: str) -> tuple[str, Any]:
+def parse_override(text: str) -> tuple[str, Any]:
     if "=" not in text:
         raise ConfigError(f"--set {text!r}: expected key=value, e.g. shear.final_strain=5%")
     key, raw = (part.strip() for part in text.split("=", 1))
@@ -342,16 +347,50 @@ def _parse_override(text: str) -> tuple[str, Any]:
     return key, value
 
 
+S = TypeVar("S", bound=Section)
+
+
+class SectionOf(Generic[S]):
+    """A :class:`Config` attribute: the configuration's section ``kind``, read once."""
+
+    def __init__(self, kind: type[S]) -> None:
+        self.kind = kind
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, config: Config | None, owner: type | None = None) -> S:
+        if config is None:
+            raise AttributeError(f"{self.name}: a configuration's section, read on the configuration")
+        if self.name not in config.__dict__:
+            config.__dict__[self.name] = config.section(self.kind)
+        found: S = config.__dict__[self.name]
+        return found
+
+
 @dataclass(frozen=True)
 class Config:
     """A resolved, validated configuration: ``values`` maps every key of its schema
-    (``schema``, a name of :data:`SCHEMAS`) to SI values."""
+    (``schema``, a name of :data:`SCHEMAS`) to SI values. Each section reads typed as
+    an attribute (``config.sample.width``; a test's subclass adds its own sections),
+    each key by its name (``config["sample.width"]``)."""
 
     values: dict[str, Any]
     schema: str = "biaxial"
 
     def __getitem__(self, key: str) -> Any:
         return self.values[key]
+
+    def section(self, kind: type[S]) -> S:
+        """The section ``kind`` of this configuration (a key its schema leaves out, as the
+        cyclic test leaves out the monotonic loading's end, keeps the section's default)."""
+        names = (f.name for f in dataclasses.fields(kind))
+        return kind(**{name: self.values[k] for name in names if (k := f"{kind.prefix}.{name}") in self.values})
+
+    sample = SectionOf(SampleSection)
+    material = SectionOf(MaterialSection)
+    consolidation = SectionOf(ConsolidationSection)
+    run = SectionOf(RunSection)
 
     def to_dict(self) -> dict[str, Any]:
         """Nested ``{section: {name: value}}``, as written to ``run.h5`` and TOML."""
@@ -367,23 +406,27 @@ class Config:
         if schema not in SCHEMAS:
             raise ConfigError(f"no configuration schema {schema!r} (import grainlab.protocols.registry); "
                               f"known: {', '.join(sorted(SCHEMAS))}")
-        return SCHEMAS[schema].resolve(overrides=flatten_keys(nested))
+        config: Config = SCHEMAS[schema].resolve(overrides=flatten_keys(nested))
+        return config
 
 
-#: The biaxial test's configuration (a :class:`Config` of the ``biaxial`` schema).
-BiaxialConfig = Config
+
+
+C = TypeVar("C", bound=Config)
 
 
 @dataclass(frozen=True)
-class ConfigSchema:
+class ConfigSchema(Generic[C]):
     """The configuration keys of one protocol: its fields (usually :data:`SHARED_FIELDS`,
-    its own and :data:`RUN_FIELDS`), the overrides of ``--quick``, and the checks that
-    span several keys (``check(values, given_keys)``, raising :class:`ConfigError`)."""
+    its own sections' and :data:`RUN_FIELDS`), the overrides of ``--quick``, the checks
+    that span several keys (``check(values, given_keys)``, raising :class:`ConfigError`)
+    and the :class:`Config` subclass it resolves to (its sections typed)."""
 
     name: str
     fields: Mapping[str, Field]
     quick: Mapping[str, Any]
     check: Callable[[dict[str, Any], AbstractSet[str]], None]
+    config_type: type[C]
 
     def coerce(self, key: str, value: Any) -> Any:
         return coerce_field(self.fields, key, value)
@@ -394,7 +437,7 @@ class ConfigSchema:
         overrides: Mapping[str, Any] | Iterable[str] | None = None,
         *,
         quick: bool = False,
-    ) -> Config:
+    ) -> C:
         """Defaults, then ``--quick``, then the TOML file, then overrides (a mapping,
         or ``key=value`` strings), all validated before anything runs."""
         values = {key: field.default for key, field in self.fields.items()}
@@ -414,13 +457,13 @@ class ConfigSchema:
             if isinstance(overrides, Mapping):
                 layers.append(dict(overrides))
             else:
-                layers.append(dict(_parse_override(text) for text in overrides))
+                layers.append(dict(parse_override(text) for text in overrides))
         for layer in layers:
             for key, value in layer.items():
                 values[key] = value
         resolved = {key: self.coerce(key, value) for key, value in values.items()}
         self.check(resolved, {key for layer in layers for key in layer})
-        return Config(resolved, self.name)
+        return self.config_type(resolved, self.name)
 
 
 def _read_toml(path: Path) -> dict[str, Any]:
@@ -434,23 +477,6 @@ def _read_toml(path: Path) -> dict[str, Any]:
         raise ConfigError(f"{path}: cannot be read as a TOML configuration file ({error})") from None
     except tomllib.TOMLDecodeError as error:
         raise ConfigError(f"{path}: not valid TOML ({error})") from None
-
-
-def coerce(key: str, value: Any) -> Any:
-    """Converts ``value`` for the biaxial key ``key`` to SI and checks its range."""
-    return coerce_field(FIELDS, key, value)
-
-
-def resolve(
-    config_file: str | Path | None = None,
-    overrides: Mapping[str, Any] | Iterable[str] | None = None,
-    *,
-    quick: bool = False,
-) -> Config:
-    """The biaxial test's configuration: defaults (Table 1), then ``--quick``, then the
-    TOML file, then overrides (a mapping, or ``key=value`` strings), all validated
-    before anything runs (:meth:`ConfigSchema.resolve` of :data:`BIAXIAL`)."""
-    return SCHEMAS["biaxial"].resolve(config_file, overrides, quick=quick)
 
 
 def _grading_curve(v: dict[str, Any], given: AbstractSet[str]) -> None:
@@ -530,56 +556,20 @@ def check_sample(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> No
         )
 
 
-def check_boundary(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
-    """A constant-volume test needs the rigid side walls: they are its boundary unless
-    another was asked for, which is refused; clumps cannot form the outermost grains'
-    chain."""
-    if v["boundary.kind"] == "outer_particles" and v["sample.shape"] != "disk" and grain_shape(v) is not None:
-        raise ConfigError(
-            f"boundary.kind: 'outer_particles' bonds the outermost grains into a chain, which the pebbles of "
-            f"sample.shape = {v['sample.shape']!r} cannot join (they move with their clump); use 'membrane' or 'walls'"
-        )
-    if v["shear.volume"] != "constant":
-        return
-    if "boundary.kind" not in given:
-        v["boundary.kind"] = "walls"
-    elif v["boundary.kind"] != "walls":
-        raise ConfigError(
-            f"shear.volume: 'constant' holds the sample's area with the rigid side walls, not with "
-            f"boundary.kind = {v['boundary.kind']!r} (whose area follows the grains); set boundary.kind = "
-            "'walls' or leave it out"
-        )
-
-
-def _check_consistency(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
-    check_sample(v, given)
-    check_boundary(v, given)
-    if 0.0 not in v["shear.snapshot_strains"]:
-        raise ConfigError(
-            "shear.snapshot_strains: must include 0, the state at the start of shearing that "
-            f"displacements, local strains and the shear band are measured from; got {v['shear.snapshot_strains']}"
-        )
-    positive = [s for s in v["shear.snapshot_strains"] if s > 0]
-    if positive and positive[0] > v["shear.final_strain"] + 1e-12:
-        raise ConfigError(
-            f"shear.final_strain: {v['shear.final_strain']:g} is below the first snapshot strain "
-            f"{positive[0]:g} (shear.snapshot_strains); raise it or change the snapshots"
-        )
-    if v["shear.final_strain"] < v["shear.record_interval"]:
-        raise ConfigError(
-            f"shear.final_strain: {v['shear.final_strain']:g} is below one record interval "
-            f"({v['shear.record_interval']:g})"
-        )
-
-
 #: The configuration schemas of the protocols, by name (a protocol registers its own
 #: with :func:`register_schema`; :mod:`grainlab.protocols.registry` imports every protocol).
-SCHEMAS: dict[str, ConfigSchema] = {
-    "biaxial": ConfigSchema("biaxial", FIELDS, QUICK, _check_consistency),
-}
+SCHEMAS: dict[str, ConfigSchema[Any]] = {}
 
 
-def register_schema(schema: ConfigSchema) -> ConfigSchema:
+def register_test(name: str, own: Mapping[str, Field], check: Callable[[dict[str, Any], AbstractSet[str]], None],
+                  config_type: type[C], quick: Mapping[str, Any] = QUICK) -> ConfigSchema[C]:
+    """Registers the schema of a test that makes a sample: :data:`SHARED_FIELDS`, its
+    ``own`` keys (one of the shared ones given again takes its place) and
+    :data:`RUN_FIELDS`; returns it."""
+    return register_schema(ConfigSchema(name, {**SHARED_FIELDS, **own, **RUN_FIELDS}, quick, check, config_type))
+
+
+def register_schema(schema: ConfigSchema[C]) -> ConfigSchema[C]:
     """Adds ``schema`` to :data:`SCHEMAS` under its name (a protocol's own module does,
     when it is imported); returns it."""
     known = SCHEMAS.setdefault(schema.name, schema)

@@ -178,11 +178,13 @@ class Stop(Operation):
         loading.stop()
 
 
-def run_loading(sim: Simulation, operations: Sequence[Operation], bar: Bar, checkpoint: Checkpoint) -> None:
-    """Runs ``operations`` as a :class:`Loading`; the bar is closed and the stage's wall
-    time booked (``checkpoint``) at its end."""
+def run_loading(sim: Simulation, operations: Sequence[Operation], checkpoint: Checkpoint,
+                bar: Bar | None = None) -> None:
+    """Runs ``operations`` as a :class:`Loading`; the stage's wall time is booked
+    (``checkpoint``) and the progress bar closed at its end."""
     try:
         Loading(sim, operations).run()
     finally:
-        bar.close()
+        if bar is not None:
+            bar.close()
     checkpoint.book()

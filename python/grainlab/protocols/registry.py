@@ -42,7 +42,8 @@ def resolve_config(name: str, config_file: str | Path | None = None,
                    overrides: Mapping[str, Any] | Iterable[str] | None = None, *, quick: bool = False) -> Config:
     """The configuration of protocol ``name`` (its schema's ``resolve``)."""
     _check_name(name)
-    return SCHEMAS[name].resolve(config_file, overrides, quick=quick)
+    config: Config = SCHEMAS[name].resolve(config_file, overrides, quick=quick)
+    return config
 
 
 def run_named(name: str, config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,

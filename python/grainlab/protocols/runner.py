@@ -48,6 +48,7 @@ from grainlab.simulation import Simulation
 __all__ = [
     "DONE",
     "EXECUTION_KEYS",
+    "RUNNER_KEYS",
     "RUN_FILES",
     "Protocol",
     "ProtocolError",
@@ -66,6 +67,8 @@ RUN_FILES = (RESULTS_FILE, RESULTS_FILE + PARTIAL_SUFFIX, CHECKPOINT_FILE)
 #: Keys that set how a run is executed, not one bit of what it computes (the
 #: engine gives the same bits on any thread count): a run resumes under other values.
 EXECUTION_KEYS = frozenset({"run.threads", "run.checkpoint_interval"})
+#: What the runner saves in a checkpoint beside the state (the state is read without them).
+RUNNER_KEYS = frozenset({"config", "elapsed_s", "rows", "snapshots"})
 #: Name of the checkpoint array that holds the partial results file (:meth:`ResultsWriter.publish`).
 _RESULTS_IMAGE = "results_partial"
 
@@ -163,7 +166,7 @@ class Protocol(ABC, Generic[C, S, R]):
 
     @abstractmethod
     def state_from_dict(self, saved: Mapping[str, Any]) -> S:
-        """The state a checkpoint saved (:meth:`RunState.to_dict`)."""
+        """The state a checkpoint saved (:meth:`RunState.to_dict`; without :data:`RUNNER_KEYS`)."""
 
     @abstractmethod
     def summary(self, context: StageContext[C, S], wall_time_s: float) -> dict[str, Any]:
@@ -335,7 +338,7 @@ def _run_locked(protocol: Protocol[Any, Any, R], out: Path, *, resume: bool, pro
             _refuse_differing(protocol, out, saved.get("config"))
             sim = Simulation.from_bytes(checkpoint.engine_state)
             sim.threads = threads  # the bits do not depend on it: a resumed run takes the count asked now
-            state = protocol.state_from_dict(saved)
+            state = protocol.state_from_dict({k: v for k, v in saved.items() if k not in RUNNER_KEYS})
             elapsed_before = float(saved.get("elapsed_s", 0.0))
             writer = _reopen_results(protocol, out, state, checkpoint, saved)
         else:

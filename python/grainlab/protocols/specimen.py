@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, Self, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,7 +27,7 @@ from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic,
 from grainlab.protocols.config import Config, grain_shape
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
 from grainlab.protocols.grains import grain_coordination, grain_porosity
-from grainlab.protocols.runner import Protocol, ProtocolError, RunResult
+from grainlab.protocols.runner import Protocol, ProtocolError, RunResult, Stage, StageContext
 from grainlab.samples import (
     PAPER_GRADING,
     GradingCurve,
@@ -41,8 +41,8 @@ from grainlab.simulation import ContactModel, Simulation
 if TYPE_CHECKING:
     from grainlab.plot.workers import FigureTask
 
-__all__ = ["CHUNK_STEPS", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
-           "damped_time_step_factor",
+__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
+           "damped_time_step_factor", "engine_columns",
            "engine_threads", "generate", "grain_model", "platen_model", "write_run_outputs"]
 
 #: Steps per engine call while a phase waits for a condition.
@@ -73,18 +73,31 @@ class SpecimenRun:
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
+    @classmethod
+    def from_dict(cls, saved: dict[str, Any]) -> Self:
+        """The state :meth:`to_dict` gave."""
+        return cls(**saved)
+
 
 R = TypeVar("R", bound=SpecimenRun)
 Result = TypeVar("Result", bound=RunResult)
+C = TypeVar("C", bound=Config)
 
 
-class SpecimenProtocol(Protocol[Config, R, Result]):
+class SpecimenProtocol(Protocol[C, R, Result]):
     """A protocol whose configuration is a :class:`Config` of the schema named as the
     protocol and whose run starts by making the sample (:func:`generate`) into a state
-    of type :attr:`state_type`, in the first stage's phase; it writes :data:`OUTPUT_FILES`."""
+    of type :attr:`state_type`, in the first stage's phase; it writes :data:`OUTPUT_FILES`,
+    sums up with :attr:`summarise` and returns a :attr:`result_type`."""
 
     state_type: ClassVar[type[SpecimenRun]]
     output_files: ClassVar[tuple[str, ...]] = OUTPUT_FILES
+    #: The summary of a run whose stages have all run: ``(state, config, time series, wall time)``.
+    summarise: ClassVar[Callable[[Any, Any, dict[str, NDArray[np.float64]], float], dict[str, Any]]]
+    #: The outputs written from the final ``run.h5``; returns the summary.
+    outputs: ClassVar[Callable[[Path], dict[str, Any]]]
+    #: What a run returns, from its folder and its summary.
+    result_type: ClassVar[type[RunResult]]
 
     def threads(self) -> int:
         return engine_threads(self.config)
@@ -102,16 +115,28 @@ class SpecimenProtocol(Protocol[Config, R, Result]):
         sim, run = generate(self.config, threads, progress, self.state_type, self.stages[0].name)
         return sim, run  # type: ignore[return-value]  # state_type is R's class
 
+    def state_from_dict(self, saved: Mapping[str, Any]) -> R:
+        return self.state_type.from_dict(dict(saved))  # type: ignore[return-value]  # state_type is R's class
+
+    def summary(self, context: StageContext[C, R], wall_time_s: float) -> dict[str, Any]:
+        return type(self).summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
+
+    def write_outputs(self, out: Path) -> dict[str, Any]:
+        return type(self).outputs(out)
+
+    def result(self, out: Path, summary: dict[str, Any]) -> Result:
+        return type(self).result_type(out, summary)  # type: ignore[return-value]  # result_type is Result's class
+
 
 def grading(config: Config) -> UniformByNumber | UniformByMass | GradingCurve:
-    kind = config["sample.grading"]
-    d_min, d_max = config["sample.d_min"], config["sample.d_max"]
+    kind = config.sample.grading
+    d_min, d_max = config.sample.d_min, config.sample.d_max
     if kind == "uniform_by_number":
         return UniformByNumber(d_min, d_max)
     if kind == "uniform_by_mass":
         return UniformByMass(d_min, d_max)
     if kind == "curve":
-        return GradingCurve(config["sample.sieve_sizes"], config["sample.percent_passing"])
+        return GradingCurve(config.sample.sieve_sizes, config.sample.percent_passing)
     if (d_min, d_max) != (PAPER_GRADING.d_min, PAPER_GRADING.d_max):
         raise ValueError(
             "sample.grading: 'paper' is the 0.5-3 mm curve; with other sample.d_min/d_max "
@@ -121,19 +146,19 @@ def grading(config: Config) -> UniformByNumber | UniformByMass | GradingCurve:
 
 
 def engine_threads(config: Config) -> int:
-    threads = config["run.threads"]
+    threads = config.run.threads
     return available_cores() if threads == "auto" else int(threads)
 
 
 def _with_rolling(config: Config, model: ContactModel) -> ContactModel:
     """``model`` with the rolling resistance of ``config`` (off by default; a
     stiffness of 0 is the engine's rule, ``auto``)."""
-    stiffness = config["material.rolling_stiffness"]
+    stiffness = config.material.rolling_stiffness
     return replace(
         model,
-        rolling_friction=float(config["material.rolling_friction"]),
+        rolling_friction=float(config.material.rolling_friction),
         rolling_stiffness=0.0 if stiffness == "auto" else float(stiffness),
-        rolling_damping_ratio=float(config["material.rolling_damping"]),
+        rolling_damping_ratio=float(config.material.rolling_damping),
     )
 
 
@@ -145,7 +170,7 @@ def damped_time_step_factor(config: Config) -> float:
     with the pair's reduced mass m*, while that mode moves the mass m*/3 (each
     disk's 1/m + r^2/I = 3/m). That mode sets the factor, so that a run whose
     dashpots act after it consolidated is stable with the time step set then."""
-    z = math.sqrt(3.0) * float(config["material.contact_damping"])
+    z = math.sqrt(3.0) * float(config.material.contact_damping)
     return math.sqrt(1.0 + z * z) - z
 
 
@@ -156,20 +181,20 @@ def contact_law(config: Config, friction: float) -> ContactModel:
     ``restitution`` (docs/contact-law.md). The sample's radius expansion and the
     membrane's disks keep the linear springs: the first is geometry, the second a
     numerical boundary."""
-    if config["material.contact_law"] == "hertz_mindlin":
+    if config.material.contact_law == "hertz_mindlin":
         return ContactModel.hertz_mindlin(
-            float(config["material.youngs_modulus"]), float(config["material.poisson_ratio"]),
-            float(config["material.restitution"]), float(friction),
+            float(config.material.youngs_modulus), float(config.material.poisson_ratio),
+            float(config.material.restitution), float(friction),
         )
-    return ContactModel(config["material.normal_stiffness"], config["material.shear_stiffness"], friction)
+    return ContactModel(config.material.normal_stiffness, config.material.shear_stiffness, friction)
 
 
 def grain_model(config: Config) -> ContactModel:
     """The grains' contact law: Table 1's, with the rolling resistance and the contact
     dashpots of ``config`` (the platens' contacts have no dashpots: a dashpot's force
     on a moving servo wall would feed back into its control)."""
-    damping = float(config["material.contact_damping"])
-    model = _with_rolling(config, contact_law(config, config["material.friction"]))
+    damping = float(config.material.contact_damping)
+    model = _with_rolling(config, contact_law(config, config.material.friction))
     return replace(model, normal_damping_ratio=damping, shear_damping_ratio=damping)
 
 
@@ -177,7 +202,7 @@ def platen_model(config: Config) -> ContactModel:
     """The grains' law at the platens (and the box's walls), without a dashpot
     (Hertz-Mindlin's restitution 1): a dashpot's force on a servo wall follows the
     wall's own velocity and feeds back into its control, which then never settles."""
-    model = contact_law(config, config["material.platen_friction"])
+    model = contact_law(config, config.material.platen_friction)
     return _with_rolling(config, replace(model, restitution=1.0))
 
 
@@ -187,19 +212,19 @@ def generate(config: Config, threads: int, progress: bool, state: type[R], phase
     right, top, left), and a new run state of type ``state`` in ``phase`` (its own
     ``fields`` besides :class:`SpecimenRun`'s)."""
     start = time.perf_counter()
-    box = (0.0, 0.0, config["sample.width"], config["sample.height"])
+    box = (0.0, 0.0, config.sample.width, config.sample.height)
     sample = expand_to_porosity(
         box,
-        config["sample.porosity"],
+        config.sample.porosity,
         grading(config),
-        seed=config["sample.seed"],
-        friction=config["sample.generation_friction"],
-        wall_friction=config["material.platen_friction"],
-        normal_stiffness=config["material.normal_stiffness"],
-        shear_stiffness=config["material.shear_stiffness"],
-        density=config["material.density"],
-        local_damping=config["material.local_damping"],
-        max_stress_pa=config["sample.max_generation_stress"],
+        seed=config.sample.seed,
+        friction=config.sample.generation_friction,
+        wall_friction=config.material.platen_friction,
+        normal_stiffness=config.material.normal_stiffness,
+        shear_stiffness=config.material.shear_stiffness,
+        density=config.material.density,
+        local_damping=config.material.local_damping,
+        max_stress_pa=config.sample.max_generation_stress,
         threads=threads,
         progress=progress,
         keep_simulation=True,
@@ -207,12 +232,12 @@ def generate(config: Config, threads: int, progress: bool, state: type[R], phase
     )
     sim = sample.simulation
     n = sim.n_particles
-    sim.densities = np.full(n, config["material.density"])  # generation may scale densities
+    sim.densities = np.full(n, config.material.density)  # generation may scale densities
     info = {k: v for k, v in sample.to_dict().items() if isinstance(v, int | float | str | bool) or v is None}
     run = state(
         phase=phase,
         n_grains=n,
-        grain_density=config["material.density"],
+        grain_density=config.material.density,
         walls={"bottom": 0, "right": 1, "top": 2, "left": 3},
         wall_time={"generate": time.perf_counter() - start},
         sample=info,
@@ -232,16 +257,16 @@ def consolidate(
     """Servo-controls the box to the confining pressure until equilibrium;
     ``on_chunk(state, steps)`` after every chunk (``benchmarks/consolidation.py``)."""
     start = time.perf_counter()
-    consolidation_model = contact_law(config, config["consolidation.friction"])
+    consolidation_model = contact_law(config, config.consolidation.friction)
     sim.set_contact_model(0, 0, consolidation_model)
     sim.set_contact_model(0, 1, platen_model(config))
-    sim.local_damping = config["material.local_damping"]
-    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0) * damped_time_step_factor(config)
-    target = config["consolidation.pressure"]
-    tolerance = config["consolidation.tolerance"]
-    limit = config["consolidation.unbalanced_force_ratio"]
-    max_steps = config["consolidation.max_steps"]
-    speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
+    sim.local_damping = config.material.local_damping
+    sim.time_step = config.run.time_step_safety * sim.critical_time_step(1.0) * damped_time_step_factor(config)
+    target = config.consolidation.pressure
+    tolerance = config.consolidation.tolerance
+    limit = config.consolidation.unbalanced_force_ratio
+    max_steps = config.consolidation.max_steps
+    speed = 0.05 * config.sample.d_min / (100 * sim.time_step)  # at most d_min/20 per 100 steps
     bar = progress_bar(max_steps, "consolidating", enabled=progress, unit="step")
 
     def show(state: BoxState, steps: int) -> None:
@@ -286,6 +311,24 @@ def consolidate(
         "time_step_s": sim.time_step,
     }
     run.wall_time["consolidate"] = time.perf_counter() - start
+
+
+def engine_columns(sim: Simulation) -> dict[str, float]:
+    """The columns every test's records read from the engine: the unbalanced force ratio
+    and the energies (J)."""
+    energy = sim.energy
+    return {"unbalanced_force_ratio": sim.unbalanced_force_ratio, "kinetic_energy_j": energy.kinetic,
+            "elastic_energy_j": energy.elastic, "friction_dissipated_j": energy.friction_dissipated,
+            "damping_dissipated_j": energy.damping_dissipated, "boundary_work_j": energy.boundary_work,
+            "wall_work_j": energy.wall_work}
+
+
+def _consolidate_stage(context: StageContext[Any, Any]) -> None:
+    consolidate(context.sim, context.state, context.config, context.progress)
+
+
+#: The stage of every test that consolidates its sample in the four walls (:func:`consolidate`).
+CONSOLIDATE = Stage("consolidate", _consolidate_stage, "the four walls servo-controlled to sigma_0 until equilibrium")
 
 
 def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.float64]], dict[str, Any]],

@@ -8,62 +8,33 @@ next for it (None: it needs no stop of its own). :class:`OnSteps` fires on
 given steps, :class:`Periodic` on every multiple of a period, :class:`EveryStop`
 at each stop, :class:`Flag` where an operation raised it, :class:`WallClock`
 once so many seconds of wall time have passed, :class:`And` where all of its
-triggers fire.
-
-A loading along a control variable (the axial strain, a shear strain) plans its
-records and snapshots in that variable: :class:`Every` at each increment of it,
-:class:`At` at given values, and :func:`schedule_steps` turns those into the
-engine steps they fall on.
-
->>> schedule_steps([Every(0.25), At([0.1, 0.6])], final=1.0, steps_per_unit=100)
-[10, 25, 50, 60, 75, 100]
+triggers fire. :func:`schedule_steps` plans steps in a control variable (the
+axial strain, a shear strain).
 """
 
 from __future__ import annotations
 
 import bisect
-import math
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-__all__ = ["And", "At", "Every", "EveryStop", "Flag", "OnSteps", "Periodic", "Trigger", "WallClock", "schedule_steps"]
+__all__ = ["And", "EveryStop", "Flag", "OnSteps", "Periodic", "Trigger", "WallClock", "schedule_steps"]
 
 
-@dataclass(frozen=True)
-class Every:
-    """Fires at every ``increment`` of the control variable: ``increment``, ``2 increment``,
-    ... up to the final value (the last multiple within it)."""
+def schedule_steps(every: float, at: Iterable[float] = (), *, final: float, steps_per_unit: float) -> list[int]:
+    """The engine steps (counted from the loading's start) of a plan in a control
+    variable (an axial or a shear strain): each multiple of ``every`` up to ``final``
+    and each value of ``at`` above 0 and within it, a value ``v`` on step
+    ``round(v * steps_per_unit)``, each step once, in order.
 
-    increment: float
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.increment) and self.increment > 0):
-            raise ValueError(f"increment: must be a positive number, got {self.increment!r}")
-
-    def values(self, final: float) -> list[float]:
-        return [k * self.increment for k in range(1, int(round(final / self.increment)) + 1)]
-
-
-@dataclass(frozen=True)
-class At:
-    """Fires at the given values of the control variable (those above 0 and within the final one)."""
-
-    at: tuple[float, ...]
-
-    def __init__(self, at: Iterable[float]) -> None:
-        object.__setattr__(self, "at", tuple(float(v) for v in at))
-
-    def values(self, final: float) -> list[float]:
-        return [v for v in self.at if 0 < v <= final + 1e-12]
-
-
-def schedule_steps(triggers: Iterable[Every | At], *, final: float, steps_per_unit: float) -> list[int]:
-    """The engine steps (counted from the loading's start) on which ``triggers`` fire,
-    each once, in order: a value ``v`` falls on step ``round(v * steps_per_unit)``."""
-    steps = {round(v * steps_per_unit) for trigger in triggers for v in trigger.values(final)}
-    return sorted(steps)
+    >>> schedule_steps(0.25, [0.1, 0.6], final=1.0, steps_per_unit=100)
+    [10, 25, 50, 60, 75, 100]
+    """
+    values = [k * every for k in range(1, int(round(final / every)) + 1)]
+    values += [float(v) for v in at if 0 < v <= final + 1e-12]
+    return sorted({round(v * steps_per_unit) for v in values})
 
 
 class Trigger(ABC):

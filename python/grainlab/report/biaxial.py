@@ -29,8 +29,9 @@ from grainlab.io.hdf5 import Results, read_results
 from grainlab.paper import BIAXIAL_CLAIMS, STRAIN_RATE_PER_S, TABLE1
 from grainlab.postprocess.band import BandNumbers
 from grainlab.postprocess.products import store_run_products
+from grainlab.protocols.biaxial.config import FIELDS
 from grainlab.protocols.biaxial.outputs import is_constant_volume
-from grainlab.protocols.config import FIELDS, QUICK
+from grainlab.protocols.config import QUICK
 from grainlab.report.angles import (
     DEFAULT_DILATION_WINDOW,
     ClassicalAngles,

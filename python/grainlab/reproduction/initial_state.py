@@ -536,7 +536,7 @@ def prepared_state(
     stress and porosities, the consolidation's steps, its porosities and
     unbalanced force ratio, and the wall time.
     """
-    from grainlab.protocols.config import resolve
+    from grainlab.protocols.biaxial.config import resolve
     from grainlab.protocols.specimen import SpecimenRun, consolidate, generate
 
     values = dict(overrides or {})

@@ -58,7 +58,7 @@ from grainlab.io.results import write_json_atomic
 from grainlab.study.campaign import CampaignResult, Run, make_run
 
 if TYPE_CHECKING:
-    from grainlab.protocols.config import BiaxialConfig
+    from grainlab.protocols.biaxial.config import BiaxialConfig
 
 __all__ = [
     "DEFAULT_SEEDS",
@@ -167,9 +167,10 @@ def _assignments(name: str, text: str) -> list[tuple[str, str]]:
 
 
 def _biaxial_value(name: str, key: str, raw: Any) -> Any:
-    from grainlab.protocols.config import ConfigError, _parse_override, coerce
+    from grainlab.protocols.biaxial.config import coerce
+    from grainlab.protocols.config import ConfigError, parse_override
 
-    value = _parse_override(f"{key}={raw}")[1] if isinstance(raw, str) else raw
+    value = parse_override(f"{key}={raw}")[1] if isinstance(raw, str) else raw
     try:
         return coerce(key, value)
     except ConfigError as error:
@@ -356,7 +357,7 @@ class ReproductionPlan:
 
     def biaxial_config(self, variant: Variant, seed: int) -> BiaxialConfig:
         """The resolved :class:`~grainlab.protocols.config.BiaxialConfig` of a biaxial run."""
-        from grainlab.protocols.config import resolve
+        from grainlab.protocols.biaxial.config import resolve
 
         params = self.biaxial_params(variant, seed)
         quick = bool(params.pop("quick", False))

@@ -16,8 +16,8 @@ from grainlab.analysis.peak import peak_record
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
 from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
+from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.state import BiaxialRun
-from grainlab.protocols.config import BiaxialConfig
 from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.runner import RunResult
 
@@ -77,8 +77,8 @@ def summarise(run: BiaxialRun, config: BiaxialConfig, timeseries: dict[str, np.n
         "final_stress_ratio": last[STRESS_RATIO],
         "final_volumetric_strain": last[VOLUMETRIC_STRAIN],
         "max_contraction": float(np.max(timeseries[VOLUMETRIC_STRAIN])),
-        "shear_volume": config["shear.volume"],
-        **(_undrained(timeseries, config["consolidation.pressure"]) if config["shear.volume"] == "constant" else {}),
+        "shear_volume": config.shear.volume,
+        **(_undrained(timeseries, config.consolidation.pressure) if config.shear.volume == "constant" else {}),
         "strain_rate": shear.strain_rate,
         "inertial_number": shear.inertial_number,
         "inertial_number_mean_diameter": shear.inertial_number_mean_diameter,

@@ -5,28 +5,24 @@ its stages in order, its configuration, its summary and its outputs; and
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any, ClassVar
 
 from grainlab.io.hdf5 import snapshot_name
 from grainlab.protocols.biaxial import records as biaxial_records
+from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.outputs import BiaxialResult, summarise, write_outputs
 from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary, start_shear
 from grainlab.protocols.biaxial.rates import check_density_scaling, check_strain_rate
 from grainlab.protocols.biaxial.shearing import shear, shear_records, shear_snapshots
 from grainlab.protocols.biaxial.state import BiaxialRun
-from grainlab.protocols.config import BiaxialConfig
 from grainlab.protocols.runner import RUN_FILES, Stage, StageContext, run_protocol
-from grainlab.protocols.specimen import OUTPUT_FILES, SpecimenProtocol, consolidate
+from grainlab.protocols.specimen import CONSOLIDATE, OUTPUT_FILES, SpecimenProtocol
 
 __all__ = ["OUTPUT_FILES", "RUN_FILES", "BiaxialProtocol", "run_biaxial"]
 
 
 Context = StageContext[BiaxialConfig, BiaxialRun]
 
-
-def _consolidate(context: Context) -> None:
-    consolidate(context.sim, context.state, context.config, context.progress)
 
 
 def _boundary(context: Context) -> None:
@@ -39,39 +35,28 @@ def _boundary(context: Context) -> None:
 def _shear(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
     records = shear_records(context, lambda: biaxial_records.measure(sim, run, config), biaxial_records.TIMESERIES_UNITS)
-    shear(context, records, shear_snapshots(context, records, snapshot_name), final=config["shear.final_strain"])
+    shear(context, records, shear_snapshots(context, records, snapshot_name), final=config.shear.final_strain)
 
 
-class BiaxialProtocol(SpecimenProtocol[BiaxialRun, BiaxialResult]):
+class BiaxialProtocol(SpecimenProtocol[BiaxialConfig, BiaxialRun, BiaxialResult]):
     """The paper's biaxial test (Sec. 6, Table 1); the sample is generated when the run starts."""
 
     name = "biaxial"
     stages: ClassVar[tuple[Stage[Any, Any], ...]] = (
-        Stage("consolidate", _consolidate, "the four walls servo-controlled to sigma_0 until equilibrium"),
+        CONSOLIDATE,
         Stage("boundary", _boundary, "the side walls replaced by the membrane (or the outer grains) under "
                                      "sigma_0, the sample re-equilibrated, the shearing planned"),
         Stage("shear", _shear, "the platens at a constant axial strain rate to the final strain; records "
                                "and snapshots on their triggers, checkpoints on the wall clock"),
     )
     state_type = BiaxialRun
+    summarise = summarise
+    outputs = write_outputs
+    result_type = BiaxialResult
 
     def check(self) -> None:
         check_strain_rate(self.config)  # a rate refused needs no warning about its inertia
         check_density_scaling(self.config)
-
-    def state_from_dict(self, saved: Any) -> BiaxialRun:
-        # "peak": the peak so far, which checkpoints of earlier grainlab versions carry; the
-        # summary takes it from the records (grainlab.analysis.peak)
-        return BiaxialRun.from_dict({k: v for k, v in saved.items() if k not in ("config", "elapsed_s", "peak")})
-
-    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
-        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
-
-    def write_outputs(self, out: Path) -> dict[str, Any]:
-        return write_outputs(out)
-
-    def result(self, out: Path, summary: dict[str, Any]) -> BiaxialResult:
-        return BiaxialResult(out, summary)
 
 
 def run_biaxial(

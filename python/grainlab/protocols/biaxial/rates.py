@@ -11,7 +11,7 @@ import warnings
 import grainlab
 from grainlab.io.hdf5 import snapshot_name
 from grainlab.paper import DENSITY_SCALING_LIMIT
-from grainlab.protocols.config import BiaxialConfig
+from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.specimen import contact_law
 from grainlab.simulation import Simulation
 
@@ -38,11 +38,11 @@ def check_density_scaling(config: BiaxialConfig) -> float | None:
     ``material.limiting_contact_pressure``), with a :class:`DensityScalingWarning`
     when it exceeds :data:`DENSITY_SCALING_LIMIT`; ``None`` for the ``auto``
     rate, which keeps the factor at or below ``shear.inertial_number``."""
-    rate = config["shear.strain_rate"]
-    if rate == "auto":
+    rate = config.shear.strain_rate
+    if isinstance(rate, str):  # "auto"
         return None
     factor = grainlab.density_scaling_factor(
-        rate, config["material.density"], 0.5 * config["sample.d_min"], config["material.limiting_contact_pressure"]
+        rate, config.material.density, 0.5 * config.sample.d_min, config.material.limiting_contact_pressure
     )
     if factor > DENSITY_SCALING_LIMIT:
         warnings.warn(
@@ -117,20 +117,20 @@ def check_strain_rate(config: BiaxialConfig) -> None:
                 "keep snapshot strains at least 0.0001 apart"
             )
         names[name] = strain
-    rate = config["shear.strain_rate"]
-    if rate == "auto":
+    rate = config.shear.strain_rate
+    if isinstance(rate, str):  # "auto"
         return  # bounded by the inertial number, far below these limits
-    diameter = config["sample.d_min"]
-    if config["boundary.kind"] == "membrane":
-        diameter = min(diameter, config["boundary.membrane_diameter"])
+    diameter = config.sample.d_min
+    if config.boundary.kind == "membrane":
+        diameter = min(diameter, config.boundary.membrane_diameter)
     radius = 0.5 * diameter
     # the critical time step of the smallest grain with the grains' law (its stiffest
     # contact: the law's tangent stiffnesses at the largest overlap allowed), as the
     # engine computes it
-    smallest = Simulation([[0.0, 0.0]], [radius], config["material.density"],
-                          contact_model=contact_law(config, config["material.friction"]))
-    time_step = 0.1 * config["run.time_step_safety"] * smallest.critical_time_step(1.0)
-    problem = strain_rate_problem(rate, time_step, config["sample.height"], radius, config["shear.record_interval"])
+    smallest = Simulation([[0.0, 0.0]], [radius], config.material.density,
+                          contact_model=contact_law(config, config.material.friction))
+    time_step = 0.1 * config.run.time_step_safety * smallest.critical_time_step(1.0)
+    problem = strain_rate_problem(rate, time_step, config.sample.height, radius, config.shear.record_interval)
     if problem is not None:
         raise ValueError(
             f"shear.strain_rate: {rate:g} 1/s is too fast even for a time step shorter than any this sample "
@@ -155,15 +155,15 @@ def default_strain_rate(config: BiaxialConfig, max_diameter: float, min_radius: 
     p_y)`` with the limiting contact pressure ``p_y`` (Table 1: 150 MPa), far
     from binding with Table 1.
     """
-    rho, p = config["material.density"], config["consolidation.pressure"]
-    alpha = config["material.local_damping"]
-    bound = config["shear.inertial_number"]
+    rho, p = config.material.density, config.consolidation.pressure
+    alpha = config.material.local_damping
+    bound = config.shear.inertial_number
     inertial = max_diameter * math.sqrt(rho / ((1.0 - alpha) * p))
-    eq16 = min_radius * math.sqrt(rho / config["material.limiting_contact_pressure"])
+    eq16 = min_radius * math.sqrt(rho / config.material.limiting_contact_pressure)
     return float(bound) / max(inertial, eq16)
 
 
 def inertial_number(config: BiaxialConfig, rate: float, diameter: float) -> float:
     """``rate * d * sqrt(rho / ((1 - alpha) sigma_3))``."""
-    rho, p = config["material.density"], config["consolidation.pressure"]
-    return rate * diameter * math.sqrt(rho / ((1.0 - config["material.local_damping"]) * p))
+    rho, p = config.material.density, config.consolidation.pressure
+    return rate * diameter * math.sqrt(rho / ((1.0 - config.material.local_damping) * p))

@@ -11,10 +11,11 @@ from grainlab.analysis import fabric_summary
 from grainlab.analysis.stress import love_weber_stress
 from grainlab.columns import BIAXIAL
 from grainlab.io.walls import WallGeometry
+from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.state import BiaxialRun, Boundary
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, sample_area
-from grainlab.protocols.config import BiaxialConfig
 from grainlab.protocols.grains import grain_count
+from grainlab.protocols.specimen import engine_columns
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind, Snapshot
 
@@ -54,7 +55,7 @@ def deviator_stress(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> 
     sigma_1 = platen_state(sim, boundary).axial_stress_pa
     if isinstance(boundary, WallBoundary) and boundary.constant_volume:
         return sigma_1 - boundary.lateral_stress(sim)
-    return sigma_1 - float(config["consolidation.pressure"])
+    return sigma_1 - float(config.consolidation.pressure)
 
 
 def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str, float]:
@@ -63,7 +64,7 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
     shear = run.shear_plan()
     platens = platen_state(sim, boundary)
     height, area, sigma_1 = platens.height_m, platens.area_m2, platens.axial_stress_pa
-    sigma_3 = config["consolidation.pressure"]  # the confining pressure held (a cell pressure)
+    sigma_3 = config.consolidation.pressure  # the confining pressure held (a cell pressure)
 
     c = sim.contacts()
     w = sim.wall_contacts()
@@ -106,7 +107,6 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
     )
     grain_contacts = int(np.count_nonzero(grain_i & grain_j & ~c.bonded))
     fabric = _fabric(sim, run)
-    energy = sim.energy
     return {
         "step": float(sim.step_count),
         "time_s": sim.time,
@@ -123,13 +123,7 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
         "love_weber_yy_pa": float(lw[1, 1]),
         "love_weber_xy_pa": float(lw[0, 1]),
         "coordination_number": 2.0 * grain_contacts / grain_count(sim, n),
-        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
-        "kinetic_energy_j": energy.kinetic,
-        "elastic_energy_j": energy.elastic,
-        "friction_dissipated_j": energy.friction_dissipated,
-        "damping_dissipated_j": energy.damping_dissipated,
-        "boundary_work_j": energy.boundary_work,
-        "wall_work_j": energy.wall_work,
+        **engine_columns(sim),
         **fabric,
     }
 

@@ -8,14 +8,15 @@ every :data:`WALL_CONTROL_STEPS` steps."""
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import TypeVar
 
 from grainlab._progress import progress_bar
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
+from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.phases import drive_platens
 from grainlab.protocols.biaxial.records import take_snapshot, wall_geometry
 from grainlab.protocols.biaxial.state import BiaxialError, BiaxialRun, ShearPlan
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, membrane_breach
-from grainlab.protocols.config import Config
 from grainlab.protocols.operations import (
     Checkpoint,
     Loading,
@@ -33,10 +34,13 @@ from grainlab.simulation import Simulation
 __all__ = ["WALL_CONTROL_STEPS", "BoundaryUpkeep", "NextTurn", "PlatenTurns", "ShearContext", "SideWalls",
            "reverse_platens", "shear", "shear_records", "shear_snapshots"]
 
+BC = TypeVar("BC", bound=BiaxialConfig)
+
 #: Steps between two settings of rigid side walls' motion while shearing (variant C).
 WALL_CONTROL_STEPS = 100
 
-ShearContext = StageContext[Config, BiaxialRun]
+#: A shearing stage's context: the biaxial or the cyclic test's.
+ShearContext = StageContext[BC, BiaxialRun]
 
 
 def reverse_platens(sim: Simulation, run: BiaxialRun) -> None:
@@ -108,14 +112,14 @@ class BoundaryUpkeep(Operation):
                 )
 
 
-def shear_records(context: ShearContext, measure: Callable[[], dict[str, float]],
+def shear_records(context: ShearContext[BC], measure: Callable[[], dict[str, float]],
                   units: dict[str, str]) -> Records:
     """The shearing's records: ``measure()`` on each planned record step."""
     plan = context.state.shear_plan()
     return Records(OnSteps(plan.record_steps, plan.start_step), context.writer, measure, units, count=plan)
 
 
-def shear_snapshots(context: ShearContext, records: Records, name_of: Callable[[float], str]) -> Snapshots:
+def shear_snapshots(context: ShearContext[BC], records: Records, name_of: Callable[[float], str]) -> Snapshots:
     """The shearing's snapshots: on each planned snapshot step, named ``name_of(path strain)``."""
     sim, run = context.sim, context.state
     plan = run.shear_plan()
@@ -124,7 +128,7 @@ def shear_snapshots(context: ShearContext, records: Records, name_of: Callable[[
                      lambda: take_snapshot(sim, run, records.values[AXIAL_STRAIN]), lambda: wall_geometry(sim, run))
 
 
-def shear(context: ShearContext, records: Records, snapshots: Snapshots, *, final: float,
+def shear(context: ShearContext[BC], records: Records, snapshots: Snapshots, *, final: float,
           first: Sequence[Operation] = ()) -> None:
     """Runs the planned shearing to its end, ``final`` of path strain (the progress
     counts to it): the operations ``first`` (a stress-controlled test's cycles), then on
@@ -141,7 +145,7 @@ def shear(context: ShearContext, records: Records, snapshots: Snapshots, *, fina
     done = 100 * final * steps[plan.next_record - 1] / steps[-1] if plan.next_record and steps[-1] else 0.0
     bar = progress_bar(round(100 * final, 3), "shearing", enabled=context.progress, unit="% strain", initial=done,
                        bar_format="{l_bar}{bar}| {n:.2f}/{total:.1f} % [{elapsed}<{remaining}{postfix}]")
-    checkpoint = Checkpoint(And(scheduled, WallClock(context.config["run.checkpoint_interval"])), context.save,
+    checkpoint = Checkpoint(And(scheduled, WallClock(context.config.run.checkpoint_interval)), context.save,
                             run.wall_time, "shear")
     operations = [
         *first, records, snapshots, BoundaryUpkeep(scheduled, run, records), PlatenTurns(run),
@@ -153,4 +157,4 @@ def shear(context: ShearContext, records: Records, snapshots: Snapshots, *, fina
     if isinstance(boundary, WallBoundary):
         speed = 0.05 * float(sim.radii[: run.n_grains].min()) / (50 * sim.time_step)
         operations.append(SideWalls(boundary, plan.area0, speed))
-    run_loading(sim, operations, bar, checkpoint)
+    run_loading(sim, operations, checkpoint, bar)

@@ -82,8 +82,6 @@ class BiaxialRun(SpecimenRun):
 
     boundary: Boundary | None = None
     shear: ShearPlan | None = None
-    rows: int = 0
-    snapshots: list[str] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         saved = dict(self.__dict__)
@@ -94,7 +92,9 @@ class BiaxialRun(SpecimenRun):
 
     @classmethod
     def from_dict(cls, saved: dict[str, Any]) -> BiaxialRun:
-        values = dict(saved)
+        # "peak": the peak so far, which checkpoints of earlier grainlab versions carry; the
+        # summary takes it from the records (grainlab.analysis.peak)
+        values = {k: v for k, v in saved.items() if k != "peak"}
         boundary = values.pop("membrane", None)
         values["boundary"] = None if boundary is None else boundary_from_dict(boundary)
         if values.get("shear") is not None:

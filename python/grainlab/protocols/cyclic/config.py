@@ -5,47 +5,57 @@ monotonic loading's end and snapshots (``shear.final_strain``,
 from __future__ import annotations
 
 from collections.abc import Set as AbstractSet
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
+from grainlab.protocols.biaxial.config import BIAXIAL_FIELDS, BiaxialConfig, check_boundary
 from grainlab.protocols.config import (
-    BIAXIAL_FIELDS,
-    QUICK,
-    RUN_FIELDS,
-    SHARED_FIELDS,
     ConfigError,
-    ConfigSchema,
-    Field,
-    check_boundary,
+    Section,
+    SectionOf,
     check_sample,
-    register_schema,
+    key,
+    register_test,
 )
 
-__all__ = ["CYCLIC_FIELDS", "CYCLIC_SCHEMA"]
+__all__ = ["CYCLIC_FIELDS", "CYCLIC_SCHEMA", "CyclicConfig", "CyclicSection"]
 
-#: The cyclic test's own keys.
-CYCLIC_FIELDS: dict[str, Field] = {
-    "cyclic.strain_amplitude": Field(
+@dataclass(frozen=True)
+class CyclicSection(Section):
+    """The cyclic test's own keys: the cycles and their control."""
+
+    prefix: ClassVar[str] = "cyclic"
+    strain_amplitude: float = key(
         "strain", 0.005, "axial strain amplitude: each cycle goes 0 -> +amplitude -> -amplitude -> 0 "
         "(compression positive); at most 5 %", minimum=0.0, maximum=0.05, exclusive_minimum=True,
-    ),
-    "cyclic.cycles": Field("integer", 5, "number of cycles", minimum=1, maximum=1000),
-    "cyclic.control": Field(
+    )
+    cycles: int = key("integer", 5, "number of cycles", minimum=1, maximum=1000)
+    control: str = key(
         "choice", "strain",
         "strain: the platens turn at +/- cyclic.strain_amplitude; stress: they turn where the deviator "
         "q = sigma_1 - sigma_3' reaches +/- cyclic.stress_amplitude",
         choices=("strain", "stress"),
-    ),
-    "cyclic.stress_amplitude": Field(
+    )
+    stress_amplitude: float | str = key(
         "stress", "auto", "deviator amplitude A_q of a stress-controlled test: each cycle goes q = 0 -> +A_q -> "
         "-A_q -> 0; below sigma_0 (extension to -A_q needs sigma_1 = sigma_3 - A_q > 0)",
         minimum=0.0, exclusive_minimum=True, allow_auto=True,
-    ),
-    "cyclic.strain_limit": Field(
+    )
+    strain_limit: float = key(
         "strain", 0.05, "a stress-controlled test ends when the axial strain reaches +/- this (the sample has "
         "failed: the cycles it completed are its cycles to failure)", minimum=0.0, maximum=0.2,
         exclusive_minimum=True,
-    ),
-}
+    )
+
+
+CYCLIC_FIELDS = CyclicSection.keys()
+
+
+@dataclass(frozen=True)
+class CyclicConfig(BiaxialConfig):
+    """The cyclic test's configuration: the biaxial test's sections and its cycles."""
+
+    cyclic = SectionOf(CyclicSection)
 
 _MONOTONIC_ONLY = ("shear.final_strain", "shear.snapshot_strains")
 
@@ -85,10 +95,6 @@ def _check_stress_control(values: dict[str, Any], given: AbstractSet[str]) -> No
 
 
 #: The cyclic test's configuration schema (registered as ``"cyclic"``).
-CYCLIC_SCHEMA = register_schema(ConfigSchema(
-    "cyclic",
-    {**SHARED_FIELDS, **{k: f for k, f in BIAXIAL_FIELDS.items() if k not in _MONOTONIC_ONLY},
-     **CYCLIC_FIELDS, **RUN_FIELDS},
-    QUICK,
-    _check,
-))
+CYCLIC_SCHEMA = register_test(
+    "cyclic", {**{k: f for k, f in BIAXIAL_FIELDS.items() if k not in _MONOTONIC_ONLY}, **CYCLIC_FIELDS}, _check,
+    CyclicConfig)

@@ -26,7 +26,7 @@ from grainlab.columns import (
     VOLUMETRIC_STRAIN,
 )
 from grainlab.protocols.biaxial.state import BiaxialRun
-from grainlab.protocols.config import Config
+from grainlab.protocols.cyclic.config import CyclicConfig
 from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.runner import RunResult
 from grainlab.protocols.specimen import write_run_outputs
@@ -94,11 +94,11 @@ def cycle_table(timeseries: dict[str, np.ndarray], cell_pressure_pa: float | Non
     return rows
 
 
-def summarise(run: BiaxialRun, config: Config, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
+def summarise(run: BiaxialRun, config: CyclicConfig, timeseries: dict[str, np.ndarray], total_s: float) -> dict[str, Any]:
     """The run's summary, as ``run.h5`` and ``summary.json`` store it."""
     plan = run.shear_plan()
-    constant_volume = config["shear.volume"] == "constant"
-    cycles = cycle_table(timeseries, config["consolidation.pressure"] if constant_volume else None)
+    constant_volume = config.shear.volume == "constant"
+    cycles = cycle_table(timeseries, config.consolidation.pressure if constant_volume else None)
     last = cycles[-1] if cycles else {}
     return {
         "n_particles": run.n_grains,
@@ -109,13 +109,13 @@ def summarise(run: BiaxialRun, config: Config, timeseries: dict[str, np.ndarray]
         "coordination_number_initial": float(timeseries[COORDINATION_NUMBER][0]),
         "mean_stability_index_initial": float(timeseries["mean_stability_index"][0]),
         "anisotropy_initial": float(timeseries["anisotropy"][0]),
-        "control": config["cyclic.control"],
-        "strain_amplitude": config["cyclic.strain_amplitude"] if config["cyclic.control"] == "strain" else None,
-        "stress_amplitude_pa": None if config["cyclic.control"] == "strain" else config["cyclic.stress_amplitude"],
-        "strain_limit": config["cyclic.strain_limit"],
-        "cycles_asked": config["cyclic.cycles"],
-        "stopped_at_strain_limit": len(cycles) < config["cyclic.cycles"],
-        "shear_volume": config["shear.volume"],
+        "control": config.cyclic.control,
+        "strain_amplitude": config.cyclic.strain_amplitude if config.cyclic.control == "strain" else None,
+        "stress_amplitude_pa": None if config.cyclic.control == "strain" else config.cyclic.stress_amplitude,
+        "strain_limit": config.cyclic.strain_limit,
+        "cycles_asked": config.cyclic.cycles,
+        "stopped_at_strain_limit": len(cycles) < config.cyclic.cycles,
+        "shear_volume": config.shear.volume,
         "strain_rate": plan.strain_rate,
         "inertial_number": plan.inertial_number,
         "cycles": cycles,

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any, ClassVar
 
 from grainlab.columns import CYCLE, CYCLIC, STRAIN_PATH
@@ -29,19 +28,18 @@ from grainlab.protocols.biaxial.shearing import (
     shear_snapshots,
 )
 from grainlab.protocols.biaxial.state import BiaxialRun
-from grainlab.protocols.config import Config
-from grainlab.protocols.cyclic.config import CYCLIC_SCHEMA  # noqa: F401 - registers the schema
+from grainlab.protocols.cyclic.config import CyclicConfig
 from grainlab.protocols.cyclic.outputs import CyclicResult, summarise, write_outputs
 from grainlab.protocols.operations import Loading, Operation, Records, Snapshots
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
-from grainlab.protocols.specimen import SpecimenProtocol, consolidate
-from grainlab.protocols.triggers import At, Every, EveryStop
+from grainlab.protocols.specimen import CONSOLIDATE, SpecimenProtocol
+from grainlab.protocols.triggers import EveryStop
 from grainlab.simulation import Simulation
 
 __all__ = ["STRESS_EVENTS", "CyclicProtocol", "StressCycles", "cycle_plan", "event_snapshot_name", "run_cyclic",
            "snapshot_name_of", "stress_path_length"]
 
-Context = StageContext[Config, BiaxialRun]
+Context = StageContext[CyclicConfig, BiaxialRun]
 
 
 def cycle_plan(amplitude: float, cycles: int) -> tuple[float, list[float], list[float]]:
@@ -75,18 +73,15 @@ def snapshot_name_of(amplitude: float) -> Callable[[float], str]:
     return name
 
 
-def _consolidate(context: Context) -> None:
-    consolidate(context.sim, context.state, context.config, context.progress)
-
 
 #: What each event of a stress-controlled cycle is, in order.
 STRESS_EVENTS = ("compression", "unloaded", "extension", "end")
 
 
-def stress_path_length(config: Config) -> float:
+def stress_path_length(config: CyclicConfig) -> float:
     """The strain path a stress-controlled test may travel at most: every cycle's
     quarters at the strain limit."""
-    return float(4 * config["cyclic.cycles"] * config["cyclic.strain_limit"])
+    return float(4 * config.cyclic.cycles * config.cyclic.strain_limit)
 
 
 def event_snapshot_name(event: int, cycles: int) -> str | None:
@@ -106,7 +101,7 @@ class StressCycles(Operation):
     counted in the plan (``events``), recorded and stored as a snapshot when
     :func:`event_snapshot_name` names one; the platens reverse at a turn."""
 
-    def __init__(self, config: Config, run: BiaxialRun, records: Records, snapshots: Snapshots) -> None:
+    def __init__(self, config: CyclicConfig, run: BiaxialRun, records: Records, snapshots: Snapshots) -> None:
         super().__init__(EveryStop(WALL_CONTROL_STEPS))
         self.config, self.run, self.records, self.snapshots = config, run, records, snapshots
 
@@ -115,16 +110,16 @@ class StressCycles(Operation):
         plan, config = self.run.shear_plan(), self.config
         boundary = self.run.lateral_boundary()
         height = float(sim.wall(boundary.top_wall).points[0, 1] - sim.wall(boundary.bottom_wall).points[0, 1])
-        if abs((plan.height0 - height) / plan.height0) >= config["cyclic.strain_limit"]:
+        if abs((plan.height0 - height) / plan.height0) >= config.cyclic.strain_limit:
             return False, True
-        q, amplitude = biaxial_records.deviator_stress(sim, self.run, config), config["cyclic.stress_amplitude"]
+        q, amplitude = biaxial_records.deviator_stress(sim, self.run, config), float(config.cyclic.stress_amplitude)
         quarter = plan.events % 4
         if quarter == 0 and q >= amplitude or quarter == 2 and q <= -amplitude:
             return True, False
         if quarter == 1 and q <= 0.0:
             return False, False
         if quarter == 3 and q >= 0.0:
-            return False, plan.events + 1 == 4 * config["cyclic.cycles"]
+            return False, plan.events + 1 == 4 * config.cyclic.cycles
         return None
 
     def act(self, loading: Loading) -> None:
@@ -138,7 +133,7 @@ class StressCycles(Operation):
             plan.turn_steps.append(sim.step_count - plan.start_step)
             reverse_platens(sim, self.run)
         self.records.write(sim.step_count)
-        name = event_snapshot_name(plan.events, self.config["cyclic.cycles"])
+        name = event_snapshot_name(plan.events, self.config.cyclic.cycles)
         if name is not None:
             self.snapshots.store(name, sim.step_count)
         if end:
@@ -149,24 +144,21 @@ class StressCycles(Operation):
 def _boundary(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
     install_boundary(sim, run, config, context.progress)
-    if config["cyclic.control"] == "stress":
-        start_platens(sim, run, config, final=stress_path_length(config),
-                      records=[Every(config["shear.record_interval"])], snapshots=[0.0])
+    if config.cyclic.control == "stress":
+        start_platens(sim, run, config, final=stress_path_length(config), snapshots=[0.0])
         check_shear_plan(sim, run, config, [0.0], key="cyclic.stress_amplitude")
         return
-    final, turns, snapshots = cycle_plan(config["cyclic.strain_amplitude"], config["cyclic.cycles"])
-    start_platens(sim, run, config, final=final,
-                  records=[Every(config["shear.record_interval"]), At([*turns, *snapshots])],
-                  snapshots=snapshots, turns=turns)
+    final, turns, snapshots = cycle_plan(config.cyclic.strain_amplitude, config.cyclic.cycles)
+    start_platens(sim, run, config, final=final, snapshots=snapshots, turns=turns)
     check_shear_plan(sim, run, config, snapshots, key="cyclic.strain_amplitude")
 
 
 def _cycle(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
-    amplitude = config["cyclic.strain_amplitude"]
+    amplitude = config.cyclic.strain_amplitude
     plan = run.shear_plan()
     strain_per_step = plan.strain_rate * sim.time_step
-    stress = config["cyclic.control"] == "stress"
+    stress = config.cyclic.control == "stress"
 
     def measure() -> dict[str, float]:
         travelled = (sim.step_count - plan.start_step) * strain_per_step
@@ -179,41 +171,32 @@ def _cycle(context: Context) -> None:
         shear(context, records, snapshots, final=stress_path_length(config),
               first=[StressCycles(config, run, records, snapshots)])
         return
-    final, _, _ = cycle_plan(amplitude, config["cyclic.cycles"])
+    final, _, _ = cycle_plan(amplitude, config.cyclic.cycles)
     shear(context, records, shear_snapshots(context, records, snapshot_name_of(amplitude)), final=final)
 
 
-class CyclicProtocol(SpecimenProtocol[BiaxialRun, CyclicResult]):
+class CyclicProtocol(SpecimenProtocol[CyclicConfig, BiaxialRun, CyclicResult]):
     """The cyclic biaxial test (strain amplitude, N cycles, constant confining pressure)."""
 
     name = "cyclic"
     stages: ClassVar[tuple[Stage[Any, Any], ...]] = (
-        Stage("consolidate", _consolidate, "the four walls servo-controlled to sigma_0 until equilibrium"),
+        CONSOLIDATE,
         Stage("boundary", _boundary, "the side walls replaced by the membrane (or the outer grains) under "
                                      "sigma_0, the sample re-equilibrated, the cycles planned"),
         Stage("shear", _cycle, "the platens between +/- the amplitude, N cycles; records and snapshots on "
                                "their triggers, checkpoints on the wall clock"),
     )
     state_type = BiaxialRun
+    summarise = summarise
+    outputs = write_outputs
+    result_type = CyclicResult
 
     def check(self) -> None:
         check_strain_rate(self.config)
         check_density_scaling(self.config)
 
-    def state_from_dict(self, saved: Any) -> BiaxialRun:
-        return BiaxialRun.from_dict({k: v for k, v in saved.items() if k not in ("config", "elapsed_s")})
 
-    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
-        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
-
-    def write_outputs(self, out: Path) -> dict[str, Any]:
-        return write_outputs(out)
-
-    def result(self, out: Path, summary: dict[str, Any]) -> CyclicResult:
-        return CyclicResult(out, summary)
-
-
-def run_cyclic(config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
+def run_cyclic(config: CyclicConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,
                progress: bool = False) -> CyclicResult:
     """Runs (or, with ``resume``, continues) the cyclic biaxial test into ``out_dir``
     (:func:`grainlab.protocols.runner.run_protocol`)."""

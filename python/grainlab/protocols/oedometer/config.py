@@ -4,42 +4,54 @@ keys, its own load path (``oedometer.*``) and the runner's keys."""
 from __future__ import annotations
 
 from collections.abc import Set as AbstractSet
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 from grainlab.protocols.config import (
-    QUICK,
-    RUN_FIELDS,
-    SHARED_FIELDS,
+    Config,
     ConfigError,
-    ConfigSchema,
-    Field,
+    Section,
+    SectionOf,
     check_sample,
-    register_schema,
+    key,
+    register_test,
 )
 
-__all__ = ["OEDOMETER_FIELDS", "OEDOMETER_SCHEMA"]
+__all__ = ["OEDOMETER_FIELDS", "OEDOMETER_SCHEMA", "OedometerConfig", "OedometerSection"]
 
 _KPA = 1e3
 
-#: The oedometer's own keys.
-OEDOMETER_FIELDS: dict[str, Field] = {
-    "oedometer.vertical_stresses": Field(
+@dataclass(frozen=True)
+class OedometerSection(Section):
+    """The oedometer's own keys: its load path."""
+
+    prefix: ClassVar[str] = "oedometer"
+    vertical_stresses: list[float] = key(
         "stress_list", [v * _KPA for v in (200, 400, 800, 1600, 800, 400, 200, 100)],
         "vertical stresses of the load steps, in order (loading, then unloading: any path)",
-    ),
-    "oedometer.tolerance": Field(
+    )
+    tolerance: float = key(
         "strain", 0.01, "a load step ends with sigma_v within this fraction of its target", minimum=0.0,
         exclusive_minimum=True,
-    ),
-    "oedometer.max_steps": Field("integer", 2_000_000, "give up a load step after this many steps", minimum=1),
-    "oedometer.friction_angle": Field(
+    )
+    max_steps: int = key("integer", 2_000_000, "give up a load step after this many steps", minimum=1)
+    friction_angle: float | str = key(
         "angle", "auto",
         "phi' of Jaky's K0 = 1 - sin phi' and Mayne-Kulhawy's K0 OCR^sin phi' in the report (e.g. the "
         "peak friction angle of a biaxial run of the same material); auto: no comparison",
         minimum=0.0, maximum=90.0 * 3.141592653589793 / 180.0, exclusive_minimum=True, exclusive_maximum=True,
         allow_auto=True,
-    ),
-}
+    )
+
+
+OEDOMETER_FIELDS = OedometerSection.keys()
+
+
+@dataclass(frozen=True)
+class OedometerConfig(Config):
+    """The oedometer's configuration: the shared sections and its load path."""
+
+    oedometer = SectionOf(OedometerSection)
 
 
 def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
@@ -49,6 +61,4 @@ def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
 
 
 #: The oedometer's configuration schema (registered as ``"oedometer"``).
-OEDOMETER_SCHEMA = register_schema(
-    ConfigSchema("oedometer", {**SHARED_FIELDS, **OEDOMETER_FIELDS, **RUN_FIELDS}, QUICK, _check)
-)
+OEDOMETER_SCHEMA = register_test("oedometer", OEDOMETER_FIELDS, _check, OedometerConfig)

@@ -27,8 +27,8 @@ from grainlab.columns import (
     OVERCONSOLIDATION_RATIO,
     VERTICAL_STRESS_PA,
 )
-from grainlab.protocols.config import Config
 from grainlab.protocols.grains import clump_summary
+from grainlab.protocols.oedometer.config import OedometerConfig
 from grainlab.protocols.oedometer.state import OedometerRun
 from grainlab.protocols.runner import RunResult
 from grainlab.protocols.specimen import write_run_outputs
@@ -75,17 +75,18 @@ def k0_loading(timeseries: dict[str, np.ndarray], consolidation_pressure_pa: flo
     return float(slope)
 
 
-def summarise(run: OedometerRun, config: Config, timeseries: dict[str, np.ndarray],
+def summarise(run: OedometerRun, config: OedometerConfig, timeseries: dict[str, np.ndarray],
               total_s: float) -> dict[str, Any]:
     """The run's summary, as ``run.h5`` and ``summary.json`` store it."""
     k = np.asarray(timeseries[LATERAL_STRESS_RATIO], dtype=np.float64)
     ocr = np.asarray(timeseries[OVERCONSOLIDATION_RATIO], dtype=np.float64)
     loading = set(first_loading(timeseries).tolist())
-    phi = config["oedometer.friction_angle"]
-    jaky = None if phi == "auto" else 1.0 - math.sin(phi)
+    angle = config.oedometer.friction_angle
+    phi = None if isinstance(angle, str) else angle  # "auto": no comparison
+    jaky = None if phi is None else 1.0 - math.sin(phi)
     unloading = [
         {"overconsolidation_ratio": float(ocr[r]), "lateral_stress_ratio": float(k[r]),
-         "mayne_kulhawy": None if jaky is None else jaky * float(ocr[r]) ** math.sin(phi)}
+         "mayne_kulhawy": None if phi is None or jaky is None else jaky * float(ocr[r]) ** math.sin(phi)}
         for r in range(len(k)) if r not in loading
     ]
     return {
@@ -95,14 +96,14 @@ def summarise(run: OedometerRun, config: Config, timeseries: dict[str, np.ndarra
         "void_ratio_initial": float(timeseries["void_ratio"][0]),
         "porosity_after_consolidation": run.consolidation["porosity"],
         "coordination_number_initial": float(timeseries["coordination_number"][0]),
-        "k0_loading": k0_loading(timeseries, config["consolidation.pressure"]),
+        "k0_loading": k0_loading(timeseries, config.consolidation.pressure),
         "k0_rule": f"slope of sigma_h on sigma_v over first loading at sigma_v >= {K0_FROM_STRESS_RATIO:g} sigma_0",
         "max_vertical_stress_pa": run.max_vertical_stress_pa,
         "void_ratio_at_max_stress": float(timeseries["void_ratio"][int(np.argmax(timeseries[VERTICAL_STRESS_PA]))]),
         "lateral_stress_ratio_final": float(k[-1]),
         "overconsolidation_ratio_final": float(ocr[-1]),
         "unloading": unloading,
-        "friction_angle_deg": None if jaky is None else math.degrees(phi),
+        "friction_angle_deg": None if phi is None else math.degrees(phi),
         "k0_jaky": jaky,
         "time_step_s": run.consolidation["time_step_s"],
         "records": len(k),

@@ -6,7 +6,6 @@ snapshot at each equilibrium; :func:`run_oedometer` runs it into a folder."""
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
@@ -17,19 +16,19 @@ from grainlab.analysis.stress import love_weber_stress
 from grainlab.columns import OEDOMETER
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols import operations
-from grainlab.protocols.config import Config
 from grainlab.protocols.consolidate import BOX_WALLS, box_state
 from grainlab.protocols.grains import grain_count, grain_porosity
-from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA  # noqa: F401 - registers the schema
+from grainlab.protocols.oedometer.config import OedometerConfig
 from grainlab.protocols.oedometer.outputs import OedometerResult, summarise, write_outputs
 from grainlab.protocols.oedometer.state import OedometerRun
 from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import (
     CHUNK_STEPS,
+    CONSOLIDATE,
     SpecimenError,
     SpecimenProtocol,
-    consolidate,
+    engine_columns,
     grain_model,
     platen_model,
 )
@@ -39,17 +38,14 @@ from grainlab.snapshot import ParticleKind
 
 __all__ = ["LoadSteps", "OedometerProtocol", "OedometerRun", "PlatenServo", "load_path", "run_oedometer"]
 
-Context = StageContext[Config, OedometerRun]
+Context = StageContext[OedometerConfig, OedometerRun]
 
 
-def load_path(config: Config) -> list[float]:
+def load_path(config: OedometerConfig) -> list[float]:
     """The vertical stresses of the load steps: sigma_0 first (the state with
     friction on, from which strains count), then the configured ones."""
-    return [config["consolidation.pressure"], *config["oedometer.vertical_stresses"]]
+    return [config.consolidation.pressure, *config.oedometer.vertical_stresses]
 
-
-def _consolidate(context: Context) -> None:
-    consolidate(context.sim, context.state, context.config, context.progress)
 
 
 def _confine(context: Context) -> None:
@@ -58,7 +54,7 @@ def _confine(context: Context) -> None:
     sim.set_contact_model(0, 1, platen_model(config))
     for name in BOX_WALLS:
         sim.wall(run.walls[name]).velocity = (0.0, 0.0)  # rigid and fixed; the top is servo-loaded
-    run.max_vertical_stress_pa = config["consolidation.pressure"]
+    run.max_vertical_stress_pa = config.consolidation.pressure
     run.load_start_step = sim.step_count
 
 
@@ -85,7 +81,7 @@ class LoadSteps(Operation):
     :attr:`finished` after the last step); a step that takes ``oedometer.max_steps``
     stops the run with a :class:`SpecimenError`."""
 
-    def __init__(self, walls: dict[str, Wall], stresses: list[float], run: OedometerRun, config: Config,
+    def __init__(self, walls: dict[str, Wall], stresses: list[float], run: OedometerRun, config: OedometerConfig,
                  step: int) -> None:
         super().__init__(EveryStop(CHUNK_STEPS))
         self.walls, self.stresses, self.run, self.config = walls, stresses, run, config
@@ -95,9 +91,9 @@ class LoadSteps(Operation):
 
     def act(self, loading: Loading) -> None:
         sim, run, config = loading.sim, self.run, self.config
-        target, limit = self.stresses[run.next_load], config["consolidation.unbalanced_force_ratio"]
+        target, limit = self.stresses[run.next_load], config.consolidation.unbalanced_force_ratio
         box = self.box = box_state(self.walls)
-        if abs(box.stress_yy_pa / target - 1.0) < config["oedometer.tolerance"] and sim.unbalanced_force_ratio < limit:
+        if abs(box.stress_yy_pa / target - 1.0) < config.oedometer.tolerance and sim.unbalanced_force_ratio < limit:
             self.walls["top"].velocity = (0.0, 0.0)
             if run.next_load == 0:  # sigma_0 with friction on: strains count from here
                 run.height0, run.area0 = box.height_m, box.width_m * box.height_m
@@ -107,7 +103,7 @@ class LoadSteps(Operation):
             self.reached.raise_at(sim.step_count)
             if run.next_load == len(self.stresses):
                 self.finished.raise_at(sim.step_count)
-        elif sim.step_count - self.started >= config["oedometer.max_steps"]:
+        elif sim.step_count - self.started >= config.oedometer.max_steps:
             raise SpecimenError(
                 f"load step {run.next_load} ({target / 1e3:.1f} kPa) did not reach equilibrium in "
                 f"{sim.step_count - self.started} steps: sigma_v {box.stress_yy_pa / 1e3:.1f} kPa, unbalanced force "
@@ -122,11 +118,11 @@ def _load(context: Context) -> None:
     if run.next_load == len(stresses):  # stopped after the last step's checkpoint
         return
     bar = progress_bar(len(stresses), "loading", enabled=context.progress, unit="step", initial=run.next_load)
-    speed = 0.05 * config["sample.d_min"] / (100 * sim.time_step)  # at most d_min/20 per 100 steps
+    speed = 0.05 * config.sample.d_min / (100 * sim.time_step)  # at most d_min/20 per 100 steps
     steps = LoadSteps(walls, stresses, run, config, sim.step_count)
     geometry = {i: n for n, i in run.walls.items()}
     # a checkpoint at an equilibrium once run.checkpoint_interval has passed
-    checkpoint = operations.Checkpoint(And(steps.reached, WallClock(config["run.checkpoint_interval"])), context.save,
+    checkpoint = operations.Checkpoint(And(steps.reached, WallClock(config.run.checkpoint_interval)), context.save,
                             run.wall_time, "load")
     operations.run_loading(sim, [
         steps,
@@ -138,7 +134,7 @@ def _load(context: Context) -> None:
         checkpoint,
         operations.Stop(steps.finished),
         PlatenServo(walls, stresses, run, speed),
-    ], bar, checkpoint)
+    ], checkpoint, bar)
 
 
 def _snapshot(sim: Simulation, run: OedometerRun) -> Any:
@@ -160,7 +156,6 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
                            wall_particle=w.particle, wall_point=w.point, wall_force_on_particle=w.force_on_particle)
     fabric = fabric_summary(_snapshot(sim, run))
     fabric.pop("coordination_number")
-    energy = sim.energy
     values = {
         "step": float(sim.step_count), "time_s": sim.time, "target_vertical_stress_pa": target,
         "vertical_stress_pa": box.stress_yy_pa, "horizontal_stress_pa": box.stress_xx_pa,
@@ -172,42 +167,30 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
         "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "height_m": box.height_m, "area_m2": area,
         "love_weber_xx_pa": float(lw[0, 0]), "love_weber_yy_pa": float(lw[1, 1]), "love_weber_xy_pa": float(lw[0, 1]),
         "coordination_number": 2.0 * int(np.count_nonzero((c.i < n) & (c.j < n))) / grain_count(sim, n),
-        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
-        "kinetic_energy_j": energy.kinetic, "elastic_energy_j": energy.elastic,
-        "friction_dissipated_j": energy.friction_dissipated, "damping_dissipated_j": energy.damping_dissipated,
-        "boundary_work_j": energy.boundary_work, "wall_work_j": energy.wall_work,
+        **engine_columns(sim),
         **fabric,
     }
     return {name: values[name] for name in OEDOMETER}
 
 
-class OedometerProtocol(SpecimenProtocol[OedometerRun, OedometerResult]):
+class OedometerProtocol(SpecimenProtocol[OedometerConfig, OedometerRun, OedometerResult]):
     """Confined (K0) compression: side walls fixed, the top platen servo-loaded to each vertical stress."""
 
     name = "oedometer"
     stages: ClassVar[tuple[Stage[Any, Any], ...]] = (
-        Stage("consolidate", _consolidate, "the four walls servo-controlled to sigma_0 until equilibrium"),
+        CONSOLIDATE,
         Stage("confine", _confine, "Table 1 friction on; the four walls fixed"),
         Stage("load", _load, "the top platen servo-controlled to sigma_0 (strains count from there), then to "
                              "each vertical stress in turn; a record and a snapshot at each equilibrium, a checkpoint there "
                              "once run.checkpoint_interval has passed"),
     )
     state_type = OedometerRun
-
-    def state_from_dict(self, saved: Any) -> OedometerRun:
-        return OedometerRun(**{k: v for k, v in saved.items() if k not in ("config", "elapsed_s", "rows", "snapshots")})
-
-    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
-        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
-
-    def write_outputs(self, out: Path) -> dict[str, Any]:
-        return write_outputs(out)
-
-    def result(self, out: Path, summary: dict[str, Any]) -> OedometerResult:
-        return OedometerResult(out, summary)
+    summarise = summarise
+    outputs = write_outputs
+    result_type = OedometerResult
 
 
-def run_oedometer(config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
+def run_oedometer(config: OedometerConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,
                   progress: bool = False) -> OedometerResult:
     """Runs (or, with ``resume``, continues) the oedometer test into ``out_dir``
     (:func:`grainlab.protocols.runner.run_protocol`)."""

@@ -9,56 +9,69 @@ simple shear")."""
 from __future__ import annotations
 
 from collections.abc import Set as AbstractSet
-from dataclasses import replace
-from typing import Any
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar
 
 from grainlab.protocols.config import (
-    RUN_FIELDS,
     SHARED_FIELDS,
+    Config,
     ConfigError,
-    ConfigSchema,
-    Field,
+    Section,
+    SectionOf,
     check_sample,
-    register_schema,
+    key,
+    register_test,
 )
 
-__all__ = ["SIMPLE_SHEAR_FIELDS", "SIMPLE_SHEAR_QUICK", "SIMPLE_SHEAR_SCHEMA"]
+__all__ = ["SIMPLE_SHEAR_FIELDS", "SIMPLE_SHEAR_QUICK", "SIMPLE_SHEAR_SCHEMA", "SimpleShearConfig", "SimpleShearSection"]
 
-#: The simple-shear test's own keys.
-SIMPLE_SHEAR_FIELDS: dict[str, Field] = {
-    "simple_shear.volume": Field(
+@dataclass(frozen=True)
+class SimpleShearSection(Section):
+    """The simple-shear test's own keys: the cell's loading."""
+
+    prefix: ClassVar[str] = "simple_shear"
+    volume: str = key(
         "choice", "free",
         "free: the cell's height is servo-controlled to hold the normal stress sigma_yy (constant normal "
         "stress); constant: the cell's area is held (constant volume)",
         choices=("free", "constant"),
-    ),
-    "simple_shear.normal_stress": Field(
+    )
+    normal_stress: float | str = key(
         "stress", "auto", "normal stress sigma_yy held at free volume (auto: consolidation.pressure)",
         minimum=0.0, exclusive_minimum=True, allow_auto=True,
-    ),
-    "simple_shear.inertial_number": Field(
+    )
+    inertial_number: float = key(
         "number", 1e-3,
         "inertial number I = gamma_dot d / sqrt(sigma_n / rho) that sets the shear rate gamma_dot (d the mean "
         "grain diameter, sigma_n the normal stress at the start of shearing, rho material.density)",
         minimum=0.0, maximum=1.0, exclusive_minimum=True,
-    ),
-    "simple_shear.local_damping": Field(
+    )
+    local_damping: float | str = key(
         "number", "auto",
         "local damping alpha while shearing (auto: material.local_damping, which makes and consolidates the "
         "sample); 0 leaves the grains' inertia undamped, as a rate sweep needs", minimum=0.0, maximum=1.0,
         exclusive_maximum=True, allow_auto=True,
-    ),
-    "simple_shear.final_strain": Field(
+    )
+    final_strain: float = key(
         "strain", 1.0, "shear strain gamma at which shearing stops (1 = 100 %)", minimum=0.0, maximum=100.0,
         exclusive_minimum=True,
-    ),
-    "simple_shear.record_interval": Field(
+    )
+    record_interval: float = key(
         "strain", 0.01, "shear strain between records", minimum=0.0, exclusive_minimum=True,
-    ),
-    "simple_shear.snapshot_strains": Field(
+    )
+    snapshot_strains: list[float] = key(
         "shear_strain_list", [0.0, 0.1, 0.25, 0.5, 1.0], "shear strains at which a snapshot is stored",
-    ),
-}
+    )
+
+
+SIMPLE_SHEAR_FIELDS = SimpleShearSection.keys()
+
+
+@dataclass(frozen=True)
+class SimpleShearConfig(Config):
+    """The simple-shear test's configuration: the shared sections and its shearing."""
+
+    simple_shear = SectionOf(SimpleShearSection)
 
 #: ``--quick``: a square cell of a few hundred disks sheared to 100 %.
 SIMPLE_SHEAR_QUICK: dict[str, Any] = {"sample.width": 0.03, "sample.height": 0.03}
@@ -90,7 +103,5 @@ _SQUARE = {"sample.height": replace(SHARED_FIELDS["sample.height"], default=SHAR
                                     help="sample height (a square cell: Table 1's width, 75 mm)")}
 
 #: The simple-shear test's configuration schema (registered as ``"simple_shear"``).
-SIMPLE_SHEAR_SCHEMA = register_schema(
-    ConfigSchema("simple_shear", {**SHARED_FIELDS, **_SQUARE, **SIMPLE_SHEAR_FIELDS, **RUN_FIELDS},
-                 SIMPLE_SHEAR_QUICK, _check)
-)
+SIMPLE_SHEAR_SCHEMA = register_test("simple_shear", {**_SQUARE, **SIMPLE_SHEAR_FIELDS}, _check, SimpleShearConfig,
+                                    SIMPLE_SHEAR_QUICK)

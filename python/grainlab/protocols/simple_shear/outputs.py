@@ -28,9 +28,9 @@ from grainlab.columns import (
     SHEAR_STRAIN,
     VOLUMETRIC_STRAIN,
 )
-from grainlab.protocols.config import Config
 from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.runner import RunResult
+from grainlab.protocols.simple_shear.config import SimpleShearConfig
 from grainlab.protocols.simple_shear.state import SimpleShearRun
 from grainlab.protocols.specimen import write_run_outputs
 
@@ -65,11 +65,11 @@ def _mean(values: np.ndarray, rows: np.ndarray) -> float:
     return float(np.mean(values[rows])) if len(rows) else math.nan
 
 
-def summarise(run: SimpleShearRun, config: Config, timeseries: dict[str, np.ndarray],
+def summarise(run: SimpleShearRun, config: SimpleShearConfig, timeseries: dict[str, np.ndarray],
               total_s: float) -> dict[str, Any]:
     """The run's summary, as ``run.h5`` and ``summary.json`` store it."""
     ts = {k: np.asarray(v, dtype=np.float64) for k, v in timeseries.items()}
-    final = config["simple_shear.final_strain"]
+    final = config.simple_shear.final_strain
     rows = steady_rows(ts, final)
     mu = ts[FRICTION_COEFFICIENT]
     peak = int(np.nanargmax(mu))
@@ -81,8 +81,8 @@ def summarise(run: SimpleShearRun, config: Config, timeseries: dict[str, np.ndar
     return {
         "n_particles": run.n_grains,
         **clump_summary(run.sample),
-        "volume": config["simple_shear.volume"],
-        "inertial_number_set": config["simple_shear.inertial_number"],
+        "volume": config.simple_shear.volume,
+        "inertial_number_set": config.simple_shear.inertial_number,
         "shear_rate_per_s": run.shear_rate_per_s,
         "normal_stress_set_pa": run.normal_stress_pa,
         "mean_diameter_m": run.mean_diameter_m,

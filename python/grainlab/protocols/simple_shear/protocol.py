@@ -12,19 +12,16 @@ from __future__ import annotations
 import math
 import os
 import time
-from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
-from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
 from grainlab.analysis import StressForceFabric, fabric_summary
 from grainlab.columns import SIMPLE_SHEAR
 from grainlab.io.hdf5.snapshot import snapshot_name
 from grainlab.io.results import SHEAR_START_FILE
 from grainlab.protocols import operations
-from grainlab.protocols.config import Config
 from grainlab.protocols.grains import grain_coordination, grain_porosity
 from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
@@ -34,7 +31,7 @@ from grainlab.protocols.simple_shear.cell import (
     servo_rate,
     side_stresses,
 )
-from grainlab.protocols.simple_shear.config import SIMPLE_SHEAR_SCHEMA  # noqa: F401 - registers the schema
+from grainlab.protocols.simple_shear.config import SimpleShearConfig
 from grainlab.protocols.simple_shear.outputs import SimpleShearResult, summarise, write_outputs
 from grainlab.protocols.simple_shear.state import SimpleShearRun
 from grainlab.protocols.specimen import (
@@ -44,12 +41,11 @@ from grainlab.protocols.specimen import (
     SpecimenProtocol,
     contact_law,
     damped_time_step_factor,
+    engine_columns,
     grain_model,
 )
 from grainlab.protocols.triggers import (
     And,
-    At,
-    Every,
     EveryStop,
     OnSteps,
     Periodic,
@@ -62,7 +58,7 @@ from grainlab.snapshot import ParticleKind
 __all__ = ["CellControl", "SimpleShearProtocol", "SimpleShearRun", "record_steps", "run_simple_shear", "set_cell_rates",
            "snapshot_name_of"]
 
-Context = StageContext[Config, SimpleShearRun]
+Context = StageContext[SimpleShearConfig, SimpleShearRun]
 
 
 def snapshot_name_of(shear_strain: float) -> str:
@@ -70,26 +66,26 @@ def snapshot_name_of(shear_strain: float) -> str:
     return snapshot_name(shear_strain, prefix="gamma")
 
 
-def record_steps(config: Config, steps_per_unit: float) -> tuple[list[int], dict[int, float]]:
+def record_steps(config: SimpleShearConfig, steps_per_unit: float) -> tuple[list[int], dict[int, float]]:
     """The steps after the start of shearing that carry a record, and those that
     also carry a snapshot (step -> its shear strain)."""
-    final = config["simple_shear.final_strain"]
-    strains = [s for s in config["simple_shear.snapshot_strains"] if 0 < s <= final]
-    steps = schedule_steps([Every(config["simple_shear.record_interval"]), At(strains)], final=final,
+    final = config.simple_shear.final_strain
+    strains = [s for s in config.simple_shear.snapshot_strains if 0 < s <= final]
+    steps = schedule_steps(config.simple_shear.record_interval, strains, final=final,
                            steps_per_unit=steps_per_unit)
     snaps = {round(s * steps_per_unit): s for s in strains}
     return steps, snaps
 
 
-def _max_rate(sim: Simulation, config: Config, shear_rate: float) -> float:
+def _max_rate(sim: Simulation, config: SimpleShearConfig, shear_rate: float) -> float:
     """The cap on the cell's rate: a twentieth of the smallest diameter per 100 steps over the
     cell's height, plus the shear rate."""
     cell = sim.cell
     assert cell is not None
-    return float(0.05 * config["sample.d_min"] / (100 * sim.time_step * cell.b[1]) + abs(shear_rate))
+    return float(0.05 * config.sample.d_min / (100 * sim.time_step * cell.b[1]) + abs(shear_rate))
 
 
-def set_cell_rates(sim: Simulation, run: SimpleShearRun, config: Config, targets: tuple[float | None, float | None],
+def set_cell_rates(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig, targets: tuple[float | None, float | None],
                    shear_rate: float) -> None:
     """The cell's velocity gradient ``[[L_xx, shear_rate], [0, L_yy]]`` for the next
     CONTROL_STEPS steps, each side's rate servo-controlled to hold its target of
@@ -112,7 +108,7 @@ class CellControl(Operation):
 
     acts_before_run = True
 
-    def __init__(self, run: SimpleShearRun, config: Config, targets: tuple[float | None, float | None],
+    def __init__(self, run: SimpleShearRun, config: SimpleShearConfig, targets: tuple[float | None, float | None],
                  shear_rate: float) -> None:
         held = targets != (None, None)
         super().__init__(Periodic(CONTROL_STEPS, run.start_step) if held else EveryStop())
@@ -129,16 +125,6 @@ class CellControl(Operation):
             sim.set_velocity_gradient(wanted)
 
 
-def _advance(sim: Simulation, run: SimpleShearRun, config: Config, to_step: int, target: float) -> None:
-    """Runs to ``to_step``, both sides of the cell servo-controlled to ``target`` every
-    CONTROL_STEPS steps (counted from ``run.start_step``)."""
-    while sim.step_count < to_step:
-        into = (sim.step_count - run.start_step) % CONTROL_STEPS
-        if into == 0:
-            set_cell_rates(sim, run, config, (target, target), 0.0)
-        sim.run(min(CONTROL_STEPS - into, to_step - sim.step_count))
-
-
 def _to_periodic(context: Context) -> None:
     """The walls give way to a periodic cell of their box; the gradient is set to 0."""
     sim, run = context.sim, context.state
@@ -152,47 +138,55 @@ def _to_periodic(context: Context) -> None:
     sim.set_velocity_gradient(np.zeros((2, 2)))
 
 
-def _equilibrate(sim: Simulation, run: SimpleShearRun, config: Config, progress: bool, label: str) -> int:
+class CellSettled(Operation):
+    """Stop rule: every CHUNK_STEPS steps from ``run.start_step``, the loading ends once both
+    sides hold sigma_0 within ``consolidation.tolerance`` in equilibrium; a loading that
+    takes ``consolidation.max_steps`` stops the run with a :class:`SpecimenError`."""
+
+    def __init__(self, run: SimpleShearRun, config: SimpleShearConfig, bar: operations.Bar, label: str) -> None:
+        super().__init__(Periodic(CHUNK_STEPS, run.start_step))
+        self.run, self.config, self.bar, self.label = run, config, bar, label
+
+    def act(self, loading: Loading) -> None:
+        sim, c = loading.sim, self.config.consolidation
+        steps, target, limit = sim.step_count - self.run.start_step, c.pressure, c.unbalanced_force_ratio
+        stress = cell_stress(sim).total
+        self.bar.update(CHUNK_STEPS)
+        self.bar.set_postfix_str(f"sxx {stress[0, 0] / 1e3:.1f} kPa, syy {stress[1, 1] / 1e3:.1f} kPa, "
+                                 f"unbalanced {sim.unbalanced_force_ratio:.1e}")
+        if max(abs(stress[0, 0] / target - 1.0), abs(stress[1, 1] / target - 1.0)) < c.tolerance and \
+                sim.unbalanced_force_ratio < limit:
+            loading.stop()
+        elif steps >= c.max_steps:
+            raise SpecimenError(
+                f"{self.label} in the periodic cell did not converge in {steps} steps: sigma_xx "
+                f"{stress[0, 0] / 1e3:.1f}, sigma_yy {stress[1, 1] / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa "
+                f"+- {c.tolerance:.0%}), unbalanced force ratio {sim.unbalanced_force_ratio:.2e} (limit "
+                f"{limit:.0e}); raise consolidation.max_steps"
+            )
+
+
+def _equilibrate(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig, progress: bool, label: str) -> int:
     """Servo-controls both sides of the cell to sigma_0 until equilibrium; returns the steps taken."""
-    target = config["consolidation.pressure"]
-    tolerance = config["consolidation.tolerance"]
-    limit = config["consolidation.unbalanced_force_ratio"]
-    max_steps = config["consolidation.max_steps"]
-    bar = progress_bar(max_steps, label, enabled=progress, unit="step")
-    steps = 0
+    target = config.consolidation.pressure
+    bar = progress_bar(config.consolidation.max_steps, label, enabled=progress, unit="step")
     run.start_step = sim.step_count  # the control's step count starts here
     run.cell_rate_integral = [0.0, 0.0]
-    while True:
-        _advance(sim, run, config, sim.step_count + CHUNK_STEPS, target)
-        steps += CHUNK_STEPS
-        stress = cell_stress(sim).total
-        bar.update(CHUNK_STEPS)
-        bar.set_postfix_str(f"sxx {stress[0, 0] / 1e3:.1f} kPa, syy {stress[1, 1] / 1e3:.1f} kPa, "
-                            f"unbalanced {sim.unbalanced_force_ratio:.1e}")
-        settled = max(abs(stress[0, 0] / target - 1.0), abs(stress[1, 1] / target - 1.0)) < tolerance
-        if settled and sim.unbalanced_force_ratio < limit:
-            break
-        if steps >= max_steps:
-            bar.close()
-            raise SpecimenError(
-                f"{label} in the periodic cell did not converge in {steps} steps: sigma_xx {stress[0, 0] / 1e3:.1f}, "
-                f"sigma_yy {stress[1, 1] / 1e3:.1f} kPa (target {target / 1e3:.1f} kPa +- {tolerance:.0%}), "
-                f"unbalanced force ratio {sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}); raise "
-                "consolidation.max_steps"
-            )
-        raise_if_interrupted()
-    bar.close()
+    try:
+        Loading(sim, [CellSettled(run, config, bar, label), CellControl(run, config, (target, target), 0.0)]).run()
+    finally:
+        bar.close()
     sim.set_velocity_gradient(np.zeros((2, 2)))
-    return steps
+    return sim.step_count - run.start_step
 
 
 def _consolidate(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
     start = time.perf_counter()
     _to_periodic(context)
-    sim.set_contact_model(0, 0, contact_law(config, config["consolidation.friction"]))
-    sim.local_damping = config["material.local_damping"]
-    sim.time_step = config["run.time_step_safety"] * sim.critical_time_step(1.0) * damped_time_step_factor(config)
+    sim.set_contact_model(0, 0, contact_law(config, config.consolidation.friction))
+    sim.local_damping = config.material.local_damping
+    sim.time_step = config.run.time_step_safety * sim.critical_time_step(1.0) * damped_time_step_factor(config)
     steps = _equilibrate(sim, run, config, context.progress, "consolidating")
     cell = sim.cell
     assert cell is not None
@@ -216,17 +210,17 @@ def _settle(context: Context) -> None:
     cell = sim.cell
     assert cell is not None
     stress = cell_stress(sim).total
-    held = config["simple_shear.normal_stress"]
-    run.normal_stress_pa = float(stress[1, 1]) if config["simple_shear.volume"] == "constant" or held == "auto" \
+    held = config.simple_shear.normal_stress
+    run.normal_stress_pa = float(stress[1, 1]) if config.simple_shear.volume == "constant" or held == "auto" \
         else float(held)
-    if config["simple_shear.volume"] == "free" and held == "auto":
-        run.normal_stress_pa = float(config["consolidation.pressure"])
+    if config.simple_shear.volume == "free" and held == "auto":
+        run.normal_stress_pa = float(config.consolidation.pressure)
     run.mean_diameter_m = float(2.0 * np.mean(sim.radii[: run.n_grains]))
-    density = config["material.density"]
-    run.shear_rate_per_s = config["simple_shear.inertial_number"] * math.sqrt(run.normal_stress_pa / density) \
+    density = config.material.density
+    run.shear_rate_per_s = config.simple_shear.inertial_number * math.sqrt(run.normal_stress_pa / density) \
         / run.mean_diameter_m
-    damping = config["simple_shear.local_damping"]
-    sim.local_damping = config["material.local_damping"] if damping == "auto" else float(damping)
+    damping = config.simple_shear.local_damping
+    sim.local_damping = config.material.local_damping if damping == "auto" else float(damping)
     run.start_step = sim.step_count
     run.cell_rate_integral = [0.0, 0.0]
     run.area0 = float(cell.area)
@@ -247,25 +241,25 @@ def _shear(context: Context) -> None:
     if run.next_record == 0 and writer.n_rows == 0:
         sim.set_velocity_gradient([[0.0, rate], [0.0, 0.0]])
         records.write(sim.step_count)
-        if 0.0 in config["simple_shear.snapshot_strains"]:
+        if 0.0 in config.simple_shear.snapshot_strains:
             snapshots.store(snapshot_name_of(0.0), sim.step_count)
     if run.next_record == len(steps):  # stopped after the last record's checkpoint
         return
-    final = config["simple_shear.final_strain"]
+    final = config.simple_shear.final_strain
     done = 100 * steps[run.next_record - 1] / steps_per_unit if run.next_record else 0.0
     bar = progress_bar(round(100 * final, 3), "shearing", enabled=context.progress, unit="% strain", initial=done,
                        bar_format="{l_bar}{bar}| {n:.1f}/{total:.0f} % [{elapsed}<{remaining}{postfix}]")
     scheduled = records.trigger
-    checkpoint = operations.Checkpoint(And(scheduled, WallClock(config["run.checkpoint_interval"])), context.save,
+    checkpoint = operations.Checkpoint(And(scheduled, WallClock(config.run.checkpoint_interval)), context.save,
                             run.wall_time, "shear")
-    targets = (None, run.normal_stress_pa) if config["simple_shear.volume"] == "free" else (None, None)
+    targets = (None, run.normal_stress_pa) if config.simple_shear.volume == "free" else (None, None)
     operations.run_loading(sim, [
         records, snapshots,
         operations.Progress(scheduled, bar, lambda step: 100 * (step - run.start_step) / steps_per_unit,
                  lambda: f"mu {records.values['friction_coefficient']:.3f}, Z {records.values['coordination_number']:.2f}",
                  done),
         checkpoint, operations.Stop(OnSteps(steps[-1:], run.start_step)), CellControl(run, config, targets, rate),
-    ], bar, checkpoint)
+    ], checkpoint, bar)
 
 
 def _snapshot(sim: Simulation, run: SimpleShearRun, values: dict[str, float]) -> Any:
@@ -275,7 +269,7 @@ def _snapshot(sim: Simulation, run: SimpleShearRun, values: dict[str, float]) ->
     return sim.snapshot(kind=kind, scalars=scalars, step=sim.step_count)  # with the cell's box and tilt
 
 
-def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, float]:
+def _record(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig) -> dict[str, float]:
     """One record, in :data:`grainlab.columns.SIMPLE_SHEAR`'s order."""
     cell = sim.cell
     assert cell is not None
@@ -290,13 +284,12 @@ def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, f
     fabric = fabric_summary(snap)
     z = fabric.pop("coordination_number")
     rb = StressForceFabric().compute(snap)
-    energy = sim.energy
     strain = (sim.step_count - run.start_step) * sim.time_step * run.shear_rate_per_s
     values = {
         "step": float(sim.step_count), "time_s": sim.time, "shear_strain": strain,
         "shear_stress_pa": tau, "normal_stress_pa": normal, "lateral_stress_pa": float(total[0, 0]),
         "friction_coefficient": tau / normal if normal > 0 else math.nan,
-        "inertial_number": run.shear_rate_per_s * run.mean_diameter_m / math.sqrt(normal / config["material.density"])
+        "inertial_number": run.shear_rate_per_s * run.mean_diameter_m / math.sqrt(normal / config.material.density)
         if normal > 0 else math.nan,
         "volumetric_strain": (run.area0 - area) / run.area0 if run.area0 else 0.0,
         "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "area_m2": area,
@@ -305,10 +298,7 @@ def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, f
         "love_weber_xx_pa": float(stress.contact[0, 0]), "love_weber_yy_pa": float(stress.contact[1, 1]),
         "love_weber_xy_pa": float(stress.contact[0, 1]),
         "coordination_number": z,
-        "unbalanced_force_ratio": sim.unbalanced_force_ratio,
-        "kinetic_energy_j": energy.kinetic, "elastic_energy_j": energy.elastic,
-        "friction_dissipated_j": energy.friction_dissipated, "damping_dissipated_j": energy.damping_dissipated,
-        "boundary_work_j": energy.boundary_work, "wall_work_j": energy.wall_work,
+        **engine_columns(sim),
         **fabric,
         "rb_stress_ratio": rb.stress_ratio, "rb_predicted_stress_ratio": rb.predicted_stress_ratio,
         "rb_residual": rb.residual,
@@ -316,7 +306,7 @@ def _record(sim: Simulation, run: SimpleShearRun, config: Config) -> dict[str, f
     return {name: values[name] for name in SIMPLE_SHEAR}
 
 
-class SimpleShearProtocol(SpecimenProtocol[SimpleShearRun, SimpleShearResult]):
+class SimpleShearProtocol(SpecimenProtocol[SimpleShearConfig, SimpleShearRun, SimpleShearResult]):
     """Periodic simple shear at constant normal stress or constant volume, to large strain."""
 
     name = "simple_shear"
@@ -331,23 +321,13 @@ class SimpleShearProtocol(SpecimenProtocol[SimpleShearRun, SimpleShearResult]):
                                "checkpoints on the wall clock"),
     )
     state_type = SimpleShearRun
+    summarise = summarise
+    outputs = write_outputs
+    result_type = SimpleShearResult
     output_files = (*OUTPUT_FILES, SHEAR_START_FILE)
 
-    def state_from_dict(self, saved: Any) -> SimpleShearRun:
-        return SimpleShearRun(**{k: v for k, v in saved.items()
-                                 if k not in ("config", "elapsed_s", "rows", "snapshots")})
 
-    def summary(self, context: Context, wall_time_s: float) -> dict[str, Any]:
-        return summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
-
-    def write_outputs(self, out: Path) -> dict[str, Any]:
-        return write_outputs(out)
-
-    def result(self, out: Path, summary: dict[str, Any]) -> SimpleShearResult:
-        return SimpleShearResult(out, summary)
-
-
-def run_simple_shear(config: Config, out_dir: str | os.PathLike[str], *, resume: bool = False,
+def run_simple_shear(config: SimpleShearConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,
                      progress: bool = False) -> SimpleShearResult:
     """Runs (or, with ``resume``, continues) the periodic simple-shear test into ``out_dir``
     (:func:`grainlab.protocols.runner.run_protocol`)."""
