@@ -80,7 +80,7 @@ def test_round_trip_of_state_and_arrays_is_exact(tmp_path):
     for name, a in arrays.items():
         b = cp.arrays[name]
         assert (b.dtype, b.shape, bits(b)) == (a.dtype, a.shape, bits(a)), name
-    assert cp.format_version == CHECKPOINT_FORMAT_VERSION == 1
+    assert cp.format_version == CHECKPOINT_FORMAT_VERSION == 2
     assert cp.grainlab_version and cp.created.endswith("+00:00")
     with h5py.File(path) as f:
         assert f.attrs["format"] == "grainlab-checkpoint"
@@ -141,8 +141,18 @@ def test_truncated_or_foreign_checkpoint_is_refused(tmp_path):
         read_checkpoint(path)
     with h5py.File(path, "w") as f:
         f.attrs["format"] = "grainlab-checkpoint"
-        f.attrs["format_version"] = 1
+        f.attrs["format_version"] = 2
     with pytest.raises(CheckpointError, match="missing dataset"):
+        read_checkpoint(path)
+
+
+def test_a_checkpoint_of_a_retired_layout_is_refused_by_name(tmp_path):
+    # layout 1 is the layout 2 of this grainlab's writer under another number
+    path = write_checkpoint(tmp_path, b"state", STATE, arrays={"results_partial": np.zeros(4, np.uint8)})
+    with h5py.File(path, "r+") as f:
+        f.attrs["format_version"] = np.int64(1)
+    with pytest.raises(CheckpointError, match=r"format_version 1: written by an earlier grainlab, which this one no "
+                                              r"longer resumes \(.*\); start the run again in a new folder"):
         read_checkpoint(path)
 
 

@@ -12,6 +12,8 @@ import sys
 import time
 from pathlib import Path
 
+import h5py
+import numpy as np
 import pytest
 from reliability_factories import TINY_TOML, assert_same_run, tiny_config
 
@@ -22,7 +24,12 @@ import grainlab.protocols.biaxial.records as records
 import grainlab.protocols.runner as runner
 import grainlab.protocols.specimen as specimen
 from grainlab.cli import main
-from grainlab.io.hdf5 import ResultsWriter, read_checkpoint, read_results, write_checkpoint
+from grainlab.io.hdf5 import (
+    CheckpointError,
+    ResultsWriter,
+    read_results,
+    write_checkpoint,
+)
 
 
 class Stop(KeyboardInterrupt):
@@ -155,25 +162,23 @@ def test_a_run_resumes_on_another_thread_count_with_the_same_bits(tmp_path, monk
     assert_same_run(tiny_reference, out, also_differing={"threads"})
 
 
-def test_a_checkpoint_without_the_results_image_resumes_from_the_partial_file(
-    tmp_path, monkeypatch, fast_figures, tiny_reference
+def test_a_checkpoint_of_a_retired_layout_is_refused_and_the_folder_left_as_it_was(
+    tmp_path, monkeypatch, fast_figures
 ):
-    """Checkpoints written before the partial file travelled with them still resume
-    while run.h5.partial is there, and say why not when it is gone."""
+    """A folder checkpointed by an earlier grainlab (checkpoint layout 1) is not
+    resumed: one message names the layout, and nothing in the folder changes."""
     out = tmp_path / "run"
     with monkeypatch.context() as patch:
         _stop_at(patch, "shearing")
         with pytest.raises(Stop):
             biaxial.run_biaxial(tiny_config(), out, progress=False)
-    old = read_checkpoint(out / "checkpoint.h5")
-    write_checkpoint(out / "checkpoint.h5", old.engine_state, old.protocol_state)  # no arrays
-    kept = (out / "run.h5.partial").read_bytes()
-    (out / "run.h5.partial").unlink()
-    with pytest.raises(ValueError, match=r"run\.h5\.partial is missing and .* cannot rebuild it"):
+    with h5py.File(out / "checkpoint.h5", "r+") as f:
+        f.attrs["format_version"] = np.int64(1)
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    with pytest.raises(CheckpointError, match=r"format_version 1: written by an earlier grainlab.*start the run "
+                                              r"again in a new folder"):
         biaxial.run_biaxial(tiny_config(), out, resume=True, progress=False)
-    (out / "run.h5.partial").write_bytes(kept)
-    biaxial.run_biaxial(tiny_config(), out, resume=True, progress=False)
-    assert_same_run(tiny_reference, out)
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
 
 
 def test_a_run_stopped_while_its_report_is_written_gets_it_with_resume(tmp_path, monkeypatch, fast_figures):

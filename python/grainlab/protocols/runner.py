@@ -68,7 +68,7 @@ RUN_FILES = (RESULTS_FILE, RESULTS_FILE + PARTIAL_SUFFIX, CHECKPOINT_FILE)
 #: engine gives the same bits on any thread count): a run resumes under other values.
 EXECUTION_KEYS = frozenset({"run.threads", "run.checkpoint_interval"})
 #: What the runner saves in a checkpoint beside the state (the state is read without them).
-RUNNER_KEYS = frozenset({"config", "elapsed_s", "rows", "snapshots"})
+RUNNER_KEYS = frozenset({"config", "elapsed_s"})
 #: Name of the checkpoint array that holds the partial results file (:meth:`ResultsWriter.publish`).
 _RESULTS_IMAGE = "results_partial"
 
@@ -268,8 +268,8 @@ def _finished_run(protocol: Protocol[Any, Any, R], out: Path) -> R | None:
     )
 
 
-def _reopen_results(protocol: Protocol[Any, Any, Any], out: Path, state: RunState, checkpoint: Any,
-                    saved: Mapping[str, Any]) -> ResultsWriter | None:
+def _reopen_results(protocol: Protocol[Any, Any, Any], out: Path, state: RunState,
+                    checkpoint: Any) -> ResultsWriter | None:
     """The results writer of a resumed run, as it was at the checkpoint; None
     when the run's ``run.h5`` is already final (only the outputs remain)."""
     final, partial = out / RESULTS_FILE, out / (RESULTS_FILE + PARTIAL_SUFFIX)
@@ -281,19 +281,10 @@ def _reopen_results(protocol: Protocol[Any, Any, Any], out: Path, state: RunStat
             f"--resume: {final} exists, but {out / CHECKPOINT_FILE} is of a run still in its {state.phase!r} "
             "phase; the folder holds two different runs: move one away"
         )
-    image = checkpoint.arrays.get(_RESULTS_IMAGE)
-    if image is not None:  # the partial file as it was at the checkpoint, whatever became of it since
-        return ResultsWriter.restore(
-            out, np.asarray(image, dtype=np.uint8).tobytes(), compression=protocol.compression, buffered=True
-        )
-    if not partial.exists():
-        raise ValueError(
-            f"--resume: {partial} is missing and {out / CHECKPOINT_FILE} (written by an earlier grainlab) "
-            "cannot rebuild it; start the run again in a new folder"
-        )
-    return ResultsWriter.resume(
-        out, timeseries_rows=int(saved.get("rows", 0)), snapshots=list(saved.get("snapshots") or []),
-        compression=protocol.compression, buffered=True,
+    # the partial file as it was at the checkpoint, whatever became of it since
+    image = checkpoint.arrays[_RESULTS_IMAGE]
+    return ResultsWriter.restore(
+        out, np.asarray(image, dtype=np.uint8).tobytes(), compression=protocol.compression, buffered=True
     )
 
 
@@ -340,7 +331,7 @@ def _run_locked(protocol: Protocol[Any, Any, R], out: Path, *, resume: bool, pro
             sim.threads = threads  # the bits do not depend on it: a resumed run takes the count asked now
             state = protocol.state_from_dict({k: v for k, v in saved.items() if k not in RUNNER_KEYS})
             elapsed_before = float(saved.get("elapsed_s", 0.0))
-            writer = _reopen_results(protocol, out, state, checkpoint, saved)
+            writer = _reopen_results(protocol, out, state, checkpoint)
         else:
             partial = out / (RESULTS_FILE + PARTIAL_SUFFIX)
             if partial.exists() and not checkpoint_path.exists() and not (out / RESULTS_FILE).exists():
@@ -362,8 +353,6 @@ def _run_locked(protocol: Protocol[Any, Any, R], out: Path, *, resume: bool, pro
                 saved_state = state.to_dict()
                 saved_state["config"] = protocol.config_dict()
                 saved_state["elapsed_s"] = elapsed_before + time.perf_counter() - started
-                saved_state["rows"] = results.n_rows
-                saved_state["snapshots"] = list(results.snapshot_names)
                 image = np.frombuffer(results.publish(), dtype=np.uint8)
                 write_checkpoint(checkpoint_path, sim.to_bytes(), saved_state, arrays={_RESULTS_IMAGE: image})
 

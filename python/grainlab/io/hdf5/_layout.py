@@ -26,8 +26,10 @@ FORMAT = "grainlab-results"
 FORMAT_VERSION = 3
 #: Root attribute ``format`` of a checkpoint file.
 CHECKPOINT_FORMAT = "grainlab-checkpoint"
-#: Checkpoint layout version written by this grainlab.
-CHECKPOINT_FORMAT_VERSION = 1
+#: Checkpoint layout version written by this grainlab: 2 is version 1 with a run's partial
+#: results file always inside (the array ``results_partial``) and its protocol state free of
+#: retired keys; a checkpoint of version 1 is refused (its run starts again).
+CHECKPOINT_FORMAT_VERSION = 2
 #: Suffix of the file a running writer works on (``run.h5.partial``).
 PARTIAL_SUFFIX = ".partial"
 

@@ -120,7 +120,7 @@ def write_checkpoint(
     return p
 
 
-def _read_checkpoint_v1(f: h5py.File, path: Path) -> Checkpoint:
+def _read_checkpoint_v2(f: h5py.File, path: Path) -> Checkpoint:
     def verify(name: str, data: bytes | NDArray[Any], ds: h5py.Dataset) -> None:
         stored = _attr_str(ds.attrs, "sha256", "")
         actual = _sha256(data)
@@ -168,10 +168,27 @@ def _read_checkpoint_v1(f: h5py.File, path: Path) -> Checkpoint:
     )
 
 
-#: Reader of each checkpoint layout version.
+#: Reader of each checkpoint layout version. A checkpoint is for resuming the run that
+#: wrote it, not an archive: a new layout replaces the reader of the one before, whose
+#: runs start again (:data:`_RETIRED_CHECKPOINT_VERSIONS`).
 _CHECKPOINT_READERS_BY_VERSION: dict[int, Callable[[h5py.File, Path], Checkpoint]] = {
-    1: _read_checkpoint_v1,
+    2: _read_checkpoint_v2,
 }
+#: Checkpoint layout versions this grainlab no longer resumes, with what they lacked.
+_RETIRED_CHECKPOINT_VERSIONS: dict[int, str] = {
+    1: "it may lack the run's partial results file",
+}
+
+
+def _retired_version(f: h5py.File) -> int | None:
+    """The file's checkpoint layout version when it is one this grainlab retired."""
+    if _attr_str(f.attrs, "format", "") != CHECKPOINT_FORMAT:
+        return None
+    try:
+        version = int(f.attrs.get("format_version"))
+    except (TypeError, ValueError):
+        return None
+    return version if version in _RETIRED_CHECKPOINT_VERSIONS else None
 
 
 def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
@@ -180,8 +197,9 @@ def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
     Raises
     ------
     CheckpointError
-        Missing file, not a checkpoint, truncated or corrupt (a checksum
-        mismatch names the damaged part).
+        Missing file, not a checkpoint, of a layout version this grainlab
+        retired, truncated or corrupt (a checksum mismatch names the damaged
+        part).
     UnsupportedVersionError
         Written by a newer grainlab (its ``format_version`` is named).
     """
@@ -190,6 +208,12 @@ def read_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
         p = p / CHECKPOINT_FILE
     f = _open_read(p, CheckpointError)
     try:
+        retired = _retired_version(f)
+        if retired is not None:
+            raise CheckpointError(
+                p, f"format_version {retired}: written by an earlier grainlab, which this one no longer resumes "
+                f"({_RETIRED_CHECKPOINT_VERSIONS[retired]}); start the run again in a new folder",
+            )
         version = _check_format(
             f, p, CHECKPOINT_FORMAT, _CHECKPOINT_READERS_BY_VERSION, CheckpointError
         )

@@ -92,9 +92,7 @@ class BiaxialRun(SpecimenRun):
 
     @classmethod
     def from_dict(cls, saved: dict[str, Any]) -> BiaxialRun:
-        # "peak": the peak so far, which checkpoints of earlier grainlab versions carry; the
-        # summary takes it from the records (grainlab.analysis.peak)
-        values = {k: v for k, v in saved.items() if k != "peak"}
+        values = dict(saved)
         boundary = values.pop("membrane", None)
         values["boundary"] = None if boundary is None else boundary_from_dict(boundary)
         if values.get("shear") is not None:
