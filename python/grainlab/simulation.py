@@ -1065,6 +1065,19 @@ class Simulation:
         return _readonly(np.asarray(self._engine.body_of_particles, dtype=np.int64))
 
     @property
+    def grain_centroids(self) -> NDArray[np.float64]:
+        """Every particle's grain centroid (N, 2), m: its clump's centroid for a pebble,
+        its own centre for a disk (the origin of a grain's contact levers in the
+        Love-Weber stress, docs/bodies.md)."""
+        clumps = self.clumps
+        centroid = np.array(self.positions)
+        if len(clumps):
+            body = self.body_of_particles
+            pebble = body < len(clumps)
+            centroid[pebble] = clumps.centroid_m[body[pebble]]
+        return centroid
+
+    @property
     def clumps(self) -> ClumpState:
         """The clumps' centroids, angles, velocities, masses and last resultants."""
         return ClumpState._from_engine(self._engine.clumps)
@@ -1187,11 +1200,9 @@ class Simulation:
             return {}
         body = self.body_of_particles
         pebble = body < len(clumps)
-        centroid = np.array(self.positions)
         angle = np.array(self.rotations)
-        centroid[pebble] = clumps.centroid_m[body[pebble]]
         angle[pebble] = clumps.angle_rad[body[pebble]]
-        return {GRAIN_FIELD: body, GRAIN_CENTROID_FIELD: centroid, GRAIN_ANGLE_FIELD: angle}
+        return {GRAIN_FIELD: body, GRAIN_CENTROID_FIELD: self.grain_centroids, GRAIN_ANGLE_FIELD: angle}
 
     # ---- state ----
 

@@ -78,6 +78,18 @@ def test_the_walls_stresses_are_the_grains_love_weber_stress_at_equilibrium(stra
     assert np.all(np.abs(ts["love_weber_xy_pa"]) < 0.02 * ts["vertical_stress_pa"])
 
 
+def test_a_trimer_samples_love_weber_stress_is_the_walls_with_levers_from_the_centroids(tmp_path):
+    """A clump's contacts act about its centroid: with each pebble's own centre as the
+    lever's origin the clumps' internal forces are missed (about 30 % too low here)."""
+    config = resolve_config("oedometer", overrides=["oedometer.vertical_stresses=[200 kPa, 400 kPa]",
+                                                    "run.threads=1", "sample.shape=trimer",
+                                                    "sample.shape_parameter=0.3"], quick=True)
+    runner.run_protocol(OedometerProtocol(config), tmp_path / "run")
+    ts = read_results(tmp_path / "run" / "run.h5").timeseries
+    np.testing.assert_allclose(ts["love_weber_yy_pa"], ts["vertical_stress_pa"], rtol=0.005)
+    np.testing.assert_allclose(ts["love_weber_xx_pa"], ts["horizontal_stress_pa"], rtol=0.005)
+
+
 def test_k_on_loading_and_unloading(straight, config):
     ts = read_results(straight / "run.h5").timeseries
     k, ocr = ts["lateral_stress_ratio"], ts["overconsolidation_ratio"]

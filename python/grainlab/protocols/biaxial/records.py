@@ -94,7 +94,7 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
     grains = np.zeros(sim.n_particles, dtype=bool)
     grains[:n] = True
     lw = love_weber_stress(
-        sim.positions,
+        sim.grain_centroids,
         c.i,
         c.j,
         c.point,

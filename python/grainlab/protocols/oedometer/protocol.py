@@ -152,7 +152,7 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
     n = run.n_grains
     porosity = grain_porosity(sim, n, area)
     c, w = sim.contacts(), sim.wall_contacts()
-    lw = love_weber_stress(sim.positions, c.i, c.j, c.point, -c.force_on_i, area, np.ones(sim.n_particles, bool),
+    lw = love_weber_stress(sim.grain_centroids, c.i, c.j, c.point, -c.force_on_i, area, np.ones(sim.n_particles, bool),
                            wall_particle=w.particle, wall_point=w.point, wall_force_on_particle=w.force_on_particle)
     fabric = fabric_summary(_snapshot(sim, run))
     fabric.pop("coordination_number")
