@@ -66,15 +66,21 @@ BASE = {
 }
 
 
+#: A quarter of the campaign's rate (docs/shapes-benchmark.md, "Rate").
+SLOW = {"shear.inertial_number": "2.5e-4"}
+
+
 def plan() -> list[dict]:
     """The runs in the order they are made: the small size (900 grains) for
     seed 1, a rate check (eta 0.3 at a quarter of the rate), the large size
-    (3,600 grains) for seed 1, seeds 2 and 3 of the small size, then the
+    (3,600 grains) for seed 1, seeds 2 and 3 of the small size, the rate checks
+    of the large size (eta 0 and 0.3 at a quarter of the rate), then the
     paper's size (5,000 grains) for seed 1."""
     runs = [dict(n=900, eta=e, seed=1) for e in ETAS]
-    runs.append(dict(n=900, eta=0.3, seed=1, tag="slow", extra={"shear.inertial_number": "2.5e-4"}))
+    runs.append(dict(n=900, eta=0.3, seed=1, tag="slow", extra=SLOW))
     runs += [dict(n=3600, eta=e, seed=1) for e in ETAS]
     runs += [dict(n=900, eta=e, seed=s) for s in (2, 3) for e in ETAS]
+    runs += [dict(n=3600, eta=e, seed=1, tag="slow", extra=SLOW) for e in (0.0, 0.3)]
     runs += [dict(n=5000, eta=e, seed=1) for e in ETAS]
     return runs
 

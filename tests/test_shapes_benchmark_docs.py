@@ -1,0 +1,50 @@
+"""docs/shapes-benchmark.md quotes the CEGEO campaign's results: its table and its
+verdict are those of benchmarks/data/cegeo_results.json (the summary that
+``benchmarks/cegeo_shapes.py summarize`` writes), so a new summary that changes
+a number fails here until the page is written again."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGE = (ROOT / "docs" / "shapes-benchmark.md").read_text()
+RESULTS = json.loads((ROOT / "benchmarks" / "data" / "cegeo_results.json").read_text())
+
+
+def _table_rows() -> dict[tuple[int, str, float], list[str]]:
+    section = PAGE[PAGE.index("| size | eta | seeds |"):]
+    rows = {}
+    for line in section.splitlines()[2:]:
+        if not line.startswith("|"):
+            break
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        size = re.match(r"[\d,]+", cells[0])
+        assert size is not None, line
+        tag = "slow" if "quarter of the rate" in cells[0] else ""
+        rows[(int(size.group(0).replace(",", "")), tag, float(cells[1]))] = cells
+    return rows
+
+
+def test_the_pages_results_table_is_the_stored_summary():
+    rows = _table_rows()
+    stored = {(r["n_target"], r["tag"], r["eta"]): r for r in RESULTS["rows"]}
+    assert set(rows) == set(stored)
+    for key, cells in rows.items():
+        r = stored[key]
+        assert int(cells[2]) == r["seeds"] and int(cells[3]) == r["n_grains"], key
+        assert cells[4].split(" ")[0] == f"{r['sin_phi_star']:.3f}", key
+        assert cells[5] == f"{r['rho_iso']:.3f}" and cells[6] == f"{r['Zc_iso']:.2f}", key
+        assert cells[7] == f"{r['Z_steady']:.2f}, {r['Zc_steady']:.2f}", key
+        assert cells[8] == ("yes" if r["all_steady"] else "no"), key
+
+
+def test_the_pages_verdict_is_the_stored_summarys():
+    size = RESULTS["verdict_size"]
+    verdict = RESULTS["verdicts"][str(size)]
+    match = re.search(r"\*\*The verdict, at size ([\d,]+) \(seed 1\)[^:]*:\s+([a-z ]+)\.\*\*", PAGE)
+    assert match is not None
+    assert int(match.group(1).replace(",", "")) == size and match.group(2) == verdict["verdict"]
+    assert f"the slope, {verdict['slope']:.3f}" in PAGE
