@@ -35,6 +35,11 @@ gets a new version, and the stored items of the old one are made again):
     :class:`~grainlab.analysis.ForceChains` with its defaults: array ``chain``
     per particle (the chain's index, -1 outside every chain); a snapshot without
     contact forces has none (all -1).
+
+``RunProducts(results, per_body=True)`` reads a run of clumps per body: each
+snapshot as its :func:`~grainlab.analysis.body_view` (one particle per body), lambda
+as :class:`~grainlab.analysis.BodyStabilityIndex`, every product made anew from
+those (the stored items are the pebbles'); a run of disks reads as without it.
 """
 
 from __future__ import annotations
@@ -49,6 +54,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.analysis.force_chains import ForceChains
+from grainlab.analysis.per_body import BodyStabilityIndex, BodyView, body_view
 from grainlab.analysis.shear_band import Slab
 from grainlab.analysis.stability import StabilityIndex
 from grainlab.analysis.tessellation import LocalPorosity
@@ -185,12 +191,19 @@ def _lambda_of(item: AnalysisItem) -> LambdaField:
     )
 
 
-def _make_items(reference: Snapshot, current: Snapshot, reference_name: str, name: str, strain: float,
+def _make_items(reference: Snapshot, current: Snapshot | BodyView, reference_name: str, name: str, strain: float,
                 wanted: Sequence[str]) -> dict[str, AnalysisItem]:
-    """The items ``wanted`` of one snapshot against the reference, made anew."""
+    """The items ``wanted`` of one snapshot against the reference, made anew (per body
+    when ``current`` is the :class:`BodyView` of a snapshot of clumps, ``reference``
+    then its view's snapshot)."""
     items: dict[str, AnalysisItem] = {}
     needs_lambda = {"stability_index", "band_strain", "band_lambda"} & set(wanted)
-    stability = StabilityIndex().compute(current) if needs_lambda else StabilityIndex()
+    stability: StabilityIndex = StabilityIndex()
+    if isinstance(current, BodyView):
+        stability = BodyStabilityIndex().compute(current) if needs_lambda else stability
+        current = current.snapshot
+    elif needs_lambda:
+        stability = stability.compute(current)
     if "stability_index" in wanted:
         items["stability_index"] = _lambda_item(stability)
     if "local_porosity" in wanted:
@@ -233,7 +246,7 @@ class RunProducts:
         A :class:`~grainlab.io.hdf5.Results` or the path of a ``run.h5`` (or its folder).
     """
 
-    def __init__(self, results: Results | str | os.PathLike[str]) -> None:
+    def __init__(self, results: Results | str | os.PathLike[str], *, per_body: bool = False) -> None:
         self.results = results if isinstance(results, Results) else read_results(results)
         infos = list(self.results.snapshots)
         if not infos:
@@ -250,16 +263,29 @@ class RunProducts:
         self.names_by_strain = [self.reference] + [infos[k].name for k in order]
         self._made: dict[tuple[str, str], AnalysisItem] = {}
         self._snapshots: dict[str, Snapshot] = {}
+        self._views: dict[str, BodyView] = {}
+        #: Whether the products are per body (module docstring): asked for, and the run has clumps.
+        self.per_body = per_body and not self.view(self.reference).identity
 
     def strain(self, name: str) -> float:
         """Snapshot ``name``'s axial strain (NaN when it has none)."""
         return self._strain[name]
 
     def snapshot(self, name: str) -> Snapshot:
-        """Snapshot ``name`` of the file (read once)."""
+        """Snapshot ``name`` of the file (read once); its bodies' snapshot when :attr:`per_body`."""
         return self._snapshot(name)
 
+    def view(self, name: str) -> BodyView:
+        """The :func:`~grainlab.analysis.body_view` of the file's snapshot ``name`` (made once)."""
+        if name not in self._views:
+            if name not in self._snapshots:
+                self._snapshots[name] = self.results.snapshot(name)
+            self._views[name] = body_view(self._snapshots[name])
+        return self._views[name]
+
     def _snapshot(self, name: str) -> Snapshot:
+        if self.per_body:
+            return self.view(name).snapshot
         if name not in self._snapshots:
             self._snapshots[name] = self.results.snapshot(name)
         return self._snapshots[name]
@@ -270,12 +296,13 @@ class RunProducts:
         key = (product, name)
         if key in self._made:
             return self._made[key]
-        if self.results.analysis_versions.get(product) == PRODUCTS[product]:
+        if not self.per_body and self.results.analysis_versions.get(product) == PRODUCTS[product]:
             stored = self.results.analysis(product, name)
             if stored is not None and stored.attrs.get("reference", self.reference) == self.reference:
                 self._made[key] = stored
                 return stored
-        made = _make_items(self._snapshot(self.reference), self._snapshot(name), self.reference, name,
+        current = self.view(name) if self.per_body else self._snapshot(name)
+        made = _make_items(self._snapshot(self.reference), current, self.reference, name,
                            self._strain[name], [product])
         if product not in made:
             raise ValueError(f"{name!r} is the reference snapshot of {self.results.path}: it has no {product}")

@@ -30,6 +30,7 @@ from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
 from grainlab.io.hdf5 import snapshot_strain
 
 if TYPE_CHECKING:
+    from grainlab.analysis.per_body import BodyView
     from grainlab.analysis.stability import StabilityIndex
     from grainlab.postprocess.products import RunProducts
 
@@ -52,13 +53,17 @@ END_WINDOW = 0.3
 LINEAR_TO = 0.005
 
 
+def _reading(options: Mapping[str, Any]) -> dict[str, Any]:
+    """Lambda's reading of ``options``: how it counts the boundary and reads Eqs. 9-11."""
+    return {"boundary": {"body": "body", "raw": "each"}[options.get("boundary_contacts", "body")],
+            "slots": options.get("lambda_slots", "angular"), "anchor": options.get("lambda_anchor", "min"),
+            "deviation": options.get("lambda_deviation", "sum")}
+
+
 def _stability(options: Mapping[str, Any]) -> StabilityIndex:
     from grainlab.analysis.stability import StabilityIndex
 
-    counting = {"body": "body", "raw": "each"}[options.get("boundary_contacts", "body")]
-    return StabilityIndex(boundary=counting, slots=options.get("lambda_slots", "angular"),
-                          anchor=options.get("lambda_anchor", "min"),
-                          deviation=options.get("lambda_deviation", "sum"))
+    return StabilityIndex(**_reading(options))
 
 
 def _finite(x: Any) -> float:
@@ -118,10 +123,17 @@ def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
     }
 
 
-def _fabric_of(snap: Any, options: Mapping[str, Any]) -> dict[str, Any]:
+def _fabric_of(view: BodyView, options: Mapping[str, Any]) -> dict[str, Any]:
+    """The fabric of a snapshot's :func:`~grainlab.analysis.body_view`: per body for clumps
+    (its contact number counts every contact, CEGEO's Z_c), per disk otherwise."""
     from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
+    from grainlab.analysis.per_body import BodyStabilityIndex
 
-    stability = _stability(options).compute(snap)
+    snap = view.snapshot
+    if view.identity:
+        stability = _stability(options).compute(snap)
+    else:  # per body: each contact's direction from the body's centroid
+        stability = BodyStabilityIndex(**_reading(options)).compute(view)
     normals = ContactAnisotropy().compute(snap)
     forces = ContactAnisotropy(weight="normal_force").compute(snap) if snap.normal_force is not None else None
     z = CoordinationNumber().compute(snap)
@@ -156,7 +168,7 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
     run and finding its bands (which do not depend on the options) once."""
     from grainlab.postprocess.products import RunProducts
 
-    products = RunProducts(run_dir)
+    products = RunProducts(run_dir, per_body=True)
     results = products.results
     ts = results.timeseries
     macro = macro_measures(ts)
@@ -165,7 +177,8 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
     position = {info.name: k for k, info in enumerate(infos)}
     order = [position[name] for name in products.names_by_strain]
     names = products.names_by_strain
-    snaps = [results.snapshot(name) for name in names]
+    views = [products.view(name) for name in names]
+    snaps = [products.snapshot(name) for name in names]
     peak_pos = nearest_snapshot([strains[k] for k in order], macro["peak_axial_strain"])
     readings: dict[str, tuple[list[NDArray[np.int32] | None], list[tuple[NDArray[np.bool_], int] | None]]] = {}
 
@@ -207,10 +220,10 @@ def measure_biaxial_each(run_dir: str | Path, options: Sequence[Mapping[str, Any
             peak_ids = np.asarray(snaps[peak_pos].ids)[peak_members[0]]
         strain_members = bands("strain")[1] if opts["band"] != "strain" else None
         rows = []
-        for i, (k, snap, band, member) in enumerate(zip(order, snaps, labels, members, strict=True)):
+        for i, (k, view, band, member) in enumerate(zip(order, views, labels, members, strict=True)):
             row = {"name": infos[k].name, AXIAL_STRAIN: strains[k],
                    STRESS_RATIO: float(np.interp(strains[k], eps_ts[finite], q_ts[finite]))}
-            row.update(_snapshot_row(snaps[0], snap, band, member, peak_ids, opts))
+            row.update(_snapshot_row(snaps[0], view, band, member, peak_ids, opts))
             if member is not None:
                 row["band_from_strain"] = strains[order[member[1]]]
             row["band_overlap_with_strain"] = (
@@ -277,7 +290,7 @@ def _final_band_members(snaps: Sequence[Any], labels: Sequence[NDArray[np.int32]
     return [None] * len(snaps)
 
 
-def _snapshot_row(reference: Any, snap: Any, labels: NDArray[np.int32] | None,
+def _snapshot_row(reference: Any, view: BodyView, labels: NDArray[np.int32] | None,
                   member: tuple[NDArray[np.bool_], int] | None, peak_ids: NDArray[np.int64],
                   options: Mapping[str, Any]) -> dict[str, Any]:
     """Fabric of one snapshot, and inside / outside the band's grains (``member``,
@@ -287,7 +300,8 @@ def _snapshot_row(reference: Any, snap: Any, labels: NDArray[np.int32] | None,
     from grainlab.analysis.band_fabric import BandFabric, roc_auc
     from grainlab.analysis.strain import match_ids
 
-    fabric = _fabric_of(snap, options)
+    fabric = _fabric_of(view, options)
+    snap = view.snapshot
     grains = np.asarray(snap.is_sample)
     stability = fabric["stability"]
     lam = np.asarray(stability.stability_index)[grains]
