@@ -263,7 +263,7 @@ def band_readings_figure(run_dir: str | Path, title: str = "") -> Figure:
     from grainlab.postprocess.products import RunProducts
     from grainlab.reproduction.measures import macro_measures
 
-    products = RunProducts(run_dir)
+    products = RunProducts(run_dir, per_body=True)  # a clump drawn as the disk of its area
     results = products.results
 
     by_name = {info.name: info for info in results.snapshots}
@@ -274,7 +274,7 @@ def band_readings_figure(run_dir: str | Path, title: str = "") -> Figure:
         fig = Figure(figsize=(8.0, 7.0), layout="constrained")
         axes = fig.subplots(1, 2)
         for ax, info in zip(axes, chosen, strict=True):
-            snap = results.snapshot(info.name)
+            snap = products.snapshot(info.name)
             strain_band = products.band_search(info.name)
             grains = np.asarray(snap.is_sample)
             plot.particle_map(snap.positions[grains], snap.radii[grains], 1e3 * strain_band.displacement[grains],
