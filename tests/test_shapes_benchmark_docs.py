@@ -48,3 +48,20 @@ def test_the_pages_verdict_is_the_stored_summarys():
     assert match is not None
     assert int(match.group(1).replace(",", "")) == size and match.group(2) == verdict["verdict"]
     assert f"the slope, {verdict['slope']:.3f}" in PAGE
+
+
+def test_the_rolling_proxy_table_is_the_stored_summary():
+    stored = json.loads((ROOT / "benchmarks" / "data" / "rolling_proxy.json").read_text())
+    section = PAGE[PAGE.index("| eta | mu_r* |"):]
+    lines = [line for line in section.splitlines()[2:] if line.startswith("|")]
+    assert len(lines) == len(stored["etas"])
+    for line, (eta, entry) in zip(lines, stored["etas"].items(), strict=True):
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        trimers, disks, rule = entry["trimers"], entry["disks"], entry["rule"]
+        assert float(cells[0]) == float(eta) and cells[1] == f"{entry['mu_r_star']:.4f}"
+        assert cells[2] == f"{trimers['sin_phi_star']:.3f} / {disks['sin_phi_star']:.3f}"
+        for cell, key in ((cells[3], "a"), (cells[4], "a_n")):
+            agrees = "yes" if rule[f"{key}_agrees"] else "no"
+            assert cell == f"{trimers[key]:.3f} / {disks[key]:.3f} ({agrees})"
+        assert cells[7] == f"{trimers['mean_lambda']:.3f} / {disks['mean_lambda']:.3f}"
+    assert f"({stored['verdict']})" in PAGE
