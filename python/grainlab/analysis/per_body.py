@@ -1,28 +1,10 @@
 r"""Measures per body: a snapshot of pebbles read as its rigid bodies.
 
-A snapshot whose ``grain`` field groups pebbles into rigid bodies (clumps,
-docs/bodies.md) is read through :func:`body_view`, a snapshot with **one
-particle per body**: at the body's centroid, of the radius of a disk of the
-body's area, its angle as rotation, its id the smallest of its pebbles' ids.
-Every contact between pebbles of two bodies is a contact of the two bodies,
-with the pebbles' normal, contact point and forces; a contact between pebbles
-of one body (a file's contacts found from the geometry list the pebbles'
-overlaps) is none. Any measure of a snapshot then runs per body on
-``body_view(snapshot).snapshot``: the anisotropies (Eq. 6-8), the Love-Weber
-stress (the arm from each body's centroid to the contact point, the branch
-vector from centroid to centroid), displacements and rotations (centroids and
-angles, matched by id). Three measures need more than the view:
-
-* :class:`BodyCoordination`: Z, touching pairs of bodies per body (a pair
-  touching at two pebbles counts once), and Z_c, contacts per body (that pair
-  counted twice); rattlers by the pairs (:meth:`BodyView.pairs`);
-* :class:`BodyStabilityIndex`: lambda with each contact's direction from the
-  body's centroid to the contact point;
-* :class:`BodyOrientation`: each body's long axis and their fabric.
-
-A snapshot whose bodies are all single disks (or without the field) is its own
-view, so each measure gives today's numbers to the bit. Formulas and choices:
-docs/fabric.md, "Measures per body".
+:func:`body_view` gives a snapshot with one particle per body, on which any
+measure runs per body; :class:`BodyCoordination`, :class:`BodyStabilityIndex`
+and :class:`BodyOrientation` need more than the view. A snapshot of single disks
+is its own view (the same bits). Formulas and choices: docs/fabric.md, "Measures
+per body".
 """
 
 from __future__ import annotations

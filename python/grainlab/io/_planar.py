@@ -1,16 +1,6 @@
 """3D input to a 2D snapshot: refuse it, or project or slice it when asked (readers only).
 
-A dump or table whose z coordinates spread by more than
-:data:`PLANAR_TOLERANCE` times the smallest radius holds spheres, not disks
-in a plane; read as 2D, its projected disks overlap everywhere (200 random
-spheres give Z = 6). The readers refuse it unless ``z_policy`` asks for
-
-* ``"project"``: every sphere becomes the disk of its radius at ``(x, y)``;
-  contacts are those of the spheres (from the contacts file, or detected in
-  3D), each with the in-plane direction of its centre line;
-* ``"slice"``: the spheres cut by the plane ``z = z0`` (``|z - z0| < r``)
-  become their cross-sections, disks of radius ``sqrt(r^2 - (z - z0)^2)``,
-  whose contacts are detected in the plane.
+The rule and the two policies: docs/analysis.md, "Files read and written" (3D data).
 """
 
 from __future__ import annotations

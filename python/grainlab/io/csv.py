@@ -1,37 +1,7 @@
-"""Particles and contacts as CSV files.
+"""Particles and contacts as CSV files, in grainlab's layout or any other through a column mapping.
 
-Particles CSV
-    A header line, then one row per particle, comma separated. Required
-    columns ``id,x,y,radius`` (SI units: m); optional ``rotation`` (rad),
-    ``kind`` (:class:`~grainlab.snapshot.ParticleKind` code), ``body``
-    (integer: the membrane chain of each membrane particle, -1 for none;
-    :meth:`Snapshot.boundary_bodies`), ``grain`` (integer >= 0: the rigid
-    body of each particle, the pebbles of a clump alike;
-    :meth:`Snapshot.grains`) with, optionally, its grain's centroid
-    ``grain_x,grain_y`` (m) and angle ``grain_angle`` (rad); any other numeric
-    column is kept in :attr:`Snapshot.particle_fields`. Column order
-    is free, names are case-insensitive; blank lines and lines starting with
-    ``#`` are skipped. A ``z`` column makes the file 3D when it is not
-    constant (within 1e-3 of the smallest radius): such a file is refused
-    unless ``z_policy`` asks for a projection or a slice.
-
-Contacts CSV
-    Header and rows ``i,j[,normal_force,shear_force]`` where ``i`` and ``j``
-    are particle *ids* from the particles file (not row numbers); forces in N
-    (normal force repulsion positive, shear force signed along rot90 of the
-    normal from i to j). Only particle–particle contacts.
-
-Other layouts
-    A ``columns`` mapping ``{role: file column}`` names the file's own
-    columns for grainlab's roles (``{"id": "ID", "x": "pos_x", "y": "pos_y"}``;
-    roles :data:`PARTICLE_ROLES` and :data:`CONTACT_ROLES`, file names
-    case-insensitive); the CLI takes it as ``--columns id=ID,x=pos_x,...``.
-    A particles file without a ``kind`` column is read as grains only and
-    warns (:class:`MissingKindWarning`): membrane or wall disks in it would
-    count as grains in Z, lambda and the fabric.
-
-Errors raise :class:`~grainlab.io.FileFormatError` (a ``ValueError``) with
-the message ``FILE:LINE: problem``.
+Columns, units, roles and the ``kind`` warning: docs/analysis.md, "Files read and
+written"; errors are :class:`~grainlab.io.FileFormatError` (``FILE:LINE: problem``).
 """
 
 from __future__ import annotations

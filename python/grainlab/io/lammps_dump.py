@@ -1,53 +1,7 @@
-"""LAMMPS / LIGGGHTS text dump files: atoms (``dump custom``) and contacts (``dump local``).
+"""LAMMPS / LIGGGHTS text dumps: atoms (``dump custom``) and contacts (``dump local``).
 
-Atoms dump (``dump ID group custom N file id x y radius ...``)
-    Frames of ``ITEM: TIMESTEP``, ``ITEM: NUMBER OF ATOMS``, ``ITEM: BOX
-    BOUNDS`` (orthogonal: ``xx yy zz`` boundary flags, ``pp`` = periodic),
-    ``ITEM: ATOMS <columns>`` and one row per atom; ``ITEM: TIME`` and
-    ``ITEM: UNITS`` are accepted. Required columns: ``id``; positions ``x y``
-    (else ``xu yu``, else scaled ``xs ys`` / ``xsu ysu``); ``radius`` (else
-    ``diameter``). ``type``, ``vx vy``, ``fx fy``, ``omegaz`` and any other
-    column are kept in :attr:`Snapshot.particle_fields` under their dump names
-    (velocities as ``velocity`` (N, 2), forces as ``force`` (N, 2)). A
-    ``z`` column that is constant (within 1e-3 of the smallest radius) is
-    dropped; 3D data is refused unless ``z_policy`` asks for a projection or a
-    slice (:func:`read_lammps_dump`). The file's units are taken as given: use
-    ``units si``.
-
-Contacts dump (``dump ID group local N file ...``)
-    Frames with ``ITEM: NUMBER OF ENTRIES`` and ``ITEM: ENTRIES <columns>``,
-    typically from ``compute property/local patom1 patom2`` (the two atom
-    ids) and ``compute pair/local dist force p1 p2 p4`` (for
-    ``gran/hooke/history``: ``force`` is the normal force, repulsion
-    positive; ``p1 p2`` the tangential force on the first atom; ``p4`` its
-    magnitude). Column roles:
-
-    ``i``, ``j``
-        atom ids of the pair (required);
-    ``normal_force``
-        normal force, repulsion positive;
-    ``fx``, ``fy``
-        the pair force on atom i (LAMMPS ``fx fy`` of ``pair/local``; for
-        granular styles the normal part only): normal force = -F.n;
-    ``shear_x``, ``shear_y``
-        tangential force on atom i: shear force = F_t . rot90(n);
-    ``shear_force``
-        signed shear force (or a magnitude, e.g. ``p4``);
-    ``dist``
-        centre distance.
-
-    Roles are found from the column names ``patom1 patom2`` / ``id1 id2`` /
-    ``atom1 atom2`` / ``i j`` (ids), ``force`` / ``fn`` / ``normal_force``,
-    ``fx fy``, ``fs`` / ``shear_force``, ``dist``; otherwise the ids are the
-    first compute whose columns ``c_NAME[1] c_NAME[2]`` hold integer atom ids.
-    Pass ``columns={"i": "c_ids[1]", "normal_force": "c_pl[2]", ...}`` to
-    say which column is which. A granular ``pair/local`` also lists pairs
-    within the force cut-off that do not touch: entries with centre distance
-    >= r_i + r_j (from ``dist`` or recomputed from the atoms with the minimum
-    image) are dropped.
-
-Multi-frame files: ``timestep=None`` takes the last frame of the atoms dump,
-and the contacts frame with the same timestep.
+Columns, the contacts' roles and how they are recognised, boundary types, labels,
+3D data and multi-frame files: docs/analysis.md, "Files read and written".
 """
 
 from __future__ import annotations

@@ -1,20 +1,8 @@
 """Figures for papers: polar fabric diagrams, particle maps, time series.
 
-All functions draw on a given matplotlib ``Axes`` (``ax=None`` creates a new
-figure with the paper style, without pyplot, so nothing global changes and
-any backend works) and return the axes; :func:`save_figure` writes PNG and
-SVG. Angles in the figures are in degrees; strains in percent, compression
-positive (docs/conventions.md).
-
-Files stay small without losing what they show: the disks of a particle map
-are one collection, rasterised inside SVG files (axes, text and band
-outlines stay vector); PNGs are written at :data:`FIGURE_DPI` with a
-256-colour palette (:func:`compact_png`), and so are the images inside SVGs.
-
-Paper figures: :func:`polar_distribution` (Figs. 6–7), :func:`particle_map`
-coloured by displacement (Fig. 11), lambda (Fig. 12) or contact count
-(Fig. 13, ``discrete=True``) with :func:`outline_shear_band`,
-:func:`anisotropy_series` (Fig. 9) and :func:`mean_lambda_series` (Fig. 14).
+Every function draws on a given ``Axes`` (``ax=None``: a new figure in the paper
+style, without pyplot) and returns it; :func:`save_figure` writes compact PNG and
+SVG files. The paper's figures each function draws: docs/analysis.md, "Figures (`grainlab.plot`)".
 """
 
 from __future__ import annotations

@@ -1,18 +1,8 @@
 """The shear band of a biaxial run, found and accepted (or not) between two snapshots.
 
-:func:`find_band` searches the grains' excess local strain since a reference
-snapshot (:class:`~grainlab.analysis.LocalStrain` on the grains only) with
-:class:`~grainlab.analysis.ShearBand`, leaving out the grains within
-:data:`EDGE_D` mean diameters of the boundary, and accepts the candidate by
-the rules of :mod:`grainlab.analysis.band_acceptance`: ShearBand's own tests,
-crossing the sample, and a permutation test against :data:`N_PERMUTATIONS`
-random rearrangements of the values (p <= 0.05, fixed seed); the second band
-by the first two. :func:`find_field_band` runs the same search and acceptance
-(one code path) on any per-grain field, Fig. 12's being
-:func:`lambda_indicator`; :func:`displacement_band` reads Fig. 11's band
-(:class:`~grainlab.analysis.DisplacementBand`); :func:`band_labels` labels the
-grains by any reading. docs/analysis.md, "Figures of a biaxial run" and
-"Three readings of the shear band".
+:func:`find_band`, :func:`find_field_band`, :func:`displacement_band` and
+:func:`band_labels`: docs/analysis.md, "Figures of a biaxial run" and "Three
+readings of the shear band".
 """
 
 from __future__ import annotations

@@ -1,27 +1,7 @@
 r"""The fabric numbers of a biaxial run, from its ``run.h5``: states, peak, shear bands.
 
-:func:`fabric_numbers` reads a run folder (or its ``run.h5``), picks its
-states, measures their fabric and finds the shear bands
-(:mod:`grainlab.postprocess.band`); :func:`analyse_run` returns the same
-together with the computed measures, for the figures
-(:mod:`grainlab.postprocess.figures`).
-
-States
-    *initial* is the first snapshot written, *final* the last, and *peak* the
-    snapshot (other than the first) whose axial strain is closest to the peak
-    of the ``stress_ratio`` time series (``peak_snapshot=`` overrides it).
-
-Shear band
-    Found on each pair (initial, peak) and (initial, final) by
-    :func:`~grainlab.postprocess.band.find_band` (its acceptance tests are
-    described there), read from the run's stored products when ``run.h5``
-    holds them (:mod:`grainlab.postprocess.products`); a band that fails
-    them is "not found" and :attr:`BandNumbers.reason` says why.
-
-Stability index
-    lambda with the library's default: contacts with membrane disks and
-    platens count as the boundary contacts of the grains; membrane disks get
-    NaN. Means are over grains with at least 2 contacts.
+:func:`fabric_numbers` and :func:`analyse_run` (with the computed measures, for
+the figures): docs/analysis.md, "Figures of a biaxial run".
 """
 
 from __future__ import annotations

@@ -1,14 +1,5 @@
-"""ParaView export of a run: one ``.vtp`` per snapshot and a ``.pvd`` time series.
-
-:func:`export_vtk` reads a run's ``run.h5``, computes each snapshot's point
-data (:func:`snapshot_arrays`: the measures of :mod:`grainlab.analysis` and
-the bands of :func:`grainlab.postprocess.band.band_labels`) and writes them
-with :mod:`grainlab.io.vtk` (the file layout is described there and in
-docs/file-formats.md, "ParaView").
-
-The ``.pvd`` collection lists the files with their time value: the
-snapshots' axial strain when it is known for every snapshot and strictly
-increasing, else their time in s under the same condition, else their index.
+"""ParaView export of a run: one ``.vtp`` per snapshot and a ``.pvd`` time series
+(docs/file-formats.md, "ParaView").
 """
 
 from __future__ import annotations

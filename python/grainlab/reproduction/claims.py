@@ -1,27 +1,7 @@
 """Every claim of the paper (Secs. 6-8), what is measured for it on each seed,
-and the rule that judges it (:mod:`.verdicts`); docs/reproduction.md lists them.
+and the rule that judges it (:mod:`.verdicts`).
 
-A :class:`Claim` reads one number per seed from the measures of that seed's
-run (:func:`~grainlab.reproduction.measures.measure_biaxial` for the biaxial
-claims, :func:`~grainlab.reproduction.measures.measure_study` for the packing
-study's) and :func:`evaluate` judges the ensemble. Tolerance bands and
-thresholds were fixed before any run:
-
-- "around" a value: +-25 % of it (a at 0.5 %: 0.135-0.225); the coordination
-  numbers, given to two digits, +-0.2;
-- the band and rest means of lambda (0.34, 0.31): +-0.015, half their
-  difference, so that the two values stay apart;
-- the isotropic-state anisotropies (0.0034, 0.009): from 0 to twice the value
-  (the same order of magnitude);
-- "near 1.5 %": 1.0-2.0 %; "almost the same strain": within 0.5 % strain;
-- "a constant": the relative change per 1 % axial strain over the end window
-  (the last 30 % of the test's strain, after the peak) within +-2 %;
-  "constant from the peak onward": final within +-5 % of the peak state;
-- "linear": R^2 of a straight line >= 0.98;
-- "lambda locates the band": ROC AUC > 0.6; "carries information": > 0.5;
-  "randomly distributed": AUC within 0.4-0.6;
-- "linearly related": R^2 >= 0.8;
-- "most" of a group: a share above 0.5.
+The claims and their tolerances, fixed before any run: docs/reproduction.md.
 """
 
 from __future__ import annotations

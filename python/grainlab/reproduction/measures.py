@@ -1,17 +1,8 @@
 """What a reproduction measures on one stored run, with the current analysis.
 
-:func:`measure_biaxial` reads a finished biaxial run (``run.h5``): the macro
-curves from its time series (stress ratio, volumetric strain) and, at every
-snapshot, the fabric recomputed from the stored contacts with the analysis
-classes (a, a_n, Z, mean lambda under both conventions) and the band-resolved
-fabric (:class:`~grainlab.analysis.band_fabric.BandFabric`) inside and outside
-the shear band that the figures' detector finds in the grains' local strain
-since the start of shearing (:func:`grainlab.postprocess.band.band_labels`:
-the accepted band and its accepted conjugate band). Nothing frozen at run time
-is used beyond the raw records and snapshots, so a newer analysis gives newer
-numbers from the same runs.
-
-:func:`measure_study` reads one seed's packing study (its ``result.json`` rows).
+:func:`measure_biaxial` recomputes a biaxial run's curves, fabric and band-resolved
+fabric from its records and snapshots; :func:`measure_study` reads one seed's
+packing study (docs/reproduction.md).
 """
 
 from __future__ import annotations
