@@ -339,60 +339,12 @@ def _checked_scalars(scalars: Mapping[str, float] | None, axial_strain: float | 
 class Snapshot:
     """One state of a 2D disk assembly: particles and their contacts.
 
-    Parameters
-    ----------
-    positions : (N, 2) float, m
-        Disk centres.
-    radii : (N,) float, m
-        Disk radii, > 0.
-    ids : (N,) int, optional
-        Stable particle labels, unique. Default ``arange(N)``.
-    rotations : (N,) float, rad, optional
-        Accumulated rotation of each disk, counter-clockwise positive.
-    kind : (N,) int, optional
-        :class:`ParticleKind` code per particle. Default all ``SOIL``.
-    contact_i : (Nc,) int, optional
-        Index of the first particle of each contact, ``0 <= i < N``.
-    contact_j : (Nc,) int, optional
-        Index of the second particle (``0 <= j < N``, ``j != i``), or
-        ``-1 - wall_id`` for a contact with wall ``wall_id``.
-    normal_force : (Nc,) float, N, optional
-        Normal force magnitude, repulsion positive.
-    shear_force : (Nc,) float, N, optional
-        Signed tangential force on particle i along ``rot90(normal)``.
-    contact_normal : (Nc, 2) float, optional
-        Unit normal from i towards j (or towards the wall). When omitted,
-        particle–particle normals are computed from the centres (minimum
-        image in periodic directions) and wall normals from ``contact_point``.
-    contact_point : (Nc, 2) float, m, optional
-        Contact point.
-    contact_fields : mapping of str to (Nc, ...) arrays, optional
-        Further per-contact data, e.g. ``overlap``, ``sliding``, ``bonded``.
-    particle_fields : mapping of str to (N, ...) arrays, optional
-        Further per-particle data, e.g. ``velocity`` (N, 2), ``force`` (N, 2);
-        ``body`` (membrane chains) and ``grain``, ``grain_centroid``,
-        ``grain_angle`` (rigid bodies) are checked as the module docstring says.
-    box : (2, 2) float, m, optional
-        ``[[xlo, xhi], [ylo, yhi]]`` of the simulation box.
-    periodic : (bool, bool)
-        Periodicity in x and y; a periodic direction needs ``box``.
-    tilt : float, m
-        A cell leaned by simple shear along x (LAMMPS's ``xy``): the images
-        along y are shifted by ``(tilt, yhi - ylo)``, the cell vectors are
-        ``a = (xhi - xlo, 0)`` and ``b = (tilt, yhi - ylo)``, its area is
-        still ``(xhi - xlo) (yhi - ylo)``. Default 0 (a rectangle); a
-        non-zero tilt needs y periodic.
-    time : float, s, optional
-    scalars : mapping of str to float, optional
-        The run's control variables at this snapshot, by name, finite: a
-        biaxial test's ``axial_strain`` (eps_11, compression positive), an
-        oedometer's ``vertical_stress_pa``, any other (a name as in
-        :mod:`grainlab.columns`).
-    axial_strain : float, optional
-        Shorthand for ``scalars={"axial_strain": axial_strain}``; read back as
-        :attr:`axial_strain` (None when the snapshot has none).
-    metadata : mapping, optional
-        Free-form provenance (source file, timestep, code, ...).
+    Every field (``positions``, ``radii``, ``ids``, ``rotations``, ``kind``, the
+    contact arrays, ``contact_fields``, ``particle_fields``, ``box``, ``periodic``,
+    ``tilt``, ``time``, ``scalars``, ``axial_strain``, ``metadata``), its shape and
+    unit: docs/analysis.md, "The snapshot". Without ``contact_normal``,
+    particle-particle normals come from the centres (minimum image) and wall
+    normals from ``contact_point``.
 
     Raises
     ------

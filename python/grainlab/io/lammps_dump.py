@@ -304,31 +304,10 @@ def read_lammps_dump(
 ) -> Snapshot:
     """Read one frame of a LAMMPS atoms dump (and its contacts) into a :class:`Snapshot`.
 
-    ``contacts`` is a ``dump local`` file (see the module docstring;
-    ``columns`` maps its roles to column names). Without it and with
-    ``detect=True``, contacts are detected from the geometry
-    (``tolerance`` in m). Atoms whose ``type`` is in ``boundary_types``
-    (e.g. frozen wall disks) get ``kind = MEMBRANE``: they bound the sample
-    but are not part of it, and contacts with them are boundary contacts.
-    ``body_column`` names an integer column (e.g. ``mol``, the molecule id of
-    a bonded chain) that says which boundary body each boundary atom belongs
-    to (:data:`~grainlab.snapshot.BODY_FIELD`); without it, boundary atoms
-    that touch one another form one body (:meth:`Snapshot.boundary_bodies`).
-    ``grain_column`` names an integer column (>= 0) that says which rigid body
-    each atom belongs to (:data:`~grainlab.snapshot.GRAIN_FIELD`): ``mol``, the
-    molecule id, for the bodies of ``fix rigid/small ... molecule``; atoms of
-    one value are the pebbles of one grain (:meth:`Snapshot.grains`), whose
-    centroid and angle a dump does not carry.
-
-    3D data (the ``z`` column, or ``zu`` / ``zs`` / ``zsu`` beside the chosen
-    x and y, spreading over more than ``PLANAR_TOLERANCE`` = 1e-3 of the
-    smallest radius) is refused with a :class:`FileFormatError` naming the
-    file and the spread, unless ``z_policy`` says what to do: ``"project"``
-    (disks of the spheres' radii at (x, y); contacts from ``contacts`` or
-    detected between the spheres in 3D, with the in-plane direction of each
-    centre line) or ``"slice"`` with ``z0`` (the spheres crossing the plane
-    z = z0, as disks of their cross-section radius; contacts detected between
-    those disks; no ``contacts`` file). ``z`` is kept in ``particle_fields``.
+    ``contacts`` is a ``dump local`` file whose roles ``columns`` names; without it
+    (and with ``detect``) contacts come from the geometry within ``tolerance`` (m).
+    ``boundary_types``, ``body_column``, ``grain_column`` and ``z_policy`` / ``z0``
+    (3D data): docs/analysis.md, "Files read and written".
     """
     check_z_policy(z_policy, z0)
     if z_policy == "slice" and contacts is not None:
