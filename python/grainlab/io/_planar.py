@@ -22,8 +22,9 @@ PLANAR_TOLERANCE = 1e-3
 Z_POLICIES = ("refuse", "project", "slice")
 
 
-def check_z_policy(z_policy: str, z0: float | None) -> None:
-    """ValueError naming ``z_policy`` / ``z0`` for a bad choice, before any reading."""
+def check_z_policy(z_policy: str, z0: float | None, contacts: Any = None) -> None:
+    """ValueError naming ``z_policy`` / ``z0`` for a bad choice (a slice takes no
+    ``contacts`` file), before any reading."""
     if z_policy not in Z_POLICIES:
         raise ValueError(f"z_policy: must be one of {', '.join(Z_POLICIES)}, got {z_policy!r}")
     if z_policy == "slice":
@@ -31,6 +32,10 @@ def check_z_policy(z_policy: str, z0: float | None) -> None:
             raise ValueError("z0: z_policy='slice' needs the height z0 (m) of the slicing plane")
     elif z0 is not None:
         raise ValueError(f"z0: only applies to z_policy='slice', not {z_policy!r}")
+    if z_policy == "slice" and contacts is not None:
+        raise ValueError(
+            "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
+        )
 
 
 @dataclass

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab.io._planar import check_z_policy, detected_snapshot, keep_planar_rows, planar
+from grainlab.io._points import pair_indices
 from grainlab.io._table import (
     FileFormatError,
     check_geometry,
@@ -25,6 +26,7 @@ from grainlab.io._table import (
     parse_float_table,
     plain,
     read_lines,
+    refuse_first,
 )
 from grainlab.snapshot import (
     BODY_FIELD,
@@ -202,15 +204,11 @@ def read_particles_csv(
     >>> s.ids.tolist(), s.n_contacts
     ([7, 8], 1)
     """
-    check_z_policy(z_policy, z0)
+    check_z_policy(z_policy, z0, contacts)
     column_map = check_column_map(columns, PARTICLE_ROLES)
     contact_map = check_column_map(contact_columns, CONTACT_ROLES, "contact_columns")
     if contact_map and contacts is None:
         raise ValueError("contact_columns: only apply to a contacts file (give contacts=)")
-    if z_policy == "slice" and contacts is not None:
-        raise ValueError(
-            "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
-        )
     names, data, numbers = _read_csv(path, PARTICLE_COLUMNS, column_map)
     if data.shape[0] == 0:
         raise FileFormatError(path, None, "no particle rows after the header")
@@ -218,10 +216,7 @@ def read_particles_csv(
     ids = integral_column(path, col["id"], numbers, "id")
     check_unique_ids(path, ids, numbers)
     radius = col["radius"]
-    bad = radius <= 0
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(path, int(numbers[k]), f"column 'radius': {plain(radius[k])} is not > 0")
+    refuse_first(path, radius <= 0, numbers, lambda k: f"column 'radius': {plain(radius[k])} is not > 0")
     kind = _kinds(path, col, numbers)
     extra = _label_fields(path, col, numbers)
     positions = np.c_[col["x"], col["y"]]
@@ -250,10 +245,8 @@ def _kinds(
         warn_missing_kind(path)
         return None
     kind = integral_column(path, col["kind"], numbers, "kind")
-    bad = ~np.isin(kind, [int(k) for k in ParticleKind])
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(path, int(numbers[k]), f"column 'kind': unknown code {int(kind[k])}")
+    refuse_first(path, ~np.isin(kind, [int(k) for k in ParticleKind]), numbers,
+                 lambda k: f"column 'kind': unknown code {int(kind[k])}")
     return kind
 
 
@@ -309,21 +302,7 @@ def attach_contacts_csv(
 ) -> Snapshot:
     """The snapshot with the contacts read from a contacts CSV (ids -> indices)."""
     c = read_contacts_csv(path, columns=columns)
-    i = snapshot.index_of(c["i"])
-    j = snapshot.index_of(c["j"])
-    for name, idx, ids in (("i", i, c["i"]), ("j", j, c["j"])):
-        bad = idx < 0
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise FileFormatError(
-                path, int(c["line"][k]), f"column {name!r}: unknown particle id {int(ids[k])}"
-            )
-    self_contact = i == j
-    if self_contact.any():
-        k = int(np.argmax(self_contact))
-        raise FileFormatError(
-            path, int(c["line"][k]), f"particle id {int(c['i'][k])} in contact with itself"
-        )
+    i, j = pair_indices(path, snapshot, (c["i"], c["j"]), ("i", "j"), c["line"], "particle", "in contact with itself")
     metadata = dict(snapshot.metadata)
     metadata["contacts"] = f"read from {path}"
     return dataclasses.replace(

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.io._planar import check_z_policy, detected_snapshot, keep_planar_rows, planar
+from grainlab.io._points import boundary_kind, pair_indices
 from grainlab.io._table import (
     MAX_LENGTH_M,
     FileFormatError,
@@ -26,8 +27,9 @@ from grainlab.io._table import (
     parse_float_table,
     plain,
     read_lines,
+    refuse_first,
 )
-from grainlab.snapshot import BODY_FIELD, GRAIN_FIELD, ParticleKind, Snapshot
+from grainlab.snapshot import BODY_FIELD, GRAIN_FIELD, Snapshot
 
 __all__ = [
     "DumpFrame",
@@ -309,11 +311,7 @@ def read_lammps_dump(
     ``boundary_types``, ``body_column``, ``grain_column`` and ``z_policy`` / ``z0``
     (3D data): docs/analysis.md, "Files read and written".
     """
-    check_z_policy(z_policy, z0)
-    if z_policy == "slice" and contacts is not None:
-        raise ValueError(
-            "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
-        )
+    check_z_policy(z_policy, z0, contacts)
     frame = _atoms_frame(path, timestep)
     col = {name: frame.data[:, k] for k, name in enumerate(frame.columns)}
     where, numbers = frame.header_line, frame.line_numbers
@@ -394,10 +392,7 @@ def _dump_radii(path: str | Path, frame: DumpFrame, col: Mapping[str, NDArray[np
             f"missing column 'radius' (or 'diameter') (columns: {' '.join(frame.columns)})",
         )
     used.add(rname)
-    bad = radius <= 0
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(path, int(frame.line_numbers[k]), f"column {rname!r}: {plain(col[rname][k])} is not > 0")
+    refuse_first(path, radius <= 0, frame.line_numbers, lambda k: f"column {rname!r}: {plain(col[rname][k])} is not > 0")
     return radius
 
 
@@ -422,9 +417,7 @@ def _dump_kinds(path: str | Path, frame: DumpFrame, col: Mapping[str, NDArray[np
         return None
     if "type" not in col:
         raise FileFormatError(path, frame.header_line, "boundary_types needs a 'type' column in the dump")
-    return np.where(
-        np.isin(col["type"], np.asarray(boundary_types, dtype=np.float64)), ParticleKind.MEMBRANE, ParticleKind.SOIL
-    )
+    return boundary_kind(col["type"], boundary_types)
 
 
 def _dump_periodic(path: str | Path, frame: DumpFrame, z_policy: str) -> tuple[bool, bool]:
@@ -536,31 +529,6 @@ def _guess_id_columns(frame: DumpFrame, atom_ids: NDArray[np.int64]) -> dict[str
     return {}
 
 
-def _pair_indices(snapshot: Snapshot, path: str | Path, frame: DumpFrame,
-                  roles: Mapping[str, int]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """The snapshot's indices of each listed pair's atoms; an unknown id or an atom
-    paired with itself is refused, naming the line."""
-    numbers = frame.line_numbers
-    id_i = integral_column(path, frame.data[:, roles["i"]], numbers, frame.columns[roles["i"]])
-    id_j = integral_column(path, frame.data[:, roles["j"]], numbers, frame.columns[roles["j"]])
-    i = snapshot.index_of(id_i)
-    j = snapshot.index_of(id_j)
-    for role, idx, vals in (("i", i, id_i), ("j", j, id_j)):
-        bad = idx < 0
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise FileFormatError(
-                path,
-                int(numbers[k]),
-                f"column {frame.columns[roles[role]]!r}: unknown atom id {int(vals[k])}",
-            )
-    same = i == j
-    if same.any():
-        k = int(np.argmax(same))
-        raise FileFormatError(path, int(numbers[k]), f"atom id {int(id_i[k])} paired with itself")
-    return i, j
-
-
 def _pair_forces(data: NDArray[np.float64], roles: Mapping[str, int],
                  n_hat: NDArray[np.float64]) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
     """Each pair's normal force (compression positive) and shear force along
@@ -598,7 +566,9 @@ def attach_lammps_contacts(
         )
     roles = _resolve_columns(path, frame, columns, np.asarray(snapshot.ids))
     data, numbers = frame.data, frame.line_numbers
-    i, j = _pair_indices(snapshot, path, frame, roles)
+    names = (frame.columns[roles["i"]], frame.columns[roles["j"]])
+    id_i, id_j = (integral_column(path, frame.data[:, roles[r]], numbers, n) for r, n in zip("ij", names, strict=True))
+    i, j = pair_indices(path, snapshot, (id_i, id_j), names, numbers, "atom", "paired with itself")
 
     d = snapshot.minimum_image(snapshot.positions[j] - snapshot.positions[i])
     dist_geom = np.hypot(d[:, 0], d[:, 1])
@@ -606,11 +576,7 @@ def attach_lammps_contacts(
     dist_3d = dist_geom if z is None else np.hypot(dist_geom, z[j] - z[i])  # projected spheres
     dist = data[:, roles["dist"]] if "dist" in roles else dist_3d
     touching = dist < snapshot.radii[i] + snapshot.radii[j]
-    if np.any(dist_geom == 0.0):
-        k = int(np.argmax(dist_geom == 0.0))
-        raise FileFormatError(
-            path, int(numbers[k]), "the two atoms of this pair have the same position"
-        )
+    refuse_first(path, dist_geom == 0.0, numbers, lambda k: "the two atoms of this pair have the same position")
     n_hat = d / dist_geom[:, None]
     normal_force, shear_force = _pair_forces(data, roles, n_hat)
 
