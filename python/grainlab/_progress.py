@@ -133,7 +133,7 @@ class _Lines(_NoProgress):
 
 def progress_bar(total: float, desc: str, *, enabled: bool = False, unit: str = "it", initial: float = 0,
                  stream: TextIO | None = None, bar_format: str | None = None) -> _NoProgress:
-    """A progress display for one phase of ``total`` units (see the module docstring).
+    """A progress display for one phase of ``total`` units (docs/cli.md).
 
     ``enabled`` False (every library call's default) shows nothing; otherwise a
     tqdm bar when ``stream`` (default ``sys.stderr``) is a terminal and plain

@@ -129,7 +129,7 @@ def has_clumps(snapshot: Snapshot) -> bool:
 
 
 def body_view(snapshot: Snapshot) -> BodyView:
-    """The bodies of ``snapshot`` (module docstring): the snapshot itself when every
+    """The bodies of ``snapshot`` (docs/fabric.md): the snapshot itself when every
     grain is one disk, else a snapshot with one particle per body.
 
     A body's centroid is its ``grain_centroid`` field, else the centroid of its

@@ -554,7 +554,7 @@ def attach_lammps_contacts(
     timestep: int | None = None,
     columns: Mapping[str, str] | None = None,
 ) -> Snapshot:
-    """The snapshot with contacts from a LAMMPS ``dump local`` file (see module docstring)."""
+    """The snapshot with contacts from a LAMMPS ``dump local`` file (docs/analysis.md)."""
     if timestep is None:
         timestep = snapshot.metadata.get("timestep")
     frame = read_dump_frames(path, timestep)

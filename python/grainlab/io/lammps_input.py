@@ -479,7 +479,7 @@ dump_modify     contacts format float %.17g
 
 def write_lammps_shear(sim: Simulation, folder: str | Path, shear: LammpsShear) -> LammpsExport:
     """Write ``sim`` and the simple shear ``shear`` as a LAMMPS run in ``folder``
-    (module docstring); returns what was written. Run it with ``mpirun -np 2 lmp
+    (docs/lammps.md); returns what was written. Run it with ``mpirun -np 2 lmp
     -in in.grainlab`` in ``folder``; read it back with :func:`read_lammps_run`.
     A packing with clumps is refused (LAMMPS cannot shear its rigid bodies:
     :func:`write_lammps_fixed_cell`)."""
@@ -496,7 +496,7 @@ def write_lammps_fixed_cell(sim: Simulation, folder: str | Path, run: LammpsFixe
 
 def check_lammps_export(sim: Simulation, protocol: LammpsShear | LammpsFixedCell) -> ContactModel:
     """Refuse, in one line, what the export of ``sim`` with ``protocol`` cannot carry
-    (walls, bonds, sheared clumps, ...: module docstring); returns the one contact
+    (walls, bonds, sheared clumps, ...: docs/lammps.md); returns the one contact
     model it writes."""
     model = _checked_state(sim, protocol)
     lammps_pair_coeff(model)  # refuses a law LAMMPS cannot say

@@ -126,7 +126,7 @@ class PendingFigures:
 
     def result(self) -> dict[str, list[Path]]:
         """``{figure name: files written}`` in the order submitted; the first
-        failure is raised again (module docstring), after the others have finished."""
+        failure is raised again (docs/analysis.md), after the others have finished."""
         self.claimed = True
         files: dict[str, list[Path]] = {}
         failure: BaseException | None = None
@@ -152,7 +152,7 @@ _current: ContextVar[FigurePool | None] = ContextVar("grainlab_figure_pool", def
 
 
 class FigurePool:
-    """Worker processes for figures (module docstring); use it as a context manager.
+    """Worker processes for figures (docs/analysis.md); use it as a context manager.
 
     ``workers``: the most processes to start (default :data:`MAX_WORKERS`; 0:
     none, every task runs here); ``tasks``: how many tasks are expected, so that

@@ -68,7 +68,7 @@ class BandNumbers:
     snapshot: str
     reference: str
     axial_strain: float
-    #: Whether the band passed the acceptance tests (module docstring).
+    #: Whether the band passed the acceptance tests (docs/analysis.md).
     found: bool
     #: Why it was not accepted ("" when found); names the candidate's numbers.
     reason: str
@@ -241,7 +241,7 @@ def _accepted_band(
     words: _Words,
 ) -> BandSearch:
     """The band of the per-grain ``field`` (N_grains,) of ``snap`` and its acceptance
-    (module docstring): the one code path of the strain band (:func:`find_band`) and
+    (docs/analysis.md): the one code path of the strain band (:func:`find_band`) and
     of the band in any field (:func:`find_field_band`), its numbers unlabelled."""
     g = snap.is_sample
     pos, rad = snap.positions[g], snap.radii[g]
@@ -348,7 +348,7 @@ def slab_members(band: ShearBand | Slab, pos: NDArray[np.float64]) -> NDArray[np
 
 
 def _band_problems(band: ShearBand, pos: NDArray[np.float64], d_mean: float) -> list[str]:
-    """Why a candidate band fails acceptance tests 1 and 2 (module docstring); [] if it passes."""
+    """Why a candidate band fails acceptance tests 1 and 2 (docs/analysis.md); [] if it passes."""
     problems = [band.reason] if not band.found else []
     tangent = np.array([np.cos(band.angle), np.sin(band.angle)])
     s = (pos - band.center) @ band.normal

@@ -337,7 +337,7 @@ def _bands(products: RunProducts, states: dict[str, RunState], k_snap: int, last
 
 
 def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> RunAnalysis:
-    """Read ``run.h5`` of ``run_dir`` and measure its states and bands (module docstring).
+    """Read ``run.h5`` of ``run_dir`` and measure its states and bands (docs/analysis.md).
 
     Raises :class:`MissingColumnError` when a column of :data:`REQUIRED_COLUMNS`
     is missing, ``ValueError`` for no snapshots, no finite stress ratio or an

@@ -51,7 +51,7 @@ def _group(label: str, values: NDArray[np.float64]) -> Group:
 
 @dataclass(frozen=True)
 class LambdaFabric:
-    """The groups and correlations of :func:`lambda_against_fabric` (module docstring)."""
+    """The groups and correlations of :func:`lambda_against_fabric` (docs/fabric.md)."""
 
     n_grains: int
     mean_lambda: float

@@ -37,7 +37,7 @@ if TYPE_CHECKING:
 
 __all__ = ["PRODUCTS", "LambdaField", "RunProducts", "store_run_products"]
 
-#: The products a run stores, with the version of the rule that makes each (module docstring).
+#: The products a run stores, with the version of the rule that makes each (docs/file-formats.md).
 PRODUCTS: dict[str, int] = {
     "stability_index": 1,
     "band_strain": 1,
@@ -191,7 +191,7 @@ def _make_items_in_file(path: str, reference: str, name: str, strain: float,
 
 # ------------------------------------------------------------------ the run's products
 class RunProducts:
-    """The analysis products of one results file (module docstring): each read from
+    """The analysis products of one results file (docs/file-formats.md): each read from
     the file's analysis group when stored there, else made anew and kept here (not
     written: :func:`store_run_products` writes them).
 
@@ -308,7 +308,7 @@ def store_run_products(
     *,
     progress: Callable[[int, int], None] | None = None,
 ) -> Results:
-    """Makes the products (module docstring) that the results file does not hold yet, one
+    """Makes the products (docs/file-formats.md) that the results file does not hold yet, one
     task per snapshot in ``pool``'s workers (in this process without one), and stores them
     in its analysis group; returns the file read again. A file that holds them all is
     left untouched. ``progress(done, total)`` is called as snapshots are finished.

@@ -120,7 +120,7 @@ class NoiseFloor:
     r"""The distribution of the anisotropy estimate for N isotropic contact normals.
 
     ``a / scale`` is Rayleigh distributed with :math:`\sigma^2 = 2 / N`
-    (module docstring); ``scale`` is 1 for the exact estimate and
+    (docs/reproduction.md); ``scale`` is 1 for the exact estimate and
     :math:`\sin\Delta\theta / \Delta\theta` for Eq. 7 on bins of width
     :math:`\Delta\theta`.
     """

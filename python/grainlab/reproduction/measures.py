@@ -132,7 +132,7 @@ def _fabric_of(snap: Any, options: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def measure_biaxial(run_dir: str | Path, options: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """Every number the claims use, of one finished biaxial run (module docstring).
+    """Every number the claims use, of one finished biaxial run (docs/reproduction.md).
 
     ``options``: analysis options (:data:`ANALYSIS_DEFAULTS`). Returns a
     JSON-ready dict: ``macro``, ``snapshots`` (one dict per snapshot, in strain

@@ -152,7 +152,7 @@ def _study_value(name: str, key: str, raw: str) -> Any:
 
 
 def parse_variant(text: str) -> Variant:
-    """The :class:`Variant` named by ``text`` (module docstring); ``ValueError`` naming it."""
+    """The :class:`Variant` named by ``text`` (docs/reproduction.md); ``ValueError`` naming it."""
     name = text.strip()
     if name == "paper":
         return Variant("paper", "biaxial", description="the paper's test: Table 1 (2 %/min), membrane boundary")

@@ -68,10 +68,10 @@ class PackingParams:
     """Diameter of the hexagonal packings' disks (Table 3's 0.875 mm read as a radius)."""
     generation_friction: float | str = GENERATION_FRICTION_SEARCH
     """Particle friction during the radius expansion: a number (fixed), or ``"search"``
-    (chosen per packing in ``[0, friction]``; see the module docstring)."""
+    (chosen per packing in ``[0, friction]``; docs/study.md)."""
     friction: float = 0.9
     """Table 2's mu: the upper end of the generation friction search (the packing is
-    measured as generated; see the module docstring)."""
+    measured as generated; docs/study.md)."""
     platen_friction: float = 0.0
     normal_stiffness: float = 8.45e7
     shear_stiffness: float = 8.45e7

@@ -178,7 +178,7 @@ def parse_plan(text: str, *, base_dir: str | os.PathLike[str] | None = None, sou
 
 
 def load_plan(path: str | os.PathLike[str]) -> Plan:
-    """Reads a plan file (see the module docstring)."""
+    """Reads a plan file (docs/study.md)."""
     p = Path(path)
     try:
         text = p.read_text()
