@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -52,9 +53,8 @@ def run_test(args: argparse.Namespace, protocol: str, overrides: Sequence[str],
     # (started when the figures are drawn: none while the test runs)
     with FigurePool(page_copies=not args.no_report):
         if runner is None:
-            result = run_named(protocol, config, args.out, resume=args.resume, progress=args.progress)
-        else:
-            result = runner(config, args.out, resume=args.resume, progress=args.progress)
+            runner = functools.partial(run_named, protocol)
+        result = runner(config, args.out, resume=args.resume, progress=args.progress)
         one_line = getattr(result, "one_line", None)
         print(one_line() if callable(one_line) else f"grainlab {protocol}: -> {result.out_dir}")
         if args.no_report or (args.resume and (result.out_dir / "report.html").exists()):

@@ -113,30 +113,40 @@ def _table_reader(fmt: str, read: Callable[..., Snapshot]) -> Callable[..., Snap
     """The :data:`READERS` entry of a particles table (CSV, PFC) read by ``read``."""
 
     def reader(
-        path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
-        columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
+        path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None,
+        tolerance: float = 0.0, columns: _Columns = None, boundary_types: Sequence[int] = (),
+        particle_columns: _Columns = None,
     ) -> Snapshot:
         _no_timestep(fmt, timestep)
         if len(boundary_types):
-            raise ValueError("boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column)")
-        return read(path, contacts=contacts, tolerance=tolerance, columns=particle_columns, contact_columns=columns)
+            raise ValueError(
+                "boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column)"
+            )
+        return read(
+            path, contacts=contacts, tolerance=tolerance, columns=particle_columns, contact_columns=columns
+        )
 
     return reader
 
 
-def _points_reader(fmt: str, read: Callable[[Path, float, Sequence[int]], Snapshot]) -> Callable[..., Snapshot]:
+def _points_reader(
+    fmt: str, read: Callable[[Path, float, Sequence[int]], Snapshot]
+) -> Callable[..., Snapshot]:
     """The :data:`READERS` entry of a file read alone, its contacts detected from the
     geometry (YADE, legacy VTK): ``read(path, tolerance, boundary_types)``."""
 
     def reader(
-        path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
-        columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
+        path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None,
+        tolerance: float = 0.0, columns: _Columns = None, boundary_types: Sequence[int] = (),
+        particle_columns: _Columns = None,
     ) -> Snapshot:
         _no_timestep(fmt, timestep)
         for name, value in (("contacts", contacts), ("contact columns", columns),
                             ("particle columns", particle_columns)):
             if value:
-                raise ValueError(f"{name}: a {fmt} is read alone (its contacts are detected from the geometry)")
+                raise ValueError(
+                    f"{name}: a {fmt} is read alone (its contacts are detected from the geometry)"
+                )
         return read(path, tolerance, boundary_types)
 
     return reader
@@ -174,7 +184,8 @@ READERS: dict[str, Callable[..., Snapshot]] = {
     "lammps-dump": _read_dump,
     "yade-text": _points_reader("YADE text export", _yade),
     "legacy-vtk": _points_reader(
-        "legacy VTK file", lambda path, tolerance, types: read_legacy_vtk(path, tolerance=tolerance, boundary_types=types)
+        "legacy VTK file",
+        lambda path, tolerance, types: read_legacy_vtk(path, tolerance=tolerance, boundary_types=types),
     ),
     "grainlab-hdf5": read_hdf5_snapshot,
 }

@@ -34,7 +34,8 @@ def check_z_policy(z_policy: str, z0: float | None, contacts: Any = None) -> Non
         raise ValueError(f"z0: only applies to z_policy='slice', not {z_policy!r}")
     if z_policy == "slice" and contacts is not None:
         raise ValueError(
-            "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
+            "contacts: z_policy='slice' takes its contacts from the cross-sections; "
+            "read it without a contacts file"
         )
 
 

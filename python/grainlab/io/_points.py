@@ -39,8 +39,10 @@ def pair_indices(
     says how) is refused, naming the line."""
     i, j = snapshot.index_of(ids[0]), snapshot.index_of(ids[1])
     for index, values, name in ((i, ids[0], columns[0]), (j, ids[1], columns[1])):
-        refuse_first(path, index < 0, line_numbers,
-                     lambda k: f"column {name!r}: unknown {what} id {int(values[k])}")  # noqa: B023 (called at once)
+        refuse_first(  # the message is made at once: the loop's names are current
+            path, index < 0, line_numbers,
+            lambda k: f"column {name!r}: unknown {what} id {int(values[k])}",  # noqa: B023
+        )
     refuse_first(path, i == j, line_numbers, lambda k: f"{what} id {int(ids[0][k])} {itself}")
     return i, j
 

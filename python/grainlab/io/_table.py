@@ -119,7 +119,10 @@ def _report_bad_row(
 
 
 def refuse_first(
-    path: str | Path, bad: NDArray[np.bool_], line_numbers: NDArray[np.int64], problem: Callable[[int], str]
+    path: str | Path,
+    bad: NDArray[np.bool_],
+    line_numbers: NDArray[np.int64],
+    problem: Callable[[int], str],
 ) -> None:
     """A :class:`FileFormatError` naming the line of the first row ``k`` where ``bad``
     holds, with the message ``problem(k)``; nothing when no row is bad."""
@@ -143,7 +146,9 @@ def integral_column(
 ) -> NDArray[np.int64]:
     """Check that a parsed column holds integers (exactly representable) and convert."""
     bad = (values != np.round(values)) | (np.abs(values) > 2.0**53)
-    refuse_first(path, bad, line_numbers, lambda k: f"column {name!r}: {plain(values[k])} is not an integer id")
+    refuse_first(
+        path, bad, line_numbers, lambda k: f"column {name!r}: {plain(values[k])} is not an integer id"
+    )
     return values.astype(np.int64)
 
 
@@ -186,9 +191,11 @@ def check_geometry(
     normal between them would be undefined)."""
     for values, name in ((positions[:, 0], position_columns[0]), (positions[:, 1], position_columns[1]),
                          (radii, "radius")):
-        refuse_first(path, np.abs(values) > MAX_LENGTH_M, line_numbers,
-                     lambda k: f"column {name!r}: {plain(values[k])} m is beyond the "  # noqa: B023 (called at once)
-                     f"{MAX_LENGTH_M:g} m grainlab reads (lengths are in metres)")
+        refuse_first(  # the message is made at once: the loop's names are current
+            path, np.abs(values) > MAX_LENGTH_M, line_numbers,
+            lambda k: f"column {name!r}: {plain(values[k])} m is beyond the "  # noqa: B023
+            f"{MAX_LENGTH_M:g} m grainlab reads (lengths are in metres)",
+        )
     if len(radii) < 2:
         return
     order = np.lexsort((positions[:, 1], positions[:, 0]))

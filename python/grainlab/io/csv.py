@@ -216,7 +216,9 @@ def read_particles_csv(
     ids = integral_column(path, col["id"], numbers, "id")
     check_unique_ids(path, ids, numbers)
     radius = col["radius"]
-    refuse_first(path, radius <= 0, numbers, lambda k: f"column 'radius': {plain(radius[k])} is not > 0")
+    refuse_first(
+        path, radius <= 0, numbers, lambda k: f"column 'radius': {plain(radius[k])} is not > 0"
+    )
     kind = _kinds(path, col, numbers)
     extra = _label_fields(path, col, numbers)
     positions = np.c_[col["x"], col["y"]]
@@ -302,7 +304,9 @@ def attach_contacts_csv(
 ) -> Snapshot:
     """The snapshot with the contacts read from a contacts CSV (ids -> indices)."""
     c = read_contacts_csv(path, columns=columns)
-    i, j = pair_indices(path, snapshot, (c["i"], c["j"]), ("i", "j"), c["line"], "particle", "in contact with itself")
+    i, j = pair_indices(
+        path, snapshot, (c["i"], c["j"]), ("i", "j"), c["line"], "particle", "in contact with itself"
+    )
     metadata = dict(snapshot.metadata)
     metadata["contacts"] = f"read from {path}"
     return dataclasses.replace(

@@ -1,4 +1,5 @@
-"""Legacy VTK particle files (``.vtk``, ASCII) as LIGGGHTS' and LAMMPS' ``dump custom/vtk`` write them.
+"""Legacy VTK particle files (``.vtk``, ASCII), as LIGGGHTS' and LAMMPS'
+``dump custom/vtk`` write them.
 
 What is read and how: docs/file-formats.md, "Formats read from other codes".
 """

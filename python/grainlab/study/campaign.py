@@ -1,5 +1,6 @@
 """A campaign: many independent runs, each in its own folder, in local processes or
-on a Dask cluster, resumable and failure-isolated (docs/study.md, "Execution, resuming, failures, seeds").
+on a Dask cluster, resumable and failure-isolated (docs/study.md, "Execution,
+resuming, failures, seeds").
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Sweep plans: a TOML file naming a base config and the parameters to vary.
 
-The plan's keys, modes and units: docs/study.md, "`grainlab sweep` and the plan format". Every value is validated
-before any run starts; errors name the key.
+The plan's keys, modes and units: docs/study.md, "`grainlab sweep` and the plan
+format". Every value is validated before any run starts; errors name the key.
 """
 
 from __future__ import annotations
