@@ -240,13 +240,8 @@ class BodyCoordination(Compute):
 
     .. math:: Z = \frac{2 N_{pairs}}{N_b}, \qquad Z_c = \frac{2 N_c}{N_b}, \qquad Z_c \ge Z,
 
-    N_pairs the touching pairs of bodies (a pair touching at two pebbles counts
-    once), N_c their contacts (that pair twice), N_b the sample bodies. The
-    rattlers are :class:`~grainlab.analysis.CoordinationNumber`'s rule on the
-    pairs: bodies left with fewer than ``min_contacts`` neighbours (a body
-    pressed by one neighbour only, at any number of points, carries no load),
-    removed iteratively; Z_m and Z_c,m count the pairs and the contacts among
-    the rest. For disks Z = Z_c and every number is CoordinationNumber's.
+    the rattlers by the pairs, as :class:`~grainlab.analysis.CoordinationNumber`'s rule;
+    for disks every number is CoordinationNumber's.
 
     Parameters
     ----------
@@ -363,18 +358,10 @@ class BodyStabilityIndex(StabilityIndex):
 class BodyOrientation(Compute):
     r"""Each body's long axis and the orientation fabric (docs/fabric.md, "Measures per body").
 
-    A body's axis is the major eigenvector of the second moment of its pebble
-    centres, weighted by their areas :math:`\pi r_p^2`, about their weighted
-    mean: for a rod or a dimer the line of its pebbles; none (NaN) for a disk
-    or a layout whose two eigenvalues differ by less than ``AXIS_TOLERANCE`` of
-    their sum (an equilateral trimer). The fabric of the axes
-    :math:`\theta_b \in [0, \pi)` is the contact normals' (Eq. 6):
-
-    .. math:: a_p = 2\left|\frac{1}{N}\sum_b e^{2i\theta_b}\right| = 2(\phi_1 - \phi_2),
-              \qquad \phi = \frac{1}{N}\sum_b u_b\otimes u_b,
-
-    0 for axes spread evenly, 2 for axes all parallel; :math:`\theta_p` the
-    direction of the major eigenvector of :math:`\phi`, in [0, pi).
+    A body's axis is the major eigenvector of its pebbles' area-weighted second moment
+    (NaN for a disk, or when the two eigenvalues differ by less than ``AXIS_TOLERANCE`` of
+    their sum); the axes' fabric is the contact normals' (Eq. 6): :math:`a_p = 2(\phi_1 -
+    \phi_2)` in [0, 2], :math:`\theta_p` in [0, pi).
     """
 
     def compute(self, snapshot: Snapshot | BodyView) -> BodyOrientation:
