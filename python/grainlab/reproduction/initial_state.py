@@ -394,11 +394,9 @@ def snapshot_initial_state(
     z, z_boundary, normals, lam, forces = _measures(snapshot)
     sample = snapshot.is_sample
     n_grains = int(sample.sum())
-    ci, cj = np.asarray(snapshot.contact_i), np.asarray(snapshot.contact_j)
-    grain_grain = (cj >= 0) & sample[ci] & sample[np.where(cj >= 0, cj, 0)]
+    grain_grain = ~np.asarray(snapshot.is_boundary_contact)
     n_c = int(grain_grain.sum())
-    counts = np.bincount(ci[grain_grain], minlength=snapshot.n_particles)
-    counts += np.bincount(cj[grain_grain], minlength=snapshot.n_particles)
+    counts = snapshot.contact_counts(include_boundary=False)
     floor = isotropic_noise_floor(max(n_c, 1))
     a_n, n_eff, force_floor_mean, force_p = _force_noise(snapshot, forces, grain_grain)
     pos = np.asarray(snapshot.positions)[sample]
