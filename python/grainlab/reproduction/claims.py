@@ -16,7 +16,7 @@ import numpy as np
 from grainlab import paper
 from grainlab._html import number
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
-from grainlab.reproduction.measures import END_WINDOW, relative_slope
+from grainlab.reproduction.measures import END_WINDOW, correlation, relative_slope
 from grainlab.reproduction.verdicts import ProportionRule, SideRule, ValueRule
 
 __all__ = ["BIAXIAL_CLAIMS", "RATE_CLAIMS", "STUDY_CLAIMS", "Claim", "band_measure", "evaluate", "single_run_rows"]
@@ -164,12 +164,7 @@ def _end_slope(m: Measures, key: str) -> float:
 
 
 def _correlation(m: Measures, a: str, b: str) -> float:
-    _, x = _series(m, a)
-    _, y = _series(m, b)
-    ok = np.isfinite(x) & np.isfinite(y)
-    if ok.sum() < 3 or np.ptp(x[ok]) == 0 or np.ptp(y[ok]) == 0:
-        return math.nan
-    return float(np.corrcoef(x[ok], y[ok])[0, 1])
+    return correlation(_series(m, a)[1], _series(m, b)[1])
 
 
 def _strain_of_max(m: Measures, key: str) -> float:

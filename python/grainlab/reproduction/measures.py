@@ -71,12 +71,12 @@ def relative_slope(x: NDArray[np.float64], y: NDArray[np.float64]) -> float:
     return float(slope * 0.01 / mean) if mean != 0 else math.nan
 
 
-def _r2(x: NDArray[np.float64], y: NDArray[np.float64]) -> float:
+def correlation(x: NDArray[np.float64], y: NDArray[np.float64]) -> float:
+    """Pearson's r of the finite pairs (NaN with fewer than 3, or a constant side)."""
     ok = np.isfinite(x) & np.isfinite(y)
     if ok.sum() < 3 or np.ptp(x[ok]) == 0 or np.ptp(y[ok]) == 0:
         return math.nan
-    r = np.corrcoef(x[ok], y[ok])[0, 1]
-    return float(r * r)
+    return float(np.corrcoef(x[ok], y[ok])[0, 1])
 
 
 def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
@@ -97,7 +97,7 @@ def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
         "peak_axial_strain": float(eps[k]),
         "peak_stress_ratio": float(q[k]),
         "peak_in_interior": peak_is_interior(eps, q),
-        "linear_r2": _r2(eps[linear], q[linear]),
+        "linear_r2": correlation(eps[linear], q[linear]) ** 2,
         "residual_stress_ratio": float(np.mean(q[window])) if window.any() else math.nan,
         "residual_relative_slope": relative_slope(eps[window], q[window]),
         "end_window_from": float(eps[window][0]) if window.any() else math.nan,

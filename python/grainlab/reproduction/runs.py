@@ -15,6 +15,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
+from grainlab.analysis.stability import LAMBDA_ANCHORS, LAMBDA_DEVIATIONS, LAMBDA_SLOTS
 from grainlab.io.results import write_json_atomic
 from grainlab.study.campaign import CampaignResult, Run, make_run
 
@@ -63,9 +64,7 @@ Kind = Literal["biaxial", "study", "analysis"]
 #: The readings of Eqs. 9-11 an analysis variant ``lambda:<key>=<value>,...`` may choose
 #: (:class:`~grainlab.analysis.StabilityIndex`'s options; the first of each is the default).
 LAMBDA_READINGS: dict[str, tuple[str, ...]] = {
-    "slots": ("angular", "list", "nearest"),
-    "anchor": ("min", "mean"),
-    "deviation": ("sum", "per_contact"),
+    "slots": LAMBDA_SLOTS, "anchor": LAMBDA_ANCHORS, "deviation": LAMBDA_DEVIATIONS
 }
 _BAND_TEXT = {
     "displacement": "the zone separating the two moving blocks of the displacement map (Fig. 11), "
