@@ -390,10 +390,6 @@ def run_reproduction(
                         table_name=RUNS_TABLE, columns=columns)
 
 
-def seeds_of(values: Sequence[int]) -> str:
-    return ", ".join(str(s) for s in values)
-
-
 def describe(plan: ReproductionPlan) -> list[str]:
     """One line per variant: what it is and what it runs."""
     lines = []
