@@ -157,10 +157,15 @@ class LammpsShear:
             raise ValueError(f"shear_rate_per_s: must be finite and non-zero, got {self.shear_rate_per_s!r}")
         if not (math.isfinite(self.final_strain) and self.final_strain > 0.0):
             raise ValueError(f"final_strain: must be a finite strain > 0, got {self.final_strain!r}")
-        if int(self.dump_every) != self.dump_every or self.dump_every < 0:
-            raise ValueError(f"dump_every: must be a whole number of steps >= 0, got {self.dump_every!r}")
-        if self.local_damping not in ("omit", "cundall"):
-            raise ValueError(f"local_damping: 'omit' or 'cundall', got {self.local_damping!r}")
+        _check_dumps_and_damping(self.dump_every, self.local_damping)
+
+
+def _check_dumps_and_damping(dump_every: int, local_damping: str) -> None:
+    """The checks of ``dump_every`` and ``local_damping`` both protocols share."""
+    if int(dump_every) != dump_every or dump_every < 0:
+        raise ValueError(f"dump_every: must be a whole number of steps >= 0, got {dump_every!r}")
+    if local_damping not in ("omit", "cundall"):
+        raise ValueError(f"local_damping: 'omit' or 'cundall', got {local_damping!r}")
 
 
 @dataclass(frozen=True)
@@ -177,10 +182,7 @@ class LammpsFixedCell:
     def __post_init__(self) -> None:
         if int(self.steps) != self.steps or self.steps < 1:
             raise ValueError(f"steps: must be a whole number of steps >= 1, got {self.steps!r}")
-        if int(self.dump_every) != self.dump_every or self.dump_every < 0:
-            raise ValueError(f"dump_every: must be a whole number of steps >= 0, got {self.dump_every!r}")
-        if self.local_damping not in ("omit", "cundall"):
-            raise ValueError(f"local_damping: 'omit' or 'cundall', got {self.local_damping!r}")
+        _check_dumps_and_damping(self.dump_every, self.local_damping)
 
 
 @dataclass(frozen=True)

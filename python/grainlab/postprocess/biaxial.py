@@ -105,27 +105,26 @@ class FabricNumbers:
     def band_found(self) -> bool:
         return self.band is not None and self.band.found
 
+    def _of_found_band(self, name: str) -> float:
+        return float(getattr(self.band, name)) if self.band is not None and self.band.found else math.nan
+
     @property
     def band_angle_deg(self) -> float:
         """Band angle at the peak snapshot, degrees (NaN when not found)."""
-        band = self.band
-        return band.angle_deg if band is not None and band.found else math.nan
+        return self._of_found_band("angle_deg")
 
     @property
     def band_thickness_diameters(self) -> float:
         """Band thickness at the peak snapshot in mean grain diameters (NaN when not found)."""
-        band = self.band
-        return band.thickness_diameters if band is not None and band.found else math.nan
+        return self._of_found_band("thickness_diameters")
 
     @property
     def mean_lambda_in_band(self) -> float:
-        band = self.band
-        return band.mean_lambda_inside if band is not None and band.found else math.nan
+        return self._of_found_band("mean_lambda_inside")
 
     @property
     def mean_lambda_outside_band(self) -> float:
-        band = self.band
-        return band.mean_lambda_outside if band is not None and band.found else math.nan
+        return self._of_found_band("mean_lambda_outside")
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready dict (NaN as None, paths as strings)."""

@@ -67,16 +67,15 @@ class Claim:
 def evaluate(claims: Sequence[Claim], measures: Sequence[Measures | None], seeds: Sequence[int],
              variant: str) -> list[dict[str, Any]]:
     """One row per claim; a seed without measures (its run failed) gives NaN."""
-    rows = []
-    for claim in claims:
-        values = []
-        for m in measures:
-            try:
-                values.append(float(claim.extract(m)) if m is not None else math.nan)
-            except (KeyError, IndexError, TypeError, ValueError, ZeroDivisionError):
-                values.append(math.nan)
-        rows.append(claim.row(values, seeds, variant))
-    return rows
+    return [claim.row([_extracted(claim, m) for m in measures], seeds, variant) for claim in claims]
+
+
+def _extracted(claim: Claim, measures: Measures | None) -> float:
+    """The claim's value in ``measures``; NaN without measures or the numbers it reads."""
+    try:
+        return float(claim.extract(measures)) if measures is not None else math.nan
+    except (KeyError, IndexError, TypeError, ValueError, ZeroDivisionError):
+        return math.nan
 
 
 def _one_run(rule: Rule, value: float) -> str:
@@ -98,10 +97,7 @@ def single_run_rows(measures: Measures, claims: Sequence[Claim] = ()) -> list[di
     event that happens). One run is not a verdict: ``grainlab reproduce`` is."""
     rows = []
     for claim in claims or BIAXIAL_CLAIMS:
-        try:
-            value = float(claim.extract(measures))
-        except (KeyError, IndexError, TypeError, ValueError, ZeroDivisionError):
-            value = math.nan
+        value = _extracted(claim, measures)
         rows.append({"id": claim.id, "statement": claim.statement, "source": claim.source,
                      "paper_value": claim.paper_value, "measure": claim.measure, "value": value,
                      "rule": claim.rule.to_dict(), "this_run": _one_run(claim.rule, value)})
