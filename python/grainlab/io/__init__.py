@@ -122,9 +122,8 @@ def _table_reader(fmt: str, read: Callable[..., Snapshot]) -> Callable[..., Snap
             raise ValueError(
                 "boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column)"
             )
-        return read(
-            path, contacts=contacts, tolerance=tolerance, columns=particle_columns, contact_columns=columns
-        )
+        return read(path, contacts=contacts, tolerance=tolerance, columns=particle_columns,
+                    contact_columns=columns)
 
     return reader
 
@@ -185,7 +184,7 @@ READERS: dict[str, Callable[..., Snapshot]] = {
     "yade-text": _points_reader("YADE text export", _yade),
     "legacy-vtk": _points_reader(
         "legacy VTK file",
-        lambda path, tolerance, types: read_legacy_vtk(path, tolerance=tolerance, boundary_types=types),
+        lambda path, tol, types: read_legacy_vtk(path, tolerance=tol, boundary_types=types),
     ),
     "grainlab-hdf5": read_hdf5_snapshot,
 }

@@ -146,9 +146,8 @@ def integral_column(
 ) -> NDArray[np.int64]:
     """Check that a parsed column holds integers (exactly representable) and convert."""
     bad = (values != np.round(values)) | (np.abs(values) > 2.0**53)
-    refuse_first(
-        path, bad, line_numbers, lambda k: f"column {name!r}: {plain(values[k])} is not an integer id"
-    )
+    refuse_first(path, bad, line_numbers,
+                 lambda k: f"column {name!r}: {plain(values[k])} is not an integer id")
     return values.astype(np.int64)
 
 

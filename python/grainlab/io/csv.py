@@ -304,9 +304,8 @@ def attach_contacts_csv(
 ) -> Snapshot:
     """The snapshot with the contacts read from a contacts CSV (ids -> indices)."""
     c = read_contacts_csv(path, columns=columns)
-    i, j = pair_indices(
-        path, snapshot, (c["i"], c["j"]), ("i", "j"), c["line"], "particle", "in contact with itself"
-    )
+    i, j = pair_indices(path, snapshot, (c["i"], c["j"]), ("i", "j"), c["line"], "particle",
+                        "in contact with itself")
     metadata = dict(snapshot.metadata)
     metadata["contacts"] = f"read from {path}"
     return dataclasses.replace(

@@ -568,9 +568,8 @@ def attach_lammps_contacts(
     roles = _resolve_columns(path, frame, columns, np.asarray(snapshot.ids))
     data, numbers = frame.data, frame.line_numbers
     names = (frame.columns[roles["i"]], frame.columns[roles["j"]])
-    id_i, id_j = (
-        integral_column(path, frame.data[:, roles[r]], numbers, n) for r, n in zip("ij", names, strict=True)
-    )
+    id_i, id_j = (integral_column(path, frame.data[:, roles[r]], numbers, n)
+                  for r, n in zip("ij", names, strict=True))
     i, j = pair_indices(path, snapshot, (id_i, id_j), names, numbers, "atom", "paired with itself")
 
     d = snapshot.minimum_image(snapshot.positions[j] - snapshot.positions[i])
@@ -579,9 +578,8 @@ def attach_lammps_contacts(
     dist_3d = dist_geom if z is None else np.hypot(dist_geom, z[j] - z[i])  # projected spheres
     dist = data[:, roles["dist"]] if "dist" in roles else dist_3d
     touching = dist < snapshot.radii[i] + snapshot.radii[j]
-    refuse_first(
-        path, dist_geom == 0.0, numbers, lambda k: "the two atoms of this pair have the same position"
-    )
+    refuse_first(path, dist_geom == 0.0, numbers,
+                 lambda k: "the two atoms of this pair have the same position")
     n_hat = d / dist_geom[:, None]
     normal_force, shear_force = _pair_forces(data, roles, n_hat)
 
