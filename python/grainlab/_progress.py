@@ -1,19 +1,6 @@
-"""The one progress display every long-running grainlab call uses.
-
-``progress_bar(total, desc, enabled=...)`` returns an object with the few
-methods the call sites need (``update``, ``set_postfix_str``, ``close``, and
-use as a context manager):
-
-- disabled (the default of every library call): it does nothing;
-- enabled, stderr a terminal: a ``tqdm`` bar, redrawn in place;
-- enabled, stderr not a terminal (a log file, a pipe): one plain line per
-  phase, no carriage returns, written as the phase passes a few milestones,
-  e.g. ``shearing: 25 % ... 50 % ... 75 % ... 100 %, done in 61.2 s``.
-
-The count is clamped to ``[0, total]``, so a phase that overshoots its total
-(a strain step past the final strain) never shows a negative time left nor
-makes tqdm warn. ``set_verbose(True)`` (``grainlab --verbose``) adds milestones
-every 10 % and the latest postfix to each of them in the plain lines.
+"""The one progress display every long-running grainlab call uses: nothing (the
+library's default), a ``tqdm`` bar on a terminal, or plain milestone lines in a
+log (docs/cli.md); the count is clamped to ``[0, total]``.
 """
 
 from __future__ import annotations
@@ -146,7 +133,7 @@ class _Lines(_NoProgress):
 
 def progress_bar(total: float, desc: str, *, enabled: bool = False, unit: str = "it", initial: float = 0,
                  stream: TextIO | None = None, bar_format: str | None = None) -> _NoProgress:
-    """A progress display for one phase of ``total`` units (see the module docstring).
+    """A progress display for one phase of ``total`` units (docs/cli.md).
 
     ``enabled`` False (every library call's default) shows nothing; otherwise a
     tqdm bar when ``stream`` (default ``sys.stderr``) is a terminal and plain

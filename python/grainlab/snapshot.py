@@ -1,48 +1,8 @@
 """The common data model between the engine, files and analysis: :class:`Snapshot`.
 
-A snapshot is one state of a 2D assembly of disks: the particles as one array
-per property (structure of arrays) and the contacts as parallel arrays.
-
-Conventions (docs/conventions.md):
-
-* SI units: positions and radii in m, rotations in rad, forces in N (per unit
-  out-of-plane thickness t = 1 m), time in s.
-* Particles are addressed by *index* ``0 .. N-1`` inside a snapshot; ``ids``
-  are the stable labels used to match particles between snapshots and files.
-* Contacts are parallel arrays of length ``Nc``. ``contact_i`` is the index of
-  the first particle. ``contact_j`` is the index of the second particle for a
-  particle–particle contact, or a *negative* code ``-1 - wall_id`` for a
-  contact between particle ``contact_i`` and wall (or other non-particle
-  boundary) ``wall_id >= 0``. Use :func:`wall_code` / :attr:`Snapshot.wall_ids`
-  rather than doing the arithmetic by hand.
-* ``contact_normal`` is the unit vector from particle i towards particle j, or
-  for a wall contact from particle i towards the wall. ``normal_force`` is the
-  normal force magnitude, compression (repulsion) positive. ``shear_force`` is
-  the signed tangential force acting on particle i along ``t = rot90(n) =
-  (-n_y, n_x)``.
-* Particle ``kind`` codes (:class:`ParticleKind`): ``SOIL`` grains,
-  ``MEMBRANE`` disks of a flexible boundary chain (not part of the sample), and
-  ``BOUNDARY`` soil grains that currently act as the flexible boundary
-  (docs/boundary.md, variant B). Analysis treats ``SOIL`` and ``BOUNDARY`` as the
-  sample and excludes ``MEMBRANE`` particles; a *boundary contact* is a contact
-  with a wall or with a membrane particle.
-* A *boundary body* is one piece of the boundary: a wall, or one chain of
-  membrane particles. The per-particle field ``particle_fields["body"]``
-  (:data:`BODY_FIELD`) labels the chain each ``MEMBRANE`` particle belongs to
-  (an integer >= 0; -1 for particles of no chain); without it the chains are
-  found from the geometry (:meth:`Snapshot.boundary_bodies`). Stability index
-  and contact counts count each boundary body once per particle by default
-  (docs/fabric.md, "Boundary contacts").
-* A *grain* is a rigid body of the sample: one disk, or a clump of disks
-  (pebbles) moved as one (docs/bodies.md). ``particle_fields["grain"]``
-  (:data:`GRAIN_FIELD`) labels the grain of each particle (an integer >= 0;
-  pebbles of one clump share it), and ``"grain_centroid"`` (N, 2) and
-  ``"grain_angle"`` (N,) carry each particle's grain's centroid and angle (the
-  same bits on every particle of one grain); without them every particle is a
-  grain of its own, at its centre, turned by its rotation
-  (:meth:`Snapshot.grains`, :meth:`Snapshot.grain_centroids`,
-  :meth:`Snapshot.grain_angles`). A simulation's snapshot has them when it has
-  clumps.
+One state of a 2D assembly of disks: particles as one array per property,
+contacts as parallel arrays. Fields, units and codes: docs/analysis.md, "The
+snapshot"; signs and boundary bodies: docs/conventions.md; grains: docs/bodies.md.
 
 Example
 -------
@@ -379,60 +339,12 @@ def _checked_scalars(scalars: Mapping[str, float] | None, axial_strain: float | 
 class Snapshot:
     """One state of a 2D disk assembly: particles and their contacts.
 
-    Parameters
-    ----------
-    positions : (N, 2) float, m
-        Disk centres.
-    radii : (N,) float, m
-        Disk radii, > 0.
-    ids : (N,) int, optional
-        Stable particle labels, unique. Default ``arange(N)``.
-    rotations : (N,) float, rad, optional
-        Accumulated rotation of each disk, counter-clockwise positive.
-    kind : (N,) int, optional
-        :class:`ParticleKind` code per particle. Default all ``SOIL``.
-    contact_i : (Nc,) int, optional
-        Index of the first particle of each contact, ``0 <= i < N``.
-    contact_j : (Nc,) int, optional
-        Index of the second particle (``0 <= j < N``, ``j != i``), or
-        ``-1 - wall_id`` for a contact with wall ``wall_id``.
-    normal_force : (Nc,) float, N, optional
-        Normal force magnitude, repulsion positive.
-    shear_force : (Nc,) float, N, optional
-        Signed tangential force on particle i along ``rot90(normal)``.
-    contact_normal : (Nc, 2) float, optional
-        Unit normal from i towards j (or towards the wall). When omitted,
-        particle–particle normals are computed from the centres (minimum
-        image in periodic directions) and wall normals from ``contact_point``.
-    contact_point : (Nc, 2) float, m, optional
-        Contact point.
-    contact_fields : mapping of str to (Nc, ...) arrays, optional
-        Further per-contact data, e.g. ``overlap``, ``sliding``, ``bonded``.
-    particle_fields : mapping of str to (N, ...) arrays, optional
-        Further per-particle data, e.g. ``velocity`` (N, 2), ``force`` (N, 2);
-        ``body`` (membrane chains) and ``grain``, ``grain_centroid``,
-        ``grain_angle`` (rigid bodies) are checked as the module docstring says.
-    box : (2, 2) float, m, optional
-        ``[[xlo, xhi], [ylo, yhi]]`` of the simulation box.
-    periodic : (bool, bool)
-        Periodicity in x and y; a periodic direction needs ``box``.
-    tilt : float, m
-        A cell leaned by simple shear along x (LAMMPS's ``xy``): the images
-        along y are shifted by ``(tilt, yhi - ylo)``, the cell vectors are
-        ``a = (xhi - xlo, 0)`` and ``b = (tilt, yhi - ylo)``, its area is
-        still ``(xhi - xlo) (yhi - ylo)``. Default 0 (a rectangle); a
-        non-zero tilt needs y periodic.
-    time : float, s, optional
-    scalars : mapping of str to float, optional
-        The run's control variables at this snapshot, by name, finite: a
-        biaxial test's ``axial_strain`` (eps_11, compression positive), an
-        oedometer's ``vertical_stress_pa``, any other (a name as in
-        :mod:`grainlab.columns`).
-    axial_strain : float, optional
-        Shorthand for ``scalars={"axial_strain": axial_strain}``; read back as
-        :attr:`axial_strain` (None when the snapshot has none).
-    metadata : mapping, optional
-        Free-form provenance (source file, timestep, code, ...).
+    Every field (``positions``, ``radii``, ``ids``, ``rotations``, ``kind``, the
+    contact arrays, ``contact_fields``, ``particle_fields``, ``box``, ``periodic``,
+    ``tilt``, ``time``, ``scalars``, ``axial_strain``, ``metadata``), its shape and
+    unit: docs/analysis.md, "The snapshot". Without ``contact_normal``,
+    particle-particle normals come from the centres (minimum image) and wall
+    normals from ``contact_point``.
 
     Raises
     ------

@@ -1,13 +1,7 @@
 r"""The band against the rest at equal contact number: is lambda more than a contact count?
 
-:class:`BandContacts` splits the grains into the strata of :data:`STRATA`
-(n = 2, 3, 4, >= 5 contacts, as lambda counts them) and gives per stratum the
-band-minus-rest mean lambda :math:`d_s`, pooled with Mantel-Haenszel weights
-:math:`w_s = n_{in,s} n_{out,s} / (n_{in,s} + n_{out,s})`, lambda's ROC AUC
-within strata pooled over band-rest pairs, and the out-of-sample AUCs of two
-logistic models of membership (the contact class alone; with lambda, one slope
-per class n >= 2; ridge-penalised, two-fold cross-fitted with
-:data:`SPLIT_SEED`). docs/analysis.md, "The band against the rest".
+:class:`BandContacts`: strata, pooled differences, AUCs and the cross-fitted
+models: docs/analysis.md, "The band against the rest".
 
 Example
 -------
@@ -99,7 +93,7 @@ def cross_fitted_scores(x: NDArray[np.float64], y: NDArray[np.bool_], seed: int 
 
 
 class BandContacts(Compute):
-    """The band against the rest at equal contact number (module docstring).
+    """The band against the rest at equal contact number (docs/analysis.md).
     """
 
     def compute(self, stability_index: ArrayLike, n_contacts: ArrayLike, members: ArrayLike) -> BandContacts:

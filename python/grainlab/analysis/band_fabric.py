@@ -1,12 +1,5 @@
-r"""Fabric inside and outside a shear band, and how well lambda alone finds the band.
-
-:class:`BandFabric` gives :data:`GROUP_MEASURES` of the band's grains and of
-the others (mean lambda under both conventions, contacts per grain, the shares
-of 0-, 1-, 2- and >= 3-contact grains, of lambda > 0.5, the mean |rotation|),
-and the ROC AUC (:func:`roc_auc`, the Mann-Whitney U over
-:math:`n_{in} n_{out}`) of per-grain lambda and of lambda coarse-grained over
-a disk (:func:`coarse_grained`) as classifiers of band membership.
-docs/analysis.md, "The band against the rest".
+r"""Fabric inside and outside a shear band, and how well lambda alone finds the band
+(docs/analysis.md, "The band against the rest").
 
 Example
 -------
@@ -124,7 +117,7 @@ def _group(
 
 class BandFabric(Compute):
     """Fabric of the grains inside and outside a band, and the AUC of lambda
-    as a classifier of band membership (module docstring).
+    as a classifier of band membership (docs/analysis.md).
 
     Parameters
     ----------

@@ -1,16 +1,8 @@
 r"""The shear band read from the grains' cumulative displacements (paper Fig. 11).
 
-:class:`DisplacementBand`: a straight slip line splits the grains into blocks
-A and B, each fitted with an affine motion of its own (1° scan, then 1.5°
-refinement); each grain's share of the blocks' relative motion,
-:math:`t = (u - u_A)\cdot\Delta / |\Delta|^2` with :math:`\Delta = u_B - u_A`,
-is 0 in block A and 1 in block B, and the band is the zone where its smoothed
-profile lies between 0.1 and 0.9. Accepted when the two blocks remove at
-least ``min_reduction`` of the residual of one affine motion,
-:math:`\rho = 1 - S_2/S_1`, the profile reaches both blocks' motions and the
-band crosses the sample (:mod:`~grainlab.analysis.band_acceptance`). The
-method and how its threshold was fixed: docs/analysis.md, "Three readings of
-the shear band".
+:class:`DisplacementBand` splits the grains by a straight slip line into two
+blocks of affine motion; the method and how its threshold was fixed:
+docs/analysis.md, "Three readings of the shear band".
 """
 
 from __future__ import annotations

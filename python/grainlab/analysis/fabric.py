@@ -1,22 +1,8 @@
 r"""Fabric measures: coordination numbers, the contact-normal distribution, anisotropy.
 
-Angles in rad, CCW from +x; a contact's normal line counts in both directions
-(:math:`\theta`, :math:`\theta + \pi`). By default only contacts between sample
-particles count (``include_boundary=True`` adds walls and membrane disks).
-
-* :math:`Z = 2 N_c / N_p`; :math:`Z_m` the same after the iterative removal of
-  the rattlers, particles with fewer than ``min_contacts`` (2) contacts.
-* Eq. 6, :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos 2(\theta-\theta_a)]`:
-  the exact :math:`a = 2|\frac{1}{W}\sum_c w_c e^{2i\theta_c}|`,
-  :math:`\theta_a = \frac12\arg\sum_c w_c e^{2i\theta_c}` in [0, pi)
-  (= :math:`2(\phi_1 - \phi_2)` of the fabric tensor
-  :math:`\phi = \frac1W\sum_c w_c n_c\otimes n_c`), and Eq. 7-8 as printed on
-  an ``ng``-bin histogram (atan2 for tan^-1; angles within ``edge_tolerance``
-  of a bin edge count half to each bin).
-* a_n: the same with each contact weighted by its normal force (N).
-
-Formulas, binning effects and lattice answers: docs/fabric.md, "Coordination
-number Z" to "Contact-force anisotropy a_n".
+Angles in rad, CCW from +x; only contacts between sample particles count unless
+``include_boundary``. Formulas (Z, Z_m, Eq. 6-8, a_n), binning effects and lattice
+answers: docs/fabric.md, "Coordination number Z" to "Contact-force anisotropy a_n".
 """
 
 from __future__ import annotations

@@ -1,12 +1,4 @@
-r"""Force chains by the criterion of Peters et al. (2005).
-
-Grains whose major principal stress exceeds the sample grains' mean (by a
-relative 1e-9) are highly stressed; two in contact are linked when their
-branch vector lies within ``angle`` (45°) of both major directions; a chain is
-a connected set of linked grains of at least ``min_grains`` (3), each grain in
-at most one. Orientation: the axial mean :math:`\tfrac12\arg\sum e^{2i\theta_l}`
-of its links, in [0, pi). docs/fabric.md, "Force chains".
-"""
+r"""Force chains by the criterion of Peters et al. (2005) (docs/fabric.md, "Force chains")."""
 
 from __future__ import annotations
 
@@ -29,7 +21,7 @@ class ForceChains(Compute):
     Grain p is highly stressed when :math:`\sigma_1^p > \bar\sigma_1`; a
     contact links two such grains when :math:`|\hat l\cdot m_p| \ge
     \cos\alpha` for both; chains are the linked sets of at least
-    ``min_grains`` grains (module docstring).
+    ``min_grains`` grains (docs/fabric.md).
 
     Parameters
     ----------

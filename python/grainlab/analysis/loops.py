@@ -1,11 +1,5 @@
-r"""The loops of the contact network: cyclomatic number and minimal loops.
-
-The contact graph: sample grains and their contacts with each other, the
-rattlers removed first by default (Thornton's rule, iteratively). The
-cyclomatic number :math:`L = E - V + C`; the minimal loops are the bounded
-faces of the planar graph of branches, traced through the half-edges, a
-loop's size its number of half-edges (a hexagonal lattice has loops of 3, a
-square one of 4). docs/fabric.md, "Loops of the contact network".
+r"""The loops of the contact network: cyclomatic number and minimal loops (docs/fabric.md,
+"Loops of the contact network").
 """
 
 from __future__ import annotations
@@ -28,7 +22,7 @@ class ContactLoops(Compute):
     .. math:: L = E - V + C,
 
     and the sizes of the bounded faces of the planar contact network
-    (module docstring).
+    (docs/fabric.md).
 
     Parameters
     ----------

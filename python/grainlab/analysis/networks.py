@@ -1,14 +1,6 @@
-r"""The strong and weak force networks (Radjai et al. 1998).
-
-Contacts between sample grains (``include_boundary`` adds walls and membrane
-disks) split at their mean normal force: strong :math:`f_n > \langle
-f_n\rangle`, weak the rest. Each network (and the whole) has its anisotropies
-(:func:`~grainlab.analysis.stress_fabric.force_anisotropies`), its stress
-(:func:`~grainlab.analysis.stress.contact_stress`, :math:`\sigma^s + \sigma^w
-= \sigma`), its deviatoric share :math:`\chi_k = \operatorname{dev}\sigma^k :
-\operatorname{dev}\sigma / \operatorname{dev}\sigma : \operatorname{dev}\sigma`
-and mean-stress share :math:`p_k / p` (each pair summing to 1).
-docs/fabric.md, "Strong and weak networks".
+r"""The strong and weak force networks (Radjai et al. 1998), split at the mean normal
+force, each with its anisotropies, stress and shares: docs/fabric.md, "Strong and
+weak networks".
 """
 
 from __future__ import annotations
@@ -77,7 +69,7 @@ class ForceNetworks(Compute):
     \operatorname{sym}(l_c \otimes f_c)` and shares
     :math:`\chi_k = \operatorname{dev}\sigma^k:\operatorname{dev}\sigma /
     \operatorname{dev}\sigma:\operatorname{dev}\sigma` and :math:`p_k/p`,
-    which sum to 1 over the two networks (module docstring).
+    which sum to 1 over the two networks (docs/fabric.md).
 
     Parameters
     ----------

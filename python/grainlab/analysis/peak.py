@@ -1,11 +1,5 @@
-"""The stress-ratio peak of a loading test, one rule for every use (the run's
-summary, its post-processing, its report and the reproduction's measures).
-
-The peak is the record with the largest stress ratio among the records whose
-axial strain and stress ratio are both finite, the first of equal maxima; the
-peak snapshot is the one whose strain is nearest the peak's, other than the
-initial state (the first snapshot) when there are more, the first of equal
-distances.
+"""The stress-ratio peak of a loading test, one rule for every use (docs/analysis.md,
+"Figures of a biaxial run").
 
 >>> peak_record([0.0, 0.01, 0.02, 0.03], [1.0, 3.0, 3.0, 2.0])
 1

@@ -1,28 +1,10 @@
 r"""Measures per body: a snapshot of pebbles read as its rigid bodies.
 
-A snapshot whose ``grain`` field groups pebbles into rigid bodies (clumps,
-docs/bodies.md) is read through :func:`body_view`, a snapshot with **one
-particle per body**: at the body's centroid, of the radius of a disk of the
-body's area, its angle as rotation, its id the smallest of its pebbles' ids.
-Every contact between pebbles of two bodies is a contact of the two bodies,
-with the pebbles' normal, contact point and forces; a contact between pebbles
-of one body (a file's contacts found from the geometry list the pebbles'
-overlaps) is none. Any measure of a snapshot then runs per body on
-``body_view(snapshot).snapshot``: the anisotropies (Eq. 6-8), the Love-Weber
-stress (the arm from each body's centroid to the contact point, the branch
-vector from centroid to centroid), displacements and rotations (centroids and
-angles, matched by id). Three measures need more than the view:
-
-* :class:`BodyCoordination`: Z, touching pairs of bodies per body (a pair
-  touching at two pebbles counts once), and Z_c, contacts per body (that pair
-  counted twice); rattlers by the pairs (:meth:`BodyView.pairs`);
-* :class:`BodyStabilityIndex`: lambda with each contact's direction from the
-  body's centroid to the contact point;
-* :class:`BodyOrientation`: each body's long axis and their fabric.
-
-A snapshot whose bodies are all single disks (or without the field) is its own
-view, so each measure gives today's numbers to the bit. Formulas and choices:
-docs/fabric.md, "Measures per body".
+:func:`body_view` gives a snapshot with one particle per body, on which any
+measure runs per body; :class:`BodyCoordination`, :class:`BodyStabilityIndex`
+and :class:`BodyOrientation` need more than the view. A snapshot of single disks
+is its own view (the same bits). Formulas and choices: docs/fabric.md, "Measures
+per body".
 """
 
 from __future__ import annotations
@@ -147,7 +129,7 @@ def has_clumps(snapshot: Snapshot) -> bool:
 
 
 def body_view(snapshot: Snapshot) -> BodyView:
-    """The bodies of ``snapshot`` (module docstring): the snapshot itself when every
+    """The bodies of ``snapshot`` (docs/fabric.md): the snapshot itself when every
     grain is one disk, else a snapshot with one particle per body.
 
     A body's centroid is its ``grain_centroid`` field, else the centroid of its
@@ -258,13 +240,8 @@ class BodyCoordination(Compute):
 
     .. math:: Z = \frac{2 N_{pairs}}{N_b}, \qquad Z_c = \frac{2 N_c}{N_b}, \qquad Z_c \ge Z,
 
-    N_pairs the touching pairs of bodies (a pair touching at two pebbles counts
-    once), N_c their contacts (that pair twice), N_b the sample bodies. The
-    rattlers are :class:`~grainlab.analysis.CoordinationNumber`'s rule on the
-    pairs: bodies left with fewer than ``min_contacts`` neighbours (a body
-    pressed by one neighbour only, at any number of points, carries no load),
-    removed iteratively; Z_m and Z_c,m count the pairs and the contacts among
-    the rest. For disks Z = Z_c and every number is CoordinationNumber's.
+    the rattlers by the pairs, as :class:`~grainlab.analysis.CoordinationNumber`'s rule;
+    for disks every number is CoordinationNumber's.
 
     Parameters
     ----------
@@ -381,18 +358,10 @@ class BodyStabilityIndex(StabilityIndex):
 class BodyOrientation(Compute):
     r"""Each body's long axis and the orientation fabric (docs/fabric.md, "Measures per body").
 
-    A body's axis is the major eigenvector of the second moment of its pebble
-    centres, weighted by their areas :math:`\pi r_p^2`, about their weighted
-    mean: for a rod or a dimer the line of its pebbles; none (NaN) for a disk
-    or a layout whose two eigenvalues differ by less than ``AXIS_TOLERANCE`` of
-    their sum (an equilateral trimer). The fabric of the axes
-    :math:`\theta_b \in [0, \pi)` is the contact normals' (Eq. 6):
-
-    .. math:: a_p = 2\left|\frac{1}{N}\sum_b e^{2i\theta_b}\right| = 2(\phi_1 - \phi_2),
-              \qquad \phi = \frac{1}{N}\sum_b u_b\otimes u_b,
-
-    0 for axes spread evenly, 2 for axes all parallel; :math:`\theta_p` the
-    direction of the major eigenvector of :math:`\phi`, in [0, pi).
+    A body's axis is the major eigenvector of its pebbles' area-weighted second moment
+    (NaN for a disk, or when the two eigenvalues differ by less than ``AXIS_TOLERANCE`` of
+    their sum); the axes' fabric is the contact normals' (Eq. 6): :math:`a_p = 2(\phi_1 -
+    \phi_2)` in [0, 2], :math:`\theta_p` in [0, pi).
     """
 
     def compute(self, snapshot: Snapshot | BodyView) -> BodyOrientation:

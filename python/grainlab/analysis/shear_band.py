@@ -1,15 +1,5 @@
-r"""The shear band as a straight slab in a per-particle strain field.
-
-A centre line at angle :math:`\beta` (CCW from +x, [0°, 180°)) and a
-thickness: the angle maximises the adjusted correlation ratio
-:math:`\eta^2_{adj}` of the strain with bins across the slab (bins that cross
-the sample only); the thickness is the full width at half height of the
-smoothed profile around its peak; a band is accepted when at least
-``min_thickness`` mean diameters thick and its ``prominence`` at least
-``min_prominence`` (:mod:`~grainlab.analysis.band_acceptance`); a second
-(conjugate) band is searched outside the first, at least 20° away.
-``inclination_degrees = min(beta, 180° - beta)``. Pass
-:attr:`LocalStrain.excess_shear_strain`. The method, its thresholds and how to
+r"""The shear band as a straight slab in a per-particle strain field (pass
+:attr:`LocalStrain.excess_shear_strain`). The method, its thresholds and how to
 read the angle: docs/fabric.md, "Shear band".
 """
 

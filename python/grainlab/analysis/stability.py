@@ -1,23 +1,8 @@
 r"""The geometrical stability index lambda (paper Sec. 5, Eqs. 9-11).
 
-For ``n >= 2`` contacts at angles :math:`\phi_0 \le \dots \le \phi_{n-1}` in
-[0, 2 pi), with each contact ``k`` as the reference of the stable arrangement
-:math:`\phi_k + 2\pi m/n`,
-
-.. math::
-
-   dS_n^{(k)} = \sum_{m=0}^{n-1}\left|\operatorname{wrap}\!\left(\phi_{(k+m) \bmod n}
-   - \phi_k - \tfrac{2\pi m}{n}\right)\right|,\qquad
-   \lambda = \frac{\min_k dS_n^{(k)}}{2\pi},
-
-and :math:`\lambda = 1` for 0 or 1 contact. Equal spacing gives 0; 0° and 90°
-give 1/4; 0°, 60°, 120° give 1/3. lambda lies in
-:math:`[0, \lfloor n^2/4\rfloor / n]`, so boundary bodies count once per grain
-by default. The keywords ``slots`` (``"angular"``, ``"list"``, ``"nearest"``),
-``anchor`` (``"min"``, ``"mean"``) and ``deviation`` (``"sum"``,
-``"per_contact"``) choose other readings of Eqs. 9-10; only the default runs
-in the compiled kernel. Definitions, range, readings and the implementation:
-docs/fabric.md, "Geometrical stability index λ".
+Definition, range, the readings ``slots`` / ``anchor`` / ``deviation`` (only the
+default runs in the compiled kernel) and boundary bodies: docs/fabric.md,
+"Geometrical stability index λ".
 """
 
 from __future__ import annotations
@@ -48,7 +33,7 @@ __all__ = [
     "stability_index_of_angles",
 ]
 
-#: Readings of Eq. 9-11 (module docstring), the default first in each.
+#: Readings of Eq. 9-11 (docs/fabric.md), the default first in each.
 LAMBDA_SLOTS = ("angular", "list", "nearest")
 LAMBDA_ANCHORS = ("min", "mean")
 LAMBDA_DEVIATIONS = ("sum", "per_contact")
@@ -87,7 +72,7 @@ def _group_reading(
     angles: NDArray[np.float64], n: int, slots: str, anchor: str, deviation: str
 ) -> NDArray[np.float64]:
     """lambda of an (m, n) block of contact angles in [0, 2 pi], each row in the
-    order its contacts were given, under any reading (module docstring)."""
+    order its contacts were given, under any reading (docs/fabric.md)."""
     step = TWO_PI / n
     if slots == "nearest":
         diff = angles[:, None, :] - angles[:, :, None]  # [row, k, j] = phi_j - phi_k
@@ -247,7 +232,7 @@ def lambda_of(
 class StabilityIndex(Compute):
     r"""Geometrical stability index lambda of every particle (paper Sec. 5).
 
-    See the module docstring for the formula. Contact angles come from the
+    The formula: docs/fabric.md. Contact angles come from the
     snapshot's contact normals (direction from the particle's centre towards
     the other particle or the wall, docs/conventions.md).
 

@@ -1,14 +1,7 @@
 r"""Kinematics between two snapshots: displacement, rotation, local strain, D2min.
 
 Particles matched by id; results indexed like the current snapshot, NaN where
-unmatched. Per particle, the best-fit :math:`F_i = X_i Y_i^{-1}` of its
-reference neighbours' branch vectors (Falk & Langer 1998),
-:math:`D^2_{min} = \sum_j |d_{ij} - F_i d^0_{ij}|^2` (m²); strain compression
-positive, small :math:`I - \tfrac12(F + F^T)` or Green :math:`-\tfrac12(F^TF -
-I)`; shear strain :math:`\gamma = \sqrt{(\varepsilon_{xx} -
-\varepsilon_{yy})^2 + 4\varepsilon_{xy}^2}`, and the excess shear strain, the
-same of :math:`\varepsilon_i - \bar\varepsilon` (:math:`\bar\varepsilon` the
-component-wise median). docs/fabric.md, "Local strain and D2min".
+unmatched. Formulas and signs: docs/fabric.md, "Local strain and D2min".
 """
 
 from __future__ import annotations
@@ -107,7 +100,7 @@ def _deformation_gradients(
 class LocalStrain(Compute):
     r"""Displacement, rotation, best-fit local strain and D2min between two snapshots.
 
-    See the module docstring for the formulas and sign conventions.
+    Formulas and sign conventions: docs/fabric.md.
 
     Parameters
     ----------

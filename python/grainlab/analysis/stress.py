@@ -1,16 +1,7 @@
 r"""Love-Weber stress from contact forces: of each grain, of a region, of a set of contacts.
 
-Compression positive, Pa, unit thickness. For the particles ``p`` of a region
-of area ``A``, with the forces ``f_c`` on ``p`` at the contact points ``x_c``,
-
-.. math:: \sigma = -\frac{1}{A}\sum_p\sum_{c \ni p}\operatorname{sym}((x_c - x_p)\otimes f_c),
-
-every contact of a selected particle counted (walls and particles outside
-included: in equilibrium, the boundary stress). The contact (branch-vector)
-form :math:`\frac1A\sum_{c\in C}\operatorname{sym}(l_c\otimes(-f^i_c))` is
-linear in the contacts (:func:`contact_stress`); a grain's stress divides by
-:math:`\pi r_p^2` or any area given. Forces, contact points and branch
-vectors: docs/fabric.md, "Stress: grains, regions and sets of contacts".
+Compression positive, Pa, unit thickness. Forms, contact points and branch vectors:
+docs/fabric.md, "Stress: grains, regions and sets of contacts".
 """
 
 from __future__ import annotations

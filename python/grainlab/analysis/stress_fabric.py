@@ -1,23 +1,7 @@
 r"""Satake's fabric tensor and Rothenburg and Bathurst's stress-force-fabric relation.
 
-Contacts between sample grains by default (``include_boundary`` adds walls and
-membrane disks), each once, normal :math:`n_c` from i to j.
-:math:`\phi_{ij} = \frac{1}{N_c}\sum_c n_i n_j` (trace 1),
-:math:`\phi_{ijkl}` its fourth-order companion, :math:`b_4 = |\langle
-e^{4i\theta}\rangle|`, and with forces the strong and weak parts. The forms
-:math:`E(\theta)`, :math:`\bar f_n = f_0[1 + a_n\cos 2(\theta-\theta_n)]`,
-:math:`\bar f_t = f_0 a_t\sin 2(\theta-\theta_t)` (and the branch lengths'
-:math:`a_l`) are least-squares fits to the contacts (NaN with normals in
-fewer than three directions modulo 180°), and
-
-.. math::
-
-   \frac{q}{p} = \frac{\sigma_1 - \sigma_2}{\sigma_1 + \sigma_2} \approx
-   \tfrac12\left[a\cos 2(\theta_a - \theta_\sigma) + a_n\cos 2(\theta_n -
-   \theta_\sigma) + a_t\cos 2(\theta_t - \theta_\sigma)\right].
-
-Fits, signs and known answers: docs/fabric.md, "Fabric tensor (Satake)" and
-"Stress-force-fabric relation".
+Definitions, fits, signs and known answers: docs/fabric.md, "Fabric tensor
+(Satake)" and "Stress-force-fabric relation".
 """
 
 from __future__ import annotations
@@ -128,7 +112,7 @@ class FabricTensor(Compute):
        \phi^{w} = \phi - \phi^{s},
 
     :math:`a = 2(\phi_1 - \phi_2)`, :math:`b_4 = |\langle e^{4i\theta}\rangle|`
-    (module docstring). 2D prefactors: :math:`\operatorname{tr}\phi = 1`.
+    (docs/fabric.md). 2D prefactors: :math:`\operatorname{tr}\phi = 1`.
 
     Parameters
     ----------
@@ -226,7 +210,7 @@ class StressForceFabric(Compute):
 
     the stress :math:`\sigma` of the contacts used (their contact form,
     :func:`~grainlab.analysis.stress.contact_stress`) and the anisotropies
-    fitted to the same contacts (module docstring). :attr:`residual` is
+    fitted to the same contacts (docs/fabric.md). :attr:`residual` is
     measured − predicted; :attr:`sigma_ratio` and
     :attr:`predicted_sigma_ratio` are :math:`\sigma_1/\sigma_2 = (1 +
     q/p)/(1 - q/p)` of each. Needs normal forces; shear forces optional

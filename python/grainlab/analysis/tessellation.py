@@ -1,13 +1,5 @@
-r"""The power diagram (radical Voronoi tessellation) of a disk packing and local porosity.
-
-The cell of disk p is :math:`\{x : |x - x_p|^2 - r_p^2 \le |x - x_q|^2 - r_q^2\
-\forall q\}`; the local porosity :math:`n_p = 1 - \pi r_p^2 / A_p` (unit
-thickness) and the sample's :math:`1 - \sum_p \pi r_p^2 / \sum_p A_p` over
-its grains. The region is the snapshot's (:func:`~grainlab.analysis._util.sample_bounds`),
-tessellated with periodic images or mirror images across bounded edges, so
-the cells sum to its area; every particle has a cell. The diagram is the dual
-of the lower convex hull of the lifted points (Qhull). docs/fabric.md,
-"Local porosity".
+r"""The power diagram (radical Voronoi tessellation) of a disk packing and local porosity
+(docs/fabric.md, "Local porosity").
 """
 
 from __future__ import annotations
@@ -112,7 +104,7 @@ def _rim_sites(faces: NDArray[np.int64], n_points: int) -> NDArray[np.int64]:
 
 def power_cells(snapshot: Snapshot) -> PowerCells:
     """The power cells (radical Voronoi tessellation) of every particle of
-    ``snapshot`` over its region (module docstring)."""
+    ``snapshot`` over its region (docs/fabric.md)."""
     from scipy.spatial import ConvexHull
 
     tilt = float(snapshot.tilt)
@@ -196,7 +188,7 @@ class LocalPorosity(Compute):
     .. math:: n_p = 1 - \frac{\pi r_p^2}{A_p},\qquad
               n = 1 - \frac{\sum_p \pi r_p^2}{\sum_p A_p}\ \text{(sample grains)},
 
-    :math:`A_p` the area of grain p's power cell (module docstring). A
+    :math:`A_p` the area of grain p's power cell (docs/fabric.md). A
     periodic hexagonal lattice of touching disks of diameter d has hexagonal
     cells of area :math:`\tfrac{\sqrt3}{2} d^2`, so
     :math:`n_p = 1 - \pi/(2\sqrt3) = 0.0931`.

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import functools
+from collections.abc import Callable, Sequence
+from typing import Any
 
 from grainlab.protocols.registry import PROTOCOLS, resolve_config, run_named
 
@@ -19,32 +22,43 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         ),
     )
     parser.add_argument("protocol", choices=sorted(PROTOCOLS), help="the test to run")
-    parser.add_argument("--out", default="results", help="results folder (default: results)")
-    parser.add_argument("--config", help="TOML file with [sample], [material], ... sections")
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help='override one key, e.g. --set "oedometer.vertical_stresses=[200 kPa, 400 kPa]"',
-    )
-    parser.add_argument("--quick", action="store_true", help="a small sample of a few hundred disks")
-    parser.add_argument("--resume", action="store_true", help="continue the killed run in --out")
-    parser.add_argument("--no-report", action="store_true", help="do not write report.html at the end")
+    add_test_arguments(parser, '--set "oedometer.vertical_stresses=[200 kPa, 400 kPa]"')
     parser.set_defaults(func=run)
 
 
+def add_test_arguments(parser: argparse.ArgumentParser, set_example: str) -> None:
+    """The options of every command that runs a test: --out, --config, --set, --quick,
+    --resume and --no-report."""
+    parser.add_argument("--out", default="results", help="results folder (default: results)")
+    parser.add_argument("--config", help="TOML file with [sample], [material], ... sections")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help=f"override one key, e.g. {set_example}")
+    parser.add_argument("--quick", action="store_true", help="a small sample of a few hundred disks")
+    parser.add_argument("--resume", action="store_true", help="continue the killed run in --out")
+    parser.add_argument("--no-report", action="store_true", help="do not write report.html at the end")
+
+
 def run(args: argparse.Namespace) -> int:
-    config = resolve_config(args.protocol, args.config, args.overrides, quick=args.quick)
+    return run_test(args, args.protocol, args.overrides)
+
+
+def run_test(args: argparse.Namespace, protocol: str, overrides: Sequence[str],
+             runner: Callable[..., Any] | None = None) -> int:
+    """Runs test ``protocol`` as ``args`` say (:func:`add_test_arguments`), then writes its
+    report; ``runner(config, out, resume=, progress=)`` runs it (default :func:`run_named`)."""
+    config = resolve_config(protocol, args.config, overrides, quick=args.quick)
     from grainlab.plot.workers import FigurePool  # matplotlib: imported once the command is valid
 
+    # one set of worker processes draws the run's figures and then serves the report
+    # (started when the figures are drawn: none while the test runs)
     with FigurePool(page_copies=not args.no_report):
-        result = run_named(args.protocol, config, args.out, resume=args.resume, progress=args.progress)
+        if runner is None:
+            runner = functools.partial(run_named, protocol)
+        result = runner(config, args.out, resume=args.resume, progress=args.progress)
         one_line = getattr(result, "one_line", None)
-        print(one_line() if callable(one_line) else f"grainlab {args.protocol}: -> {result.out_dir}")
+        print(one_line() if callable(one_line) else f"grainlab {protocol}: -> {result.out_dir}")
         if args.no_report or (args.resume and (result.out_dir / "report.html").exists()):
-            return 0
+            return 0  # a report is written last (atomically): one there is this finished run's
         from grainlab.commands.report import write_after_run
 
-        return write_after_run(result.out_dir, args.protocol, quiet=args.quiet)
+        return write_after_run(result.out_dir, protocol, quiet=args.quiet)

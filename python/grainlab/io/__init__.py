@@ -109,60 +109,52 @@ def _no_timestep(fmt: str, timestep: int | None) -> None:
         raise ValueError(f"timestep: only applies to LAMMPS dumps and run.h5, not to a {fmt}")
 
 
-def _read_csv(
-    path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
-    columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
-) -> Snapshot:
-    _no_timestep("particles CSV", timestep)
-    if len(boundary_types):
-        raise ValueError(
-            "boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column in a CSV)"
-        )
-    if columns and contacts is None:
-        raise ValueError("contact columns: only apply to a contacts file (give one)")
-    return read_particles_csv(
-        path, contacts=contacts, tolerance=tolerance, columns=particle_columns, contact_columns=columns
-    )
+def _table_reader(fmt: str, read: Callable[..., Snapshot]) -> Callable[..., Snapshot]:
+    """The :data:`READERS` entry of a particles table (CSV, PFC) read by ``read``."""
+
+    def reader(
+        path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None,
+        tolerance: float = 0.0, columns: _Columns = None, boundary_types: Sequence[int] = (),
+        particle_columns: _Columns = None,
+    ) -> Snapshot:
+        _no_timestep(fmt, timestep)
+        if len(boundary_types):
+            raise ValueError(
+                "boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column)"
+            )
+        return read(path, contacts=contacts, tolerance=tolerance, columns=particle_columns,
+                    contact_columns=columns)
+
+    return reader
 
 
-def _read_pfc(
-    path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
-    columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
-) -> Snapshot:
-    _no_timestep("PFC ball table", timestep)
-    if len(boundary_types):
-        raise ValueError("boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column)")
-    return read_pfc_balls(
-        path, contacts=contacts, tolerance=tolerance, columns=particle_columns, contact_columns=columns
-    )
+def _points_reader(
+    fmt: str, read: Callable[[Path, float, Sequence[int]], Snapshot]
+) -> Callable[..., Snapshot]:
+    """The :data:`READERS` entry of a file read alone, its contacts detected from the
+    geometry (YADE, legacy VTK): ``read(path, tolerance, boundary_types)``."""
+
+    def reader(
+        path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None,
+        tolerance: float = 0.0, columns: _Columns = None, boundary_types: Sequence[int] = (),
+        particle_columns: _Columns = None,
+    ) -> Snapshot:
+        _no_timestep(fmt, timestep)
+        for name, value in (("contacts", contacts), ("contact columns", columns),
+                            ("particle columns", particle_columns)):
+            if value:
+                raise ValueError(
+                    f"{name}: a {fmt} is read alone (its contacts are detected from the geometry)"
+                )
+        return read(path, tolerance, boundary_types)
+
+    return reader
 
 
-def _points_only(
-    fmt: str, contacts: _PathOrNone, timestep: int | None, columns: _Columns, particle_columns: _Columns
-) -> None:
-    _no_timestep(fmt, timestep)
-    for name, value in (("contacts", contacts), ("contact columns", columns),
-                        ("particle columns", particle_columns)):
-        if value:
-            raise ValueError(f"{name}: a {fmt} is read alone (its contacts are detected from the geometry)")
-
-
-def _read_yade(
-    path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
-    columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
-) -> Snapshot:
-    _points_only("YADE text export", contacts, timestep, columns, particle_columns)
+def _yade(path: Path, tolerance: float, boundary_types: Sequence[int]) -> Snapshot:
     if len(boundary_types):
         raise ValueError("boundary types: a YADE file has no atom types (read_yade_text(boundary_materials=...))")
     return read_yade_text(path, tolerance=tolerance)
-
-
-def _read_vtk(
-    path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None, tolerance: float = 0.0,
-    columns: _Columns = None, boundary_types: Sequence[int] = (), particle_columns: _Columns = None,
-) -> Snapshot:
-    _points_only("legacy VTK file", contacts, timestep, columns, particle_columns)
-    return read_legacy_vtk(path, tolerance=tolerance, boundary_types=boundary_types)
 
 
 def _read_dump(
@@ -186,11 +178,14 @@ def _read_dump(
 #: Reader per format name: ``reader(path, *, contacts, timestep, tolerance, columns,
 #: boundary_types, particle_columns) -> Snapshot``.
 READERS: dict[str, Callable[..., Snapshot]] = {
-    "particles-csv": _read_csv,
-    "pfc-csv": _read_pfc,
+    "particles-csv": _table_reader("particles CSV", read_particles_csv),
+    "pfc-csv": _table_reader("PFC ball table", read_pfc_balls),
     "lammps-dump": _read_dump,
-    "yade-text": _read_yade,
-    "legacy-vtk": _read_vtk,
+    "yade-text": _points_reader("YADE text export", _yade),
+    "legacy-vtk": _points_reader(
+        "legacy VTK file",
+        lambda path, tol, types: read_legacy_vtk(path, tolerance=tol, boundary_types=types),
+    ),
     "grainlab-hdf5": read_hdf5_snapshot,
 }
 

@@ -1,16 +1,6 @@
 """3D input to a 2D snapshot: refuse it, or project or slice it when asked (readers only).
 
-A dump or table whose z coordinates spread by more than
-:data:`PLANAR_TOLERANCE` times the smallest radius holds spheres, not disks
-in a plane; read as 2D, its projected disks overlap everywhere (200 random
-spheres give Z = 6). The readers refuse it unless ``z_policy`` asks for
-
-* ``"project"``: every sphere becomes the disk of its radius at ``(x, y)``;
-  contacts are those of the spheres (from the contacts file, or detected in
-  3D), each with the in-plane direction of its centre line;
-* ``"slice"``: the spheres cut by the plane ``z = z0`` (``|z - z0| < r``)
-  become their cross-sections, disks of radius ``sqrt(r^2 - (z - z0)^2)``,
-  whose contacts are detected in the plane.
+The rule and the two policies: docs/analysis.md, "Files read and written" (3D data).
 """
 
 from __future__ import annotations
@@ -32,8 +22,9 @@ PLANAR_TOLERANCE = 1e-3
 Z_POLICIES = ("refuse", "project", "slice")
 
 
-def check_z_policy(z_policy: str, z0: float | None) -> None:
-    """ValueError naming ``z_policy`` / ``z0`` for a bad choice, before any reading."""
+def check_z_policy(z_policy: str, z0: float | None, contacts: Any = None) -> None:
+    """ValueError naming ``z_policy`` / ``z0`` for a bad choice (a slice takes no
+    ``contacts`` file), before any reading."""
     if z_policy not in Z_POLICIES:
         raise ValueError(f"z_policy: must be one of {', '.join(Z_POLICIES)}, got {z_policy!r}")
     if z_policy == "slice":
@@ -41,6 +32,11 @@ def check_z_policy(z_policy: str, z0: float | None) -> None:
             raise ValueError("z0: z_policy='slice' needs the height z0 (m) of the slicing plane")
     elif z0 is not None:
         raise ValueError(f"z0: only applies to z_policy='slice', not {z_policy!r}")
+    if z_policy == "slice" and contacts is not None:
+        raise ValueError(
+            "contacts: z_policy='slice' takes its contacts from the cross-sections; "
+            "read it without a contacts file"
+        )
 
 
 @dataclass

@@ -9,7 +9,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.io._planar import detected_snapshot, planar
-from grainlab.io._table import FileFormatError, check_geometry, check_unique_ids, plain
+from grainlab.io._table import (
+    FileFormatError,
+    check_geometry,
+    check_unique_ids,
+    plain,
+    refuse_first,
+)
 from grainlab.snapshot import ParticleKind, Snapshot
 
 
@@ -17,6 +23,28 @@ def boundary_kind(codes: NDArray[Any], boundary: Any) -> NDArray[np.int8]:
     """Kind MEMBRANE where ``codes`` (atom types, material ids) is one of ``boundary``, else SOIL."""
     bounding = np.isin(codes, np.asarray(list(boundary), dtype=np.float64))
     return np.where(bounding, ParticleKind.MEMBRANE, ParticleKind.SOIL).astype(np.int8)
+
+
+def pair_indices(
+    path: str | Path,
+    snapshot: Snapshot,
+    ids: tuple[NDArray[np.int64], NDArray[np.int64]],
+    columns: tuple[str, str],
+    line_numbers: NDArray[np.int64],
+    what: str,
+    itself: str,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The snapshot's indices of the pairs of ``what`` ids (``"particle"``, ``"atom"``) a
+    contacts file lists in ``columns``; an unknown id or one paired with itself (``itself``
+    says how) is refused, naming the line."""
+    i, j = snapshot.index_of(ids[0]), snapshot.index_of(ids[1])
+    for index, values, name in ((i, ids[0], columns[0]), (j, ids[1], columns[1])):
+        refuse_first(  # the message is made at once: the loop's names are current
+            path, index < 0, line_numbers,
+            lambda k: f"column {name!r}: unknown {what} id {int(values[k])}",  # noqa: B023
+        )
+    refuse_first(path, i == j, line_numbers, lambda k: f"{what} id {int(ids[0][k])} {itself}")
+    return i, j
 
 
 def snapshot_from_points(
@@ -43,10 +71,7 @@ def snapshot_from_points(
     if radii.shape[0] == 0:
         raise FileFormatError(path, None, "no particles in the file")
     check_unique_ids(path, ids, line_numbers)
-    bad = ~(radii > 0)
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(path, int(line_numbers[k]), f"radius {plain(radii[k])} is not > 0")
+    refuse_first(path, ~(radii > 0), line_numbers, lambda k: f"radius {plain(radii[k])} is not > 0")
     if not (0 <= tolerance < np.inf):
         raise ValueError(f"tolerance: must be a finite value >= 0 m, got {tolerance}")
     plan = planar(path, None, z, radii, z_policy=z_policy, z0=z0)

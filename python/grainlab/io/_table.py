@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -118,16 +118,36 @@ def _report_bad_row(
     raise FileFormatError(path, None, "could not parse the numeric table")
 
 
+def refuse_first(
+    path: str | Path,
+    bad: NDArray[np.bool_],
+    line_numbers: NDArray[np.int64],
+    problem: Callable[[int], str],
+) -> None:
+    """A :class:`FileFormatError` naming the line of the first row ``k`` where ``bad``
+    holds, with the message ``problem(k)``; nothing when no row is bad."""
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise FileFormatError(path, int(line_numbers[k]), problem(k))
+
+
+def _first_repeat(order: NDArray[np.int64], repeated: NDArray[np.bool_]) -> tuple[int, int] | None:
+    """The rows (first, second) of the first pair of neighbours in ``order`` that
+    ``repeated`` marks, in file order; None when there is none."""
+    if not repeated.any():
+        return None
+    k = int(np.argmax(repeated))
+    first, second = sorted((int(order[k]), int(order[k + 1])))
+    return first, second
+
+
 def integral_column(
     path: str | Path, values: NDArray[np.float64], line_numbers: NDArray[np.int64], name: str
 ) -> NDArray[np.int64]:
     """Check that a parsed column holds integers (exactly representable) and convert."""
     bad = (values != np.round(values)) | (np.abs(values) > 2.0**53)
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(
-            path, int(line_numbers[k]), f"column {name!r}: {plain(values[k])} is not an integer id"
-        )
+    refuse_first(path, bad, line_numbers,
+                 lambda k: f"column {name!r}: {plain(values[k])} is not an integer id")
     return values.astype(np.int64)
 
 
@@ -137,12 +157,8 @@ def label_column(
     """An integer column of ``what`` labels (``"body"``, ``"grain"``), each >= ``least``; the
     error names the line of the first that is not."""
     labels = integral_column(path, values, line_numbers, name)
-    bad = labels < least
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(
-            path, int(line_numbers[k]), f"column {name!r}: {int(labels[k])} is not a {what} label (>= {least})"
-        )
+    refuse_first(path, labels < least, line_numbers,
+                 lambda k: f"column {name!r}: {int(labels[k])} is not a {what} label (>= {least})")
     return labels
 
 
@@ -151,10 +167,9 @@ def check_unique_ids(
 ) -> None:
     """Raise naming the line of the second occurrence of a duplicate id."""
     order = np.argsort(ids, kind="stable")
-    dup = ids[order[1:]] == ids[order[:-1]]
-    if dup.any():
-        k = int(np.argmax(dup))
-        first, second = sorted((int(order[k]), int(order[k + 1])))
+    pair = _first_repeat(order, ids[order[1:]] == ids[order[:-1]])
+    if pair is not None:
+        first, second = pair
         raise FileFormatError(
             path,
             int(line_numbers[second]),
@@ -175,22 +190,17 @@ def check_geometry(
     normal between them would be undefined)."""
     for values, name in ((positions[:, 0], position_columns[0]), (positions[:, 1], position_columns[1]),
                          (radii, "radius")):
-        bad = np.abs(values) > MAX_LENGTH_M
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise FileFormatError(
-                path,
-                int(line_numbers[k]),
-                f"column {name!r}: {plain(values[k])} m is beyond the {MAX_LENGTH_M:g} m grainlab reads "
-                "(lengths are in metres)",
-            )
+        refuse_first(  # the message is made at once: the loop's names are current
+            path, np.abs(values) > MAX_LENGTH_M, line_numbers,
+            lambda k: f"column {name!r}: {plain(values[k])} m is beyond the "  # noqa: B023
+            f"{MAX_LENGTH_M:g} m grainlab reads (lengths are in metres)",
+        )
     if len(radii) < 2:
         return
     order = np.lexsort((positions[:, 1], positions[:, 0]))
-    same = np.all(positions[order[1:]] == positions[order[:-1]], axis=1)
-    if same.any():
-        k = int(np.argmax(same))
-        first, second = sorted((int(order[k]), int(order[k + 1])))
+    pair = _first_repeat(order, np.all(positions[order[1:]] == positions[order[:-1]], axis=1))
+    if pair is not None:
+        first, second = pair
         raise FileFormatError(
             path,
             int(line_numbers[second]),

@@ -1,37 +1,7 @@
-"""Particles and contacts as CSV files.
+"""Particles and contacts as CSV files, in grainlab's layout or any other through a column mapping.
 
-Particles CSV
-    A header line, then one row per particle, comma separated. Required
-    columns ``id,x,y,radius`` (SI units: m); optional ``rotation`` (rad),
-    ``kind`` (:class:`~grainlab.snapshot.ParticleKind` code), ``body``
-    (integer: the membrane chain of each membrane particle, -1 for none;
-    :meth:`Snapshot.boundary_bodies`), ``grain`` (integer >= 0: the rigid
-    body of each particle, the pebbles of a clump alike;
-    :meth:`Snapshot.grains`) with, optionally, its grain's centroid
-    ``grain_x,grain_y`` (m) and angle ``grain_angle`` (rad); any other numeric
-    column is kept in :attr:`Snapshot.particle_fields`. Column order
-    is free, names are case-insensitive; blank lines and lines starting with
-    ``#`` are skipped. A ``z`` column makes the file 3D when it is not
-    constant (within 1e-3 of the smallest radius): such a file is refused
-    unless ``z_policy`` asks for a projection or a slice.
-
-Contacts CSV
-    Header and rows ``i,j[,normal_force,shear_force]`` where ``i`` and ``j``
-    are particle *ids* from the particles file (not row numbers); forces in N
-    (normal force repulsion positive, shear force signed along rot90 of the
-    normal from i to j). Only particle–particle contacts.
-
-Other layouts
-    A ``columns`` mapping ``{role: file column}`` names the file's own
-    columns for grainlab's roles (``{"id": "ID", "x": "pos_x", "y": "pos_y"}``;
-    roles :data:`PARTICLE_ROLES` and :data:`CONTACT_ROLES`, file names
-    case-insensitive); the CLI takes it as ``--columns id=ID,x=pos_x,...``.
-    A particles file without a ``kind`` column is read as grains only and
-    warns (:class:`MissingKindWarning`): membrane or wall disks in it would
-    count as grains in Z, lambda and the fabric.
-
-Errors raise :class:`~grainlab.io.FileFormatError` (a ``ValueError``) with
-the message ``FILE:LINE: problem``.
+Columns, units, roles and the ``kind`` warning: docs/analysis.md, "Files read and
+written"; errors are :class:`~grainlab.io.FileFormatError` (``FILE:LINE: problem``).
 """
 
 from __future__ import annotations
@@ -46,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab.io._planar import check_z_policy, detected_snapshot, keep_planar_rows, planar
+from grainlab.io._points import pair_indices
 from grainlab.io._table import (
     FileFormatError,
     check_geometry,
@@ -55,6 +26,7 @@ from grainlab.io._table import (
     parse_float_table,
     plain,
     read_lines,
+    refuse_first,
 )
 from grainlab.snapshot import (
     BODY_FIELD,
@@ -232,15 +204,11 @@ def read_particles_csv(
     >>> s.ids.tolist(), s.n_contacts
     ([7, 8], 1)
     """
-    check_z_policy(z_policy, z0)
+    check_z_policy(z_policy, z0, contacts)
     column_map = check_column_map(columns, PARTICLE_ROLES)
     contact_map = check_column_map(contact_columns, CONTACT_ROLES, "contact_columns")
     if contact_map and contacts is None:
         raise ValueError("contact_columns: only apply to a contacts file (give contacts=)")
-    if z_policy == "slice" and contacts is not None:
-        raise ValueError(
-            "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
-        )
     names, data, numbers = _read_csv(path, PARTICLE_COLUMNS, column_map)
     if data.shape[0] == 0:
         raise FileFormatError(path, None, "no particle rows after the header")
@@ -248,10 +216,9 @@ def read_particles_csv(
     ids = integral_column(path, col["id"], numbers, "id")
     check_unique_ids(path, ids, numbers)
     radius = col["radius"]
-    bad = radius <= 0
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(path, int(numbers[k]), f"column 'radius': {plain(radius[k])} is not > 0")
+    refuse_first(
+        path, radius <= 0, numbers, lambda k: f"column 'radius': {plain(radius[k])} is not > 0"
+    )
     kind = _kinds(path, col, numbers)
     extra = _label_fields(path, col, numbers)
     positions = np.c_[col["x"], col["y"]]
@@ -280,10 +247,8 @@ def _kinds(
         warn_missing_kind(path)
         return None
     kind = integral_column(path, col["kind"], numbers, "kind")
-    bad = ~np.isin(kind, [int(k) for k in ParticleKind])
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(path, int(numbers[k]), f"column 'kind': unknown code {int(kind[k])}")
+    refuse_first(path, ~np.isin(kind, [int(k) for k in ParticleKind]), numbers,
+                 lambda k: f"column 'kind': unknown code {int(kind[k])}")
     return kind
 
 
@@ -339,21 +304,8 @@ def attach_contacts_csv(
 ) -> Snapshot:
     """The snapshot with the contacts read from a contacts CSV (ids -> indices)."""
     c = read_contacts_csv(path, columns=columns)
-    i = snapshot.index_of(c["i"])
-    j = snapshot.index_of(c["j"])
-    for name, idx, ids in (("i", i, c["i"]), ("j", j, c["j"])):
-        bad = idx < 0
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise FileFormatError(
-                path, int(c["line"][k]), f"column {name!r}: unknown particle id {int(ids[k])}"
-            )
-    self_contact = i == j
-    if self_contact.any():
-        k = int(np.argmax(self_contact))
-        raise FileFormatError(
-            path, int(c["line"][k]), f"particle id {int(c['i'][k])} in contact with itself"
-        )
+    i, j = pair_indices(path, snapshot, (c["i"], c["j"]), ("i", "j"), c["line"], "particle",
+                        "in contact with itself")
     metadata = dict(snapshot.metadata)
     metadata["contacts"] = f"read from {path}"
     return dataclasses.replace(

@@ -1,53 +1,7 @@
-"""LAMMPS / LIGGGHTS text dump files: atoms (``dump custom``) and contacts (``dump local``).
+"""LAMMPS / LIGGGHTS text dumps: atoms (``dump custom``) and contacts (``dump local``).
 
-Atoms dump (``dump ID group custom N file id x y radius ...``)
-    Frames of ``ITEM: TIMESTEP``, ``ITEM: NUMBER OF ATOMS``, ``ITEM: BOX
-    BOUNDS`` (orthogonal: ``xx yy zz`` boundary flags, ``pp`` = periodic),
-    ``ITEM: ATOMS <columns>`` and one row per atom; ``ITEM: TIME`` and
-    ``ITEM: UNITS`` are accepted. Required columns: ``id``; positions ``x y``
-    (else ``xu yu``, else scaled ``xs ys`` / ``xsu ysu``); ``radius`` (else
-    ``diameter``). ``type``, ``vx vy``, ``fx fy``, ``omegaz`` and any other
-    column are kept in :attr:`Snapshot.particle_fields` under their dump names
-    (velocities as ``velocity`` (N, 2), forces as ``force`` (N, 2)). A
-    ``z`` column that is constant (within 1e-3 of the smallest radius) is
-    dropped; 3D data is refused unless ``z_policy`` asks for a projection or a
-    slice (:func:`read_lammps_dump`). The file's units are taken as given: use
-    ``units si``.
-
-Contacts dump (``dump ID group local N file ...``)
-    Frames with ``ITEM: NUMBER OF ENTRIES`` and ``ITEM: ENTRIES <columns>``,
-    typically from ``compute property/local patom1 patom2`` (the two atom
-    ids) and ``compute pair/local dist force p1 p2 p4`` (for
-    ``gran/hooke/history``: ``force`` is the normal force, repulsion
-    positive; ``p1 p2`` the tangential force on the first atom; ``p4`` its
-    magnitude). Column roles:
-
-    ``i``, ``j``
-        atom ids of the pair (required);
-    ``normal_force``
-        normal force, repulsion positive;
-    ``fx``, ``fy``
-        the pair force on atom i (LAMMPS ``fx fy`` of ``pair/local``; for
-        granular styles the normal part only): normal force = -F.n;
-    ``shear_x``, ``shear_y``
-        tangential force on atom i: shear force = F_t . rot90(n);
-    ``shear_force``
-        signed shear force (or a magnitude, e.g. ``p4``);
-    ``dist``
-        centre distance.
-
-    Roles are found from the column names ``patom1 patom2`` / ``id1 id2`` /
-    ``atom1 atom2`` / ``i j`` (ids), ``force`` / ``fn`` / ``normal_force``,
-    ``fx fy``, ``fs`` / ``shear_force``, ``dist``; otherwise the ids are the
-    first compute whose columns ``c_NAME[1] c_NAME[2]`` hold integer atom ids.
-    Pass ``columns={"i": "c_ids[1]", "normal_force": "c_pl[2]", ...}`` to
-    say which column is which. A granular ``pair/local`` also lists pairs
-    within the force cut-off that do not touch: entries with centre distance
-    >= r_i + r_j (from ``dist`` or recomputed from the atoms with the minimum
-    image) are dropped.
-
-Multi-frame files: ``timestep=None`` takes the last frame of the atoms dump,
-and the contacts frame with the same timestep.
+Columns, the contacts' roles and how they are recognised, boundary types, labels,
+3D data and multi-frame files: docs/analysis.md, "Files read and written".
 """
 
 from __future__ import annotations
@@ -62,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.io._planar import check_z_policy, detected_snapshot, keep_planar_rows, planar
+from grainlab.io._points import boundary_kind, pair_indices
 from grainlab.io._table import (
     MAX_LENGTH_M,
     FileFormatError,
@@ -72,8 +27,9 @@ from grainlab.io._table import (
     parse_float_table,
     plain,
     read_lines,
+    refuse_first,
 )
-from grainlab.snapshot import BODY_FIELD, GRAIN_FIELD, ParticleKind, Snapshot
+from grainlab.snapshot import BODY_FIELD, GRAIN_FIELD, Snapshot
 
 __all__ = [
     "DumpFrame",
@@ -350,37 +306,12 @@ def read_lammps_dump(
 ) -> Snapshot:
     """Read one frame of a LAMMPS atoms dump (and its contacts) into a :class:`Snapshot`.
 
-    ``contacts`` is a ``dump local`` file (see the module docstring;
-    ``columns`` maps its roles to column names). Without it and with
-    ``detect=True``, contacts are detected from the geometry
-    (``tolerance`` in m). Atoms whose ``type`` is in ``boundary_types``
-    (e.g. frozen wall disks) get ``kind = MEMBRANE``: they bound the sample
-    but are not part of it, and contacts with them are boundary contacts.
-    ``body_column`` names an integer column (e.g. ``mol``, the molecule id of
-    a bonded chain) that says which boundary body each boundary atom belongs
-    to (:data:`~grainlab.snapshot.BODY_FIELD`); without it, boundary atoms
-    that touch one another form one body (:meth:`Snapshot.boundary_bodies`).
-    ``grain_column`` names an integer column (>= 0) that says which rigid body
-    each atom belongs to (:data:`~grainlab.snapshot.GRAIN_FIELD`): ``mol``, the
-    molecule id, for the bodies of ``fix rigid/small ... molecule``; atoms of
-    one value are the pebbles of one grain (:meth:`Snapshot.grains`), whose
-    centroid and angle a dump does not carry.
-
-    3D data (the ``z`` column, or ``zu`` / ``zs`` / ``zsu`` beside the chosen
-    x and y, spreading over more than ``PLANAR_TOLERANCE`` = 1e-3 of the
-    smallest radius) is refused with a :class:`FileFormatError` naming the
-    file and the spread, unless ``z_policy`` says what to do: ``"project"``
-    (disks of the spheres' radii at (x, y); contacts from ``contacts`` or
-    detected between the spheres in 3D, with the in-plane direction of each
-    centre line) or ``"slice"`` with ``z0`` (the spheres crossing the plane
-    z = z0, as disks of their cross-section radius; contacts detected between
-    those disks; no ``contacts`` file). ``z`` is kept in ``particle_fields``.
+    ``contacts`` is a ``dump local`` file whose roles ``columns`` names; without it
+    (and with ``detect``) contacts come from the geometry within ``tolerance`` (m).
+    ``boundary_types``, ``body_column``, ``grain_column`` and ``z_policy`` / ``z0``
+    (3D data): docs/analysis.md, "Files read and written".
     """
-    check_z_policy(z_policy, z0)
-    if z_policy == "slice" and contacts is not None:
-        raise ValueError(
-            "contacts: z_policy='slice' takes its contacts from the cross-sections; read it without a contacts file"
-        )
+    check_z_policy(z_policy, z0, contacts)
     frame = _atoms_frame(path, timestep)
     col = {name: frame.data[:, k] for k, name in enumerate(frame.columns)}
     where, numbers = frame.header_line, frame.line_numbers
@@ -461,10 +392,8 @@ def _dump_radii(path: str | Path, frame: DumpFrame, col: Mapping[str, NDArray[np
             f"missing column 'radius' (or 'diameter') (columns: {' '.join(frame.columns)})",
         )
     used.add(rname)
-    bad = radius <= 0
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(path, int(frame.line_numbers[k]), f"column {rname!r}: {plain(col[rname][k])} is not > 0")
+    refuse_first(path, radius <= 0, frame.line_numbers,
+                 lambda k: f"column {rname!r}: {plain(col[rname][k])} is not > 0")
     return radius
 
 
@@ -489,9 +418,7 @@ def _dump_kinds(path: str | Path, frame: DumpFrame, col: Mapping[str, NDArray[np
         return None
     if "type" not in col:
         raise FileFormatError(path, frame.header_line, "boundary_types needs a 'type' column in the dump")
-    return np.where(
-        np.isin(col["type"], np.asarray(boundary_types, dtype=np.float64)), ParticleKind.MEMBRANE, ParticleKind.SOIL
-    )
+    return boundary_kind(col["type"], boundary_types)
 
 
 def _dump_periodic(path: str | Path, frame: DumpFrame, z_policy: str) -> tuple[bool, bool]:
@@ -603,31 +530,6 @@ def _guess_id_columns(frame: DumpFrame, atom_ids: NDArray[np.int64]) -> dict[str
     return {}
 
 
-def _pair_indices(snapshot: Snapshot, path: str | Path, frame: DumpFrame,
-                  roles: Mapping[str, int]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """The snapshot's indices of each listed pair's atoms; an unknown id or an atom
-    paired with itself is refused, naming the line."""
-    numbers = frame.line_numbers
-    id_i = integral_column(path, frame.data[:, roles["i"]], numbers, frame.columns[roles["i"]])
-    id_j = integral_column(path, frame.data[:, roles["j"]], numbers, frame.columns[roles["j"]])
-    i = snapshot.index_of(id_i)
-    j = snapshot.index_of(id_j)
-    for role, idx, vals in (("i", i, id_i), ("j", j, id_j)):
-        bad = idx < 0
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise FileFormatError(
-                path,
-                int(numbers[k]),
-                f"column {frame.columns[roles[role]]!r}: unknown atom id {int(vals[k])}",
-            )
-    same = i == j
-    if same.any():
-        k = int(np.argmax(same))
-        raise FileFormatError(path, int(numbers[k]), f"atom id {int(id_i[k])} paired with itself")
-    return i, j
-
-
 def _pair_forces(data: NDArray[np.float64], roles: Mapping[str, int],
                  n_hat: NDArray[np.float64]) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
     """Each pair's normal force (compression positive) and shear force along
@@ -653,7 +555,7 @@ def attach_lammps_contacts(
     timestep: int | None = None,
     columns: Mapping[str, str] | None = None,
 ) -> Snapshot:
-    """The snapshot with contacts from a LAMMPS ``dump local`` file (see module docstring)."""
+    """The snapshot with contacts from a LAMMPS ``dump local`` file (docs/analysis.md)."""
     if timestep is None:
         timestep = snapshot.metadata.get("timestep")
     frame = read_dump_frames(path, timestep)
@@ -665,7 +567,10 @@ def attach_lammps_contacts(
         )
     roles = _resolve_columns(path, frame, columns, np.asarray(snapshot.ids))
     data, numbers = frame.data, frame.line_numbers
-    i, j = _pair_indices(snapshot, path, frame, roles)
+    names = (frame.columns[roles["i"]], frame.columns[roles["j"]])
+    id_i, id_j = (integral_column(path, frame.data[:, roles[r]], numbers, n)
+                  for r, n in zip("ij", names, strict=True))
+    i, j = pair_indices(path, snapshot, (id_i, id_j), names, numbers, "atom", "paired with itself")
 
     d = snapshot.minimum_image(snapshot.positions[j] - snapshot.positions[i])
     dist_geom = np.hypot(d[:, 0], d[:, 1])
@@ -673,11 +578,8 @@ def attach_lammps_contacts(
     dist_3d = dist_geom if z is None else np.hypot(dist_geom, z[j] - z[i])  # projected spheres
     dist = data[:, roles["dist"]] if "dist" in roles else dist_3d
     touching = dist < snapshot.radii[i] + snapshot.radii[j]
-    if np.any(dist_geom == 0.0):
-        k = int(np.argmax(dist_geom == 0.0))
-        raise FileFormatError(
-            path, int(numbers[k]), "the two atoms of this pair have the same position"
-        )
+    refuse_first(path, dist_geom == 0.0, numbers,
+                 lambda k: "the two atoms of this pair have the same position")
     n_hat = d / dist_geom[:, None]
     normal_force, shear_force = _pair_forces(data, roles, n_hat)
 

@@ -1,55 +1,7 @@
 """A grainlab state as a LAMMPS run: data file, input deck, and the dumps read back.
 
-:func:`write_lammps_shear` writes a :class:`~grainlab.simulation.Simulation` in
-a periodic cell (positions, radii, densities, velocities, angular velocities,
-the cell, the contact model, the time step, the skin) and a periodic simple
-shear (``L = [[0, shear_rate], [0, 0]]`` at constant area) as
-
-``data.grainlab``
-    ``atom_style sphere``, a triclinic box (``xy`` = the cell's tilt), one atom
-    type per density (``set type T density/disc`` in the deck: ``m = rho pi
-    r^2``), velocities ``v + L (x - origin)``: grainlab's velocities are
-    fluctuations about the imposed flow, LAMMPS's (``fix deform ... remap v``)
-    are whole velocities.
-``in.grainlab``
-    ``dimension 2``, ``pair_style granular`` with ``hooke`` normal force,
-    ``linear_history`` tangential spring (kept tangent at its length as the
-    contact turns, grainlab's rotating spring) with the Coulomb cap,
-    ``damping tsuji`` (a fraction of ``sqrt(m* kn)``: grainlab's damping ratio
-    ``zeta`` is ``alpha(e) / 2`` of Tsuji's restitution coefficient ``e``),
-    ``fix nve/sphere disc`` (``I = m r^2 / 2``), ``fix enforce2d``, ``fix
-    deform 1 xy erate`` with ``remap v``, and the dumps below.
-``export.json``
-    the settings, what was left out, and the dumps' column roles, which
-    :func:`read_lammps_run` reads.
-
-The dumps, every ``dump_every`` steps: ``atoms.dump`` (``id type x y radius
-vx vy omegaz fx fy``) and ``contacts.dump`` (``patom1 patom2`` and ``pair/local
-dist force p1 p2``: the centre distance, the normal force and the tangential
-force on the first atom). The thermo output has LAMMPS's own stress of the
-contacts (``compute pressure NULL virial``: ``pxx pyy pxy``, compression
-positive) and the mean contact count.
-
-:func:`write_lammps_fixed_cell` writes the same with the cell held fixed for a
-number of steps (:class:`LammpsFixedCell`), and carries clumps: every atom has
-a molecule id (``fix property/atom mol``; grainlab's body + 1), each clump is a
-``fix rigid/small molecule`` body whose mass, centroid, moment of inertia,
-velocity and angular momentum are grainlab's (``bodies.grainlab``, read by the
-``infile`` keyword: LAMMPS's own sums over the pebbles would count their
-overlaps twice), contacts inside a clump are excluded (``neigh_modify exclude
-molecule/intra``), the disks move by ``fix nve/sphere disc``, and
-``bodies.dump`` (``compute rigid/local``: ``mol x y vx vy omegaz``) has a row per
-clump at every dump. Clumps cannot be sheared (a rigid body keeps its velocity
-across the sheared boundary, where ``remap v`` shifts an atom's): refused.
-
-What a data file cannot carry is named in :attr:`LammpsExport.dropped`: the
-contacts' shear springs (LAMMPS starts them at zero), the rotation angles (a
-LAMMPS sphere has none), grainlab's local damping when ``local_damping`` is
-``"omit"`` (Debian's LAMMPS of 29 Sep 2021 has no ``fix damping/cundall``).
-A state that LAMMPS's law cannot reproduce (walls, bonds, fixed or loaded
-disks, gravity, rolling resistance, several contact models, sheared clumps) is
-refused before anything is written (:func:`check_lammps_export`). See
-docs/lammps.md.
+What each file holds, what is carried and what is dropped or refused
+(:func:`check_lammps_export`, :attr:`LammpsExport.dropped`): docs/lammps.md.
 """
 
 from __future__ import annotations
@@ -205,10 +157,15 @@ class LammpsShear:
             raise ValueError(f"shear_rate_per_s: must be finite and non-zero, got {self.shear_rate_per_s!r}")
         if not (math.isfinite(self.final_strain) and self.final_strain > 0.0):
             raise ValueError(f"final_strain: must be a finite strain > 0, got {self.final_strain!r}")
-        if int(self.dump_every) != self.dump_every or self.dump_every < 0:
-            raise ValueError(f"dump_every: must be a whole number of steps >= 0, got {self.dump_every!r}")
-        if self.local_damping not in ("omit", "cundall"):
-            raise ValueError(f"local_damping: 'omit' or 'cundall', got {self.local_damping!r}")
+        _check_dumps_and_damping(self.dump_every, self.local_damping)
+
+
+def _check_dumps_and_damping(dump_every: int, local_damping: str) -> None:
+    """The checks of ``dump_every`` and ``local_damping`` both protocols share."""
+    if int(dump_every) != dump_every or dump_every < 0:
+        raise ValueError(f"dump_every: must be a whole number of steps >= 0, got {dump_every!r}")
+    if local_damping not in ("omit", "cundall"):
+        raise ValueError(f"local_damping: 'omit' or 'cundall', got {local_damping!r}")
 
 
 @dataclass(frozen=True)
@@ -225,10 +182,7 @@ class LammpsFixedCell:
     def __post_init__(self) -> None:
         if int(self.steps) != self.steps or self.steps < 1:
             raise ValueError(f"steps: must be a whole number of steps >= 1, got {self.steps!r}")
-        if int(self.dump_every) != self.dump_every or self.dump_every < 0:
-            raise ValueError(f"dump_every: must be a whole number of steps >= 0, got {self.dump_every!r}")
-        if self.local_damping not in ("omit", "cundall"):
-            raise ValueError(f"local_damping: 'omit' or 'cundall', got {self.local_damping!r}")
+        _check_dumps_and_damping(self.dump_every, self.local_damping)
 
 
 @dataclass(frozen=True)
@@ -527,7 +481,7 @@ dump_modify     contacts format float %.17g
 
 def write_lammps_shear(sim: Simulation, folder: str | Path, shear: LammpsShear) -> LammpsExport:
     """Write ``sim`` and the simple shear ``shear`` as a LAMMPS run in ``folder``
-    (module docstring); returns what was written. Run it with ``mpirun -np 2 lmp
+    (docs/lammps.md); returns what was written. Run it with ``mpirun -np 2 lmp
     -in in.grainlab`` in ``folder``; read it back with :func:`read_lammps_run`.
     A packing with clumps is refused (LAMMPS cannot shear its rigid bodies:
     :func:`write_lammps_fixed_cell`)."""
@@ -544,7 +498,7 @@ def write_lammps_fixed_cell(sim: Simulation, folder: str | Path, run: LammpsFixe
 
 def check_lammps_export(sim: Simulation, protocol: LammpsShear | LammpsFixedCell) -> ContactModel:
     """Refuse, in one line, what the export of ``sim`` with ``protocol`` cannot carry
-    (walls, bonds, sheared clumps, ...: module docstring); returns the one contact
+    (walls, bonds, sheared clumps, ...: docs/lammps.md); returns the one contact
     model it writes."""
     model = _checked_state(sim, protocol)
     lammps_pair_coeff(model)  # refuses a law LAMMPS cannot say

@@ -1,21 +1,7 @@
-"""PFC (Itasca) ball and contact tables exported as CSV.
+"""PFC (Itasca) ball and contact tables exported as CSV, read through the CSV reader.
 
-A PFC2D model's balls written as a CSV table (from FISH or PFC's Python,
-``itasca.ballarray``) carry the columns ``id,pos_x,pos_y,radius`` (any case,
-any order; ``pos_z`` in PFC3D, other columns such as ``vel_x`` kept as
-per-particle fields), and its contacts ``end1,end2`` (the two balls' ids),
-optionally with ``force_normal`` (N, compression positive, grainlab's
-``normal_force``). This module reads them through the particles-CSV reader
-with those names mapped (:data:`PFC_BALL_COLUMNS`,
-:data:`PFC_CONTACT_COLUMNS`); any other layout can be read the same way with
-a ``columns`` mapping (:func:`grainlab.io.read_particles_csv`).
-
-Only ball-ball contacts belong in the contacts file: an ``end2`` that is
-not a ball id (a wall facet) is an error naming its line. PFC's shear force
-is given in each contact's own frame, whose sign differs from grainlab's
-(docs/conventions.md), so it is kept out unless mapped explicitly. A PFC
-table has no particle kinds: reading it warns
-(:class:`~grainlab.io.csv.MissingKindWarning`) unless it has a ``kind`` column.
+Columns, the ball-ball rule and the shear force's sign: docs/file-formats.md,
+"Formats read from other codes".
 """
 
 from __future__ import annotations

@@ -1,27 +1,21 @@
-"""Files of a results folder written so that a crash never leaves half a file.
+r"""Files of a results folder published atomically: a crash never leaves half a file.
 
-A run writes its outputs (``run.h5``, ``timeseries.csv``, ``summary.json``,
-``checkpoint.h5``) into one folder. Every file a reader may pick up is
-*published atomically*: the content goes to a temporary file in the same
-folder, is flushed to disk (``fsync``), and is then renamed over the final
-name with :func:`os.replace`, which is atomic on POSIX and Windows when both
-names are on the same file system. A reader therefore sees either the old
-file or the new one, never a mixture; a killed writer leaves at most a stray
-temporary file (``.NAME.*.tmp``), never a truncated ``NAME``.
+Each file goes to a temporary name in its folder, is fsynced and renamed with
+:func:`os.replace` (docs/file-formats.md, "Crash safety").
 
 Example
 -------
 >>> import tempfile, pathlib
 >>> from grainlab.io.results import write_json_atomic, write_text_atomic
 >>> folder = pathlib.Path(tempfile.mkdtemp())
->>> write_text_atomic(folder / "timeseries.csv", "axial_strain,q\\n0.0,0.0\\n").name
+>>> write_text_atomic(folder / "timeseries.csv", "axial_strain,q\n0.0,0.0\n").name
 'timeseries.csv'
 >>> (folder / "timeseries.csv").read_text().splitlines()[0]
 'axial_strain,q'
 >>> write_json_atomic(folder / "summary.json", {"peak": 1.5, "missing": float("nan")}).name
 'summary.json'
 >>> (folder / "summary.json").read_text()
-'{\\n  "peak": 1.5,\\n  "missing": null\\n}\\n'
+'{\n  "peak": 1.5,\n  "missing": null\n}\n'
 """
 
 from __future__ import annotations

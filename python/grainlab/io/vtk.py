@@ -1,51 +1,7 @@
-"""ParaView files: VTK XML PolyData (``.vtp``) and a ``.pvd`` time series.
+"""ParaView files: VTK XML PolyData (``.vtp``), UnstructuredGrid (``.vtu``) and ``.pvd`` series.
 
-A small writer (:func:`write_vtp`; no VTK needed to write, VTK's own reader in
-the tests) and the contact lines of a snapshot (:func:`contact_lines`). The
-export of a run (:func:`grainlab.postprocess.vtk.export_vtk`) writes one
-``.vtp`` per snapshot with them:
-
-* every particle is a point (z = 0) with one vertex cell (``Verts``), carrying
-  the point data the export computes
-  (:func:`grainlab.postprocess.vtk.snapshot_arrays`: radius, kind, displacement,
-  rotation, n_contacts, stability_index, local_shear_strain, in_shear_band, the
-  snapshot's per-particle fields such as velocity, ...);
-* every particle–particle contact is a line cell (``Lines``) between the two
-  particle centres, carrying the cell data of :func:`contact_lines`
-  (normal_force, shear_force, and the stored contact fields such as overlap,
-  sliding, bonded).
-
-VTK numbers the cells of a PolyData vertices first, then lines, and a cell
-array covers all of them. The writer therefore adds ``cell_kind`` (0 particle
-vertex, 1 contact line) and fills the contact arrays on the vertex cells with
-NaN (floating point) or -1 (integers and flags), so that a *Threshold* on
-``cell_kind`` or on a force keeps only the contacts.
-
-A snapshot with clumps (grains of several pebbles, :meth:`Snapshot.grains
-<grainlab.snapshot.Snapshot.grains>`) has a second PolyData beside it
-(:func:`write_clumps_vtp`, :func:`clump_points`): one vertex per clump at its
-centroid, carrying its ``grain`` label, ``angle``, ``orientation`` (the body
-frame's x axis, for a glyph) and ``n_pebbles``; the pebbles' own points carry
-``grain``, ``grain_centroid`` and ``grain_angle`` as any per-particle field.
-
-Contacts that cannot be drawn as a line between two centres are left out of
-the lines (they still count in ``n_contacts`` and the stability index), and
-their numbers are stored in the file's field data: wall contacts
-(``contact_j < 0``, no second particle) as ``n_wall_contacts``, contacts
-across a periodic boundary (a line between the stored centres would cross the
-box) as ``n_periodic_contacts``.
-
-The ``.pvd`` collection lists the files with their time value: the
-snapshots' axial strain when it is known for every snapshot and strictly
-increasing, else their time in s under the same condition, else their index.
-(ParaView merges datasets that share a time value into one step, so a
-repeated value would overlay two snapshots.)
-
-Binary files hold each array as base64 of the raw little-endian values with a
-UInt64 byte-count header, so float64 values (NaN, inf and -0.0 included) are
-read back bit for bit. ASCII files write floats with :func:`repr`, which VTK
-reads back to the same values, except that its ASCII parser turns ``-inf`` into
-``+inf``: the ASCII writer refuses ``-inf`` (no exported array holds one).
+The layout (points, contact lines, ``cell_kind``, fills, clumps, field data, time
+values, exact binary and ASCII values): docs/file-formats.md, "ParaView".
 """
 
 from __future__ import annotations

@@ -1,28 +1,7 @@
-"""Legacy VTK particle files (``.vtk``) as LIGGGHTS and LAMMPS write them.
+"""Legacy VTK particle files (``.vtk``, ASCII), as LIGGGHTS' and LAMMPS'
+``dump custom/vtk`` write them.
 
-LIGGGHTS' ``dump custom/vtk`` and LAMMPS' ``dump custom/vtk`` with a
-``.vtk`` file name write one legacy VTK file per dump step: the particles
-are the ``POINTS`` of a ``POLYDATA`` (or an ``UNSTRUCTURED_GRID``) with one
-vertex cell each, and the dumped per-atom quantities are ``POINT_DATA``
-arrays, written as ``SCALARS`` / ``VECTORS`` sections (VTK file version 2
-to 4) or as the arrays of a ``FIELD`` section (VTK's own writer, file
-version 4.2 and 5.1). This reader takes the ASCII form of both:
-
-* the particles are the points, their radius the point array
-  ``radius_array`` (default ``radius``), their ids the array ``id`` (else
-  the point numbers 0, 1, ...);
-* atoms whose ``type`` array value is in ``boundary_types`` get
-  ``kind = MEMBRANE``, as for LAMMPS dumps;
-* every other point array is kept as a per-particle field, vectors as their
-  (x, y) components;
-* cells and ``CELL_DATA`` are skipped; contacts are detected from the
-  geometry (centre distance < r_i + r_j + ``tolerance``);
-* z as for the other readers: a 2D run has every z equal, real 3D data is
-  refused unless ``z_policy`` projects or slices it.
-
-A binary legacy file is refused with a message saying to dump ASCII (LAMMPS:
-``dump_modify ... binary no``; VTK writers: ``SetFileTypeToASCII``).
-Errors name the file and line.
+What is read and how: docs/file-formats.md, "Formats read from other codes".
 """
 
 from __future__ import annotations

@@ -1,14 +1,5 @@
-"""The walls (platens) of a run at one instant, as stored in ``run.h5`` and exported.
-
-A :class:`WallGeometry` holds every wall of a simulation: its name, its kind
-(segment or line), its two points ``a`` and ``b`` (m), its inward normal
-(towards the particles) and whether it is active. A segment runs from ``a``
-to ``b``; a line is infinite, through ``a`` (``b = a``) with the inward
-normal given. :meth:`WallGeometry.from_simulation` takes them from a running
-:class:`grainlab.Simulation`; :meth:`ResultsWriter.write_snapshot
-<grainlab.io.hdf5.ResultsWriter.write_snapshot>` stores them with a snapshot as
-the group ``/snapshots/<name>/walls`` (docs/file-formats.md) and
-:meth:`Results.walls <grainlab.io.hdf5.Results.walls>` reads them back.
+"""The walls (platens) of a run at one instant, as stored in ``run.h5``
+(``/snapshots/<name>/walls``, docs/file-formats.md) and exported.
 
 >>> import numpy as np
 >>> w = WallGeometry(("bottom",), np.array([0]), np.array([[0.0, 0.0]]), np.array([[0.02, 0.0]]),

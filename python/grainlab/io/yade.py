@@ -1,28 +1,7 @@
 """YADE's sphere text export (``yade.export.text`` / ``export.textExt``).
 
-YADE writes one sphere per line, fields separated by tabs (``%g``), after a
-first line ``#format NAME`` and an optional ``# comment`` line:
-
-=====================  ====================================================
-``#format``            columns of each line
-=====================  ====================================================
-``x_y_z_r``            x, y, z, radius (``export.text``'s layout)
-``x_y_z_r_matId``      x, y, z, radius, material id
-``id_x_y_z_r_matId``   body id, x, y, z, radius, material id
-``x_y_z_r_attrs``      x, y, z, radius, then the extra quantities named, one
-                       word per column, by the last comment line
-=====================  ====================================================
-
-YADE is a 3D code: a 2D sample has every z equal (checked like the other
-readers' z columns, :mod:`grainlab.io._planar`; ``z_policy`` projects or
-slices real 3D packings). Without a body id column the ids are the row
-numbers 0, 1, ... in file order (YADE writes the spheres in body order,
-skipping non-spheres, so these are not YADE's body ids). The material id is
-kept as the per-particle field ``material_id``; spheres whose material id is
-in ``boundary_materials`` get ``kind = MEMBRANE`` (they bound the sample).
-A file with no way to tell those apart warns
-(:class:`~grainlab.io.csv.MissingKindWarning`). Contacts are detected from
-the geometry (YADE's text export has none).
+Its formats, ids, materials and boundary spheres: docs/file-formats.md, "Formats
+read from other codes".
 """
 
 from __future__ import annotations

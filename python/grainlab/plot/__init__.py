@@ -1,20 +1,8 @@
 """Figures for papers: polar fabric diagrams, particle maps, time series.
 
-All functions draw on a given matplotlib ``Axes`` (``ax=None`` creates a new
-figure with the paper style, without pyplot, so nothing global changes and
-any backend works) and return the axes; :func:`save_figure` writes PNG and
-SVG. Angles in the figures are in degrees; strains in percent, compression
-positive (docs/conventions.md).
-
-Files stay small without losing what they show: the disks of a particle map
-are one collection, rasterised inside SVG files (axes, text and band
-outlines stay vector); PNGs are written at :data:`FIGURE_DPI` with a
-256-colour palette (:func:`compact_png`), and so are the images inside SVGs.
-
-Paper figures: :func:`polar_distribution` (Figs. 6–7), :func:`particle_map`
-coloured by displacement (Fig. 11), lambda (Fig. 12) or contact count
-(Fig. 13, ``discrete=True``) with :func:`outline_shear_band`,
-:func:`anisotropy_series` (Fig. 9) and :func:`mean_lambda_series` (Fig. 14).
+Every function draws on a given ``Axes`` (``ax=None``: a new figure in the paper
+style, without pyplot) and returns it; :func:`save_figure` writes compact PNG and
+SVG files. The paper's figures each function draws: docs/analysis.md, "Figures (`grainlab.plot`)".
 """
 
 from __future__ import annotations
@@ -28,7 +16,7 @@ import numpy as np
 from matplotlib.collections import EllipseCollection
 from matplotlib.colors import BoundaryNorm, Normalize
 from matplotlib.figure import Figure
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from grainlab._notebook import new_figure, prepare_notebook
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
@@ -266,6 +254,17 @@ def _strain_axis(ax: Any) -> None:
     ax.set_xlabel(r"axial strain $\varepsilon_{11}$ (%, compression positive)")
 
 
+def _along(
+    eps: NDArray[np.float64], values: ArrayLike, name: str, scale: float = 1.0
+) -> NDArray[np.float64]:
+    """``values`` (times ``scale``) as floats of the strain axis' shape; a ValueError
+    naming ``name`` otherwise."""
+    y = np.asarray(values, dtype=np.float64) * scale
+    if y.shape != eps.shape:
+        raise ValueError(f"{name}: expected shape {eps.shape}, got {y.shape}")
+    return y
+
+
 def anisotropy_series(
     axial_strain: ArrayLike,
     anisotropy: ArrayLike,
@@ -278,16 +277,12 @@ def anisotropy_series(
     ``axial_strain`` is a fraction (0.01 = 1 %), compression positive.
     """
     eps = 100.0 * np.asarray(axial_strain, dtype=np.float64)
-    a = np.asarray(anisotropy, dtype=np.float64)
-    if eps.shape != a.shape:
-        raise ValueError(f"anisotropy: expected shape {eps.shape}, got {a.shape}")
+    a = _along(eps, anisotropy, "anisotropy")
+    an = None if normal_force is None else _along(eps, normal_force, "normal_force")
     ax = new_axes(ax)
     with paper_style():
         ax.plot(eps, a, marker="o", markersize=2.5, label="$a$ (contact normals)")
-        if normal_force is not None:
-            an = np.asarray(normal_force, dtype=np.float64)
-            if an.shape != eps.shape:
-                raise ValueError(f"normal_force: expected shape {eps.shape}, got {an.shape}")
+        if an is not None:
             ax.plot(eps, an, marker="s", markersize=2.5, label="$a_n$ (normal forces)")
             ax.legend(frameon=False)
         _strain_axis(ax)
@@ -306,16 +301,12 @@ def mean_lambda_series(
     ``mean_lambda`` over grains with >= 2 contacts and, when given,
     ``mean_lambda_all`` over every grain (0- and 1-contact grains at 1), dashed."""
     eps = 100.0 * np.asarray(axial_strain, dtype=np.float64)
-    lam = np.asarray(mean_lambda, dtype=np.float64)
-    if eps.shape != lam.shape:
-        raise ValueError(f"mean_lambda: expected shape {eps.shape}, got {lam.shape}")
+    lam = _along(eps, mean_lambda, "mean_lambda")
+    lam_all = None if mean_lambda_all is None else _along(eps, mean_lambda_all, "mean_lambda_all")
     ax = new_axes(ax)
     with paper_style():
         ax.plot(eps, lam, marker="o", markersize=2.5, color="C2", label=r"grains with $\geq 2$ contacts")
-        if mean_lambda_all is not None:
-            lam_all = np.asarray(mean_lambda_all, dtype=np.float64)
-            if lam_all.shape != eps.shape:
-                raise ValueError(f"mean_lambda_all: expected shape {eps.shape}, got {lam_all.shape}")
+        if lam_all is not None:
             ax.plot(eps, lam_all, ls="--", color="C4", label=r"all grains (0-1 contact: $\lambda = 1$)")
             ax.legend(frameon=False, fontsize="small")
         _strain_axis(ax)
@@ -338,9 +329,7 @@ def strain_series(
     ``values`` (a fraction) in %; ``reference`` draws a horizontal line.
     """
     eps = 100.0 * np.asarray(axial_strain, dtype=np.float64)
-    y = np.asarray(values, dtype=np.float64) * (100.0 if percent else 1.0)
-    if eps.shape != y.shape:
-        raise ValueError(f"values: expected shape {eps.shape}, got {y.shape}")
+    y = _along(eps, values, "values", 100.0 if percent else 1.0)
     ax = new_axes(ax)
     with paper_style():
         ax.plot(eps, y, color="C0")

@@ -28,36 +28,36 @@ def _branches(timeseries: Mapping[str, ArrayLike], loading: ArrayLike, y: str) -
             ("unloading", "s--", sigma_v[later], values[later])]
 
 
+def _against_vertical_stress(
+    timeseries: Mapping[str, ArrayLike], loading: ArrayLike, y: str, ylabel: str,
+    line: tuple[float, str] | None = None,
+) -> Figure:
+    """Column ``y`` against sigma_v (log axis), loading and unloading, with a horizontal
+    ``line`` (value, label) when given."""
+    with paper_style():
+        fig = Figure(figsize=(3.5, 3.0), layout="constrained")
+        ax = fig.add_subplot()
+        for label, style, x, values in _branches(timeseries, loading, y):
+            if len(x):
+                ax.plot(x, values, style, markersize=3, label=label)
+        if line is not None:
+            ax.axhline(line[0], color="0.4", linewidth=0.8, linestyle=":", label=line[1])
+        ax.set_xscale("log")
+        ax.set_xlabel(r"vertical stress $\sigma_v$ (kPa)")
+        ax.set_ylabel(ylabel)
+        ax.legend(frameon=False)
+    return fig
+
+
 def lateral_stress_ratio_figure(timeseries: Mapping[str, ArrayLike], loading: ArrayLike, k0_jaky: float | None,
                                 friction_angle_deg: float | None) -> Figure:
     """K = sigma_h / sigma_v against sigma_v (log axis), loading and unloading, with
     Jaky's 1 - sin phi' as a line when a friction angle is given."""
-    with paper_style():
-        fig = Figure(figsize=(3.5, 3.0), layout="constrained")
-        ax = fig.add_subplot()
-        for label, style, x, y in _branches(timeseries, loading, LATERAL_STRESS_RATIO):
-            if len(x):
-                ax.plot(x, y, style, markersize=3, label=label)
-        if k0_jaky is not None:
-            ax.axhline(k0_jaky, color="0.4", linewidth=0.8, linestyle=":",
-                       label=f"Jaky, phi' = {friction_angle_deg:.1f} deg")
-        ax.set_xscale("log")
-        ax.set_xlabel(r"vertical stress $\sigma_v$ (kPa)")
-        ax.set_ylabel(r"$K = \sigma_h / \sigma_v$")
-        ax.legend(frameon=False)
-    return fig
+    jaky = None if k0_jaky is None else (k0_jaky, f"Jaky, phi' = {friction_angle_deg:.1f} deg")
+    k = r"$K = \sigma_h / \sigma_v$"
+    return _against_vertical_stress(timeseries, loading, LATERAL_STRESS_RATIO, k, jaky)
 
 
 def compression_figure(timeseries: Mapping[str, ArrayLike], loading: ArrayLike) -> Figure:
     """Void ratio against sigma_v (log axis): the compression and swelling lines."""
-    with paper_style():
-        fig = Figure(figsize=(3.5, 3.0), layout="constrained")
-        ax = fig.add_subplot()
-        for label, style, x, y in _branches(timeseries, loading, VOID_RATIO):
-            if len(x):
-                ax.plot(x, y, style, markersize=3, label=label)
-        ax.set_xscale("log")
-        ax.set_xlabel(r"vertical stress $\sigma_v$ (kPa)")
-        ax.set_ylabel("void ratio e")
-        ax.legend(frameon=False)
-    return fig
+    return _against_vertical_stress(timeseries, loading, VOID_RATIO, "void ratio e")

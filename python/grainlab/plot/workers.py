@@ -1,29 +1,9 @@
 """Figures drawn side by side in worker processes, written as :func:`grainlab.plot.save_figure` writes them.
 
-A :class:`FigureTask` names a figure file and a function of plain data (arrays,
-numbers, strings, computed measures) that makes its matplotlib ``Figure``.
-:meth:`FigurePool.draw` draws tasks in worker processes, one figure per task:
-each is made afresh and saved (PNG, then SVG), exactly as in one process, so
-the files hold the same pixels and the same drawing whichever process drew
-them. :meth:`FigurePool.submit` runs any other function of picklable arguments
-there (the report measures the paper's claims while it draws its own figures).
-
-Workers are started with ``spawn``: nothing of this process's state, threads or
-open files is inherited, and they import grainlab only, never the script that
-started them (which therefore needs no ``if __name__ == "__main__":`` guard: a
-script calling :func:`grainlab.protocols.biaxial.run_biaxial` at its top level
-is not run again in them); their numerical libraries run on one thread each
-(the workers are the parallelism). At most :data:`MAX_WORKERS` start, no more
-than the cores this process may use. There are
-none, and every task runs here when submitted, on one core, with
-``workers=0``, or inside a worker process of another pool (a campaign that
-runs several tests at once already uses the cores). Figure functions called
-inside a ``with FigurePool()`` block draw in that pool (:func:`figure_pool`),
-so that one set of workers serves a whole post-processing step. Results come
-back in the order submitted. An exception raised in a worker is raised again here, with
-the worker's traceback as its cause and a note naming the figure. Workers
-ignore Ctrl-C (this process receives it and stops them) and, on Linux, end
-with this process, however it ends.
+A :class:`FigureTask` names a figure file and a function of plain data that makes
+its ``Figure``; :meth:`FigurePool.draw` draws tasks in ``spawn``-ed workers (the same
+files as in one process) and :meth:`FigurePool.submit` runs any other function there.
+How workers start, stop and report errors: docs/analysis.md, "Figures (`grainlab.plot`)".
 """
 
 from __future__ import annotations
@@ -146,7 +126,7 @@ class PendingFigures:
 
     def result(self) -> dict[str, list[Path]]:
         """``{figure name: files written}`` in the order submitted; the first
-        failure is raised again (module docstring), after the others have finished."""
+        failure is raised again (docs/analysis.md), after the others have finished."""
         self.claimed = True
         files: dict[str, list[Path]] = {}
         failure: BaseException | None = None
@@ -172,7 +152,7 @@ _current: ContextVar[FigurePool | None] = ContextVar("grainlab_figure_pool", def
 
 
 class FigurePool:
-    """Worker processes for figures (module docstring); use it as a context manager.
+    """Worker processes for figures (docs/analysis.md); use it as a context manager.
 
     ``workers``: the most processes to start (default :data:`MAX_WORKERS`; 0:
     none, every task runs here); ``tasks``: how many tasks are expected, so that

@@ -1,18 +1,8 @@
 """The shear band of a biaxial run, found and accepted (or not) between two snapshots.
 
-:func:`find_band` searches the grains' excess local strain since a reference
-snapshot (:class:`~grainlab.analysis.LocalStrain` on the grains only) with
-:class:`~grainlab.analysis.ShearBand`, leaving out the grains within
-:data:`EDGE_D` mean diameters of the boundary, and accepts the candidate by
-the rules of :mod:`grainlab.analysis.band_acceptance`: ShearBand's own tests,
-crossing the sample, and a permutation test against :data:`N_PERMUTATIONS`
-random rearrangements of the values (p <= 0.05, fixed seed); the second band
-by the first two. :func:`find_field_band` runs the same search and acceptance
-(one code path) on any per-grain field, Fig. 12's being
-:func:`lambda_indicator`; :func:`displacement_band` reads Fig. 11's band
-(:class:`~grainlab.analysis.DisplacementBand`); :func:`band_labels` labels the
-grains by any reading. docs/analysis.md, "Figures of a biaxial run" and
-"Three readings of the shear band".
+:func:`find_band`, :func:`find_field_band`, :func:`displacement_band` and
+:func:`band_labels`: docs/analysis.md, "Figures of a biaxial run" and "Three
+readings of the shear band".
 """
 
 from __future__ import annotations
@@ -78,7 +68,7 @@ class BandNumbers:
     snapshot: str
     reference: str
     axial_strain: float
-    #: Whether the band passed the acceptance tests (module docstring).
+    #: Whether the band passed the acceptance tests (docs/analysis.md).
     found: bool
     #: Why it was not accepted ("" when found); names the candidate's numbers.
     reason: str
@@ -251,7 +241,7 @@ def _accepted_band(
     words: _Words,
 ) -> BandSearch:
     """The band of the per-grain ``field`` (N_grains,) of ``snap`` and its acceptance
-    (module docstring): the one code path of the strain band (:func:`find_band`) and
+    (docs/analysis.md): the one code path of the strain band (:func:`find_band`) and
     of the band in any field (:func:`find_field_band`), its numbers unlabelled."""
     g = snap.is_sample
     pos, rad = snap.positions[g], snap.radii[g]
@@ -358,7 +348,7 @@ def slab_members(band: ShearBand | Slab, pos: NDArray[np.float64]) -> NDArray[np
 
 
 def _band_problems(band: ShearBand, pos: NDArray[np.float64], d_mean: float) -> list[str]:
-    """Why a candidate band fails acceptance tests 1 and 2 (module docstring); [] if it passes."""
+    """Why a candidate band fails acceptance tests 1 and 2 (docs/analysis.md); [] if it passes."""
     problems = [band.reason] if not band.found else []
     tangent = np.array([np.cos(band.angle), np.sin(band.angle)])
     s = (pos - band.center) @ band.normal

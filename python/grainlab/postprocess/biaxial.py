@@ -1,27 +1,7 @@
 r"""The fabric numbers of a biaxial run, from its ``run.h5``: states, peak, shear bands.
 
-:func:`fabric_numbers` reads a run folder (or its ``run.h5``), picks its
-states, measures their fabric and finds the shear bands
-(:mod:`grainlab.postprocess.band`); :func:`analyse_run` returns the same
-together with the computed measures, for the figures
-(:mod:`grainlab.postprocess.figures`).
-
-States
-    *initial* is the first snapshot written, *final* the last, and *peak* the
-    snapshot (other than the first) whose axial strain is closest to the peak
-    of the ``stress_ratio`` time series (``peak_snapshot=`` overrides it).
-
-Shear band
-    Found on each pair (initial, peak) and (initial, final) by
-    :func:`~grainlab.postprocess.band.find_band` (its acceptance tests are
-    described there), read from the run's stored products when ``run.h5``
-    holds them (:mod:`grainlab.postprocess.products`); a band that fails
-    them is "not found" and :attr:`BandNumbers.reason` says why.
-
-Stability index
-    lambda with the library's default: contacts with membrane disks and
-    platens count as the boundary contacts of the grains; membrane disks get
-    NaN. Means are over grains with at least 2 contacts.
+:func:`fabric_numbers` and :func:`analyse_run` (with the computed measures, for
+the figures): docs/analysis.md, "Figures of a biaxial run".
 """
 
 from __future__ import annotations
@@ -125,27 +105,27 @@ class FabricNumbers:
     def band_found(self) -> bool:
         return self.band is not None and self.band.found
 
+    def _of_found_band(self, name: str) -> float:
+        found = self.band is not None and self.band.found
+        return float(getattr(self.band, name)) if found else math.nan
+
     @property
     def band_angle_deg(self) -> float:
         """Band angle at the peak snapshot, degrees (NaN when not found)."""
-        band = self.band
-        return band.angle_deg if band is not None and band.found else math.nan
+        return self._of_found_band("angle_deg")
 
     @property
     def band_thickness_diameters(self) -> float:
         """Band thickness at the peak snapshot in mean grain diameters (NaN when not found)."""
-        band = self.band
-        return band.thickness_diameters if band is not None and band.found else math.nan
+        return self._of_found_band("thickness_diameters")
 
     @property
     def mean_lambda_in_band(self) -> float:
-        band = self.band
-        return band.mean_lambda_inside if band is not None and band.found else math.nan
+        return self._of_found_band("mean_lambda_inside")
 
     @property
     def mean_lambda_outside_band(self) -> float:
-        band = self.band
-        return band.mean_lambda_outside if band is not None and band.found else math.nan
+        return self._of_found_band("mean_lambda_outside")
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready dict (NaN as None, paths as strings)."""
@@ -357,7 +337,7 @@ def _bands(products: RunProducts, states: dict[str, RunState], k_snap: int, last
 
 
 def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> RunAnalysis:
-    """Read ``run.h5`` of ``run_dir`` and measure its states and bands (module docstring).
+    """Read ``run.h5`` of ``run_dir`` and measure its states and bands (docs/analysis.md).
 
     Raises :class:`MissingColumnError` when a column of :data:`REQUIRED_COLUMNS`
     is missing, ``ValueError`` for no snapshots, no finite stress ratio or an

@@ -1,13 +1,5 @@
-"""The paper's Figs. 6, 7, 9, 11, 12, 13 and 14 of a biaxial run, as PNG + SVG files.
-
-:func:`fabric_figures` measures the run (:func:`~grainlab.postprocess.biaxial.analyse_run`),
-turns its states into panels and draws them with :mod:`grainlab.plot.biaxial`,
-side by side in worker processes (:class:`~grainlab.plot.workers.FigurePool`:
-the same files as drawn one after the other).
-Maps draw the membrane disks light grey (NaN); a found band is outlined
-dashed (its second, conjugate band dotted) and the panel title gives its
-inclination to the horizontal and thickness; a band that was searched and
-not found leaves the maps without an outline and the title says so.
+"""The paper's Figs. 6, 7, 9, 11, 12, 13 and 14 of a biaxial run, as PNG + SVG files
+(docs/analysis.md, "Figures of a biaxial run").
 """
 
 from __future__ import annotations

@@ -1,31 +1,8 @@
 r"""The stability index lambda against the force network, the force chains,
-the local porosity and the contact loops, at a biaxial run's peak
-(docs/fabric.md, "Lambda, the force network and the voids").
+the local porosity and the contact loops, at a biaxial run's peak.
 
-For the grains that lambda measures (sample grains with at least 2 contacts,
-counted as :class:`~grainlab.analysis.StabilityIndex` counts them, as its
-``mean`` does), the mean lambda and its standard error
-
-* in the strong network (a contact with :math:`f_n > \langle f_n\rangle`,
-  :class:`~grainlab.analysis.ForceNetworks`) and out of it;
-* in a force chain (:class:`~grainlab.analysis.ForceChains`, Peters et al.)
-  and out of one;
-* in the five quintiles of the local porosity (power cells,
-  :class:`~grainlab.analysis.LocalPorosity`): equally populated bins, so
-  that no bin edge is chosen by hand;
-* by the mean size of the loops the grain sits on
-  (:class:`~grainlab.analysis.ContactLoops`): about 3 (< 3.5), about 4
-  ([3.5, 4.5)), about 5 ([4.5, 5.5)), larger, and none (a grain on no loop
-  of the rattler-free network);
-
-and Spearman's rank correlation of lambda with the local porosity, with the
-loop size and with the grain's radius, and of the radius with the local
-porosity (a large disk fills more of its cell). Every measure takes its
-defaults.
-
-``python -m grainlab.postprocess.lambda_fabric RUN_DIR FIGURE`` prints the
-numbers (JSON) of the snapshot nearest the run's stress-ratio peak (the one
-peak rule, :mod:`grainlab.analysis.peak`) and draws the figure.
+What is measured and how: docs/fabric.md, "Lambda, the force network and the voids";
+``python -m grainlab.postprocess.lambda_fabric RUN_DIR FIGURE`` prints and draws it.
 """
 
 from __future__ import annotations
@@ -74,7 +51,7 @@ def _group(label: str, values: NDArray[np.float64]) -> Group:
 
 @dataclass(frozen=True)
 class LambdaFabric:
-    """The groups and correlations of :func:`lambda_against_fabric` (module docstring)."""
+    """The groups and correlations of :func:`lambda_against_fabric` (docs/fabric.md)."""
 
     n_grains: int
     mean_lambda: float

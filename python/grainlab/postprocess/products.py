@@ -1,45 +1,10 @@
 """The analysis products of a run, stored in its ``run.h5`` rather than found again.
 
-A biaxial run's shear band searches (twenty band fits each), its displacement
-map's two-block split and its lambda fields are what the figures, the report,
-the viewer and the reproduction's claims all read. They are made once per
-snapshot, by :func:`store_run_products` (at the end of a run, or by the first
-reader of an older file), and kept in the results file's analysis group
-(:mod:`grainlab.io.hdf5.analysis`; ``docs/file-formats.md``). :class:`RunProducts`
-is how every reader gets them: the stored item when the file holds it, made
-anew (and not stored) otherwise, so a read-only file is read all the same.
-
-Every product of a snapshot is taken against the run's *reference*: its first
-snapshot written (a biaxial run's start of shearing, its smallest axial strain),
-as the paper measures the displacements. The products and the rule of each (its version; a changed rule
-gets a new version, and the stored items of the old one are made again):
-
-``stability_index`` (version 1)
-    :class:`~grainlab.analysis.StabilityIndex` with its defaults: arrays
-    ``stability_index`` and ``n_contacts`` per particle.
-``band_strain`` (version 1)
-    :func:`~grainlab.postprocess.band.find_band` of the snapshot against the
-    reference (the band of the local strain, the paper's Fig. 12 reading):
-    the :class:`~grainlab.postprocess.band.BandNumbers`, the accepted slabs,
-    the per-particle displacement.
-``band_lambda`` (version 1)
-    :func:`~grainlab.postprocess.band.find_field_band` of the grains with
-    lambda > 0.5 (:func:`~grainlab.postprocess.band.lambda_indicator`).
-``band_displacement`` (version 1)
-    :func:`~grainlab.postprocess.band.displacement_zone` of the snapshot
-    against the reference (Fig. 11's two-block split, accepted or not).
-``local_porosity`` (version 1)
-    :class:`~grainlab.analysis.LocalPorosity` with its defaults: array
-    ``local_porosity`` per particle (NaN for membrane disks).
-``force_chains`` (version 1)
-    :class:`~grainlab.analysis.ForceChains` with its defaults: array ``chain``
-    per particle (the chain's index, -1 outside every chain); a snapshot without
-    contact forces has none (all -1).
-
-``RunProducts(results, per_body=True)`` reads a run of clumps per body: each
-snapshot as its :func:`~grainlab.analysis.body_view` (one particle per body), lambda
-as :class:`~grainlab.analysis.BodyStabilityIndex`, every product made anew from
-those (the stored items are the pebbles'); a run of disks reads as without it.
+:func:`store_run_products` makes them, :class:`RunProducts` reads them (made anew,
+unstored, when the file lacks them), each against the run's first snapshot with
+the version of its rule: docs/file-formats.md, "/analysis/<product>/<snapshot>".
+``RunProducts(results, per_body=True)`` reads a run of clumps per body, made anew
+(docs/file-formats.md).
 """
 
 from __future__ import annotations
@@ -75,7 +40,7 @@ if TYPE_CHECKING:
 
 __all__ = ["PRODUCTS", "LambdaField", "RunProducts", "store_run_products"]
 
-#: The products a run stores, with the version of the rule that makes each (module docstring).
+#: The products a run stores, with the version of the rule that makes each (docs/file-formats.md).
 PRODUCTS: dict[str, int] = {
     "stability_index": 1,
     "band_strain": 1,
@@ -236,7 +201,7 @@ def _make_items_in_file(path: str, reference: str, name: str, strain: float,
 
 # ------------------------------------------------------------------ the run's products
 class RunProducts:
-    """The analysis products of one results file (module docstring): each read from
+    """The analysis products of one results file (docs/file-formats.md): each read from
     the file's analysis group when stored there, else made anew and kept here (not
     written: :func:`store_run_products` writes them).
 
@@ -367,7 +332,7 @@ def store_run_products(
     *,
     progress: Callable[[int, int], None] | None = None,
 ) -> Results:
-    """Makes the products (module docstring) that the results file does not hold yet, one
+    """Makes the products (docs/file-formats.md) that the results file does not hold yet, one
     task per snapshot in ``pool``'s workers (in this process without one), and stores them
     in its analysis group; returns the file read again. A file that holds them all is
     left untouched. ``progress(done, total)`` is called as snapshots are finished.

@@ -1,14 +1,5 @@
-"""ParaView export of a run: one ``.vtp`` per snapshot and a ``.pvd`` time series.
-
-:func:`export_vtk` reads a run's ``run.h5``, computes each snapshot's point
-data (:func:`snapshot_arrays`: the measures of :mod:`grainlab.analysis` and
-the bands of :func:`grainlab.postprocess.band.band_labels`) and writes them
-with :mod:`grainlab.io.vtk` (the file layout is described there and in
-docs/file-formats.md, "ParaView").
-
-The ``.pvd`` collection lists the files with their time value: the
-snapshots' axial strain when it is known for every snapshot and strictly
-increasing, else their time in s under the same condition, else their index.
+"""ParaView export of a run: one ``.vtp`` per snapshot and a ``.pvd`` time series
+(docs/file-formats.md, "ParaView").
 """
 
 from __future__ import annotations
@@ -40,21 +31,11 @@ __all__ = ["VtkExport", "export_vtk", "snapshot_arrays"]
 
 
 def snapshot_arrays(snap: Any, reference: Any | None = None) -> dict[str, NDArray[Any]]:
-    """Point data of one :class:`~grainlab.snapshot.Snapshot` for the export.
-
-    ``reference`` is the run's first snapshot (``None`` or ``snap`` itself for
-    the first one): displacement, local shear strain and shear band are taken
-    against it. Keys, in order (units in docs/file-formats.md, "ParaView"):
-
-    ``id``, ``kind``, ``radius``, ``displacement`` (N, 3) (matched by id, NaN
-    for particles absent from the reference, 0 in the first snapshot),
-    ``rotation`` (only when the snapshot has rotations), ``n_contacts`` (walls
-    included), ``stability_index``, ``local_shear_strain`` (NaN in the first
-    snapshot), ``in_shear_band`` (0 outside, 1 in the dominant band, 2 in
-    the conjugate band: the bands the biaxial figures outline,
-    :func:`grainlab.postprocess.band.band_labels`), then every numeric per-particle field
-    of the snapshot (``velocity``, ...) under its own name, 2-vectors padded to
-    (N, 3); a field whose name is already taken above is left out.
+    """Point data of one :class:`~grainlab.snapshot.Snapshot` for the export, in the
+    order and units of docs/file-formats.md, "ParaView"; ``reference`` is the run's first
+    snapshot (``None`` or ``snap`` itself for the first one), which displacement, local
+    shear strain and shear band are taken against. A particle field whose name is
+    already taken is left out.
     """
     n = snap.n_particles
     out: dict[str, NDArray[Any]] = {
@@ -128,16 +109,8 @@ def export_vtk(
 ) -> VtkExport:
     """Write one ``.vtp`` per snapshot of ``run`` (a run folder or its ``run.h5``) and a ``.pvd``.
 
-    Files go to ``out_dir`` (default ``<run folder>/vtk``) as ``snapshot_0000.vtp``, ...
-    (in the run's snapshot order) and ``run.pvd``. Each file's field data holds
-    ``axial_strain`` and ``time`` (when the snapshot has them) and the counts
-    of :func:`contact_lines`. Beside each ``.vtp`` the same data as an
-    UnstructuredGrid ``snapshot_0000.vtu`` (:func:`grainlab.io.vtk.write_vtu`,
-    for meshio); when ``run.h5`` stores a snapshot's walls, its active walls
-    as lines in ``walls_0000.vtp`` (infinite walls clipped to the particles'
-    extent) and a ``walls.pvd`` collection on the same time axis; for the
-    snapshots with clumps, their centroids and angles in ``clumps_0000.vtp``
-    (:func:`grainlab.io.vtk.write_clumps_vtp`) and a ``clumps.pvd``. Raises
+    Into ``out_dir`` (default ``<run folder>/vtk``): the files of docs/file-formats.md,
+    "ParaView" (``.vtu`` twins, walls and clumps when the run has them). Raises
     ValueError when the run has no snapshots.
     """
     path = Path(run)

@@ -1,13 +1,5 @@
 """``report.html``: one self-contained page describing a results folder (docs/report.md).
 
-:func:`write_report` tells a run (``run.h5``, its ``kind`` naming the test)
-from a packing study (``study.csv``), looks its page up in the registry
-(:mod:`.pages`: each test's declared :class:`~.run_page.ReportPage`),
-assembles it (:mod:`.run_page`; the biaxial test's and the study's own
-layout in :mod:`.render`) and writes ``DIR/report.html`` atomically. The
-page embeds its figures as PNG ``data:`` URIs and has no scripts, fonts or
-links to other hosts: it opens offline from ``file://``.
-
 Example
 -------
 >>> from grainlab.report import write_report          # doctest: +SKIP

@@ -1,29 +1,7 @@
 r"""Friction and dilation angles of a biaxial run, and the classical shear-band angles.
 
-Conventions (docs/conventions.md): stresses and strains compression positive,
-:math:`\sigma_1` the axial (vertical) stress, :math:`\sigma_3` the confining
-(horizontal) one; angles in radians here, degrees only in the report's text.
-A band's inclination is measured from the :math:`\sigma_3` direction (the
-horizontal), so a band at 90° would run along :math:`\sigma_1`.
-
-**Mobilised friction angle** at a record with stress ratio
-:math:`R = \sigma_1/\sigma_3`:
-
-.. math:: \sin\varphi = \frac{\sigma_1 - \sigma_3}{\sigma_1 + \sigma_3} = \frac{R - 1}{R + 1}.
-
-**Dilation angle**, in 2D with the area strain
-:math:`\varepsilon_v = \varepsilon_1 + \varepsilon_3` and the shear strain
-:math:`\gamma = \varepsilon_1 - \varepsilon_3`:
-
-.. math:: \sin\psi = -\frac{d\varepsilon_v}{d\gamma}
-          = -\frac{s}{2 - s},\qquad s = \frac{d\varepsilon_v}{d\varepsilon_1},
-
-since :math:`d\gamma = 2\,d\varepsilon_1 - d\varepsilon_v`. A dilating
-sample (:math:`\varepsilon_v` falling, :math:`s < 0`) has :math:`\psi > 0`.
-
-**Classical band inclinations** to the :math:`\sigma_3` direction:
-Mohr–Coulomb :math:`45° + \varphi/2`, Roscoe :math:`45° + \psi/2`, Arthur
-:math:`45° + (\varphi + \psi)/4`.
+Radians here, degrees only in the report's text; the formulas and conventions:
+docs/report.md, "How the angles are computed".
 
 Example
 -------

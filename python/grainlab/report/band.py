@@ -1,13 +1,6 @@
-"""The shear band of a biaxial run, as the report shows it.
-
-The report shows the bands that the run's figures show: those of
-:func:`grainlab.postprocess.fabric_numbers` (``band``, at the
-snapshot nearest the peak, and ``band_final``, at the end of shearing; the
-detector :class:`grainlab.analysis.ShearBand` on the grains' excess local
-strain since the first snapshot, grains away from the boundary, with the
-figures' acceptance tests). :func:`band_from_numbers` reads one of them back
-from its JSON form in ``summary.json`` as the
-:class:`~grainlab.postprocess.band.BandNumbers` it was written from.
+"""The shear band of a biaxial run, as the report shows it: :func:`band_from_numbers`
+reads the figures' bands back from ``summary.json`` (docs/report.md, "How the angles
+are computed").
 """
 
 from __future__ import annotations

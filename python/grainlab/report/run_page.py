@@ -1,13 +1,5 @@
-"""A test's report page, declared (:class:`ReportPage`) and assembled here once.
-
-A declaration names its protocol (the results file's ``kind``), its figures,
-its summary numbers ("At a glance") and its own sections; this module writes
-what every run's page shares: the head line, the gathered run
-(:class:`RunPage`: the run, its summary and its figures, drawn first when
-missing), the figures grid, how to rerun the run (``grainlab run KIND`` with
-the keys that differ from the defaults), its resolved configuration and the
-footer. A test whose page is laid out by its own module (the biaxial test's,
-the packing study's) declares that module's ``render`` instead.
+"""A test's report page, declared (:class:`ReportPage`) and assembled here once
+(docs/report.md, "Pages from the registry").
 """
 
 from __future__ import annotations

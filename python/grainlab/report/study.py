@@ -12,6 +12,7 @@ import csv
 import json
 import math
 import shlex
+from collections import Counter
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -234,9 +235,7 @@ def gather_study(folder: str | Path, *, redraw: bool = False) -> StudyReport:
         png = folder / f"{key}.png"
         if is_usable_png(png):
             figures[key] = EmbeddedFigure(key, title, caption, embedded_png(png.read_bytes()), f"{png.name} in the study folder")
-    statuses: dict[str, int] = {}
-    for r in rows:
-        statuses[r.get("status", "?")] = statuses.get(r.get("status", "?"), 0) + 1
+    statuses = dict(Counter(r.get("status", "?") for r in rows))
     command, rerun_notes = _rerun(folder, summary, irregular, hexagonal)
     return StudyReport(
         folder=folder,

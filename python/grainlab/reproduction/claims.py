@@ -1,27 +1,7 @@
 """Every claim of the paper (Secs. 6-8), what is measured for it on each seed,
-and the rule that judges it (:mod:`.verdicts`); docs/reproduction.md lists them.
+and the rule that judges it (:mod:`.verdicts`).
 
-A :class:`Claim` reads one number per seed from the measures of that seed's
-run (:func:`~grainlab.reproduction.measures.measure_biaxial` for the biaxial
-claims, :func:`~grainlab.reproduction.measures.measure_study` for the packing
-study's) and :func:`evaluate` judges the ensemble. Tolerance bands and
-thresholds were fixed before any run:
-
-- "around" a value: +-25 % of it (a at 0.5 %: 0.135-0.225); the coordination
-  numbers, given to two digits, +-0.2;
-- the band and rest means of lambda (0.34, 0.31): +-0.015, half their
-  difference, so that the two values stay apart;
-- the isotropic-state anisotropies (0.0034, 0.009): from 0 to twice the value
-  (the same order of magnitude);
-- "near 1.5 %": 1.0-2.0 %; "almost the same strain": within 0.5 % strain;
-- "a constant": the relative change per 1 % axial strain over the end window
-  (the last 30 % of the test's strain, after the peak) within +-2 %;
-  "constant from the peak onward": final within +-5 % of the peak state;
-- "linear": R^2 of a straight line >= 0.98;
-- "lambda locates the band": ROC AUC > 0.6; "carries information": > 0.5;
-  "randomly distributed": AUC within 0.4-0.6;
-- "linearly related": R^2 >= 0.8;
-- "most" of a group: a share above 0.5.
+The claims and their tolerances, fixed before any run: docs/reproduction.md.
 """
 
 from __future__ import annotations
@@ -36,7 +16,7 @@ import numpy as np
 from grainlab import paper
 from grainlab._html import number
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
-from grainlab.reproduction.measures import END_WINDOW, relative_slope
+from grainlab.reproduction.measures import END_WINDOW, correlation, relative_slope
 from grainlab.reproduction.verdicts import ProportionRule, SideRule, ValueRule
 
 __all__ = ["BIAXIAL_CLAIMS", "RATE_CLAIMS", "STUDY_CLAIMS", "Claim", "band_measure", "evaluate", "single_run_rows"]
@@ -87,16 +67,15 @@ class Claim:
 def evaluate(claims: Sequence[Claim], measures: Sequence[Measures | None], seeds: Sequence[int],
              variant: str) -> list[dict[str, Any]]:
     """One row per claim; a seed without measures (its run failed) gives NaN."""
-    rows = []
-    for claim in claims:
-        values = []
-        for m in measures:
-            try:
-                values.append(float(claim.extract(m)) if m is not None else math.nan)
-            except (KeyError, IndexError, TypeError, ValueError, ZeroDivisionError):
-                values.append(math.nan)
-        rows.append(claim.row(values, seeds, variant))
-    return rows
+    return [claim.row([_extracted(claim, m) for m in measures], seeds, variant) for claim in claims]
+
+
+def _extracted(claim: Claim, measures: Measures | None) -> float:
+    """The claim's value in ``measures``; NaN without measures or the numbers it reads."""
+    try:
+        return float(claim.extract(measures)) if measures is not None else math.nan
+    except (KeyError, IndexError, TypeError, ValueError, ZeroDivisionError):
+        return math.nan
 
 
 def _one_run(rule: Rule, value: float) -> str:
@@ -118,10 +97,7 @@ def single_run_rows(measures: Measures, claims: Sequence[Claim] = ()) -> list[di
     event that happens). One run is not a verdict: ``grainlab reproduce`` is."""
     rows = []
     for claim in claims or BIAXIAL_CLAIMS:
-        try:
-            value = float(claim.extract(measures))
-        except (KeyError, IndexError, TypeError, ValueError, ZeroDivisionError):
-            value = math.nan
+        value = _extracted(claim, measures)
         rows.append({"id": claim.id, "statement": claim.statement, "source": claim.source,
                      "paper_value": claim.paper_value, "measure": claim.measure, "value": value,
                      "rule": claim.rule.to_dict(), "this_run": _one_run(claim.rule, value)})
@@ -184,12 +160,7 @@ def _end_slope(m: Measures, key: str) -> float:
 
 
 def _correlation(m: Measures, a: str, b: str) -> float:
-    _, x = _series(m, a)
-    _, y = _series(m, b)
-    ok = np.isfinite(x) & np.isfinite(y)
-    if ok.sum() < 3 or np.ptp(x[ok]) == 0 or np.ptp(y[ok]) == 0:
-        return math.nan
-    return float(np.corrcoef(x[ok], y[ok])[0, 1])
+    return correlation(_series(m, a)[1], _series(m, b)[1])
 
 
 def _strain_of_max(m: Measures, key: str) -> float:

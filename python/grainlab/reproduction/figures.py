@@ -1,15 +1,5 @@
 """Figures of a reproduction: every seed, their mean and the 95 % interval over
-seeds against axial strain (PNG at a modest resolution, for ``reproduction.html``).
-
-For each biaxial variant: ``macro_<variant>`` (stress ratio, volumetric
-strain), ``fabric_<variant>`` (a, Z, mean lambda, the paper's values marked)
-``band_<variant>`` (the band-resolved fabric: lambda inside and outside
-the band under both conventions, Z, the share of 2-contact grains, rotation,
-and the ROC AUC of lambda as a classifier of band membership) and
-``strata_<variant>`` (band and rest at the peak at equal contact number, and the
-AUCs of lambda, of the contact number and of both). For each study
-variant ``study_<variant>`` (Figs. 15-17 with every seed); ``rates`` for a
-rate family.
+seeds against axial strain (PNG for ``reproduction.html``; docs/reproduction.md).
 """
 
 from __future__ import annotations

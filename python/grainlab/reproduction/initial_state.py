@@ -1,55 +1,9 @@
 r"""The state a biaxial run starts shearing from, set against the paper's (Sec. 6).
 
-The paper reports at the isotropic state (0 % axial strain, after consolidation
-to 100 kPa) a coordination number Z of about 3.9, a contact-normal anisotropy
-a = 0.0034 and a normal-force anisotropy a_n = 0.009. This module measures the
-same state of grainlab's runs, and of preparations alone, with the readings
-that could explain a difference:
-
-* Z over all grains (grain-grain contacts, the time series' column), the
-  mechanical Z (:class:`~grainlab.analysis.CoordinationNumber`'s rattler rule,
-  the time series' ``mechanical_coordination_number``), the rattler share, and
-  Z inside measurement circles (away from the boundary);
-* a and a_n (the exact estimate, :class:`~grainlab.analysis.ContactAnisotropy`)
-  against the noise floor of an isotropic sample with as many contacts
-  (:func:`isotropic_noise_floor`);
-* the porosity in three PFC2D-style measurement circles, nominal and
-  overlap-corrected (:func:`~grainlab.samples.measurement_circle_porosity`),
-  and the whole sample's nominal porosity;
-* the mean lambda over the grains with >= 2 contacts (the library's
-  ``mean_stability_index``) and over the mechanically active grains.
-
-Noise floor of the anisotropy estimate
-    grainlab's headline a is :math:`a = 2 |m|` with :math:`m = \frac{1}{N}
-    \sum_c e^{2 i \theta_c}` over the N grain-grain contacts (fabric.py; each
-    contact once: its two ends, :math:`\theta` and :math:`\theta + \pi`, give
-    the same :math:`e^{2 i \theta}`, so counting both changes nothing). For N
-    normals drawn independently from the uniform distribution, :math:`\sum_c
-    e^{2 i \theta_c}` is a sum of N unit steps with mean 0 and
-    :math:`E[\cos^2] = E[\sin^2] = 1/2`: by the central limit theorem
-    :math:`N |m|^2` is exponential with mean 1, so :math:`a` is Rayleigh
-    distributed with :math:`\sigma^2 = 2/N`:
-
-    .. math::
-
-       P(a \le x) = 1 - e^{-N x^2 / 4},\qquad
-       E[a] = \sqrt{\pi / N},\qquad
-       \mathrm{median}(a) = 2 \sqrt{\ln 2 / N}.
-
-    Eq. 7 on ``bins`` bins (``anisotropy_binned``) moves each contact to its
-    bin centre and multiplies by :math:`s = \sin\Delta\theta / \Delta\theta`
-    (0.980 at 18 bins); the bin centres of uniform angles are uniform on
-    equally spaced directions whose second harmonic vanishes, so the same law
-    holds for :math:`a / s`. For a_n, each contact weighted by its normal force
-    :math:`f_c`, :math:`E|m|^2 = \sum f^2 / (\sum f)^2`: the same law with the
-    effective number :math:`N_\mathrm{eff} = (\sum f)^2 / \sum f^2` (directions
-    independent of the forces).
-
-Run ``python -m grainlab.reproduction.initial_state RUNS`` for the table of the
-finished runs under ``RUNS`` (every ``run.h5``), and ``--explore`` for the
-preparations of :data:`EXPLORE_SETTINGS`, three seeds each, appended to
-:data:`EXPLORE_FILE` as each finishes (a setting and seed already there is
-skipped, so the exploration resumes where it was stopped).
+Z (all grains, mechanical, in measurement circles), the anisotropies against the
+noise floor of an isotropic sample (:func:`isotropic_noise_floor`), the porosity
+and the mean lambda; ``python -m grainlab.reproduction.initial_state RUNS`` (or
+``--explore``) prints the table: docs/reproduction.md, "The initial state".
 """
 
 from __future__ import annotations
@@ -166,7 +120,7 @@ class NoiseFloor:
     r"""The distribution of the anisotropy estimate for N isotropic contact normals.
 
     ``a / scale`` is Rayleigh distributed with :math:`\sigma^2 = 2 / N`
-    (module docstring); ``scale`` is 1 for the exact estimate and
+    (docs/reproduction.md); ``scale`` is 1 for the exact estimate and
     :math:`\sin\Delta\theta / \Delta\theta` for Eq. 7 on bins of width
     :math:`\Delta\theta`.
     """
@@ -440,11 +394,9 @@ def snapshot_initial_state(
     z, z_boundary, normals, lam, forces = _measures(snapshot)
     sample = snapshot.is_sample
     n_grains = int(sample.sum())
-    ci, cj = np.asarray(snapshot.contact_i), np.asarray(snapshot.contact_j)
-    grain_grain = (cj >= 0) & sample[ci] & sample[np.where(cj >= 0, cj, 0)]
+    grain_grain = ~np.asarray(snapshot.is_boundary_contact)
     n_c = int(grain_grain.sum())
-    counts = np.bincount(ci[grain_grain], minlength=snapshot.n_particles)
-    counts += np.bincount(cj[grain_grain], minlength=snapshot.n_particles)
+    counts = snapshot.contact_counts(include_boundary=False)
     floor = isotropic_noise_floor(max(n_c, 1))
     a_n, n_eff, force_floor_mean, force_p = _force_noise(snapshot, forces, grain_grain)
     pos = np.asarray(snapshot.positions)[sample]

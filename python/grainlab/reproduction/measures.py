@@ -1,17 +1,8 @@
 """What a reproduction measures on one stored run, with the current analysis.
 
-:func:`measure_biaxial` reads a finished biaxial run (``run.h5``): the macro
-curves from its time series (stress ratio, volumetric strain) and, at every
-snapshot, the fabric recomputed from the stored contacts with the analysis
-classes (a, a_n, Z, mean lambda under both conventions) and the band-resolved
-fabric (:class:`~grainlab.analysis.band_fabric.BandFabric`) inside and outside
-the shear band that the figures' detector finds in the grains' local strain
-since the start of shearing (:func:`grainlab.postprocess.band.band_labels`:
-the accepted band and its accepted conjugate band). Nothing frozen at run time
-is used beyond the raw records and snapshots, so a newer analysis gives newer
-numbers from the same runs.
-
-:func:`measure_study` reads one seed's packing study (its ``result.json`` rows).
+:func:`measure_biaxial` recomputes a biaxial run's curves, fabric and band-resolved
+fabric from its records and snapshots; :func:`measure_study` reads one seed's
+packing study (docs/reproduction.md).
 """
 
 from __future__ import annotations
@@ -85,12 +76,12 @@ def relative_slope(x: NDArray[np.float64], y: NDArray[np.float64]) -> float:
     return float(slope * 0.01 / mean) if mean != 0 else math.nan
 
 
-def _r2(x: NDArray[np.float64], y: NDArray[np.float64]) -> float:
+def correlation(x: NDArray[np.float64], y: NDArray[np.float64]) -> float:
+    """Pearson's r of the finite pairs (NaN with fewer than 3, or a constant side)."""
     ok = np.isfinite(x) & np.isfinite(y)
     if ok.sum() < 3 or np.ptp(x[ok]) == 0 or np.ptp(y[ok]) == 0:
         return math.nan
-    r = np.corrcoef(x[ok], y[ok])[0, 1]
-    return float(r * r)
+    return float(np.corrcoef(x[ok], y[ok])[0, 1])
 
 
 def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
@@ -111,7 +102,7 @@ def macro_measures(ts: Mapping[str, NDArray[np.float64]]) -> dict[str, Any]:
         "peak_axial_strain": float(eps[k]),
         "peak_stress_ratio": float(q[k]),
         "peak_in_interior": peak_is_interior(eps, q),
-        "linear_r2": _r2(eps[linear], q[linear]),
+        "linear_r2": correlation(eps[linear], q[linear]) ** 2,
         "residual_stress_ratio": float(np.mean(q[window])) if window.any() else math.nan,
         "residual_relative_slope": relative_slope(eps[window], q[window]),
         "end_window_from": float(eps[window][0]) if window.any() else math.nan,
@@ -153,7 +144,7 @@ def _fabric_of(view: BodyView, options: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def measure_biaxial(run_dir: str | Path, options: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """Every number the claims use, of one finished biaxial run (module docstring).
+    """Every number the claims use, of one finished biaxial run (docs/reproduction.md).
 
     ``options``: analysis options (:data:`ANALYSIS_DEFAULTS`). Returns a
     JSON-ready dict: ``macro``, ``snapshots`` (one dict per snapshot, in strain

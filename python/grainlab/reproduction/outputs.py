@@ -1,24 +1,7 @@
 """From the runs of a reproduction to ``claims.json``, ``claims.csv``, ``measures.json``,
-the figures and ``reproduction.html``.
+the figures and ``reproduction.html``, all recomputed from the stored runs.
 
-Everything is recomputed from the stored runs each time (:mod:`.measures`), in
-parallel over the runs; nothing of an earlier call is reused, so a newer
-analysis gives newer claims from the same runs (``grainlab reproduce --out DIR
---claims-only``).
-
-``claims.json``::
-
-    {"claims": [...], "seeds": [...], "variant": "paper", "grainlab_version": "...",
-     "variants": [{"variant", "kind", "description", "seeds", "claims": [...], "runs", "wall_time_s",
-                   "notes"}, ...],
-     "rate_convergence": [...], "verdict_counts": {...}}
-
-The top-level ``claims`` are the paper's: the biaxial claims of the main
-biaxial variant (``paper`` when run) followed by the packing-study claims of
-the main study variant (``study``); ``variant`` names them (``paper+study``).
-``variants`` holds one block per variant, with all its claims, each row
-naming its variant; ``rate_convergence`` the rate family's comparison
-(:func:`rate_convergence`).
+The files and their fields: docs/reproduction.md, "Outputs".
 """
 
 from __future__ import annotations

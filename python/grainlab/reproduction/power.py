@@ -1,17 +1,7 @@
 """How many seeds a band-against-rest claim needs: a power estimate from the first seeds.
 
-The side rule (:class:`~grainlab.reproduction.verdicts.SideRule`) reproduces a
-paired difference when the 95 % t-interval of its mean over seeds lies above
-0. With ``n`` seeds and a per-seed standard deviation ``sd`` (estimated from
-the seeds already run), the interval's half-width is
-``t(0.975, n - 1) sd / sqrt(n)`` and the chance that it excludes 0 when the
-true difference is ``effect`` is the noncentral-t power
-``1 - F_nct(t(0.975, n - 1); n - 1, effect sqrt(n) / sd)``. The chance that it
-lies inside ``+-width`` when the true difference is 0 (a difference shown to
-be smaller than the paper's) is estimated by sampling normal seeds.
-
-``python -m grainlab.reproduction.power [CAMPAIGN] [CLAIM ...]`` prints the
-table for the stored campaign's claims (docs/reproduction.md, "How many seeds").
+``python -m grainlab.reproduction.power [CAMPAIGN] [CLAIM ...]`` prints the table
+(docs/reproduction.md, "How many seeds").
 """
 
 from __future__ import annotations

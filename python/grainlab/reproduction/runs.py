@@ -1,46 +1,7 @@
 """The runs of a reproduction: variants, seeds, the run configuration, the folder layout.
 
-A reproduction runs the paper's biaxial test (and its Sec. 7 packing study)
-once per seed for each **variant** and lays the runs out as
-
-``DIR/runs/<variant>/seed-<k>/biaxial/``  (a biaxial run: ``run.h5``, ``summary.json``, ...)
-``DIR/runs/<variant>/seed-<k>/<kind>_<porosity>/``  (one packing of the study)
-
-on the campaign machinery of :mod:`grainlab.study.campaign` (local processes
-or Dask; resumable: a finished run is skipped; a failing run does not stop the
-others). Seed ``k`` is the biaxial sample's ``sample.seed`` in every biaxial
-variant, so the variants of one seed shear the same sample and compare paired;
-for the study it is the campaign seed of :func:`grainlab.study.study_runs`.
-
-Variants (:func:`parse_variant`):
-
-``paper``
-    The paper's test: Table 1, the membrane boundary (variant A), 2 %/min.
-``boundary_b``
-    The sample's own outermost grains as the lateral boundary
-    (``boundary.kind = outer_particles``), as the paper's Sec. 6 describes it.
-``rate=<rate>``
-    ``paper`` at another axial strain rate, e.g. ``rate=1%/min``; a rate equal to
-    the paper variant's reads the paper variant's runs.
-``set:<key>=<value>[,<key>=<value>...]``
-    ``paper`` with any biaxial configuration keys changed.
-``lambda:<key>=<value>[,...]``, ``lambda:<key>=<value>[,...]:<variant>``
-    Analysis only: the paper variant's runs (or the given variant's: a biaxial
-    variant's runs, or a study variant's stored packings), lambda read another way
-    (Eqs. 9-11): ``slots`` (angular, list, nearest), ``anchor`` (min, mean),
-    ``deviation`` (sum, per_contact), e.g. ``lambda:slots=nearest,deviation=per_contact``
-    or ``lambda:deviation=per_contact:study:generation_friction=0``.
-``band:displacement``, ``band:lambda``, ``band:final``
-    Analysis only: the paper variant's runs, the band's grains read from the
-    displacement map (Fig. 11), from the zone of lambda > 0.5 (Fig. 12), or the
-    final band carried back to every snapshot.
-``lambda_raw``, ``lambda_raw:<variant>``
-    Analysis only: the paper variant's (or the given biaxial variant's) runs,
-    lambda counting every membrane disk a grain touches as a contact (instead
-    of each boundary body once).
-``study``, ``study:<field>=<value>[,...]``
-    The Sec. 7 packing study (19 packings per seed), with packing parameters
-    changed, e.g. ``study:generation_friction=0.9``.
+The layout ``DIR/runs/<variant>/seed-<k>/...`` and the variants
+(:func:`parse_variant`): docs/reproduction.md.
 """
 
 from __future__ import annotations
@@ -54,6 +15,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
+from grainlab.analysis.stability import LAMBDA_ANCHORS, LAMBDA_DEVIATIONS, LAMBDA_SLOTS
 from grainlab.io.results import write_json_atomic
 from grainlab.study.campaign import CampaignResult, Run, make_run
 
@@ -102,9 +64,7 @@ Kind = Literal["biaxial", "study", "analysis"]
 #: The readings of Eqs. 9-11 an analysis variant ``lambda:<key>=<value>,...`` may choose
 #: (:class:`~grainlab.analysis.StabilityIndex`'s options; the first of each is the default).
 LAMBDA_READINGS: dict[str, tuple[str, ...]] = {
-    "slots": ("angular", "list", "nearest"),
-    "anchor": ("min", "mean"),
-    "deviation": ("sum", "per_contact"),
+    "slots": LAMBDA_SLOTS, "anchor": LAMBDA_ANCHORS, "deviation": LAMBDA_DEVIATIONS
 }
 _BAND_TEXT = {
     "displacement": "the zone separating the two moving blocks of the displacement map (Fig. 11), "
@@ -192,7 +152,7 @@ def _study_value(name: str, key: str, raw: str) -> Any:
 
 
 def parse_variant(text: str) -> Variant:
-    """The :class:`Variant` named by ``text`` (module docstring); ``ValueError`` naming it."""
+    """The :class:`Variant` named by ``text`` (docs/reproduction.md); ``ValueError`` naming it."""
     name = text.strip()
     if name == "paper":
         return Variant("paper", "biaxial", description="the paper's test: Table 1 (2 %/min), membrane boundary")
@@ -429,10 +389,6 @@ def run_reproduction(
     columns = ["name", "variant", "seed_index", "kind", "status", "wall_time_s", "seed", "error"]
     return run_campaign(plan.runs(), out_dir, workers=workers, scheduler=scheduler, progress=progress,
                         table_name=RUNS_TABLE, columns=columns)
-
-
-def seeds_of(values: Sequence[int]) -> str:
-    return ", ".join(str(s) for s in values)
 
 
 def describe(plan: ReproductionPlan) -> list[str]:

@@ -1,16 +1,7 @@
-"""The paper-scale campaign's verdicts, shipped with grainlab.
+"""The paper-scale campaign's verdicts, shipped with grainlab in ``paper_scale/``.
 
-``grainlab reproduce`` runs at paper scale take hours; their ``claims.json``
-documents are kept in ``grainlab/reproduction/paper_scale/`` (one per campaign
-folder: ``main.json``, the 2 %/min ensemble of 20 seeds with its analysis variants;
-``readings.json``, the same runs under the readings of Eqs. 9-11 that the paper's
-lambda_max admits; ``rates.json``, the faster rates,
-boundary B and the time-step check; ``rate1.json``, 1 %/min; ``rate05.json``, 0.5
-against 1 %/min; ``study.json``, the
-packing study generated with friction 0 and 0.9; ``study_readings.json``, its
-frictionless packings under the readings of Eqs. 9-11). docs/reproduction.md
-quotes their tables (a test keeps them equal) and ``report.html`` shows, beside
-a run's own value of each claim, the verdict of the ensemble.
+docs/reproduction.md quotes their tables (a test keeps them equal); ``report.html``
+shows each claim's ensemble verdict beside a run's own value.
 """
 
 from __future__ import annotations

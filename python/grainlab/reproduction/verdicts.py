@@ -1,27 +1,8 @@
 """Verdict rules: how the per-seed values of a claim become ``reproduced``,
-``not reproduced`` or ``inconclusive`` (fixed before any run; docs/reproduction.md).
+``not reproduced`` or ``inconclusive`` (fixed before any run).
 
-Every rule takes the finite per-seed values (NaN values, e.g. a seed whose band
-was not found, are left out, and ``n`` says how many remain) and returns a
-:class:`Judgement`. With fewer than 2 values the verdict is ``inconclusive``.
-
-- :class:`ValueRule` (a value the paper gives): the 95 % t-interval of the
-  mean over seeds is compared with a tolerance band ``[low, high]`` around the
-  paper's value: **reproduced** when the interval lies inside the band,
-  **not reproduced** when it lies entirely outside, **inconclusive** when it
-  straddles an edge.
-- :class:`SideRule` (a direction or a threshold: a difference of the paper's
-  sign, a value above a bound): the 95 % t-interval of the mean (of the
-  per-seed paired differences for a comparison) is compared with the
-  reference: **reproduced** when entirely on the paper's side, **not
-  reproduced** when entirely on the other side, **inconclusive** when it
-  contains the reference.
-- :class:`ProportionRule` (an event the paper reports, e.g. a band found at
-  0.5 %): per seed 1 or 0; the exact one-sided binomial test at 5 % that the
-  share of seeds exceeds one half: **reproduced** when significant, **not
-  reproduced** when the share is significantly below one half, otherwise
-  **inconclusive** (5 of 5 seeds are needed with 5 seeds; 3 of 3 cannot
-  decide). ``ci95`` is the two-sided exact (Clopper-Pearson) interval.
+:class:`ValueRule`, :class:`SideRule` and :class:`ProportionRule` judge the finite
+values into a :class:`Judgement`: docs/reproduction.md, "Verdict rules".
 
 Example
 -------

@@ -1,18 +1,6 @@
-"""A campaign: many independent runs, each in its own folder, run in local
-processes (:class:`concurrent.futures.ProcessPoolExecutor`) or on a Dask
-distributed cluster, resumable and failure-isolated.
-
-- A run is ``(name, kind, params)``; ``kind`` names a task in :data:`TASKS`
-  (``"packing"``) or a protocol of :mod:`grainlab.protocols.registry` (``"biaxial"``). Its folder is ``OUT/runs/NAME``.
-- **Finished** means ``OUT/runs/NAME/result.json`` exists (written atomically
-  at the very end of the run). A rerun of the same campaign skips finished
-  runs and reruns the others, including failed ones (a failure may be
-  transient; a deterministic one fails again and says so again).
-- A run that raises is recorded with status ``failed`` and its error (also in
-  ``OUT/runs/NAME/error.txt``); the others go on.
-- Seeds: :func:`derive_seed` hashes the campaign seed, the kind and the run's
-  parameters (not its name or position), so a run repeated alone
-  (:func:`execute_run`) gives the same numbers.
+"""A campaign: many independent runs, each in its own folder, in local processes or
+on a Dask cluster, resumable and failure-isolated (docs/study.md, "Execution,
+resuming, failures, seeds").
 """
 
 from __future__ import annotations

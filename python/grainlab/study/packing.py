@@ -1,33 +1,8 @@
-"""One packing of the paper's Sec. 7 study, made and measured.
+"""One packing of the paper's Sec. 7 study, made and measured (Tables 2 and 3).
 
-Two kinds (Tables 2 and 3):
-
-- ``irregular``: radius expansion (:func:`grainlab.samples.expand_to_porosity`)
-  to a target *nominal* porosity inside the rigid box, Table 1/2 contact
-  properties, diameters 0.5-3 mm (radii 0.25-1.5 mm); the packing is the
-  equilibrium state at the target. The generation friction is by default
-  ``"search"``: the least friction, found by bisection in ``[0, friction]``
-  (:func:`grainlab.samples.expand_with_friction_search`), whose packing at the
-  target bears a mean wall stress of at least ``search_stress_min`` (aiming
-  at ``search_stress_min`` ... ``search_stress_max``) with ``Z_m >= 3``; the
-  targets the frictionless expansion already jams at keep friction 0. A number
-  fixes it instead (0: the frictionless expansion; 0.9: Table 2's mu
-  throughout). The packing is measured as generated: switching Table 2's
-  mu = 0.9 on at rest changes nothing (shear springs start at zero and the
-  packing is already in equilibrium), so it is not cycled again.
-- ``hexagonal``: equal disks (Table 3's 0.875 mm read as a radius: 1.75 mm
-  diameter) on a hexagonal lattice in a periodic cell of the box's size:
-  random vacancies above the contact porosity 0.0931, uniform compression
-  below it. Both are static: a compressed full lattice is in equilibrium by
-  symmetry, a lattice at contact carries no load. Contacts come from the
-  geometry (touching within 1e-9 d), normal forces from the linear law
-  ``kn * overlap``.
-
-:func:`run_packing` returns a flat dict of measures (:data:`MEASURES`) plus
-``status`` and ``note``; given a folder, it also stores the measured packing
-there (:data:`PACKING_FILE`, a results file of kind ``packing`` with one
-snapshot), so that the packing can be measured again another way
-(:func:`read_packing`) without being made again.
+The two kinds, the generation friction search and what is measured: docs/study.md.
+:func:`run_packing` returns :data:`MEASURES`, ``status`` and ``note``, and stores the
+packing (:data:`PACKING_FILE`) for :func:`read_packing`.
 """
 
 from __future__ import annotations
@@ -93,10 +68,10 @@ class PackingParams:
     """Diameter of the hexagonal packings' disks (Table 3's 0.875 mm read as a radius)."""
     generation_friction: float | str = GENERATION_FRICTION_SEARCH
     """Particle friction during the radius expansion: a number (fixed), or ``"search"``
-    (chosen per packing in ``[0, friction]``; see the module docstring)."""
+    (chosen per packing in ``[0, friction]``; docs/study.md)."""
     friction: float = 0.9
     """Table 2's mu: the upper end of the generation friction search (the packing is
-    measured as generated; see the module docstring)."""
+    measured as generated; docs/study.md)."""
     platen_friction: float = 0.0
     normal_stiffness: float = 8.45e7
     shear_stiffness: float = 8.45e7

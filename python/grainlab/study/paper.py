@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from pathlib import Path
@@ -210,9 +211,7 @@ def run_study(
                             table_name="study.csv", columns=STUDY_COLUMNS)
     no_figures: dict[str, Any] = {"files": {}, "fig17_fit": {}, "fig17_fit_all": {}}
     fig = study_figures(campaign.rows, out) if figures else no_figures
-    statuses: dict[str, int] = {}
-    for row in campaign.rows:
-        statuses[row.get("status", "?")] = statuses.get(row.get("status", "?"), 0) + 1
+    statuses = dict(Counter(row.get("status", "?") for row in campaign.rows))
     summary = {
         "campaign_wall_time_s": time.perf_counter() - started,
         "runs_wall_time_s_sum": float(sum(float(r.get("wall_time_s") or 0.0) for r in campaign.rows)),

@@ -1,27 +1,7 @@
 """Sweep plans: a TOML file naming a base config and the parameters to vary.
 
-```toml
-base = "packing"            # or a test: "biaxial", "oedometer", "cyclic", "simple_shear"
-mode = "grid"               # "grid" (every combination) or "zip" (element-wise)
-seed = 0                    # campaign seed (each run's seed is derived from it)
-# config = "biaxial.toml"   # a test only: a config file, relative to the plan
-# quick = true              # a test only: the --quick sample
-
-[fixed]                     # the same for every run
-width = 0.02
-height = 0.04
-
-[vary]                      # one list or range per parameter
-porosity = [0.14, 0.16, 0.18]
-generation_friction = { start = 0.0, stop = 0.4, num = 3 }   # or { start, stop, step }
-```
-
-For ``base = "packing"`` the keys are :class:`~grainlab.study.packing.PackingParams`
-fields; for a test (``"biaxial"``, ``"oedometer"``, ...: a protocol of
-:mod:`grainlab.protocols.registry`) they are the dotted config keys of its
-schema (``"sample.porosity"`` or a nested
-``[vary.sample]`` table) and accept units (``"100 kPa"``). Every value is
-validated before any run starts; errors name the key.
+The plan's keys, modes and units: docs/study.md, "`grainlab sweep` and the plan
+format". Every value is validated before any run starts; errors name the key.
 """
 
 from __future__ import annotations
@@ -198,7 +178,7 @@ def parse_plan(text: str, *, base_dir: str | os.PathLike[str] | None = None, sou
 
 
 def load_plan(path: str | os.PathLike[str]) -> Plan:
-    """Reads a plan file (see the module docstring)."""
+    """Reads a plan file (docs/study.md)."""
     p = Path(path)
     try:
         text = p.read_text()

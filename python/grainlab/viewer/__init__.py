@@ -1,16 +1,6 @@
 """An interactive page of a run: ``grainlab view DIR`` writes ``DIR/viewer.html``.
 
-One self-contained HTML file (no network, no libraries: the drawing code is
-grainlab's own, inlined, and the data are embedded as base64 arrays): the
-grains of every snapshot in a canvas, coloured by the stability index
-lambda, the number of contacts, the displacement, the rotation or the local
-shear strain since the first snapshot, or by grain (a clump's pebbles one
-colour; every clump outlined, and a run with clumps opens coloured by
-grain); the contact network (line width by normal force); the walls when the
-run stores them; the outlines of the accepted shear bands; a strain slider
-with the stress–strain curve beside it (click the curve to jump to the
-nearest snapshot); and a grain's values on hover. What is shown is gathered by :func:`grainlab.viewer.data.viewer_data`
-(docs/report.md, section "The viewer").
+One self-contained HTML file (docs/report.md, "The viewer").
 
 >>> from grainlab.viewer import write_viewer  # doctest: +SKIP
 >>> write_viewer("results/quick")  # doctest: +SKIP

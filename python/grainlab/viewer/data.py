@@ -1,23 +1,5 @@
-"""What the viewer page shows of a run, gathered from its ``run.h5``.
-
-:func:`viewer_data` reads every snapshot of a results file and computes, per
-snapshot, the per-grain values the page colours by (the ones the ParaView
-export writes, :func:`grainlab.postprocess.vtk.snapshot_arrays`): the
-stability index lambda, the local porosity and the force chains (the run's
-stored products, :class:`grainlab.postprocess.products.RunProducts`), the number of contacts, the displacement and
-the rotation since the first snapshot, the local shear strain since it and
-the shear band labels; the particle–particle contacts with their normal
-forces; the accepted bands' outlines (the run's stored band searches, against its
-first snapshot);
-the walls when the file stores them; each particle's grain (the pebbles of a
-clump share theirs, :meth:`~grainlab.snapshot.Snapshot.grains`) and each
-snapshot's number of grains, for the page's colour per grain and its outlines
-of the clumps (``clumps`` says whether the run has any: the page then opens
-coloured by grain); and the stress–strain curve of the time series.
-
-Arrays are quantised for the page: coordinates, radii and values as
-float32 (about 7 significant digits: a grain's lambda shows to 1e-6), codes
-and counts as uint8, contact ends as uint16 or uint32, each base64 encoded.
+"""What the viewer page shows of a run, gathered from its ``run.h5`` (docs/report.md,
+"The viewer"); arrays quantised to float32, uint8 and uint16/32, base64 encoded.
 """
 
 from __future__ import annotations

@@ -1,16 +1,7 @@
 """The analysis group of a results file: products of the analysis stored with the run.
 
-``/analysis/<product>/<item>`` is one product of one snapshot (a band search, a
-lambda field: what they are is the analysis's, ``grainlab.postprocess.products``);
-this module only stores and reads them as an :class:`AnalysisItem`, attributes and
-arrays, each product with the version of the rule that made it
-(``docs/file-formats.md``, "The analysis group").
-
-A product is added to a complete ``run.h5`` by :func:`write_analysis`, which
-works on a copy of the file and renames it over the original: an interrupted
-write leaves the file as it was. Files of layout version 1 have no analysis
-group; a product written into an older file makes it a file of the current
-version (whose readers read the older snapshots as they were).
+Stored and read as :class:`AnalysisItem` (what they are is
+:mod:`grainlab.postprocess.products`'); docs/file-formats.md, "/analysis/<product>/<snapshot>".
 """
 
 from __future__ import annotations

@@ -1,12 +1,7 @@
-"""One snapshot as an HDF5 group (``/snapshots/<name>`` of a results file): its
-name, its datasets and attributes written and read, and what the group says
-about it without loading it (:class:`SnapshotInfo`).
-
-Layout version 3 stores a snapshot's grains (rigid bodies: a clump's pebbles
-share one) as the dataset ``grain`` (N,) and the group ``grains`` of one row per
-grain (``label``, ``centroid``, ``angle``) instead of three per-particle fields;
-versions 1 and 2 have neither, and their snapshots read with every particle a
-grain of its own unless their ``particle_fields`` say otherwise."""
+"""One snapshot as an HDF5 group (``/snapshots/<name>`` of a results file): written, read,
+and described without loading it (:class:`SnapshotInfo`); the layouts of versions 1-3:
+docs/file-formats.md.
+"""
 
 from __future__ import annotations
 

@@ -44,21 +44,11 @@ __all__ = ["ResultsWriter"]
 class ResultsWriter:
     """Writes a results file ``run.h5`` while a run goes on.
 
-    The writer works on ``PATH.partial`` (root attribute ``status =
-    "running"``) and flushes after every call, so a killed run leaves a
-    partial file that :meth:`resume` can continue. :meth:`finalize` marks the
-    file complete and renames it to ``PATH`` atomically. Used as a context
-    manager, a block that ends normally finalizes; a block that raises marks
-    the partial file ``"failed"`` (with the error message) and does not
-    rename it (``KeyboardInterrupt`` leaves it ``"running"``, resumable).
-
-    With ``buffered=True`` the file is built in memory and reaches the disk
-    only whole, through :meth:`publish`, :meth:`close` and :meth:`finalize`,
-    each an atomic write of the complete file (:func:`write_bytes_atomic`):
-    the HDF5 library never writes the disk itself, so a kill or a full disk
-    can never leave a damaged ``PATH.partial`` (a full disk is a plain
-    ``OSError`` from that write, and the file on disk stays the last one
-    published). The biaxial test writes this way and publishes at every checkpoint.
+    The writer works on ``PATH.partial`` and :meth:`finalize` publishes ``PATH``
+    atomically; as a context manager a block that raises marks the partial file
+    ``"failed"`` (``KeyboardInterrupt`` leaves it ``"running"``, resumable by
+    :meth:`resume`). ``buffered=True`` builds the file in memory and writes it only
+    whole. docs/file-formats.md, "Crash safety".
 
     Parameters
     ----------
