@@ -1,17 +1,7 @@
-"""The flexible lateral boundary of the biaxial test (docs/boundary.md, variant A):
-a chain of small bonded membrane disks along each side of the sample, ends
-tied to the platens, loaded by the confining pressure as a follower load.
-
-Geometry: the left chain runs bottom to top just outside the sample's left
-face, the right chain top to bottom outside its right face, so that walking
-either chain the sample lies on the right (clockwise), as the engine's pressure
-chains expect. Each membrane disk of radius ``r_m`` sits with its centre
-``r_m`` outside the face it replaces, neighbours overlapping by a fraction of
-their diameter and bonded at that distance (bonded pairs do not repel), so the
-chain is a smooth, closed skin that grains cannot pass through until it has
-stretched by that fraction. The end disks have a prescribed vertical velocity,
-that of their platen; horizontally they slide freely on the frictionless platens.
-"""
+"""The lateral boundaries of the biaxial test (docs/boundary.md, "The flexible
+boundary of the biaxial test"): A, chains of bonded membrane disks outside the
+sample's sides, walked clockwise around it as the engine's pressure chains
+expect; B, the sample's outermost grains; C, rigid side walls."""
 
 from __future__ import annotations
 

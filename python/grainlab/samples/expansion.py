@@ -1,35 +1,7 @@
-"""Radius expansion: the paper's way of making a dense sample inside rigid walls.
-
-The procedure (paper Sec. 6; docs/samples.md gives the details and the reasons):
-
-1. Draw ``N`` diameters from the grading (``N`` from :func:`particle_count` unless
-   given) and scale them all by one factor ``f`` (close to 1) so that the final
-   nominal porosity is exactly the target.
-2. Place the disks at random, without overlap, at ``initial_scale`` (0.5) of
-   their final radii (:func:`random_placement`), inside four rigid segment
-   walls on the box edges.
-3. Grow all radii by a common factor, one small increment at a time, with
-   ``steps_per_increment`` DEM steps (in Rust) after each. The increment in
-   ``ln r`` is ``growth_per_increment / (1 + sigma / growth_stress_scale_pa)``,
-   with ``sigma`` the mean wall stress just measured: fast while the packing is
-   loose, slow once it carries stress.
-4. At the final radii, cycle until the mean unbalanced force ratio is below
-   ``equilibrium_ratio`` (default 1e-4), or, for a target looser than the
-   jamming porosity, until the contacts carry no load (rms overlap below
-   ``stress_free_overlap`` = 1e-5 of the smallest radius; ``Sample.jammed`` is
-   then False).
-
-Stress bound: whenever the mean wall stress exceeds ``max_stress_pa``, growth
-stops and the packing is cycled to equilibrium at its current radii; if it
-still exceeds the bound, :class:`ExpansionError` reports the densest nominal
-porosity reached and the stress it needed.
-
-While generating, every disk is given the mass of the largest one (density
-scaling for a static solution, as PFC's ``timestep scale``): the static
-equilibrium does not depend on the masses, and the time step, set by the
-lightest disk, grows by ``d_max / d_min``. The Table 1 density is restored at
-the end, velocities are zeroed, and the time step is reset to half the
-critical one.
+"""Radius expansion: the paper's way of making a dense sample inside rigid walls
+(Sec. 6): the disks placed at half their radii, grown by increments that slow as
+the wall stress rises, then cycled to equilibrium. docs/samples.md, "Radius
+expansion", gives the steps, the stopping rules and the density scaling.
 
 Example
 -------
@@ -326,8 +298,8 @@ def expand_to_porosity(
     density : kg/m^3 (Table 1: 2e8); local_damping : alpha (Table 1: 0.8)
     initial_scale : placed radius over final radius (the paper halves: 0.5)
     growth_per_increment, steps_per_increment, growth_stress_scale_pa : the
-        growth (module docstring, steps 3); equilibrium_ratio, stress_free_overlap,
-        max_equilibrium_steps : the end (step 4; past the last, the sample comes
+        growth (docs/samples.md, step 4); equilibrium_ratio, stress_free_overlap,
+        max_equilibrium_steps : the end (step 5; past the last, the sample comes
         with ``equilibrium_reached = False`` and a warning)
     max_stress_pa : stress bound (mean wall stress in equilibrium), Pa
     time_step_safety : time step = this x the critical step, re-evaluated every increment

@@ -1,33 +1,6 @@
-"""Regular packings of equal disks: hexagonal and square lattices at a given porosity.
-
-At contact (spacing ``a`` = diameter ``d``) an infinite lattice has porosity
-
-- hexagonal: ``1 - pi / (2 sqrt 3) = 0.093100...`` (each disk owns ``sqrt(3)/2 a^2``),
-- square: ``1 - pi / 4 = 0.214602...`` (each disk owns ``a^2``).
-
-Other porosities are made the two ways the paper's packing study allows:
-
-- **above** the contact value: random sites are left empty (vacancies), as
-  many as the target needs (rounded to a whole disk);
-- **below** it: the lattice is compressed uniformly, ``a = d sqrt((1 - n_contact) / (1 - n))``,
-  so neighbours overlap by ``d - a``; the nominal porosity is then exactly the
-  target and the overlap-corrected one is higher (each overlap is counted once).
-
-Two boundaries:
-
-- ``"periodic"`` (default): the box is a whole number of lattice periods and
-  is meant as a periodic cell; porosities are those of the infinite lattice
-  (0.0931 and 0.2146 exactly at contact). A given box is rounded to whole
-  periods (the returned :attr:`Lattice.box` is the cell used).
-- ``"walls"``: the disks sit inside a rigid box, the first row and column
-  touching the bottom and left walls; porosities are those of the box, which
-  include the gaps along the walls. With ``box`` given, as many sites as fit
-  are used: the lattice is compressed just enough for the full lattice to reach
-  the target or below, and vacancies make up the rest. With ``n_rows``/``n_cols``
-  the box is fitted around the lattice, the spacing solved so that the full
-  lattice has the target porosity in it (or the contact spacing and vacancies
-  above the contact value).
-
+"""Regular packings of equal disks: hexagonal and square lattices at a given
+porosity, vacancies above the contact porosity and a uniform compression below
+it, in a periodic cell or a walled box (docs/samples.md, "Lattices");
 :attr:`Lattice.note` says what was done.
 
 Example
@@ -340,7 +313,7 @@ def hexagonal_lattice(
     diameter : m (the paper's Table 3 prints 0.875 mm; see docs/samples.md)
     porosity : target nominal porosity in (0, 1); ``None``: the lattice at contact.
         Above the contact porosity (0.0931 periodic) random vacancies, below it a
-        uniform compression (module docstring).
+        uniform compression (docs/samples.md, "Lattices").
     box : ``(xmin, ymin, xmax, ymax)``, m; or ``n_rows`` and ``n_cols`` (even
         ``n_rows`` when periodic)
     boundary : ``"periodic"`` or ``"walls"``

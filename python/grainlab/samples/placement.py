@@ -1,12 +1,5 @@
-"""Random sequential placement of non-overlapping disks in a box.
-
-Disks go in largest first (big disks are the hard ones to fit). Each round
-takes the next ``batch`` unplaced disks, draws ``tries`` candidate centres for
-each, uniformly where the disk fits inside the box, and keeps, per disk, the
-first candidate that overlaps neither a placed disk (a cKDTree query against the
-placed set) nor an earlier accepted candidate of the same round. Disks whose
-candidates all failed stay at the front of the queue for the next round. All
-of it is array work; the only Python loop is over rounds.
+"""Random sequential placement of non-overlapping disks in a box, largest
+first, in rounds of array work (docs/samples.md, "Random placement").
 
 Example
 -------

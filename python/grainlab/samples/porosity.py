@@ -1,16 +1,8 @@
-"""Porosity of a 2D disk packing, read two ways, and the particle count for a target.
-
-- **Nominal** porosity (PFC's reading): ``n = 1 - sum(pi r^2) / A``. Overlaps are
-  counted twice, so a packing of overlapping disks can have a nominal porosity
-  below what its geometry covers, even below zero.
-- **Overlap-corrected** porosity: ``n_c = 1 - |union of disks ∩ box| / A``, the
-  void fraction really left in the box. :func:`overlap_corrected_porosity`
-  computes it by inclusion-exclusion up to pairs: each disk clipped exactly at
-  the box edges, minus the lens of every overlapping pair.
-- Either reading inside a **measurement circle**, as PFC2D's measurement circles
-  report porosity: :func:`measurement_circle_porosity`.
-
-Areas are per unit thickness (m^2); boxes are ``(xmin, ymin, xmax, ymax)`` in m.
+"""Porosity of a 2D disk packing, nominal (``1 - sum(pi r^2) / A``, PFC's) and
+overlap-corrected (``1 - |union of disks ∩ box| / A``), in a box or inside a
+measurement circle, and the particle count for a target (docs/samples.md,
+"Porosity: two readings"). Areas per unit thickness (m^2); boxes
+``(xmin, ymin, xmax, ymax)`` in m.
 
 Example
 -------
