@@ -5,8 +5,9 @@ expect; B, the sample's outermost grains; C, rigid side walls."""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
-from typing import Any
+from collections.abc import Callable, Mapping
+from dataclasses import asdict, dataclass, fields
+from typing import Any, Self
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,9 +26,29 @@ SLACK_TIE = 1.0e-6
 #: and the run stops with an error (at rest they are half a diameter apart).
 MAX_NEIGHBOUR_DISTANCE_DIAMETERS = 2.0
 
+#: How a saved boundary's field is read back, by its annotation.
+_READ: dict[str, Callable[[Any], Any]] = {
+    "int": int, "float": float, "bool": bool, "list[int]": lambda v: [int(k) for k in v],
+    "tuple[int, int]": lambda v: (int(v[0]), int(v[1])),
+}
+
 
 @dataclass(frozen=True)
-class Membrane:
+class _Saved:
+    """A boundary as checkpoints store it: its fields, and its ``kind`` where it has one."""
+
+    def to_dict(self) -> dict[str, Any]:
+        kind = getattr(self, "kind", None)
+        return asdict(self) | ({} if kind is None else {"kind": kind})
+
+    @classmethod
+    def from_dict(cls, saved: Mapping[str, Any]) -> Self:
+        """The boundary :meth:`to_dict` gave."""
+        return cls(**{f.name: _READ[str(f.type)](saved[f.name]) for f in fields(cls)})
+
+
+@dataclass(frozen=True)
+class Membrane(_Saved):
     """The two membrane chains of a biaxial sample."""
 
     left: list[int]
@@ -49,20 +70,6 @@ class Membrane:
     def ends(self) -> list[int]:
         """The four end disks tied to the platens."""
         return [self.left[0], self.left[-1], self.right[0], self.right[-1]]
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Membrane:
-        return cls(
-            left=list(d["left"]),
-            right=list(d["right"]),
-            radius=float(d["radius"]),
-            chains=(int(d["chains"][0]), int(d["chains"][1])),
-            bottom_wall=int(d["bottom_wall"]),
-            top_wall=int(d["top_wall"]),
-        )
 
 
 def _column(x: float, y0: float, y1: float, radius: float, spacing: float) -> NDArray[np.float64]:
@@ -319,7 +326,7 @@ def outer_contour(
 
 
 @dataclass(frozen=True)
-class GrainBoundary:
+class GrainBoundary(_Saved):
     """Variant B: the confining pressure acts on the grains of the sample's outer
     contour, each touching the next, re-identified as the boundary changes (Kuhn
     1995; Cheung & O'Sullivan 2008)."""
@@ -335,24 +342,6 @@ class GrainBoundary:
     right: list[int]
 
     kind = "outer_particles"
-
-    def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["kind"] = self.kind
-        return d
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> GrainBoundary:
-        return cls(
-            chains=(int(d["chains"][0]), int(d["chains"][1])),
-            bottom_wall=int(d["bottom_wall"]),
-            top_wall=int(d["top_wall"]),
-            n_grains=int(d["n_grains"]),
-            bin_height=float(d["bin_height"]),
-            pressure=float(d["pressure"]),
-            left=list(d["left"]),
-            right=list(d["right"]),
-        )
 
     def identify(self, sim: Simulation) -> GrainBoundary:
         """Re-identifies the grains of the outer contour on each side
@@ -405,7 +394,7 @@ def install_grain_boundary(
 
 
 @dataclass(frozen=True)
-class WallBoundary:
+class WallBoundary(_Saved):
     """Variant C: the consolidation box's rigid side walls stay as the lateral
     boundary. Drained, each is servo-controlled to the confining ``pressure``
     (:meth:`control`, between records); at constant volume they move apart or
@@ -421,16 +410,6 @@ class WallBoundary:
     constant_volume: bool
 
     kind = "walls"
-
-    def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["kind"] = self.kind
-        return d
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> WallBoundary:
-        return cls(int(d["left_wall"]), int(d["right_wall"]), int(d["bottom_wall"]), int(d["top_wall"]),
-                   float(d["pressure"]), bool(d["constant_volume"]))
 
     def size(self, sim: Simulation) -> tuple[float, float]:
         """The box's width and height now, m."""

@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -50,6 +50,11 @@ _DENSITY = paper.DENSITY_KG_PER_M3
 _DAMPING = paper.LOCAL_DAMPING
 #: Default stress bound of the expansion (mean wall stress in equilibrium), Pa.
 MAX_STRESS_PA = 5.0e6
+
+
+#: The fields of a :class:`Sample` that :meth:`Sample.to_dict` leaves out (arrays, the
+#: simulation) or gives first (a clump sample's shape).
+_NOT_SCALARS = ("positions", "radii", "wall_points", "shape", "shape_parameter", "grain", "simulation")
 
 
 class ExpansionError(ValueError):
@@ -185,31 +190,9 @@ class Sample:
         grains = {} if self.grain is None else {
             "n_grains": self.n_grains, "shape": self.shape, "shape_parameter": self.shape_parameter,
         }
-        return {
-            "n_particles": self.n_particles,
-            **grains,
-            "box": list(self.box),
-            "porosity_target": self.porosity_target,
-            "porosity": self.porosity,
-            "porosity_overlap_corrected": self.porosity_overlap_corrected,
-            "wall_stresses_pa": self.wall_stresses_pa.tolist(),
-            "mean_wall_stress_pa": self.mean_wall_stress_pa,
-            "coordination_number": self.coordination_number,
-            "mechanical_coordination_number": self.mechanical_coordination_number,
-            "mean_overlap_ratio": self.mean_overlap_ratio,
-            "max_overlap_ratio": self.max_overlap_ratio,
-            "unbalanced_force_ratio": self.unbalanced_force_ratio,
-            "equilibrium_reached": self.equilibrium_reached,
-            "jammed": self.jammed,
-            "radius_factor": self.radius_factor,
-            "seed": self.seed,
-            "grading": self.grading,
-            "friction": self.friction,
-            "wall_friction": self.wall_friction,
-            "threads": self.threads,
-            "steps": self.steps,
-            "wall_time_s": self.wall_time_s,
-        }
+        scalars = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in _NOT_SCALARS}
+        return {"n_particles": self.n_particles, **grains, **scalars, "box": list(self.box),
+                "wall_stresses_pa": self.wall_stresses_pa.tolist()}
 
 
 def _positive(name: str, value: float, allow_zero: bool = False) -> float:

@@ -23,7 +23,7 @@ import math
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any
 
 from numpy.typing import ArrayLike
@@ -75,16 +75,7 @@ class FrictionTrial:
         return self.outcome in ("in_band", "above_band")
 
     def to_dict(self) -> dict[str, Any]:
-        return {
-            "friction": self.friction,
-            "outcome": self.outcome,
-            "mean_wall_stress_pa": self.mean_wall_stress_pa,
-            "mechanical_coordination_number": self.mechanical_coordination_number,
-            "coordination_number": self.coordination_number,
-            "steps": self.steps,
-            "wall_time_s": self.wall_time_s,
-            "message": self.message,
-        }
+        return asdict(self)
 
     def describe(self) -> str:
         """``"0.05: in_band, 218 kPa, Z_m 3.93"``."""
