@@ -157,24 +157,20 @@ def set_platen_velocity(sim: Simulation, membrane: Membrane, speed: float) -> No
     sim.velocities = v
 
 
+def _clockwise(sim: Simulation, boundary: Membrane | GrainBoundary, left: NDArray[np.float64],
+               right: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The clockwise polygon of the points ``left`` (bottom to top) and ``right`` (top to
+    bottom), each side's ends anchored on the platens below and above them."""
+    y_bottom = float(sim.wall(boundary.bottom_wall).points[0, 1])
+    y_top = float(sim.wall(boundary.top_wall).points[0, 1])
+    return np.vstack([[[left[0, 0], y_bottom]], left, [[left[-1, 0], y_top]],
+                      [[right[0, 0], y_top]], right, [[right[-1, 0], y_bottom]]])
+
+
 def boundary_polygon(sim: Simulation, membrane: Membrane) -> NDArray[np.float64]:
     """The clockwise polygon around the sample: left chain (bottom to top), its
     anchors on the platens, right chain (top to bottom), its anchors."""
-    x = sim.positions
-    y_bottom = float(sim.wall(membrane.bottom_wall).points[0, 1])
-    y_top = float(sim.wall(membrane.top_wall).points[0, 1])
-    left = x[membrane.left]
-    right = x[membrane.right]
-    return np.vstack(
-        [
-            [[left[0, 0], y_bottom]],
-            left,
-            [[left[-1, 0], y_top]],
-            [[right[0, 0], y_top]],
-            right,
-            [[right[-1, 0], y_bottom]],
-        ]
-    )
+    return _clockwise(sim, membrane, sim.positions[membrane.left], sim.positions[membrane.right])
 
 
 def shoelace_area(polygon: NDArray[np.float64]) -> float:
@@ -370,13 +366,9 @@ class GrainBoundary(_Saved):
     def polygon(self, sim: Simulation) -> NDArray[np.float64]:
         """Clockwise polygon through the chains' outer edges and their anchors on the platens."""
         x, r = sim.positions, sim.radii
-        y_bottom = float(sim.wall(self.bottom_wall).points[0, 1])
-        y_top = float(sim.wall(self.top_wall).points[0, 1])
         left = x[self.left] - np.column_stack([r[self.left], np.zeros(len(self.left))])
         right = x[self.right] + np.column_stack([r[self.right], np.zeros(len(self.right))])
-        return np.vstack(
-            [[[left[0, 0], y_bottom]], left, [[left[-1, 0], y_top]], [[right[0, 0], y_top]], right, [[right[-1, 0], y_bottom]]]
-        )
+        return _clockwise(sim, self, left, right)
 
     def area(self, sim: Simulation) -> float:
         return shoelace_area(self.polygon(sim))
