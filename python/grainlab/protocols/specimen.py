@@ -20,13 +20,14 @@ from typing import TYPE_CHECKING, Any, ClassVar, Self, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+import grainlab
 from grainlab._cores import available_cores
 from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
 from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
 from grainlab.protocols.config import Config, grain_shape
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
-from grainlab.protocols.grains import grain_coordination, grain_porosity
+from grainlab.protocols.grains import clump_summary, grain_coordination, grain_porosity
 from grainlab.protocols.runner import Protocol, ProtocolError, RunResult, Stage, StageContext
 from grainlab.samples import (
     PAPER_GRADING,
@@ -43,7 +44,7 @@ if TYPE_CHECKING:
 
 __all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
            "damped_time_step_factor", "engine_columns",
-           "engine_threads", "generate", "grain_model", "platen_model", "write_run_outputs"]
+           "engine_threads", "generate", "grain_model", "platen_model", "run_summary", "write_run_outputs"]
 
 #: Steps per engine call while a phase waits for a condition.
 CHUNK_STEPS = 2000
@@ -329,6 +330,16 @@ def _consolidate_stage(context: StageContext[Any, Any]) -> None:
 
 #: The stage of every test that consolidates its sample in the four walls (:func:`consolidate`).
 CONSOLIDATE = Stage("consolidate", _consolidate_stage, "the four walls servo-controlled to sigma_0 until equilibrium")
+
+
+def run_summary(run: SpecimenRun, fields: Mapping[str, Any], *, records: int, wall_time_s: float,
+                **after_records: Any) -> dict[str, Any]:
+    """A test's summary: the grain counts, its ``fields``, the time step, the record
+    count, ``after_records``, the wall times and grainlab's version."""
+    return {"n_particles": run.n_grains, **clump_summary(run.sample), **fields,
+            "time_step_s": run.consolidation["time_step_s"], "records": records, **after_records,
+            "wall_time_s": wall_time_s, "wall_time_by_phase_s": dict(run.wall_time),
+            "grainlab_version": grainlab.__version__}
 
 
 def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.float64]], dict[str, Any]],
