@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from grainlab import paper
 from grainlab.analysis.fabric import CoordinationNumber
 from grainlab.analysis.per_body import BodyCoordination
+from grainlab.samples._checks import in_range, positive_lengths
 from grainlab.samples.grading import PAPER_GRADING, Grading
 from grainlab.samples.placement import random_placement
 from grainlab.samples.porosity import (
@@ -193,14 +194,6 @@ class Sample:
         scalars = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in _NOT_SCALARS}
         return {"n_particles": self.n_particles, **grains, **scalars, "box": list(self.box),
                 "wall_stresses_pa": self.wall_stresses_pa.tolist()}
-
-
-def _positive(name: str, value: float, allow_zero: bool = False) -> float:
-    value = float(value)
-    ok = value >= 0 if allow_zero else value > 0
-    if not (math.isfinite(value) and ok):
-        raise ValueError(f"{name}: must be a finite number {'>= 0' if allow_zero else '> 0'}, got {value}")
-    return value
 
 
 #: Each wall reaches this fraction of the box's shorter side beyond its corners,
@@ -379,42 +372,21 @@ class _Settings:
     def checked(cls, *, box: ArrayLike, porosity: float, grading: Grading, **values: Any) -> _Settings:
         """The settings, or a ``ValueError`` naming the first bad one, before any work."""
         box = check_box(box)
-        porosity = float(porosity)
-        if not (0.0 < porosity < 1.0):
-            raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+        porosity = in_range("porosity", porosity, "(0, 1)")
         if not isinstance(grading, Grading):
             raise TypeError(
                 f"grading: expected a Grading (UniformByNumber, UniformByMass, GradingCurve), got {grading!r}"
             )
-        v = dict(values)
-        for name in ("friction", "wall_friction"):
-            v[name] = _positive(name, v[name], allow_zero=True)
-        for name in ("normal_stiffness", "shear_stiffness", "density"):
-            v[name] = _positive(name, v[name])
-        v["local_damping"] = float(v["local_damping"])
-        if not (0.0 <= v["local_damping"] < 1.0):
-            raise ValueError(f"local_damping: must be in [0, 1), got {v['local_damping']}")
-        v["initial_scale"] = float(v["initial_scale"])
-        if not (0.0 < v["initial_scale"] <= 1.0):
-            raise ValueError(f"initial_scale: must be in (0, 1], got {v['initial_scale']}")
-        for name in ("growth_per_increment", "growth_stress_scale_pa"):
-            v[name] = _positive(name, v[name])
-        v["steps_per_increment"] = int(v["steps_per_increment"])
-        if v["steps_per_increment"] < 1:
-            raise ValueError(f"steps_per_increment: must be >= 1, got {v['steps_per_increment']}")
-        for name in ("equilibrium_ratio", "stress_free_overlap"):
-            v[name] = _positive(name, v[name])
-        v["max_equilibrium_steps"] = int(v["max_equilibrium_steps"])
-        if v["max_equilibrium_steps"] < 0:
-            raise ValueError(f"max_equilibrium_steps: must be >= 0, got {v['max_equilibrium_steps']}")
-        v["max_stress_pa"] = _positive("max_stress_pa", v["max_stress_pa"])
-        v["time_step_safety"] = float(v["time_step_safety"])
-        if not (0.0 < v["time_step_safety"] <= 1.0):
-            raise ValueError(f"time_step_safety: must be in (0, 1], got {v['time_step_safety']}")
-        v["threads"] = int(v["threads"])
-        if v["threads"] < 1:
-            raise ValueError(f"threads: must be >= 1, got {v['threads']}")
+        v: dict[str, Any] = {name: in_range(name, value, _RANGES.get(name, "(0, inf)")) for name, value in values.items()}
+        for name in ("steps_per_increment", "max_equilibrium_steps", "threads"):
+            v[name] = int(v[name])
         return cls(box=box, porosity=porosity, **v)
+
+
+#: The range of each of :class:`_Settings`' numbers but the positive ones.
+_RANGES = {"friction": "[0, inf)", "wall_friction": "[0, inf)", "local_damping": "[0, 1)", "initial_scale": "(0, 1]",
+           "steps_per_increment": "[1, inf)", "max_equilibrium_steps": "[0, inf)", "time_step_safety": "(0, 1]",
+           "threads": "[1, inf)"}
 
 
 def _diameters(
@@ -431,12 +403,9 @@ def _diameters(
     if diameters is not None:
         if n_particles is not None:
             raise ValueError("n_particles: give either n_particles or diameters, not both")
-        d = np.array(diameters, dtype=np.float64)
-        if d.ndim != 1 or len(d) == 0:
-            raise ValueError(f"diameters: expected a non-empty 1-D array, got shape {d.shape}")
-        if not np.all(np.isfinite(d)) or np.any(d <= 0):
-            k = int(np.argmax(~np.isfinite(d) | (d <= 0)))
-            raise ValueError(f"diameters[{k}]: must be a finite diameter > 0 (m), got {d[k]}")
+        d = np.array(positive_lengths("diameters", diameters, "diameter"))
+        if len(d) == 0:
+            raise ValueError("diameters: expected at least one diameter")
         return d
     if n_particles is not None:
         n = int(n_particles)

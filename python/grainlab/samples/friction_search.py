@@ -28,6 +28,7 @@ from typing import Any
 
 from numpy.typing import ArrayLike
 
+from grainlab.samples._checks import in_range
 from grainlab.samples.expansion import MAX_STRESS_PA, ExpansionError, Sample, expand_to_porosity
 from grainlab.samples.grading import PAPER_GRADING, Grading
 
@@ -193,14 +194,8 @@ def _checked_limits(
             f"stress_band_pa: the band's upper end {stress_high:.4g} Pa exceeds max_stress_pa = "
             f"{max_stress_pa:.4g} Pa, beyond which the expansion stops; lower the band or raise max_stress_pa"
         )
-    friction_tolerance = float(friction_tolerance)
-    if not (math.isfinite(friction_tolerance) and friction_tolerance > 0.0):
-        raise ValueError(f"friction_tolerance: must be a finite number > 0, got {friction_tolerance!r}")
-    min_mechanical_coordination = float(min_mechanical_coordination)
-    if not (math.isfinite(min_mechanical_coordination) and min_mechanical_coordination >= 0.0):
-        raise ValueError(
-            f"min_mechanical_coordination: must be a finite number >= 0, got {min_mechanical_coordination!r}")
-    return friction_tolerance, min_mechanical_coordination
+    return (in_range("friction_tolerance", friction_tolerance, "(0, inf)"),
+            in_range("min_mechanical_coordination", min_mechanical_coordination, "[0, inf)"))
 
 
 class _Search:
@@ -336,9 +331,7 @@ def expand_with_friction_search(
     """
     if "friction" in expansion:
         raise ValueError("friction: chosen by the search; give friction_range = (low, high) instead")
-    porosity = float(porosity)
-    if not (0.0 < porosity < 1.0):
-        raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+    porosity = in_range("porosity", porosity, "(0, 1)")
     mu_min, mu_max = _pair("friction_range", friction_range, 0.0, strict_minimum=False)
     stress_low, stress_high = _pair("stress_band_pa", stress_band_pa, 0.0, strict_minimum=True)
     max_stress_pa = float(expansion.get("max_stress_pa", MAX_STRESS_PA))

@@ -23,6 +23,8 @@ from abc import ABC, abstractmethod
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from grainlab.samples._checks import in_range, positive_lengths
+
 __all__ = [
     "PAPER_GRADING",
     "Grading",
@@ -33,12 +35,8 @@ __all__ = [
 
 
 def _check_range(d_min: float, d_max: float) -> tuple[float, float]:
-    d_min = float(d_min)
-    d_max = float(d_max)
-    if not (math.isfinite(d_min) and d_min > 0):
-        raise ValueError(f"d_min: must be a finite diameter > 0 (m), got {d_min}")
-    if not (math.isfinite(d_max) and d_max > 0):
-        raise ValueError(f"d_max: must be a finite diameter > 0 (m), got {d_max}")
+    d_min = in_range("d_min", d_min, "(0, inf)", "a diameter (m)")
+    d_max = in_range("d_max", d_max, "(0, inf)", "a diameter (m)")
     if d_min > d_max:
         raise ValueError(f"d_min: must be <= d_max, got d_min={d_min} > d_max={d_max}")
     return d_min, d_max
@@ -207,9 +205,7 @@ class GradingCurve(Grading):
             raise ValueError(
                 f"percent_passing: expected {len(sizes)} values (one per sieve size), got shape {pct.shape}"
             )
-        if not np.all(np.isfinite(sizes)) or np.any(sizes <= 0):
-            k = int(np.argmax(~np.isfinite(sizes) | (sizes <= 0)))
-            raise ValueError(f"sieve_sizes_m[{k}]: must be a finite size > 0 (m), got {sizes[k]}")
+        positive_lengths("sieve_sizes_m", sizes, "size")
         if np.any(np.diff(sizes) <= 0):
             k = int(np.argmax(np.diff(sizes) <= 0)) + 1
             raise ValueError(

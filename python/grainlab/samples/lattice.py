@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from grainlab.samples._checks import in_range
 from grainlab.samples.porosity import check_box, nominal_porosity, overlap_corrected_porosity
 
 __all__ = [
@@ -109,13 +110,8 @@ def _checked(
     offset: float,
 ) -> tuple[float, float | None, int | None, int | None]:
     """The diameter, porosity and row and column counts, checked (bad input names its field)."""
-    d = float(diameter)
-    if not (math.isfinite(d) and d > 0):
-        raise ValueError(f"diameter: must be a finite diameter > 0 (m), got {diameter}")
-    if porosity is not None:
-        porosity = float(porosity)
-        if not (0.0 < porosity < 1.0):
-            raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+    d = in_range("diameter", diameter, "(0, inf)", "a diameter (m)")
+    porosity = None if porosity is None else in_range("porosity", porosity, "(0, 1)")
     if boundary not in ("periodic", "walls"):
         raise ValueError(f"boundary: must be 'periodic' or 'walls', got {boundary!r}")
     if (box is None) == (n_rows is None and n_cols is None):

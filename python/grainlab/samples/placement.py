@@ -20,7 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
-from grainlab.samples.porosity import check_box, positive_lengths
+from grainlab.samples._checks import in_range, positive_lengths
+from grainlab.samples.porosity import check_box
 
 __all__ = ["PlacementError", "random_placement"]
 
@@ -111,9 +112,7 @@ def random_placement(
 def _checked(diameters: ArrayLike, scale: float, batch: int, tries: int) -> tuple[NDArray[np.float64], float]:
     """The diameters and the scale, checked (bad input names its field)."""
     d = positive_lengths("diameters", diameters, "diameter")
-    scale = float(scale)
-    if not (0.0 < scale <= 1.0):
-        raise ValueError(f"scale: must be in (0, 1], got {scale}")
+    scale = in_range("scale", scale, "(0, 1]")
     if int(batch) < 1 or int(tries) < 1:
         raise ValueError(f"batch and tries: must be >= 1, got batch={batch}, tries={tries}")
     return d, scale
