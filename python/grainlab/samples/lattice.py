@@ -179,7 +179,8 @@ def _walled_sites(
             return 1.0 - n_sites * disk / (((nc - 1) * a + d) * ((nr - 1) * row * a + d))
 
         full_contact = box_porosity(d)
-        a = d if porosity is None or porosity >= full_contact else _bisect(box_porosity, porosity, d)
+        a = d if porosity is None or porosity >= full_contact else _largest_spacing_at_most(
+            box_porosity, porosity, d, nearest=True)
         cell = (0.0, 0.0, (nc - 1) * a + d, (nr - 1) * row * a + d)
         note = f"{what} in a walled box fitted around {nc} x {nr} rows"
     else:
@@ -260,24 +261,10 @@ def _make(
     )
 
 
-def _bisect(f, target: float, d: float) -> float:  # type: ignore[no-untyped-def]
-    """Spacing ``a <= d`` with ``f(a) = target`` for ``f`` increasing in ``a``."""
-    lo, hi = 0.5 * d, d
-    if f(lo) > target:
-        raise ValueError(f"porosity: {target} needs a lattice compressed beyond half its contact spacing")
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if mid in (lo, hi):
-            break
-        if f(mid) < target:
-            lo = mid
-        else:
-            hi = mid
-    return lo if abs(f(lo) - target) <= abs(f(hi) - target) else hi
-
-
-def _largest_spacing_at_most(f, target: float, d: float) -> float:  # type: ignore[no-untyped-def]
-    """Largest spacing ``a <= d`` whose (stepwise, non-decreasing in ``a``) porosity ``f(a) <= target``."""
+def _largest_spacing_at_most(f, target: float, d: float, nearest: bool = False) -> float:  # type: ignore[no-untyped-def]
+    """Largest spacing ``a <= d`` whose porosity ``f(a) <= target`` (``f`` non-decreasing in
+    ``a``, maybe stepwise), by bisection; with ``nearest``, of the two spacings that end
+    the bisection the one whose ``f`` is nearer ``target`` (for a continuous ``f``)."""
     lo, hi = 0.5 * d, d
     if f(lo) > target:
         raise ValueError(f"porosity: {target} needs a lattice compressed beyond half its contact spacing")
@@ -289,7 +276,7 @@ def _largest_spacing_at_most(f, target: float, d: float) -> float:  # type: igno
             lo = mid
         else:
             hi = mid
-    return lo
+    return hi if nearest and abs(f(hi) - target) < abs(f(lo) - target) else lo
 
 
 def hexagonal_lattice(
