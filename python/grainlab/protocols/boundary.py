@@ -1,22 +1,13 @@
-"""The flexible lateral boundary of the biaxial test (docs/boundary.md, variant A):
-a chain of small bonded membrane disks along each side of the sample, ends
-tied to the platens, loaded by the confining pressure as a follower load.
-
-Geometry: the left chain runs bottom to top just outside the sample's left
-face, the right chain top to bottom outside its right face, so that walking
-either chain the sample lies on the right (clockwise), as the engine's pressure
-chains expect. Each membrane disk of radius ``r_m`` sits with its centre
-``r_m`` outside the face it replaces, neighbours overlapping by a fraction of
-their diameter and bonded at that distance (bonded pairs do not repel), so the
-chain is a smooth, closed skin that grains cannot pass through until it has
-stretched by that fraction. The end disks have a prescribed vertical velocity,
-that of their platen; horizontally they slide freely on the frictionless platens.
-"""
+"""The lateral boundaries of the biaxial test (docs/boundary.md, "The flexible
+boundary of the biaxial test"): A, chains of bonded membrane disks outside the
+sample's sides, walked clockwise around it as the engine's pressure chains
+expect; B, the sample's outermost grains; C, rigid side walls."""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
-from typing import Any
+from collections.abc import Callable, Mapping
+from dataclasses import asdict, dataclass, fields
+from typing import Any, Self
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,9 +26,29 @@ SLACK_TIE = 1.0e-6
 #: and the run stops with an error (at rest they are half a diameter apart).
 MAX_NEIGHBOUR_DISTANCE_DIAMETERS = 2.0
 
+#: How a saved boundary's field is read back, by its annotation.
+_READ: dict[str, Callable[[Any], Any]] = {
+    "int": int, "float": float, "bool": bool, "list[int]": lambda v: [int(k) for k in v],
+    "tuple[int, int]": lambda v: (int(v[0]), int(v[1])),
+}
+
 
 @dataclass(frozen=True)
-class Membrane:
+class _Saved:
+    """A boundary as checkpoints store it: its fields, and its ``kind`` where it has one."""
+
+    def to_dict(self) -> dict[str, Any]:
+        kind = getattr(self, "kind", None)
+        return asdict(self) | ({} if kind is None else {"kind": kind})
+
+    @classmethod
+    def from_dict(cls, saved: Mapping[str, Any]) -> Self:
+        """The boundary :meth:`to_dict` gave."""
+        return cls(**{f.name: _READ[str(f.type)](saved[f.name]) for f in fields(cls)})
+
+
+@dataclass(frozen=True)
+class Membrane(_Saved):
     """The two membrane chains of a biaxial sample."""
 
     left: list[int]
@@ -59,20 +70,6 @@ class Membrane:
     def ends(self) -> list[int]:
         """The four end disks tied to the platens."""
         return [self.left[0], self.left[-1], self.right[0], self.right[-1]]
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Membrane:
-        return cls(
-            left=list(d["left"]),
-            right=list(d["right"]),
-            radius=float(d["radius"]),
-            chains=(int(d["chains"][0]), int(d["chains"][1])),
-            bottom_wall=int(d["bottom_wall"]),
-            top_wall=int(d["top_wall"]),
-        )
 
 
 def _column(x: float, y0: float, y1: float, radius: float, spacing: float) -> NDArray[np.float64]:
@@ -160,24 +157,20 @@ def set_platen_velocity(sim: Simulation, membrane: Membrane, speed: float) -> No
     sim.velocities = v
 
 
+def _clockwise(sim: Simulation, boundary: Membrane | GrainBoundary, left: NDArray[np.float64],
+               right: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The clockwise polygon of the points ``left`` (bottom to top) and ``right`` (top to
+    bottom), each side's ends anchored on the platens below and above them."""
+    y_bottom = float(sim.wall(boundary.bottom_wall).points[0, 1])
+    y_top = float(sim.wall(boundary.top_wall).points[0, 1])
+    return np.vstack([[[left[0, 0], y_bottom]], left, [[left[-1, 0], y_top]],
+                      [[right[0, 0], y_top]], right, [[right[-1, 0], y_bottom]]])
+
+
 def boundary_polygon(sim: Simulation, membrane: Membrane) -> NDArray[np.float64]:
     """The clockwise polygon around the sample: left chain (bottom to top), its
     anchors on the platens, right chain (top to bottom), its anchors."""
-    x = sim.positions
-    y_bottom = float(sim.wall(membrane.bottom_wall).points[0, 1])
-    y_top = float(sim.wall(membrane.top_wall).points[0, 1])
-    left = x[membrane.left]
-    right = x[membrane.right]
-    return np.vstack(
-        [
-            [[left[0, 0], y_bottom]],
-            left,
-            [[left[-1, 0], y_top]],
-            [[right[0, 0], y_top]],
-            right,
-            [[right[-1, 0], y_bottom]],
-        ]
-    )
+    return _clockwise(sim, membrane, sim.positions[membrane.left], sim.positions[membrane.right])
 
 
 def shoelace_area(polygon: NDArray[np.float64]) -> float:
@@ -329,7 +322,7 @@ def outer_contour(
 
 
 @dataclass(frozen=True)
-class GrainBoundary:
+class GrainBoundary(_Saved):
     """Variant B: the confining pressure acts on the grains of the sample's outer
     contour, each touching the next, re-identified as the boundary changes (Kuhn
     1995; Cheung & O'Sullivan 2008)."""
@@ -345,24 +338,6 @@ class GrainBoundary:
     right: list[int]
 
     kind = "outer_particles"
-
-    def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["kind"] = self.kind
-        return d
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> GrainBoundary:
-        return cls(
-            chains=(int(d["chains"][0]), int(d["chains"][1])),
-            bottom_wall=int(d["bottom_wall"]),
-            top_wall=int(d["top_wall"]),
-            n_grains=int(d["n_grains"]),
-            bin_height=float(d["bin_height"]),
-            pressure=float(d["pressure"]),
-            left=list(d["left"]),
-            right=list(d["right"]),
-        )
 
     def identify(self, sim: Simulation) -> GrainBoundary:
         """Re-identifies the grains of the outer contour on each side
@@ -391,13 +366,9 @@ class GrainBoundary:
     def polygon(self, sim: Simulation) -> NDArray[np.float64]:
         """Clockwise polygon through the chains' outer edges and their anchors on the platens."""
         x, r = sim.positions, sim.radii
-        y_bottom = float(sim.wall(self.bottom_wall).points[0, 1])
-        y_top = float(sim.wall(self.top_wall).points[0, 1])
         left = x[self.left] - np.column_stack([r[self.left], np.zeros(len(self.left))])
         right = x[self.right] + np.column_stack([r[self.right], np.zeros(len(self.right))])
-        return np.vstack(
-            [[[left[0, 0], y_bottom]], left, [[left[-1, 0], y_top]], [[right[0, 0], y_top]], right, [[right[-1, 0], y_bottom]]]
-        )
+        return _clockwise(sim, self, left, right)
 
     def area(self, sim: Simulation) -> float:
         return shoelace_area(self.polygon(sim))
@@ -415,7 +386,7 @@ def install_grain_boundary(
 
 
 @dataclass(frozen=True)
-class WallBoundary:
+class WallBoundary(_Saved):
     """Variant C: the consolidation box's rigid side walls stay as the lateral
     boundary. Drained, each is servo-controlled to the confining ``pressure``
     (:meth:`control`, between records); at constant volume they move apart or
@@ -431,16 +402,6 @@ class WallBoundary:
     constant_volume: bool
 
     kind = "walls"
-
-    def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["kind"] = self.kind
-        return d
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> WallBoundary:
-        return cls(int(d["left_wall"]), int(d["right_wall"]), int(d["bottom_wall"]), int(d["top_wall"]),
-                   float(d["pressure"]), bool(d["constant_volume"]))
 
     def size(self, sim: Simulation) -> tuple[float, float]:
         """The box's width and height now, m."""

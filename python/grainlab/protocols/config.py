@@ -225,9 +225,7 @@ class ConsolidationSection(Section):
         "grain friction while consolidating (the generation's; Table 1 friction acts from the membrane on)",
         minimum=0.0,
     )
-    tolerance: float = key(
-        "strain", 0.01, "wall stresses within this fraction of sigma_0", minimum=0.0, exclusive_minimum=True
-    )
+    tolerance: float = key("strain", 0.01, "wall stresses within this fraction of sigma_0", **POSITIVE)
     unbalanced_force_ratio: float = key(
         "number", 1.0e-3, "equilibrium: mean unbalanced force ratio below this", **POSITIVE
     )
@@ -258,9 +256,9 @@ RUN_FIELDS: dict[str, Field] = RunSection.keys()
 _LIST_ITEMS: dict[str, tuple[str, Field]] = {
     "strain_list": ("strains", Field("strain", 0.0, "", minimum=0.0, maximum=0.5)),
     "shear_strain_list": ("shear strains", Field("strain", 0.0, "", minimum=0.0, maximum=100.0)),
-    "length_list": ("lengths", Field("length", 0.0, "", minimum=0.0, exclusive_minimum=True)),
+    "length_list": ("lengths", Field("length", 0.0, "", **POSITIVE)),
     "percent_list": ("percentages", Field("number", 0.0, "", minimum=0.0, maximum=100.0)),
-    "stress_list": ("stresses", Field("stress", 0.0, "", minimum=0.0, exclusive_minimum=True)),
+    "stress_list": ("stresses", Field("stress", 0.0, "", **POSITIVE)),
 }
 
 #: Overrides of ``--quick``: a small sample of a few hundred disks, for demos and CI.

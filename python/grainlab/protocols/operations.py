@@ -1,19 +1,8 @@
 """Operations: what a loading does at its stops, each on its own trigger
-(:mod:`grainlab.protocols.triggers`), as a stage composes them.
-
-A :class:`Loading` runs the engine from one stop to the next: the first step
-that any operation's trigger asks for (:meth:`~grainlab.protocols.triggers.Trigger.next_step`).
-When the engine reaches a stop, the operations act in the list's order, each
-where its trigger fires: writers (:class:`Records`, :class:`Snapshots`,
-:class:`Checkpoint`, :class:`Progress`), stop rules (:class:`Stop`, or any
-operation that calls :meth:`Loading.stop`, which ends the loading at once: the
-operations after it do not act at that stop) and controllers (the cyclic
-test's turns). As the engine leaves a stop (the first one too), each operation
-that :attr:`~Operation.acts_before_run` and whose trigger fires sets the motion
-of the steps ahead, to :attr:`Loading.next_stop` (the side walls, the periodic
-cell's servo, the oedometer's platen). The loop checks for an interrupt at each
-stop.
-"""
+(:mod:`grainlab.protocols.triggers`): a :class:`Loading` runs the engine from
+one stop to the next, the operations acting in the list's order where their
+triggers fire, and those that :attr:`~Operation.acts_before_run` as it leaves a
+stop (docs/protocols.md, "Operations and triggers")."""
 
 from __future__ import annotations
 
@@ -48,7 +37,7 @@ class Operation(ABC):
 
 
 class Loading:
-    """The engine run from stop to stop, ``operations`` acting at each (module docstring)."""
+    """The engine run from stop to stop, ``operations`` acting at each (docs/protocols.md)."""
 
     def __init__(self, sim: Simulation, operations: Sequence[Operation]) -> None:
         self.sim = sim

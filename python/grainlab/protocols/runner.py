@@ -1,22 +1,8 @@
 """One runner for every protocol: a protocol is a named list of stages over its
-run state, and :func:`run_protocol` runs them into a results folder.
-
-The runner owns what every protocol needs and none should write again: the
-folder's writer lock, the refusal of a folder holding another run, the results
-writer (``run.h5.partial``, published at every checkpoint and carried in it),
-the checkpoints, ``--resume`` from any stop point (a checkpoint, a final
-``run.h5`` whose outputs a stop left unwritten, or nothing yet), the refusal of
-a resume under another configuration, interrupts and the full disk
-(docs/file-formats.md, crash safety).
-
-A protocol (:class:`Protocol`) gives its configuration, how a run starts (the
-simulation and the state the first stage reads), its stages in order, its
-summary and its outputs. A stage runs while the state's ``phase`` is its name;
-the runner then moves the phase to the next stage's name (``"done"`` after the
-last) and writes a checkpoint. A stage that runs long checkpoints itself with
-``context.save()`` (for example on a :class:`~grainlab.protocols.triggers.WallClock`
-trigger). ``docs/protocols.md`` shows how to add one.
-"""
+run state, and :func:`run_protocol` runs them into a results folder, owning what
+every test needs and none should write again: the folder's lock, the results
+file, the checkpoints, ``--resume``, interrupts and the full disk
+(docs/protocols.md, which also shows how to add one)."""
 
 from __future__ import annotations
 

@@ -20,13 +20,16 @@ from typing import TYPE_CHECKING, Any, ClassVar, Self, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+import grainlab
 from grainlab._cores import available_cores
 from grainlab._interrupt import raise_if_interrupted
 from grainlab._progress import progress_bar
+from grainlab.analysis import fabric_summary
+from grainlab.analysis.stress import love_weber_stress
 from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic, write_text_atomic
 from grainlab.protocols.config import Config, grain_shape
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
-from grainlab.protocols.grains import grain_coordination, grain_porosity
+from grainlab.protocols.grains import clump_summary, grain_coordination, grain_count, grain_porosity
 from grainlab.protocols.runner import Protocol, ProtocolError, RunResult, Stage, StageContext
 from grainlab.samples import (
     PAPER_GRADING,
@@ -36,14 +39,16 @@ from grainlab.samples import (
     expand_to_porosity,
     overlap_corrected_porosity,
 )
-from grainlab.simulation import ContactModel, Simulation
+from grainlab.simulation import ContactModel, Contacts, Simulation
+from grainlab.snapshot import Snapshot
 
 if TYPE_CHECKING:
     from grainlab.plot.workers import FigureTask
 
 __all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
            "damped_time_step_factor", "engine_columns",
-           "engine_threads", "generate", "grain_model", "platen_model", "write_run_outputs"]
+           "engine_threads", "generate", "grain_model", "grain_columns", "platen_model", "run_summary",
+           "write_run_outputs"]
 
 #: Steps per engine call while a phase waits for a condition.
 CHUNK_STEPS = 2000
@@ -323,12 +328,39 @@ def engine_columns(sim: Simulation) -> dict[str, float]:
             "wall_work_j": energy.wall_work}
 
 
+def grain_columns(sim: Simulation, n: int, area: float, contacts: Contacts, snapshot: Snapshot) -> dict[str, float]:
+    """The columns a walled test's records share, for the grains (the first ``n``
+    particles; membrane disks follow): the Love-Weber stress over ``area`` (levers from
+    each grain's centroid, the walls' contacts included), the coordination number of the
+    unbonded grain-grain ``contacts`` per grain, :func:`engine_columns` and the fabric of
+    ``snapshot`` (:func:`~grainlab.analysis.fabric_summary`)."""
+    c, w = contacts, sim.wall_contacts()
+    lw = love_weber_stress(sim.grain_centroids, c.i, c.j, c.point, -c.force_on_i, area, np.arange(sim.n_particles) < n,
+                           wall_particle=w.particle, wall_point=w.point, wall_force_on_particle=w.force_on_particle)
+    fabric = fabric_summary(snapshot)
+    fabric.pop("coordination_number")  # the record's own, grain-grain contacts
+    grain_contacts = int(np.count_nonzero((c.i < n) & (c.j < n) & ~c.bonded))
+    return {"love_weber_xx_pa": float(lw[0, 0]), "love_weber_yy_pa": float(lw[1, 1]),
+            "love_weber_xy_pa": float(lw[0, 1]), "coordination_number": 2.0 * grain_contacts / grain_count(sim, n),
+            **engine_columns(sim), **fabric}
+
+
 def _consolidate_stage(context: StageContext[Any, Any]) -> None:
     consolidate(context.sim, context.state, context.config, context.progress)
 
 
 #: The stage of every test that consolidates its sample in the four walls (:func:`consolidate`).
 CONSOLIDATE = Stage("consolidate", _consolidate_stage, "the four walls servo-controlled to sigma_0 until equilibrium")
+
+
+def run_summary(run: SpecimenRun, fields: Mapping[str, Any], *, records: int, wall_time_s: float,
+                **after_records: Any) -> dict[str, Any]:
+    """A test's summary: the grain counts, its ``fields``, the time step, the record
+    count, ``after_records``, the wall times and grainlab's version."""
+    return {"n_particles": run.n_grains, **clump_summary(run.sample), **fields,
+            "time_step_s": run.consolidation["time_step_s"], "records": records, **after_records,
+            "wall_time_s": wall_time_s, "wall_time_by_phase_s": dict(run.wall_time),
+            "grainlab_version": grainlab.__version__}
 
 
 def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.float64]], dict[str, Any]],

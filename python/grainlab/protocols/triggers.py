@@ -1,16 +1,7 @@
 """Triggers: on which steps an operation of a loading acts
-(:mod:`grainlab.protocols.operations`).
-
-A loading runs the engine from one *stop* to the next. Each operation has a
-trigger: asked ``trigger(step)`` at every stop, it says whether the operation
-acts there, and ``trigger.next_step(step)`` says where the loading must stop
-next for it (None: it needs no stop of its own). :class:`OnSteps` fires on
-given steps, :class:`Periodic` on every multiple of a period, :class:`EveryStop`
-at each stop, :class:`Flag` where an operation raised it, :class:`WallClock`
-once so many seconds of wall time have passed, :class:`And` where all of its
-triggers fire. :func:`schedule_steps` plans steps in a control variable (the
-axial strain, a shear strain).
-"""
+(:mod:`grainlab.protocols.operations`): ``trigger(step)`` says whether it acts at
+a stop, ``trigger.next_step(step)`` where the loading must stop next for it
+(docs/protocols.md, "Operations and triggers")."""
 
 from __future__ import annotations
 

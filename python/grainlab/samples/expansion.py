@@ -1,35 +1,7 @@
-"""Radius expansion: the paper's way of making a dense sample inside rigid walls.
-
-The procedure (paper Sec. 6; docs/samples.md gives the details and the reasons):
-
-1. Draw ``N`` diameters from the grading (``N`` from :func:`particle_count` unless
-   given) and scale them all by one factor ``f`` (close to 1) so that the final
-   nominal porosity is exactly the target.
-2. Place the disks at random, without overlap, at ``initial_scale`` (0.5) of
-   their final radii (:func:`random_placement`), inside four rigid segment
-   walls on the box edges.
-3. Grow all radii by a common factor, one small increment at a time, with
-   ``steps_per_increment`` DEM steps (in Rust) after each. The increment in
-   ``ln r`` is ``growth_per_increment / (1 + sigma / growth_stress_scale_pa)``,
-   with ``sigma`` the mean wall stress just measured: fast while the packing is
-   loose, slow once it carries stress.
-4. At the final radii, cycle until the mean unbalanced force ratio is below
-   ``equilibrium_ratio`` (default 1e-4), or, for a target looser than the
-   jamming porosity, until the contacts carry no load (rms overlap below
-   ``stress_free_overlap`` = 1e-5 of the smallest radius; ``Sample.jammed`` is
-   then False).
-
-Stress bound: whenever the mean wall stress exceeds ``max_stress_pa``, growth
-stops and the packing is cycled to equilibrium at its current radii; if it
-still exceeds the bound, :class:`ExpansionError` reports the densest nominal
-porosity reached and the stress it needed.
-
-While generating, every disk is given the mass of the largest one (density
-scaling for a static solution, as PFC's ``timestep scale``): the static
-equilibrium does not depend on the masses, and the time step, set by the
-lightest disk, grows by ``d_max / d_min``. The Table 1 density is restored at
-the end, velocities are zeroed, and the time step is reset to half the
-critical one.
+"""Radius expansion: the paper's way of making a dense sample inside rigid walls
+(Sec. 6): the disks placed at half their radii, grown by increments that slow as
+the wall stress rises, then cycled to equilibrium. docs/samples.md, "Radius
+expansion", gives the steps, the stopping rules and the density scaling.
 
 Example
 -------
@@ -47,7 +19,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -56,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from grainlab import paper
 from grainlab.analysis.fabric import CoordinationNumber
 from grainlab.analysis.per_body import BodyCoordination
+from grainlab.samples._checks import in_range, positive_lengths
 from grainlab.samples.grading import PAPER_GRADING, Grading
 from grainlab.samples.placement import random_placement
 from grainlab.samples.porosity import (
@@ -78,6 +51,11 @@ _DENSITY = paper.DENSITY_KG_PER_M3
 _DAMPING = paper.LOCAL_DAMPING
 #: Default stress bound of the expansion (mean wall stress in equilibrium), Pa.
 MAX_STRESS_PA = 5.0e6
+
+
+#: The fields of a :class:`Sample` that :meth:`Sample.to_dict` leaves out (arrays, the
+#: simulation) or gives first (a clump sample's shape).
+_NOT_SCALARS = ("positions", "radii", "wall_points", "shape", "shape_parameter", "grain", "simulation")
 
 
 class ExpansionError(ValueError):
@@ -213,39 +191,9 @@ class Sample:
         grains = {} if self.grain is None else {
             "n_grains": self.n_grains, "shape": self.shape, "shape_parameter": self.shape_parameter,
         }
-        return {
-            "n_particles": self.n_particles,
-            **grains,
-            "box": list(self.box),
-            "porosity_target": self.porosity_target,
-            "porosity": self.porosity,
-            "porosity_overlap_corrected": self.porosity_overlap_corrected,
-            "wall_stresses_pa": self.wall_stresses_pa.tolist(),
-            "mean_wall_stress_pa": self.mean_wall_stress_pa,
-            "coordination_number": self.coordination_number,
-            "mechanical_coordination_number": self.mechanical_coordination_number,
-            "mean_overlap_ratio": self.mean_overlap_ratio,
-            "max_overlap_ratio": self.max_overlap_ratio,
-            "unbalanced_force_ratio": self.unbalanced_force_ratio,
-            "equilibrium_reached": self.equilibrium_reached,
-            "jammed": self.jammed,
-            "radius_factor": self.radius_factor,
-            "seed": self.seed,
-            "grading": self.grading,
-            "friction": self.friction,
-            "wall_friction": self.wall_friction,
-            "threads": self.threads,
-            "steps": self.steps,
-            "wall_time_s": self.wall_time_s,
-        }
-
-
-def _positive(name: str, value: float, allow_zero: bool = False) -> float:
-    value = float(value)
-    ok = value >= 0 if allow_zero else value > 0
-    if not (math.isfinite(value) and ok):
-        raise ValueError(f"{name}: must be a finite number {'>= 0' if allow_zero else '> 0'}, got {value}")
-    return value
+        scalars = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in _NOT_SCALARS}
+        return {"n_particles": self.n_particles, **grains, **scalars, "box": list(self.box),
+                "wall_stresses_pa": self.wall_stresses_pa.tolist()}
 
 
 #: Each wall reaches this fraction of the box's shorter side beyond its corners,
@@ -326,8 +274,8 @@ def expand_to_porosity(
     density : kg/m^3 (Table 1: 2e8); local_damping : alpha (Table 1: 0.8)
     initial_scale : placed radius over final radius (the paper halves: 0.5)
     growth_per_increment, steps_per_increment, growth_stress_scale_pa : the
-        growth (module docstring, steps 3); equilibrium_ratio, stress_free_overlap,
-        max_equilibrium_steps : the end (step 4; past the last, the sample comes
+        growth (docs/samples.md, step 4); equilibrium_ratio, stress_free_overlap,
+        max_equilibrium_steps : the end (step 5; past the last, the sample comes
         with ``equilibrium_reached = False`` and a warning)
     max_stress_pa : stress bound (mean wall stress in equilibrium), Pa
     time_step_safety : time step = this x the critical step, re-evaluated every increment
@@ -424,42 +372,21 @@ class _Settings:
     def checked(cls, *, box: ArrayLike, porosity: float, grading: Grading, **values: Any) -> _Settings:
         """The settings, or a ``ValueError`` naming the first bad one, before any work."""
         box = check_box(box)
-        porosity = float(porosity)
-        if not (0.0 < porosity < 1.0):
-            raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+        porosity = in_range("porosity", porosity, "(0, 1)")
         if not isinstance(grading, Grading):
             raise TypeError(
                 f"grading: expected a Grading (UniformByNumber, UniformByMass, GradingCurve), got {grading!r}"
             )
-        v = dict(values)
-        for name in ("friction", "wall_friction"):
-            v[name] = _positive(name, v[name], allow_zero=True)
-        for name in ("normal_stiffness", "shear_stiffness", "density"):
-            v[name] = _positive(name, v[name])
-        v["local_damping"] = float(v["local_damping"])
-        if not (0.0 <= v["local_damping"] < 1.0):
-            raise ValueError(f"local_damping: must be in [0, 1), got {v['local_damping']}")
-        v["initial_scale"] = float(v["initial_scale"])
-        if not (0.0 < v["initial_scale"] <= 1.0):
-            raise ValueError(f"initial_scale: must be in (0, 1], got {v['initial_scale']}")
-        for name in ("growth_per_increment", "growth_stress_scale_pa"):
-            v[name] = _positive(name, v[name])
-        v["steps_per_increment"] = int(v["steps_per_increment"])
-        if v["steps_per_increment"] < 1:
-            raise ValueError(f"steps_per_increment: must be >= 1, got {v['steps_per_increment']}")
-        for name in ("equilibrium_ratio", "stress_free_overlap"):
-            v[name] = _positive(name, v[name])
-        v["max_equilibrium_steps"] = int(v["max_equilibrium_steps"])
-        if v["max_equilibrium_steps"] < 0:
-            raise ValueError(f"max_equilibrium_steps: must be >= 0, got {v['max_equilibrium_steps']}")
-        v["max_stress_pa"] = _positive("max_stress_pa", v["max_stress_pa"])
-        v["time_step_safety"] = float(v["time_step_safety"])
-        if not (0.0 < v["time_step_safety"] <= 1.0):
-            raise ValueError(f"time_step_safety: must be in (0, 1], got {v['time_step_safety']}")
-        v["threads"] = int(v["threads"])
-        if v["threads"] < 1:
-            raise ValueError(f"threads: must be >= 1, got {v['threads']}")
+        v: dict[str, Any] = {name: in_range(name, value, _RANGES.get(name, "(0, inf)")) for name, value in values.items()}
+        for name in ("steps_per_increment", "max_equilibrium_steps", "threads"):
+            v[name] = int(v[name])
         return cls(box=box, porosity=porosity, **v)
+
+
+#: The range of each of :class:`_Settings`' numbers but the positive ones.
+_RANGES = {"friction": "[0, inf)", "wall_friction": "[0, inf)", "local_damping": "[0, 1)", "initial_scale": "(0, 1]",
+           "steps_per_increment": "[1, inf)", "max_equilibrium_steps": "[0, inf)", "time_step_safety": "(0, 1]",
+           "threads": "[1, inf)"}
 
 
 def _diameters(
@@ -476,12 +403,9 @@ def _diameters(
     if diameters is not None:
         if n_particles is not None:
             raise ValueError("n_particles: give either n_particles or diameters, not both")
-        d = np.array(diameters, dtype=np.float64)
-        if d.ndim != 1 or len(d) == 0:
-            raise ValueError(f"diameters: expected a non-empty 1-D array, got shape {d.shape}")
-        if not np.all(np.isfinite(d)) or np.any(d <= 0):
-            k = int(np.argmax(~np.isfinite(d) | (d <= 0)))
-            raise ValueError(f"diameters[{k}]: must be a finite diameter > 0 (m), got {d[k]}")
+        d = np.array(positive_lengths("diameters", diameters, "diameter"))
+        if len(d) == 0:
+            raise ValueError("diameters: expected at least one diameter")
         return d
     if n_particles is not None:
         n = int(n_particles)

@@ -1,52 +1,9 @@
-"""Radius expansion with the generation friction chosen by a bracketed search.
-
-A frictionless radius expansion jams at one nominal porosity, ``n_J(0)``
-(between 0.155 and 0.16 in the paper's 75 x 150 mm box, docs/samples.md): a
-looser target comes out stress-free. Friction during the expansion lets arches
-carry load before the disks fill the space, so the packing jams looser: the
-jamming porosity ``n_J(mu)`` rises with the generation friction ``mu``. For a
-target ``n`` this makes the packing's state at ``n`` a monotone function of
-``mu``: stress-free below the friction at which ``n_J(mu) = n``, stress-bearing
-above it, with a mean wall stress that rises with ``mu``, until the expansion
-stops at the stress bound or the engine's overlap limit.
-:func:`expand_with_friction_search` bisects on that relation for a friction
-whose packing at ``n`` bears a mean wall stress inside a band.
-
-Each trial is a whole :func:`~grainlab.samples.expand_to_porosity` with the
-same seed (same diameters, same initial placement), so only the friction
-differs. A trial's outcome, in the order the outcomes come with rising friction:
-
-``stress_free`` / ``unsettled`` / ``below_band`` < ``in_band`` < ``above_band`` < ``stopped``
-
-- ``stress_free``: the contacts carry no load (``Sample.jammed`` false);
-- ``unsettled``: the unbalanced force ratio did not fall below the equilibrium
-  threshold within ``max_equilibrium_steps`` (near the jamming point the
-  relaxation is slow; more friction settles it);
-- ``below_band``: in equilibrium, but the mean wall stress is below the band
-  or the mechanical coordination number ``Z_m`` below
-  ``min_mechanical_coordination`` (3 = d + 1, the fewest contacts per disk
-  with which a frictional disk network in 2D can be rigid);
-- ``in_band``: stress-bearing (equilibrium, ``jammed``, ``Z_m`` at least the
-  minimum) with the mean wall stress in the band: accepted;
-- ``above_band``: stress-bearing above the band;
-- ``stopped``: :class:`~grainlab.samples.ExpansionError` (the stress bound,
-  or an overlap beyond the engine's limit).
-
-The search (cost: one expansion when the least friction already bears the
-band's lower end, otherwise two plus at most
-``ceil(log2((mu_max - mu_min) / friction_tolerance))``):
-
-1. the least friction ``mu_min``: if the packing is stress-bearing (in or above
-   the band) it is taken (friction only adds stress); an ``ExpansionError`` is
-   raised as it is (the target is too dense for the stress bound even then);
-2. the largest friction ``mu_max``: if the packing is still on the loose side
-   the target cannot be made stress-bearing (:class:`FrictionSearchError`);
-   ``in_band`` is taken;
-3. bisection: the midpoint replaces the lower end when it is on the loose side,
-   the upper end otherwise, until a trial is ``in_band`` or the bracket is
-   narrower than ``friction_tolerance``; then the least friction found above
-   the band is taken (``FrictionSearch.in_band`` false), or, if none was,
-   :class:`FrictionSearchError`.
+"""Radius expansion with the generation friction chosen by a bracketed search:
+friction lets the packing jam looser, so the state at a target porosity is
+monotone in the friction, and :func:`expand_with_friction_search` bisects on it
+for a packing whose mean wall stress lies in a band. docs/samples.md, "The
+generation friction search", gives the trials' outcomes (:data:`TRIAL_OUTCOMES`),
+the algorithm and its cost.
 
 Example
 -------
@@ -66,11 +23,12 @@ import math
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any
 
 from numpy.typing import ArrayLike
 
+from grainlab.samples._checks import in_range
 from grainlab.samples.expansion import MAX_STRESS_PA, ExpansionError, Sample, expand_to_porosity
 from grainlab.samples.grading import PAPER_GRADING, Grading
 
@@ -118,16 +76,7 @@ class FrictionTrial:
         return self.outcome in ("in_band", "above_band")
 
     def to_dict(self) -> dict[str, Any]:
-        return {
-            "friction": self.friction,
-            "outcome": self.outcome,
-            "mean_wall_stress_pa": self.mean_wall_stress_pa,
-            "mechanical_coordination_number": self.mechanical_coordination_number,
-            "coordination_number": self.coordination_number,
-            "steps": self.steps,
-            "wall_time_s": self.wall_time_s,
-            "message": self.message,
-        }
+        return asdict(self)
 
     def describe(self) -> str:
         """``"0.05: in_band, 218 kPa, Z_m 3.93"``."""
@@ -245,14 +194,8 @@ def _checked_limits(
             f"stress_band_pa: the band's upper end {stress_high:.4g} Pa exceeds max_stress_pa = "
             f"{max_stress_pa:.4g} Pa, beyond which the expansion stops; lower the band or raise max_stress_pa"
         )
-    friction_tolerance = float(friction_tolerance)
-    if not (math.isfinite(friction_tolerance) and friction_tolerance > 0.0):
-        raise ValueError(f"friction_tolerance: must be a finite number > 0, got {friction_tolerance!r}")
-    min_mechanical_coordination = float(min_mechanical_coordination)
-    if not (math.isfinite(min_mechanical_coordination) and min_mechanical_coordination >= 0.0):
-        raise ValueError(
-            f"min_mechanical_coordination: must be a finite number >= 0, got {min_mechanical_coordination!r}")
-    return friction_tolerance, min_mechanical_coordination
+    return (in_range("friction_tolerance", friction_tolerance, "(0, inf)"),
+            in_range("min_mechanical_coordination", min_mechanical_coordination, "[0, inf)"))
 
 
 class _Search:
@@ -359,7 +302,7 @@ def expand_with_friction_search(
     **expansion: Any,
 ) -> FrictionSearch:
     """Radius expansion to a target nominal porosity with the generation friction chosen so
-    that the packing there is stress-bearing (module docstring: criterion, algorithm, cost).
+    that the packing there is stress-bearing (docs/samples.md: criterion, algorithm, cost).
 
     Parameters
     ----------
@@ -388,9 +331,7 @@ def expand_with_friction_search(
     """
     if "friction" in expansion:
         raise ValueError("friction: chosen by the search; give friction_range = (low, high) instead")
-    porosity = float(porosity)
-    if not (0.0 < porosity < 1.0):
-        raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+    porosity = in_range("porosity", porosity, "(0, 1)")
     mu_min, mu_max = _pair("friction_range", friction_range, 0.0, strict_minimum=False)
     stress_low, stress_high = _pair("stress_band_pa", stress_band_pa, 0.0, strict_minimum=True)
     max_stress_pa = float(expansion.get("max_stress_pa", MAX_STRESS_PA))

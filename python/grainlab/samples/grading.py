@@ -1,18 +1,7 @@
-"""Particle-size distributions (gradings) of 2D disks.
-
-A grading is described two ways:
-
-- by **number**: ``F_N(d)``, the fraction of particles with diameter ``<= d``;
-  this is what :meth:`Grading.sample` draws from (inverse transform of one
-  uniform number per particle, so the draw is monotone in the uniform).
-- by **mass**: ``P(d)``, the percent of solid mass passing a sieve of size
-  ``d`` (the soil-mechanics grading curve, :meth:`Grading.passing`).
-
-In 2D a disk of unit thickness has mass ``m = rho pi d^2 / 4``: mass goes as
-``d^2`` (not ``d^3`` as for spheres), so a number density ``f_N(d)`` and a mass
-density ``f_M(d)`` are related by ``f_M(d) = d^2 f_N(d) / E_N[d^2]``.
-
-Diameters are in metres (SI, docs/conventions.md).
+"""Particle-size distributions (gradings) of 2D disks, by number (what
+:meth:`Grading.sample` draws from) and by mass (the grading curve,
+:meth:`Grading.passing`; in 2D mass goes as ``d^2``). Diameters in metres;
+docs/samples.md, "Gradings", gives each one's formulas.
 
 Example
 -------
@@ -34,6 +23,8 @@ from abc import ABC, abstractmethod
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from grainlab.samples._checks import in_range, positive_lengths
+
 __all__ = [
     "PAPER_GRADING",
     "Grading",
@@ -44,12 +35,8 @@ __all__ = [
 
 
 def _check_range(d_min: float, d_max: float) -> tuple[float, float]:
-    d_min = float(d_min)
-    d_max = float(d_max)
-    if not (math.isfinite(d_min) and d_min > 0):
-        raise ValueError(f"d_min: must be a finite diameter > 0 (m), got {d_min}")
-    if not (math.isfinite(d_max) and d_max > 0):
-        raise ValueError(f"d_max: must be a finite diameter > 0 (m), got {d_max}")
+    d_min = in_range("d_min", d_min, "(0, inf)", "a diameter (m)")
+    d_max = in_range("d_max", d_max, "(0, inf)", "a diameter (m)")
     if d_min > d_max:
         raise ValueError(f"d_min: must be <= d_max, got d_min={d_min} > d_max={d_max}")
     return d_min, d_max
@@ -161,14 +148,9 @@ class UniformByNumber(_UniformRange):
 
 class UniformByMass(_UniformRange):
     """Mass uniform in diameter on ``[d_min, d_max]``: the grading curve is a
-    straight line in ``d``, ``P(d) = 100 (d - d_min) / (d_max - d_min)``.
-
-    Derivation (2D): a constant mass density ``f_M(d) = 1/(d_max - d_min)`` and a
-    particle mass ``∝ d^2`` give a number density ``f_N(d) ∝ f_M(d) / d^2 ∝ d^-2``;
-    normalised, ``f_N(d) = d^-2 / (1/d_min - 1/d_max)``, so
-    ``F_N(d) = (1/d_min - 1/d) / (1/d_min - 1/d_max)``, its inverse
-    ``d(u) = 1 / (1/d_min - u (1/d_min - 1/d_max))``, and
-    ``E_N[d^2] = (d_max - d_min) / (1/d_min - 1/d_max) = d_min d_max``.
+    straight line in ``d``, ``P(d) = 100 (d - d_min) / (d_max - d_min)``; by number
+    ``F_N(d) = (1/d_min - 1/d) / (1/d_min - 1/d_max)`` and ``E_N[d^2] = d_min d_max``
+    (docs/samples.md derives them).
     """
 
     _kind = "mass"
@@ -202,19 +184,9 @@ class GradingCurve(Grading):
     and the last 100% (``d_max``); sizes strictly increase and percentages never
     decrease.
 
-    Within segment ``k`` (sizes ``d_k .. d_{k+1}``, mass fraction
-    ``w_k = (P_{k+1} - P_k) / 100``) the mass density is constant in the
-    interpolation variable ``x`` (``ln d`` or ``d``), and the 2D number density is
-    that over ``d^2``:
-
-    - log: ``f_N ∝ w_k / ln(d_{k+1}/d_k) * d^-2`` per unit ``ln d``, so the segment
-      holds ``n_k ∝ w_k / ln(d_{k+1}/d_k) * (d_k^-2 - d_{k+1}^-2) / 2`` particles and
-      within it ``d^-2`` is uniform by number;
-    - linear: ``f_N ∝ w_k / (d_{k+1} - d_k) * d^-2`` per unit ``d``, so
-      ``n_k ∝ w_k / (d_{k+1} - d_k) * (1/d_k - 1/d_{k+1})`` and ``1/d`` is uniform
-      within the segment.
-
-    ``E_N[d^2] = sum_k w_k / sum_k n_k`` (total "mass" over total number).
+    Within a segment the number density is the mass density over ``d^2``: ``d^-2``
+    (log) or ``1/d`` (linear) is uniform by number there; docs/samples.md gives
+    each segment's count and ``E_N[d^2]``.
     """
 
     def __init__(
@@ -233,9 +205,7 @@ class GradingCurve(Grading):
             raise ValueError(
                 f"percent_passing: expected {len(sizes)} values (one per sieve size), got shape {pct.shape}"
             )
-        if not np.all(np.isfinite(sizes)) or np.any(sizes <= 0):
-            k = int(np.argmax(~np.isfinite(sizes) | (sizes <= 0)))
-            raise ValueError(f"sieve_sizes_m[{k}]: must be a finite size > 0 (m), got {sizes[k]}")
+        positive_lengths("sieve_sizes_m", sizes, "size")
         if np.any(np.diff(sizes) <= 0):
             k = int(np.argmax(np.diff(sizes) <= 0)) + 1
             raise ValueError(

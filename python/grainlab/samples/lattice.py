@@ -1,33 +1,6 @@
-"""Regular packings of equal disks: hexagonal and square lattices at a given porosity.
-
-At contact (spacing ``a`` = diameter ``d``) an infinite lattice has porosity
-
-- hexagonal: ``1 - pi / (2 sqrt 3) = 0.093100...`` (each disk owns ``sqrt(3)/2 a^2``),
-- square: ``1 - pi / 4 = 0.214602...`` (each disk owns ``a^2``).
-
-Other porosities are made the two ways the paper's packing study allows:
-
-- **above** the contact value: random sites are left empty (vacancies), as
-  many as the target needs (rounded to a whole disk);
-- **below** it: the lattice is compressed uniformly, ``a = d sqrt((1 - n_contact) / (1 - n))``,
-  so neighbours overlap by ``d - a``; the nominal porosity is then exactly the
-  target and the overlap-corrected one is higher (each overlap is counted once).
-
-Two boundaries:
-
-- ``"periodic"`` (default): the box is a whole number of lattice periods and
-  is meant as a periodic cell; porosities are those of the infinite lattice
-  (0.0931 and 0.2146 exactly at contact). A given box is rounded to whole
-  periods (the returned :attr:`Lattice.box` is the cell used).
-- ``"walls"``: the disks sit inside a rigid box, the first row and column
-  touching the bottom and left walls; porosities are those of the box, which
-  include the gaps along the walls. With ``box`` given, as many sites as fit
-  are used: the lattice is compressed just enough for the full lattice to reach
-  the target or below, and vacancies make up the rest. With ``n_rows``/``n_cols``
-  the box is fitted around the lattice, the spacing solved so that the full
-  lattice has the target porosity in it (or the contact spacing and vacancies
-  above the contact value).
-
+"""Regular packings of equal disks: hexagonal and square lattices at a given
+porosity, vacancies above the contact porosity and a uniform compression below
+it, in a periodic cell or a walled box (docs/samples.md, "Lattices");
 :attr:`Lattice.note` says what was done.
 
 Example
@@ -46,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from grainlab.samples._checks import in_range
 from grainlab.samples.porosity import check_box, nominal_porosity, overlap_corrected_porosity
 
 __all__ = [
@@ -136,13 +110,8 @@ def _checked(
     offset: float,
 ) -> tuple[float, float | None, int | None, int | None]:
     """The diameter, porosity and row and column counts, checked (bad input names its field)."""
-    d = float(diameter)
-    if not (math.isfinite(d) and d > 0):
-        raise ValueError(f"diameter: must be a finite diameter > 0 (m), got {diameter}")
-    if porosity is not None:
-        porosity = float(porosity)
-        if not (0.0 < porosity < 1.0):
-            raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+    d = in_range("diameter", diameter, "(0, inf)", "a diameter (m)")
+    porosity = None if porosity is None else in_range("porosity", porosity, "(0, 1)")
     if boundary not in ("periodic", "walls"):
         raise ValueError(f"boundary: must be 'periodic' or 'walls', got {boundary!r}")
     if (box is None) == (n_rows is None and n_cols is None):
@@ -210,7 +179,8 @@ def _walled_sites(
             return 1.0 - n_sites * disk / (((nc - 1) * a + d) * ((nr - 1) * row * a + d))
 
         full_contact = box_porosity(d)
-        a = d if porosity is None or porosity >= full_contact else _bisect(box_porosity, porosity, d)
+        a = d if porosity is None or porosity >= full_contact else _largest_spacing_at_most(
+            box_porosity, porosity, d, nearest=True)
         cell = (0.0, 0.0, (nc - 1) * a + d, (nr - 1) * row * a + d)
         note = f"{what} in a walled box fitted around {nc} x {nr} rows"
     else:
@@ -291,24 +261,10 @@ def _make(
     )
 
 
-def _bisect(f, target: float, d: float) -> float:  # type: ignore[no-untyped-def]
-    """Spacing ``a <= d`` with ``f(a) = target`` for ``f`` increasing in ``a``."""
-    lo, hi = 0.5 * d, d
-    if f(lo) > target:
-        raise ValueError(f"porosity: {target} needs a lattice compressed beyond half its contact spacing")
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if mid in (lo, hi):
-            break
-        if f(mid) < target:
-            lo = mid
-        else:
-            hi = mid
-    return lo if abs(f(lo) - target) <= abs(f(hi) - target) else hi
-
-
-def _largest_spacing_at_most(f, target: float, d: float) -> float:  # type: ignore[no-untyped-def]
-    """Largest spacing ``a <= d`` whose (stepwise, non-decreasing in ``a``) porosity ``f(a) <= target``."""
+def _largest_spacing_at_most(f, target: float, d: float, nearest: bool = False) -> float:  # type: ignore[no-untyped-def]
+    """Largest spacing ``a <= d`` whose porosity ``f(a) <= target`` (``f`` non-decreasing in
+    ``a``, maybe stepwise), by bisection; with ``nearest``, of the two spacings that end
+    the bisection the one whose ``f`` is nearer ``target`` (for a continuous ``f``)."""
     lo, hi = 0.5 * d, d
     if f(lo) > target:
         raise ValueError(f"porosity: {target} needs a lattice compressed beyond half its contact spacing")
@@ -320,7 +276,7 @@ def _largest_spacing_at_most(f, target: float, d: float) -> float:  # type: igno
             lo = mid
         else:
             hi = mid
-    return lo
+    return hi if nearest and abs(f(hi) - target) < abs(f(lo) - target) else lo
 
 
 def hexagonal_lattice(
@@ -340,7 +296,7 @@ def hexagonal_lattice(
     diameter : m (the paper's Table 3 prints 0.875 mm; see docs/samples.md)
     porosity : target nominal porosity in (0, 1); ``None``: the lattice at contact.
         Above the contact porosity (0.0931 periodic) random vacancies, below it a
-        uniform compression (module docstring).
+        uniform compression (docs/samples.md, "Lattices").
     box : ``(xmin, ymin, xmax, ymax)``, m; or ``n_rows`` and ``n_cols`` (even
         ``n_rows`` when periodic)
     boundary : ``"periodic"`` or ``"walls"``

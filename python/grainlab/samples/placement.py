@@ -1,12 +1,5 @@
-"""Random sequential placement of non-overlapping disks in a box.
-
-Disks go in largest first (big disks are the hard ones to fit). Each round
-takes the next ``batch`` unplaced disks, draws ``tries`` candidate centres for
-each, uniformly where the disk fits inside the box, and keeps, per disk, the
-first candidate that overlaps neither a placed disk (a cKDTree query against the
-placed set) nor an earlier accepted candidate of the same round. Disks whose
-candidates all failed stay at the front of the queue for the next round. All
-of it is array work; the only Python loop is over rounds.
+"""Random sequential placement of non-overlapping disks in a box, largest
+first, in rounds of array work (docs/samples.md, "Random placement").
 
 Example
 -------
@@ -27,7 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
-from grainlab.samples.porosity import check_box, positive_lengths
+from grainlab.samples._checks import in_range, positive_lengths
+from grainlab.samples.porosity import check_box
 
 __all__ = ["PlacementError", "random_placement"]
 
@@ -118,9 +112,7 @@ def random_placement(
 def _checked(diameters: ArrayLike, scale: float, batch: int, tries: int) -> tuple[NDArray[np.float64], float]:
     """The diameters and the scale, checked (bad input names its field)."""
     d = positive_lengths("diameters", diameters, "diameter")
-    scale = float(scale)
-    if not (0.0 < scale <= 1.0):
-        raise ValueError(f"scale: must be in (0, 1], got {scale}")
+    scale = in_range("scale", scale, "(0, 1]")
     if int(batch) < 1 or int(tries) < 1:
         raise ValueError(f"batch and tries: must be >= 1, got batch={batch}, tries={tries}")
     return d, scale

@@ -1,16 +1,8 @@
-"""Porosity of a 2D disk packing, read two ways, and the particle count for a target.
-
-- **Nominal** porosity (PFC's reading): ``n = 1 - sum(pi r^2) / A``. Overlaps are
-  counted twice, so a packing of overlapping disks can have a nominal porosity
-  below what its geometry covers, even below zero.
-- **Overlap-corrected** porosity: ``n_c = 1 - |union of disks ∩ box| / A``, the
-  void fraction really left in the box. :func:`overlap_corrected_porosity`
-  computes it by inclusion-exclusion up to pairs: each disk clipped exactly at
-  the box edges, minus the lens of every overlapping pair.
-- Either reading inside a **measurement circle**, as PFC2D's measurement circles
-  report porosity: :func:`measurement_circle_porosity`.
-
-Areas are per unit thickness (m^2); boxes are ``(xmin, ymin, xmax, ymax)`` in m.
+"""Porosity of a 2D disk packing, nominal (``1 - sum(pi r^2) / A``, PFC's) and
+overlap-corrected (``1 - |union of disks ∩ box| / A``), in a box or inside a
+measurement circle, and the particle count for a target (docs/samples.md,
+"Porosity: two readings"). Areas per unit thickness (m^2); boxes
+``(xmin, ymin, xmax, ymax)`` in m.
 
 Example
 -------
@@ -32,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
+from grainlab.samples._checks import in_range, positive_lengths
 from grainlab.samples.grading import Grading
 
 __all__ = [
@@ -69,17 +62,6 @@ def box_area(box: ArrayLike) -> float:
     return (x1 - x0) * (y1 - y0)
 
 
-def positive_lengths(name: str, values: ArrayLike, what: str) -> NDArray[np.float64]:
-    """``values`` as a 1-D array of finite lengths > 0 (m), else one line naming ``name[k]``."""
-    r = np.asarray(values, dtype=np.float64)
-    if r.ndim != 1:
-        raise ValueError(f"{name}: expected a 1-D array, got shape {r.shape}")
-    if not np.all(np.isfinite(r)) or np.any(r <= 0):
-        k = int(np.argmax(~np.isfinite(r) | (r <= 0)))
-        raise ValueError(f"{name}[{k}]: must be a finite {what} > 0 (m), got {r[k]}")
-    return r
-
-
 def _radii(radii: ArrayLike) -> NDArray[np.float64]:
     return positive_lengths("radii", radii, "radius")
 
@@ -91,9 +73,7 @@ def nominal_porosity(radii: ArrayLike, area: float, *, positions: ArrayLike | No
     disks' ``positions``, a grain of several disks (a clump) counts the area of
     their union, its own overlaps once (:func:`grain_overlap_area`)."""
     r = _radii(radii)
-    area = float(area)
-    if not (math.isfinite(area) and area > 0):
-        raise ValueError(f"area: must be a finite area > 0 (m^2), got {area}")
+    area = in_range("area", area, "(0, inf)", "an area (m^2)")
     covered = math.pi * np.sum(r * r)
     if grain is not None:
         covered -= grain_overlap_area(_positions(positions, r), r, grain)
@@ -283,9 +263,7 @@ def overlap_corrected_porosity(
     """
     x0, y0, x1, y1 = check_box(box)
     r = _radii(radii)
-    p = np.asarray(positions, dtype=np.float64)
-    if p.ndim != 2 or p.shape != (len(r), 2):
-        raise ValueError(f"positions: expected shape ({len(r)}, 2), got {p.shape}")
+    p = _positions(positions, r)
     if periodic:
         i, j, d = overlapping_pairs(p - np.array([x0, y0]), r, cell=(x1 - x0, y1 - y0))
         disks = math.pi * np.sum(r * r)
@@ -340,17 +318,13 @@ def measurement_circle_porosity(
     0.995
     """
     r = _radii(radii)
-    p = np.asarray(positions, dtype=np.float64)
-    if p.ndim != 2 or p.shape != (len(r), 2):
-        raise ValueError(f"positions: expected shape ({len(r)}, 2), got {p.shape}")
+    p = _positions(positions, r)
     if not np.all(np.isfinite(p)):
         raise ValueError("positions: must be finite (m)")
     c = np.asarray(centre, dtype=np.float64)
     if c.shape != (2,) or not np.all(np.isfinite(c)):
         raise ValueError(f"centre: expected two finite coordinates (x, y) in m, got {centre!r}")
-    big_r = float(radius)
-    if not (math.isfinite(big_r) and big_r > 0):
-        raise ValueError(f"radius: must be a finite radius > 0 (m), got {radius!r}")
+    big_r = in_range("radius", radius, "(0, inf)", "a radius (m)")
     d = np.hypot(p[:, 0] - c[0], p[:, 1] - c[1])
     near = d < big_r + r
     covered = float(lens_area(r[near], big_r, d[near]).sum())
@@ -368,10 +342,6 @@ def measurement_circle_porosity(
 def particle_count(box_area: float, porosity: float, grading: Grading) -> int:
     """``round((1 - n) A / mean disk area)``: the number of disks of ``grading``
     that fill ``box_area`` (m^2) to nominal porosity ``porosity`` on average."""
-    box_area = float(box_area)
-    porosity = float(porosity)
-    if not (math.isfinite(box_area) and box_area > 0):
-        raise ValueError(f"box_area: must be a finite area > 0 (m^2), got {box_area}")
-    if not (0.0 < porosity < 1.0):
-        raise ValueError(f"porosity: must be in (0, 1), got {porosity}")
+    box_area = in_range("box_area", box_area, "(0, inf)", "an area (m^2)")
+    porosity = in_range("porosity", porosity, "(0, 1)")
     return round((1.0 - porosity) * box_area / grading.mean_disk_area())

@@ -10,7 +10,6 @@ from typing import Any
 
 import numpy as np
 
-import grainlab
 from grainlab._interrupt import raise_if_interrupted
 from grainlab.analysis.peak import peak_record
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO, VOLUMETRIC_STRAIN
@@ -18,8 +17,8 @@ from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic,
 from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
 from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.state import BiaxialRun
-from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.runner import RunResult
+from grainlab.protocols.specimen import run_summary
 
 #: The paper's reported values, for the summary and the docs.
 PAPER_VALUES = {
@@ -58,9 +57,7 @@ def summarise(run: BiaxialRun, config: BiaxialConfig, timeseries: dict[str, np.n
     k = peak_record(timeseries[AXIAL_STRAIN], timeseries[STRESS_RATIO])
     peak = {name: float(timeseries[name][k])
             for name in (STRESS_RATIO, AXIAL_STRAIN, "coordination_number", VOLUMETRIC_STRAIN)}
-    return {
-        "n_particles": run.n_grains,
-        **clump_summary(run.sample),
+    return run_summary(run, {
         "n_membrane_disks": run.consolidation.get("membrane_disks", 0),
         "porosity_initial": shear.porosity_initial,
         "porosity_after_consolidation": run.consolidation["porosity"],
@@ -83,13 +80,7 @@ def summarise(run: BiaxialRun, config: BiaxialConfig, timeseries: dict[str, np.n
         "inertial_number": shear.inertial_number,
         "inertial_number_mean_diameter": shear.inertial_number_mean_diameter,
         "density_scaling_factor": shear.density_scaling_factor,
-        "time_step_s": run.consolidation["time_step_s"],
-        "records": len(timeseries[AXIAL_STRAIN]),
-        "wall_time_s": total_s,
-        "wall_time_by_phase_s": dict(run.wall_time),
-        "paper": PAPER_VALUES,
-        "grainlab_version": grainlab.__version__,
-    }
+    }, records=len(timeseries[AXIAL_STRAIN]), wall_time_s=total_s, paper=PAPER_VALUES)
 
 
 def is_constant_volume(config: dict[str, Any]) -> bool:

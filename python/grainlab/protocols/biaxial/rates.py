@@ -139,21 +139,12 @@ def check_strain_rate(config: BiaxialConfig) -> None:
 
 
 def default_strain_rate(config: BiaxialConfig, max_diameter: float, min_radius: float) -> float:
-    """The fastest axial strain rate whose inertial number and paper's Eq. 16
-    factor are both at most ``shear.inertial_number`` (the ``auto`` rate; the run
-    passes the grading's nominal ``sample.d_max`` and ``sample.d_min / 2``).
-
-    The inertial number is taken for the heaviest grain and with local
-    damping's effective mass ``m / (1 - alpha)``:
-    ``I = rate * d_max * sqrt(rho / ((1 - alpha) sigma_3))``. The bound's default,
-    1e-4, is this number at the paper's 2 %/min with Table 1: in the
-    paper-scale rate study (docs/reproduction.md) no faster rate matched
-    2 %/min (4 and 8 %/min dilated more beyond the seed scatter, 8 %/min also
-    peaked higher), and 2 %/min itself did not match 1 %/min, so ``auto`` is
-    the paper's rate, not a converged one. For another material or sample, ``auto`` keeps that inertial
-    number, which the study did not test. Eq. 16: ``rate * r_min * sqrt(rho /
-    p_y)`` with the limiting contact pressure ``p_y`` (Table 1: 150 MPa), far
-    from binding with Table 1.
+    """The fastest axial strain rate (the ``auto`` rate) whose inertial number
+    ``I = rate * d_max * sqrt(rho / ((1 - alpha) sigma_3))`` (the heaviest grain, with
+    local damping's effective mass) and paper's Eq. 16 factor ``rate * r_min * sqrt(rho /
+    p_y)`` are both at most ``shear.inertial_number``; the run passes the grading's
+    nominal ``sample.d_max`` and ``sample.d_min / 2`` (docs/biaxial.md, "The strain
+    rate": why the bound is 1e-4, the paper's 2 %/min with Table 1).
     """
     rho, p = config.material.density, config.consolidation.pressure
     alpha = config.material.local_damping

@@ -7,15 +7,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from grainlab.analysis import fabric_summary
-from grainlab.analysis.stress import love_weber_stress
 from grainlab.columns import BIAXIAL
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.state import BiaxialRun, Boundary
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, sample_area
-from grainlab.protocols.grains import grain_count
-from grainlab.protocols.specimen import engine_columns
+from grainlab.protocols.specimen import grain_columns
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind, Snapshot
 
@@ -67,7 +64,6 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
     sigma_3 = config.consolidation.pressure  # the confining pressure held (a cell pressure)
 
     c = sim.contacts()
-    w = sim.wall_contacts()
     n = run.n_grains
     f_on_j = -c.force_on_i
     grain_i, grain_j = c.i < n, c.j < n
@@ -90,23 +86,6 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
         felt_left = felt_right = boundary.pressure
     # at constant volume the side walls' stress is the effective one, sigma_3'
     sigma_3_ratio = felt_left if isinstance(boundary, WallBoundary) and boundary.constant_volume else sigma_3
-    wall_force = w.force_on_particle
-    grains = np.zeros(sim.n_particles, dtype=bool)
-    grains[:n] = True
-    lw = love_weber_stress(
-        sim.grain_centroids,
-        c.i,
-        c.j,
-        c.point,
-        f_on_j,
-        area,
-        grains,
-        wall_particle=w.particle,
-        wall_point=w.point,
-        wall_force_on_particle=wall_force,
-    )
-    grain_contacts = int(np.count_nonzero(grain_i & grain_j & ~c.bonded))
-    fabric = _fabric(sim, run)
     return {
         "step": float(sim.step_count),
         "time_s": sim.time,
@@ -119,23 +98,8 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
         "volumetric_strain": (shear.area0 - area) / shear.area0,
         "area_m2": area,
         "height_m": height,
-        "love_weber_xx_pa": float(lw[0, 0]),
-        "love_weber_yy_pa": float(lw[1, 1]),
-        "love_weber_xy_pa": float(lw[0, 1]),
-        "coordination_number": 2.0 * grain_contacts / grain_count(sim, n),
-        **engine_columns(sim),
-        **fabric,
+        **grain_columns(sim, n, area, c, take_snapshot(sim, run, 0.0)),
     }
-
-
-def _fabric(sim: Simulation, run: BiaxialRun) -> dict[str, float]:
-    """Fabric measures of the grains (membrane disks excluded as particles):
-    anisotropy of contact normals and normal forces (the exact estimate, and
-    Eq. 7-8 on the histogram as ``*_binned``), the mean stability index (Sec. 5)
-    and the mechanical coordination number."""
-    summary = fabric_summary(take_snapshot(sim, run, 0.0))
-    summary.pop("coordination_number")  # the record's own, grain-grain contacts
-    return summary
 
 
 def enclosed_area(sim: Simulation, boundary: Boundary) -> float:

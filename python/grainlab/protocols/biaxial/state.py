@@ -67,11 +67,8 @@ Boundary = Membrane | GrainBoundary | WallBoundary
 
 def boundary_from_dict(saved: dict[str, Any]) -> Boundary:
     """The lateral boundary a checkpoint stored (its ``to_dict()``)."""
-    if saved.get("kind") == GrainBoundary.kind:
-        return GrainBoundary.from_dict(saved)
-    if saved.get("kind") == WallBoundary.kind:
-        return WallBoundary.from_dict(saved)
-    return Membrane.from_dict(saved)
+    kinds: dict[str, type[Boundary]] = {GrainBoundary.kind: GrainBoundary, WallBoundary.kind: WallBoundary}
+    return kinds.get(saved.get("kind", ""), Membrane).from_dict(saved)
 
 
 @dataclass

@@ -10,6 +10,7 @@ from typing import Any, ClassVar
 
 from grainlab.protocols.biaxial.config import BIAXIAL_FIELDS, BiaxialConfig, check_boundary
 from grainlab.protocols.config import (
+    POSITIVE,
     ConfigError,
     Section,
     SectionOf,
@@ -39,7 +40,7 @@ class CyclicSection(Section):
     stress_amplitude: float | str = key(
         "stress", "auto", "deviator amplitude A_q of a stress-controlled test: each cycle goes q = 0 -> +A_q -> "
         "-A_q -> 0; below sigma_0 (extension to -A_q needs sigma_1 = sigma_3 - A_q > 0)",
-        minimum=0.0, exclusive_minimum=True, allow_auto=True,
+        **POSITIVE, allow_auto=True,
     )
     strain_limit: float = key(
         "strain", 0.05, "a stress-controlled test ends when the axial strain reaches +/- this (the sample has "

@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 
-import grainlab
 from grainlab.columns import (
     AXIAL_STRAIN,
     COORDINATION_NUMBER,
@@ -27,9 +26,8 @@ from grainlab.columns import (
 )
 from grainlab.protocols.biaxial.state import BiaxialRun
 from grainlab.protocols.cyclic.config import CyclicConfig
-from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.runner import RunResult
-from grainlab.protocols.specimen import write_run_outputs
+from grainlab.protocols.specimen import run_summary, write_run_outputs
 
 __all__ = ["CyclicResult", "cycle_table", "summarise", "write_outputs"]
 
@@ -100,9 +98,7 @@ def summarise(run: BiaxialRun, config: CyclicConfig, timeseries: dict[str, np.nd
     constant_volume = config.shear.volume == "constant"
     cycles = cycle_table(timeseries, config.consolidation.pressure if constant_volume else None)
     last = cycles[-1] if cycles else {}
-    return {
-        "n_particles": run.n_grains,
-        **clump_summary(run.sample),
+    return run_summary(run, {
         "n_membrane_disks": run.consolidation.get("membrane_disks", 0),
         "porosity_initial": plan.porosity_initial,
         "porosity_after_consolidation": run.consolidation["porosity"],
@@ -128,12 +124,7 @@ def summarise(run: BiaxialRun, config: CyclicConfig, timeseries: dict[str, np.nd
         "anisotropy_after_cycles": last.get("anisotropy"),
         "mean_effective_stress_after_cycles_pa": last.get("mean_effective_stress_pa"),
         "pore_pressure_after_cycles_pa": last.get("pore_pressure_pa"),
-        "time_step_s": run.consolidation["time_step_s"],
-        "records": len(timeseries[AXIAL_STRAIN]),
-        "wall_time_s": total_s,
-        "wall_time_by_phase_s": dict(run.wall_time),
-        "grainlab_version": grainlab.__version__,
-    }
+    }, records=len(timeseries[AXIAL_STRAIN]), wall_time_s=total_s)
 
 
 def write_outputs(out: Path) -> dict[str, Any]:

@@ -1,14 +1,8 @@
 """The cyclic biaxial test as a protocol of the runner: the biaxial test's sample,
-consolidation and flexible boundary under sigma_0, then the platens driven at
-``shear.strain_rate`` from 0 to +A, to -A and back to 0 (A =
-``cyclic.strain_amplitude``, compression positive), ``cyclic.cycles`` times, the
-confining pressure held. Records every ``shear.record_interval`` of strain path and
-at every turning point; snapshots at the start, at the first and last cycles'
-turning points and at the end of every cycle. With ``cyclic.control = "stress"``
-the platens turn where the deviator q reaches +/- ``cyclic.stress_amplitude``
-instead (asked every 100 steps), and the loading ends after the cycles or where
-the axial strain reaches ``cyclic.strain_limit``. :func:`run_cyclic` runs it into
-a folder."""
+consolidation and flexible boundary, then the platens driven between +/- A in
+strain or, with ``cyclic.control = "stress"``, in the deviator q, for
+``cyclic.cycles`` cycles (docs/protocols.md, "The cyclic biaxial test");
+:func:`run_cyclic` runs it into a folder."""
 
 from __future__ import annotations
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from grainlab.protocols.config import (
+    POSITIVE,
     Config,
     ConfigError,
     Section,
@@ -30,10 +31,8 @@ class OedometerSection(Section):
         "stress_list", [v * _KPA for v in (200, 400, 800, 1600, 800, 400, 200, 100)],
         "vertical stresses of the load steps, in order (loading, then unloading: any path)",
     )
-    tolerance: float = key(
-        "strain", 0.01, "a load step ends with sigma_v within this fraction of its target", minimum=0.0,
-        exclusive_minimum=True,
-    )
+    tolerance: float = key("strain", 0.01, "a load step ends with sigma_v within this fraction of its target",
+                           **POSITIVE)
     max_steps: int = key("integer", 2_000_000, "give up a load step after this many steps", minimum=1)
     friction_angle: float | str = key(
         "angle", "auto",

@@ -20,18 +20,16 @@ from typing import Any
 
 import numpy as np
 
-import grainlab
 from grainlab.columns import (
     HORIZONTAL_STRESS_PA,
     LATERAL_STRESS_RATIO,
     OVERCONSOLIDATION_RATIO,
     VERTICAL_STRESS_PA,
 )
-from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.oedometer.config import OedometerConfig
 from grainlab.protocols.oedometer.state import OedometerRun
 from grainlab.protocols.runner import RunResult
-from grainlab.protocols.specimen import write_run_outputs
+from grainlab.protocols.specimen import run_summary, write_run_outputs
 
 __all__ = ["K0_FROM_STRESS_RATIO", "OedometerResult", "first_loading", "k0_loading", "summarise", "write_outputs"]
 
@@ -89,9 +87,7 @@ def summarise(run: OedometerRun, config: OedometerConfig, timeseries: dict[str, 
          "mayne_kulhawy": None if phi is None or jaky is None else jaky * float(ocr[r]) ** math.sin(phi)}
         for r in range(len(k)) if r not in loading
     ]
-    return {
-        "n_particles": run.n_grains,
-        **clump_summary(run.sample),
+    return run_summary(run, {
         "porosity_initial": float(timeseries["porosity"][0]),
         "void_ratio_initial": float(timeseries["void_ratio"][0]),
         "porosity_after_consolidation": run.consolidation["porosity"],
@@ -105,13 +101,7 @@ def summarise(run: OedometerRun, config: OedometerConfig, timeseries: dict[str, 
         "unloading": unloading,
         "friction_angle_deg": None if phi is None else math.degrees(phi),
         "k0_jaky": jaky,
-        "time_step_s": run.consolidation["time_step_s"],
-        "records": len(k),
-        "load_steps": int(timeseries["step"][-1]) - run.load_start_step,
-        "wall_time_s": total_s,
-        "wall_time_by_phase_s": dict(run.wall_time),
-        "grainlab_version": grainlab.__version__,
-    }
+    }, records=len(k), load_steps=int(timeseries["step"][-1]) - run.load_start_step, wall_time_s=total_s)
 
 
 def write_outputs(out: Path) -> dict[str, Any]:

@@ -11,13 +11,11 @@ from typing import Any, ClassVar
 import numpy as np
 
 from grainlab._progress import progress_bar
-from grainlab.analysis import fabric_summary
-from grainlab.analysis.stress import love_weber_stress
 from grainlab.columns import OEDOMETER
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols import operations
 from grainlab.protocols.consolidate import BOX_WALLS, box_state
-from grainlab.protocols.grains import grain_count, grain_porosity
+from grainlab.protocols.grains import grain_porosity
 from grainlab.protocols.oedometer.config import OedometerConfig
 from grainlab.protocols.oedometer.outputs import OedometerResult, summarise, write_outputs
 from grainlab.protocols.oedometer.state import OedometerRun
@@ -28,7 +26,7 @@ from grainlab.protocols.specimen import (
     CONSOLIDATE,
     SpecimenError,
     SpecimenProtocol,
-    engine_columns,
+    grain_columns,
     grain_model,
     platen_model,
 )
@@ -151,11 +149,6 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
     area = box.width_m * box.height_m
     n = run.n_grains
     porosity = grain_porosity(sim, n, area)
-    c, w = sim.contacts(), sim.wall_contacts()
-    lw = love_weber_stress(sim.grain_centroids, c.i, c.j, c.point, -c.force_on_i, area, np.ones(sim.n_particles, bool),
-                           wall_particle=w.particle, wall_point=w.point, wall_force_on_particle=w.force_on_particle)
-    fabric = fabric_summary(_snapshot(sim, run))
-    fabric.pop("coordination_number")
     values = {
         "step": float(sim.step_count), "time_s": sim.time, "target_vertical_stress_pa": target,
         "vertical_stress_pa": box.stress_yy_pa, "horizontal_stress_pa": box.stress_xx_pa,
@@ -165,10 +158,7 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
         "axial_strain": (run.height0 - box.height_m) / run.height0,
         "volumetric_strain": (run.area0 - area) / run.area0,
         "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "height_m": box.height_m, "area_m2": area,
-        "love_weber_xx_pa": float(lw[0, 0]), "love_weber_yy_pa": float(lw[1, 1]), "love_weber_xy_pa": float(lw[0, 1]),
-        "coordination_number": 2.0 * int(np.count_nonzero((c.i < n) & (c.j < n))) / grain_count(sim, n),
-        **engine_columns(sim),
-        **fabric,
+        **grain_columns(sim, n, area, sim.contacts(), _snapshot(sim, run)),
     }
     return {name: values[name] for name in OEDOMETER}
 

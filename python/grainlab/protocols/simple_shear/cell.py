@@ -1,33 +1,8 @@
-"""The periodic cell as a test's boundary: the cell's stress, measured from
-the contacts and the grains' fluctuating motion, and its stress control, the
-periodic counterpart of the servo-controlled walls (docs/boundary.md,
-"A stress-controlled cell").
-
-The stress of the cell (compression positive) is
-
-    sigma = (1/A) [ sum_c l_c (x) f_c + sum_p m_p v_p (x) v_p ],
-
-``l_c = (r_i + r_j - delta) n`` the branch vector of contact c from i to j
-(for a clump's pebble, from the clump's centroid: the pebbles' arms added),
-``f_c`` the contact force on j, ``v_p`` each grain's velocity about the
-imposed flow (a clump's, with its mass) and ``A`` the cell's area.
-
-The control sets the rate of the cell's side k, ``L_kk``, once every
-:data:`CONTROL_STEPS` steps, proportional and integral in the stress gap
-``e = sigma_kk - target``: ``L_kk = K e + J``, ``J <- J + INTEGRAL_SHARE K e``.
-The proportional part alone would close :data:`RELAXATION` of the gap over
-one interval at the packing's stiffness, estimated from above by the affine
-(Voigt) sum ``E_kk = (1/A) sum_c k_n |l_c|^2 n_k^4`` with each contact's
-tangent normal stiffness ``k_n`` (the contact law's: ``kn`` for the linear
-law, ``2 E* a`` for Hertz-Mindlin), so ``K = RELAXATION /
-(E_kk dt_interval)``; the integral part ``J`` learns the steady rate that
-shearing asks for (a dilating sample's), which a proportional control alone
-would only give at a standing stress error. With the true stiffness any
-fraction ``r <= 1`` of the estimate, the loop is stable for an integral share
-below 1 (its gain matrix has determinant ``1 - RELAXATION r (1 - share)``).
-The rate and ``J`` are capped as the walls' speed is (a twentieth of the
-smallest diameter per 100 steps) plus the shear rate.
-"""
+"""The periodic cell as a test's boundary: the cell's stress, from the contacts
+(a clump's branch vectors from its centroid) and the grains' motion about the
+imposed flow, and its stress control, proportional and integral in the stress
+gap at the affine stiffness estimate, the periodic counterpart of the
+servo-controlled walls (docs/boundary.md, "A stress-controlled cell")."""
 
 from __future__ import annotations
 
@@ -156,7 +131,7 @@ def side_stresses(sim: Simulation, sides: Sequence[int]) -> list[tuple[float, fl
 
 def servo_rate(stress_pa: float, target_pa: float, stiffness_pa: float, interval_s: float, max_rate: float,
                integral: float) -> tuple[float, float]:
-    """``(L_kk, J)``: the rate (1/s; positive stretches the cell) of the module's
+    """``(L_kk, J)``: the rate (1/s; positive stretches the cell) of the cell's
     control for the gap ``stress - target`` at ``stiffness_pa`` over
     ``interval_s``, and the integral part ``J`` updated from ``integral``, both
     within ``+- max_rate``. A cell without stiffness yet (no contacts) keeps

@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 from grainlab.protocols.config import (
+    POSITIVE,
     SHARED_FIELDS,
     Config,
     ConfigError,
@@ -38,7 +39,7 @@ class SimpleShearSection(Section):
     )
     normal_stress: float | str = key(
         "stress", "auto", "normal stress sigma_yy held at free volume (auto: consolidation.pressure)",
-        minimum=0.0, exclusive_minimum=True, allow_auto=True,
+        **POSITIVE, allow_auto=True,
     )
     inertial_number: float = key(
         "number", 1e-3,
@@ -56,9 +57,7 @@ class SimpleShearSection(Section):
         "strain", 1.0, "shear strain gamma at which shearing stops (1 = 100 %)", minimum=0.0, maximum=100.0,
         exclusive_minimum=True,
     )
-    record_interval: float = key(
-        "strain", 0.01, "shear strain between records", minimum=0.0, exclusive_minimum=True,
-    )
+    record_interval: float = key("strain", 0.01, "shear strain between records", **POSITIVE)
     snapshot_strains: list[float] = key(
         "shear_strain_list", [0.0, 0.1, 0.25, 0.5, 1.0], "shear strains at which a snapshot is stored",
     )

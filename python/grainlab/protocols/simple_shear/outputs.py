@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 
-import grainlab
 from grainlab.columns import (
     COORDINATION_NUMBER,
     FRICTION_COEFFICIENT,
@@ -28,11 +27,10 @@ from grainlab.columns import (
     SHEAR_STRAIN,
     VOLUMETRIC_STRAIN,
 )
-from grainlab.protocols.grains import clump_summary
 from grainlab.protocols.runner import RunResult
 from grainlab.protocols.simple_shear.config import SimpleShearConfig
 from grainlab.protocols.simple_shear.state import SimpleShearRun
-from grainlab.protocols.specimen import write_run_outputs
+from grainlab.protocols.specimen import run_summary, write_run_outputs
 
 __all__ = ["STEADY_FROM", "SimpleShearResult", "steady_rows", "summarise", "write_outputs"]
 
@@ -78,9 +76,7 @@ def summarise(run: SimpleShearRun, config: SimpleShearConfig, timeseries: dict[s
               (FRICTION_COEFFICIENT, POROSITY, COORDINATION_NUMBER, "mechanical_coordination_number",
                "mean_stability_index", "anisotropy", "force_anisotropy", INERTIAL_NUMBER, NORMAL_STRESS_PA,
                VOLUMETRIC_STRAIN, "kinetic_stress_share")}
-    return {
-        "n_particles": run.n_grains,
-        **clump_summary(run.sample),
+    return run_summary(run, {
         "volume": config.simple_shear.volume,
         "inertial_number_set": config.simple_shear.inertial_number,
         "shear_rate_per_s": run.shear_rate_per_s,
@@ -102,13 +98,7 @@ def summarise(run: SimpleShearRun, config: SimpleShearConfig, timeseries: dict[s
         "normal_stress_final_pa": float(ts[NORMAL_STRESS_PA][-1]),
         "rb_residual_max_abs": float(np.nanmax(residual)),
         "rb_residual_mean_abs": float(np.nanmean(residual)),
-        "time_step_s": run.consolidation["time_step_s"],
-        "records": len(mu),
-        "shear_steps": int(ts["step"][-1] - ts["step"][0]),
-        "wall_time_s": total_s,
-        "wall_time_by_phase_s": dict(run.wall_time),
-        "grainlab_version": grainlab.__version__,
-    }
+    }, records=len(mu), shear_steps=int(ts["step"][-1] - ts["step"][0]), wall_time_s=total_s)
 
 
 def write_outputs(out: Path) -> dict[str, Any]:

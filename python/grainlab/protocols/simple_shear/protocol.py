@@ -1,10 +1,6 @@
-"""Periodic simple shear as a protocol of the runner: the sample made as
-every test's (:mod:`grainlab.protocols.specimen`), its four walls then
-replaced by a periodic cell of the same box, consolidated there by the
-stress-controlled cell (:mod:`grainlab.protocols.simple_shear.cell`), and
-sheared at a constant rate ``L = [[0, gamma_dot], [0, L_yy]]`` to large
-strain, the cell remapped whenever it leans past half its width. At free
-volume ``L_yy`` holds the normal stress; at constant volume it is 0.
+"""Periodic simple shear as a protocol of the runner: the sample made as every
+test's, consolidated in a periodic cell of its box and sheared at a constant
+rate to large strain (docs/protocols.md, "Periodic simple shear");
 :func:`run_simple_shear` runs it into a folder."""
 
 from __future__ import annotations
