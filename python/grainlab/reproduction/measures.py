@@ -121,10 +121,8 @@ def _fabric_of(view: BodyView, options: Mapping[str, Any]) -> dict[str, Any]:
     from grainlab.analysis.per_body import BodyStabilityIndex
 
     snap = view.snapshot
-    if view.identity:
-        stability = _stability(options).compute(snap)
-    else:  # per body: each contact's direction from the body's centroid
-        stability = BodyStabilityIndex(**_reading(options)).compute(view)
+    # per body, each contact's direction from the body's centroid (a disk's own: StabilityIndex's bits)
+    stability = BodyStabilityIndex(**_reading(options)).compute(view)
     normals = ContactAnisotropy().compute(snap)
     forces = ContactAnisotropy(weight="normal_force").compute(snap) if snap.normal_force is not None else None
     z = CoordinationNumber().compute(snap)
