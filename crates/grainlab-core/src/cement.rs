@@ -200,11 +200,15 @@ impl CementBond {
     /// How the bond breaks under normal force `fn_` and its own shear force
     /// and moment, if it does: tension first, then shear.
     #[inline]
+    ///
+    /// Both criteria are taken over the section, in newtons, so that a step
+    /// divides nothing: `-F_n + |M| A R_b / I >= sigma_c A` and
+    /// `|F_s| >= c A + F_n tan(phi_b)`.
     pub fn rupture_mode(&self, fn_: f64) -> Option<BreakMode> {
-        let (sigma, sigma_max) = self.normal_stresses(fn_);
-        if sigma_max >= self.tensile_strength {
+        let a = self.area;
+        if self.moment.abs() * self.bending_factor * a - fn_ >= self.tensile_strength * a {
             Some(BreakMode::Tension)
-        } else if self.shear.abs() / self.area >= self.cohesion - sigma * self.friction_tangent {
+        } else if self.shear.abs() >= self.cohesion * a + fn_ * self.friction_tangent {
             Some(BreakMode::Shear)
         } else {
             None
@@ -342,15 +346,16 @@ pub(crate) struct Rupture {
     pub normal: Vec2,
     pub energy: f64,
     /// What the ledger books: `energy` plus half a step of the bond's work
-    /// at the half-step velocities (see [`cement_slot`]).
+    /// at the half-step velocities (see [`evaluate_cement`]).
     pub booked: f64,
     pub normal_force: f64,
     pub shear_force: f64,
     pub moment: f64,
 }
 
-/// A cement bond's forces of this step (added as [`crate::bond::BondSlot`]s
-/// are), or its rupture.
+/// A cement bond's forces of this step, added as [`crate::bond::BondSlot`]s
+/// are (a broken bond's slot holds zeros). Kept to the forces alone: the
+/// slots are written and read at every step.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct CementSlot {
     /// Force on `j` (N); its opposite acts on `i`.
@@ -359,61 +364,85 @@ pub(crate) struct CementSlot {
     pub torque_i: f64,
     /// Taken from `j`'s torque: `a_j F_s - M` (N m).
     pub torque_j: f64,
-    /// Strain energy (J), measured steps only.
-    pub elastic: f64,
-    /// Magnitude of the force (N), measured steps only.
-    pub force_norm: f64,
-    /// Set when the bond broke at this evaluation (its force is then zero).
-    pub rupture: Option<Rupture>,
+}
+
+/// What one evaluation of a cement bond gives.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum CementEvaluation {
+    /// The bond holds: its forces, and (measured steps only, else zeros) its
+    /// strain energy (J) and the magnitude of its force (N).
+    Holds {
+        slot: CementSlot,
+        elastic: f64,
+        force_norm: f64,
+    },
+    /// The bond broke at this evaluation; it adds no force.
+    Breaks(Rupture),
 }
 
 /// Evaluates `bond` at the current state (its springs take the increment
 /// over `increment_time`), deciding whether it breaks.
-#[inline]
-pub(crate) fn cement_slot<const MEASURE: bool>(
+#[inline(always)]
+pub(crate) fn evaluate_cement<const MEASURE: bool>(
     bond: &mut CementBond,
     p: &ParticleMotion<'_>,
     cell: Option<&PeriodicCell>,
     velocity_gradient: Option<Mat2>,
     increment_time: f64,
-) -> CementSlot {
+) -> CementEvaluation {
     let g = advance_springs(bond, p, cell, velocity_gradient, increment_time);
     let fn_ = bond.normal_stiffness * (bond.rest_length - g.distance);
     let (fs, m) = (bond.shear, bond.moment);
     if let Some(mode) = bond.rupture_mode(fn_) {
-        let position = add(p.position[bond.i as usize], scale(g.normal, g.arm_i));
-        let energy = bond.energy(fn_);
-        // Leapfrog conserves 1/2 m v(n-1/2).v(n+1/2) + U(x(n)) (the ledger's
-        // kinetic and elastic lines); a force that stops at step n misses the
-        // half of its trapezoid of work that step n's kick would have given,
-        // 1/2 dt F(x(n)) . v(n-1/2): booking it with U makes the ledger
-        // balance to round-off through the break.
-        let power = fn_ * g.normal_velocity + fs * g.shear_velocity + m * g.spin;
-        return CementSlot {
-            rupture: Some(Rupture {
-                mode,
-                position,
-                normal: g.normal,
-                energy,
-                booked: energy + 0.5 * increment_time * power,
-                normal_force: fn_,
-                shear_force: fs,
-                moment: m,
-            }),
-            ..CementSlot::default()
-        };
+        return CementEvaluation::Breaks(rupture(bond, p, &g, mode, fn_, increment_time));
     }
-    let mut slot = CementSlot {
+    let slot = CementSlot {
         force: add(scale(g.normal, fn_), scale(perp(g.normal), fs)),
         torque_i: g.arm_i * fs + m,
         torque_j: g.arm_j * fs - m,
-        ..CementSlot::default()
     };
-    if MEASURE {
-        slot.elastic = bond.energy(fn_);
-        slot.force_norm = (fn_ * fn_ + fs * fs).sqrt();
+    let (elastic, force_norm) = if MEASURE {
+        (bond.energy(fn_), (fn_ * fn_ + fs * fs).sqrt())
+    } else {
+        (0.0, 0.0)
+    };
+    CementEvaluation::Holds {
+        slot,
+        elastic,
+        force_norm,
     }
-    slot
+}
+
+/// The record of `bond` breaking in `mode` under normal force `fn_`, at
+/// geometry `g`.
+#[cold]
+#[inline(never)]
+fn rupture(
+    bond: &CementBond,
+    p: &ParticleMotion<'_>,
+    g: &CementGeometry,
+    mode: BreakMode,
+    fn_: f64,
+    increment_time: f64,
+) -> Rupture {
+    let (fs, m) = (bond.shear, bond.moment);
+    let energy = bond.energy(fn_);
+    // Leapfrog conserves 1/2 m v(n-1/2).v(n+1/2) + U(x(n)) (the ledger's
+    // kinetic and elastic lines); a force that stops at step n misses the
+    // half of its trapezoid of work that step n's kick would have given,
+    // 1/2 dt F(x(n)) . v(n-1/2): booking it with U makes the ledger
+    // balance to round-off through the break.
+    let power = fn_ * g.normal_velocity + fs * g.shear_velocity + m * g.spin;
+    Rupture {
+        mode,
+        position: add(p.position[bond.i as usize], scale(g.normal, g.arm_i)),
+        normal: g.normal,
+        energy,
+        booked: energy + 0.5 * increment_time * power,
+        normal_force: fn_,
+        shear_force: fs,
+        moment: m,
+    }
 }
 
 #[cfg(test)]

@@ -152,7 +152,8 @@ impl BondEnds for CementBond {
 pub(crate) trait BondForce {
     /// `(force on j, torque taken from i, torque taken from j)`.
     fn parts(&self) -> (Vec2, f64, f64);
-    /// `(elastic energy, force magnitude)`, or `None` for a bond that broke.
+    /// `(elastic energy, force magnitude)` for the serial pass's tally, or
+    /// `None` when the evaluation tallied it.
     fn measured(&self) -> Option<(f64, f64)>;
 }
 
@@ -172,11 +173,10 @@ impl BondForce for CementSlot {
     fn parts(&self) -> (Vec2, f64, f64) {
         (self.force, self.torque_i, self.torque_j)
     }
+    /// Never measured here: the stripe that evaluates a cement bond tallies it.
     #[inline(always)]
     fn measured(&self) -> Option<(f64, f64)> {
-        self.rupture
-            .is_none()
-            .then_some((self.elastic, self.force_norm))
+        None
     }
 }
 

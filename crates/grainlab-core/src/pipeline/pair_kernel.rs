@@ -4,7 +4,7 @@
 //! particle-wall contact.
 use crate::bond::{Bond, BondSlot};
 use crate::cell::PeriodicCell;
-use crate::cement::{CementBond, CementSlot};
+use crate::cement::{CementBond, CementSlot, Rupture};
 use crate::contact::ContactGeometry;
 use crate::diagnostics::ContactDissipation;
 use crate::law::history::{forget, HistoryRun};
@@ -28,6 +28,8 @@ pub(crate) struct ContactTally {
     pub(crate) overlap_violation: bool,
     /// Cement bonds that broke at this evaluation.
     pub(crate) bond_breaks: usize,
+    /// Cement bonds that hold, of `contacts` (measured steps).
+    pub(crate) cement_holding: usize,
 }
 
 impl ContactTally {
@@ -39,6 +41,7 @@ impl ContactTally {
         self.contacts += o.contacts;
         self.overlap_violation |= o.overlap_violation;
         self.bond_breaks += o.bond_breaks;
+        self.cement_holding += o.cement_holding;
     }
 }
 
@@ -275,6 +278,11 @@ pub(crate) struct StripeWork<'a> {
     /// The stripe's share of the cement bonds, and their slots.
     pub(crate) cement: &'a mut [CementBond],
     pub(crate) cement_slots: &'a mut [CementSlot],
+    /// The index of the share's first cement bond in the whole list.
+    pub(crate) cement_first: usize,
+    /// The share's bonds that break at this evaluation (whole-list index and
+    /// record), in bond order.
+    pub(crate) cement_ruptures: &'a mut Vec<(usize, Rupture)>,
 }
 
 /// The reset of step 2: each particle's resultant starts from its external

@@ -10,7 +10,9 @@ use crate::body::Clumps;
 use crate::bond::{bond_force, Bond, BondForce, BondSlot, Bonds};
 use crate::boundary::{ChainStripes, PressureChain};
 use crate::cell::{minimum_image, PeriodicCell};
-use crate::cement::{advance_springs, BondBreak, Cement, CementBond, CementSlot, CementSpec};
+use crate::cement::{
+    advance_springs, BondBreak, Cement, CementBond, CementSlot, CementSpec, Rupture,
+};
 use crate::contact::{disk_disk, ContactGeometry};
 use crate::diagnostics::{EnergyLedger, Measurements};
 use crate::error::{
@@ -110,9 +112,13 @@ pub struct Simulation {
     /// The bonds' forces of this step, in bond order (`step::bond_forces`).
     #[serde(skip)]
     pub(crate) bond_slots: Vec<BondSlot>,
-    /// The cement bonds' forces (or ruptures) of this step, in cement order.
+    /// The cement bonds' forces of this step, in cement order.
     #[serde(skip)]
     pub(crate) cement_slots: Vec<CementSlot>,
+    /// The cement bonds that broke at this step's evaluation, per stripe, in
+    /// bond order (whole-list index and record).
+    #[serde(skip)]
+    pub(crate) cement_ruptures: Vec<Vec<(usize, Rupture)>>,
     /// Follower loads of this step, per internal particle (recomputed every step).
     #[serde(skip)]
     pub(crate) boundary_load: Vec<Vec2>,
@@ -197,6 +203,7 @@ impl Simulation {
             cross_forces: Vec::new(),
             bond_slots: Vec::new(),
             cement_slots: Vec::new(),
+            cement_ruptures: Vec::new(),
             boundary_load: Vec::new(),
             chain_stripes: ChainStripes::default(),
             deferred_index: DeferredIndex::default(),

@@ -10,7 +10,9 @@ use super::pair_kernel::{
 use super::Simulation;
 use crate::body::ClumpFrame;
 use crate::bond::{bond_slot, Bond, BondSlot};
-use crate::cement::{cement_slot, BondBreak, CementBond, CementSlot};
+use crate::cement::{
+    evaluate_cement, BondBreak, CementBond, CementEvaluation, CementSlot, Rupture,
+};
 use crate::diagnostics::Measurements;
 use crate::error::Result;
 use crate::integrate::{
@@ -253,7 +255,7 @@ impl Simulation {
         };
         self.measurements = Measurements {
             step: self.step_count,
-            contact_count: contacts.contacts - bonds.contacts,
+            contact_count: contacts.contacts - bonds.contacts - contacts.cement_holding,
             wall_contact_count: walls.contacts,
             mean_unbalanced_force_ratio: if mean_contact > 0.0 {
                 mean_unbalanced / mean_contact
@@ -311,7 +313,11 @@ impl Simulation {
             pairs.i.len(),
             &mut self.cross_forces,
             (&mut self.bonds.list, &mut self.bond_slots),
-            (&mut self.cement.bonds, &mut self.cement_slots),
+            (
+                &mut self.cement.bonds,
+                &mut self.cement_slots,
+                &mut self.cement_ruptures,
+            ),
             n_stripes,
         );
 
@@ -396,11 +402,9 @@ impl Simulation {
                     tally.merge(&cross);
                 }
                 let at = (&motion, cell, velocity_gradient, increment_time);
-                tally.bond_breaks += evaluate_bonds::<MEASURE>(
-                    (work.bonds, work.bond_slots),
-                    (work.cement, work.cement_slots),
-                    at,
-                );
+                evaluate_bonds::<MEASURE>((work.bonds, work.bond_slots), at);
+                let cement = (work.cement, work.cement_slots, work.cement_first);
+                evaluate_cement_bonds::<MEASURE>(cement, work.cement_ruptures, at, &mut tally);
                 if defer {
                     // SAFETY: each wall pair is in the list of one stripe only
                     wall_pairs.evaluate::<MEASURE>(deferred_index.walls_of_stripe(b), &wall_step);
@@ -455,11 +459,13 @@ impl Simulation {
         let bonds = (self.bonds.list.as_slice(), self.bond_slots.as_slice());
         let resultants = (p.force.as_mut_slice(), p.torque.as_mut_slice());
         add_bond_slots::<MEASURE, _, _>(bonds, resultants, apply, &mut tally);
-        // then the cement bonds, in their order (a broken one's slot holds zeros
-        // and is not counted)
-        let cement = (self.cement.bonds.as_slice(), self.cement_slots.as_slice());
-        let resultants = (p.force.as_mut_slice(), p.torque.as_mut_slice());
-        add_bond_slots::<MEASURE, _, _>(cement, resultants, apply, &mut tally);
+        // then the cement bonds' forces, in their order (a broken one's slot
+        // holds zeros; their tally is the stripes', made as they evaluate them)
+        if apply {
+            let cement = (self.cement.bonds.as_slice(), self.cement_slots.as_slice());
+            let resultants = (p.force.as_mut_slice(), p.torque.as_mut_slice());
+            add_bond_slots::<false, _, _>(cement, resultants, apply, &mut tally);
+        }
         tally
     }
 
@@ -468,29 +474,34 @@ impl Simulation {
     /// logged and its bond's strain energy booked as released. On any number
     /// of threads the same bonds break, so the same bits follow.
     fn remove_broken_cement(&mut self) {
-        let slots = &self.cement_slots;
-        for (bond, slot) in self.cement.bonds.iter().zip(slots) {
-            if let Some(r) = slot.rupture {
-                self.ledger.bond_released += r.booked;
-                self.cement.breaks.push(BondBreak {
-                    step: self.step_count,
-                    time: self.time,
-                    i: self.order[bond.i as usize],
-                    j: self.order[bond.j as usize],
-                    position: r.position,
-                    normal: r.normal,
-                    mode: r.mode,
-                    energy: r.energy,
-                    normal_force: r.normal_force,
-                    shear_force: r.shear_force,
-                    moment: r.moment,
-                });
-            }
+        let ruptures: Vec<(usize, Rupture)> = self
+            .cement_ruptures
+            .iter_mut()
+            .flat_map(|stripe| stripe.drain(..))
+            .collect();
+        for &(k, r) in &ruptures {
+            let bond = &self.cement.bonds[k];
+            self.ledger.bond_released += r.booked;
+            self.cement.breaks.push(BondBreak {
+                step: self.step_count,
+                time: self.time,
+                i: self.order[bond.i as usize],
+                j: self.order[bond.j as usize],
+                position: r.position,
+                normal: r.normal,
+                mode: r.mode,
+                energy: r.energy,
+                normal_force: r.normal_force,
+                shear_force: r.shear_force,
+                moment: r.moment,
+            });
         }
+        let mut broken = ruptures.iter().map(|&(k, _)| k).peekable();
         let mut k = 0;
         self.cement.bonds.retain(|_| {
+            let gone = broken.next_if_eq(&k).is_some();
             k += 1;
-            slots[k - 1].rupture.is_none()
+            !gone
         });
         self.cement_slots.clear();
         self.index_stripes();
@@ -857,7 +868,7 @@ fn stripe_shares<'a>(
     n_pairs: usize,
     cross_forces: &'a mut Vec<PairForce>,
     (bonds, bond_slots): (&'a mut [Bond], &'a mut Vec<BondSlot>),
-    (cement, cement_slots): (&'a mut [CementBond], &'a mut Vec<CementSlot>),
+    (cement, cement_slots, cement_ruptures): CementShares<'a>,
     n_stripes: usize,
 ) -> (Vec<(usize, usize)>, Vec<StripeWork<'a>>) {
     let cross_start = starts[n_stripes];
@@ -884,28 +895,41 @@ fn stripe_shares<'a>(
     cement_slots.resize(cement.len(), CementSlot::default());
     let cement_parts = split_ranges(cement, &cement_ranges);
     let cement_slot_parts = split_ranges(cement_slots, &cement_ranges);
+    cement_ruptures.resize_with(n_stripes, Vec::new);
     let stripes = history_parts
         .into_iter()
         .zip(cross_history)
         .zip(cross_buffers)
         .zip(bond_parts.into_iter().zip(bond_slot_parts))
         .zip(cement_parts.into_iter().zip(cement_slot_parts))
+        .zip(cement_ruptures.iter_mut())
         .enumerate()
         .map(
-            |(b, ((((history, cross_history), cross_forces), bonds), cement))| StripeWork {
-                stripe: b,
-                history,
-                cross_history,
-                cross_forces,
-                bonds: bonds.0,
-                bond_slots: bonds.1,
-                cement: cement.0,
-                cement_slots: cement.1,
+            |(b, (((((history, cross_history), cross_forces), bonds), cement), ruptures))| {
+                StripeWork {
+                    stripe: b,
+                    history,
+                    cross_history,
+                    cross_forces,
+                    bonds: bonds.0,
+                    bond_slots: bonds.1,
+                    cement: cement.0,
+                    cement_slots: cement.1,
+                    cement_first: cement_ranges[b].0,
+                    cement_ruptures: ruptures,
+                }
             },
         )
         .collect();
     (ranges, stripes)
 }
+
+/// The cement bonds, their slots and the per-stripe lists of their ruptures.
+type CementShares<'a> = (
+    &'a mut [CementBond],
+    &'a mut Vec<CementSlot>,
+    &'a mut Vec<Vec<(usize, Rupture)>>,
+);
 
 /// What a bond's evaluation reads besides the bond: the particles' motion,
 /// the cell, its velocity gradient and the increment's time.
@@ -916,22 +940,48 @@ type BondStep<'a> = (
     f64,
 );
 
-/// Evaluates a stripe's share of the bonds and then of the cement bonds into
-/// their slots; returns how many cement bonds broke.
+/// Evaluates a stripe's share of the bonds into their slots.
 #[inline]
 fn evaluate_bonds<const MEASURE: bool>(
     (bonds, bond_slots): (&mut [Bond], &mut [BondSlot]),
-    (cement, cement_slots): (&mut [CementBond], &mut [CementSlot]),
-    at: BondStep<'_>,
-) -> usize {
-    let (motion, cell, gradient, increment_time) = at;
+    (motion, cell, gradient, increment_time): BondStep<'_>,
+) {
     for (bond, slot) in bonds.iter_mut().zip(bond_slots.iter_mut()) {
         *slot = bond_slot::<MEASURE>(bond, motion, cell, gradient, increment_time);
     }
-    let mut breaks = 0;
-    for (bond, slot) in cement.iter_mut().zip(cement_slots.iter_mut()) {
-        *slot = cement_slot::<MEASURE>(bond, motion, cell, gradient, increment_time);
-        breaks += usize::from(slot.rupture.is_some());
+}
+
+/// Evaluates a stripe's share of the cement bonds (the first of which is
+/// bond `first` of the list) into their slots, adding the holding ones'
+/// terms to `tally` (`MEASURE`) and recording the ones that break in
+/// `ruptures`, in bond order.
+#[inline]
+fn evaluate_cement_bonds<const MEASURE: bool>(
+    (cement, slots, first): (&mut [CementBond], &mut [CementSlot], usize),
+    ruptures: &mut Vec<(usize, Rupture)>,
+    (motion, cell, gradient, increment_time): BondStep<'_>,
+    tally: &mut ContactTally,
+) {
+    for (k, (bond, slot)) in cement.iter_mut().zip(slots.iter_mut()).enumerate() {
+        match evaluate_cement::<MEASURE>(bond, motion, cell, gradient, increment_time) {
+            CementEvaluation::Holds {
+                slot: held,
+                elastic,
+                force_norm,
+            } => {
+                *slot = held;
+                if MEASURE {
+                    tally.elastic += elastic;
+                    tally.force_sum += force_norm;
+                    tally.contacts += 1;
+                    tally.cement_holding += 1;
+                }
+            }
+            CementEvaluation::Breaks(rupture) => {
+                *slot = CementSlot::default();
+                ruptures.push((first + k, rupture));
+                tally.bond_breaks += 1;
+            }
+        }
     }
-    breaks
 }
