@@ -38,6 +38,7 @@ LAYERS: dict[str, int] = {
     # 1: the engine API and the snapshot data model
     "grainlab": 1,
     "grainlab.bodies": 1,
+    "grainlab.cement": 1,
     "grainlab.shapes": 1,
     "grainlab.simulation": 1,
     "grainlab.snapshot": 1,

@@ -132,6 +132,7 @@ class _Energy(TypedDict):
     wall_work: float
     external_work: float
     boundary_work: float
+    bond_released: float
     balance: float
 
 #: A 2-vector argument: any sequence of two floats (a tuple, a list, a NumPy array).
@@ -297,6 +298,24 @@ class Engine:
     ) -> None: ...
     @property
     def n_bonds(self) -> int: ...
+
+    # cement (breakable bonds)
+    def add_cement_bonds(
+        self,
+        i: NDArray[np.int64],
+        j: NDArray[np.int64],
+        kind: str,
+        radius_multiplier: NDArray[np.float64],
+        normal_stiffness: NDArray[np.float64],
+        shear_stiffness: NDArray[np.float64],
+        tensile_strength: NDArray[np.float64],
+        cohesion: NDArray[np.float64],
+        friction_angle: NDArray[np.float64],
+    ) -> None: ...
+    @property
+    def n_cement_bonds(self) -> int: ...
+    def cement_bonds(self) -> dict[str, Any]: ...
+    def take_bond_breaks(self) -> dict[str, Any]: ...
 
     # bodies
     def add_bodies(

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, paper
 from grainlab.bodies import ClumpState, clump_mass_properties
+from grainlab.cement import BondBreaks, CementBonds, cement_arguments
 from grainlab.snapshot import GRAIN_ANGLE_FIELD, GRAIN_CENTROID_FIELD, GRAIN_FIELD, Snapshot
 
 #: Table 1 of the paper (:mod:`grainlab.paper`): contact stiffnesses (N/m), particle
@@ -237,6 +238,8 @@ class Energy:
     external_work: float
     boundary_work: float
     """Work of the pressure chains' follower loads."""
+    bond_released: float
+    """Strain energy released by broken cement bonds (docs/cemented.md), counted with the dissipated terms."""
     balance: float
 
 
@@ -963,6 +966,55 @@ class Simulation:
     @property
     def n_bonds(self) -> int:
         return int(self._engine.n_bonds)
+
+    def add_cement_bonds(
+        self,
+        i: ArrayLike,
+        j: ArrayLike,
+        *,
+        normal_stiffness: ArrayLike,
+        shear_stiffness: ArrayLike,
+        tensile_strength: ArrayLike,
+        cohesion: ArrayLike,
+        friction_angle: ArrayLike = 0.0,
+        radius_multiplier: ArrayLike = 1.0,
+        kind: Literal["parallel", "contact"] = "parallel",
+    ) -> None:
+        """Cements the pairs ``(i[k], j[k])`` with bonds that break (docs/cemented.md),
+        each stress-free at the pair's current distance and acting beside the
+        contact law. ``kind="parallel"``: stiffnesses per area ``kn_bar``, ``ks_bar``
+        (Pa/m), ``tensile_strength`` ``sigma_c`` and ``cohesion`` ``c`` (Pa),
+        ``friction_angle`` ``phi_b`` (degrees), bond radius ``radius_multiplier`` times
+        the smaller radius; ``kind="contact"``: stiffnesses in N/m, strengths in
+        N, no moment. Each parameter is one value or one per pair (seeded
+        strengths: :func:`grainlab.cement.draw_strengths`). Bad input (an index
+        out of range, a particle cemented to itself, a pair twice or already
+        bonded, a negative strength, ``radius_multiplier <= 0``, a non-finite
+        value) is refused in one line before any bond is made."""
+        values = {
+            "radius_multiplier": radius_multiplier,
+            "normal_stiffness": normal_stiffness,
+            "shear_stiffness": shear_stiffness,
+            "tensile_strength": tensile_strength,
+            "cohesion": cohesion,
+            "friction_angle": friction_angle,
+        }
+        self._engine.add_cement_bonds(*cement_arguments(self.n_particles, i, j, kind, values))
+
+    @property
+    def n_cement_bonds(self) -> int:
+        """Number of intact cement bonds."""
+        return int(self._engine.n_cement_bonds)
+
+    def cement_bonds(self) -> CementBonds:
+        """The intact cement bonds, their forces and strengths (:class:`~grainlab.cement.CementBonds`)."""
+        return CementBonds._from_engine(self._engine.cement_bonds())
+
+    def take_bond_breaks(self) -> BondBreaks:
+        """The cement bonds broken since the last call, in the order they broke
+        (:class:`~grainlab.cement.BondBreaks`); the engine's log is emptied. The log
+        is part of the saved state, so breaks not yet taken survive a checkpoint."""
+        return BondBreaks._from_engine(self._engine.take_bond_breaks())
 
     # ---- bodies (docs/bodies.md) ----
 

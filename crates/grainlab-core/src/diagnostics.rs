@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 /// Energies (J per unit thickness). `kinetic` and `elastic` are the state at the
 /// last measured step (full-step velocities); the rest accumulate from step 0.
 ///
-/// Balance: `kinetic + elastic + friction + viscous + rolling + damping -
-/// wall_work - external_work - boundary_work` stays constant, up to the work
+/// Balance: `kinetic + elastic + friction + viscous + rolling + damping +
+/// bond_released - wall_work - external_work - boundary_work` stays constant, up to the work
 /// of prescribed velocities and of the periodic cell's imposed deformation,
 /// which are not counted. The contact law's sub-models book their dissipation
 /// in one entry each ([`ContactDissipation`], `docs/contact-law.md`).
@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 pub struct EnergyLedger {
     /// Translational plus rotational kinetic energy.
     pub kinetic: f64,
-    /// Elastic energy in contact and bond springs.
+    /// Elastic energy in contact and bond springs (cement bonds' bending included).
     pub elastic: f64,
     /// Energy dissipated by Coulomb slip.
     pub friction_dissipated: f64,
@@ -32,6 +32,9 @@ pub struct EnergyLedger {
     pub external_work: f64,
     /// Work done by the follower loads of pressure chains (the confining pressure).
     pub boundary_work: f64,
+    /// Strain energy released by broken cement bonds: each break books the
+    /// energy its bond held at the evaluation that broke it ([`crate::cement`]).
+    pub bond_released: f64,
 }
 
 impl EnergyLedger {
@@ -43,6 +46,7 @@ impl EnergyLedger {
             + self.viscous_dissipated
             + self.rolling_dissipated
             + self.damping_dissipated
+            + self.bond_released
             - self.wall_work
             - self.external_work
             - self.boundary_work

@@ -9,6 +9,7 @@ pub mod body;
 pub mod bond;
 pub mod boundary;
 pub mod cell;
+pub mod cement;
 pub mod contact;
 pub mod contact_list;
 pub mod diagnostics;

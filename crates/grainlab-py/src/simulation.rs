@@ -1,5 +1,6 @@
 //! `grainlab._core.Engine`: the engine's simulation, method for method.
 use grainlab_core::body::GivenMass;
+use grainlab_core::cement::{BondBreak, CementBond, CementKind, CementSpec};
 use grainlab_core::state::PEBBLE;
 use grainlab_core::{
     BodySpec, ContactLaw, ContactModel, Particles, PeriodicCell, ServoControl, Simulation, Wall,
@@ -632,6 +633,157 @@ impl Engine {
         self.sim.bonds().len()
     }
 
+    // ---- cement (breakable bonds) ----
+
+    /// Cement bonds between `i[k]` and `j[k]` (external indices); every
+    /// parameter array has one value per pair (the Python layer broadcasts).
+    #[pyo3(signature = (i, j, kind, radius_multiplier, normal_stiffness, shear_stiffness, tensile_strength, cohesion, friction_angle))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_cement_bonds(
+        &mut self,
+        i: PyReadonlyArray1<'_, i64>,
+        j: PyReadonlyArray1<'_, i64>,
+        kind: &str,
+        radius_multiplier: PyReadonlyArray1<'_, f64>,
+        normal_stiffness: PyReadonlyArray1<'_, f64>,
+        shear_stiffness: PyReadonlyArray1<'_, f64>,
+        tensile_strength: PyReadonlyArray1<'_, f64>,
+        cohesion: PyReadonlyArray1<'_, f64>,
+        friction_angle: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<()> {
+        let kind = CementKind::from_name(kind).map_err(to_py_err)?;
+        let (i, j) = (values(&i), values(&j));
+        let n = i.len();
+        let per_pair = |field: &str, a: &PyReadonlyArray1<'_, f64>| -> PyResult<Vec<f64>> {
+            let v = values(a);
+            if v.len() != n {
+                return Err(PyValueError::new_err(format!(
+                    "cement.{field}: has {} entries for {n} pairs",
+                    v.len()
+                )));
+            }
+            Ok(v)
+        };
+        let lambda = per_pair("radius_multiplier", &radius_multiplier)?;
+        let kn = per_pair("normal_stiffness", &normal_stiffness)?;
+        let ks = per_pair("shear_stiffness", &shear_stiffness)?;
+        let sigma_c = per_pair("tensile_strength", &tensile_strength)?;
+        let c = per_pair("cohesion", &cohesion)?;
+        let phi = per_pair("friction_angle", &friction_angle)?;
+        if j.len() != n {
+            return Err(PyValueError::new_err(format!(
+                "cement.j: has {} entries for {n} pairs",
+                j.len()
+            )));
+        }
+        let index = |field: &str, k: usize, x: i64| -> PyResult<usize> {
+            usize::try_from(x).map_err(|_| {
+                PyValueError::new_err(format!(
+                    "cement.{field}[{k}]: particle index {x} out of range"
+                ))
+            })
+        };
+        let mut pairs = Vec::with_capacity(n);
+        for k in 0..n {
+            pairs.push((index("i", k, i[k])?, index("j", k, j[k])?));
+        }
+        let specs: Vec<CementSpec> = (0..n)
+            .map(|k| CementSpec {
+                kind,
+                radius_multiplier: lambda[k],
+                normal_stiffness: kn[k],
+                shear_stiffness: ks[k],
+                tensile_strength: sigma_c[k],
+                cohesion: c[k],
+                friction_angle: phi[k],
+            })
+            .collect();
+        self.sim.add_cement_bonds(&pairs, &specs).map_err(to_py_err)
+    }
+
+    #[getter]
+    fn n_cement_bonds(&self) -> usize {
+        self.sim.cement().bonds.len()
+    }
+
+    /// The intact cement bonds: external indices, kind, forces and strengths.
+    fn cement_bonds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let bonds = &self.sim.cement().bonds;
+        let column = |f: fn(&CementBond) -> f64| -> Vec<f64> { bonds.iter().map(f).collect() };
+        let ext = |q: u32| self.sim.external_index(q as usize) as u32;
+        let d = PyDict::new(py);
+        d.set_item(
+            "i",
+            values_to_py(py, &bonds.iter().map(|b| ext(b.i)).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "j",
+            values_to_py(py, &bonds.iter().map(|b| ext(b.j)).collect::<Vec<_>>()),
+        )?;
+        let kinds: Vec<&str> = bonds
+            .iter()
+            .map(|b| match b.kind {
+                CementKind::Parallel => "parallel",
+                CementKind::Contact => "contact",
+            })
+            .collect();
+        d.set_item("kind", kinds)?;
+        d.set_item(
+            "normal_force",
+            values_to_py(py, &self.sim.cement_normal_forces()),
+        )?;
+        d.set_item("shear_force", values_to_py(py, &column(|b| b.shear)))?;
+        d.set_item("moment", values_to_py(py, &column(|b| b.moment)))?;
+        d.set_item("area", values_to_py(py, &column(|b| b.area)))?;
+        d.set_item("bond_radius", values_to_py(py, &column(|b| b.bond_radius)))?;
+        d.set_item(
+            "tensile_strength",
+            values_to_py(py, &column(|b| b.tensile_strength)),
+        )?;
+        d.set_item("cohesion", values_to_py(py, &column(|b| b.cohesion)))?;
+        Ok(d)
+    }
+
+    /// The breaks since the last call, as arrays (the engine's log is emptied).
+    fn take_bond_breaks<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let breaks = self.sim.take_bond_breaks();
+        let column = |f: fn(&BondBreak) -> f64| -> Vec<f64> { breaks.iter().map(f).collect() };
+        let d = PyDict::new(py);
+        d.set_item(
+            "step",
+            values_to_py(py, &breaks.iter().map(|b| b.step).collect::<Vec<_>>()),
+        )?;
+        d.set_item("time", values_to_py(py, &column(|b| b.time)))?;
+        d.set_item(
+            "i",
+            values_to_py(py, &breaks.iter().map(|b| b.i).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "j",
+            values_to_py(py, &breaks.iter().map(|b| b.j).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "position",
+            points_to_py(py, &breaks.iter().map(|b| b.position).collect::<Vec<_>>())?,
+        )?;
+        d.set_item(
+            "normal",
+            points_to_py(py, &breaks.iter().map(|b| b.normal).collect::<Vec<_>>())?,
+        )?;
+        d.set_item(
+            "mode",
+            breaks.iter().map(|b| b.mode.name()).collect::<Vec<_>>(),
+        )?;
+        d.set_item("energy", values_to_py(py, &column(|b| b.energy)))?;
+        d.set_item(
+            "normal_force",
+            values_to_py(py, &column(|b| b.normal_force)),
+        )?;
+        d.set_item("shear_force", values_to_py(py, &column(|b| b.shear_force)))?;
+        d.set_item("moment", values_to_py(py, &column(|b| b.moment)))?;
+        Ok(d)
+    }
+
     // ---- bodies ----
 
     /// Bodies of particles: `pebbles[b]` the particle indices of body `b`,
@@ -761,6 +913,7 @@ impl Engine {
         d.set_item("wall_work", e.wall_work)?;
         d.set_item("external_work", e.external_work)?;
         d.set_item("boundary_work", e.boundary_work)?;
+        d.set_item("bond_released", e.bond_released)?;
         d.set_item("balance", e.balance())?;
         Ok(d)
     }

@@ -120,16 +120,18 @@ impl Simulation {
                 ),
             ));
         }
-        if let Some(bond) = self.bonds.list.iter().find(|bond| {
-            let (i, j) = (bond.i as usize, bond.j as usize);
+        let bonded = self.bonds.list.iter().map(|b| (b.i, b.j));
+        let cemented = self.cement.bonds.iter().map(|b| (b.i, b.j));
+        if let Some((i, j)) = bonded.chain(cemented).find(|&(i, j)| {
+            let (i, j) = (i as usize, j as usize);
             clumped(i) && body_of[i] == body_of[j]
         }) {
             return Err(EngineError::invalid(
-                format!("bodies[{}]", body_of[bond.i as usize]),
+                format!("bodies[{}]", body_of[i as usize]),
                 format!(
                     "particles {} and {} are bonded; two pebbles of one body cannot be",
-                    self.external_index(bond.i as usize),
-                    self.external_index(bond.j as usize)
+                    self.external_index(i as usize),
+                    self.external_index(j as usize)
                 ),
             ));
         }

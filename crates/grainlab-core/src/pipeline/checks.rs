@@ -129,6 +129,11 @@ impl Simulation {
             .list
             .iter()
             .any(|b| b.i as usize >= n || b.j as usize >= n)
+            || self
+                .cement
+                .bonds
+                .iter()
+                .any(|b| b.i as usize >= n || b.j as usize >= n)
             || self.chains.iter().any(|c| {
                 c.particles.iter().any(|&q| q as usize >= n)
                     || [c.start_wall, c.end_wall]

@@ -8,7 +8,11 @@
 //!    stripes in parallel, then the cross-stripe pairs. The shear increment is the
 //!    displacement since the last force evaluation: none on a step that starts
 //!    from full-step velocities (see [`Simulation::catch_up_shear_springs`]).
-//! 4. **Bonds**: linear normal and shear springs that carry tension.
+//! 4. **Bonds**: linear normal and shear springs that carry tension (permanent
+//!    bonds), then the cement bonds ([`crate::cement`]), which act beside the
+//!    contact law and break at the evaluation where their stress reaches their
+//!    strength; the broken ones are logged, booked and removed in bond order
+//!    after the integration (8).
 //! 5. **Wall contacts**: the same law against walls; walls sum their force.
 //!    With a team the forces of 4 and 5 wait in slots, and each stripe's
 //!    integration (7) adds its own particles' in the same order (`deferred.rs`).

@@ -4,6 +4,7 @@
 //! particle-wall contact.
 use crate::bond::{Bond, BondSlot};
 use crate::cell::PeriodicCell;
+use crate::cement::{CementBond, CementSlot, Rupture};
 use crate::contact::ContactGeometry;
 use crate::diagnostics::ContactDissipation;
 use crate::law::history::{forget, HistoryRun};
@@ -25,6 +26,10 @@ pub(crate) struct ContactTally {
     pub(crate) force_sum: f64,
     pub(crate) contacts: usize,
     pub(crate) overlap_violation: bool,
+    /// Cement bonds that broke at this evaluation.
+    pub(crate) bond_breaks: usize,
+    /// Cement bonds that hold, of `contacts` (measured steps).
+    pub(crate) cement_holding: usize,
 }
 
 impl ContactTally {
@@ -35,6 +40,8 @@ impl ContactTally {
         self.force_sum += o.force_sum;
         self.contacts += o.contacts;
         self.overlap_violation |= o.overlap_violation;
+        self.bond_breaks += o.bond_breaks;
+        self.cement_holding += o.cement_holding;
     }
 }
 
@@ -268,6 +275,14 @@ pub(crate) struct StripeWork<'a> {
     /// The stripe's share of the bonds, and the slots of their forces.
     pub(crate) bonds: &'a mut [Bond],
     pub(crate) bond_slots: &'a mut [BondSlot],
+    /// The stripe's share of the cement bonds, and their slots.
+    pub(crate) cement: &'a mut [CementBond],
+    pub(crate) cement_slots: &'a mut [CementSlot],
+    /// The index of the share's first cement bond in the whole list.
+    pub(crate) cement_first: usize,
+    /// The share's bonds that break at this evaluation (whole-list index and
+    /// record), in bond order.
+    pub(crate) cement_ruptures: &'a mut Vec<(usize, Rupture)>,
 }
 
 /// The reset of step 2: each particle's resultant starts from its external

@@ -10,6 +10,9 @@ use crate::body::Clumps;
 use crate::bond::{bond_force, Bond, BondForce, BondSlot, Bonds};
 use crate::boundary::{ChainStripes, PressureChain};
 use crate::cell::{minimum_image, PeriodicCell};
+use crate::cement::{
+    advance_springs, BondBreak, Cement, CementBond, CementSlot, CementSpec, Rupture,
+};
 use crate::contact::{disk_disk, ContactGeometry};
 use crate::diagnostics::{EnergyLedger, Measurements};
 use crate::error::{
@@ -28,7 +31,7 @@ use crate::wall::{Wall, WallControl};
 
 /// The first bytes of [`Simulation::to_bytes`]: the layout of the state that
 /// follows (bincode of [`Simulation`]); a new field makes a new tag.
-const STATE_TAG: &[u8; 8] = b"GLSTATE6";
+const STATE_TAG: &[u8; 8] = b"GLSTATE7";
 
 /// Tunables of the step, in one place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -73,6 +76,8 @@ pub struct Simulation {
     pub(crate) walls: Vec<Wall>,
     /// Permanent bonds.
     pub(crate) bonds: Bonds,
+    /// Breakable cement bonds and the log of their breaks.
+    pub(crate) cement: Cement,
     /// Chains of boundary particles under a follower pressure.
     pub(crate) chains: Vec<PressureChain>,
     /// Periodic cell, if any.
@@ -107,6 +112,13 @@ pub struct Simulation {
     /// The bonds' forces of this step, in bond order (`step::bond_forces`).
     #[serde(skip)]
     pub(crate) bond_slots: Vec<BondSlot>,
+    /// The cement bonds' forces of this step, in cement order.
+    #[serde(skip)]
+    pub(crate) cement_slots: Vec<CementSlot>,
+    /// The cement bonds that broke at this step's evaluation, per stripe, in
+    /// bond order (whole-list index and record).
+    #[serde(skip)]
+    pub(crate) cement_ruptures: Vec<Vec<(usize, Rupture)>>,
     /// Follower loads of this step, per internal particle (recomputed every step).
     #[serde(skip)]
     pub(crate) boundary_load: Vec<Vec2>,
@@ -173,6 +185,7 @@ impl Simulation {
             materials: MaterialTable::uniform(model)?,
             walls: Vec::new(),
             bonds: Bonds::default(),
+            cement: Cement::default(),
             chains: Vec::new(),
             cell: None,
             params,
@@ -189,6 +202,8 @@ impl Simulation {
             pool: None,
             cross_forces: Vec::new(),
             bond_slots: Vec::new(),
+            cement_slots: Vec::new(),
+            cement_ruptures: Vec::new(),
             boundary_load: Vec::new(),
             chain_stripes: ChainStripes::default(),
             deferred_index: DeferredIndex::default(),
@@ -236,6 +251,31 @@ impl Simulation {
     /// The permanent bonds (internal particle indices).
     pub fn bonds(&self) -> &Bonds {
         &self.bonds
+    }
+
+    /// The intact cement bonds (internal particle indices) and the breaks not
+    /// yet taken ([`Simulation::take_bond_breaks`]).
+    pub fn cement(&self) -> &Cement {
+        &self.cement
+    }
+
+    /// The breaks of cement bonds since the last call, in the order they
+    /// happened (particles as external indices); the log is emptied.
+    pub fn take_bond_breaks(&mut self) -> Vec<BondBreak> {
+        std::mem::take(&mut self.cement.breaks)
+    }
+
+    /// Each intact cement bond's normal force at the current state (N,
+    /// compression positive: `k_n (L_0 - d)`), in cement order.
+    pub fn cement_normal_forces(&self) -> Vec<f64> {
+        self.cement
+            .bonds
+            .iter()
+            .map(|b| {
+                let d = norm(self.branch(b.i as usize, b.j as usize));
+                b.normal_stiffness * (b.rest_length - d)
+            })
+            .collect()
     }
 
     /// Number of pressure chains.
@@ -608,6 +648,86 @@ impl Simulation {
         Ok(())
     }
 
+    /// Cements the pairs `pairs` (external indices), bond `k` made from
+    /// `specs[k]` (or `specs[0]` for all when it has one entry), each
+    /// stress-free at the pair's current distance ([`crate::cement`]). Every
+    /// pair and value is checked before any bond is made: an index out of
+    /// range, a particle cemented to itself or to a pebble of its own clump,
+    /// a pair named twice or already bonded (cemented or by a permanent bond),
+    /// a bad value (naming its field and index).
+    pub fn add_cement_bonds(
+        &mut self,
+        pairs: &[(usize, usize)],
+        specs: &[CementSpec],
+    ) -> Result<()> {
+        if specs.len() != pairs.len() && specs.len() != 1 {
+            return Err(EngineError::invalid(
+                "cement",
+                format!(
+                    "{} pairs but {} sets of parameters (give one, or one per pair)",
+                    pairs.len(),
+                    specs.len()
+                ),
+            ));
+        }
+        for (k, spec) in specs.iter().enumerate() {
+            spec.validate(&format!("[{k}]"))?;
+        }
+        let internal = self.cement_pairs(pairs)?;
+        let p = &self.particles;
+        let bonds: Vec<CementBond> = internal
+            .iter()
+            .enumerate()
+            .map(|(k, &(i, j))| {
+                let spec = &specs[if specs.len() == 1 { 0 } else { k }];
+                let rest = norm(self.branch(i, j));
+                CementBond::new(i as u32, j as u32, p.radius[i], p.radius[j], rest, spec)
+            })
+            .collect();
+        // new springs start from zero: no displacement before they existed counts
+        self.modify_motion(|s| {
+            s.cement.bonds.extend(bonds);
+            s.neighbors.invalidate();
+        });
+        Ok(())
+    }
+
+    /// The internal pairs of `pairs` (external indices), each checked for a
+    /// cement bond: in range, two particles, not of one clump, new.
+    fn cement_pairs(&self, pairs: &[(usize, usize)]) -> Result<Vec<(usize, usize)>> {
+        let mut seen: std::collections::HashSet<(u32, u32)> = self
+            .cement
+            .bonds
+            .iter()
+            .map(|b| (b.i.min(b.j), b.i.max(b.j)))
+            .collect();
+        let mut out = Vec::with_capacity(pairs.len());
+        for (k, &(ei, ej)) in pairs.iter().enumerate() {
+            self.particles.check_index(&format!("cement.i[{k}]"), ei)?;
+            self.particles.check_index(&format!("cement.j[{k}]"), ej)?;
+            let (i, j) = (self.internal_index(ei), self.internal_index(ej));
+            let refuse = |why: String| Err(EngineError::invalid(format!("cement[{k}]"), why));
+            if i == j {
+                return refuse(format!("cannot cement particle {ei} to itself"));
+            }
+            let clump = self.particles.clump[i];
+            if clump != NO_CLUMP && clump == self.particles.clump[j] {
+                return refuse(format!(
+                    "particles {ei} and {ej} are pebbles of one clump and cannot be cemented"
+                ));
+            }
+            let key = ((i as u32).min(j as u32), (i as u32).max(j as u32));
+            if self.bonds.contains(i as u32, j as u32) {
+                return refuse(format!("particles {ei} and {ej} have a permanent bond"));
+            }
+            if !seen.insert(key) {
+                return refuse(format!("particles {ei} and {ej} are already cemented"));
+            }
+            out.push((i, j));
+        }
+        Ok(out)
+    }
+
     /// Branch vector from internal slot `i` to the nearest image of internal slot `j`.
     pub(crate) fn branch(&self, i: usize, j: usize) -> Vec2 {
         let d = sub(self.particles.position[j], self.particles.position[i]);
@@ -885,6 +1005,10 @@ impl Simulation {
                 &mut bond.shear,
             );
         }
+        for bond in self.cement.bonds.iter_mut() {
+            let motion = ParticleMotion::of(&self.particles);
+            advance_springs(bond, &motion, self.cell.as_ref(), l, dt);
+        }
         let wp = &mut self.neighbors.wall_pairs;
         let motion = ParticleMotion::of(&self.particles);
         for k in 0..wp.wall.len() {
@@ -1043,6 +1167,13 @@ impl Simulation {
                 ks[q] += b.shear_stiffness;
             }
         }
+        for b in &self.cement.bonds {
+            for q in [b.i as usize, b.j as usize] {
+                kn[q] += b.normal_stiffness;
+                ks[q] += b.shear_stiffness;
+                kr[q] += b.bending_stiffness;
+            }
+        }
         let fallback = |q: usize| {
             self.materials.max_stiffness_for_group(
                 p.group[q],
@@ -1108,6 +1239,7 @@ impl Simulation {
         for chain in self.chains.iter_mut() {
             chain.remap(&new_of_old);
         }
+        self.cement.remap(&new_of_old);
         self.clumps.remap(&new_of_old, &mut self.particles);
         self.clumps.rewrap(&self.particles, self.cell.as_ref());
         self.index_stripes();
@@ -1124,6 +1256,7 @@ impl Simulation {
         self.chain_stripes = ChainStripes::new(&self.chains, stripes);
         self.deferred_index = DeferredIndex::new(
             &self.bonds.list,
+            &self.cement.bonds,
             &self.neighbors.wall_pairs.particle,
             stripes,
         );
@@ -1194,6 +1327,7 @@ mod tests {
         "cell =",
         "materials.set(",
         "bonds.push(",
+        "cement.bonds.extend(",
         ".translate(",
         "wall.velocity =",
         "wall.active =",
@@ -1283,8 +1417,8 @@ mod tests {
         }
         // the setters of velocities, spins, positions, radii, groups, the step
         // parameters, contact models, the cell, walls (velocity, translation,
-        // activity), bonds and particles
-        assert_eq!(setters, 13, "the setters of motion found in this file");
+        // activity), bonds, cement bonds and particles
+        assert_eq!(setters, 14, "the setters of motion found in this file");
     }
 
     #[test]

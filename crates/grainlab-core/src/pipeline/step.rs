@@ -2,7 +2,7 @@
 //! order of the module documentation of [`crate::pipeline`].
 use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 
-use super::deferred::{DeferredForces, WallSlot};
+use super::deferred::{add_bond_slots, DeferredForces, WallSlot};
 use super::pair_kernel::{
     pair_kernel, wall_contact, BufferSink, ContactTally, CrossForces, DirectSink, PairForce,
     PairKernel, ResetKernel, StripeWork,
@@ -10,6 +10,9 @@ use super::pair_kernel::{
 use super::Simulation;
 use crate::body::ClumpFrame;
 use crate::bond::{bond_slot, Bond, BondSlot};
+use crate::cement::{
+    evaluate_cement, BondBreak, CementBond, CementEvaluation, CementSlot, Rupture,
+};
 use crate::diagnostics::Measurements;
 use crate::error::Result;
 use crate::integrate::{
@@ -112,6 +115,7 @@ impl Simulation {
             && self.deferred_index.fits(
                 self.neighbors.stripe_ranges.len(),
                 self.bonds.list.len(),
+                self.cement.bonds.len(),
                 self.neighbors.wall_pairs.wall.len(),
             );
         let mut stripes = self.particle_contacts::<MEASURE>(team, defer);
@@ -126,6 +130,9 @@ impl Simulation {
         self.move_walls();
         self.deform_cell();
         self.move_clumps::<MEASURE>(team, &integration, &mut motion);
+        if contacts.bond_breaks > 0 {
+            self.remove_broken_cement();
+        }
         self.track_displacements(&motion);
         self.book_energy(&contacts, &walls, wall_work, &motion);
         if MEASURE {
@@ -248,7 +255,7 @@ impl Simulation {
         };
         self.measurements = Measurements {
             step: self.step_count,
-            contact_count: contacts.contacts - bonds.contacts,
+            contact_count: contacts.contacts - bonds.contacts - contacts.cement_holding,
             wall_contact_count: walls.contacts,
             mean_unbalanced_force_ratio: if mean_contact > 0.0 {
                 mean_unbalanced / mean_contact
@@ -305,8 +312,12 @@ impl Simulation {
             &pairs.stripe_start,
             pairs.i.len(),
             &mut self.cross_forces,
-            &mut self.bonds.list,
-            &mut self.bond_slots,
+            (&mut self.bonds.list, &mut self.bond_slots),
+            (
+                &mut self.cement.bonds,
+                &mut self.cement_slots,
+                &mut self.cement_ruptures,
+            ),
             n_stripes,
         );
 
@@ -390,15 +401,10 @@ impl Simulation {
                     );
                     tally.merge(&cross);
                 }
-                for (bond, slot) in work.bonds.iter_mut().zip(work.bond_slots.iter_mut()) {
-                    *slot = bond_slot::<MEASURE>(
-                        bond,
-                        &motion,
-                        cell,
-                        velocity_gradient,
-                        increment_time,
-                    );
-                }
+                let at = (&motion, cell, velocity_gradient, increment_time);
+                evaluate_bonds::<MEASURE>((work.bonds, work.bond_slots), at);
+                let cement = (work.cement, work.cement_slots, work.cement_first);
+                evaluate_cement_bonds::<MEASURE>(cement, work.cement_ruptures, at, &mut tally);
                 if defer {
                     // SAFETY: each wall pair is in the list of one stripe only
                     wall_pairs.evaluate::<MEASURE>(deferred_index.walls_of_stripe(b), &wall_step);
@@ -450,22 +456,55 @@ impl Simulation {
             return tally;
         }
         let p = &mut self.particles;
-        for (bond, slot) in self.bonds.list.iter().zip(&self.bond_slots) {
-            if apply {
-                let (i, j) = (bond.i as usize, bond.j as usize);
-                let f = slot.force;
-                p.force[j] = add(p.force[j], f);
-                p.force[i] = sub(p.force[i], f);
-                p.torque[i] -= slot.torque_i;
-                p.torque[j] -= slot.torque_j;
-            }
-            if MEASURE {
-                tally.elastic += slot.elastic;
-                tally.force_sum += slot.force_norm;
-                tally.contacts += 1;
-            }
+        let bonds = (self.bonds.list.as_slice(), self.bond_slots.as_slice());
+        let resultants = (p.force.as_mut_slice(), p.torque.as_mut_slice());
+        add_bond_slots::<MEASURE, _, _>(bonds, resultants, apply, &mut tally);
+        // then the cement bonds' forces, in their order (a broken one's slot
+        // holds zeros; their tally is the stripes', made as they evaluate them)
+        if apply {
+            let cement = (self.cement.bonds.as_slice(), self.cement_slots.as_slice());
+            let resultants = (p.force.as_mut_slice(), p.torque.as_mut_slice());
+            add_bond_slots::<false, _, _>(cement, resultants, apply, &mut tally);
         }
         tally
+    }
+
+    /// Step 8b'': the cement bonds that broke at this step's evaluation leave
+    /// the list (the others keep their order), in cement order: each break is
+    /// logged and its bond's strain energy booked as released. On any number
+    /// of threads the same bonds break, so the same bits follow.
+    fn remove_broken_cement(&mut self) {
+        let ruptures: Vec<(usize, Rupture)> = self
+            .cement_ruptures
+            .iter_mut()
+            .flat_map(|stripe| stripe.drain(..))
+            .collect();
+        for &(k, r) in &ruptures {
+            let bond = &self.cement.bonds[k];
+            self.ledger.bond_released += r.booked;
+            self.cement.breaks.push(BondBreak {
+                step: self.step_count,
+                time: self.time,
+                i: self.order[bond.i as usize],
+                j: self.order[bond.j as usize],
+                position: r.position,
+                normal: r.normal,
+                mode: r.mode,
+                energy: r.energy,
+                normal_force: r.normal_force,
+                shear_force: r.shear_force,
+                moment: r.moment,
+            });
+        }
+        let mut broken = ruptures.iter().map(|&(k, _)| k).peekable();
+        let mut k = 0;
+        self.cement.bonds.retain(|_| {
+            let gone = broken.next_if_eq(&k).is_some();
+            k += 1;
+            !gone
+        });
+        self.cement_slots.clear();
+        self.index_stripes();
     }
 
     /// Step 5: particle-wall contacts, their forces added to the particles (or,
@@ -621,6 +660,8 @@ impl Simulation {
             index: &self.deferred_index,
             bonds: &self.bonds.list,
             bond_slots: &self.bond_slots,
+            cement: &self.cement.bonds,
+            cement_slots: &self.cement_slots,
             wall_particles: &self.neighbors.wall_pairs.particle,
             wall_slots: &self.wall_slots,
         };
@@ -637,7 +678,8 @@ impl Simulation {
         let tallies = map_stripes(team, stripes, |work| {
             let MotionWork { stripe: b, motion } = work;
             if defer {
-                // the bonds, then the wall contacts, as their serial passes add them
+                // the bonds, the cement bonds, then the wall contacts, as their
+                // serial passes add them
                 deferred.apply(b, motion.lo, motion.force, motion.torque);
             }
             if buffered {
@@ -825,8 +867,8 @@ fn stripe_shares<'a>(
     starts: &[usize],
     n_pairs: usize,
     cross_forces: &'a mut Vec<PairForce>,
-    bonds: &'a mut [Bond],
-    bond_slots: &'a mut Vec<BondSlot>,
+    (bonds, bond_slots): (&'a mut [Bond], &'a mut Vec<BondSlot>),
+    (cement, cement_slots, cement_ruptures): CementShares<'a>,
     n_stripes: usize,
 ) -> (Vec<(usize, usize)>, Vec<StripeWork<'a>>) {
     let cross_start = starts[n_stripes];
@@ -849,22 +891,97 @@ fn stripe_shares<'a>(
     bond_slots.resize(bonds.len(), BondSlot::default());
     let bond_parts = split_ranges(bonds, &bond_ranges);
     let bond_slot_parts = split_ranges(bond_slots, &bond_ranges);
+    let cement_ranges = even_bounds(cement.len(), n_stripes);
+    cement_slots.resize(cement.len(), CementSlot::default());
+    let cement_parts = split_ranges(cement, &cement_ranges);
+    let cement_slot_parts = split_ranges(cement_slots, &cement_ranges);
+    cement_ruptures.resize_with(n_stripes, Vec::new);
     let stripes = history_parts
         .into_iter()
         .zip(cross_history)
         .zip(cross_buffers)
         .zip(bond_parts.into_iter().zip(bond_slot_parts))
+        .zip(cement_parts.into_iter().zip(cement_slot_parts))
+        .zip(cement_ruptures.iter_mut())
         .enumerate()
         .map(
-            |(b, (((history, cross_history), cross_forces), (bonds, bond_slots)))| StripeWork {
-                stripe: b,
-                history,
-                cross_history,
-                cross_forces,
-                bonds,
-                bond_slots,
+            |(b, (((((history, cross_history), cross_forces), bonds), cement), ruptures))| {
+                StripeWork {
+                    stripe: b,
+                    history,
+                    cross_history,
+                    cross_forces,
+                    bonds: bonds.0,
+                    bond_slots: bonds.1,
+                    cement: cement.0,
+                    cement_slots: cement.1,
+                    cement_first: cement_ranges[b].0,
+                    cement_ruptures: ruptures,
+                }
             },
         )
         .collect();
     (ranges, stripes)
+}
+
+/// The cement bonds, their slots and the per-stripe lists of their ruptures.
+type CementShares<'a> = (
+    &'a mut [CementBond],
+    &'a mut Vec<CementSlot>,
+    &'a mut Vec<Vec<(usize, Rupture)>>,
+);
+
+/// What a bond's evaluation reads besides the bond: the particles' motion,
+/// the cell, its velocity gradient and the increment's time.
+type BondStep<'a> = (
+    &'a ParticleMotion<'a>,
+    Option<&'a crate::cell::PeriodicCell>,
+    Option<Mat2>,
+    f64,
+);
+
+/// Evaluates a stripe's share of the bonds into their slots.
+#[inline]
+fn evaluate_bonds<const MEASURE: bool>(
+    (bonds, bond_slots): (&mut [Bond], &mut [BondSlot]),
+    (motion, cell, gradient, increment_time): BondStep<'_>,
+) {
+    for (bond, slot) in bonds.iter_mut().zip(bond_slots.iter_mut()) {
+        *slot = bond_slot::<MEASURE>(bond, motion, cell, gradient, increment_time);
+    }
+}
+
+/// Evaluates a stripe's share of the cement bonds (the first of which is
+/// bond `first` of the list) into their slots, adding the holding ones'
+/// terms to `tally` (`MEASURE`) and recording the ones that break in
+/// `ruptures`, in bond order.
+#[inline]
+fn evaluate_cement_bonds<const MEASURE: bool>(
+    (cement, slots, first): (&mut [CementBond], &mut [CementSlot], usize),
+    ruptures: &mut Vec<(usize, Rupture)>,
+    (motion, cell, gradient, increment_time): BondStep<'_>,
+    tally: &mut ContactTally,
+) {
+    for (k, (bond, slot)) in cement.iter_mut().zip(slots.iter_mut()).enumerate() {
+        match evaluate_cement::<MEASURE>(bond, motion, cell, gradient, increment_time) {
+            CementEvaluation::Holds {
+                slot: held,
+                elastic,
+                force_norm,
+            } => {
+                *slot = held;
+                if MEASURE {
+                    tally.elastic += elastic;
+                    tally.force_sum += force_norm;
+                    tally.contacts += 1;
+                    tally.cement_holding += 1;
+                }
+            }
+            CementEvaluation::Breaks(rupture) => {
+                *slot = CementSlot::default();
+                ruptures.push((first + k, rupture));
+                tally.bond_breaks += 1;
+            }
+        }
+    }
 }
