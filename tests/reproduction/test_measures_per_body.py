@@ -56,3 +56,32 @@ def test_the_claims_measures_read_each_trimer_as_one_grain(trimer_run):
         if row["band_members_known"]:
             grains = int(np.count_nonzero(np.asarray(view.snapshot.is_sample)))
             assert row["inside_n_grains"] + row["outside_n_grains"] == grains
+
+
+def test_the_runs_fabric_numbers_and_figures_read_each_trimer_as_one_grain(trimer_run):
+    """summary.json's states and bands (what report.html and the figures show) are per body."""
+    from grainlab.postprocess.biaxial import analyse_run
+
+    results = read_results(trimer_run / "run.h5")
+    analysis = analyse_run(trimer_run)
+    for role, state in analysis.states.items():
+        view = body_view(results.snapshot(state.name))
+        assert state.snap.n_particles == view.n_bodies, role
+        expected = BodyStabilityIndex().compute(view)
+        np.testing.assert_array_equal(state.stability.stability_index, expected.stability_index)
+        numbers = analysis.numbers.states[role]
+        assert numbers.mean_lambda == expected.mean
+        assert numbers.mean_lambda != pytest.approx(StabilityIndex().compute(view.pebbles).mean, rel=1e-3)
+        assert numbers.coordination_number == CoordinationNumber().compute(view.snapshot).coordination_number
+    assert analysis.bands
+    for band in analysis.bands.values():
+        labels = RunProducts(results, per_body=True).band_labels(band.numbers.snapshot)
+        assert labels.shape == (view.n_bodies,)
+    # the maps draw the pebbles, each in its body's colour
+    from grainlab.postprocess.figures import figure_tasks
+
+    maps = next(t for t in figure_tasks(analysis) if t.name == "fig12_stability_index")
+    for panel, role in zip(maps.args[0][:2], ("initial", "peak"), strict=True):
+        state = analysis.states[role]
+        assert len(panel.radii) == state.view.pebbles.n_particles > state.snap.n_particles
+        np.testing.assert_array_equal(panel.values, state.stability.stability_index[state.view.body])

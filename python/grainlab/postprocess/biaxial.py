@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from grainlab.analysis.fabric import ContactAnisotropy, CoordinationNumber
 from grainlab.analysis.peak import nearest_snapshot, peak_is_interior, peak_record
+from grainlab.analysis.per_body import BodyStabilityIndex, BodyView
 from grainlab.analysis.stability import StabilityIndex
 from grainlab.columns import AXIAL_STRAIN, STRESS_RATIO
 from grainlab.io.hdf5 import Results, read_results, snapshot_strain
@@ -220,6 +221,8 @@ class RunState:
     forces: ContactAnisotropy | None
     #: How the figures name the state.
     label: str = ""
+    #: The pebbles and their bodies, when ``snap`` holds a run of clumps' bodies.
+    view: BodyView | None = None
 
 
 @dataclass
@@ -253,7 +256,11 @@ def _timeseries(results: Results) -> dict[str, NDArray[np.float64]]:
     return ts
 
 
-def _state(role: str, name: str, strain: float, snap: Snapshot) -> RunState:
+def _state(role: str, name: str, strain: float, products: RunProducts) -> RunState:
+    """The state at snapshot ``name``, per body when ``products`` are (a disk's lambda when they are not)."""
+    snap = products.snapshot(name)
+    stability = (BodyStabilityIndex().compute(products.view(name)) if products.per_body
+                 else StabilityIndex().compute(snap))
     forces = (
         ContactAnisotropy(weight="normal_force").compute(snap)
         if snap.normal_force is not None
@@ -264,9 +271,10 @@ def _state(role: str, name: str, strain: float, snap: Snapshot) -> RunState:
         name,
         strain,
         snap,
-        StabilityIndex().compute(snap),
+        stability,
         ContactAnisotropy().compute(snap),
         forces,
+        view=products.view(name) if products.per_body else None,
     )
 
 
@@ -348,7 +356,8 @@ def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> 
     names = results.snapshot_names
     if not names:
         raise ValueError(f"{results.path}: the run has no snapshots")
-    products = RunProducts(results)
+    # a run of clumps is measured per body (docs/fabric.md, "Measures per body")
+    products = RunProducts(results, per_body=True)
     notes: list[str] = []
     eps = np.asarray(ts[AXIAL_STRAIN], dtype=np.float64)
     q = np.asarray(ts[STRESS_RATIO], dtype=np.float64)
@@ -382,12 +391,12 @@ def analyse_run(run_dir: str | Path, peak_snapshot: str | int | None = None) -> 
 
     def state(role: str, k: int) -> RunState:
         if k not in cache:
-            cache[k] = _state(role, names[k], strains[k], results.snapshot(names[k]))
+            cache[k] = _state(role, names[k], strains[k], products)
         st = cache[k]
         label = {"initial": "initial", "peak": "nearest the peak", "final": "final"}[role]
         if role == "peak" and peak_snapshot is not None:
             label = "chosen peak state"
-        return RunState(role, st.name, st.strain, st.snap, st.stability, st.normals, st.forces, label)
+        return replace(st, role=role, label=label)
 
     last = len(names) - 1
     states = {"initial": state("initial", 0), "peak": state("peak", k_snap)}

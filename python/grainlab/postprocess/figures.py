@@ -101,7 +101,12 @@ def _band_note(band: BandSearch | None) -> tuple[str, tuple[BandOutline, ...]]:
 
 
 def _panel(analysis: RunAnalysis, k: int, st: RunState, values: NDArray[np.float64]) -> MapPanel:
+    """A map of ``values`` (one per grain of ``st.snap``); a run of clumps drawn as its
+    pebbles, each in its body's colour."""
     note, outlines = _band_note(analysis.band_of(st))
+    if st.view is not None:
+        pebbles = st.view.pebbles
+        return MapPanel(pebbles.positions, pebbles.radii, values[st.view.body], _title(k, st), note, outlines)
     return MapPanel(st.snap.positions, st.snap.radii, values, _title(k, st), note, outlines)
 
 
