@@ -90,6 +90,49 @@ def draw_strengths(
     return out
 
 
+def pairs_within_gap(
+    positions: ArrayLike,
+    radii: ArrayLike,
+    gap: float,
+    *,
+    body: ArrayLike | None = None,
+    period: tuple[float, float] | None = None,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The pairs ``(i, j)``, ``i < j``, whose surfaces are at most ``gap`` apart
+    (touching and overlapping pairs included), sorted; two pebbles of one ``body``
+    are no pair. ``period`` ``(Lx, Ly)``: positions in a periodic rectangle whose
+    corner is the origin (the nearest image of each pair).
+
+    >>> i, j = pairs_within_gap([[0, 0], [2.0, 0], [4.5, 0]], [1.0, 1.0, 1.0], 0.5)
+    >>> i.tolist(), j.tolist()
+    ([0, 1], [1, 2])
+    """
+    from scipy.spatial import cKDTree
+
+    x = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
+    r = np.asarray(radii, dtype=np.float64).reshape(-1)
+    if not (math.isfinite(gap) and gap >= 0):
+        raise ValueError(f"gap: a distance is finite and >= 0, got {gap}")
+    if len(r) != len(x):
+        raise ValueError(f"radii: {len(r)} for {len(x)} positions")
+    if len(x) < 2:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    box = None if period is None else np.asarray(period, dtype=np.float64)
+    tree = cKDTree(x if box is None else np.mod(x, box), boxsize=box)
+    pairs = tree.query_pairs(2.0 * float(r.max()) + gap, output_type="ndarray").astype(np.int64)
+    pairs.sort(axis=1)
+    d = x[pairs[:, 1]] - x[pairs[:, 0]]
+    if box is not None:
+        d -= box * np.round(d / box)
+    keep = np.hypot(d[:, 0], d[:, 1]) <= r[pairs[:, 0]] + r[pairs[:, 1]] + gap
+    if body is not None:
+        b = np.asarray(body).reshape(-1)
+        keep &= b[pairs[:, 0]] != b[pairs[:, 1]]
+    pairs = pairs[keep]
+    pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+    return pairs[:, 0], pairs[:, 1]
+
+
 def _weibull_shape(cv: float) -> float:
     """The Weibull shape whose coefficient of variation is ``cv`` (bisection on log m)."""
 

@@ -37,6 +37,26 @@ def stop_and_resume(protocol: Any, out: Path, checkpoints: int, monkeypatch: Any
     runner.run_protocol(protocol, out, resume=True)
 
 
+def kill_at_measure(monkeypatch: Any, module: Any, n: int, run: Any) -> None:
+    """Runs ``run()`` with ``module.measure`` raising ``KeyboardInterrupt`` at its
+    ``n``-th call (a kill while a record is measured), then puts it back."""
+    real_measure = module.measure
+    calls = {"n": 0}
+
+    def dying_measure(*args: Any, **kwargs: Any) -> Any:
+        calls["n"] += 1
+        if calls["n"] == n:
+            raise KeyboardInterrupt("simulated kill during shearing")
+        return real_measure(*args, **kwargs)
+
+    monkeypatch.setattr(module, "measure", dying_measure)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run()
+    finally:
+        monkeypatch.setattr(module, "measure", real_measure)
+
+
 def assert_same_run(a_dir: Path, b_dir: Path, *, snapshots: str = "all") -> None:
     """The two runs' records and snapshot names are equal, and the positions of every
     snapshot (or of the last one, ``snapshots="last"``), bit for bit."""

@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 import pytest
+from resume_check import kill_at_measure
 
 import grainlab.protocols.biaxial as biaxial
 import grainlab.protocols.biaxial.protocol as protocol
@@ -93,23 +94,11 @@ def test_resumed_run_ends_with_the_same_results(tmp_path, monkeypatch):
     config = resolve(overrides=overrides, quick=True)
     straight = biaxial.run_biaxial(config, tmp_path / "straight", progress=False)
 
-    real_measure = records.measure
-    calls = {"n": 0}
-
-    def dying_measure(*args, **kwargs):
-        calls["n"] += 1
-        if calls["n"] == 17:
-            raise KeyboardInterrupt("simulated kill during shearing")
-        return real_measure(*args, **kwargs)
-
-    monkeypatch.setattr(records, "measure", dying_measure)
     killed = tmp_path / "killed"
-    with pytest.raises(KeyboardInterrupt):
-        biaxial.run_biaxial(config, killed, progress=False)
+    kill_at_measure(monkeypatch, records, 17, lambda: biaxial.run_biaxial(config, killed, progress=False))
     # a killed run leaves nothing that looks complete
     assert not (killed / "run.h5").exists() and not (killed / "summary.json").exists()
     assert (killed / "checkpoint.h5").exists()
-    monkeypatch.setattr(records, "measure", real_measure)
     resumed = biaxial.run_biaxial(config, killed, resume=True, progress=False)
 
     a = read_results(straight.out_dir / "run.h5")

@@ -233,6 +233,42 @@ class ConsolidationSection(Section):
 
 
 @dataclass(frozen=True)
+class CementSection(Section):
+    """Cement bonds made at the end of the consolidation (docs/cemented.md, "Cemented samples")."""
+
+    prefix: ClassVar[str] = "cement"
+    bonds: str = key(
+        "choice", "none",
+        "'parallel': the grains' pairs are cemented with parallel bonds at the end of the consolidation "
+        "(Potyondy and Cundall); 'none': no cement",
+        choices=("none", "parallel"),
+    )
+    gap: float = key("length", 0.0, "pairs whose surfaces are at most this far apart are cemented (0: touching)",
+                     minimum=0.0)
+    radius_multiplier: float = key("number", 1.0, "lambda_b: bond radius over the smaller grain's", **POSITIVE)
+    normal_stiffness: float | str = key(
+        "number", "auto", "kn_bar of the bonds in Pa/m (auto: material.normal_stiffness over each bond's area)",
+        **POSITIVE, allow_auto=True,
+    )
+    shear_stiffness: float | str = key(
+        "number", "auto", "ks_bar of the bonds in Pa/m (auto: material.shear_stiffness over each bond's area)",
+        **POSITIVE, allow_auto=True,
+    )
+    tensile_strength: float = key("stress", 0.0, "sigma_c: mean tensile strength of the bonds (required)",
+                                  minimum=0.0)
+    cohesion: float = key("stress", 0.0, "c: mean cohesion of the bonds (required)", minimum=0.0)
+    friction_angle: float = key("number", 0.0, "phi_b in degrees: tau_c = c - sigma tan(phi_b)", minimum=0.0,
+                                maximum=90.0, exclusive_maximum=True)
+    strength_scatter: float = key(
+        "number", 0.0, "coefficient of variation of both strengths over the bonds (0: every bond the mean)",
+        minimum=0.0,
+    )
+    strength_distribution: str = key(
+        "choice", "normal", "law of the strengths' scatter, seeded by sample.seed", choices=("normal", "weibull")
+    )
+
+
+@dataclass(frozen=True)
 class RunSection(Section):
     """How a run executes (the runner's keys, in every test's configuration)."""
 
@@ -248,7 +284,9 @@ class RunSection(Section):
 
 #: The keys of every test that makes a sample and consolidates it: the sample, its
 #: material (Table 1) and the consolidation.
-SHARED_FIELDS: dict[str, Field] = {**SampleSection.keys(), **MaterialSection.keys(), **ConsolidationSection.keys()}
+SHARED_FIELDS: dict[str, Field] = {
+    **SampleSection.keys(), **MaterialSection.keys(), **ConsolidationSection.keys(), **CementSection.keys()
+}
 #: How a run executes (the runner's keys, in every test's configuration).
 RUN_FIELDS: dict[str, Field] = RunSection.keys()
 
@@ -388,6 +426,7 @@ class Config:
     sample = SectionOf(SampleSection)
     material = SectionOf(MaterialSection)
     consolidation = SectionOf(ConsolidationSection)
+    cement = SectionOf(CementSection)
     run = SectionOf(RunSection)
 
     def to_dict(self) -> dict[str, Any]:
@@ -532,12 +571,31 @@ def grain_shape(v: Mapping[str, Any]) -> ShapeTemplate | None:
     return template if template.n_pebbles > 1 else None
 
 
+def _check_cement(v: Mapping[str, Any], given: AbstractSet[str]) -> None:
+    """Cement keys set without cement (a stored configuration's defaults pass), strengths
+    missing, automatic stiffnesses without a linear law."""
+    if v["cement.bonds"] == "none":
+        defaults = CementSection.keys()
+        stray = sorted(k for k in given if k in defaults and k != "cement.bonds" and v[k] != defaults[k].default)
+        if stray:
+            raise ConfigError(f"{stray[0]}: given, but cement.bonds is 'none' (give cement.bonds=parallel)")
+        return
+    for name in ("cement.tensile_strength", "cement.cohesion"):
+        if not v[name] > 0:
+            raise ConfigError(f"{name}: cemented grains need a strength > 0 (e.g. {name}=\"1 MPa\")")
+    auto = [k for k in ("cement.normal_stiffness", "cement.shear_stiffness") if v[k] == "auto"]
+    if auto and v["material.contact_law"] != "linear":
+        raise ConfigError(f"{auto[0]}: 'auto' follows the linear law's stiffness; with "
+                          f"{v['material.contact_law']} give it in Pa/m")
+
+
 def check_sample(v: dict[str, Any], given: AbstractSet[str] = frozenset()) -> None:
     """The checks of :data:`SHARED_FIELDS` that span several keys (the grading, the
     grains' shape, the sample's size against its grains, Hertz-Mindlin without
     contact dashpots); a 'curve' grading sets ``sample.d_min/d_max``."""
     _grading_curve(v, given)
     grain_shape(v)
+    _check_cement(v, given)
     if v["material.contact_law"] == "hertz_mindlin" and v["material.contact_damping"] > 0:
         raise ConfigError(
             "material.contact_damping: hertz_mindlin is damped by material.restitution, "

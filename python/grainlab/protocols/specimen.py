@@ -45,7 +45,8 @@ from grainlab.snapshot import Snapshot
 if TYPE_CHECKING:
     from grainlab.plot.workers import FigureTask
 
-__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "consolidate",
+__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "cement_sample",
+           "consolidate",
            "damped_time_step_factor", "engine_columns",
            "engine_threads", "generate", "grain_model", "grain_columns", "platen_model", "run_summary",
            "write_run_outputs"]
@@ -315,7 +316,43 @@ def consolidate(
         "unbalanced_force_ratio": sim.unbalanced_force_ratio,
         "time_step_s": sim.time_step,
     }
+    cement_sample(sim, run, config)
     run.wall_time["consolidate"] = time.perf_counter() - start
+
+
+def cement_sample(sim: Simulation, run: SpecimenRun, config: Config, period: tuple[float, float] | None = None) -> None:
+    """Cements the grains' pairs within ``cement.gap`` with parallel bonds (docs/cemented.md,
+    "Cemented samples"), when ``cement.bonds`` asks for it: stiffnesses ``auto`` make each
+    bond's ``kn_bar A`` the contact law's ``kn`` (and ``ks``), strengths drawn with
+    ``sample.seed``. ``period``: the grains in a periodic cell of that size whose corner
+    is ``sim.cell.origin``. Records the count in ``run.consolidation["cement_bonds"]``."""
+    c = config.cement
+    if c.bonds == "none":
+        return
+    from grainlab.cement import draw_strengths, pairs_within_gap
+
+    n = run.n_grains
+    positions, radii = sim.positions[:n], sim.radii[:n]
+    if period is not None and sim.cell is not None:
+        positions = positions - np.asarray(sim.cell.origin)
+    body = sim.body_of_particles[:n] if len(sim.clumps) else None
+    i, j = pairs_within_gap(positions, radii, c.gap, body=body, period=period)
+    if len(i) == 0:
+        raise SpecimenError(f"cement.gap: no two grains are within {c.gap:g} m of each other to cement")
+    area = 2.0 * c.radius_multiplier * np.minimum(radii[i], radii[j])
+    kn = config.material.normal_stiffness / area if c.normal_stiffness == "auto" else float(c.normal_stiffness)
+    ks = config.material.shear_stiffness / area if c.shear_stiffness == "auto" else float(c.shear_stiffness)
+    rng = np.random.default_rng([config.sample.seed, 0x43454D])  # "CEM": a stream of its own
+    law = c.strength_distribution
+
+    def strengths(mean: float) -> NDArray[np.float64]:
+        return draw_strengths(rng, mean, c.strength_scatter * mean, len(i), law)  # type: ignore[arg-type]
+
+    sim.add_cement_bonds(i, j, normal_stiffness=kn, shear_stiffness=ks, tensile_strength=strengths(c.tensile_strength),
+                         cohesion=strengths(c.cohesion), friction_angle=c.friction_angle,
+                         radius_multiplier=c.radius_multiplier)
+    run.consolidation["cement_bonds"] = len(i)
+
 
 
 def engine_columns(sim: Simulation) -> dict[str, float]:
@@ -357,7 +394,8 @@ def run_summary(run: SpecimenRun, fields: Mapping[str, Any], *, records: int, wa
                 **after_records: Any) -> dict[str, Any]:
     """A test's summary: the grain counts, its ``fields``, the time step, the record
     count, ``after_records``, the wall times and grainlab's version."""
-    return {"n_particles": run.n_grains, **clump_summary(run.sample), **fields,
+    cement = {"cement_bonds": run.consolidation["cement_bonds"]} if "cement_bonds" in run.consolidation else {}
+    return {"n_particles": run.n_grains, **clump_summary(run.sample), **cement, **fields,
             "time_step_s": run.consolidation["time_step_s"], "records": records, **after_records,
             "wall_time_s": wall_time_s, "wall_time_by_phase_s": dict(run.wall_time),
             "grainlab_version": grainlab.__version__}

@@ -35,6 +35,7 @@ from grainlab.protocols.specimen import (
     OUTPUT_FILES,
     SpecimenError,
     SpecimenProtocol,
+    cement_sample,
     contact_law,
     damped_time_step_factor,
     engine_columns,
@@ -194,6 +195,7 @@ def _consolidate(context: Context) -> None:
         "coordination_number": grain_coordination(sim), "unbalanced_force_ratio": sim.unbalanced_force_ratio,
         "time_step_s": sim.time_step,
     }
+    cement_sample(sim, run, config, period=(float(cell.a[0]), float(cell.b[1])))
     run.wall_time["consolidate"] = time.perf_counter() - start
 
 
