@@ -212,8 +212,15 @@ SIMPLE_SHEAR = Columns(
 )
 
 #: Every test's columns, by the results file's ``kind``.
+# ---- a cemented sample's, after its test's own -------------------------------------------
+CEMENT_BONDS_BROKEN = Column("cement_bonds_broken", "1", "cement bonds broken since the end of the consolidation")
+
+#: The column a cemented sample (``cement.bonds`` not ``none``) adds to the biaxial and
+#: cyclic tests' records (docs/cemented.md).
+CEMENTED = Columns("cemented", (CEMENT_BONDS_BROKEN,))
+
 BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER, CYCLIC.kind: CYCLIC,
-                               SIMPLE_SHEAR.kind: SIMPLE_SHEAR}
+                               SIMPLE_SHEAR.kind: SIMPLE_SHEAR, CEMENTED.kind: CEMENTED}
 
 
 _BLOCK = re.compile(

@@ -89,6 +89,10 @@ def test_a_cemented_biaxial_test_is_stronger_and_resumes_through_cracking_to_the
     straight = biaxial.run_biaxial(config, tmp_path / "straight", progress=False)
     assert straight.summary["cement_bonds"] > straight.summary["n_particles"]
     assert straight.summary["peak_stress_ratio"] > 1.5 * plain.summary["peak_stress_ratio"]
+    # the records count the broken bonds: from none, never down, some by the end; the plain run has no such column
+    broken = read_results(straight.out_dir / "run.h5").timeseries["cement_bonds_broken"]
+    assert broken[0] == 0 and np.all(np.diff(broken) >= 0) and 0 < broken[-1] < straight.summary["cement_bonds"]
+    assert "cement_bonds_broken" not in read_results(plain.out_dir / "run.h5").timeseries
 
     killed = tmp_path / "killed"
     kill_at_measure(monkeypatch, records, 20, lambda: biaxial.run_biaxial(config, killed, progress=False))

@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 from typing import Any, ClassVar
 
+from grainlab.columns import BIAXIAL
 from grainlab.io.hdf5 import snapshot_name
 from grainlab.protocols.biaxial import records as biaxial_records
 from grainlab.protocols.biaxial.config import BiaxialConfig
@@ -34,7 +35,7 @@ def _boundary(context: Context) -> None:
 
 def _shear(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
-    records = shear_records(context, lambda: biaxial_records.measure(sim, run, config), biaxial_records.TIMESERIES_UNITS)
+    records = shear_records(context, lambda: biaxial_records.measure(sim, run, config), biaxial_records.record_units(BIAXIAL, config))
     shear(context, records, shear_snapshots(context, records, snapshot_name), final=config.shear.final_strain)
 
 

@@ -159,7 +159,7 @@ def _cycle(context: Context) -> None:
         cycle = plan.events / 4.0 if stress else travelled / (4.0 * amplitude)
         return {**biaxial_records.measure(sim, run, config), STRAIN_PATH: travelled, CYCLE: cycle}
 
-    records = shear_records(context, measure, CYCLIC.units())
+    records = shear_records(context, measure, biaxial_records.record_units(CYCLIC, config))
     if stress:
         snapshots = shear_snapshots(context, records, lambda path: "start")
         shear(context, records, snapshots, final=stress_path_length(config),
