@@ -93,6 +93,15 @@ def test_a_cemented_biaxial_test_is_stronger_and_resumes_through_cracking_to_the
     broken = read_results(straight.out_dir / "run.h5").timeseries["cement_bonds_broken"]
     assert broken[0] == 0 and np.all(np.diff(broken) >= 0) and 0 < broken[-1] < straight.summary["cement_bonds"]
     assert "cement_bonds_broken" not in read_results(plain.out_dir / "run.h5").timeseries
+    # every break is in the crack records, at its time's axial strain, inside the sample
+    cracks = read_results(straight.out_dir / "run.h5").cracks
+    assert len(cracks["step"]) == broken[-1] and not read_results(plain.out_dir / "run.h5").cracks
+    assert np.all(np.diff(cracks["step"]) >= 0) and np.all(np.diff(cracks["axial_strain"]) >= 0)
+    assert 0 <= cracks["axial_strain"].min() and cracks["axial_strain"].max() <= 0.015
+    assert set(np.unique(cracks["tension"])) <= {0, 1} and np.all(cracks["energy_j"] > 0)
+    first = read_results(straight.out_dir / "run.h5").snapshot(0).positions
+    for axis, column in enumerate(("x_m", "y_m")):
+        assert first[:, axis].min() < cracks[column].min() and cracks[column].max() < first[:, axis].max()
 
     killed = tmp_path / "killed"
     kill_at_measure(monkeypatch, records, 20, lambda: biaxial.run_biaxial(config, killed, progress=False))
@@ -104,3 +113,6 @@ def test_a_cemented_biaxial_test_is_stronger_and_resumes_through_cracking_to_the
     for name in a.timeseries:
         np.testing.assert_array_equal(a.timeseries[name], b.timeseries[name], err_msg=name)
     np.testing.assert_array_equal(a.snapshot(-1).positions, b.snapshot(-1).positions)
+    assert a.cracks.keys() == b.cracks.keys()
+    for name in a.cracks:
+        np.testing.assert_array_equal(a.cracks[name], b.cracks[name], err_msg=name)

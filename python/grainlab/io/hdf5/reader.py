@@ -69,6 +69,9 @@ class Results:
     summary: dict[str, Any]
     #: Wall time per phase, ``name -> s`` (empty when not recorded).
     phases: dict[str, float]
+    #: The ``/cracks`` table, ``column -> (n_cracks,)`` (empty for a run without cement;
+    #: docs/file-formats.md).
+    cracks: dict[str, NDArray[Any]]
     #: The snapshots in the order written.
     snapshots: tuple[SnapshotInfo, ...]
     #: All root attributes of the file (including ``error`` of a failed run).
@@ -160,6 +163,11 @@ def _read_results_v1(f: h5py.File, path: Path, allow_incomplete: bool) -> Result
         g = f["phases"]
         names = [str(n) for n in g["name"].asstr()[()]]
         phases = dict(zip(names, (float(s) for s in g["wall_time"][()]), strict=True))
+    cracks: dict[str, NDArray[Any]] = {}
+    if "cracks" in f:
+        g = f["cracks"]
+        n_cracks = int(g.attrs.get("n_rows", 0))
+        cracks = {str(c): np.asarray(g[str(c)][:n_cracks]) for c in g.attrs["columns"]}
     attrs = {
         k: (v.decode() if isinstance(v, bytes) else v.item() if isinstance(v, np.generic) else v)
         for k, v in f.attrs.items()
@@ -176,6 +184,7 @@ def _read_results_v1(f: h5py.File, path: Path, allow_incomplete: bool) -> Result
         timeseries_units=units,
         summary=_read_json(f.get("summary"), path),
         phases=phases,
+        cracks=cracks,
         snapshots=_snapshot_infos_v1(f),
         attrs=attrs,
         analysis_versions=read_analysis_versions(f),

@@ -275,6 +275,31 @@ class ResultsWriter:
         _write_json_group(self._f["summary"], summary, "summary")
         self.flush()
 
+    def append_cracks(self, columns: Mapping[str, ArrayLike], units: Mapping[str, str]) -> None:
+        """Append rows to the ``/cracks`` table (``column -> 1D values``, one row per
+        broken bond; the first call sets the columns and their ``units``, later calls
+        give the same columns)."""
+        data = {str(k): np.asarray(v) for k, v in columns.items()}
+        if len({a.shape for a in data.values()}) > 1 or any(a.ndim != 1 for a in data.values()):
+            raise ValueError(f"cracks: expected 1D columns of one length, got { {k: a.shape for k, a in data.items()} }")
+        g = self._f.require_group("cracks")
+        if "columns" not in g.attrs:
+            for name, a in data.items():
+                g.create_dataset(_check_name("cracks column", name), shape=(0,), maxshape=(None,), dtype=a.dtype,
+                                 chunks=(_TIMESERIES_CHUNK,)).attrs["units"] = str(units.get(name, ""))
+            g.attrs["columns"] = np.array(list(data), dtype=_STR)
+            g.attrs["n_rows"] = np.int64(0)
+        existing = [str(c) for c in g.attrs["columns"]]
+        if sorted(existing) != sorted(data):
+            raise ValueError(f"cracks: columns {sorted(data)} differ from the file's {existing}")
+        start = int(g.attrs["n_rows"])
+        n_new = len(next(iter(data.values()))) if data else 0
+        for name in existing:
+            g[name].resize((start + n_new,))
+            g[name][start:] = data[name]
+        g.attrs["n_rows"] = np.int64(start + n_new)  # last: marks the rows complete
+        self.flush()
+
     def write_phases(self, phases: Mapping[str, float]) -> None:
         """Store the wall-clock time of each phase, ``name -> seconds`` (replaces any earlier)."""
         names = [_check_name("phases", str(k)) for k in phases]

@@ -1,0 +1,56 @@
+"""The crack records of a cemented sample (docs/cemented.md, "Crack records"): each
+cement bond that broke, taken from the engine's log on a record step and appended to
+``run.h5``'s ``/cracks`` table (docs/file-formats.md), its axial strain read off the
+time series at the break's time."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from grainlab.cement import BondBreaks
+from grainlab.columns import AXIAL_STRAIN, TIME_S
+from grainlab.io.hdf5 import ResultsWriter
+from grainlab.protocols.operations import Loading, Operation
+from grainlab.protocols.triggers import Trigger
+
+__all__ = ["CRACK_UNITS", "CrackRecords", "crack_columns"]
+
+#: The ``/cracks`` table's columns and units, in order.
+CRACK_UNITS: dict[str, str] = {
+    "step": "1", "time_s": "s", "axial_strain": "1", "i": "1", "j": "1", "x_m": "m", "y_m": "m",
+    "normal_x": "1", "normal_y": "1", "tension": "1", "energy_j": "J", "normal_force_n": "N",
+    "shear_force_n": "N", "moment_n_m": "N m",
+}
+
+
+def crack_columns(breaks: BondBreaks, axial_strain: NDArray[np.float64]) -> dict[str, NDArray[np.generic]]:
+    """The ``/cracks`` rows of ``breaks`` at ``axial_strain`` (one per break): the step
+    and time, the particles (user indices), the bond's centre and normal, ``tension`` 1
+    for a break in tension and 0 in shear, the energy released and the forces at the break."""
+    return {
+        "step": breaks.step.astype(np.int64), "time_s": breaks.time, "axial_strain": axial_strain,
+        "i": breaks.i.astype(np.int64), "j": breaks.j.astype(np.int64),
+        "x_m": breaks.position[:, 0], "y_m": breaks.position[:, 1],
+        "normal_x": breaks.normal[:, 0], "normal_y": breaks.normal[:, 1],
+        "tension": (breaks.mode == "tension").astype(np.int8), "energy_j": breaks.energy,
+        "normal_force_n": breaks.normal_force, "shear_force_n": breaks.shear_force, "moment_n_m": breaks.moment,
+    }
+
+
+class CrackRecords(Operation):
+    """Writer: the bonds broken since its last act, appended to ``/cracks`` (after the
+    step's record, so that each break's axial strain is the time series' at its time:
+    exact at a constant strain rate, the first record's for a break before shearing)."""
+
+    def __init__(self, trigger: Trigger, writer: ResultsWriter) -> None:
+        super().__init__(trigger)
+        self.writer = writer
+
+    def act(self, loading: Loading) -> None:
+        breaks = loading.sim.take_bond_breaks()
+        if len(breaks) == 0:
+            return
+        series = self.writer.read_timeseries()
+        strain = np.interp(breaks.time, series[TIME_S], series[AXIAL_STRAIN])
+        self.writer.append_cracks(crack_columns(breaks, strain), CRACK_UNITS)
