@@ -81,6 +81,14 @@ def test_the_bonds_are_made_stress_free_with_the_contact_stiffness_and_seeded_st
     assert len(set(bonds.tensile_strength.tolist())) == 2
 
 
+def test_a_cracks_orientation_is_across_its_bonds_normal():
+    from grainlab.plot.cracks import crack_orientations
+
+    normals = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [np.sqrt(0.5), np.sqrt(0.5)]])
+    angles = crack_orientations(normals[:, 0], normals[:, 1])
+    np.testing.assert_allclose(angles, [0.5 * np.pi, 0.0, 0.5 * np.pi, 0.75 * np.pi], atol=1e-15)
+
+
 @pytest.mark.slow
 def test_a_cemented_biaxial_test_is_stronger_and_resumes_through_cracking_to_the_same_bits(tmp_path, monkeypatch):
     shear = ["shear.final_strain=0.015", "shear.strain_rate=20%/min", "run.checkpoint_interval=1e-9"]
@@ -99,6 +107,7 @@ def test_a_cemented_biaxial_test_is_stronger_and_resumes_through_cracking_to_the
     assert np.all(np.diff(cracks["step"]) >= 0) and np.all(np.diff(cracks["axial_strain"]) >= 0)
     assert 0 <= cracks["axial_strain"].min() and cracks["axial_strain"].max() <= 0.015
     assert set(np.unique(cracks["tension"])) <= {0, 1} and np.all(cracks["energy_j"] > 0)
+    assert (straight.out_dir / "fig20_cracks.png").exists() and not (plain.out_dir / "fig20_cracks.png").exists()
     first = read_results(straight.out_dir / "run.h5").snapshot(0).positions
     for axis, column in enumerate(("x_m", "y_m")):
         assert first[:, axis].min() < cracks[column].min() and cracks[column].max() < first[:, axis].max()
