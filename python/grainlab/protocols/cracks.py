@@ -5,16 +5,21 @@ time series at the break's time."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.cement import BondBreaks
 from grainlab.columns import AXIAL_STRAIN, TIME_S
-from grainlab.io.hdf5 import ResultsWriter
+from grainlab.io.hdf5 import Results, ResultsWriter
 from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.triggers import Trigger
 
-__all__ = ["CRACK_UNITS", "CrackRecords", "crack_columns"]
+if TYPE_CHECKING:
+    from grainlab.plot.workers import FigureTask
+
+__all__ = ["CRACK_UNITS", "CrackRecords", "crack_columns", "crack_task"]
 
 #: The ``/cracks`` table's columns and units, in order.
 CRACK_UNITS: dict[str, str] = {
@@ -36,6 +41,20 @@ def crack_columns(breaks: BondBreaks, axial_strain: NDArray[np.float64]) -> dict
         "tension": (breaks.mode == "tension").astype(np.int8), "energy_j": breaks.energy,
         "normal_force_n": breaks.normal_force, "shear_force_n": breaks.shear_force, "moment_n_m": breaks.moment,
     }
+
+
+def crack_task(results: Results) -> FigureTask | None:
+    """The crack map and rose (``fig20_cracks``) of a run with crack records, on its last
+    snapshot's grains; None without cracks."""
+    if not results.cracks:
+        return None
+    from grainlab.plot.cracks import crack_figure
+    from grainlab.plot.workers import FigureTask
+
+    last = results.snapshot(-1)
+    grains = np.asarray(last.is_sample)
+    title = f"Broken cement bonds to {100 * results.timeseries[AXIAL_STRAIN][-1]:.2f} % axial strain"
+    return FigureTask("fig20_cracks", crack_figure, (last.positions[grains], last.radii[grains], results.cracks, title))
 
 
 class CrackRecords(Operation):

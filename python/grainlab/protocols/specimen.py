@@ -408,13 +408,15 @@ def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.fl
     the summary is written (which says the outputs are complete); returns the summary."""
     from grainlab.io.hdf5 import read_results
     from grainlab.plot.workers import figure_pool
+    from grainlab.protocols.cracks import crack_task
 
     results = read_results(out / RESULTS_FILE)
     raise_if_interrupted()
     summary = dict(results.summary)
     write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
     series = {name: np.asarray(values, dtype=np.float64) for name, values in results.timeseries.items()}
-    tasks = figure_tasks(series, summary)
+    cracks = crack_task(results)
+    tasks = figure_tasks(series, summary) + ([cracks] if cracks is not None else [])
     with figure_pool(tasks=len(tasks), page_copies=True) as pool:
         pool.draw(tasks, out).result()
     raise_if_interrupted()

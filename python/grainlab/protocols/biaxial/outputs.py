@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -17,11 +17,9 @@ from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic,
 from grainlab.paper import STRAIN_AT_PEAK, Z_AT_PEAK, Z_INITIAL
 from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.state import BiaxialRun
+from grainlab.protocols.cracks import crack_task
 from grainlab.protocols.runner import RunResult
 from grainlab.protocols.specimen import run_summary
-
-if TYPE_CHECKING:
-    from grainlab.io.hdf5 import Results
 
 #: The paper's reported values, for the summary and the docs.
 PAPER_VALUES = {
@@ -123,19 +121,6 @@ def _figures(timeseries: dict[str, np.ndarray], out: Path, constant_volume: bool
         pool.draw(curve_tasks(timeseries, stress_path=constant_volume), out)
 
 
-def _crack_map(results: Results, out: Path) -> None:
-    """A cemented run's crack map and rose (``fig20_cracks``), on its last snapshot."""
-    from grainlab.plot.cracks import crack_figure
-    from grainlab.plot.workers import FigureTask, figure_pool
-
-    last = results.snapshot(-1)
-    grains = np.asarray(last.is_sample)
-    title = f"Broken cement bonds to {100 * results.timeseries[AXIAL_STRAIN][-1]:.2f} % axial strain"
-    task = FigureTask("fig20_cracks", crack_figure, (last.positions[grains], last.radii[grains], results.cracks, title))
-    with figure_pool(tasks=1) as pool:
-        pool.draw([task], out)
-
-
 def write_outputs(out: Path) -> dict[str, Any]:
     """``timeseries.csv``, the figures and ``summary.json``, all from the finished
     ``run.h5``: a run stopped while they were written finishes them with ``--resume``.
@@ -160,8 +145,9 @@ def write_outputs(out: Path) -> dict[str, Any]:
         raise_if_interrupted()
         # the paper's fabric figures (6, 7, 9, 11-14) from the snapshots, and their numbers
         summary["fabric"] = figures.fabric_figures(out).numbers.summary()
-        if results.cracks:
-            _crack_map(results, out)
+        cracks = crack_task(results)
+        if cracks is not None:
+            pool.draw([cracks], out)
     raise_if_interrupted()
     write_json_atomic(out / "summary.json", summary)
     return summary
