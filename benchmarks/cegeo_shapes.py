@@ -70,6 +70,11 @@ BASE = {
 #: strength is too high: the rate").
 SLOW = {"shear.inertial_number": "2.5e-4"}
 SLOWER = {"shear.inertial_number": "6.25e-5"}
+#: A sixty-fourth of the rate, and a quarter of it with the local damping halved (0.4): the
+#: runs that ask whether size 900 converges in rate and whether the damping keeps it from it
+#: (docs/shapes-benchmark.md, "What the rate family gave").
+SLOWEST = {"shear.inertial_number": "1.5625e-5"}
+SLOW_DAMPED = {**SLOW, "material.local_damping": "0.4"}
 
 
 def plan() -> list[dict]:
@@ -77,8 +82,9 @@ def plan() -> list[dict]:
     seed 1, a rate check (eta 0.3 at a quarter of the rate), the large size
     (3,600 grains) for seed 1, seeds 2 and 3 of the small size, the rate checks
     of the large size (eta 0 and 0.3 at a quarter of the rate), the small size's
-    rate family (every eta at a quarter, eta 0 and 0.3 at a sixteenth), then the
-    paper's size (5,000 grains) for seed 1."""
+    rate family (every eta at a quarter, eta 0 and 0.3 at a sixteenth), its follow-up
+    (eta 0 at a quarter with half the local damping, eta 0 and 0.3 at a sixty-fourth),
+    then the paper's size (5,000 grains) for seed 1."""
     runs = [dict(n=900, eta=e, seed=1) for e in ETAS]
     runs.append(dict(n=900, eta=0.3, seed=1, tag="slow", extra=SLOW))
     runs += [dict(n=3600, eta=e, seed=1) for e in ETAS]
@@ -87,6 +93,9 @@ def plan() -> list[dict]:
     # the rate family of size 900: every eta at a quarter of the rate, eta 0 and 0.3 at a sixteenth
     runs += [dict(n=900, eta=e, seed=1, tag="slow", extra=SLOW) for e in ETAS if e != 0.3]
     runs += [dict(n=900, eta=e, seed=1, tag="slower", extra=SLOWER) for e in (0.0, 0.3)]
+    # what the rate family left open, before the paper's size's trimers
+    runs += [dict(n=900, eta=0.0, seed=1, tag="slow_damped", extra=SLOW_DAMPED)]
+    runs += [dict(n=900, eta=e, seed=1, tag="slowest", extra=SLOWEST) for e in (0.0, 0.3)]
     runs += [dict(n=5000, eta=e, seed=1) for e in ETAS]
     return runs
 

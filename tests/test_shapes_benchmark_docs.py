@@ -23,7 +23,9 @@ def _table_rows() -> dict[tuple[int, str, float], list[str]]:
         cells = [c.strip() for c in line.strip("|").split("|")]
         size = re.match(r"[\d,]+", cells[0])
         assert size is not None, line
-        tag = {"quarter": "slow", "sixteenth": "slower"}.get(next((w for w in ("quarter", "sixteenth") if w in cells[0]), ""), "")
+        words = {"half the local damping": "slow_damped", "quarter": "slow", "sixteenth": "slower",
+                 "sixty-fourth": "slowest"}
+        tag = next((t for w, t in words.items() if w in cells[0]), "")
         rows[(int(size.group(0).replace(",", "")), tag, float(cells[1]))] = cells
     return rows
 
