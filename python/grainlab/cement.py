@@ -133,6 +133,17 @@ def pairs_within_gap(
     return pairs[:, 0], pairs[:, 1]
 
 
+def crack_orientations(normal_x: ArrayLike, normal_y: ArrayLike) -> NDArray[np.float64]:
+    """Each crack's orientation in [0, pi): the line of the broken bond's section,
+    perpendicular to its normal (a crack opened by vertical tension runs horizontally).
+
+    >>> crack_orientations([1.0, 0.0], [0.0, 1.0]).round(4).tolist()
+    [1.5708, 0.0]
+    """
+    nx, ny = np.asarray(normal_x, dtype=np.float64), np.asarray(normal_y, dtype=np.float64)
+    return np.mod(np.arctan2(ny, nx) + 0.5 * np.pi, np.pi)
+
+
 def _weibull_shape(cv: float) -> float:
     """The Weibull shape whose coefficient of variation is ``cv`` (bisection on log m)."""
 

@@ -82,7 +82,7 @@ def test_the_bonds_are_made_stress_free_with_the_contact_stiffness_and_seeded_st
 
 
 def test_a_cracks_orientation_is_across_its_bonds_normal():
-    from grainlab.plot.cracks import crack_orientations
+    from grainlab.cement import crack_orientations
 
     normals = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [np.sqrt(0.5), np.sqrt(0.5)]])
     angles = crack_orientations(normals[:, 0], normals[:, 1])

@@ -217,3 +217,55 @@ def test_clumps_are_drawn_one_colour_each_and_outlined(tmp_path):
     assert len({tuple(colour[0]), tuple(colour[3]), tuple(colour[6]), tuple(colour[9])}) == 4
     assert all(sum(rgb) < 300 for rgb in above[:2]), above  # the trimers' outlines, just above their top pebbles
     assert sum(above[2]) == 3 * 255, above  # no outline round the disk: the white page
+
+
+def test_a_cemented_runs_cracks_are_a_layer_drawn_as_they_broke(tmp_path):
+    """Two snapshots, one crack broken before each: the data say which are broken by
+    each snapshot, and the page draws them (tension blue) where they are, and no more."""
+    from grainlab.io.hdf5 import ResultsWriter
+    from grainlab.protocols.cracks import CRACK_UNITS
+    from grainlab.snapshot import Snapshot
+    from grainlab.viewer.data import viewer_data
+
+    a, b = np.meshgrid(np.arange(10), np.arange(10), indexing="ij")
+    pos = np.c_[a.ravel(), b.ravel()] * 1e-3 + 1e-3
+    radii = np.full(100, 0.5e-3)
+    crack = {name: np.zeros(2, dtype=np.int64 if name in ("step", "i", "j") else np.float64) for name in CRACK_UNITS}
+    crack |= {"time_s": np.array([0.5, 1.5]), "x_m": np.array([1.5e-3, 8.5e-3]), "y_m": np.array([5.0e-3, 5.0e-3]),
+              "normal_x": np.ones(2), "tension": np.array([1, 0], dtype=np.int8)}
+    with ResultsWriter(tmp_path / "run.h5", kind="biaxial") as out:
+        out.append_rows({"axial_strain": [0.0, 0.01], "time_s": [1.0, 2.0]})
+        for k in range(2):
+            out.write_snapshot(f"strain_{k}", Snapshot.from_geometry(pos, radii, tolerance=1e-9, time=1.0 + k,
+                                                                     axial_strain=0.01 * k))
+        out.append_cracks(crack, CRACK_UNITS)
+    data = viewer_data(tmp_path)
+    assert data["cracks"]["n"] == 2 and [s["n_cracks"] for s in data["snapshots"]] == [1, 2]
+    np.testing.assert_allclose(_decode(data["cracks"]["angle"], "f4"), 0.5 * np.pi, rtol=1e-6)  # vertical
+    chromium_or_skip()
+    page_file = write_viewer(tmp_path)
+    colour = """([x, y]) => {
+        const c = document.getElementById('grains'), r = c.getBoundingClientRect();
+        const k = 4 * (Math.floor((y - r.top) * c.height / r.height) * c.width + Math.floor((x - r.left) * c.width / r.width));
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        return [d[k], d[k + 1], d[k + 2]];
+    }"""
+    problems: list[str] = []
+    with _in_chromium(page_file, problems, []) as page:
+        # the crack centres sit between grains 10/11 (x 1.5 mm) and 80/81 (x 8.5 mm), at y = 5 mm
+        def at(x_m: float) -> list[int]:
+            x0, y0 = page.evaluate("grainlabViewer.clientPosition(0)")
+            x1, _ = page.evaluate("grainlabViewer.clientPosition(90)")
+            per_m = (x1 - x0) / 9e-3
+            return page.evaluate(colour, [x0 + (x_m - 1e-3) * per_m, y0 - (5e-3 - 1e-3) * per_m])
+
+        last = (at(1.5e-3), at(8.5e-3))
+        page.locator("#snapshot").fill("0")
+        first = (at(1.5e-3), at(8.5e-3))
+        label = page.inner_text("#strain-label")
+    # the test's own readbacks of the canvas draw chromium's hint to read it otherwise
+    assert [p for p in problems if not p.startswith("Canvas2D: Multiple readback")] == []
+    assert last[0][2] > 150 and last[0][0] < 100, last  # blue: the tension crack
+    assert last[1][0] > 150 and last[1][2] < 100, last  # red: the shear crack, broken by the last snapshot
+    assert first[0] == last[0] and first[1] != last[1], first  # not yet broken at the first
+    assert "1 cracks so far" in label

@@ -12,19 +12,14 @@ from matplotlib.ticker import MaxNLocator
 from numpy.typing import NDArray
 
 from grainlab import plot
+from grainlab.cement import crack_orientations
 
-__all__ = ["ROSE_BINS", "crack_figure", "crack_orientations"]
+__all__ = ["ROSE_BINS", "crack_figure"]
 
 #: Bins of the rose over [0, 180) degrees.
 ROSE_BINS = 18
 _MM = 1e3
 _MODES = (("tension", 1, "tab:blue"), ("shear", 0, "tab:red"))
-
-
-def crack_orientations(normal_x: NDArray[np.float64], normal_y: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Each crack's orientation in [0, pi): the line of the broken bond's section,
-    perpendicular to its normal (a crack opened by vertical tension runs horizontally)."""
-    return np.mod(np.arctan2(normal_y, normal_x) + 0.5 * np.pi, np.pi)
 
 
 def crack_figure(positions: NDArray[np.float64], radii: NDArray[np.float64],

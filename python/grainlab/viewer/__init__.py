@@ -52,6 +52,7 @@ _BODY = """<!DOCTYPE html>
   </label>
   <label><input type="checkbox" id="show-contacts"> contact network</label>
   <label><input type="checkbox" id="show-band" checked> shear band outline</label>
+  <label id="cracks-control" hidden><input type="checkbox" id="show-cracks" checked> cracks</label>
 </div>
 <div class="controls">
   <label>snapshot <input type="range" id="snapshot" min="0" max="0" step="1" value="0"></label>

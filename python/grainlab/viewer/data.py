@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from grainlab.analysis import match_ids
+from grainlab.cement import crack_orientations
 from grainlab.columns import (
     AXIAL_STRAIN,
     AXIAL_STRESS_PA,
@@ -115,6 +116,22 @@ def _finite(value: Any) -> float | None:
     return None if value is None or not math.isfinite(float(value)) else float(value)
 
 
+def _cracks(results: Any, snaps: list[Any]) -> tuple[dict[str, Any] | None, list[int]]:
+    """The run's crack records as the page draws them (None without any), and how many
+    had broken by each snapshot."""
+    cracks = results.cracks
+    if not cracks:
+        return None, [0] * len(snaps)
+    angle = crack_orientations(cracks["normal_x"], cracks["normal_y"])
+    grains = np.asarray(snaps[-1].radii)[np.asarray(snaps[-1].is_sample)]
+    data = {"n": int(len(angle)), "x": encode(cracks["x_m"], "f4"), "y": encode(cracks["y_m"], "f4"),
+            "angle": encode(angle, "f4"), "tension": encode(cracks["tension"], "u1"),
+            "half_length_m": 0.5 * float(np.median(grains))}
+    by = [len(angle) if snap.time is None else int(np.searchsorted(cracks["time_s"], snap.time, side="right"))
+          for snap in snaps]
+    return data, by
+
+
 def viewer_data(run: str | Path) -> dict[str, Any]:
     """Everything the page shows of ``run`` (a run folder or its ``run.h5``), JSON-ready.
 
@@ -138,7 +155,9 @@ def viewer_data(run: str | Path) -> dict[str, Any]:
             curve = {"x": x, "y": y, "xs": encode(xs[ok], "f4"), "ys": encode(ys[ok], "f4"), "n": int(ok.sum())}
             break
     bounds = np.array([_bounds(s) for s in snaps])
+    cracks, cracks_by = _cracks(results, snaps)
     return {
+        "cracks": cracks,
         "clumps": any(s.n_grains < s.n_particles for s in snaps),
         "title": f"{results.kind} run {h5.parent.name}",
         "source": str(h5),
@@ -148,7 +167,7 @@ def viewer_data(run: str | Path) -> dict[str, Any]:
         "strain_label": "shear strain" if curve is not None and curve["x"] == SHEAR_STRAIN else "axial strain",
         "curve": curve,
         "snapshots": [
-            _snapshot(name, snap, snaps[0], results.walls(name), index_dtype, products)
-            for name, snap in zip(names, snaps, strict=True)
+            {**_snapshot(name, snap, snaps[0], results.walls(name), index_dtype, products), "n_cracks": by}
+            for name, snap, by in zip(names, snaps, cracks_by, strict=True)
         ],
     }

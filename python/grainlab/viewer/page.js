@@ -86,6 +86,13 @@
   const mode = document.getElementById("mode");
   const showContacts = document.getElementById("show-contacts");
   const showBand = document.getElementById("show-band");
+  const showCracks = document.getElementById("show-cracks");
+  // a cemented run's broken bonds: one segment each along the crack, blue in tension, red in shear
+  const cracks = D.cracks ? {
+    x: decode(D.cracks.x, "f4"), y: decode(D.cracks.y, "f4"), angle: decode(D.cracks.angle, "f4"),
+    tension: decode(D.cracks.tension, "u1"), half: D.cracks.half_length_m,
+  } : null;
+  if (cracks) document.getElementById("cracks-control").hidden = false;
   const tip = document.getElementById("tip");
   const strainLabel = document.getElementById("strain-label");
   const legend = document.getElementById("legend");
@@ -185,6 +192,17 @@
       drawBand(s.meta.band.second);
       ctx.restore();
     }
+    if (cracks && showCracks.checked) {
+      ctx.lineWidth = 2;
+      for (let k = 0; k < s.meta.n_cracks; k++) {
+        const dx = cracks.half * Math.cos(cracks.angle[k]), dy = cracks.half * Math.sin(cracks.angle[k]);
+        ctx.strokeStyle = cracks.tension[k] ? "#1f77b4" : "#d62728";
+        ctx.beginPath();
+        ctx.moveTo(sx(cracks.x[k] - dx), sy(cracks.y[k] - dy));
+        ctx.lineTo(sx(cracks.x[k] + dx), sy(cracks.y[k] + dy));
+        ctx.stroke();
+      }
+    }
     if (hovered >= 0 && hovered < s.meta.n) {
       ctx.lineWidth = 2;
       ctx.strokeStyle = "#000000";
@@ -194,7 +212,7 @@
     }
     strainLabel.textContent = D.strain_label + " " + strainText(s) + " (" + s.meta.name + ", " + s.meta.n +
       " particles" + (s.meta.n_grains !== s.meta.n ? " in " + s.meta.n_grains + " grains" : "") + ", " +
-      s.meta.n_contacts + " contacts drawn)";
+      s.meta.n_contacts + " contacts drawn" + (cracks ? ", " + s.meta.n_cracks + " cracks so far" : "") + ")";
     legend.innerHTML = "";
     const bar = document.createElement("span");
     bar.className = "bar";
@@ -361,7 +379,7 @@
     draw();
   }
   slider.addEventListener("input", function () { show(Number(slider.value)); });
-  [mode, showContacts, showBand].forEach(function (el) { el.addEventListener("change", draw); });
+  [mode, showContacts, showBand, showCracks].forEach(function (el) { el.addEventListener("change", draw); });
   let timer = null;
   document.getElementById("play").addEventListener("click", function (ev) {
     if (timer) { clearInterval(timer); timer = null; ev.target.textContent = "\u25b6 play"; return; }
