@@ -321,15 +321,10 @@ def measure_study(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     failed rows left out). Fits are least squares (:func:`scipy.stats.linregress`)."""
     from scipy.stats import linregress
 
-    def series(kind: str | None, x: str, y: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        use = [r for r in rows if r.get("status") != "failed" and (kind is None or r.get("kind") == kind)]
-        xs = np.array([_finite(r.get(x)) for r in use])
-        ys = np.array([_finite(r.get(y)) for r in use])
-        ok = np.isfinite(xs) & np.isfinite(ys)
-        return xs[ok], ys[ok]
+    from grainlab.study.paper import packing_series
 
     def fit(kind: str | None, x: str, y: str = "mean_stability_index") -> dict[str, float]:
-        xs, ys = series(kind, x, y)
+        xs, ys = packing_series(rows, kind, x, y)
         if xs.size < 3 or np.ptp(xs) == 0:
             return {"slope": math.nan, "intercept": math.nan, "r2": math.nan, "n": int(xs.size)}
         if np.ptp(ys) == 0:
@@ -347,8 +342,8 @@ def measure_study(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
         out[f"lambda_vs_porosity_{label}"] = fit(kind, "porosity")
         out[f"lambda_vs_a_{label}"] = fit(kind, "anisotropy")
     # hexagonal against the irregular fit at the same Z, where the Z ranges overlap
-    irr_z, _ = series("irregular", "coordination_number", "mean_stability_index")
-    hex_z, hex_l = series("hexagonal", "coordination_number", "mean_stability_index")
+    irr_z, _ = packing_series(rows, "irregular", "coordination_number", "mean_stability_index")
+    hex_z, hex_l = packing_series(rows, "hexagonal", "coordination_number", "mean_stability_index")
     f = out["lambda_vs_z_irregular"]
     inside = (hex_z >= irr_z.min()) & (hex_z <= irr_z.max()) if irr_z.size else np.zeros(hex_z.size, bool)
     out["hexagonal_in_irregular_z_range"] = int(inside.sum())
@@ -364,7 +359,7 @@ def measure_study(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     diffs = [by_target["hexagonal"][t] - by_target["irregular"][t] for t in shared]
     diffs = [d for d in diffs if math.isfinite(d)]
     out["hexagonal_minus_irregular_at_porosity"] = float(np.mean(diffs)) if diffs else math.nan
-    _, irr_l = series("irregular", "coordination_number", "mean_stability_index")
+    _, irr_l = packing_series(rows, "irregular", "coordination_number", "mean_stability_index")
     out["hexagonal_minus_irregular_mean"] = (
         float(np.mean(hex_l) - np.mean(irr_l)) if hex_l.size and irr_l.size else math.nan
     )
