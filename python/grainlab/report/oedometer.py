@@ -5,7 +5,6 @@ records and the figures (:class:`~grainlab.report.run_page.ReportPage`)."""
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from grainlab._html import Markup, fmt, paragraph, table
@@ -19,6 +18,7 @@ from grainlab.columns import (
     VOID_RATIO,
 )
 from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA
+from grainlab.protocols.oedometer.outputs import write_outputs
 from grainlab.report.run_page import PageSection, ReportPage, RunPage
 
 __all__ = ["FIGURES", "PAGE"]
@@ -33,12 +33,6 @@ FIGURES = {
 #: The load path table's columns, those the run recorded shown.
 _PATH_COLUMNS = (TARGET_VERTICAL_STRESS_PA, VERTICAL_STRESS_PA, HORIZONTAL_STRESS_PA, LATERAL_STRESS_RATIO,
                  OVERCONSOLIDATION_RATIO, VOID_RATIO, COORDINATION_NUMBER, "mean_stability_index", "anisotropy")
-
-
-def _draw(folder: Path) -> None:
-    from grainlab.protocols.oedometer.outputs import write_outputs  # draws them from run.h5
-
-    write_outputs(folder)
 
 
 def _kpa(x: float) -> str:
@@ -84,7 +78,7 @@ def _unloading(r: RunPage) -> list[Any]:
 
 #: The oedometer test's page.
 PAGE = ReportPage(
-    OEDOMETER_SCHEMA.name, test="oedometer test", name="oedometer", figures=FIGURES, draw=_draw, glance=_glance,
+    OEDOMETER_SCHEMA.name, test="oedometer test", name="oedometer", figures=FIGURES, draw=write_outputs, glance=_glance,
     sections=(PageSection("path", "The load path", _load_path, with_figures=True),
               PageSection("unloading", "Unloading: K against OCR", _unloading)),
 )
