@@ -22,7 +22,6 @@ from grainlab.io.hdf5 import snapshot_strain
 
 if TYPE_CHECKING:
     from grainlab.analysis.per_body import BodyView
-    from grainlab.analysis.stability import StabilityIndex
     from grainlab.postprocess.products import RunProducts
 
 #: Analysis options a variant may set, with their defaults: how lambda counts the boundary
@@ -49,12 +48,6 @@ def _reading(options: Mapping[str, Any]) -> dict[str, Any]:
     return {"boundary": {"body": "body", "raw": "each"}[options.get("boundary_contacts", "body")],
             "slots": options.get("lambda_slots", "angular"), "anchor": options.get("lambda_anchor", "min"),
             "deviation": options.get("lambda_deviation", "sum")}
-
-
-def _stability(options: Mapping[str, Any]) -> StabilityIndex:
-    from grainlab.analysis.stability import StabilityIndex
-
-    return StabilityIndex(**_reading(options))
 
 
 def _finite(x: Any) -> float:
@@ -380,6 +373,7 @@ def read_study_rows(folder: str | Path, options: Mapping[str, Any] | None = None
 
 def read_study_rows_each(folder: str | Path, options: Sequence[Mapping[str, Any]]) -> list[list[dict[str, Any]]]:
     """:func:`read_study_rows` under each of ``options``, each packing read once."""
+    from grainlab.analysis.stability import StabilityIndex
     from grainlab.study.packing import read_packing
 
     for given in options:
@@ -396,7 +390,7 @@ def read_study_rows_each(folder: str | Path, options: Sequence[Mapping[str, Any]
         snap = read_packing(path.parent) if measured else None
         for rows, given in zip(out, options, strict=True):
             if given and snap is not None:
-                stability = _stability(given).compute(snap)
+                stability = StabilityIndex(**_reading(given)).compute(snap)
                 rows.append({**row, "mean_stability_index": stability.mean,
                              "mean_stability_index_all": stability.mean_all})
             else:
