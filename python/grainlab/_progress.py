@@ -22,10 +22,6 @@ def set_verbose(verbose: bool) -> None:
     _verbose = bool(verbose)
 
 
-def is_verbose() -> bool:
-    return _verbose
-
-
 def _is_terminal(stream: TextIO) -> bool:
     try:
         return bool(stream.isatty())
@@ -147,4 +143,4 @@ def progress_bar(total: float, desc: str, *, enabled: bool = False, unit: str = 
     return _Lines(total, desc, initial, stream)
 
 
-__all__ = ["progress_bar", "set_verbose", "is_verbose", "MILESTONES", "VERBOSE_MILESTONES"]
+__all__ = ["progress_bar", "set_verbose", "MILESTONES", "VERBOSE_MILESTONES"]

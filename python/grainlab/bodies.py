@@ -52,14 +52,18 @@ class ClumpMassProperties:
     body_offsets_m: NDArray[np.float64]
 
 
-def _points(name: str, value: ArrayLike) -> NDArray[np.float64]:
-    array = np.ascontiguousarray(value, dtype=np.float64)
+def _points(name: str, value: ArrayLike, n: int | None = None) -> NDArray[np.float64]:
+    try:
+        array = np.ascontiguousarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name}: expected an (N, 2) array of numbers ({error})") from None
     if array.ndim != 2 or array.shape[1] != 2:
         raise ValueError(f"{name}: expected shape (N, 2), got {array.shape}")
-    if not np.isfinite(array).all():
-        raise ValueError(
-            f"{name}: must be finite, got {array[~np.isfinite(array).all(axis=1)][0].tolist()}"
-        )
+    if n is not None and len(array) != n:
+        raise ValueError(f"{name}: has {len(array)} rows but there are {n} particles")
+    if not np.all(np.isfinite(array)):
+        k = int(np.argwhere(~np.isfinite(array))[0, 0])
+        raise ValueError(f"{name}[{k}]: must be finite, got {array[k].tolist()}")
     return array
 
 

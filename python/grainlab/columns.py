@@ -139,6 +139,8 @@ FABRIC = (
     Column("force_anisotropy", "1", "normal-force anisotropy a_n (exact estimate, Eq. 8)"),
     Column("force_anisotropy_binned", "1", "normal-force anisotropy, Eq. 8 on 18 bins"),
 )
+#: What every test records after its own columns: the stress, Z, the energy ledger and the fabric.
+EVERY_TEST = (*LOVE_WEBER, COORDINATION_NUMBER, UNBALANCED_FORCE_RATIO, *ENERGY, *FABRIC)
 
 # ---- the biaxial test's ------------------------------------------------------------
 CONFINING_PRESSURE_PA = Column("confining_pressure_pa", "Pa", "confining pressure sigma_3 applied")
@@ -151,10 +153,7 @@ BIAXIAL = Columns(
     "biaxial",
     (STEP, TIME_S, AXIAL_STRAIN, AXIAL_STRESS_PA, CONFINING_PRESSURE_PA, CONFINING_STRESS_FELT_PA,
      STRESS_RATIO, STRESS_RATIO_MOBILISED, VOLUMETRIC_STRAIN, AREA_M2, HEIGHT_M),
-    LOVE_WEBER,
-    (COORDINATION_NUMBER, UNBALANCED_FORCE_RATIO),
-    ENERGY,
-    FABRIC,
+    EVERY_TEST,
 )
 
 # ---- the oedometer's ---------------------------------------------------------------
@@ -173,10 +172,7 @@ OEDOMETER = Columns(
     (STEP, TIME_S, TARGET_VERTICAL_STRESS_PA, VERTICAL_STRESS_PA, HORIZONTAL_STRESS_PA, LATERAL_STRESS_RATIO,
      MAX_VERTICAL_STRESS_PA, OVERCONSOLIDATION_RATIO, AXIAL_STRAIN, VOLUMETRIC_STRAIN, POROSITY, VOID_RATIO,
      HEIGHT_M, AREA_M2),
-    LOVE_WEBER,
-    (COORDINATION_NUMBER, UNBALANCED_FORCE_RATIO),
-    ENERGY,
-    FABRIC,
+    EVERY_TEST,
 )
 
 # ---- the cyclic biaxial test's ------------------------------------------------------
@@ -204,10 +200,7 @@ SIMPLE_SHEAR = Columns(
     "simple_shear",
     (STEP, TIME_S, SHEAR_STRAIN, SHEAR_STRESS_PA, NORMAL_STRESS_PA, LATERAL_NORMAL_STRESS_PA, FRICTION_COEFFICIENT,
      INERTIAL_NUMBER, VOLUMETRIC_STRAIN, POROSITY, VOID_RATIO, AREA_M2, HEIGHT_M, CELL_TILT, KINETIC_STRESS_RATIO),
-    LOVE_WEBER,
-    (COORDINATION_NUMBER, UNBALANCED_FORCE_RATIO),
-    ENERGY,
-    FABRIC,
+    EVERY_TEST,
     (RB_STRESS_RATIO, RB_PREDICTED, RB_RESIDUAL),
 )
 

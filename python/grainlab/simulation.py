@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from grainlab import _core, paper
-from grainlab.bodies import ClumpState, clump_mass_properties
+from grainlab.bodies import ClumpState, _points, clump_mass_properties
 from grainlab.cement import BondBreaks, CementBonds, cement_arguments
 from grainlab.snapshot import GRAIN_ANGLE_FIELD, GRAIN_CENTROID_FIELD, GRAIN_FIELD, Snapshot
 
@@ -273,21 +273,6 @@ def _readonly(array: object) -> NDArray[Any]:
     marked = np.asarray(array)
     marked.flags.writeable = False
     return marked
-
-
-def _points(name: str, value: ArrayLike, n: int | None = None) -> NDArray[np.float64]:
-    try:
-        array = np.ascontiguousarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"{name}: expected an (N, 2) array of numbers ({error})") from None
-    if array.ndim != 2 or array.shape[1] != 2:
-        raise ValueError(f"{name}: expected shape (N, 2), got {array.shape}")
-    if n is not None and len(array) != n:
-        raise ValueError(f"{name}: has {len(array)} rows but there are {n} particles")
-    if not np.all(np.isfinite(array)):
-        k = int(np.argwhere(~np.isfinite(array))[0, 0])
-        raise ValueError(f"{name}[{k}]: must be finite, got {array[k].tolist()}")
-    return array
 
 
 def _values(name: str, value: ArrayLike, n: int, dtype: Any = np.float64) -> NDArray[Any]:

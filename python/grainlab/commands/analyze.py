@@ -276,31 +276,32 @@ def _read_input(args: argparse.Namespace, columns: Any, particle_columns: Any, b
     return snapshot
 
 
+def _f(x: float | None, fmt: str = ".3f") -> str:
+    """A number of the summary line (``n/a`` for None)."""
+    return "n/a" if x is None else format(x, fmt)
+
+
 def _summary_line(s: dict[str, Any]) -> str:
     """The printed line of ``grainlab analyze``: the fabric, and what was measured beyond it."""
-
-    def f(x: float | None, fmt: str = ".3f") -> str:
-        return "n/a" if x is None else format(x, fmt)
-
     line = (
         f"grainlab analyze: {s['n_particles']} particles, {s['n_contacts']} contacts, "
-        f"Z = {f(s['Z'])}, "
-        f"Zm = {f(s['mechanical_Z'])}, a = {f(s['a'])}, a_n = {f(s['a_n'])}, "
-        f"mean lambda = {f(s['mean_lambda'])}"
+        f"Z = {_f(s['Z'])}, "
+        f"Zm = {_f(s['mechanical_Z'])}, a = {_f(s['a'])}, a_n = {_f(s['a_n'])}, "
+        f"mean lambda = {_f(s['mean_lambda'])}"
     )
     if "lambda_reading" in s:  # said only when not the default reading
         line += f" ({s['lambda_reading']})"
     if s.get("strong_deviatoric_share") is not None:
         line += (
-            f", strong network's share of q = {f(s['strong_deviatoric_share'], '.2f')}, "
-            f"q/p = {f(s['rb_stress_ratio'])} (R-B {f(s['rb_predicted_stress_ratio'])}), "
+            f", strong network's share of q = {_f(s['strong_deviatoric_share'], '.2f')}, "
+            f"q/p = {_f(s['rb_stress_ratio'])} (R-B {_f(s['rb_predicted_stress_ratio'])}), "
             f"{s['chains_n_chains']} force chains"
         )
     if s["band_angle_deg"] is not None:
         line += (
-            f", band {f(s['band_angle_deg'], '.1f')} deg x "
-            f"{f(s['band_thickness_diameters'], '.1f')} d, "
-            f"lambda in/out {f(s['mean_lambda_in_band'])}/{f(s['mean_lambda_outside_band'])}"
+            f", band {_f(s['band_angle_deg'], '.1f')} deg x "
+            f"{_f(s['band_thickness_diameters'], '.1f')} d, "
+            f"lambda in/out {_f(s['mean_lambda_in_band'])}/{_f(s['mean_lambda_outside_band'])}"
         )
     return line + _bodies_line(s)
 
@@ -309,12 +310,8 @@ def _bodies_line(s: dict[str, Any]) -> str:
     """The measures per body of a snapshot of clumps for the summary line ("" for disks)."""
     if "n_bodies" not in s:
         return ""
-
-    def f(x: float | None) -> str:
-        return "n/a" if x is None else format(x, ".3f")
-
     return (
-        f"; {s['n_bodies']} bodies ({s['n_clumps']} clumps): Z = {f(s['body_Z'])}, "
-        f"Z_c = {f(s['body_Z_c'])}, Zm = {f(s['body_mechanical_Z'])}, a = {f(s['body_a'])}, "
-        f"mean lambda = {f(s['body_mean_lambda'])}, orientation a_p = {f(s['body_orientation_a'])}"
+        f"; {s['n_bodies']} bodies ({s['n_clumps']} clumps): Z = {_f(s['body_Z'])}, "
+        f"Z_c = {_f(s['body_Z_c'])}, Zm = {_f(s['body_mechanical_Z'])}, a = {_f(s['body_a'])}, "
+        f"mean lambda = {_f(s['body_mean_lambda'])}, orientation a_p = {_f(s['body_orientation_a'])}"
     )

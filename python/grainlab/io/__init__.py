@@ -104,42 +104,25 @@ _PathOrNone = str | Path | None
 _Columns = Mapping[str, str] | None
 
 
-def _no_timestep(fmt: str, timestep: int | None) -> None:
-    if timestep is not None:
-        raise ValueError(f"timestep: only applies to LAMMPS dumps and run.h5, not to a {fmt}")
-
-
-def _table_reader(fmt: str, read: Callable[..., Snapshot]) -> Callable[..., Snapshot]:
-    """The :data:`READERS` entry of a particles table (CSV, PFC) read by ``read``."""
+def _reader(fmt: str, read: Callable[..., Snapshot], *, alone: bool = False) -> Callable[..., Snapshot]:
+    """The :data:`READERS` entry of a particles table (CSV, PFC) read by ``read``, or
+    with ``alone`` of a file read alone, its contacts detected from the geometry
+    (YADE, legacy VTK): ``read(path, tolerance, boundary_types)``."""
 
     def reader(
         path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None,
         tolerance: float = 0.0, columns: _Columns = None, boundary_types: Sequence[int] = (),
         particle_columns: _Columns = None,
     ) -> Snapshot:
-        _no_timestep(fmt, timestep)
-        if len(boundary_types):
-            raise ValueError(
-                "boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column)"
-            )
-        return read(path, contacts=contacts, tolerance=tolerance, columns=particle_columns,
-                    contact_columns=columns)
-
-    return reader
-
-
-def _points_reader(
-    fmt: str, read: Callable[[Path, float, Sequence[int]], Snapshot]
-) -> Callable[..., Snapshot]:
-    """The :data:`READERS` entry of a file read alone, its contacts detected from the
-    geometry (YADE, legacy VTK): ``read(path, tolerance, boundary_types)``."""
-
-    def reader(
-        path: Path, *, contacts: _PathOrNone = None, timestep: int | None = None,
-        tolerance: float = 0.0, columns: _Columns = None, boundary_types: Sequence[int] = (),
-        particle_columns: _Columns = None,
-    ) -> Snapshot:
-        _no_timestep(fmt, timestep)
+        if timestep is not None:
+            raise ValueError(f"timestep: only applies to LAMMPS dumps and run.h5, not to a {fmt}")
+        if not alone:
+            if len(boundary_types):
+                raise ValueError(
+                    "boundary types: only apply to LAMMPS dumps and VTK files (use a 'kind' column)"
+                )
+            return read(path, contacts=contacts, tolerance=tolerance, columns=particle_columns,
+                        contact_columns=columns)
         for name, value in (("contacts", contacts), ("contact columns", columns),
                             ("particle columns", particle_columns)):
             if value:
@@ -178,13 +161,14 @@ def _read_dump(
 #: Reader per format name: ``reader(path, *, contacts, timestep, tolerance, columns,
 #: boundary_types, particle_columns) -> Snapshot``.
 READERS: dict[str, Callable[..., Snapshot]] = {
-    "particles-csv": _table_reader("particles CSV", read_particles_csv),
-    "pfc-csv": _table_reader("PFC ball table", read_pfc_balls),
+    "particles-csv": _reader("particles CSV", read_particles_csv),
+    "pfc-csv": _reader("PFC ball table", read_pfc_balls),
     "lammps-dump": _read_dump,
-    "yade-text": _points_reader("YADE text export", _yade),
-    "legacy-vtk": _points_reader(
+    "yade-text": _reader("YADE text export", _yade, alone=True),
+    "legacy-vtk": _reader(
         "legacy VTK file",
         lambda path, tol, types: read_legacy_vtk(path, tolerance=tol, boundary_types=types),
+        alone=True,
     ),
     "grainlab-hdf5": read_hdf5_snapshot,
 }

@@ -13,6 +13,7 @@ from grainlab.io._table import (
     FileFormatError,
     check_geometry,
     check_unique_ids,
+    integral_column,
     plain,
     refuse_first,
 )
@@ -53,7 +54,7 @@ def snapshot_from_points(
     positions: NDArray[np.float64],
     z: NDArray[np.float64] | None,
     radii: NDArray[np.float64],
-    ids: NDArray[np.int64],
+    id_column: NDArray[np.float64] | None,
     *,
     kind: NDArray[np.int8] | None,
     fields: dict[str, NDArray[Any]],
@@ -66,10 +67,13 @@ def snapshot_from_points(
 
     ``line_numbers`` name the file line of each row in errors (``None``
     entries are not allowed: pass the first data line for files without rows
-    per particle). ``kind`` None means every particle a grain.
+    per particle). ``id_column`` is the file's id column (whole numbers), None for
+    0..N-1; ``kind`` None means every particle a grain.
     """
     if radii.shape[0] == 0:
         raise FileFormatError(path, None, "no particles in the file")
+    ids = (np.arange(radii.shape[0], dtype=np.int64) if id_column is None
+           else integral_column(path, id_column, line_numbers, "id"))
     check_unique_ids(path, ids, line_numbers)
     refuse_first(path, ~(radii > 0), line_numbers, lambda k: f"radius {plain(radii[k])} is not > 0")
     if not (0 <= tolerance < np.inf):

@@ -285,11 +285,6 @@ def read_legacy_vtk(
             "dump the radius, or name its array with radius_array="
         )
     numbers = point_lines
-    ids = (
-        integral_column(p, arrays["id"], numbers, "id")
-        if "id" in arrays
-        else np.arange(points.shape[0], dtype=np.int64)
-    )
     kind = None
     if len(boundary_types):
         if "type" not in arrays:
@@ -302,7 +297,7 @@ def read_legacy_vtk(
         points[:, :2].copy(),
         points[:, 2].copy(),
         arrays[radius_array],
-        ids,
+        arrays.get("id"),
         kind=kind,
         fields=fields,
         metadata={"source": str(p), "format": "legacy-vtk", "vtk_version": version},

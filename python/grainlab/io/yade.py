@@ -92,11 +92,6 @@ def read_yade_text(
     if table.shape[0] == 0:
         raise FileFormatError(p, None, "no sphere lines after the header")
     col = {n: table[:, k] for k, n in enumerate(names)}
-    ids = (
-        integral_column(p, col["id"], numbers, "id")
-        if "id" in col
-        else np.arange(table.shape[0], dtype=np.int64)
-    )
     fields: dict[str, NDArray[np.generic]] = {
         n: v for n, v in col.items() if n not in ("id", "x", "y", "z", "radius")
     }
@@ -117,7 +112,7 @@ def read_yade_text(
         np.c_[col["x"], col["y"]],
         col["z"],
         col["radius"],
-        ids,
+        col.get("id"),
         kind=kind,
         fields=fields,
         metadata={"source": str(p), "format": "yade-text", "yade_format": fmt},

@@ -107,8 +107,7 @@ class FabricNumbers:
         return self.band is not None and self.band.found
 
     def _of_found_band(self, name: str) -> float:
-        found = self.band is not None and self.band.found
-        return float(getattr(self.band, name)) if found else math.nan
+        return float(getattr(self.band, name)) if self.band_found else math.nan
 
     @property
     def band_angle_deg(self) -> float:

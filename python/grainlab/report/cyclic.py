@@ -5,12 +5,12 @@ anisotropy), the loops and the fabric over the cycles
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from grainlab._html import fmt, paragraph, table
 from grainlab.columns import COORDINATION_NUMBER, VOLUMETRIC_STRAIN
 from grainlab.protocols.cyclic.config import CYCLIC_SCHEMA
+from grainlab.protocols.cyclic.outputs import write_outputs
 from grainlab.report.run_page import PageSection, ReportPage, RunPage
 
 __all__ = ["FIGURES", "PAGE"]
@@ -23,12 +23,6 @@ FIGURES = {
                                  "index lambda and contact-normal anisotropy a at every record; markers at the "
                                  "start and at the end of each cycle (axial strain back to 0)."),
 }
-
-
-def _draw(folder: Path) -> None:
-    from grainlab.protocols.cyclic.outputs import write_outputs  # draws them from run.h5
-
-    write_outputs(folder)
 
 
 def _amplitude(s: dict[str, Any]) -> str:
@@ -79,6 +73,6 @@ def _cycles(r: RunPage) -> list[Any]:
 
 #: The cyclic biaxial test's page.
 PAGE = ReportPage(
-    CYCLIC_SCHEMA.name, test="cyclic biaxial test", name="cyclic", figures=FIGURES, draw=_draw, glance=_glance,
+    CYCLIC_SCHEMA.name, test="cyclic biaxial test", name="cyclic", figures=FIGURES, draw=write_outputs, glance=_glance,
     sections=(PageSection("cycles", "The cycles", _cycles, with_figures=True),),
 )

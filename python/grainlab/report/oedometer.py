@@ -5,7 +5,6 @@ records and the figures (:class:`~grainlab.report.run_page.ReportPage`)."""
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from grainlab._html import Markup, fmt, paragraph, table
@@ -19,6 +18,7 @@ from grainlab.columns import (
     VOID_RATIO,
 )
 from grainlab.protocols.oedometer.config import OEDOMETER_SCHEMA
+from grainlab.protocols.oedometer.outputs import write_outputs
 from grainlab.report.run_page import PageSection, ReportPage, RunPage
 
 __all__ = ["FIGURES", "PAGE"]
@@ -35,16 +35,6 @@ _PATH_COLUMNS = (TARGET_VERTICAL_STRESS_PA, VERTICAL_STRESS_PA, HORIZONTAL_STRES
                  OVERCONSOLIDATION_RATIO, VOID_RATIO, COORDINATION_NUMBER, "mean_stability_index", "anisotropy")
 
 
-def _draw(folder: Path) -> None:
-    from grainlab.protocols.oedometer.outputs import write_outputs  # draws them from run.h5
-
-    write_outputs(folder)
-
-
-def _kpa(x: float) -> str:
-    return fmt(x / 1e3, 4, unit="kPa")
-
-
 def _glance(r: RunPage) -> list[tuple[str, str]]:
     s = r.summary
     jaky = s.get("k0_jaky")
@@ -55,7 +45,7 @@ def _glance(r: RunPage) -> list[tuple[str, str]]:
         ("K0 on first loading", f"{fmt(s['k0_loading'], 3)} ({s['k0_rule']})"),
         ("Jaky's K0 = 1 - sin phi'", "no phi' given (oedometer.friction_angle)" if jaky is None
          else f"{fmt(jaky, 3)} for phi' = {fmt(s.get('friction_angle_deg'), 3)} deg"),
-        ("largest vertical stress", _kpa(s["max_vertical_stress_pa"])),
+        ("largest vertical stress", fmt(s["max_vertical_stress_pa"] / 1e3, 4, unit="kPa")),
         ("K at the end", f"{fmt(s['lateral_stress_ratio_final'], 3)} at OCR {fmt(s['overconsolidation_ratio_final'], 3)}"),
         ("wall time", fmt(s["wall_time_s"], 3, unit="s")),
     ]
@@ -84,7 +74,7 @@ def _unloading(r: RunPage) -> list[Any]:
 
 #: The oedometer test's page.
 PAGE = ReportPage(
-    OEDOMETER_SCHEMA.name, test="oedometer test", name="oedometer", figures=FIGURES, draw=_draw, glance=_glance,
+    OEDOMETER_SCHEMA.name, test="oedometer test", name="oedometer", figures=FIGURES, draw=write_outputs, glance=_glance,
     sections=(PageSection("path", "The load path", _load_path, with_figures=True),
               PageSection("unloading", "Unloading: K against OCR", _unloading)),
 )

@@ -48,10 +48,6 @@ def _notes(notes: list[str]) -> Markup:
     return Markup("<ul>" + "".join(f"<li>{escape(n)}</li>" for n in notes) + "</ul>\n")
 
 
-def _details(summary_text: str, body: Markup) -> Markup:
-    return Markup(f"<details><summary>{escape(summary_text)}</summary>{body}</details>\n")
-
-
 def _header(title: str, lines: list[Any]) -> Markup:
     body = "".join(f"<p>{escape(line)}</p>" for line in lines)
     return Markup(f"<h1>{escape(title)}</h1>{body}")
@@ -227,7 +223,8 @@ def _rerun_section(r: BiaxialReport) -> tuple[str, str, Markup]:
     rerun_parts += [
         paragraph("Or with the whole resolved configuration in a file:"),
         code_block(r.rerun.command_with_file),
-        _details("config.toml (the resolved configuration)", code_block(r.rerun.toml)),
+        Markup(f"<details><summary>config.toml (the resolved configuration)</summary>{code_block(r.rerun.toml)}"
+               "</details>\n"),
         paragraph(f"Rebuild this report: grainlab report {shlex.quote(str(r.folder.resolve()))}", "note"),
     ]
     return section("rerun", "How to rerun", *rerun_parts)

@@ -5,11 +5,11 @@ Rothenburg-Bathurst residual over every record and the figures
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from grainlab._html import fmt, paragraph
 from grainlab.protocols.simple_shear.config import SIMPLE_SHEAR_SCHEMA
+from grainlab.protocols.simple_shear.outputs import write_outputs
 from grainlab.report.run_page import PageSection, ReportPage, RunPage
 
 __all__ = ["FIGURES", "PAGE"]
@@ -27,12 +27,6 @@ FIGURES = {
                           "tau = mu sigma_n, and the normal stress against the shear strain: at constant volume, "
                           "the undrained test's path."),
 }
-
-
-def _draw(folder: Path) -> None:
-    from grainlab.protocols.simple_shear.outputs import write_outputs  # draws them from run.h5
-
-    write_outputs(folder)
 
 
 def _held(s: dict[str, Any]) -> str:
@@ -75,6 +69,6 @@ def _shearing(r: RunPage) -> list[Any]:
 
 #: The periodic simple-shear test's page.
 PAGE = ReportPage(
-    SIMPLE_SHEAR_SCHEMA.name, test="periodic simple-shear test", name="simple-shear", figures=FIGURES, draw=_draw,
+    SIMPLE_SHEAR_SCHEMA.name, test="periodic simple-shear test", name="simple-shear", figures=FIGURES, draw=write_outputs,
     glance=_glance, sections=(PageSection("shear", "Shearing", _shearing, with_figures=True),),
 )

@@ -28,6 +28,8 @@ from grainlab.study.paper import (
     HEXAGONAL_POROSITIES,
     IRREGULAR_POROSITIES,
     linear_fit,
+    number_or_nan,
+    packing_series,
     study_figures,
 )
 
@@ -103,25 +105,8 @@ def read_study_table(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     return columns, rows
 
 
-def _float(text: Any) -> float:
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return math.nan
-
-
-def _series(rows: list[dict[str, str]], kind: str | None, x: str, y: str) -> tuple[np.ndarray, np.ndarray]:
-    pts = [
-        (_float(r.get(x)), _float(r.get(y)))
-        for r in rows
-        if (kind is None or r.get("kind") == kind) and r.get("status") != "failed"
-    ]
-    arr = np.array([p for p in pts if math.isfinite(p[0]) and math.isfinite(p[1])], dtype=float).reshape(-1, 2)
-    return arr[:, 0], arr[:, 1]
-
-
 def _fit_text(rows: list[dict[str, str]], kind: str | None, x: str) -> str:
-    xs, ys = _series(rows, kind, x, "mean_stability_index")
+    xs, ys = packing_series(rows, kind, x, "mean_stability_index")
     fit = linear_fit(xs, ys)
     label = kind or "all packings"
     if not math.isfinite(fit["slope"]):
@@ -134,8 +119,8 @@ def _claims(rows: list[dict[str, str]], summary: dict[str, Any]) -> list[tuple[s
     run["lambda_vs_z"] = "; ".join(
         _fit_text(rows, k, "coordination_number") for k in ("irregular", "hexagonal", None)
     )
-    zi, li = _series(rows, "irregular", "coordination_number", "mean_stability_index")
-    zh, lh = _series(rows, "hexagonal", "coordination_number", "mean_stability_index")
+    zi, li = packing_series(rows, "irregular", "coordination_number", "mean_stability_index")
+    zh, lh = packing_series(rows, "hexagonal", "coordination_number", "mean_stability_index")
     if li.size and lh.size:
         overlap = int(np.sum((zh >= zi.min()) & (zh <= zi.max())))
         run["hexagonal_lower"] = (
@@ -150,11 +135,12 @@ def _claims(rows: list[dict[str, str]], summary: dict[str, Any]) -> list[tuple[s
     run["lambda_vs_porosity"] = "; ".join(_fit_text(rows, k, "porosity") for k in ("irregular", "hexagonal"))
     fit = summary.get("fig17_fit") or {}
     if not fit:
-        xs, ys = _series(rows, None, "anisotropy", "mean_stability_index")
+        xs, ys = packing_series(rows, None, "anisotropy", "mean_stability_index")
         fit = linear_fit(xs, ys)
     text = (
-        f"all packings: λ = {fmt(_float(fit.get('slope')), 3)} a + {fmt(_float(fit.get('intercept')), 3)}, "
-        f"R² {fmt(_float(fit.get('r2')), 3)} (Eq. 7's a)"
+        f"all packings: λ = {fmt(number_or_nan(fit.get('slope')), 3)} a + "
+        f"{fmt(number_or_nan(fit.get('intercept')), 3)}, "
+        f"R² {fmt(number_or_nan(fit.get('r2')), 3)} (Eq. 7's a)"
     )
     text += "; " + _fit_text(rows, None, "anisotropy_fourier").replace("all packings", "on the unbinned a")
     run["lambda_vs_a"] = text
@@ -162,7 +148,7 @@ def _claims(rows: list[dict[str, str]], summary: dict[str, Any]) -> list[tuple[s
 
 
 def _targets(rows: list[dict[str, str]], kind: str) -> list[float]:
-    return [_float(r.get("porosity_target")) for r in rows if r.get("kind") == kind]
+    return [number_or_nan(r.get("porosity_target")) for r in rows if r.get("kind") == kind]
 
 
 def _same(a: list[float], b: tuple[float, ...]) -> bool:

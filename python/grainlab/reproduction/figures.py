@@ -170,10 +170,9 @@ def _band_figure(runs: Sequence[Measures], title: str) -> Figure:
             _band_plot(ax, runs, f"inside_{name}", "inside the band", "crimson")
             _band_plot(ax, runs, f"outside_{name}", "outside", "C0")
             ax.set_ylabel(ylabel)
-        axes[0].axhline(0.34, color="crimson", linestyle=":", linewidth=0.8)
-        axes[0].axhline(0.31, color="C0", linestyle=":", linewidth=0.8)
-        axes[1].axhline(0.34, color="crimson", linestyle=":", linewidth=0.8)
-        axes[1].axhline(0.31, color="C0", linestyle=":", linewidth=0.8)
+        for ax in axes[:2]:  # the paper's band and rest lambda
+            ax.axhline(0.34, color="crimson", linestyle=":", linewidth=0.8)
+            ax.axhline(0.31, color="C0", linestyle=":", linewidth=0.8)
         _band_plot(axes[5], runs, "auc_lambda", r"per-grain $\lambda$, band at this strain", "C3")
         _band_plot(axes[5], runs, "auc_lambda_field", r"$\lambda$ field (2 d), band at this strain", "C4")
         _band_plot(axes[5], runs, "auc_lambda_peak_band", r"per-grain $\lambda$, the peak's band", "C5")
@@ -358,10 +357,9 @@ def draw_figures(plan: ReproductionPlan, results: Mapping[tuple[str, str, str], 
             drawn[f"study_{stem}"] = _save(_study_figure(runs, f"{v.name}: packing study"), out / f"study_{stem}.png")
             continue
         title = f"{v.name}, {len(runs)} seeds"
-        drawn[f"macro_{stem}"] = _save(_macro_figure(runs, title), out / f"macro_{stem}.png")
-        drawn[f"fabric_{stem}"] = _save(_fabric_figure(runs, title), out / f"fabric_{stem}.png")
-        drawn[f"band_{stem}"] = _save(_band_figure(runs, title), out / f"band_{stem}.png")
-        drawn[f"strata_{stem}"] = _save(_strata_figure(runs, title), out / f"strata_{stem}.png")
+        for name, draw in (("macro", _macro_figure), ("fabric", _fabric_figure), ("band", _band_figure),
+                           ("strata", _strata_figure)):
+            drawn[f"{name}_{stem}"] = _save(draw(runs, title), out / f"{name}_{stem}.png")
     if runs_root is not None and any(v.name.startswith("band:") for v in plan.variants):
         first = plan.biaxial_folder(runs_root, plan.variant("paper"), plan.seeds[0])
         if (first / "run.h5").exists():

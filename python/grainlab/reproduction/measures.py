@@ -22,7 +22,6 @@ from grainlab.io.hdf5 import snapshot_strain
 
 if TYPE_CHECKING:
     from grainlab.analysis.per_body import BodyView
-    from grainlab.analysis.stability import StabilityIndex
     from grainlab.postprocess.products import RunProducts
 
 #: Analysis options a variant may set, with their defaults: how lambda counts the boundary
@@ -49,12 +48,6 @@ def _reading(options: Mapping[str, Any]) -> dict[str, Any]:
     return {"boundary": {"body": "body", "raw": "each"}[options.get("boundary_contacts", "body")],
             "slots": options.get("lambda_slots", "angular"), "anchor": options.get("lambda_anchor", "min"),
             "deviation": options.get("lambda_deviation", "sum")}
-
-
-def _stability(options: Mapping[str, Any]) -> StabilityIndex:
-    from grainlab.analysis.stability import StabilityIndex
-
-    return StabilityIndex(**_reading(options))
 
 
 def _finite(x: Any) -> float:
@@ -321,15 +314,10 @@ def measure_study(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     failed rows left out). Fits are least squares (:func:`scipy.stats.linregress`)."""
     from scipy.stats import linregress
 
-    def series(kind: str | None, x: str, y: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        use = [r for r in rows if r.get("status") != "failed" and (kind is None or r.get("kind") == kind)]
-        xs = np.array([_finite(r.get(x)) for r in use])
-        ys = np.array([_finite(r.get(y)) for r in use])
-        ok = np.isfinite(xs) & np.isfinite(ys)
-        return xs[ok], ys[ok]
+    from grainlab.study.paper import packing_series
 
     def fit(kind: str | None, x: str, y: str = "mean_stability_index") -> dict[str, float]:
-        xs, ys = series(kind, x, y)
+        xs, ys = packing_series(rows, kind, x, y)
         if xs.size < 3 or np.ptp(xs) == 0:
             return {"slope": math.nan, "intercept": math.nan, "r2": math.nan, "n": int(xs.size)}
         if np.ptp(ys) == 0:
@@ -347,8 +335,8 @@ def measure_study(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
         out[f"lambda_vs_porosity_{label}"] = fit(kind, "porosity")
         out[f"lambda_vs_a_{label}"] = fit(kind, "anisotropy")
     # hexagonal against the irregular fit at the same Z, where the Z ranges overlap
-    irr_z, _ = series("irregular", "coordination_number", "mean_stability_index")
-    hex_z, hex_l = series("hexagonal", "coordination_number", "mean_stability_index")
+    irr_z, _ = packing_series(rows, "irregular", "coordination_number", "mean_stability_index")
+    hex_z, hex_l = packing_series(rows, "hexagonal", "coordination_number", "mean_stability_index")
     f = out["lambda_vs_z_irregular"]
     inside = (hex_z >= irr_z.min()) & (hex_z <= irr_z.max()) if irr_z.size else np.zeros(hex_z.size, bool)
     out["hexagonal_in_irregular_z_range"] = int(inside.sum())
@@ -364,7 +352,7 @@ def measure_study(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     diffs = [by_target["hexagonal"][t] - by_target["irregular"][t] for t in shared]
     diffs = [d for d in diffs if math.isfinite(d)]
     out["hexagonal_minus_irregular_at_porosity"] = float(np.mean(diffs)) if diffs else math.nan
-    _, irr_l = series("irregular", "coordination_number", "mean_stability_index")
+    _, irr_l = packing_series(rows, "irregular", "coordination_number", "mean_stability_index")
     out["hexagonal_minus_irregular_mean"] = (
         float(np.mean(hex_l) - np.mean(irr_l)) if hex_l.size and irr_l.size else math.nan
     )
@@ -385,6 +373,7 @@ def read_study_rows(folder: str | Path, options: Mapping[str, Any] | None = None
 
 def read_study_rows_each(folder: str | Path, options: Sequence[Mapping[str, Any]]) -> list[list[dict[str, Any]]]:
     """:func:`read_study_rows` under each of ``options``, each packing read once."""
+    from grainlab.analysis.stability import StabilityIndex
     from grainlab.study.packing import read_packing
 
     for given in options:
@@ -401,7 +390,7 @@ def read_study_rows_each(folder: str | Path, options: Sequence[Mapping[str, Any]
         snap = read_packing(path.parent) if measured else None
         for rows, given in zip(out, options, strict=True):
             if given and snap is not None:
-                stability = _stability(given).compute(snap)
+                stability = StabilityIndex(**_reading(given)).compute(snap)
                 rows.append({**row, "mean_stability_index": stability.mean,
                              "mean_stability_index_all": stability.mean_all})
             else:

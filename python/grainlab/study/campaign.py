@@ -185,11 +185,6 @@ def load_finished(run: Run, out_dir: str | os.PathLike[str]) -> dict[str, Any] |
 SCHEDULER_TIMEOUT_S = 10.0
 
 
-def default_workers() -> int:
-    """The cores this process may run on (``taskset`` and cgroup affinity count)."""
-    return available_cores()
-
-
 @dataclass
 class CampaignResult:
     """Rows in run order, and how the campaign went."""
@@ -237,7 +232,7 @@ def run_campaign(
             skipped.append(run.name)
         else:
             todo.append(run)
-    cores = default_workers()
+    cores = available_cores()  # taskset and cgroup affinity count
     n_workers = max(1, int(workers)) if workers else cores
     if threads is None:
         threads = max(1, cores // n_workers) if scheduler is None else 1

@@ -47,9 +47,6 @@ MEASURES: tuple[str, ...] = (
 #: ``PackingParams.generation_friction`` value that asks for the friction search.
 GENERATION_FRICTION_SEARCH = "search"
 
-#: Statuses a packing row can have.
-STATUSES = ("ok", "unjammed", "densest_reached", "failed")
-
 
 @dataclass(frozen=True)
 class PackingParams:

@@ -85,11 +85,20 @@ def study_runs(seed: int = 0, overrides: Mapping[str, Any] | None = None,
     return runs
 
 
-def _series(rows: Sequence[Mapping[str, Any]], kind: str, x: str, y: str) -> tuple[np.ndarray, np.ndarray]:
-    pts = [(float(r[x]), float(r[y])) for r in rows
-           if r.get("kind") == kind and r.get("status") != "failed" and x in r and y in r]
-    pts = [p for p in pts if math.isfinite(p[0]) and math.isfinite(p[1])]
-    arr = np.array(pts, dtype=float).reshape(-1, 2)
+def number_or_nan(value: Any) -> float:
+    """A table's value (a number or its text) as a float; NaN when it is none."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def packing_series(rows: Sequence[Mapping[str, Any]], kind: str | None, x: str, y: str) -> tuple[np.ndarray, np.ndarray]:
+    """The finite ``(x, y)`` of the packings of ``kind`` (None: every kind) that did not
+    fail, in row order: what every fit and figure of the study reads."""
+    pts = [(number_or_nan(r.get(x)), number_or_nan(r.get(y))) for r in rows
+           if (kind is None or r.get("kind") == kind) and r.get("status") != "failed"]
+    arr = np.array([p for p in pts if math.isfinite(p[0]) and math.isfinite(p[1])], dtype=float).reshape(-1, 2)
     return arr[:, 0], arr[:, 1]
 
 
@@ -112,7 +121,7 @@ _STYLE_ALL = {"irregular": dict(marker="^", color="tab:blue", alpha=0.45, label=
 
 
 def _pooled(rows: Sequence[Mapping[str, Any]], x: str, y: str) -> tuple[np.ndarray, np.ndarray]:
-    xs = [_series(rows, kind, x, y) for kind in ("irregular", "hexagonal")]
+    xs = [packing_series(rows, kind, x, y) for kind in ("irregular", "hexagonal")]
     return np.concatenate([a for a, _ in xs]), np.concatenate([b for _, b in xs])
 
 
@@ -137,7 +146,7 @@ def study_figures(rows: Sequence[Mapping[str, Any]], out_dir: str | os.PathLike[
         for lam_key, suffix in LAMBDA_COLUMNS.items():
             style = _STYLE if not suffix else _STYLE_ALL
             for kind in ("irregular", "hexagonal"):
-                x, y = _series(rows, kind, x_key, lam_key)
+                x, y = packing_series(rows, kind, x_key, lam_key)
                 if len(x):
                     order = np.argsort(x)
                     ax.plot(x[order], y[order], linestyle="none", **style[kind])
@@ -172,14 +181,14 @@ def trends(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
         for x_key, x_name in (("coordination_number", "z"), ("porosity", "porosity"),
                               *((a, a) for a in anisotropies)):
             for kind in ("irregular", "hexagonal"):
-                fit = linear_fit(*_series(rows, kind, x_key, lam_key))
+                fit = linear_fit(*packing_series(rows, kind, x_key, lam_key))
                 out[f"{kind}_{lam}_vs_{x_name}_slope"] = fit["slope"]
                 out[f"{kind}_{lam}_vs_{x_name}_r2"] = fit["r2"]
             fit = linear_fit(*_pooled(rows, x_key, lam_key))
             out[f"all_{lam}_vs_{x_name}_slope"] = fit["slope"]
             out[f"all_{lam}_vs_{x_name}_r2"] = fit["r2"]
-        zi, li = _series(rows, "irregular", "coordination_number", lam_key)
-        zh, lh = _series(rows, "hexagonal", "coordination_number", lam_key)
+        zi, li = packing_series(rows, "irregular", "coordination_number", lam_key)
+        zh, lh = packing_series(rows, "hexagonal", "coordination_number", lam_key)
         if len(zi) >= 2 and len(zh):
             order = np.argsort(zi)
             inside = (zh >= zi.min()) & (zh <= zi.max())

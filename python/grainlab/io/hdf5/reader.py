@@ -100,7 +100,7 @@ class Results:
         """Load a snapshot: by name, by position in the order written (``-1`` the last), or the last."""
         info = _select(self.path, self.snapshots, name, None)
         with _open_results(self.path, self._allow_incomplete) as (f, reader):
-            return reader.read_snapshot(f, info.name, self.path)
+            return reader.read_snapshot(_snapshot_group(f, info.name, self.path), self.path)
 
     def analysis(self, product: str, item: str) -> AnalysisItem | None:
         """The stored ``item`` (a snapshot's name) of the analysis ``product``, or None
@@ -136,7 +136,8 @@ class _LayoutReader:
 
     read_results: Callable[[h5py.File, Path, bool], Results]
     list_snapshots: Callable[[h5py.File], tuple[SnapshotInfo, ...]]
-    read_snapshot: Callable[[h5py.File, str, Path], Snapshot]
+    #: Reads one snapshot group.
+    read_snapshot: Callable[[h5py.Group, Path], Snapshot]
 
 
 def _read_results_v1(f: h5py.File, path: Path, allow_incomplete: bool) -> Results:
@@ -199,21 +200,13 @@ def _snapshot_group(f: h5py.File, name: str, path: Path) -> h5py.Group:
     return group[name]
 
 
-def _read_snapshot_v1(f: h5py.File, name: str, path: Path) -> Snapshot:
-    return _read_snapshot_group_v1(_snapshot_group(f, name, path), path)
-
-
-def _read_snapshot_v3(f: h5py.File, name: str, path: Path) -> Snapshot:
-    return _read_snapshot_group_v3(_snapshot_group(f, name, path), path)
-
-
 #: Reader of each results layout version. A new layout adds an entry; old ones stay.
 _READERS_BY_VERSION: dict[int, _LayoutReader] = {
-    1: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_v1),
+    1: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_group_v1),
     # version 2 is version 1 and the analysis group, which version 1 files do not have
-    2: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_v1),
+    2: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_group_v1),
     # version 3 is version 2 with the snapshots' grains one row per grain
-    3: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_v3),
+    3: _LayoutReader(_read_results_v1, _snapshot_infos_v1, _read_snapshot_group_v3),
 }
 
 
@@ -363,4 +356,4 @@ def read_hdf5_snapshot(
         raise ValueError("boundary types: only apply to LAMMPS dumps (run.h5 stores 'kind')")
     with _open_results(p, allow_incomplete) as (f, reader):
         info = _select(p, reader.list_snapshots(f), snapshot, timestep)
-        return reader.read_snapshot(f, info.name, Path(f.filename))
+        return reader.read_snapshot(_snapshot_group(f, info.name, Path(f.filename)), Path(f.filename))
