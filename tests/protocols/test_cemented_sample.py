@@ -51,7 +51,7 @@ def test_pairs_within_a_gap_on_a_row_across_a_period_and_within_a_body():
     ],
 )
 def test_bad_cement_keys_are_refused_in_one_line(overrides, message):
-    for test in ("biaxial", "oedometer", "cyclic", "simple_shear", "ucs"):
+    for test in ("biaxial", "oedometer", "cyclic", "simple_shear"):
         with pytest.raises(ConfigError, match=message):
             SCHEMAS[test].resolve(overrides=overrides, quick=True)
 
