@@ -7,6 +7,7 @@ refusal of an uncemented sample or a bad key."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -106,11 +107,13 @@ def test_a_stopped_run_resumes_to_the_same_bits(straight, tmp_path, monkeypatch,
         np.testing.assert_array_equal(a.cracks[name], b.cracks[name], err_msg=name)
 
 
-def test_the_command_line_runs_it_with_its_report(tmp_path, capsys):
+def test_the_command_line_runs_it_with_its_report_as_cemented_md_prints(tmp_path, capsys):
     out = tmp_path / "ucs"
     assert main(["run", "ucs", "--quick", "--out", str(out), "--no-progress",
-                 *(arg for key in QUICK for arg in ("--set", key))]) == 0
+                 *(arg for key in [*CEMENT, "ucs.final_strain=0.01"] for arg in ("--set", key))]) == 0
     printed = capsys.readouterr().out.splitlines()[0]
+    quoted = " ".join((Path(__file__).resolve().parents[2] / "docs" / "cemented.md").read_text().split())
+    assert "; ".join(printed.split("; ")[:-1]) in quoted, printed  # all but the wall time and folder
     summary = json.loads((out / "summary.json").read_text())
     assert printed.startswith(f"grainlab ucs: {summary['n_particles']} grains, {summary['cement_bonds']} cement")
     assert f"q_u {summary['unconfined_strength_pa'] / 1e3:.0f} kPa" in printed
