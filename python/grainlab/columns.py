@@ -1,7 +1,7 @@
 """The time-series columns the protocols record, in one place: each column's
 name, unit and meaning (:class:`Column`), and the columns of each test
 (:class:`Columns`: :data:`BIAXIAL`, :data:`OEDOMETER`, :data:`CYCLIC`,
-:data:`SIMPLE_SHEAR`).
+:data:`SIMPLE_SHEAR`, :data:`UCS`).
 
 A :class:`Column` *is* its name (a ``str``), so ``timeseries[AXIAL_STRAIN]``
 reads the column from a results file, a CSV or a record, while
@@ -37,6 +37,7 @@ __all__ = [
     "FRICTION_COEFFICIENT",
     "HORIZONTAL_STRESS_PA",
     "INERTIAL_NUMBER",
+    "LATERAL_STRAIN",
     "LATERAL_STRESS_RATIO",
     "OEDOMETER",
     "NORMAL_STRESS_PA",
@@ -46,8 +47,10 @@ __all__ = [
     "SIMPLE_SHEAR",
     "STRAIN_PATH",
     "STRESS_RATIO",
+    "UCS",
     "VERTICAL_STRESS_PA",
     "VOLUMETRIC_STRAIN",
+    "WIDTH_M",
 ]
 
 
@@ -204,16 +207,31 @@ SIMPLE_SHEAR = Columns(
     (RB_STRESS_RATIO, RB_PREDICTED, RB_RESIDUAL),
 )
 
-#: Every test's columns, by the results file's ``kind``.
 # ---- a cemented sample's, after its test's own -------------------------------------------
 CEMENT_BONDS_BROKEN = Column("cement_bonds_broken", "1", "cement bonds broken since the end of the consolidation")
+
+# ---- the unconfined compression test's ----------------------------------------------
+LATERAL_STRAIN = Column("lateral_strain", "1", "lateral strain (W - W0) / W0 of the grains' width over the middle "
+                        "half of the height, extension positive")
+WIDTH_M = Column("width_m", "m", "the grains' width over the middle half of the height, max(x + r) - min(x - r)")
+UCS_AXIAL_STRESS_PA = Column("axial_stress_pa", "Pa", "axial stress on the top platen over the sample's width")
+
+#: The unconfined compression test's records (grainlab.protocols.ucs): a cemented sample's always.
+UCS = Columns(
+    "ucs",
+    (STEP, TIME_S, AXIAL_STRAIN, UCS_AXIAL_STRESS_PA, LATERAL_STRAIN, WIDTH_M, HEIGHT_M, UNBALANCED_FORCE_RATIO),
+    ENERGY,
+    (CEMENT_BONDS_BROKEN,),
+)
+
+#: Every test's columns, by the results file's ``kind``.
 
 #: The column a cemented sample (``cement.bonds`` not ``none``) adds to the biaxial and
 #: cyclic tests' records (docs/cemented.md).
 CEMENTED = Columns("cemented", (CEMENT_BONDS_BROKEN,))
 
 BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER, CYCLIC.kind: CYCLIC,
-                               SIMPLE_SHEAR.kind: SIMPLE_SHEAR, CEMENTED.kind: CEMENTED}
+                               SIMPLE_SHEAR.kind: SIMPLE_SHEAR, CEMENTED.kind: CEMENTED, UCS.kind: UCS}
 
 
 _BLOCK = re.compile(

@@ -5,7 +5,7 @@ registers here, and its schema in :data:`SCHEMAS` (``register_schema`` in its ow
 package; importing this module imports every protocol, so :data:`SCHEMAS` holds them all).
 
 >>> sorted(PROTOCOLS)
-['biaxial', 'cyclic', 'oedometer', 'simple_shear']
+['biaxial', 'cyclic', 'oedometer', 'simple_shear', 'ucs']
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from grainlab.protocols.cyclic.protocol import CyclicProtocol
 from grainlab.protocols.oedometer.protocol import OedometerProtocol
 from grainlab.protocols.runner import Protocol, RunResult, run_protocol
 from grainlab.protocols.simple_shear.protocol import SimpleShearProtocol
+from grainlab.protocols.ucs.protocol import UcsProtocol
 
 __all__ = ["PROTOCOLS", "SCHEMAS", "resolve_config", "run_named"]
 
@@ -30,6 +31,7 @@ PROTOCOLS: dict[str, type[Protocol[Any, Any, Any]]] = {
     OedometerProtocol.name: OedometerProtocol,
     CyclicProtocol.name: CyclicProtocol,
     SimpleShearProtocol.name: SimpleShearProtocol,
+    UcsProtocol.name: UcsProtocol,
 }
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from grainlab.report import cyclic, oedometer, simple_shear
+from grainlab.report import cyclic, oedometer, simple_shear, ucs
 from grainlab.report.run_page import ReportPage
 
 __all__ = ["PAGES", "STUDY", "STUDY_PAGE"]
@@ -39,6 +39,7 @@ PAGES: dict[str, ReportPage] = {page.protocol: page for page in (
     oedometer.PAGE,
     cyclic.PAGE,
     simple_shear.PAGE,
+    ucs.PAGE,
 )}
 
 #: The packing study's page.

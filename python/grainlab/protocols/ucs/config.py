@@ -1,0 +1,62 @@
+"""The unconfined compression test's configuration: the shared sample, material,
+consolidation and cement keys, its own loading (``ucs.*``) and the runner's keys."""
+
+from __future__ import annotations
+
+from collections.abc import Set as AbstractSet
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from grainlab.protocols.config import (
+    POSITIVE,
+    Config,
+    ConfigError,
+    Section,
+    SectionOf,
+    check_sample,
+    key,
+    register_test,
+)
+
+__all__ = ["UCS_FIELDS", "UCS_SCHEMA", "UcsConfig", "UcsSection"]
+
+#: The one-line refusal of a sample without cement.
+UNCEMENTED = ("ucs: an uncemented sample has no unconfined strength; give cement.bonds=parallel and its "
+              "strengths")
+
+
+@dataclass(frozen=True)
+class UcsSection(Section):
+    """The unconfined compression test's own keys: its loading and its end."""
+
+    prefix: ClassVar[str] = "ucs"
+    strain_rate: float = key("strain_rate", "1 %/min", "axial strain rate of the top platen (of the height "
+                             "after the release)", **POSITIVE)
+    final_strain: float = key("strain", 0.02, "the loading ends at this axial strain", minimum=0.0, maximum=0.5,
+                              exclusive_minimum=True)
+    residual_fraction: float = key(
+        "number", 0.5, "the loading ends once the axial stress after the peak falls below this fraction of the "
+        "peak", minimum=0.0, maximum=1.0, exclusive_maximum=True,
+    )
+    records: int = key("integer", 200, "records over ucs.final_strain (one every final_strain / records)",
+                       minimum=1)
+
+
+UCS_FIELDS = UcsSection.keys()
+
+
+@dataclass(frozen=True)
+class UcsConfig(Config):
+    """The unconfined compression test's configuration: the shared sections and its loading."""
+
+    ucs = SectionOf(UcsSection)
+
+
+def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
+    if values["cement.bonds"] == "none":
+        raise ConfigError(UNCEMENTED)
+    check_sample(values, given)
+
+
+#: The unconfined compression test's configuration schema (registered as ``"ucs"``).
+UCS_SCHEMA = register_test("ucs", UCS_FIELDS, _check, UcsConfig)
