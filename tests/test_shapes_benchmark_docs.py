@@ -23,7 +23,8 @@ def _table_rows() -> dict[tuple[int, str, float], list[str]]:
         cells = [c.strip() for c in line.strip("|").split("|")]
         size = re.match(r"[\d,]+", cells[0])
         assert size is not None, line
-        words = {"half the local damping": "slow_damped", "quarter": "slow", "sixteenth": "slower",
+        words = {"at the same strain rate": "slow_damped_same_rate", "half the local damping": "slow_damped",
+                 "quarter": "slow", "sixteenth": "slower",
                  "sixty-fourth": "slowest"}
         tag = next((t for w, t in words.items() if w in cells[0]), "")
         rows[(int(size.group(0).replace(",", "")), tag, float(cells[1]))] = cells
