@@ -75,3 +75,20 @@ def servo_box(
             return state, steps, True
         if steps >= max_steps:
             return state, steps, False
+
+
+def long_platens(sim: Simulation, walls: dict[str, int]) -> tuple[Wall, Wall, float, float]:
+    """The box's four walls switched off and its top and bottom replaced by platens three
+    sample widths long (so that the sample can widen and still bear on them), their ids
+    put in ``walls``; returns the platens (bottom, top) and the box's side positions."""
+    left_x = float(sim.wall(walls["left"]).points[0, 0])
+    right_x = float(sim.wall(walls["right"]).points[0, 0])
+    y_bottom = float(sim.wall(walls["bottom"]).points[0, 1])
+    y_top = float(sim.wall(walls["top"]).points[0, 1])
+    for name in BOX_WALLS:
+        sim.wall(walls[name]).active = False
+    reach = left_x - (right_x - left_x), right_x + (right_x - left_x)
+    bottom = sim.add_segment_wall((reach[0], y_bottom), (reach[1], y_bottom))  # the sample above
+    top = sim.add_segment_wall((reach[1], y_top), (reach[0], y_top))  # the sample below
+    walls["bottom"], walls["top"] = bottom.id, top.id
+    return bottom, top, left_x, right_x

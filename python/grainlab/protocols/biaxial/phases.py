@@ -35,7 +35,7 @@ from grainlab.protocols.boundary import (
     install_membrane,
     set_platen_velocity,
 )
-from grainlab.protocols.consolidate import servo_box
+from grainlab.protocols.consolidate import long_platens, servo_box
 from grainlab.protocols.grains import grain_porosity
 from grainlab.protocols.specimen import grain_model, platen_model
 from grainlab.protocols.triggers import schedule_steps
@@ -49,19 +49,7 @@ def install_boundary(sim: Simulation, run: BiaxialRun, config: BiaxialConfig, pr
     boundary of ``boundary.kind`` (the membrane, the outer grains or rigid side walls),
     Table 1 friction on, the sample re-equilibrated under sigma_0."""
     start = time.perf_counter()
-    walls = run.walls
-    left_x = float(sim.wall(walls["left"]).points[0, 0])
-    right_x = float(sim.wall(walls["right"]).points[0, 0])
-    y_bottom = float(sim.wall(walls["bottom"]).points[0, 1])
-    y_top = float(sim.wall(walls["top"]).points[0, 1])
-    # the rigid box goes; platens three sample widths long take the place of its
-    # top and bottom, so that the sample can bulge and still bear on them
-    for name in ("left", "right", "bottom", "top"):
-        sim.wall(walls[name]).active = False
-    reach = left_x - (right_x - left_x), right_x + (right_x - left_x)
-    bottom = sim.add_segment_wall((reach[0], y_bottom), (reach[1], y_bottom))  # sample on the left
-    top = sim.add_segment_wall((reach[1], y_top), (reach[0], y_top))
-    walls["bottom"], walls["top"] = bottom.id, top.id
+    bottom, top, left_x, right_x = long_platens(sim, run.walls)
     sim.set_contact_model(0, 0, grain_model(config))  # Table 1 friction from here on
     sim.set_contact_model(0, 1, platen_model(config))
     if config.boundary.kind == "walls":

@@ -20,6 +20,7 @@ from grainlab._progress import progress_bar
 from grainlab.columns import AXIAL_STRAIN, AXIAL_STRESS_PA, UCS
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols import operations
+from grainlab.protocols.consolidate import long_platens
 from grainlab.protocols.cracks import CrackRecords
 from grainlab.protocols.operations import Loading, Operation, Records
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
@@ -98,16 +99,7 @@ def _release(context: Context) -> None:
     ``consolidation.max_steps``); its height and width are the strains' references."""
     sim, run, config = context.sim, context.state, context.config
     start = time.perf_counter()
-    walls = run.walls
-    left_x = float(sim.wall(walls["left"]).points[0, 0])
-    right_x = float(sim.wall(walls["right"]).points[0, 0])
-    y_bottom = float(sim.wall(walls["bottom"]).points[0, 1])
-    y_top = float(sim.wall(walls["top"]).points[0, 1])
-    for name in ("left", "right", "bottom", "top"):
-        sim.wall(walls[name]).active = False
-    reach = left_x - (right_x - left_x), right_x + (right_x - left_x)
-    walls["bottom"] = sim.add_segment_wall((reach[0], y_bottom), (reach[1], y_bottom)).id  # sample above
-    walls["top"] = sim.add_segment_wall((reach[1], y_top), (reach[0], y_top)).id  # sample below
+    long_platens(sim, run.walls)
     sim.set_contact_model(0, 0, grain_model(config))  # Table 1 friction from here on
     sim.set_contact_model(0, 1, platen_model(config))
     limit, steps = config.consolidation.unbalanced_force_ratio, 0
