@@ -1,7 +1,7 @@
 """The time-series columns the protocols record, in one place: each column's
 name, unit and meaning (:class:`Column`), and the columns of each test
 (:class:`Columns`: :data:`BIAXIAL`, :data:`OEDOMETER`, :data:`CYCLIC`,
-:data:`SIMPLE_SHEAR`, :data:`UCS`).
+:data:`SIMPLE_SHEAR`, :data:`UCS`, :data:`CRUSHING`).
 
 A :class:`Column` *is* its name (a ``str``), so ``timeseries[AXIAL_STRAIN]``
 reads the column from a results file, a CSV or a record, while
@@ -25,6 +25,15 @@ from collections.abc import Iterator
 from pathlib import Path
 
 __all__ = [
+    "AGGLOMERATE",
+    "CHARACTERISTIC_STRESS_PA",
+    "CRUSHING",
+    "DIAMETER_M",
+    "FRAGMENTS",
+    "LARGEST_FRAGMENT",
+    "MAJOR_FRAGMENTS",
+    "PLATEN_DISPLACEMENT_M",
+    "PLATEN_FORCE_N",
     "AXIAL_STRAIN",
     "AXIAL_STRESS_PA",
     "BIAXIAL",
@@ -224,6 +233,30 @@ UCS = Columns(
     (CEMENT_BONDS_BROKEN,),
 )
 
+# ---- the crushing test's ----------------------------------------------------------
+AGGLOMERATE = Column("agglomerate", "1", "the agglomerate crushed (0 .. crushing.agglomerates - 1)")
+DIAMETER_M = Column("diameter_m", "m", "the agglomerate's diameter d")
+PLATEN_DISPLACEMENT_M = Column("platen_displacement_m", "m", "the top platen's displacement since the "
+                               "agglomerate's start, down positive")
+PLATEN_FORCE_N = Column("platen_force_n", "N", "force of the agglomerate on the top platen, N per m of thickness")
+CHARACTERISTIC_STRESS_PA = Column("characteristic_stress_pa", "Pa", "F / (d t), the platen force over the "
+                                  "diameter and the thickness t = 1 m")
+FRAGMENTS = Column("fragments", "1", "the agglomerate's fragments: connected components of its intact bonds")
+MAJOR_FRAGMENTS = Column("major_fragments", "1", "the fragments holding at least 0.1 of the agglomerate's solid area")
+LARGEST_FRAGMENT = Column("largest_fragment_fraction", "1", "the largest fragment's share of the agglomerate's "
+                          "solid area")
+
+#: The crushing test's records (grainlab.protocols.crushing): every agglomerate's, one after the other.
+CRUSHING = Columns(
+    "crushing",
+    (AGGLOMERATE, STEP, Column("time_s", "s", "simulated time since the agglomerate's start"), DIAMETER_M,
+     Column("axial_strain", "1", "the platen's displacement over d, compression positive"), PLATEN_DISPLACEMENT_M,
+     PLATEN_FORCE_N, CHARACTERISTIC_STRESS_PA,
+     Column("cement_bonds_broken", "1", "the agglomerate's bonds broken since its start"), FRAGMENTS,
+     MAJOR_FRAGMENTS, LARGEST_FRAGMENT, UNBALANCED_FORCE_RATIO),
+    ENERGY,
+)
+
 #: Every test's columns, by the results file's ``kind``.
 
 #: The column a cemented sample (``cement.bonds`` not ``none``) adds to the biaxial and
@@ -231,7 +264,8 @@ UCS = Columns(
 CEMENTED = Columns("cemented", (CEMENT_BONDS_BROKEN,))
 
 BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER, CYCLIC.kind: CYCLIC,
-                               SIMPLE_SHEAR.kind: SIMPLE_SHEAR, CEMENTED.kind: CEMENTED, UCS.kind: UCS}
+                               SIMPLE_SHEAR.kind: SIMPLE_SHEAR, CEMENTED.kind: CEMENTED, UCS.kind: UCS,
+                               CRUSHING.kind: CRUSHING}
 
 
 _BLOCK = re.compile(

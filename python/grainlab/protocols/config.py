@@ -580,6 +580,11 @@ def _check_cement(v: Mapping[str, Any], given: AbstractSet[str]) -> None:
         if stray:
             raise ConfigError(f"{stray[0]}: given, but cement.bonds is 'none' (give cement.bonds=parallel)")
         return
+    check_bonds(v)
+
+
+def check_bonds(v: Mapping[str, Any]) -> None:
+    """The bonds' strengths missing, automatic stiffnesses without a linear law."""
     for name in ("cement.tensile_strength", "cement.cohesion"):
         if not v[name] > 0:
             raise ConfigError(f"{name}: cemented grains need a strength > 0 (e.g. {name}=\"1 MPa\")")

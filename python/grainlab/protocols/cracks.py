@@ -5,6 +5,7 @@ time series at the break's time."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -60,16 +61,24 @@ def crack_task(results: Results) -> FigureTask | None:
 class CrackRecords(Operation):
     """Writer: the bonds broken since its last act, appended to ``/cracks`` (after the
     step's record, so that each break's axial strain is the time series' at its time:
-    exact at a constant strain rate, the first record's for a break before shearing)."""
+    exact at a constant strain rate, the first record's for a break before shearing).
+    ``strain(times)`` gives the axial strain at the breaks' times instead, and ``labels``
+    columns of one value each (with their units) after the table's own."""
 
-    def __init__(self, trigger: Trigger, writer: ResultsWriter) -> None:
+    def __init__(self, trigger: Trigger, writer: ResultsWriter,
+                 strain: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
+                 labels: Mapping[str, int] | None = None) -> None:
         super().__init__(trigger)
-        self.writer = writer
+        self.writer, self.strain, self.labels = writer, strain, dict(labels or {})
 
     def act(self, loading: Loading) -> None:
         breaks = loading.sim.take_bond_breaks()
         if len(breaks) == 0:
             return
-        series = self.writer.read_timeseries()
-        strain = np.interp(breaks.time, series[TIME_S], series[AXIAL_STRAIN])
-        self.writer.append_cracks(crack_columns(breaks, strain), CRACK_UNITS)
+        if self.strain is None:
+            series = self.writer.read_timeseries()
+            strain = np.interp(breaks.time, series[TIME_S], series[AXIAL_STRAIN])
+        else:
+            strain = self.strain(breaks.time)
+        columns = {**crack_columns(breaks, strain), **{k: np.full(len(breaks), v) for k, v in self.labels.items()}}
+        self.writer.append_cracks(columns, {**CRACK_UNITS, **dict.fromkeys(self.labels, "1")})

@@ -87,21 +87,32 @@ class RecordCount(TypingProtocol):
 class Records(Operation):
     """Writer: ``measure()`` appended to the time series (in ``units``), at most once
     a step (:attr:`values` is the last record); each scheduled one counted in
-    ``count.next_record``."""
+    ``count.next_record``. ``buffered``: the records are kept until :meth:`flush`
+    appends them at once (a loading with no checkpoint inside)."""
 
     def __init__(self, trigger: Trigger, writer: ResultsWriter, measure: Callable[[], dict[str, float]],
-                 units: Mapping[str, str], count: RecordCount | None = None) -> None:
+                 units: Mapping[str, str], count: RecordCount | None = None, *, buffered: bool = False) -> None:
         super().__init__(trigger)
         self.writer, self.measure, self.units, self.count = writer, measure, units, count
         self.values: dict[str, float] = {}
         self.step = -1
+        self.kept: list[dict[str, float]] | None = [] if buffered else None
 
     def write(self, step: int) -> dict[str, float]:
-        """The record of ``step``, taken and written unless it was already."""
+        """The record of ``step``, taken and written (or kept) unless it was already."""
         if step != self.step:
             self.values, self.step = self.measure(), step
-            self.writer.append_timeseries(self.values, units=self.units)
+            if self.kept is None:
+                self.writer.append_timeseries(self.values, units=self.units)
+            else:
+                self.kept.append(self.values)
         return self.values
+
+    def flush(self) -> None:
+        """The records kept so far appended to the time series."""
+        if self.kept:
+            self.writer.append_rows({name: [r[name] for r in self.kept] for name in self.kept[0]}, units=self.units)
+            self.kept.clear()
 
     def act(self, loading: Loading) -> None:
         self.write(loading.sim.step_count)

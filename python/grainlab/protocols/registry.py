@@ -5,7 +5,7 @@ registers here, and its schema in :data:`SCHEMAS` (``register_schema`` in its ow
 package; importing this module imports every protocol, so :data:`SCHEMAS` holds them all).
 
 >>> sorted(PROTOCOLS)
-['biaxial', 'cyclic', 'oedometer', 'simple_shear', 'ucs']
+['biaxial', 'crushing', 'cyclic', 'oedometer', 'simple_shear', 'ucs']
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from typing import Any
 
 from grainlab.protocols.biaxial.protocol import BiaxialProtocol
 from grainlab.protocols.config import SCHEMAS, Config
+from grainlab.protocols.crushing.protocol import CrushingProtocol
 from grainlab.protocols.cyclic.protocol import CyclicProtocol
 from grainlab.protocols.oedometer.protocol import OedometerProtocol
 from grainlab.protocols.runner import Protocol, RunResult, run_protocol
@@ -32,6 +33,7 @@ PROTOCOLS: dict[str, type[Protocol[Any, Any, Any]]] = {
     CyclicProtocol.name: CyclicProtocol,
     SimpleShearProtocol.name: SimpleShearProtocol,
     UcsProtocol.name: UcsProtocol,
+    CrushingProtocol.name: CrushingProtocol,
 }
 
 

@@ -80,7 +80,8 @@ C = TypeVar("C")
 @dataclass
 class StageContext(Generic[C, S]):
     """What a stage works on: the simulation, the run state, the configuration,
-    the results writer, ``save()`` (a checkpoint now) and whether to show progress."""
+    the results writer, ``save()`` (a checkpoint now, of the simulation here: a stage
+    may put another one in its place) and whether to show progress."""
 
     sim: Simulation
     state: S
@@ -335,23 +336,24 @@ def _run_locked(protocol: Protocol[Any, Any, R], out: Path, *, resume: bool, pro
         if writer is not None:
             results = writer  # the writer as the checkpoints see it
 
-            def save() -> None:
+            def save() -> None:  # the simulation in the context: a stage may put another there
                 saved_state = state.to_dict()
                 saved_state["config"] = protocol.config_dict()
                 saved_state["elapsed_s"] = elapsed_before + time.perf_counter() - started
                 image = np.frombuffer(results.publish(), dtype=np.uint8)
-                write_checkpoint(checkpoint_path, sim.to_bytes(), saved_state, arrays={_RESULTS_IMAGE: image})
+                write_checkpoint(checkpoint_path, context.sim.to_bytes(), saved_state,
+                                 arrays={_RESULTS_IMAGE: image})
 
+            context = StageContext(sim, state, protocol.config, writer, save, progress)
             if not resume:
                 save()
-            context = StageContext(sim, state, protocol.config, writer, save, progress)
             while state.phase != DONE:
                 stage = protocol.stage(state.phase)
                 stage.run(context)
                 state.phase = protocol.next_phase(stage.name)
                 save()
             summary = protocol.summary(context, elapsed_before + time.perf_counter() - started)
-            summary["threads"] = sim.threads  # the count the run ended with (any count reruns it bitwise)
+            summary["threads"] = context.sim.threads  # the count the run ended with (any count reruns it bitwise)
             writer.write_summary(summary)
             writer.write_phases(state.wall_time)
             writer.finalize()

@@ -30,7 +30,14 @@ from grainlab.io.results import RESULTS_FILE, timeseries_csv, write_json_atomic,
 from grainlab.protocols.config import Config, grain_shape
 from grainlab.protocols.consolidate import BOX_WALLS, BoxState, servo_box
 from grainlab.protocols.grains import clump_summary, grain_coordination, grain_count, grain_porosity
-from grainlab.protocols.runner import Protocol, ProtocolError, RunResult, Stage, StageContext
+from grainlab.protocols.runner import (
+    Protocol,
+    ProtocolError,
+    RunResult,
+    RunState,
+    Stage,
+    StageContext,
+)
 from grainlab.samples import (
     PAPER_GRADING,
     GradingCurve,
@@ -45,7 +52,7 @@ from grainlab.snapshot import Snapshot
 if TYPE_CHECKING:
     from grainlab.plot.workers import FigureTask
 
-__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "cement_sample",
+__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "ConfiguredProtocol", "SpecimenError", "add_parallel_bonds", "SpecimenProtocol", "SpecimenRun", "cement_sample",
            "consolidate",
            "damped_time_step_factor", "engine_columns",
            "engine_threads", "generate", "grain_model", "grain_columns", "platen_model", "run_summary",
@@ -86,17 +93,18 @@ class SpecimenRun:
 
 
 R = TypeVar("R", bound=SpecimenRun)
+S = TypeVar("S", bound=RunState)
 Result = TypeVar("Result", bound=RunResult)
 C = TypeVar("C", bound=Config)
 
 
-class SpecimenProtocol(Protocol[C, R, Result]):
+class ConfiguredProtocol(Protocol[C, S, Result]):
     """A protocol whose configuration is a :class:`Config` of the schema named as the
-    protocol and whose run starts by making the sample (:func:`generate`) into a state
-    of type :attr:`state_type`, in the first stage's phase; it writes :data:`OUTPUT_FILES`,
-    sums up with :attr:`summarise` and returns a :attr:`result_type`."""
+    protocol and whose state is of type :attr:`state_type`; it writes
+    :data:`OUTPUT_FILES`, sums up with :attr:`summarise` and returns a
+    :attr:`result_type`. Its subclass says how a run starts (:meth:`start`)."""
 
-    state_type: ClassVar[type[SpecimenRun]]
+    state_type: ClassVar[type[Any]]
     output_files: ClassVar[tuple[str, ...]] = OUTPUT_FILES
     #: The summary of a run whose stages have all run: ``(state, config, time series, wall time)``.
     summarise: ClassVar[Callable[[Any, Any, dict[str, NDArray[np.float64]], float], dict[str, Any]]]
@@ -117,14 +125,11 @@ class SpecimenProtocol(Protocol[C, R, Result]):
         except (ValueError, TypeError, AttributeError):
             return None
 
-    def start(self, threads: int, progress: bool) -> tuple[Simulation, R]:
-        sim, run = generate(self.config, threads, progress, self.state_type, self.stages[0].name)
-        return sim, run  # type: ignore[return-value]  # state_type is R's class
+    def state_from_dict(self, saved: Mapping[str, Any]) -> S:
+        state: S = self.state_type.from_dict(dict(saved))
+        return state
 
-    def state_from_dict(self, saved: Mapping[str, Any]) -> R:
-        return self.state_type.from_dict(dict(saved))  # type: ignore[return-value]  # state_type is R's class
-
-    def summary(self, context: StageContext[C, R], wall_time_s: float) -> dict[str, Any]:
+    def summary(self, context: StageContext[C, S], wall_time_s: float) -> dict[str, Any]:
         return type(self).summarise(context.state, self.config, context.writer.read_timeseries(), wall_time_s)
 
     def write_outputs(self, out: Path) -> dict[str, Any]:
@@ -132,6 +137,15 @@ class SpecimenProtocol(Protocol[C, R, Result]):
 
     def result(self, out: Path, summary: dict[str, Any]) -> Result:
         return type(self).result_type(out, summary)  # type: ignore[return-value]  # result_type is Result's class
+
+
+class SpecimenProtocol(ConfiguredProtocol[C, R, Result]):
+    """A :class:`ConfiguredProtocol` whose run starts by making the sample
+    (:func:`generate`) into a state of type :attr:`state_type`, in the first stage's phase."""
+
+    def start(self, threads: int, progress: bool) -> tuple[Simulation, R]:
+        sim, run = generate(self.config, threads, progress, self.state_type, self.stages[0].name)
+        return sim, run  # state_type is R's class
 
 
 def grading(config: Config) -> UniformByNumber | UniformByMass | GradingCurve:
@@ -339,19 +353,28 @@ def cement_sample(sim: Simulation, run: SpecimenRun, config: Config, period: tup
     i, j = pairs_within_gap(positions, radii, c.gap, body=body, period=period)
     if len(i) == 0:
         raise SpecimenError(f"cement.gap: no two grains are within {c.gap:g} m of each other to cement")
-    area = 2.0 * c.radius_multiplier * np.minimum(radii[i], radii[j])
-    kn = config.material.normal_stiffness / area if c.normal_stiffness == "auto" else float(c.normal_stiffness)
-    ks = config.material.shear_stiffness / area if c.shear_stiffness == "auto" else float(c.shear_stiffness)
     rng = np.random.default_rng([config.sample.seed, 0x43454D])  # "CEM": a stream of its own
     law = c.strength_distribution
 
     def strengths(mean: float) -> NDArray[np.float64]:
         return draw_strengths(rng, mean, c.strength_scatter * mean, len(i), law)  # type: ignore[arg-type]
 
-    sim.add_cement_bonds(i, j, normal_stiffness=kn, shear_stiffness=ks, tensile_strength=strengths(c.tensile_strength),
-                         cohesion=strengths(c.cohesion), friction_angle=c.friction_angle,
-                         radius_multiplier=c.radius_multiplier)
+    add_parallel_bonds(sim, config, i, j, strengths(c.tensile_strength), strengths(c.cohesion))
     run.consolidation["cement_bonds"] = len(i)
+
+
+def add_parallel_bonds(sim: Simulation, config: Config, i: NDArray[np.int64], j: NDArray[np.int64],
+                       tensile_strength: NDArray[np.float64], cohesion: NDArray[np.float64]) -> None:
+    """Parallel bonds between the particles ``i`` and ``j`` with the strengths given and
+    ``cement.*``'s section and stiffnesses: ``auto`` makes each bond's ``kn_bar A`` the
+    contact law's ``kn`` (and ``ks``)."""
+    c = config.cement
+    radii = sim.radii
+    area = 2.0 * c.radius_multiplier * np.minimum(radii[i], radii[j])
+    kn = config.material.normal_stiffness / area if c.normal_stiffness == "auto" else float(c.normal_stiffness)
+    ks = config.material.shear_stiffness / area if c.shear_stiffness == "auto" else float(c.shear_stiffness)
+    sim.add_cement_bonds(i, j, normal_stiffness=kn, shear_stiffness=ks, tensile_strength=tensile_strength,
+                         cohesion=cohesion, friction_angle=c.friction_angle, radius_multiplier=c.radius_multiplier)
 
 
 
@@ -402,10 +425,11 @@ def run_summary(run: SpecimenRun, fields: Mapping[str, Any], *, records: int, wa
 
 
 def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.float64]], dict[str, Any]],
-                                                          list[FigureTask]]) -> dict[str, Any]:
+                                                          list[FigureTask]], *, crack_map: bool = True) -> dict[str, Any]:
     """A finished run's ``timeseries.csv``, figures and ``summary.json``, from its ``run.h5``:
-    the figures of ``figure_tasks(time series, summary)`` drawn in the figure pool before
-    the summary is written (which says the outputs are complete); returns the summary."""
+    the figures of ``figure_tasks(time series, summary)`` (and the crack map of a run
+    with cracks, unless ``crack_map`` is False) drawn in the figure pool before the
+    summary is written (which says the outputs are complete); returns the summary."""
     from grainlab.io.hdf5 import read_results
     from grainlab.plot.workers import figure_pool
     from grainlab.protocols.cracks import crack_task
@@ -415,7 +439,7 @@ def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.fl
     summary = dict(results.summary)
     write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
     series = {name: np.asarray(values, dtype=np.float64) for name, values in results.timeseries.items()}
-    cracks = crack_task(results)
+    cracks = crack_task(results) if crack_map else None
     tasks = figure_tasks(series, summary) + ([cracks] if cracks is not None else [])
     with figure_pool(tasks=len(tasks), page_copies=True) as pool:
         pool.draw(tasks, out).result()
