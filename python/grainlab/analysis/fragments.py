@@ -15,10 +15,12 @@ arrays out.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["fragment_labels", "fragment_sizes", "percent_passing"]
+__all__ = ["fragment_grading", "fragment_labels", "fragment_sizes", "percent_passing"]
 
 
 def fragment_labels(n: int, i: ArrayLike, j: ArrayLike) -> NDArray[np.int64]:
@@ -55,3 +57,15 @@ def percent_passing(sizes: ArrayLike, areas: ArrayLike, sieves: ArrayLike) -> ND
     cumulative = np.concatenate([[0.0], np.cumsum(w[order])])
     below = np.searchsorted(d[order], np.asarray(sieves, dtype=np.float64), side="right")
     return np.asarray(100.0 * cumulative[below] / cumulative[-1], dtype=np.float64)
+
+
+def fragment_grading(radii: ArrayLike, labels: ArrayLike, sieves: ArrayLike) -> dict[str, Any]:
+    """The fragments of ``labels``: their count, their solid area, the size d50 that half
+    of it passes (interpolated in log size between the fragments' sizes) and the percent
+    passing each of ``sieves``."""
+    area, size = fragment_sizes(radii, labels)
+    order = np.argsort(size)
+    cumulative = 100.0 * np.cumsum(area[order]) / area.sum()
+    d50 = float(np.exp(np.interp(50.0, cumulative, np.log(size[order]))))
+    return {"fragments": len(area), "solid_area_m2": float(area.sum()), "d50_m": d50,
+            "percent_passing": percent_passing(size, area, sieves).tolist()}

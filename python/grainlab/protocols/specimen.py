@@ -341,7 +341,7 @@ def cement_sample(sim: Simulation, run: SpecimenRun, config: Config, period: tup
     ``sample.seed``. ``period``: the grains in a periodic cell of that size whose corner
     is ``sim.cell.origin``. Records the count in ``run.consolidation["cement_bonds"]``."""
     c = config.cement
-    if c.bonds == "none":
+    if c.bonds == "none" or config.values.get("sample.grains") == "agglomerate":  # agglomerates: bonded within
         return
     from grainlab.cement import draw_strengths, pairs_within_gap
 
@@ -425,11 +425,13 @@ def run_summary(run: SpecimenRun, fields: Mapping[str, Any], *, records: int, wa
 
 
 def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.float64]], dict[str, Any]],
-                                                          list[FigureTask]], *, crack_map: bool = True) -> dict[str, Any]:
+                                                          list[FigureTask]], *, crack_map: bool = True,
+                      files: Callable[[Path, dict[str, Any]], None] | None = None) -> dict[str, Any]:
     """A finished run's ``timeseries.csv``, figures and ``summary.json``, from its ``run.h5``:
     the figures of ``figure_tasks(time series, summary)`` (and the crack map of a run
-    with cracks, unless ``crack_map`` is False) drawn in the figure pool before the
-    summary is written (which says the outputs are complete); returns the summary."""
+    with cracks, unless ``crack_map`` is False) drawn in the figure pool, and the
+    test's own ``files(out, summary)``, before the summary is written (which says the
+    outputs are complete); returns the summary."""
     from grainlab.io.hdf5 import read_results
     from grainlab.plot.workers import figure_pool
     from grainlab.protocols.cracks import crack_task
@@ -443,6 +445,8 @@ def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.fl
     tasks = figure_tasks(series, summary) + ([cracks] if cracks is not None else [])
     with figure_pool(tasks=len(tasks), page_copies=True) as pool:
         pool.draw(tasks, out).result()
+    if files is not None:
+        files(out, summary)
     raise_if_interrupted()
     write_json_atomic(out / "summary.json", summary)
     return summary

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from grainlab._html import Markup, fmt, paragraph, table
+from grainlab._html import EmbeddedFigure, Markup, figures, fmt, paragraph, table
 from grainlab.columns import (
     COORDINATION_NUMBER,
     HORIZONTAL_STRESS_PA,
@@ -72,9 +72,30 @@ def _unloading(r: RunPage) -> list[Any]:
             table(["OCR", "K (this run)", "Mayne-Kulhawy"], rows, numeric=(0, 1, 2))]
 
 
+def _fragments(r: RunPage) -> list[Any]:
+    from grainlab.report.figures import embedded_png  # matplotlib: only when a page is made
+
+    s = r.summary
+    if "agglomerates" not in s:
+        return [paragraph("The grains are disks (sample.grains = disk): nothing to crush.", "note")]
+    y = s["yield_stress_pa"]
+    rows = [(g["load_step"], fmt(g["vertical_stress_pa"] / 1e3, 4), g["fragments"], fmt(1e3 * g["d50_m"], 3))
+            for g in s["fragment_grading"]]
+    path = r.folder / "fig03_fragment_grading.png"
+    shown = [figures([EmbeddedFigure("fig03_fragment_grading", "Fragment grading", "Percent of the solid area "
+                                     "passing each size at each load step; a fragment's size is its "
+                                     "equivalent-area diameter.", embedded_png(path.read_bytes()), path.name)])] \
+        if path.exists() else []
+    return [paragraph(f"{s['agglomerates']} agglomerates of bonded disks; the fragments are the connected components "
+                      f"of the intact bonds (fragments.csv). Yield stress: "
+                      f"{'n/a' if y is None else fmt(y / 1e3, 4, unit='kPa')} ({s['yield_rule']}).", "note"),
+            table(["load step", "sigma_v (kPa)", "fragments", "d50 (mm)"], rows, numeric=(0, 1, 2, 3)), *shown]
+
+
 #: The oedometer test's page.
 PAGE = ReportPage(
     OEDOMETER_SCHEMA.name, test="oedometer test", name="oedometer", figures=FIGURES, draw=write_outputs, glance=_glance,
     sections=(PageSection("path", "The load path", _load_path, with_figures=True),
-              PageSection("unloading", "Unloading: K against OCR", _unloading)),
+              PageSection("unloading", "Unloading: K against OCR", _unloading),
+              PageSection("fragments", "Crushable grains", _fragments)),
 )

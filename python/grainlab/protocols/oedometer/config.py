@@ -7,6 +7,7 @@ from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
+from grainlab.protocols.agglomerates import AgglomerateSection, GrainsSection, check_agglomerates
 from grainlab.protocols.config import (
     POSITIVE,
     Config,
@@ -43,18 +44,22 @@ class OedometerSection(Section):
     )
 
 
-OEDOMETER_FIELDS = OedometerSection.keys()
+OEDOMETER_FIELDS = {**OedometerSection.keys(), **GrainsSection.keys(), **AgglomerateSection.keys()}
 
 
 @dataclass(frozen=True)
 class OedometerConfig(Config):
-    """The oedometer's configuration: the shared sections and its load path."""
+    """The oedometer's configuration: the shared sections, its load path and its grains
+    (disks, or crushable agglomerates)."""
 
     oedometer = SectionOf(OedometerSection)
+    grain_kind = SectionOf(GrainsSection)
+    agglomerate = SectionOf(AgglomerateSection)
 
 
 def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
     check_sample(values, given)
+    check_agglomerates(values, given)
     if not values["oedometer.vertical_stresses"]:
         raise ConfigError("oedometer.vertical_stresses: give at least one vertical stress")
 

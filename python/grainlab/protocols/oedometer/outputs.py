@@ -26,12 +26,20 @@ from grainlab.columns import (
     OVERCONSOLIDATION_RATIO,
     VERTICAL_STRESS_PA,
 )
+from grainlab.io.results import write_text_atomic
 from grainlab.protocols.oedometer.config import OedometerConfig
 from grainlab.protocols.oedometer.state import OedometerRun
 from grainlab.protocols.runner import RunResult
 from grainlab.protocols.specimen import run_summary, write_run_outputs
 
-__all__ = ["K0_FROM_STRESS_RATIO", "OedometerResult", "first_loading", "k0_loading", "summarise", "write_outputs"]
+__all__ = ["FRAGMENTS_CSV", "K0_FROM_STRESS_RATIO", "OedometerResult", "first_loading", "k0_loading", "summarise",
+           "fragment_sieves", "write_outputs", "yield_stress"]
+
+#: A sample of agglomerates' fragment grading at each load step.
+FRAGMENTS_CSV = "fragments.csv"
+#: The yield stress's rule (fixed before any run of agglomerates was seen).
+YIELD_RULE = ("intersection, on e against log sigma_v over first loading, of the line through the first two "
+              "records (sigma_0 and the first load step) and the line through the last two")
 
 #: The first-loading records that K0 is fitted on start at this many times sigma_0.
 K0_FROM_STRESS_RATIO = 4.0
@@ -48,8 +56,19 @@ class OedometerResult(RunResult):
             f"grainlab oedometer: {s.get('n_grains', s['n_particles'])} grains, porosity {s['porosity_initial']:.3f}; K0 "
             f"{s['k0_loading']:.3f}{jaky} on loading to {s['max_vertical_stress_pa'] / 1e3:.0f} kPa; "
             f"K {s['lateral_stress_ratio_final']:.3f} at OCR {s['overconsolidation_ratio_final']:.2f}; "
-            f"{s['wall_time_s']:.1f} s -> {self.out_dir}"
+            f"{self._agglomerates()}{s['wall_time_s']:.1f} s -> {self.out_dir}"
         )
+
+    def _agglomerates(self) -> str:
+        s = self.summary
+        if "agglomerates" not in s:
+            return ""
+        y = "n/a" if s["yield_stress_pa"] is None else f"{s['yield_stress_pa'] / 1e3:.0f} kPa"
+        g = s["fragment_grading"]
+        return (f"{s['agglomerates']} agglomerates of {s['n_particles']} disks: yield stress {y}; fragments "
+                f"{g[0]['fragments']} at {g[0]['vertical_stress_pa'] / 1e3:.0f} kPa, {g[-1]['fragments']} at "
+                f"{g[-1]['vertical_stress_pa'] / 1e3:.0f} kPa (d50 {1e3 * g[0]['d50_m']:.2f} -> "
+                f"{1e3 * g[-1]['d50_m']:.2f} mm); ")
 
 
 def first_loading(timeseries: dict[str, np.ndarray]) -> np.ndarray:
@@ -71,6 +90,32 @@ def k0_loading(timeseries: dict[str, np.ndarray], consolidation_pressure_pa: flo
         return math.nan
     slope, _ = np.polyfit(sigma_v[far], sigma_h[far], 1)
     return float(slope)
+
+
+def yield_stress(timeseries: dict[str, np.ndarray]) -> float | None:
+    """The yield stress (Pa) by :data:`YIELD_RULE`: None with fewer than four first-loading
+    records, parallel lines, or an intersection outside the first loading's stresses."""
+    rows = first_loading(timeseries)
+    if len(rows) < 4:
+        return None
+    x = np.log(np.asarray(timeseries[VERTICAL_STRESS_PA], dtype=np.float64)[rows])
+    e = np.asarray(timeseries["void_ratio"], dtype=np.float64)[rows]
+    before = np.polyfit(x[:2], e[:2], 1)
+    after = np.polyfit(x[-2:], e[-2:], 1)
+    if before[0] == after[0]:
+        return None
+    crossing = (after[1] - before[1]) / (before[0] - after[0])
+    return float(np.exp(crossing)) if x[0] <= crossing <= x[-1] else None
+
+
+def _agglomerates(run: OedometerRun, timeseries: dict[str, np.ndarray], sieves: list[float]) -> dict[str, Any]:
+    """A sample of agglomerates' summary: their count, the yield stress and the fragments'
+    grading at each load step."""
+    if "agglomerates" not in run.sample:
+        return {}
+    return {"agglomerates": run.sample["agglomerates"], "agglomerate_bonds": run.sample["agglomerate_bonds"],
+            "yield_stress_pa": yield_stress(timeseries),
+            "yield_rule": YIELD_RULE, "fragment_sieves_m": sieves, "fragment_grading": run.fragment_grading}
 
 
 def summarise(run: OedometerRun, config: OedometerConfig, timeseries: dict[str, np.ndarray],
@@ -101,12 +146,32 @@ def summarise(run: OedometerRun, config: OedometerConfig, timeseries: dict[str, 
         "unloading": unloading,
         "friction_angle_deg": None if phi is None else math.degrees(phi),
         "k0_jaky": jaky,
+        **_agglomerates(run, timeseries, fragment_sieves(config)),
     }, records=len(k), load_steps=int(timeseries["step"][-1]) - run.load_start_step, wall_time_s=total_s)
 
 
+def fragment_sieves(config: OedometerConfig) -> list[float]:
+    """The fragment grading's sieves: 25, evenly in log size from half a disk's diameter
+    to the largest grain's."""
+    sieves: list[float] = np.geomspace(0.5 * config.agglomerate.disk_diameter, config.sample.d_max, 25).tolist()
+    return sieves
+
+
 def write_outputs(out: Path) -> dict[str, Any]:
-    """``timeseries.csv``, the figures and ``summary.json`` from the finished ``run.h5``."""
-    return write_run_outputs(out, _figure_tasks)
+    """``timeseries.csv``, the figures, a sample of agglomerates' ``fragments.csv`` and
+    ``summary.json`` from the finished ``run.h5``."""
+    return write_run_outputs(out, _figure_tasks, files=_fragments_csv)
+
+
+def _fragments_csv(out: Path, summary: dict[str, Any]) -> None:
+    """One row per load step and sieve: the percent of the solid area passing it."""
+    if "fragment_grading" not in summary:
+        return
+    lines = ["load_step,vertical_stress_pa,fragments,d50_m,sieve_m,percent_passing"]
+    for g in summary["fragment_grading"]:
+        lines += [f"{g['load_step']},{g['vertical_stress_pa']!r},{g['fragments']},{g['d50_m']!r},{size!r},{p!r}"
+                  for size, p in zip(summary["fragment_sieves_m"], g["percent_passing"], strict=True)]
+    write_text_atomic(out / FRAGMENTS_CSV, "\n".join(lines) + "\n")
 
 
 def _figure_tasks(series: dict[str, np.ndarray], summary: dict[str, Any]) -> list[Any]:
@@ -114,8 +179,11 @@ def _figure_tasks(series: dict[str, np.ndarray], summary: dict[str, Any]) -> lis
     from grainlab.plot.workers import FigureTask
 
     loading = first_loading(series)
+    grading = [FigureTask("fig03_fragment_grading", oedometer.fragment_grading_figure,
+                          (summary["fragment_sieves_m"], summary["fragment_grading"]))] if "fragment_grading" in summary else []
     return [
         FigureTask("fig01_lateral_stress_ratio", oedometer.lateral_stress_ratio_figure,
                    (series, loading, summary["k0_jaky"], summary["friction_angle_deg"])),
-        FigureTask("fig02_compression", oedometer.compression_figure, (series, loading)),
+        FigureTask("fig02_compression", oedometer.compression_figure, (series, loading, summary.get("yield_stress_pa"))),
+        *grading,
     ]

@@ -5,25 +5,36 @@ snapshot at each equilibrium; :func:`run_oedometer` runs it into a folder."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from grainlab._progress import progress_bar
+from grainlab.analysis.fragments import fragment_grading, fragment_labels
 from grainlab.columns import OEDOMETER
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols import operations
+from grainlab.protocols.agglomerates import agglomerate_labels, agglomerate_sample
 from grainlab.protocols.consolidate import BOX_WALLS, box_state
 from grainlab.protocols.grains import grain_porosity
 from grainlab.protocols.oedometer.config import OedometerConfig
-from grainlab.protocols.oedometer.outputs import OedometerResult, summarise, write_outputs
+from grainlab.protocols.oedometer.outputs import (
+    FRAGMENTS_CSV,
+    OedometerResult,
+    fragment_sieves,
+    summarise,
+    write_outputs,
+)
 from grainlab.protocols.oedometer.state import OedometerRun
 from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import (
     CHUNK_STEPS,
     CONSOLIDATE,
+    OUTPUT_FILES,
     SpecimenError,
     SpecimenProtocol,
     grain_columns,
@@ -34,7 +45,8 @@ from grainlab.protocols.triggers import And, EveryStop, Flag, WallClock
 from grainlab.simulation import Simulation, Wall
 from grainlab.snapshot import ParticleKind
 
-__all__ = ["LoadSteps", "OedometerProtocol", "OedometerRun", "PlatenServo", "load_path", "run_oedometer"]
+__all__ = ["FragmentGrading", "LoadSteps", "OedometerProtocol", "OedometerRun", "PlatenServo", "load_path",
+           "run_oedometer"]
 
 Context = StageContext[OedometerConfig, OedometerRun]
 
@@ -122,9 +134,11 @@ def _load(context: Context) -> None:
     # a checkpoint at an equilibrium once run.checkpoint_interval has passed
     checkpoint = operations.Checkpoint(And(steps.reached, WallClock(config.run.checkpoint_interval)), context.save,
                             run.wall_time, "load")
+    grading = [FragmentGrading(steps.reached, run, np.asarray(fragment_sieves(config)), steps)] if "agglomerates" in run.sample else []
     operations.run_loading(sim, [
         steps,
         operations.Records(steps.reached, context.writer, lambda: _record(sim, run, steps.target), OEDOMETER.units()),
+        *grading,
         operations.Snapshots(steps.reached, context.writer, lambda step: f"load_{run.next_load - 1:02d}", lambda: _snapshot(sim, run),
                   lambda: WallGeometry.from_simulation(sim, names=geometry)),
         operations.Progress(steps.reached, bar, lambda step: run.next_load, lambda: f"sigma_v {steps.box.stress_yy_pa / 1e3:.0f} "
@@ -140,7 +154,32 @@ def _snapshot(sim: Simulation, run: OedometerRun) -> Any:
     box = box_state({name: sim.wall(run.walls[name]) for name in BOX_WALLS})
     scalars = {"axial_strain": (run.height0 - box.height_m) / run.height0, "vertical_stress_pa": box.stress_yy_pa,
                "horizontal_stress_pa": box.stress_xx_pa}
-    return sim.snapshot(kind=kind, scalars=scalars, step=sim.step_count)
+    snapshot = sim.snapshot(kind=kind, scalars=scalars, step=sim.step_count)
+    if "agglomerates" not in run.sample:
+        return snapshot
+    fields = {"agglomerate": agglomerate_labels(run), "fragment": _fragments(sim)}  # each disk's
+    return dataclasses.replace(snapshot, particle_fields={**snapshot.particle_fields, **fields})
+
+
+def _fragments(sim: Simulation) -> NDArray[np.int64]:
+    bonds = sim.cement_bonds()
+    return fragment_labels(sim.n_particles, bonds.i, bonds.j)
+
+
+class FragmentGrading(Operation):
+    """Writer: at each load step's equilibrium, the fragments of a sample of agglomerates
+    (the connected components of the intact bonds) and their grading, appended to the
+    run's ``fragment_grading``."""
+
+    def __init__(self, trigger: Flag, run: OedometerRun, sieves: NDArray[np.float64], steps: LoadSteps) -> None:
+        super().__init__(trigger)
+        self.run, self.sieves, self.steps = run, sieves, steps
+
+    def act(self, loading: Loading) -> None:
+        sim = loading.sim
+        grading = fragment_grading(sim.radii, _fragments(sim), self.sieves)
+        self.run.fragment_grading.append({"load_step": self.run.next_load - 1,
+                                          "vertical_stress_pa": self.steps.box.stress_yy_pa, **grading})
 
 
 def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, float]:
@@ -178,6 +217,15 @@ class OedometerProtocol(SpecimenProtocol[OedometerConfig, OedometerRun, Oedomete
     summarise = summarise
     outputs = write_outputs
     result_type = OedometerResult
+    output_files = (*OUTPUT_FILES, FRAGMENTS_CSV)
+
+    def start(self, threads: int, progress: bool) -> tuple[Simulation, OedometerRun]:
+        """The sample generated; with ``sample.grains = agglomerate`` each grain then
+        replaced by an agglomerate (:func:`grainlab.protocols.agglomerates.agglomerate_sample`)."""
+        sim, run = super().start(threads, progress)
+        if self.config.grain_kind.grains == "agglomerate":
+            sim = agglomerate_sample(sim, run, self.config)
+        return sim, run
 
 
 def run_oedometer(config: OedometerConfig, out_dir: str | os.PathLike[str], *, resume: bool = False,

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 from grainlab.protocols.specimen import SpecimenRun
 
@@ -21,3 +22,5 @@ class OedometerRun(SpecimenRun):
     max_vertical_stress_pa: float = 0.0
     #: The engine step at which the loading started (after the confinement).
     load_start_step: int = 0
+    #: A sample of agglomerates: the fragments' grading at each load step's equilibrium.
+    fragment_grading: list[dict[str, Any]] = field(default_factory=list)
