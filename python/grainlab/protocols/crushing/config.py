@@ -1,4 +1,4 @@
-"""The crushing test's configuration: the grains' material (``material.*``), their
+"""The crushing test's configuration: the seed (``sample.seed``), the grains' material (``material.*``), their
 bonds (``cement.*`` but the pairs' choice: every lattice neighbour is bonded), how an
 agglomerate is made (``agglomerate.*``), the test's own keys (``crushing.*``) and the
 runner's."""
@@ -19,6 +19,7 @@ from grainlab.protocols.config import (
     ConfigError,
     ConfigSchema,
     MaterialSection,
+    SampleSection,
     Section,
     SectionOf,
     check_bonds,
@@ -40,7 +41,6 @@ class CrushingSection(Section):
     d_min: float = key("length", 2.0e-3, "smallest agglomerate diameter d (uniform by number up to d_max)",
                        **POSITIVE)
     d_max: float = key("length", 2.0e-3, "largest agglomerate diameter d", **POSITIVE)
-    seed: int = key("integer", 1, "random seed: agglomerate k draws from its own stream of it", minimum=0)
     strain_rate: float = key("strain_rate", "50 %/min", "the top platen's speed over the agglomerate's diameter",
                              **POSITIVE)
     final_strain: float = key("strain", 0.2, "an agglomerate's loading ends at this platen displacement over d",
@@ -66,7 +66,11 @@ _CEMENT["cement.strength_scatter"] = dataclasses.replace(_CEMENT["cement.strengt
 _MATERIAL = MaterialSection.keys()
 _MATERIAL["material.platen_friction"] = dataclasses.replace(_MATERIAL["material.platen_friction"], default=0.5)
 
-CRUSHING_FIELDS = {**_MATERIAL, **_CEMENT, **AgglomerateSection.keys(), **CrushingSection.keys()}
+#: Every test's seed key: agglomerate k draws from its own stream of it.
+_SEED = {"sample.seed": dataclasses.replace(SampleSection.keys()["sample.seed"], help=(
+    "random seed: agglomerate k draws its diameter, lattice and bonds' strengths from its own stream of it"))}
+
+CRUSHING_FIELDS = {**_SEED, **_MATERIAL, **_CEMENT, **AgglomerateSection.keys(), **CrushingSection.keys()}
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """The crushing test of single agglomerates as a protocol of the runner: agglomerate k
 (``crushing.agglomerates`` of them, each from its own random stream of
-``crushing.seed``) is made of bonded disks (:mod:`grainlab.samples.agglomerate`),
+``sample.seed``) is made of bonded disks (:mod:`grainlab.samples.agglomerate`),
 set between two platens that touch it, and crushed diametrically by the top platen
 at ``crushing.strain_rate`` x d, the bottom one fixed, until it fails (the first
 record with a bond broken whose force is below ``crushing.residual_fraction`` of the
@@ -61,7 +61,7 @@ def agglomerate_test(config: CrushingConfig, k: int, threads: int) -> tuple[Simu
     bonded, between two platens three diameters long that touch it, the contact laws,
     local damping and time step of ``config`` (as the consolidation sets them)."""
     c, a = config.crushing, config.agglomerate
-    rng = agglomerate_stream(c.seed, k)
+    rng = agglomerate_stream(config.sample.seed, k)
     d = float(UniformByNumber(c.d_min, c.d_max).sample(1, rng)[0])
     grain = build_agglomerate(d, a.disk_diameter, rng, vacancies=a.vacancies, size_scatter=a.size_scatter,
                               strengths=bond_strengths(config))
