@@ -70,7 +70,8 @@ PAGE = ReportPage(
     UCS_SCHEMA.name, test="unconfined compression test", name="ucs", figures=FIGURES, draw=_draw, glance=_glance,
     sections=(PageSection("curve", "The stress-strain curve", lambda r: [paragraph(
         "The sample is cemented at the end of the consolidation, released (side walls removed, platens held "
-        "still) and settled; strains count from there. The loading ends at ucs.final_strain or once the axial "
+        "still) and settled, then seated (the top platen servo-controlled to ucs.seating_stress); strains count "
+        "from there. The loading ends at ucs.final_strain or once the axial "
         "stress after the peak falls below ucs.residual_fraction of q_u.", "note")], with_figures=True),
               PageSection("cracks", "Cracks", _cracks)),
 )

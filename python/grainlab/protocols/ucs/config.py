@@ -31,12 +31,16 @@ class UcsSection(Section):
 
     prefix: ClassVar[str] = "ucs"
     strain_rate: float = key("strain_rate", "1 %/min", "axial strain rate of the top platen (of the height "
-                             "after the release)", **POSITIVE)
+                             "after the seating)", **POSITIVE)
     final_strain: float = key("strain", 0.02, "the loading ends at this axial strain", minimum=0.0, maximum=0.5,
                               exclusive_minimum=True)
     residual_fraction: float = key(
         "number", 0.5, "the loading ends once the axial stress after the peak falls below this fraction of the "
         "peak", minimum=0.0, maximum=1.0, exclusive_maximum=True,
+    )
+    seating_stress: float = key(
+        "stress", 1.0e3, "the seating: after the release the top platen is servo-controlled to this axial stress "
+        "in equilibrium (within a tenth of it) before the compression; the strains count from there", **POSITIVE,
     )
     records: int = key("integer", 200, "records over ucs.final_strain (one every final_strain / records)",
                        minimum=1)

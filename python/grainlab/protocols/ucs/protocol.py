@@ -1,7 +1,8 @@
 """The unconfined compression test (UCS) of a cemented sample as a protocol of the
 runner: the sample made and consolidated as every test's and cemented at the end of
 the consolidation (:mod:`grainlab.protocols.specimen`), released (the side walls
-removed, the platens held still, Table 1 friction on) and settled, then compressed
+removed, the platens held still, Table 1 friction on) and settled, seated (the top
+platen servo-controlled to ``ucs.seating_stress``), then compressed
 by the top platen at a constant strain rate, the bottom one fixed, until
 ``ucs.final_strain`` or until the axial stress falls below ``ucs.residual_fraction``
 of its peak; :func:`run_ucs` runs it into a folder (docs/cemented.md, "The
@@ -12,6 +13,7 @@ from __future__ import annotations
 import os
 import time
 import warnings
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
@@ -92,31 +94,57 @@ def _walls(sim: Simulation, run: UcsRun) -> WallGeometry:
     return WallGeometry.from_simulation(sim, names={wall_id: name for name, wall_id in run.walls.items()})
 
 
+def _settle(sim: Simulation, config: UcsConfig, what: str, settled: Callable[[], bool],
+            each_chunk: Callable[[], None] = lambda: None) -> int:
+    """Chunks of steps until ``settled()`` and the unbalanced force ratio is below
+    ``consolidation.unbalanced_force_ratio``, or until ``consolidation.max_steps`` (a
+    warning: the test goes on from there); the steps run."""
+    limit, steps = config.consolidation.unbalanced_force_ratio, 0
+    while True:
+        each_chunk()
+        sim.run(CHUNK_STEPS)
+        steps += CHUNK_STEPS
+        if sim.unbalanced_force_ratio < limit and settled():
+            return steps
+        if steps >= config.consolidation.max_steps:
+            warnings.warn(f"{what}: consolidation.max_steps reached with an unbalanced force ratio of "
+                          f"{sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}): the compression starts from there",
+                          RuntimeWarning, stacklevel=3)
+            return steps
+
+
 def _release(context: Context) -> None:
     """Table 1 friction on; the box's walls replaced by platens three sample widths long
-    (none at the sides), held still; the sample settled until the unbalanced force ratio
-    is below ``consolidation.unbalanced_force_ratio`` (a warning after
-    ``consolidation.max_steps``); its height and width are the strains' references."""
+    (none at the sides), held still; the sample settled."""
     sim, run, config = context.sim, context.state, context.config
     start = time.perf_counter()
     long_platens(sim, run.walls)
     sim.set_contact_model(0, 0, grain_model(config))  # Table 1 friction from here on
     sim.set_contact_model(0, 1, platen_model(config))
-    limit, steps = config.consolidation.unbalanced_force_ratio, 0
-    while True:
-        sim.run(CHUNK_STEPS)
-        steps += CHUNK_STEPS
-        if sim.unbalanced_force_ratio < limit:
-            break
-        if steps >= config.consolidation.max_steps:
-            warnings.warn(f"release: consolidation.max_steps reached with an unbalanced force ratio of "
-                          f"{sim.unbalanced_force_ratio:.2e} (limit {limit:.0e}): the compression starts from there",
-                          RuntimeWarning, stacklevel=2)
-            break
-    run.release_steps = steps
-    run.height0, run.width0 = _height(sim, run), sample_width(sim, run)
-    run.consolidation["release_steps"] = steps
+    run.release_steps = _settle(sim, config, "release", lambda: True)
+    run.consolidation["release_steps"] = run.release_steps
     run.wall_time["release"] = time.perf_counter() - start
+
+
+def _seat(context: Context) -> None:
+    """The top platen servo-controlled to ``ucs.seating_stress`` over the sample's width
+    until it holds it within a tenth in equilibrium, then stopped; the sample's height
+    and width there are the strains' references."""
+    sim, run, config = context.sim, context.state, context.config
+    start = time.perf_counter()
+    target, top = config.ucs.seating_stress, sim.wall(run.walls["top"])
+    speed = 0.05 * config.sample.d_min / (100 * sim.time_step)  # at most d_min/20 per 100 steps
+
+    def servo() -> None:
+        top.servo(target, sample_width(sim, run), relaxation=0.5, max_speed_m_per_s=speed)
+
+    run.seating_steps = _settle(sim, config, "seating",
+                                lambda: abs(top.normal_stress(sample_width(sim, run)) - target) <= 0.1 * target,
+                                servo)
+    top.velocity = (0.0, 0.0)
+    run.height0, run.width0 = _height(sim, run), sample_width(sim, run)
+    run.consolidation["seating_steps"] = run.seating_steps
+    run.wall_time["seat"] = time.perf_counter() - start
 
 
 def record_steps(config: UcsConfig, time_step: float) -> list[int]:
@@ -129,7 +157,7 @@ def record_steps(config: UcsConfig, time_step: float) -> list[int]:
 
 class TopPlaten(Operation):
     """Controller: the top platen down at ``ucs.strain_rate`` x the height after the
-    release, the bottom one fixed, over the steps ahead."""
+    seating, the bottom one fixed, over the steps ahead."""
 
     acts_before_run = True
 
@@ -213,6 +241,8 @@ class UcsProtocol(SpecimenProtocol[UcsConfig, UcsRun, UcsResult]):
         CONSOLIDATE,
         Stage("release", _release, "Table 1 friction on; the side walls removed, the platens held still; settled "
                                    "until the unbalanced force ratio is below consolidation.unbalanced_force_ratio"),
+        Stage("seat", _seat, "the top platen servo-controlled to ucs.seating_stress until it holds it within a tenth "
+                             "in equilibrium; the strains count from there"),
         Stage("compress", _compress, "the top platen down at ucs.strain_rate, the bottom one fixed; a record every "
                                      "ucs.final_strain / ucs.records of strain, to ucs.final_strain or the residual "
                                      "drop; a checkpoint on a record step once run.checkpoint_interval has passed"),
