@@ -15,6 +15,7 @@ from grainlab.columns import OEDOMETER
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols import operations
 from grainlab.protocols.consolidate import BOX_WALLS, box_state
+from grainlab.protocols.cracks import bonds_broken, crack_records, record_units
 from grainlab.protocols.grains import grain_porosity
 from grainlab.protocols.oedometer.config import OedometerConfig
 from grainlab.protocols.oedometer.outputs import OedometerResult, summarise, write_outputs
@@ -124,7 +125,9 @@ def _load(context: Context) -> None:
                             run.wall_time, "load")
     operations.run_loading(sim, [
         steps,
-        operations.Records(steps.reached, context.writer, lambda: _record(sim, run, steps.target), OEDOMETER.units()),
+        operations.Records(steps.reached, context.writer, lambda: _record(sim, run, config, steps.target),
+                           record_units(OEDOMETER, config)),
+        *crack_records(steps.reached, context.writer, config),  # the breaks, after the record of their step
         operations.Snapshots(steps.reached, context.writer, lambda step: f"load_{run.next_load - 1:02d}", lambda: _snapshot(sim, run),
                   lambda: WallGeometry.from_simulation(sim, names=geometry)),
         operations.Progress(steps.reached, bar, lambda step: run.next_load, lambda: f"sigma_v {steps.box.stress_yy_pa / 1e3:.0f} "
@@ -143,8 +146,9 @@ def _snapshot(sim: Simulation, run: OedometerRun) -> Any:
     return sim.snapshot(kind=kind, scalars=scalars, step=sim.step_count)
 
 
-def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, float]:
-    """One record at a load step's equilibrium, in :data:`grainlab.columns.OEDOMETER`'s order."""
+def _record(sim: Simulation, run: OedometerRun, config: OedometerConfig, target: float) -> dict[str, float]:
+    """One record at a load step's equilibrium, in :data:`grainlab.columns.OEDOMETER`'s order
+    (a cemented sample's bonds broken after them)."""
     box = box_state({name: sim.wall(run.walls[name]) for name in BOX_WALLS})
     area = box.width_m * box.height_m
     n = run.n_grains
@@ -160,7 +164,7 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
         "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "height_m": box.height_m, "area_m2": area,
         **grain_columns(sim, n, area, sim.contacts(), _snapshot(sim, run)),
     }
-    return {name: values[name] for name in OEDOMETER}
+    return {**{name: values[name] for name in OEDOMETER}, **bonds_broken(sim, run.consolidation, config)}
 
 
 class OedometerProtocol(SpecimenProtocol[OedometerConfig, OedometerRun, OedometerResult]):
