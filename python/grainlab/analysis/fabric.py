@@ -223,11 +223,9 @@ def fabric_tensor(normals: ArrayLike, weights: ArrayLike | None = None) -> NDArr
 
 # --------------------------------------------------------------------------- classes
 class CoordinationNumber(Compute):
-    r"""Coordination number Z, mechanical coordination number Z_m, contact counts.
-
-    .. math:: Z = \frac{2 N_c}{N_p}, \qquad Z_m = \frac{2 N_c^m}{N_p^m}
-
-    (the rattler rule: docs/fabric.md, "Mechanical coordination number Z_m").
+    """Coordination number Z, mechanical coordination number Z_m (after the iterative
+    rattler removal), contact counts: docs/fabric.md, "Coordination number Z" and
+    "Mechanical coordination number Z_m".
 
     Parameters
     ----------
