@@ -1,23 +1,10 @@
 """Configuration of the protocols: defaults from the paper's Table 1, TOML
 files, ``key=value`` overrides, units at the edge, validation before any work.
 
-A configuration's keys come in typed sections (:class:`Section`: a frozen
-dataclass whose fields are the keys ``section.name``, each declared with
-:func:`key`: its kind, default, range and help). Every test that makes a
-sample shares :class:`SampleSection`, :class:`MaterialSection`,
-:class:`ConsolidationSection` (:data:`SHARED_FIELDS`) and the runner's
-:class:`RunSection` (:data:`RUN_FIELDS`); each test declares its own sections
-in its package (``protocols/biaxial/config.py``: ``boundary.*``, ``shear.*``)
-and its :class:`ConfigSchema` (in :data:`SCHEMAS`), whose resolved
-:class:`Config` (a subclass per test) reads each section typed
-(``config.shear.final_strain``) or by its dotted key (``config["shear.final_strain"]``).
-
-Values are in SI units. Files and overrides may give
-numbers (SI) or strings with a unit: ``"75 mm"``, ``"100 kPa"``, ``"2 %/min"``,
-``"0.5 %"``. Every key has a kind that says which units it accepts and which
-range is allowed; a bad key or value raises :class:`ConfigError` (a
-``ValueError``) naming the key and the allowed values.
-"""
+Typed sections of keys (:class:`Section`, :func:`key`), the shared ones and each
+test's :class:`ConfigSchema`: docs/protocols.md, "Configuration"; units:
+docs/conventions.md, "Units". A bad key or value raises :class:`ConfigError` (a
+``ValueError``) naming the key and the allowed values."""
 
 from __future__ import annotations
 
