@@ -943,10 +943,8 @@ class Simulation:
         ``friction_angle`` ``phi_b`` (degrees), bond radius ``radius_multiplier`` times
         the smaller radius; ``kind="contact"``: stiffnesses in N/m, strengths in
         N, no moment. Each parameter is one value or one per pair (seeded
-        strengths: :func:`grainlab.cement.draw_strengths`). Bad input (an index
-        out of range, a particle cemented to itself, a pair twice or already
-        bonded, a negative strength, ``radius_multiplier <= 0``, a non-finite
-        value) is refused in one line before any bond is made."""
+        strengths: :func:`grainlab.cement.draw_strengths`). Bad input is refused in one
+        line before any bond is made (docs/cemented.md, "From Python")."""
         values = {
             "radius_multiplier": radius_multiplier,
             "normal_stiffness": normal_stiffness,
@@ -1010,10 +1008,8 @@ class Simulation:
             kg m^2/m, centroid (2,) m)``
 
         A clump starts with the rigid motion of its pebbles' momentum and angular
-        momentum. Refused, before any change: a body with no pebble, a pebble in
-        two bodies or already in one, a pebble of a pressure chain, two bonded
-        pebbles of one body, pebbles of one body with different fixity or (mass
-        not given) densities, a zero or negative mass.
+        momentum. What is refused, in one line before any change: docs/bodies.md,
+        "Clumps in a simulation".
         """
         lists = [[int(q) for q in body] for body in pebbles]
         for b, body in enumerate(lists):

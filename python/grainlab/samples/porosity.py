@@ -140,11 +140,9 @@ def lens_area(r1: ArrayLike, r2: ArrayLike, distance: ArrayLike) -> NDArray[np.f
     """Area shared by two disks of radii ``r1``, ``r2`` with centres ``distance`` apart (vectorised).
 
     ``0`` when ``distance >= r1 + r2``; ``pi min(r1, r2)^2`` when one disk lies in
-    the other; otherwise the two circular segments cut off by the common chord,
-    ``r1^2 s(theta1) + r2^2 s(theta2)`` with ``s(t) = t - sin t cos t`` and
-    ``cos theta1 = (d^2 + r1^2 - r2^2) / (2 d r1)`` (and 1 <-> 2). This equals the
-    textbook ``r1^2 acos(...) + r2^2 acos(...) - sqrt((-d + r1 + r2)(d + r1 - r2)(d - r1 + r2)(d + r1 + r2)) / 2``
-    but keeps its accuracy for tiny overlaps (touching disks give 0, not round-off).
+    the other; otherwise the two circular segments cut off by the common chord, in
+    the form that keeps its accuracy for tiny overlaps (docs/samples.md, "Porosity:
+    two readings").
     """
     r1, r2, d = np.broadcast_arrays(
         np.asarray(r1, dtype=np.float64), np.asarray(r2, dtype=np.float64), np.asarray(distance, dtype=np.float64)
