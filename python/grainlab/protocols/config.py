@@ -269,6 +269,25 @@ class RunSection(Section):
     checkpoint_interval: float = key("time", 30.0, "wall-clock time between checkpoints", **POSITIVE)
 
 
+@dataclass(frozen=True)
+class PlatenSection(Section):
+    """The loading keys of a test of a cemented sample pressed by its top platen (the
+    unconfined compression and Brazilian tests, ``grainlab.protocols.platens``), under
+    the test's own prefix; the strain is the top platen's travel over the sample's height
+    (the disc's diameter D in the Brazilian test)."""
+
+    prefix: ClassVar[str] = ""
+    strain_rate: float = key("strain_rate", "1 %/min", "the top platen's speed over the sample's height where "
+                             "the strains start (the disc's diameter D in the Brazilian test)", **POSITIVE)
+    final_strain: float = key("strain", 0.02, "the loading ends at this strain (the top platen's travel over that "
+                              "height)", minimum=0.0, maximum=0.5, exclusive_minimum=True)
+    residual_fraction: float = key(
+        "number", 0.5, "the loading ends once the stress after the peak falls below this fraction of the peak",
+        minimum=0.0, maximum=1.0, exclusive_maximum=True,
+    )
+    records: int = key("integer", 200, "records over final_strain (one every final_strain / records)", minimum=1)
+
+
 #: The keys of every test that makes a sample and consolidates it: the sample, its
 #: material (Table 1) and the consolidation.
 SHARED_FIELDS: dict[str, Field] = {
@@ -276,6 +295,10 @@ SHARED_FIELDS: dict[str, Field] = {
 }
 #: How a run executes (the runner's keys, in every test's configuration).
 RUN_FIELDS: dict[str, Field] = RunSection.keys()
+#: A square sample by default (a test's own keys): Table 1's width, 75 mm, on both sides.
+SQUARE: dict[str, Field] = {"sample.height": dataclasses.replace(
+    SHARED_FIELDS["sample.height"], default=SHARED_FIELDS["sample.width"].default,
+    help="sample height (a square sample: Table 1's width, 75 mm)")}
 
 #: Item kind and range of each list kind.
 _LIST_ITEMS: dict[str, tuple[str, Field]] = {

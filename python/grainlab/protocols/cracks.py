@@ -64,9 +64,10 @@ def crack_columns(breaks: BondBreaks, strain: NDArray[np.float64],
     }
 
 
-def crack_task(results: Results) -> FigureTask | None:
+def crack_task(results: Results, strain: str = "axial strain") -> FigureTask | None:
     """The crack map and rose (``fig20_cracks``) of a run with crack records, on its last
-    snapshot's grains; None without cracks."""
+    snapshot's grains, titled with the run's last ``axial_strain`` (what it is: ``strain``);
+    None without cracks."""
     if not results.cracks:
         return None
     from grainlab.plot.cracks import crack_figure
@@ -74,8 +75,9 @@ def crack_task(results: Results) -> FigureTask | None:
 
     last = results.snapshot(-1)
     grains = np.asarray(last.is_sample)
-    strain = AXIAL_STRAIN if AXIAL_STRAIN in results.cracks else next(iter(set(results.cracks) - set(crack_units())))
-    title = f"Broken cement bonds to {100 * results.timeseries[strain][-1]:.2f} % {strain.replace('_', ' ')}"
+    column = AXIAL_STRAIN if AXIAL_STRAIN in results.cracks else next(iter(set(results.cracks) - set(crack_units())))
+    label = strain if column == AXIAL_STRAIN else column.replace("_", " ")
+    title = f"Broken cement bonds to {100 * results.timeseries[column][-1]:.2f} % {label}"
     return FigureTask("fig20_cracks", crack_figure, (last.positions[grains], last.radii[grains], results.cracks, title))
 
 

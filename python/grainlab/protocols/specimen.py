@@ -45,7 +45,8 @@ from grainlab.snapshot import Snapshot
 if TYPE_CHECKING:
     from grainlab.plot.workers import FigureTask
 
-__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "cement_sample",
+__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "SpecimenError", "SpecimenProtocol", "SpecimenRun", "add_cement",
+           "cement_sample",
            "consolidate",
            "damped_time_step_factor", "engine_columns",
            "engine_threads", "generate", "grain_model", "grain_columns", "platen_model", "run_summary",
@@ -339,19 +340,27 @@ def cement_sample(sim: Simulation, run: SpecimenRun, config: Config, period: tup
     i, j = pairs_within_gap(positions, radii, c.gap, body=body, period=period)
     if len(i) == 0:
         raise SpecimenError(f"cement.gap: no two grains are within {c.gap:g} m of each other to cement")
-    area = 2.0 * c.radius_multiplier * np.minimum(radii[i], radii[j])
-    kn = config.material.normal_stiffness / area if c.normal_stiffness == "auto" else float(c.normal_stiffness)
-    ks = config.material.shear_stiffness / area if c.shear_stiffness == "auto" else float(c.shear_stiffness)
     rng = np.random.default_rng([config.sample.seed, 0x43454D])  # "CEM": a stream of its own
     law = c.strength_distribution
 
     def strengths(mean: float) -> NDArray[np.float64]:
         return draw_strengths(rng, mean, c.strength_scatter * mean, len(i), law)  # type: ignore[arg-type]
 
-    sim.add_cement_bonds(i, j, normal_stiffness=kn, shear_stiffness=ks, tensile_strength=strengths(c.tensile_strength),
-                         cohesion=strengths(c.cohesion), friction_angle=c.friction_angle,
-                         radius_multiplier=c.radius_multiplier)
+    add_cement(sim, config, i, j, strengths(c.tensile_strength), strengths(c.cohesion))
     run.consolidation["cement_bonds"] = len(i)
+
+
+def add_cement(sim: Simulation, config: Config, i: NDArray[np.int64], j: NDArray[np.int64],
+               tensile_strength: NDArray[np.float64], cohesion: NDArray[np.float64]) -> None:
+    """Parallel bonds of the ``cement.*`` keys between the particles ``i[k]`` and ``j[k]``
+    with the strengths given: stiffnesses ``auto`` make each bond's ``kn_bar A`` the
+    contact law's ``kn`` (and ``ks``)."""
+    c = config.cement
+    area = 2.0 * c.radius_multiplier * np.minimum(sim.radii[i], sim.radii[j])
+    kn = config.material.normal_stiffness / area if c.normal_stiffness == "auto" else float(c.normal_stiffness)
+    ks = config.material.shear_stiffness / area if c.shear_stiffness == "auto" else float(c.shear_stiffness)
+    sim.add_cement_bonds(i, j, normal_stiffness=kn, shear_stiffness=ks, tensile_strength=tensile_strength,
+                         cohesion=cohesion, friction_angle=c.friction_angle, radius_multiplier=c.radius_multiplier)
 
 
 
@@ -402,10 +411,11 @@ def run_summary(run: SpecimenRun, fields: Mapping[str, Any], *, records: int, wa
 
 
 def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.float64]], dict[str, Any]],
-                                                          list[FigureTask]]) -> dict[str, Any]:
+                                                          list[FigureTask]], strain: str = "axial strain") -> dict[str, Any]:
     """A finished run's ``timeseries.csv``, figures and ``summary.json``, from its ``run.h5``:
-    the figures of ``figure_tasks(time series, summary)`` drawn in the figure pool before
-    the summary is written (which says the outputs are complete); returns the summary."""
+    the figures of ``figure_tasks(time series, summary)`` and the crack map (its
+    ``axial_strain`` column named ``strain``) drawn in the figure pool before the summary
+    is written (which says the outputs are complete); returns the summary."""
     from grainlab.io.hdf5 import read_results
     from grainlab.plot.workers import figure_pool
     from grainlab.protocols.cracks import crack_task
@@ -415,7 +425,7 @@ def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.fl
     summary = dict(results.summary)
     write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
     series = {name: np.asarray(values, dtype=np.float64) for name, values in results.timeseries.items()}
-    cracks = crack_task(results)
+    cracks = crack_task(results, strain)
     tasks = figure_tasks(series, summary) + ([cracks] if cracks is not None else [])
     with figure_pool(tasks=len(tasks), page_copies=True) as pool:
         pool.draw(tasks, out).result()
