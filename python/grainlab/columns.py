@@ -1,7 +1,7 @@
 """The time-series columns the protocols record, in one place: each column's
 name, unit and meaning (:class:`Column`), and the columns of each test
 (:class:`Columns`: :data:`BIAXIAL`, :data:`OEDOMETER`, :data:`CYCLIC`,
-:data:`SIMPLE_SHEAR`, :data:`UCS`).
+:data:`SIMPLE_SHEAR`, :data:`UCS`, :data:`BRAZILIAN`).
 
 A :class:`Column` *is* its name (a ``str``), so ``timeseries[AXIAL_STRAIN]``
 reads the column from a results file, a CSV or a record, while
@@ -28,6 +28,7 @@ __all__ = [
     "AXIAL_STRAIN",
     "AXIAL_STRESS_PA",
     "BIAXIAL",
+    "BRAZILIAN",
     "COORDINATION_NUMBER",
     "CYCLE",
     "CYCLIC",
@@ -42,11 +43,14 @@ __all__ = [
     "OEDOMETER",
     "NORMAL_STRESS_PA",
     "OVERCONSOLIDATION_RATIO",
+    "PLATEN_DISPLACEMENT_M",
+    "PLATEN_FORCE_N_PER_M",
     "SHEAR_STRAIN",
     "SHEAR_STRESS_PA",
     "SIMPLE_SHEAR",
     "STRAIN_PATH",
     "STRESS_RATIO",
+    "TENSILE_STRESS_PA",
     "UCS",
     "VERTICAL_STRESS_PA",
     "VOLUMETRIC_STRAIN",
@@ -224,14 +228,31 @@ UCS = Columns(
     (CEMENT_BONDS_BROKEN,),
 )
 
-#: Every test's columns, by the results file's ``kind``.
+# ---- the Brazilian test's -----------------------------------------------------------
+DISC_STRAIN = Column("axial_strain", "1", "the platens' displacement over the disc's diameter, delta / D")
+PLATEN_DISPLACEMENT_M = Column("platen_displacement_m", "m", "delta = D - the distance between the platens, "
+                               "the top platen's travel since the loading's start")
+PLATEN_FORCE_N_PER_M = Column("platen_force_n_per_m", "N/m", "F, the mean of the two platens' normal forces (per m "
+                              "of thickness), compression positive")
+TENSILE_STRESS_PA = Column("tensile_stress_pa", "Pa", "the indirect tensile stress 2 F / (pi D t) at the disc's "
+                           "centre, t = 1 m")
+
+#: The Brazilian test's records (grainlab.protocols.brazilian): a cemented disc's always.
+BRAZILIAN = Columns(
+    "brazilian",
+    (STEP, TIME_S, DISC_STRAIN, PLATEN_DISPLACEMENT_M, PLATEN_FORCE_N_PER_M, TENSILE_STRESS_PA,
+     UNBALANCED_FORCE_RATIO),
+    ENERGY,
+    (CEMENT_BONDS_BROKEN,),
+)
 
 #: The column a cemented sample (``cement.bonds`` not ``none``) adds to the biaxial and
 #: cyclic tests' records (docs/cemented.md).
 CEMENTED = Columns("cemented", (CEMENT_BONDS_BROKEN,))
 
 BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER, CYCLIC.kind: CYCLIC,
-                               SIMPLE_SHEAR.kind: SIMPLE_SHEAR, CEMENTED.kind: CEMENTED, UCS.kind: UCS}
+                               SIMPLE_SHEAR.kind: SIMPLE_SHEAR, CEMENTED.kind: CEMENTED, UCS.kind: UCS,
+                               BRAZILIAN.kind: BRAZILIAN}
 
 
 _BLOCK = re.compile(
