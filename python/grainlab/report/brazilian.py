@@ -31,8 +31,8 @@ def _draw(folder: Path) -> None:
 def _glance(r: RunPage) -> list[tuple[str, str]]:
     s = r.summary
     return [
-        ("disc", f"D {fmt(1e3 * s['diameter_m'], 4, unit='mm')} between the platens; grains within "
-                 f"{fmt(1e3 * s['carve_diameter_m'], 4, unit='mm')} of its centre (a diameter)"),
+        ("disc", f"D {fmt(1e3 * s['diameter_m'], 4, unit='mm')} between the platens; its grains' centres in a "
+                 f"circle {fmt(1e3 * s['carve_diameter_m'], 4, unit='mm')} across"),
         ("grains / cement bonds", f"{fmt(s['n_particles'])} / {fmt(s['cement_bonds'])} (of the sample's "
                                   f"{fmt(s['sample_particles'])} / {fmt(s['sample_cement_bonds'])}; "
                                   f"{fmt(s['loose_particles'])} in the circle not held by the cement)"),
@@ -53,8 +53,8 @@ def _glance(r: RunPage) -> list[tuple[str, str]]:
 PAGE = ReportPage(
     BRAZILIAN_SCHEMA.name, test="Brazilian test", name="brazilian", figures=FIGURES, draw=_draw, glance=_glance,
     sections=(PageSection("curve", "The force-displacement curve", lambda r: [paragraph(
-        "The sample is cemented at the end of the consolidation; the disc is carved from it (the grains within its "
-        "circle that the cement holds together), put between two platens touching it and settled; the "
+        "The sample is cemented at the end of the consolidation; the disc is carved from it (the grains in its "
+        "circle that the cement holds, each by two bonds or more), put between two platens touching it and settled; the "
         "displacement counts from there. The loading ends at brazilian.final_strain (of D) or once the platen "
         "force after the peak falls below brazilian.residual_fraction of F_max. Forces are per metre of "
         "thickness (t = 1 m).", "note")], with_figures=True),

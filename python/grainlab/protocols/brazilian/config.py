@@ -39,8 +39,8 @@ class BrazilianSection(PlatenSection):
         "peak (the split leaves the halves bearing almost nothing)", minimum=0.0, maximum=1.0, exclusive_maximum=True,
     )
     diameter_fraction: float = key(
-        "number", 0.9, "the disc's grains are those whose centre lies within this fraction of the consolidated "
-        "sample's smaller side (a diameter) of its centre", minimum=0.0, maximum=1.0, exclusive_minimum=True,
+        "number", 0.9, "the disc's grains are those whose centre lies in the circle at the consolidated sample's "
+        "centre whose diameter is this fraction of its smaller side", minimum=0.0, maximum=1.0, exclusive_minimum=True,
     )
     platen_friction: float = key(
         "number", 0.5, "friction between the grains and the two platens that load the disc (the box's walls "
