@@ -1,7 +1,7 @@
 """The Brazilian test's report page, declared: the indirect tensile strength
 sigma_t = 2 F_max / (pi D t), the disc, its bonds and its cracks, the
-force-displacement figure and the crack map
-(:class:`~grainlab.report.run_page.ReportPage`)."""
+force-displacement figure (:class:`~grainlab.report.run_page.ReportPage`; the crack
+map is every cemented run's)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 
 from grainlab._html import fmt, paragraph
 from grainlab.protocols.brazilian.config import BRAZILIAN_SCHEMA
-from grainlab.report.run_page import PageSection, ReportPage, RunPage, crack_map
+from grainlab.report.run_page import PageSection, ReportPage, RunPage
 
 __all__ = ["FIGURES", "PAGE"]
 
@@ -57,6 +57,5 @@ PAGE = ReportPage(
         "circle that the cement holds, each by two bonds or more), put between two platens touching it and settled; the "
         "displacement counts from there. The loading ends at brazilian.final_strain (of D) or once the platen "
         "force after the peak falls below brazilian.residual_fraction of F_max. Forces are per metre of "
-        "thickness (t = 1 m).", "note")], with_figures=True),
-              PageSection("cracks", "Cracks", crack_map)),
+        "thickness (t = 1 m).", "note")], with_figures=True),),
 )
