@@ -1,18 +1,10 @@
 """Bodies: the mass properties of a clump, a rigid body of overlapping disks.
 
-A clump is the union of its pebbles (disks of centre ``c_k`` and radius
-``r_k``); a point covered by several pebbles counts once, and a region that a
-ring of pebbles encloses without covering is a hole, not material. Its area,
-centroid and polar second moment come exactly, in closed form, from Green's
-theorem over the arcs of the union's boundary (the engine's
-``grainlab_core::body``; docs/bodies.md writes the arc integrals out):
-
-    A = 1/2 sum_arcs int (x dy - y dx),   A c = (sum int x^2/2 dy, -sum int y^2/2 dx),
-    J = 1/3 sum_arcs int (x^3 dy - y^3 dx) - A |c|^2.
-
-In 2D per unit thickness, as :class:`grainlab.Simulation`'s disks (mass
-``rho pi r^2``): mass ``m = rho A`` (kg per m of thickness), moment of inertia
-about the centroid ``I = rho J`` (kg m^2 per m).
+The union of its pebbles (overlaps counted once, enclosed holes left out), its area,
+centroid and polar second moment exact from Green's theorem over the arcs of its
+boundary (the engine's ``grainlab_core::body``; docs/bodies.md, "The closed form:
+Green's theorem over the arcs"); per unit thickness, mass ``rho A`` and moment of
+inertia ``rho J`` about the centroid.
 
 >>> import numpy as np
 >>> two = clump_mass_properties([[-0.5e-3, 0.0], [0.5e-3, 0.0]], [1e-3, 1e-3], density=2650.0)

@@ -1,7 +1,7 @@
 """The time-series columns the protocols record, in one place: each column's
 name, unit and meaning (:class:`Column`), and the columns of each test
 (:class:`Columns`: :data:`BIAXIAL`, :data:`OEDOMETER`, :data:`CYCLIC`,
-:data:`SIMPLE_SHEAR`, :data:`UCS`, :data:`CRUSHING`).
+:data:`SIMPLE_SHEAR`, :data:`UCS`, :data:`BRAZILIAN`, :data:`CRUSHING`).
 
 A :class:`Column` *is* its name (a ``str``), so ``timeseries[AXIAL_STRAIN]``
 reads the column from a results file, a CSV or a record, while
@@ -32,11 +32,12 @@ __all__ = [
     "FRAGMENTS",
     "LARGEST_FRAGMENT",
     "MAJOR_FRAGMENTS",
-    "PLATEN_DISPLACEMENT_M",
+    "AGGLOMERATE_PLATEN_DISPLACEMENT_M",
     "PLATEN_FORCE_N",
     "AXIAL_STRAIN",
     "AXIAL_STRESS_PA",
     "BIAXIAL",
+    "BRAZILIAN",
     "COORDINATION_NUMBER",
     "CYCLE",
     "CYCLIC",
@@ -51,11 +52,14 @@ __all__ = [
     "OEDOMETER",
     "NORMAL_STRESS_PA",
     "OVERCONSOLIDATION_RATIO",
+    "PLATEN_DISPLACEMENT_M",
+    "PLATEN_FORCE_N_PER_M",
     "SHEAR_STRAIN",
     "SHEAR_STRESS_PA",
     "SIMPLE_SHEAR",
     "STRAIN_PATH",
     "STRESS_RATIO",
+    "TENSILE_STRESS_PA",
     "UCS",
     "VERTICAL_STRESS_PA",
     "VOLUMETRIC_STRAIN",
@@ -233,11 +237,29 @@ UCS = Columns(
     (CEMENT_BONDS_BROKEN,),
 )
 
+# ---- the Brazilian test's -----------------------------------------------------------
+DISC_STRAIN = Column("axial_strain", "1", "the platens' displacement over the disc's diameter, delta / D")
+PLATEN_DISPLACEMENT_M = Column("platen_displacement_m", "m", "delta = D - the distance between the platens, "
+                               "the top platen's travel since the loading's start")
+PLATEN_FORCE_N_PER_M = Column("platen_force_n_per_m", "N/m", "F, the mean of the two platens' normal forces (per m "
+                              "of thickness), compression positive")
+TENSILE_STRESS_PA = Column("tensile_stress_pa", "Pa", "the indirect tensile stress 2 F / (pi D t) at the disc's "
+                           "centre, t = 1 m")
+
+#: The Brazilian test's records (grainlab.protocols.brazilian): a cemented disc's always.
+BRAZILIAN = Columns(
+    "brazilian",
+    (STEP, TIME_S, DISC_STRAIN, PLATEN_DISPLACEMENT_M, PLATEN_FORCE_N_PER_M, TENSILE_STRESS_PA,
+     UNBALANCED_FORCE_RATIO),
+    ENERGY,
+    (CEMENT_BONDS_BROKEN,),
+)
+
 # ---- the crushing test's ----------------------------------------------------------
 AGGLOMERATE = Column("agglomerate", "1", "the agglomerate crushed (0 .. crushing.agglomerates - 1)")
 DIAMETER_M = Column("diameter_m", "m", "the agglomerate's diameter d")
-PLATEN_DISPLACEMENT_M = Column("platen_displacement_m", "m", "the top platen's displacement since the "
-                               "agglomerate's start, down positive")
+AGGLOMERATE_PLATEN_DISPLACEMENT_M = Column("platen_displacement_m", "m", "the top platen's displacement "
+                                           "since the agglomerate's start, down positive")
 PLATEN_FORCE_N = Column("platen_force_n", "N", "force of the agglomerate on the top platen, N per m of thickness")
 CHARACTERISTIC_STRESS_PA = Column("characteristic_stress_pa", "Pa", "F / (d t), the platen force over the "
                                   "diameter and the thickness t = 1 m")
@@ -250,7 +272,8 @@ LARGEST_FRAGMENT = Column("largest_fragment_fraction", "1", "the largest fragmen
 CRUSHING = Columns(
     "crushing",
     (AGGLOMERATE, STEP, Column("time_s", "s", "simulated time since the agglomerate's start"), DIAMETER_M,
-     Column("axial_strain", "1", "the platen's displacement over d, compression positive"), PLATEN_DISPLACEMENT_M,
+     Column("axial_strain", "1", "the platen's displacement over d, compression positive"),
+     AGGLOMERATE_PLATEN_DISPLACEMENT_M,
      PLATEN_FORCE_N, CHARACTERISTIC_STRESS_PA,
      Column("cement_bonds_broken", "1", "the agglomerate's bonds broken since its start"), FRAGMENTS,
      MAJOR_FRAGMENTS, LARGEST_FRAGMENT, UNBALANCED_FORCE_RATIO),
@@ -265,7 +288,7 @@ CEMENTED = Columns("cemented", (CEMENT_BONDS_BROKEN,))
 
 BY_KIND: dict[str, Columns] = {BIAXIAL.kind: BIAXIAL, OEDOMETER.kind: OEDOMETER, CYCLIC.kind: CYCLIC,
                                SIMPLE_SHEAR.kind: SIMPLE_SHEAR, CEMENTED.kind: CEMENTED, UCS.kind: UCS,
-                               CRUSHING.kind: CRUSHING}
+                               BRAZILIAN.kind: BRAZILIAN, CRUSHING.kind: CRUSHING}
 
 
 _BLOCK = re.compile(

@@ -1,26 +1,7 @@
 """Grain shapes as clumps of disks: dimers, trimers, straight rods and user
-templates, each sized by its circumscribed radius and shaped by CEGEO's
-parameter eta (docs/bodies.md, "Shapes").
-
-``eta = dR / R``: ``R`` the radius of the smallest circle about the body's
-centroid that contains it (circumscribed), ``R - dR`` the radius of the largest
-one about the centroid inside it (inscribed); eta = 0 is a disk. A sample's
-grading gives each body's *circumscribed* diameter ``2 R``, whatever its shape,
-as CEGEO's benchmark draws its trimers' sizes.
-
-For ``n`` equal pebbles of radius ``r`` (``R`` = 1 below):
-
-- dimer, centres ``+-l`` on the x axis: the waist is ``sqrt(r^2 - l^2)`` from
-  the centre, so ``r = (1 + (1 - eta)^2) / 2``, ``l = (1 - (1 - eta)^2) / 2``
-  (eta < 1: at 1 the pebbles only touch);
-- trimer, centres on a circle of radius ``l`` 120 degrees apart: the waists are
-  ``l / 2 + sqrt(r^2 - 3 l^2 / 4)`` from the centre, so
-  ``l = eta (2 - eta) / (1 + eta)``, ``r = 1 - l`` (eta < 1 - 1 / (2 + sqrt 3)
-  = 0.732..., where they only touch);
-- rod, centres ``s`` apart on the x axis: with ``n`` odd the middle pebble is
-  the inscribed circle (``r = 1 - eta``, ``s = 2 eta / (n - 1)``, eta <= (n - 1)
-  / n), with ``n`` even the middle waist is (``sqrt(r^2 - s^2 / 4) = 1 - eta``
-  with ``r = 1 - (n - 1) s / 2``).
+templates, each sized by its circumscribed radius ``R`` (a grading gives ``2 R``)
+and shaped by CEGEO's parameter ``eta = dR / R`` (``R - dR`` the inscribed radius;
+eta = 0 is a disk). The pebbles of each shape, and why: docs/bodies.md, "Shapes".
 
 >>> t = shape_template("trimer", 0.3)
 >>> round(t.circumscribed_radius, 12), round(t.inscribed_radius, 12)

@@ -67,20 +67,12 @@ class ContactModel:
     ratios are fractions of critical damping of optional viscous dashpots
     (``2 sqrt(m* k)``); they are independent of local damping.
 
-    Rolling resistance (docs/contact-law.md, "Rolling resistance"), off by
-    default: ``rolling_friction`` mu_r caps the rolling moment at
-    ``mu_r R* Fn`` (``R* = r_i r_j / (r_i + r_j)``, the radius against a wall);
-    ``rolling_stiffness`` k_r (N m/rad), 0 for the rule
-    ``2.25 kn mu_r^2 R*^2``; ``rolling_damping_ratio`` a fraction of
-    ``2 sqrt(I_r k_r)`` acting below the cap.
-
-    Hertz-Mindlin (docs/contact-law.md, "Hertz-Mindlin"), as LAMMPS's ``pair
-    granular hertz/material E damping nu tangential mindlin`` computes it:
-    ``Fn = 4/3 E* sqrt(R*) overlap^(3/2)`` with ``E* = E / (2 (1 - nu^2))``,
-    Mindlin's tangential stiffness ``8 G* a`` (``a = sqrt(R* overlap)``,
-    ``G* = E / (4 (2 - nu) (1 + nu))``), a normal dashpot set from the
-    coefficient of restitution; the stiffnesses and damping ratios above are
-    then not read (give the damping ratios 0). :meth:`hertz_mindlin` makes one.
+    Rolling resistance (``rolling_friction``, ``rolling_stiffness``,
+    ``rolling_damping_ratio``), off by default: docs/contact-law.md, "Rolling
+    resistance (optional)". Hertz-Mindlin from ``youngs_modulus``, ``poisson_ratio``
+    and ``restitution``, as LAMMPS's ``pair granular`` computes it: docs/contact-law.md,
+    "Hertz-Mindlin"; the stiffnesses and damping ratios above are then not read
+    (give the damping ratios 0). :meth:`hertz_mindlin` makes one.
     """
 
     @classmethod
@@ -127,30 +119,14 @@ def _tangent(normal: NDArray[np.float64]) -> NDArray[np.float64]:
 
 @dataclass(frozen=True)
 class Contacts:
-    """Particle-particle contacts (and bonds) as parallel arrays, sorted by ``(i, j)``,
-    in the one force convention of grainlab's Python side, the snapshot's
-    (docs/conventions.md, "Contact forces"):
+    """Particle-particle contacts (and bonds) as parallel arrays, sorted by ``(i, j)``.
 
-    ``normal`` is the unit vector from ``i`` to ``j``; ``normal_force`` is the
-    normal force's magnitude, compression positive (N, >= 0 unless bonded);
-    ``shear_force`` is the tangential force **on i** along ``t = (-n_y, n_x)``
-    (N, signed). The force on ``i`` is ``-normal_force n + shear_force t``
-    (:attr:`force_on_i`), its opposite acts on ``j``. Every row is one
-    consistent state: the forces at the current positions exactly as the next
-    step's force evaluation computes them, ``normal_force = kn * overlap`` and
-    the shear spring with the increment of the displacement since the last
-    evaluation, capped at ``mu * normal_force``; ``sliding`` is true exactly
-    where ``|shear_force| = mu * normal_force``. ``rolling_moment`` is the
-    rolling resistance's moment **on i** (N m, counter-clockwise positive; its
-    opposite acts on ``j``), the rolling spring with its increment, capped at
-    ``mu_r R* normal_force``; 0 without rolling resistance and for bonds.
-    Forces and moments are the elastic parts (no dashpot forces or moments);
-    see docs/contact-law.md. The torque of a contact on ``i`` is
-    ``r_i * shear_force + rolling_moment``, on ``j`` ``r_j * shear_force -
-    rolling_moment``. ``normal_stiffness`` is the normal force's tangent
-    stiffness ``dF_n / d(overlap)`` at the current overlap (N/m): ``kn`` for the
-    linear law, ``2 E* a`` for Hertz-Mindlin (docs/contact-law.md), the bond's
-    ``kn`` for a bond.
+    One consistent state (docs/contact-law.md, "What `Simulation.contacts()` reports")
+    in the Python side's one force convention (docs/conventions.md, "Contact forces"):
+    ``normal`` from ``i`` to ``j``, ``normal_force`` compression positive,
+    ``shear_force`` along ``(-n_y, n_x)`` and ``rolling_moment`` on ``i``
+    (:attr:`force_on_i`), ``normal_stiffness`` the tangent stiffness
+    ``dF_n / d(overlap)`` (N/m).
 
     Two touching disks held in place, ``i`` turning against ``j``: the rolling
     moment on ``i`` is ``-k_r dtheta`` while below its cap
@@ -192,13 +168,8 @@ class Contacts:
 @dataclass(frozen=True)
 class WallContacts:
     """Particle-wall contacts, in the same consistent state and the same convention
-    as :class:`Contacts` with the wall as ``j``: ``normal`` points from the particle
-    to the wall, ``normal_force`` is compression positive, ``shear_force`` acts
-    on the particle along ``(-n_y, n_x)`` and ``rolling_moment`` (N m,
-    counter-clockwise positive, 0 without rolling resistance) on the particle;
-    the contact's torque on the particle is ``r * shear_force + rolling_moment``;
-    ``normal_stiffness`` is the normal force's tangent stiffness (N/m), as
-    :class:`Contacts`'s."""
+    as :class:`Contacts` with the wall as ``j`` (``normal`` from the particle to the
+    wall; ``shear_force`` and ``rolling_moment`` on the particle)."""
 
     wall: NDArray[np.uint32]
     particle: NDArray[np.uint32]
@@ -972,10 +943,8 @@ class Simulation:
         ``friction_angle`` ``phi_b`` (degrees), bond radius ``radius_multiplier`` times
         the smaller radius; ``kind="contact"``: stiffnesses in N/m, strengths in
         N, no moment. Each parameter is one value or one per pair (seeded
-        strengths: :func:`grainlab.cement.draw_strengths`). Bad input (an index
-        out of range, a particle cemented to itself, a pair twice or already
-        bonded, a negative strength, ``radius_multiplier <= 0``, a non-finite
-        value) is refused in one line before any bond is made."""
+        strengths: :func:`grainlab.cement.draw_strengths`). Bad input is refused in one
+        line before any bond is made (docs/cemented.md, "From Python")."""
         values = {
             "radius_multiplier": radius_multiplier,
             "normal_stiffness": normal_stiffness,
@@ -1039,10 +1008,8 @@ class Simulation:
             kg m^2/m, centroid (2,) m)``
 
         A clump starts with the rigid motion of its pebbles' momentum and angular
-        momentum. Refused, before any change: a body with no pebble, a pebble in
-        two bodies or already in one, a pebble of a pressure chain, two bonded
-        pebbles of one body, pebbles of one body with different fixity or (mass
-        not given) densities, a zero or negative mass.
+        momentum. What is refused, in one line before any change: docs/bodies.md,
+        "Clumps in a simulation".
         """
         lists = [[int(q) for q in body] for body in pebbles]
         for b, body in enumerate(lists):

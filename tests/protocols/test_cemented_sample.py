@@ -1,7 +1,7 @@
 """Cemented samples (docs/cemented.md, "Cemented samples"): the pairs the ``cement.*``
-keys bond, the refusals before any work, and a cemented biaxial test: stronger than the
+keys bond, the refusals before any work, a cemented biaxial test: stronger than the
 same sample without cement, and resumed after a kill in the middle of cracking to the
-same bits."""
+same bits; and the crack records of a cemented oedometer and simple-shear test."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from resume_check import kill_at_measure
+from resume_check import assert_same_run, kill_at_measure, stop_and_resume
 
 import grainlab
 import grainlab.protocols.biaxial as biaxial
@@ -19,7 +19,10 @@ from grainlab.cement import pairs_within_gap
 from grainlab.io.hdf5 import read_checkpoint, read_results
 from grainlab.protocols.biaxial.config import resolve
 from grainlab.protocols.config import SCHEMAS, ConfigError
+from grainlab.protocols.registry import PROTOCOLS, resolve_config
+from grainlab.protocols.runner import run_protocol
 from grainlab.protocols.specimen import cement_sample
+from grainlab.report import write_report
 
 CEMENT = ["cement.bonds=parallel", "cement.tensile_strength=500 kPa", "cement.cohesion=500 kPa",
           "cement.strength_scatter=0.2"]
@@ -125,3 +128,40 @@ def test_a_cemented_biaxial_test_is_stronger_and_resumes_through_cracking_to_the
     assert a.cracks.keys() == b.cracks.keys()
     for name in a.cracks:
         np.testing.assert_array_equal(a.cracks[name], b.cracks[name], err_msg=name)
+
+
+@pytest.mark.parametrize(("test", "strain", "loading"), [
+    ("oedometer", "axial_strain", ["oedometer.vertical_stresses=[200 kPa, 400 kPa, 800 kPa, 400 kPa]"]),
+    ("simple_shear", "shear_strain", ["simple_shear.final_strain=0.3", "simple_shear.record_interval=0.02",
+                                      "simple_shear.inertial_number=0.01"]),
+])
+def test_a_cemented_oedometer_or_simple_shear_test_records_its_cracks_and_resumes_to_the_same_bits(
+        tmp_path, monkeypatch, test, strain, loading):
+    # weak bonds (100 kPa): the loading breaks most of them
+    weak = ["cement.bonds=parallel", "cement.tensile_strength=100 kPa", "cement.cohesion=100 kPa",
+            "cement.strength_scatter=0.2", *loading, "run.threads=1", "run.checkpoint_interval=1e-9"]
+    protocol = PROTOCOLS[test](resolve_config(test, overrides=weak, quick=True))
+    straight = tmp_path / "straight"
+    run_protocol(protocol, straight)
+    results = read_results(straight / "run.h5")
+    broken, cracks = results.timeseries["cement_bonds_broken"], results.cracks
+    # every break since the consolidation is a crack row, at the test's own strain, in the order they broke
+    assert broken[0] == 0 and np.all(np.diff(broken) >= 0) and 0 < broken[-1] <= results.summary["cement_bonds"]
+    assert len(cracks["step"]) == broken[-1] and strain in cracks
+    assert ("axial_strain" in cracks) == (strain == "axial_strain")
+    np.testing.assert_array_equal(np.bincount(np.searchsorted(results.timeseries["step"], cracks["step"]),
+                                              minlength=len(broken)).cumsum(), broken)
+    series = results.timeseries[strain]
+    assert series[0] <= cracks[strain].min() and cracks[strain].max() <= series.max()
+    assert np.all(np.diff(cracks["step"]) >= 0) and set(np.unique(cracks["tension"])) <= {0, 1}
+    # the crack map, and the report's crack section that shows it
+    assert (straight / "fig20_cracks.png").exists()
+    assert 'id="cracks"' in write_report(straight).read_text() and "figure-fig20_cracks" in (straight / "report.html").read_text()
+    # stopped at its third checkpoint, with bonds broken: resumed to the same records, snapshots and cracks
+    stop_and_resume(PROTOCOLS[test](resolve_config(test, overrides=weak, quick=True)), tmp_path / "resumed", 3,
+                    monkeypatch)
+    assert_same_run(straight, tmp_path / "resumed")
+    again = read_results(tmp_path / "resumed" / "run.h5").cracks
+    assert again.keys() == cracks.keys()
+    for name in cracks:
+        np.testing.assert_array_equal(again[name], cracks[name], err_msg=name)

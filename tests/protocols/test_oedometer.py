@@ -151,7 +151,7 @@ def test_bad_input_gets_one_line_and_no_folder(tmp_path, capsys, override, messa
 def test_the_load_path_keeps_its_order_and_the_registry_knows_it():
     config = resolve_config("oedometer", overrides=["oedometer.vertical_stresses=[1 MPa, 200 kPa, 300 kPa]"])
     assert config["oedometer.vertical_stresses"] == [1e6, 2e5, 3e5]
-    assert set(PROTOCOLS) == {"biaxial", "crushing", "cyclic", "oedometer", "simple_shear", "ucs"}
+    assert set(PROTOCOLS) == {"biaxial", "brazilian", "crushing", "cyclic", "oedometer", "simple_shear", "ucs"}
     with pytest.raises(ConfigError, match="unknown configuration key"):
         resolve_config("oedometer", overrides=["boundary.kind=membrane"])
 

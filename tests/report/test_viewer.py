@@ -223,14 +223,14 @@ def test_a_cemented_runs_cracks_are_a_layer_drawn_as_they_broke(tmp_path):
     """Two snapshots, one crack broken before each: the data say which are broken by
     each snapshot, and the page draws them (tension blue) where they are, and no more."""
     from grainlab.io.hdf5 import ResultsWriter
-    from grainlab.protocols.cracks import CRACK_UNITS
+    from grainlab.protocols.cracks import crack_units
     from grainlab.snapshot import Snapshot
     from grainlab.viewer.data import viewer_data
 
     a, b = np.meshgrid(np.arange(10), np.arange(10), indexing="ij")
     pos = np.c_[a.ravel(), b.ravel()] * 1e-3 + 1e-3
     radii = np.full(100, 0.5e-3)
-    crack = {name: np.zeros(2, dtype=np.int64 if name in ("step", "i", "j") else np.float64) for name in CRACK_UNITS}
+    crack = {name: np.zeros(2, dtype=np.int64 if name in ("step", "i", "j") else np.float64) for name in crack_units()}
     crack |= {"time_s": np.array([0.5, 1.5]), "x_m": np.array([1.5e-3, 8.5e-3]), "y_m": np.array([5.0e-3, 5.0e-3]),
               "normal_x": np.ones(2), "tension": np.array([1, 0], dtype=np.int8)}
     with ResultsWriter(tmp_path / "run.h5", kind="biaxial") as out:
@@ -238,7 +238,7 @@ def test_a_cemented_runs_cracks_are_a_layer_drawn_as_they_broke(tmp_path):
         for k in range(2):
             out.write_snapshot(f"strain_{k}", Snapshot.from_geometry(pos, radii, tolerance=1e-9, time=1.0 + k,
                                                                      axial_strain=0.01 * k))
-        out.append_cracks(crack, CRACK_UNITS)
+        out.append_cracks(crack, crack_units())
     data = viewer_data(tmp_path)
     assert data["cracks"]["n"] == 2 and [s["n_cracks"] for s in data["snapshots"]] == [1, 2]
     np.testing.assert_allclose(_decode(data["cracks"]["angle"], "f4"), 0.5 * np.pi, rtol=1e-6)  # vertical

@@ -48,4 +48,4 @@ def test_a_plan_of_an_unknown_test_names_the_known_ones(tmp_path, capsys):
     plan = tmp_path / "plan.toml"
     plan.write_text('base = "triaxial"\n')
     assert main(["sweep", str(plan), "--out", str(tmp_path / "out")]) == 2
-    assert "base: expected one of 'packing', 'biaxial', 'crushing', 'cyclic', 'oedometer', 'simple_shear', 'ucs', got 'triaxial'" in capsys.readouterr().err
+    assert "base: expected one of 'packing', 'biaxial', 'brazilian', 'crushing', 'cyclic', 'oedometer', 'simple_shear', 'ucs', got 'triaxial'" in capsys.readouterr().err

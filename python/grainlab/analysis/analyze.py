@@ -229,18 +229,9 @@ class AnalysisResult:
 
 def fabric_summary(snapshot: Snapshot) -> dict[str, float]:
     """The scalar fabric of a snapshot with the library's defaults (boundary
-    contacts excluded from Z and the anisotropies, included in lambda):
-    ``coordination_number``, ``mechanical_coordination_number``,
-    ``mean_stability_index`` (grains with >= 2 contacts),
-    ``mean_stability_index_all`` (every grain, 0- and 1-contact grains at
-    lambda = 1, paper Sec. 5), ``anisotropy`` and ``anisotropy_direction_rad``
-    (the exact, unbinned estimate; ``anisotropy_fourier`` is the same value
-    under its earlier name), ``anisotropy_binned`` (Eq. 7 on 18 bins),
-    ``force_anisotropy`` and ``force_anisotropy_binned`` (NaN when no contact
-    carries a force). A snapshot of clumps is read per body (docs/fabric.md,
-    "Measures per body"): contacts per body (``Z_c``, and ``Z_c`` of the bodies
-    left once rattlers are removed), lambda about each body's centroid, the
-    anisotropies of the contacts between bodies."""
+    contacts excluded from Z and the anisotropies, included in lambda), per body
+    for a snapshot of clumps; the keys: docs/fabric.md, "Fabric in the biaxial
+    records" (the force anisotropies NaN when no contact carries a force)."""
     stability: StabilityIndex
     if has_clumps(snapshot):
         view = body_view(snapshot)

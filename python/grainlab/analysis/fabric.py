@@ -223,11 +223,9 @@ def fabric_tensor(normals: ArrayLike, weights: ArrayLike | None = None) -> NDArr
 
 # --------------------------------------------------------------------------- classes
 class CoordinationNumber(Compute):
-    r"""Coordination number Z, mechanical coordination number Z_m, contact counts.
-
-    .. math:: Z = \frac{2 N_c}{N_p}, \qquad Z_m = \frac{2 N_c^m}{N_p^m}
-
-    (the rattler rule: docs/fabric.md, "Mechanical coordination number Z_m").
+    """Coordination number Z, mechanical coordination number Z_m (after the iterative
+    rattler removal), contact counts: docs/fabric.md, "Coordination number Z" and
+    "Mechanical coordination number Z_m".
 
     Parameters
     ----------
@@ -339,13 +337,11 @@ class CoordinationNumber(Compute):
 
 
 class ContactAnisotropy(Compute):
-    r"""Contact-normal (or normal-force) distribution and its anisotropy (Eq. 6–8).
+    """Contact-normal (or normal-force) distribution and its anisotropy (Eq. 6–8).
 
-    Fitted distribution (Eq. 6): :math:`E(\theta) = \frac{1}{2\pi}[1 + a\cos
-    2(\theta - \theta_a)]`. The headline :attr:`anisotropy` and
-    :attr:`direction` are the exact (unbinned) estimate from the second
-    Fourier moment; :attr:`anisotropy_binned` and :attr:`direction_binned`
-    are the paper's Eq. 7–8 on the histogram (docs/fabric.md,
+    The headline :attr:`anisotropy` and :attr:`direction` are the exact (unbinned)
+    estimate from the second Fourier moment; :attr:`anisotropy_binned` and
+    :attr:`direction_binned` the paper's Eq. 7–8 on the histogram (docs/fabric.md,
     "Contact-normal distribution and anisotropy (Eq. 6–8)").
 
     Parameters

@@ -16,12 +16,8 @@ __all__ = ["ForceChains"]
 
 
 class ForceChains(Compute):
-    r"""Force chains: highly stressed grains linked along their major principal directions.
-
-    Grain p is highly stressed when :math:`\sigma_1^p > \bar\sigma_1`; a
-    contact links two such grains when :math:`|\hat l\cdot m_p| \ge
-    \cos\alpha` for both; chains are the linked sets of at least
-    ``min_grains`` grains (docs/fabric.md).
+    """Force chains: highly stressed grains linked along their major principal directions,
+    in chains of at least ``min_grains`` grains (docs/fabric.md, "Force chains").
 
     Parameters
     ----------

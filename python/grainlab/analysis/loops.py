@@ -17,12 +17,8 @@ __all__ = ["ContactLoops"]
 
 
 class ContactLoops(Compute):
-    r"""Independent cycles and minimal loops (faces) of the contact graph.
-
-    .. math:: L = E - V + C,
-
-    and the sizes of the bounded faces of the planar contact network
-    (docs/fabric.md).
+    """Independent cycles (the cyclomatic number) and minimal loops (the bounded faces of
+    the planar contact network): docs/fabric.md, "Loops of the contact network".
 
     Parameters
     ----------

@@ -62,14 +62,9 @@ def _deviator(s: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 class ForceNetworks(Compute):
-    r"""The strong and weak force networks split at the mean normal force.
-
-    Strong: :math:`f_n > \langle f_n\rangle`; weak: the rest. Each network's
-    anisotropies, stress :math:`\sigma^k = \frac1A\sum_{c\in k}
-    \operatorname{sym}(l_c \otimes f_c)` and shares
-    :math:`\chi_k = \operatorname{dev}\sigma^k:\operatorname{dev}\sigma /
-    \operatorname{dev}\sigma:\operatorname{dev}\sigma` and :math:`p_k/p`,
-    which sum to 1 over the two networks (docs/fabric.md).
+    """The strong and weak force networks split at the mean normal force, each with its
+    anisotropies, stress and shares of the deviatoric and mean stress, which sum to 1
+    over the two networks (docs/fabric.md, "Strong and weak networks").
 
     Parameters
     ----------

@@ -193,19 +193,9 @@ def grain_stress(snapshot: Snapshot, area: ArrayLike | None = None) -> NDArray[n
 
 
 class GrainStress(Compute):
-    r"""The Love-Weber stress of each grain and its principal values.
-
-    .. math::
-
-       \sigma^p = -\frac{1}{V_p}\sum_{c \ni p}\operatorname{sym}\big((x_c - x_p)\otimes f^p_c\big),
-       \qquad \sigma_{1,2} = \frac{\sigma_{xx}+\sigma_{yy}}{2} \pm
-       \sqrt{\Big(\frac{\sigma_{xx}-\sigma_{yy}}{2}\Big)^2 + \sigma_{xy}^2},
-
-    compression positive (Pa), :math:`V_p = \pi r_p^2` by default, the
-    major direction :math:`\tfrac12\operatorname{atan2}(2\sigma_{xy},
-    \sigma_{xx}-\sigma_{yy}) \in [0, \pi)`. In equilibrium the area-weighted
-    sum over grains equals the contact stress (:func:`contact_stress`) of
-    their contacts.
+    """The Love-Weber stress of each grain and its principal values, compression positive
+    (Pa), spread over its disk by default: docs/fabric.md, "Stress: grains, regions and
+    sets of contacts".
 
     Parameters
     ----------
@@ -259,14 +249,10 @@ class GrainStress(Compute):
 
 
 class LoveWeberStress(Compute):
-    r"""The average (Love-Weber) stress of a region of a snapshot.
-
-    .. math:: \sigma = -\frac{1}{A}\sum_{p \in R}\sum_{c \ni p}
-              \operatorname{sym}\big((x_c - x_p)\otimes f^p_c\big)
-
-    (:func:`love_weber_stress`), Pa, compression positive, over the
-    particles ``p`` of the region R, every contact of theirs counted (those
-    with walls and with particles outside R: the region's boundary forces).
+    """The average (Love-Weber) stress of a region of a snapshot (:func:`love_weber_stress`),
+    Pa, compression positive, every contact of the region's particles counted (those with
+    walls and with particles outside it: its boundary forces); docs/fabric.md, "Stress:
+    grains, regions and sets of contacts".
 
     Parameters
     ----------

@@ -102,17 +102,8 @@ def _normal_products(normals: NDArray[np.float64]) -> tuple[NDArray[np.float64],
 
 
 class FabricTensor(Compute):
-    r"""Satake's fabric tensor, its fourth-order companion and its strong and weak parts.
-
-    .. math::
-
-       \phi_{ij} = \frac{1}{N_c}\sum_c n_i n_j,\quad
-       \phi_{ijkl} = \frac{1}{N_c}\sum_c n_i n_j n_k n_l,\quad
-       \phi^{s}_{ij} = \frac{1}{N_c}\sum_{f_{n,c} > \langle f_n\rangle} n_i n_j,\quad
-       \phi^{w} = \phi - \phi^{s},
-
-    :math:`a = 2(\phi_1 - \phi_2)`, :math:`b_4 = |\langle e^{4i\theta}\rangle|`
-    (docs/fabric.md). 2D prefactors: :math:`\operatorname{tr}\phi = 1`.
+    """Satake's fabric tensor, its fourth-order companion and its strong and weak parts
+    (split at the mean normal force), with a and b_4: docs/fabric.md, "Fabric tensor (Satake)".
 
     Parameters
     ----------
@@ -200,21 +191,13 @@ class FabricTensor(Compute):
 
 
 class StressForceFabric(Compute):
-    r"""Rothenburg and Bathurst's stress-force-fabric relation, with its residual.
+    """Rothenburg and Bathurst's stress-force-fabric relation, with its residual.
 
-    .. math::
-
-       \frac{q}{p} = \frac{\sigma_1 - \sigma_2}{\sigma_1 + \sigma_2}
-       \quad\text{against}\quad
-       \tfrac12\sum_{k \in \{a, a_n, a_t\}} k\cos 2(\theta_k - \theta_\sigma),
-
-    the stress :math:`\sigma` of the contacts used (their contact form,
-    :func:`~grainlab.analysis.stress.contact_stress`) and the anisotropies
-    fitted to the same contacts (docs/fabric.md). :attr:`residual` is
-    measured − predicted; :attr:`sigma_ratio` and
-    :attr:`predicted_sigma_ratio` are :math:`\sigma_1/\sigma_2 = (1 +
-    q/p)/(1 - q/p)` of each. Needs normal forces; shear forces optional
-    (without them :math:`a_t` is NaN and left out of the sum).
+    The measured q/p of the contacts used (their contact form,
+    :func:`~grainlab.analysis.stress.contact_stress`) against the prediction from
+    the anisotropies fitted to the same contacts; :attr:`residual` is measured −
+    predicted (docs/fabric.md, "Stress-force-fabric relation"). Needs normal
+    forces; shear forces optional (without them a_t is NaN and left out of the sum).
 
     Parameters
     ----------

@@ -183,15 +183,8 @@ def power_cell_areas(snapshot: Snapshot) -> NDArray[np.float64]:
 
 
 class LocalPorosity(Compute):
-    r"""Local porosity of each grain from its power (radical Voronoi) cell.
-
-    .. math:: n_p = 1 - \frac{\pi r_p^2}{A_p},\qquad
-              n = 1 - \frac{\sum_p \pi r_p^2}{\sum_p A_p}\ \text{(sample grains)},
-
-    :math:`A_p` the area of grain p's power cell (docs/fabric.md). A
-    periodic hexagonal lattice of touching disks of diameter d has hexagonal
-    cells of area :math:`\tfrac{\sqrt3}{2} d^2`, so
-    :math:`n_p = 1 - \pi/(2\sqrt3) = 0.0931`.
+    """Local porosity of each grain from its power (radical Voronoi) cell, and the sample
+    grains' porosity over their cells: docs/fabric.md, "Local porosity".
 
     Example
     -------

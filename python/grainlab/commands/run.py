@@ -18,7 +18,8 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
             "Runs a registered test (docs/protocols.md) into a results folder: run.h5, timeseries.csv, "
             "summary.json, its figures and report.html. `grainlab run biaxial` is `grainlab biaxial` without "
             "its --strain-rate shortcut; `grainlab run oedometer` loads a sample between fixed side walls "
-            "(K0); `grainlab run ucs` compresses a cemented sample without side walls (unconfined); `grainlab run "
+            "(K0); `grainlab run ucs` compresses a cemented sample without side walls (unconfined); "
+            "`grainlab run brazilian` splits a cemented disc between two platens (indirect tension); `grainlab run "
             "crushing` crushes single agglomerates of bonded disks and fits their Weibull statistics. Keys: docs/cli.md."
         ),
     )

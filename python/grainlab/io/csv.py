@@ -183,16 +183,12 @@ def read_particles_csv(
     """Read a particles CSV (and optionally a contacts CSV) into a :class:`Snapshot`.
 
     Without ``contacts`` and with ``detect=True`` contacts are detected from
-    the geometry (centre distance < r_i + r_j + ``tolerance``). A ``z``
-    column spreading over more than 1e-3 of the smallest radius is 3D data:
-    refused unless ``z_policy`` is ``"project"`` or ``"slice"`` (with ``z0``),
-    as for :func:`~grainlab.io.read_lammps_dump`.
-
-    ``columns`` maps grainlab's roles (:data:`PARTICLE_ROLES`) to the file's
-    column names, ``contact_columns`` those of the contacts file
-    (:data:`CONTACT_ROLES`), e.g. ``columns={"id": "ID", "x": "pos_x",
-    "y": "pos_y"}``, ``contact_columns={"i": "end1", "j": "end2"}``. A file
-    without a ``kind`` column warns (:class:`MissingKindWarning`).
+    the geometry (centre distance < r_i + r_j + ``tolerance``). ``columns`` maps
+    grainlab's roles (:data:`PARTICLE_ROLES`) to the file's column names,
+    ``contact_columns`` those of the contacts file (:data:`CONTACT_ROLES`). The
+    columns, the ``z`` check (``z_policy``, ``z0``) and the warning of a file without
+    a ``kind`` column (:class:`MissingKindWarning`): docs/analysis.md, "Files read
+    and written".
 
     >>> import pathlib, tempfile, warnings
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "balls.csv"

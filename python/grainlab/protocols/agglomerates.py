@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from grainlab.cement import pairs_within_gap
 from grainlab.protocols.config import POSITIVE, Config, ConfigError, Section, key
-from grainlab.protocols.specimen import SpecimenRun, add_parallel_bonds
+from grainlab.protocols.specimen import SpecimenRun, add_cement
 from grainlab.samples.agglomerate import (
     MAX_SIZE_SCATTER,
     MAX_VACANCIES,
@@ -130,6 +130,6 @@ def bond_strengths(config: Config) -> BondStrengths:
 
 def bond_agglomerates(sim: Simulation, grains: Agglomerates, config: Config, first: int = 0) -> None:
     """The grains' bonds put into ``sim``, whose particle ``first`` is the grains' first
-    disk (:func:`grainlab.protocols.specimen.add_parallel_bonds`)."""
-    add_parallel_bonds(sim, config, grains.bond_i + first, grains.bond_j + first,
+    disk (:func:`grainlab.protocols.specimen.add_cement`)."""
+    add_cement(sim, config, grains.bond_i + first, grains.bond_j + first,
                        np.asarray(grains.tensile_strength), np.asarray(grains.cohesion))

@@ -272,17 +272,9 @@ def outer_contour(
 ) -> list[int]:
     """The grains along one side of the sample's outer contour, each touching the
     next (surfaces within ``gap``): the paper's "particles at the edges of the
-    sample which formed continuous boundaries".
-
-    The walk starts at the outermost grain touching the platen it starts from
-    (the bottom one on the ``"left"``, walked upwards; the top one on the
-    ``"right"``, walked downwards: the sample on the right, as the engine's
-    pressure chains expect) and at each grain goes on to the neighbour that comes
-    first turning clockwise from the way it came, which keeps the outside on its
-    left, until it reaches a grain touching the other platen. A grain reached
-    again cuts off the loop walked since (a grain hanging off the contour by one
-    contact is not part of it). Raises ``ValueError`` when the contact network
-    has no such path."""
+    sample which formed continuous boundaries". The walk: docs/boundary.md, "B: the
+    outermost grains"; the sample lies on its right, as the engine's pressure
+    chains expect. Raises ``ValueError`` when the contact network has no such path."""
     x = positions[grains]
     r = radii[grains]
     neighbours = _neighbour_lists(x, r, gap)

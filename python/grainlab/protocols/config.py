@@ -1,23 +1,10 @@
 """Configuration of the protocols: defaults from the paper's Table 1, TOML
 files, ``key=value`` overrides, units at the edge, validation before any work.
 
-A configuration's keys come in typed sections (:class:`Section`: a frozen
-dataclass whose fields are the keys ``section.name``, each declared with
-:func:`key`: its kind, default, range and help). Every test that makes a
-sample shares :class:`SampleSection`, :class:`MaterialSection`,
-:class:`ConsolidationSection` (:data:`SHARED_FIELDS`) and the runner's
-:class:`RunSection` (:data:`RUN_FIELDS`); each test declares its own sections
-in its package (``protocols/biaxial/config.py``: ``boundary.*``, ``shear.*``)
-and its :class:`ConfigSchema` (in :data:`SCHEMAS`), whose resolved
-:class:`Config` (a subclass per test) reads each section typed
-(``config.shear.final_strain``) or by its dotted key (``config["shear.final_strain"]``).
-
-Values are in SI units. Files and overrides may give
-numbers (SI) or strings with a unit: ``"75 mm"``, ``"100 kPa"``, ``"2 %/min"``,
-``"0.5 %"``. Every key has a kind that says which units it accepts and which
-range is allowed; a bad key or value raises :class:`ConfigError` (a
-``ValueError``) naming the key and the allowed values.
-"""
+Typed sections of keys (:class:`Section`, :func:`key`), the shared ones and each
+test's :class:`ConfigSchema`: docs/protocols.md, "Configuration"; units:
+docs/conventions.md, "Units". A bad key or value raises :class:`ConfigError` (a
+``ValueError``) naming the key and the allowed values."""
 
 from __future__ import annotations
 
@@ -282,6 +269,25 @@ class RunSection(Section):
     checkpoint_interval: float = key("time", 30.0, "wall-clock time between checkpoints", **POSITIVE)
 
 
+@dataclass(frozen=True)
+class PlatenSection(Section):
+    """The loading keys of a test of a cemented sample pressed by its top platen (the
+    unconfined compression and Brazilian tests, ``grainlab.protocols.platens``), under
+    the test's own prefix; the strain is the top platen's travel over the sample's height
+    (the disc's diameter D in the Brazilian test)."""
+
+    prefix: ClassVar[str] = ""
+    strain_rate: float = key("strain_rate", "1 %/min", "the top platen's speed over the sample's height where "
+                             "the strains start (the disc's diameter D in the Brazilian test)", **POSITIVE)
+    final_strain: float = key("strain", 0.02, "the loading ends at this strain (the top platen's travel over that "
+                              "height)", minimum=0.0, maximum=0.5, exclusive_minimum=True)
+    residual_fraction: float = key(
+        "number", 0.5, "the loading ends once the stress after the peak falls below this fraction of the peak",
+        minimum=0.0, maximum=1.0, exclusive_maximum=True,
+    )
+    records: int = key("integer", 200, "records over final_strain (one every final_strain / records)", minimum=1)
+
+
 #: The keys of every test that makes a sample and consolidates it: the sample, its
 #: material (Table 1) and the consolidation.
 SHARED_FIELDS: dict[str, Field] = {
@@ -289,6 +295,10 @@ SHARED_FIELDS: dict[str, Field] = {
 }
 #: How a run executes (the runner's keys, in every test's configuration).
 RUN_FIELDS: dict[str, Field] = RunSection.keys()
+#: A square sample by default (a test's own keys): Table 1's width, 75 mm, on both sides.
+SQUARE: dict[str, Field] = {"sample.height": dataclasses.replace(
+    SHARED_FIELDS["sample.height"], default=SHARED_FIELDS["sample.width"].default,
+    help="sample height (a square sample: Table 1's width, 75 mm)")}
 
 #: Item kind and range of each list kind.
 _LIST_ITEMS: dict[str, tuple[str, Field]] = {

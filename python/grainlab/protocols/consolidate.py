@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from grainlab.simulation import Simulation, Wall
 
-__all__ = ["BOX_WALLS", "BoxState", "box_state", "servo_box"]
+__all__ = ["BOX_WALLS", "BoxState", "add_platens", "box_state", "long_platens", "servo_box"]
 
 #: The walls of a box, in the order the box is built (counter-clockwise from the bottom).
 BOX_WALLS = ("bottom", "right", "top", "left")
@@ -87,8 +87,15 @@ def long_platens(sim: Simulation, walls: dict[str, int]) -> tuple[Wall, Wall, fl
     y_top = float(sim.wall(walls["top"]).points[0, 1])
     for name in BOX_WALLS:
         sim.wall(walls[name]).active = False
-    reach = left_x - (right_x - left_x), right_x + (right_x - left_x)
-    bottom = sim.add_segment_wall((reach[0], y_bottom), (reach[1], y_bottom))  # the sample above
-    top = sim.add_segment_wall((reach[1], y_top), (reach[0], y_top))  # the sample below
-    walls["bottom"], walls["top"] = bottom.id, top.id
+    bottom, top = add_platens(sim, walls, (left_x - (right_x - left_x), right_x + (right_x - left_x)), y_bottom, y_top)
     return bottom, top, left_x, right_x
+
+
+def add_platens(sim: Simulation, walls: dict[str, int], reach: tuple[float, float], y_bottom: float,
+                y_top: float) -> tuple[Wall, Wall]:
+    """Two horizontal platens from ``reach[0]`` to ``reach[1]`` in x, at ``y_bottom`` (the
+    sample above) and ``y_top`` (the sample below), their ids put in ``walls``."""
+    bottom = sim.add_segment_wall((reach[0], y_bottom), (reach[1], y_bottom))
+    top = sim.add_segment_wall((reach[1], y_top), (reach[0], y_top))
+    walls["bottom"], walls["top"] = bottom.id, top.id
+    return bottom, top

@@ -5,7 +5,7 @@ registers here, and its schema in :data:`SCHEMAS` (``register_schema`` in its ow
 package; importing this module imports every protocol, so :data:`SCHEMAS` holds them all).
 
 >>> sorted(PROTOCOLS)
-['biaxial', 'crushing', 'cyclic', 'oedometer', 'simple_shear', 'ucs']
+['biaxial', 'brazilian', 'crushing', 'cyclic', 'oedometer', 'simple_shear', 'ucs']
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from grainlab.protocols.biaxial.protocol import BiaxialProtocol
+from grainlab.protocols.brazilian.protocol import BrazilianProtocol
 from grainlab.protocols.config import SCHEMAS, Config
 from grainlab.protocols.crushing.protocol import CrushingProtocol
 from grainlab.protocols.cyclic.protocol import CyclicProtocol
@@ -33,6 +34,7 @@ PROTOCOLS: dict[str, type[Protocol[Any, Any, Any]]] = {
     CyclicProtocol.name: CyclicProtocol,
     SimpleShearProtocol.name: SimpleShearProtocol,
     UcsProtocol.name: UcsProtocol,
+    BrazilianProtocol.name: BrazilianProtocol,
     CrushingProtocol.name: CrushingProtocol,
 }
 

@@ -80,8 +80,9 @@ C = TypeVar("C")
 @dataclass
 class StageContext(Generic[C, S]):
     """What a stage works on: the simulation, the run state, the configuration,
-    the results writer, ``save()`` (a checkpoint now, of the simulation here: a stage
-    may put another one in its place) and whether to show progress."""
+    the results writer, ``save()`` (a checkpoint now) and whether to show progress.
+    A stage may put a new simulation in :attr:`sim` (the Brazilian test's disc, carved
+    from the consolidated sample): the checkpoints and the stages after it take that one."""
 
     sim: Simulation
     state: S
@@ -341,8 +342,8 @@ def _run_locked(protocol: Protocol[Any, Any, R], out: Path, *, resume: bool, pro
                 saved_state["config"] = protocol.config_dict()
                 saved_state["elapsed_s"] = elapsed_before + time.perf_counter() - started
                 image = np.frombuffer(results.publish(), dtype=np.uint8)
-                write_checkpoint(checkpoint_path, context.sim.to_bytes(), saved_state,
-                                 arrays={_RESULTS_IMAGE: image})
+                # the context's simulation: a stage may have put a new one there
+                write_checkpoint(checkpoint_path, context.sim.to_bytes(), saved_state, arrays={_RESULTS_IMAGE: image})
 
             context = StageContext(sim, state, protocol.config, writer, save, progress)
             if not resume:

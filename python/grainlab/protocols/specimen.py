@@ -52,7 +52,8 @@ from grainlab.snapshot import Snapshot
 if TYPE_CHECKING:
     from grainlab.plot.workers import FigureTask
 
-__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "ConfiguredProtocol", "SpecimenError", "add_parallel_bonds", "SpecimenProtocol", "SpecimenRun", "cement_sample",
+__all__ = ["CHUNK_STEPS", "CONSOLIDATE", "OUTPUT_FILES", "ConfiguredProtocol", "SpecimenError", "SpecimenProtocol",
+           "SpecimenRun", "add_cement", "cement_sample",
            "consolidate",
            "damped_time_step_factor", "engine_columns",
            "engine_threads", "generate", "grain_model", "grain_columns", "platen_model", "run_summary",
@@ -359,23 +360,21 @@ def cement_sample(sim: Simulation, run: SpecimenRun, config: Config, period: tup
     def strengths(mean: float) -> NDArray[np.float64]:
         return draw_strengths(rng, mean, c.strength_scatter * mean, len(i), law)  # type: ignore[arg-type]
 
-    add_parallel_bonds(sim, config, i, j, strengths(c.tensile_strength), strengths(c.cohesion))
+    add_cement(sim, config, i, j, strengths(c.tensile_strength), strengths(c.cohesion))
     run.consolidation["cement_bonds"] = len(i)
 
 
-def add_parallel_bonds(sim: Simulation, config: Config, i: NDArray[np.int64], j: NDArray[np.int64],
-                       tensile_strength: NDArray[np.float64], cohesion: NDArray[np.float64]) -> None:
-    """Parallel bonds between the particles ``i`` and ``j`` with the strengths given and
-    ``cement.*``'s section and stiffnesses: ``auto`` makes each bond's ``kn_bar A`` the
+def add_cement(sim: Simulation, config: Config, i: NDArray[np.int64], j: NDArray[np.int64],
+               tensile_strength: NDArray[np.float64], cohesion: NDArray[np.float64]) -> None:
+    """Parallel bonds of the ``cement.*`` keys between the particles ``i[k]`` and ``j[k]``
+    with the strengths given: stiffnesses ``auto`` make each bond's ``kn_bar A`` the
     contact law's ``kn`` (and ``ks``)."""
     c = config.cement
-    radii = sim.radii
-    area = 2.0 * c.radius_multiplier * np.minimum(radii[i], radii[j])
+    area = 2.0 * c.radius_multiplier * np.minimum(sim.radii[i], sim.radii[j])
     kn = config.material.normal_stiffness / area if c.normal_stiffness == "auto" else float(c.normal_stiffness)
     ks = config.material.shear_stiffness / area if c.shear_stiffness == "auto" else float(c.shear_stiffness)
     sim.add_cement_bonds(i, j, normal_stiffness=kn, shear_stiffness=ks, tensile_strength=tensile_strength,
                          cohesion=cohesion, friction_angle=c.friction_angle, radius_multiplier=c.radius_multiplier)
-
 
 
 def engine_columns(sim: Simulation) -> dict[str, float]:
@@ -425,13 +424,14 @@ def run_summary(run: SpecimenRun, fields: Mapping[str, Any], *, records: int, wa
 
 
 def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.float64]], dict[str, Any]],
-                                                          list[FigureTask]], *, crack_map: bool = True,
+                                                          list[FigureTask]], strain: str = "axial strain", *,
+                      crack_map: bool = True,
                       files: Callable[[Path, dict[str, Any]], None] | None = None) -> dict[str, Any]:
     """A finished run's ``timeseries.csv``, figures and ``summary.json``, from its ``run.h5``:
     the figures of ``figure_tasks(time series, summary)`` (and the crack map of a run
-    with cracks, unless ``crack_map`` is False) drawn in the figure pool, and the
-    test's own ``files(out, summary)``, before the summary is written (which says the
-    outputs are complete); returns the summary."""
+    with cracks, its ``axial_strain`` column named ``strain``, unless ``crack_map`` is
+    False) drawn in the figure pool, and the test's own ``files(out, summary)``, before
+    the summary is written (which says the outputs are complete); returns the summary."""
     from grainlab.io.hdf5 import read_results
     from grainlab.plot.workers import figure_pool
     from grainlab.protocols.cracks import crack_task
@@ -441,7 +441,7 @@ def write_run_outputs(out: Path, figure_tasks: Callable[[dict[str, NDArray[np.fl
     summary = dict(results.summary)
     write_text_atomic(out / "timeseries.csv", timeseries_csv(results.timeseries))
     series = {name: np.asarray(values, dtype=np.float64) for name, values in results.timeseries.items()}
-    cracks = crack_task(results) if crack_map else None
+    cracks = crack_task(results, strain) if crack_map else None
     tasks = figure_tasks(series, summary) + ([cracks] if cracks is not None else [])
     with figure_pool(tasks=len(tasks), page_copies=True) as pool:
         pool.draw(tasks, out).result()

@@ -52,7 +52,7 @@ def detect_kind(folder: str | os.PathLike[str]) -> tuple[Path, str]:
 
     A run's folder holds a finished ``run.h5``, whose ``kind`` attribute names
     its test, one with a page in :data:`grainlab.report.pages.PAGES`
-    (``"biaxial"``, ``"oedometer"``, ``"cyclic"``, ``"simple_shear"``, ``"ucs"``, ``"crushing"``); a
+    (``"biaxial"``, ``"oedometer"``, ``"cyclic"``, ``"simple_shear"``, ``"ucs"``, ``"brazilian"``, ``"crushing"``); a
     study folder holds ``study.csv`` (kind ``"study"``). A path to either file
     stands for its folder. Nothing is read beyond the folder listing and that
     attribute, so this fails before any work.

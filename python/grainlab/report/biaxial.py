@@ -41,6 +41,7 @@ from grainlab.report.angles import (
 )
 from grainlab.report.band import band_from_numbers
 from grainlab.report.figures import embedded_png, grading_figure, macro_figure
+from grainlab.report.run_page import CRACKS
 from grainlab.samples import PAPER_GRADING, UniformByMass, UniformByNumber
 from grainlab.samples.grading import Grading, GradingCurve
 
@@ -452,9 +453,7 @@ def _figure_specs(fab: dict[str, Any] | None, peak_strain: float) -> list[tuple[
         ("fig19_stress_path", "Stress path at constant volume",
          "q = (σ₁′ − σ₃′)/2 against p′ = (σ₁′ + σ₃′)/2, and the pore-pressure analogue u = σ₀ − σ₃′ against "
          "axial strain: the rigid side walls hold the sample's area and measure the effective lateral stress."),
-        ("fig20_cracks", "Cracks",
-         "The cement bonds broken during the test on the last snapshot's grains (a segment along each crack, "
-         "blue in tension, red in shear) and the rose of their orientations (docs/cemented.md)."),
+        CRACKS,
         ("fig06_contact_normals", "Fig. 6: contact normals",
          f"Polar histogram of contact normals (18 bins of 20 deg) with Eq. 6; a = {c['a']}."),
         ("fig07_normal_forces", "Fig. 7: normal forces",

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from grainlab.report import crushing, cyclic, oedometer, simple_shear, ucs
+from grainlab.report import brazilian, crushing, cyclic, oedometer, simple_shear, ucs
 from grainlab.report.run_page import ReportPage
 
 __all__ = ["PAGES", "STUDY", "STUDY_PAGE"]
@@ -40,6 +40,7 @@ PAGES: dict[str, ReportPage] = {page.protocol: page for page in (
     cyclic.PAGE,
     simple_shear.PAGE,
     ucs.PAGE,
+    brazilian.PAGE,
     crushing.PAGE,
 )}
 

@@ -27,7 +27,7 @@ from grainlab._mapping import flatten_keys
 from grainlab.io.hdf5 import Results, read_results
 from grainlab.protocols.config import SCHEMAS
 
-__all__ = ["PageSection", "ReportPage", "RunPage", "footer", "gather_run_page", "rerun_sections"]
+__all__ = ["CRACKS", "PageSection", "ReportPage", "RunPage", "crack_map", "footer", "gather_run_page", "rerun_sections"]
 
 
 @dataclass
@@ -60,8 +60,9 @@ class ReportPage:
     ``name`` in its title ("grainlab oedometer report"); ``figures`` maps each
     figure's file stem to (title, caption), drawn by ``draw(folder)`` (the
     protocol's outputs) when one is missing; ``glance`` gives the summary
-    numbers as (label, value) pairs; ``sections`` follow them, before "How to
-    rerun" and "Resolved configuration". A page laid out by a module of its own
+    numbers as (label, value) pairs; ``sections`` follow them, then a cemented
+    sample's "Cracks" (:func:`crack_map`), before "How to rerun" and "Resolved
+    configuration". A page laid out by a module of its own
     sets ``render(folder, redraw)`` instead, and the rest is not used.
     """
 
@@ -89,11 +90,30 @@ class ReportPage:
         parts = [section("glance", "At a glance", definition_table(list(self.glance(r))))]
         parts += [section(s.anchor, s.title, *s.parts(r), *([figures(r.figures)] if s.with_figures else []))
                   for s in self.sections]
+        if "cement_bonds" in r.summary:  # a cemented sample's
+            parts.append(section("cracks", "Cracks", *crack_map(r)))
         parts += rerun_sections(self.protocol, r.folder, r.results)
         title = r.folder.resolve().name
         header = paragraph(f"grainlab {self.test}: {title}; run by grainlab {r.results.grainlab_version}, "
                            f"report generated {r.generated}.")
         return page(f"grainlab {self.name} report: {title}", header, parts, footer())
+
+
+#: The crack map (drawn by the outputs when the run has cracks): stem, title, caption.
+CRACKS = ("fig20_cracks", "Cracks", "The cement bonds broken during the test on the last snapshot's grains (a "
+          "segment along each crack, blue in tension, red in shear) and the rose of their orientations "
+          "(docs/cemented.md).")
+
+
+def crack_map(r: RunPage) -> list[Any]:
+    """A cemented run's crack map, or a note that no bond broke."""
+    from grainlab.report.figures import embedded_png  # matplotlib: only when a page is made
+
+    stem, title, caption = CRACKS
+    path = r.folder / f"{stem}.png"
+    if not path.exists():
+        return [paragraph("No cement bond broke: no crack map.", "note")]
+    return [figures([EmbeddedFigure(stem, title, caption, embedded_png(path.read_bytes()), path.name)])]
 
 
 def gather_run_page(folder: str | Path, figures: Mapping[str, tuple[str, str]],

@@ -1,18 +1,18 @@
 """The unconfined compression test's report page, declared: the unconfined strength
 q_u, Young's modulus and Poisson's ratio with their fit's rule, the bonds and the
-cracks, the stress-strain figure and the crack map
-(:class:`~grainlab.report.run_page.ReportPage`)."""
+cracks and the stress-strain figure (:class:`~grainlab.report.run_page.ReportPage`;
+the crack map is every cemented run's)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
-from grainlab._html import EmbeddedFigure, figures, fmt, paragraph
+from grainlab._html import fmt, paragraph
 from grainlab.protocols.ucs.config import UCS_SCHEMA
 from grainlab.report.run_page import PageSection, ReportPage, RunPage
 
-__all__ = ["CRACKS", "FIGURES", "PAGE"]
+__all__ = ["FIGURES", "PAGE"]
 
 #: The run's figures: file stem -> (title, caption).
 FIGURES = {
@@ -20,11 +20,6 @@ FIGURES = {
                             "and the lateral strain of the grains' width over the middle half of the height, "
                             "against the axial strain; the records of the E and nu fit are shaded, q_u marked."),
 }
-
-#: The crack map (drawn by the outputs when the run has cracks): stem, title, caption.
-CRACKS = ("fig20_cracks", "Cracks", "The cement bonds broken during the test on the last snapshot's grains (a "
-          "segment along each crack, blue in tension, red in shear) and the rose of their orientations "
-          "(docs/cemented.md).")
 
 
 def _draw(folder: Path) -> None:
@@ -55,22 +50,12 @@ def _glance(r: RunPage) -> list[tuple[str, str]]:
     ]
 
 
-def _cracks(r: RunPage) -> list[Any]:
-    from grainlab.report.figures import embedded_png  # matplotlib: only when a page is made
-
-    stem, title, caption = CRACKS
-    path = r.folder / f"{stem}.png"
-    if not path.exists():
-        return [paragraph("No cement bond broke: no crack map.", "note")]
-    return [figures([EmbeddedFigure(stem, title, caption, embedded_png(path.read_bytes()), path.name)])]
-
-
 #: The unconfined compression test's page.
 PAGE = ReportPage(
     UCS_SCHEMA.name, test="unconfined compression test", name="ucs", figures=FIGURES, draw=_draw, glance=_glance,
     sections=(PageSection("curve", "The stress-strain curve", lambda r: [paragraph(
         "The sample is cemented at the end of the consolidation, released (side walls removed, platens held "
-        "still) and settled; strains count from there. The loading ends at ucs.final_strain or once the axial "
-        "stress after the peak falls below ucs.residual_fraction of q_u.", "note")], with_figures=True),
-              PageSection("cracks", "Cracks", _cracks)),
+        "still) and settled, then seated (the top platen servo-controlled to ucs.seating_stress); strains count "
+        "from there. The loading ends at ucs.final_strain or once the axial "
+        "stress after the peak falls below ucs.residual_fraction of q_u.", "note")], with_figures=True),),
 )

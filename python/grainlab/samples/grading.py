@@ -176,17 +176,10 @@ class UniformByMass(_UniformRange):
 
 
 class GradingCurve(Grading):
-    """A grading curve: sieve sizes (m) against percent passing *by mass*.
-
-    Between two sieves the curve is a straight line in ``log d`` (the usual
-    semi-logarithmic grading chart; ``interpolation="log"``, default) or in ``d``
-    (``interpolation="linear"``). The first sieve must pass 0% (it is ``d_min``)
-    and the last 100% (``d_max``); sizes strictly increase and percentages never
-    decrease.
-
-    Within a segment the number density is the mass density over ``d^2``: ``d^-2``
-    (log) or ``1/d`` (linear) is uniform by number there; docs/samples.md gives
-    each segment's count and ``E_N[d^2]``.
+    """A grading curve: sieve sizes (m) against percent passing *by mass*, a straight
+    line between two sieves in ``log d`` (``interpolation="log"``, default) or in ``d``
+    (``"linear"``), from 0% at ``d_min`` to 100% at ``d_max``. Each segment's
+    number density, the checks and ``E_N[d^2]``: docs/samples.md, "Gradings".
     """
 
     def __init__(

@@ -1,15 +1,5 @@
-"""A dense packing of disks in a periodic cell, compressed to a mean stress.
-
-:func:`periodic_packing` places disks at random (no overlap) in a square
-periodic cell, then shrinks the cell isotropically (``L = -rate I``) under a
-servo on the mean stress of the contacts (Love-Weber over the cell,
-:func:`grainlab.analysis.stress.contact_stress`), frictionless and with local
-damping, until the mean stress is within 1 % of the target and the
-unbalanced force ratio below ``1e-4``. The result is a
-:class:`~grainlab.simulation.Simulation` at rest in the cell, without velocity
-gradient, ready for a periodic test (the LAMMPS export's simple shear,
-docs/lammps.md).
-"""
+"""A dense packing of disks in a periodic cell, compressed frictionless to a mean
+stress (:func:`periodic_packing`; docs/samples.md, "A periodic packing")."""
 
 from __future__ import annotations
 
@@ -45,12 +35,9 @@ def periodic_packing(
     max_steps: int = 2_000_000,
 ) -> Simulation:
     """``n`` disks (radii uniform in ``radius_range_m``) compressed frictionless in a
-    square periodic cell to ``mean_stress_pa`` (module docstring).
-
-    The strain per block of 100 steps is at most 2e-4, scaled by ``1 - p / p0``
-    (a proportional servo on the mean stress ``p``). Raises ValueError before
-    any work for bad input, RuntimeError when ``max_steps`` do not reach the
-    state.
+    square periodic cell to ``mean_stress_pa`` (docs/samples.md, "A periodic packing").
+    Raises ValueError before any work for bad input, RuntimeError when ``max_steps``
+    do not reach the state.
     """
     if int(n) != n or n < 10:
         raise ValueError(f"n: need at least 10 disks, got {n!r}")

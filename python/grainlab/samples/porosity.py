@@ -140,11 +140,9 @@ def lens_area(r1: ArrayLike, r2: ArrayLike, distance: ArrayLike) -> NDArray[np.f
     """Area shared by two disks of radii ``r1``, ``r2`` with centres ``distance`` apart (vectorised).
 
     ``0`` when ``distance >= r1 + r2``; ``pi min(r1, r2)^2`` when one disk lies in
-    the other; otherwise the two circular segments cut off by the common chord,
-    ``r1^2 s(theta1) + r2^2 s(theta2)`` with ``s(t) = t - sin t cos t`` and
-    ``cos theta1 = (d^2 + r1^2 - r2^2) / (2 d r1)`` (and 1 <-> 2). This equals the
-    textbook ``r1^2 acos(...) + r2^2 acos(...) - sqrt((-d + r1 + r2)(d + r1 - r2)(d - r1 + r2)(d + r1 + r2)) / 2``
-    but keeps its accuracy for tiny overlaps (touching disks give 0, not round-off).
+    the other; otherwise the two circular segments cut off by the common chord, in
+    the form that keeps its accuracy for tiny overlaps (docs/samples.md, "Porosity:
+    two readings").
     """
     r1, r2, d = np.broadcast_arrays(
         np.asarray(r1, dtype=np.float64), np.asarray(r2, dtype=np.float64), np.asarray(distance, dtype=np.float64)
@@ -244,22 +242,10 @@ def overlap_corrected_porosity(
 ) -> float:
     """``1 - |union of the disks ∩ box| / box area``: the void fraction really left.
 
-    The union is ``sum_i |disk_i ∩ box| - sum_{i<j} lens_ij`` (inclusion-exclusion
-    to pairs; overlapping pairs found with a cKDTree). Disks are clipped exactly at
-    the box edges (:func:`disk_area_in_box`); lenses are taken whole. With
-    ``periodic=True`` the box is a periodic cell: disks are not clipped (what
-    leaves one side enters the other) and pairs are found across the sides.
-
-    Exact when no point is covered by three disks (true for the small overlaps of
-    a DEM packing: a triple point needs overlaps comparable to the radii) and,
-    with walls, no lens crosses the box edge; otherwise the lens sum
-    over-subtracts and the porosity comes out slightly high.
-
-    With ``grain`` (each disk's grain) the disks of one grain (a clump, whose
-    pebbles overlap deeply, three at a point in a trimer) count their exact
-    union (:func:`grain_overlap_area`) and only pairs of disks of different
-    grains subtract a lens; a clump cut by the box edge is clipped pebble by
-    pebble (exact but where two of its pebbles overlap outside the box).
+    The union by inclusion-exclusion to pairs, disks clipped exactly at the box edges
+    (none across the sides of a periodic cell, ``periodic=True``); with ``grain``
+    (each disk's grain) each clump's union counts once. When it is exact:
+    docs/samples.md, "Porosity: two readings".
     """
     x0, y0, x1, y1 = check_box(box)
     r = _radii(radii)
@@ -288,22 +274,10 @@ def measurement_circle_porosity(
     *,
     overlap_corrected: bool = False,
 ) -> float:
-    r"""Porosity inside a measurement circle of centre ``c`` and radius ``R`` (m).
-
-    Each disk is clipped exactly by the circle (the circle-circle lens,
-    :func:`lens_area`, of the disk and the circle):
-
-    .. math::
-
-       n = 1 - \frac{\sum_i L(r_i, R, |x_i - c|)}{\pi R^2}
-
-    This is the nominal reading (overlaps counted twice, as PFC2D's measurement
-    circles count them). With ``overlap_corrected=True`` the lens of every
-    overlapping pair is subtracted, :math:`n_c = n + \sum_{i<j} L(r_i, r_j,
-    d_{ij}) / \pi R^2` over the pairs whose lens lies in the circle: a lens is
-    taken whole when the midpoint of its common chord is inside the circle and
-    left out otherwise (exact but for the few lenses the circle's edge cuts,
-    each a DEM overlap's sliver). Disks wholly outside the circle contribute 0.
+    """Porosity inside a measurement circle of centre ``c`` and radius ``R`` (m), each
+    disk clipped exactly by the circle: the nominal reading, or with
+    ``overlap_corrected=True`` the pairs' lenses inside it subtracted
+    (docs/samples.md, "Porosity: two readings").
 
     Example
     -------

@@ -20,6 +20,7 @@ from grainlab.columns import (
     FRICTION_COEFFICIENT,
     SHEAR_STRAIN,
     STRESS_RATIO,
+    TENSILE_STRESS_PA,
     VERTICAL_STRESS_PA,
 )
 from grainlab.io.hdf5 import read_results
@@ -30,9 +31,10 @@ from grainlab.postprocess.vtk import snapshot_arrays
 __all__ = ["CURVE_COLUMNS", "encode", "viewer_data"]
 
 #: Time series columns drawn as the stress–strain curve (x, y), the first pair the file has
-#: (the biaxial test's stress ratio, the oedometer's vertical stress, simple shear's mu).
+#: (the biaxial test's stress ratio, the oedometer's vertical stress, simple shear's mu, the
+#: Brazilian test's 2F / (pi D t) against delta / D).
 CURVE_COLUMNS = ((AXIAL_STRAIN, STRESS_RATIO), (AXIAL_STRAIN, AXIAL_STRESS_PA), (AXIAL_STRAIN, VERTICAL_STRESS_PA),
-                 (SHEAR_STRAIN, FRICTION_COEFFICIENT))
+                 (SHEAR_STRAIN, FRICTION_COEFFICIENT), (AXIAL_STRAIN, TENSILE_STRESS_PA))
 
 
 def encode(values: NDArray[Any], dtype: str) -> str:
@@ -132,6 +134,14 @@ def _cracks(results: Any, snaps: list[Any]) -> tuple[dict[str, Any] | None, list
     return data, by
 
 
+def _strain_label(curve: dict[str, Any] | None) -> str:
+    """What the curve's x and the snapshots' strain are: a shear strain, the Brazilian test's
+    platen displacement over the disc's diameter, or an axial strain."""
+    if curve is not None and curve["x"] == SHEAR_STRAIN:
+        return "shear strain"
+    return "platen displacement / D" if curve is not None and curve["y"] == TENSILE_STRESS_PA else "axial strain"
+
+
 def viewer_data(run: str | Path) -> dict[str, Any]:
     """Everything the page shows of ``run`` (a run folder or its ``run.h5``), JSON-ready.
 
@@ -164,7 +174,7 @@ def viewer_data(run: str | Path) -> dict[str, Any]:
         "index_dtype": index_dtype,
         "bounds": [bounds[:, 0].min(axis=0).tolist(), bounds[:, 1].max(axis=0).tolist()],
         "peak_stress_ratio": _finite(results.summary.get("peak_stress_ratio")),
-        "strain_label": "shear strain" if curve is not None and curve["x"] == SHEAR_STRAIN else "axial strain",
+        "strain_label": _strain_label(curve),
         "curve": curve,
         "snapshots": [
             {**_snapshot(name, snap, snaps[0], results.walls(name), index_dtype, products), "n_cracks": by}

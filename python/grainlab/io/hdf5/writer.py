@@ -42,13 +42,9 @@ __all__ = ["ResultsWriter"]
 
 
 class ResultsWriter:
-    """Writes a results file ``run.h5`` while a run goes on.
-
-    The writer works on ``PATH.partial`` and :meth:`finalize` publishes ``PATH``
-    atomically; as a context manager a block that raises marks the partial file
-    ``"failed"`` (``KeyboardInterrupt`` leaves it ``"running"``, resumable by
-    :meth:`resume`). ``buffered=True`` builds the file in memory and writes it only
-    whole. docs/file-formats.md, "Crash safety".
+    """Writes a results file ``run.h5`` while a run goes on, on ``PATH.partial`` until
+    :meth:`finalize` publishes ``PATH`` atomically (the context manager, :meth:`resume`
+    and ``buffered``: docs/file-formats.md, "Crash safety").
 
     Parameters
     ----------
@@ -62,14 +58,14 @@ class ResultsWriter:
     compression
         HDF5 filter for snapshot arrays (``"gzip"``, ``"lzf"``) or None (default).
     buffered
-        Build the file in memory and write it to disk only whole (above).
+        Build the file in memory and write it to disk only whole.
 
     Notes
     -----
     Time series columns are fixed by the first :meth:`define_timeseries`,
     :meth:`append_timeseries` or :meth:`append_rows`; later records must
     have exactly the same columns. A snapshot group is complete once its
-    ``index`` attribute exists (written last); readers ignore groups without it.
+    ``index`` attribute exists (written last).
     """
 
     def __init__(

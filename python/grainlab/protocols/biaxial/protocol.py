@@ -16,6 +16,7 @@ from grainlab.protocols.biaxial.phases import check_shear_plan, install_boundary
 from grainlab.protocols.biaxial.rates import check_density_scaling, check_strain_rate
 from grainlab.protocols.biaxial.shearing import shear, shear_records, shear_snapshots
 from grainlab.protocols.biaxial.state import BiaxialRun
+from grainlab.protocols.cracks import record_units
 from grainlab.protocols.runner import RUN_FILES, Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import CONSOLIDATE, OUTPUT_FILES, SpecimenProtocol
 
@@ -35,7 +36,7 @@ def _boundary(context: Context) -> None:
 
 def _shear(context: Context) -> None:
     sim, run, config = context.sim, context.state, context.config
-    records = shear_records(context, lambda: biaxial_records.measure(sim, run, config), biaxial_records.record_units(BIAXIAL, config))
+    records = shear_records(context, lambda: biaxial_records.measure(sim, run, config), record_units(BIAXIAL, config))
     shear(context, records, shear_snapshots(context, records, snapshot_name), final=config.shear.final_strain)
 
 

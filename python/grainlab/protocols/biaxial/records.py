@@ -7,26 +7,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from grainlab.columns import BIAXIAL, CEMENT_BONDS_BROKEN, CEMENTED, Columns
+from grainlab.columns import BIAXIAL
 from grainlab.io.walls import WallGeometry
 from grainlab.protocols.biaxial.config import BiaxialConfig
 from grainlab.protocols.biaxial.state import BiaxialRun, Boundary
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, sample_area
-from grainlab.protocols.config import Config
+from grainlab.protocols.cracks import bonds_broken
 from grainlab.protocols.specimen import grain_columns
 from grainlab.simulation import Simulation
 from grainlab.snapshot import ParticleKind, Snapshot
 
-__all__ = ["TIMESERIES_UNITS", "PlatenState", "deviator_stress", "enclosed_area", "measure", "platen_state", "record_units",
+__all__ = ["TIMESERIES_UNITS", "PlatenState", "deviator_stress", "enclosed_area", "measure", "platen_state",
            "take_snapshot", "wall_geometry"]
 
 #: Column -> unit of the shearing's records (:data:`grainlab.columns.BIAXIAL`).
 TIMESERIES_UNITS = BIAXIAL.units()
-
-
-def record_units(columns: Columns, config: Config) -> dict[str, str]:
-    """The units of a record of ``columns``, a cemented sample's column after them."""
-    return {**columns.units(), **(CEMENTED.units() if config.cement.bonds != "none" else {})}
 
 
 @dataclass(frozen=True)
@@ -105,8 +100,7 @@ def measure(sim: Simulation, run: BiaxialRun, config: BiaxialConfig) -> dict[str
         "area_m2": area,
         "height_m": height,
         **grain_columns(sim, n, area, c, take_snapshot(sim, run, 0.0)),
-        **({CEMENT_BONDS_BROKEN: float(run.consolidation["cement_bonds"] - sim.n_cement_bonds)}
-           if config.cement.bonds != "none" else {}),
+        **bonds_broken(sim, run.consolidation, config),
     }
 
 

@@ -17,7 +17,7 @@ from grainlab.protocols.biaxial.phases import drive_platens
 from grainlab.protocols.biaxial.records import take_snapshot, wall_geometry
 from grainlab.protocols.biaxial.state import BiaxialError, BiaxialRun, ShearPlan
 from grainlab.protocols.boundary import GrainBoundary, Membrane, WallBoundary, membrane_breach
-from grainlab.protocols.cracks import CrackRecords
+from grainlab.protocols.cracks import crack_records
 from grainlab.protocols.operations import (
     Checkpoint,
     Loading,
@@ -149,7 +149,7 @@ def shear(context: ShearContext[BC], records: Records, snapshots: Snapshots, *, 
     checkpoint = Checkpoint(And(scheduled, WallClock(context.config.run.checkpoint_interval)), context.save,
                             run.wall_time, "shear")
     # a cemented sample's breaks, stored after the record of their step
-    cracks = [CrackRecords(scheduled, context.writer)] if context.config.cement.bonds != "none" else []
+    cracks = crack_records(scheduled, context.writer, context.config)
     operations = [
         *first, records, *cracks, snapshots, BoundaryUpkeep(scheduled, run, records), PlatenTurns(run),
         Progress(scheduled, bar, lambda step: 100 * final * (step - plan.start_step) / steps[-1],

@@ -169,7 +169,7 @@ def crush(context: Context, k: int) -> dict[str, Any]:
     sim.wall(TOP).velocity = (0.0, -c.strain_rate * diameter)
     Loading(sim, [
         records,
-        CrackRecords(scheduled, context.writer, strain=lambda t: c.strain_rate * t, labels={"agglomerate": k}),
+        CrackRecords(scheduled, context.writer, strain_of=lambda t: c.strain_rate * t, labels={"agglomerate": k}),
         failure,
         Stop(failure.ended),
     ]).run()

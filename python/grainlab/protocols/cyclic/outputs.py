@@ -1,12 +1,7 @@
 """A finished cyclic run's outputs: the summary (each cycle's stress ratios at its
 turning points, and its end state: volumetric strain, Z, mean lambda, anisotropy),
-``timeseries.csv``, ``summary.json`` and the figures, all from ``run.h5``.
-
-A cycle's end state is its record nearest ``cycle == k`` (the records fall on
-each cycle's end exactly, in strain and in stress control); its compression and
-extension turning points are the records of largest and smallest axial strain
-within it. The rules were fixed
-before any run was seen.
+``timeseries.csv``, ``summary.json`` and the figures, all from ``run.h5``. The
+cycle table's rule (:func:`cycle_table`): docs/protocols.md, "The cyclic biaxial test".
 """
 
 from __future__ import annotations

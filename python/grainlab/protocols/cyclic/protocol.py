@@ -22,6 +22,7 @@ from grainlab.protocols.biaxial.shearing import (
     shear_snapshots,
 )
 from grainlab.protocols.biaxial.state import BiaxialRun
+from grainlab.protocols.cracks import record_units
 from grainlab.protocols.cyclic.config import CyclicConfig
 from grainlab.protocols.cyclic.outputs import CyclicResult, summarise, write_outputs
 from grainlab.protocols.operations import Loading, Operation, Records, Snapshots
@@ -159,7 +160,7 @@ def _cycle(context: Context) -> None:
         cycle = plan.events / 4.0 if stress else travelled / (4.0 * amplitude)
         return {**biaxial_records.measure(sim, run, config), STRAIN_PATH: travelled, CYCLE: cycle}
 
-    records = shear_records(context, measure, biaxial_records.record_units(CYCLIC, config))
+    records = shear_records(context, measure, record_units(CYCLIC, config))
     if stress:
         snapshots = shear_snapshots(context, records, lambda path: "start")
         shear(context, records, snapshots, final=stress_path_length(config),

@@ -1,14 +1,8 @@
-"""A finished oedometer run's outputs: the summary (K0 on first loading by the
-rule below, K against the overconsolidation ratio on unloading, Jaky's and
-Mayne-Kulhawy's values when a friction angle is given), ``timeseries.csv``,
-``summary.json`` and the figures, all from ``run.h5``.
-
-K0 on first loading is the slope of sigma_h against sigma_v, fitted by least
-squares over the first-loading records whose sigma_v is at least
-:data:`K0_FROM_STRESS_RATIO` times the consolidation stress (the records
-nearer the isotropic start still carry its K = 1); with fewer than two such
-records, over every first-loading record but the start. The rule was fixed
-before any run was seen.
+"""A finished oedometer run's outputs: the summary (K0 on first loading, K against
+the overconsolidation ratio on unloading, Jaky's and Mayne-Kulhawy's values when a
+friction angle is given), ``timeseries.csv``, ``summary.json`` and the figures, all
+from ``run.h5``. The K0 rule (:func:`k0_loading`): docs/protocols.md, "The
+oedometer (K0) test".
 """
 
 from __future__ import annotations

@@ -19,6 +19,7 @@ from grainlab.io.walls import WallGeometry
 from grainlab.protocols import operations
 from grainlab.protocols.agglomerates import agglomerate_labels, agglomerate_sample
 from grainlab.protocols.consolidate import BOX_WALLS, box_state
+from grainlab.protocols.cracks import bonds_broken, crack_records, record_units
 from grainlab.protocols.grains import grain_porosity
 from grainlab.protocols.oedometer.config import OedometerConfig
 from grainlab.protocols.oedometer.outputs import (
@@ -137,7 +138,9 @@ def _load(context: Context) -> None:
     grading = [FragmentGrading(steps.reached, run, np.asarray(fragment_sieves(config)), steps)] if "agglomerates" in run.sample else []
     operations.run_loading(sim, [
         steps,
-        operations.Records(steps.reached, context.writer, lambda: _record(sim, run, steps.target), OEDOMETER.units()),
+        operations.Records(steps.reached, context.writer, lambda: _record(sim, run, config, steps.target),
+                           record_units(OEDOMETER, config)),
+        *crack_records(steps.reached, context.writer, config),  # the breaks, after the record of their step
         *grading,
         operations.Snapshots(steps.reached, context.writer, lambda step: f"load_{run.next_load - 1:02d}", lambda: _snapshot(sim, run),
                   lambda: WallGeometry.from_simulation(sim, names=geometry)),
@@ -182,8 +185,9 @@ class FragmentGrading(Operation):
                                           "vertical_stress_pa": self.steps.box.stress_yy_pa, **grading})
 
 
-def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, float]:
-    """One record at a load step's equilibrium, in :data:`grainlab.columns.OEDOMETER`'s order."""
+def _record(sim: Simulation, run: OedometerRun, config: OedometerConfig, target: float) -> dict[str, float]:
+    """One record at a load step's equilibrium, in :data:`grainlab.columns.OEDOMETER`'s order
+    (a cemented sample's bonds broken after them)."""
     box = box_state({name: sim.wall(run.walls[name]) for name in BOX_WALLS})
     area = box.width_m * box.height_m
     n = run.n_grains
@@ -199,7 +203,7 @@ def _record(sim: Simulation, run: OedometerRun, target: float) -> dict[str, floa
         "porosity": porosity, "void_ratio": porosity / (1.0 - porosity), "height_m": box.height_m, "area_m2": area,
         **grain_columns(sim, n, area, sim.contacts(), _snapshot(sim, run)),
     }
-    return {name: values[name] for name in OEDOMETER}
+    return {**{name: values[name] for name in OEDOMETER}, **bonds_broken(sim, run.consolidation, config)}
 
 
 class OedometerProtocol(SpecimenProtocol[OedometerConfig, OedometerRun, OedometerResult]):

@@ -9,12 +9,12 @@ simple shear")."""
 from __future__ import annotations
 
 from collections.abc import Set as AbstractSet
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from grainlab.protocols.config import (
     POSITIVE,
-    SHARED_FIELDS,
+    SQUARE,
     Config,
     ConfigError,
     Section,
@@ -97,10 +97,7 @@ def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
         )
 
 
-#: A square cell by default: Table 1's width, 75 mm, on both sides (about 1,700 grains).
-_SQUARE = {"sample.height": replace(SHARED_FIELDS["sample.height"], default=SHARED_FIELDS["sample.width"].default,
-                                    help="sample height (a square cell: Table 1's width, 75 mm)")}
-
-#: The simple-shear test's configuration schema (registered as ``"simple_shear"``).
-SIMPLE_SHEAR_SCHEMA = register_test("simple_shear", {**_SQUARE, **SIMPLE_SHEAR_FIELDS}, _check, SimpleShearConfig,
+#: The simple-shear test's configuration schema (registered as ``"simple_shear"``): a square
+#: cell by default, Table 1's width on both sides (about 1,700 grains).
+SIMPLE_SHEAR_SCHEMA = register_test("simple_shear", {**SQUARE, **SIMPLE_SHEAR_FIELDS}, _check, SimpleShearConfig,
                                     SIMPLE_SHEAR_QUICK)

@@ -1,12 +1,8 @@
 """A finished simple-shear run's outputs: the summary (the peak and the steady
-state by the rule below, the dilatancy, the Rothenburg-Bathurst residual over
-every record), ``timeseries.csv``, ``summary.json`` and the figures, all from
-``run.h5``.
-
-The steady state is the mean over the records at shear strains of at least
-:data:`STEADY_FROM` times the final strain (the second half of a run's
-strain by default); the rule was fixed before any run was seen.
-"""
+state, the mean over the records from :data:`STEADY_FROM` of the final strain on;
+the dilatancy, the Rothenburg-Bathurst residual over every record),
+``timeseries.csv``, ``summary.json`` and the figures, all from ``run.h5``
+(docs/protocols.md, "Periodic simple shear")."""
 
 from __future__ import annotations
 

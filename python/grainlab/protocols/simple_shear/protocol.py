@@ -14,10 +14,11 @@ import numpy as np
 
 from grainlab._progress import progress_bar
 from grainlab.analysis import StressForceFabric, fabric_summary
-from grainlab.columns import SIMPLE_SHEAR
+from grainlab.columns import SHEAR_STRAIN, SIMPLE_SHEAR
 from grainlab.io.hdf5.snapshot import snapshot_name
 from grainlab.io.results import SHEAR_START_FILE
 from grainlab.protocols import operations
+from grainlab.protocols.cracks import bonds_broken, crack_records, record_units
 from grainlab.protocols.grains import grain_coordination, grain_porosity
 from grainlab.protocols.operations import Loading, Operation
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
@@ -231,7 +232,8 @@ def _shear(context: Context) -> None:
     rate = run.shear_rate_per_s
     steps_per_unit = 1.0 / (rate * sim.time_step)
     steps, snaps = record_steps(config, steps_per_unit)
-    records = operations.Records(OnSteps(steps, run.start_step), writer, lambda: _record(sim, run, config), SIMPLE_SHEAR.units(),
+    records = operations.Records(OnSteps(steps, run.start_step), writer, lambda: _record(sim, run, config),
+                                 record_units(SIMPLE_SHEAR, config),
                       count=run)
     strains = {run.start_step + step: strain for step, strain in snaps.items()}
     snapshots = operations.Snapshots(OnSteps(strains), writer, lambda step: snapshot_name_of(strains[step]),
@@ -252,7 +254,7 @@ def _shear(context: Context) -> None:
                             run.wall_time, "shear")
     targets = (None, run.normal_stress_pa) if config.simple_shear.volume == "free" else (None, None)
     operations.run_loading(sim, [
-        records, snapshots,
+        records, *crack_records(scheduled, writer, config, SHEAR_STRAIN), snapshots,
         operations.Progress(scheduled, bar, lambda step: 100 * (step - run.start_step) / steps_per_unit,
                  lambda: f"mu {records.values['friction_coefficient']:.3f}, Z {records.values['coordination_number']:.2f}",
                  done),
@@ -268,7 +270,7 @@ def _snapshot(sim: Simulation, run: SimpleShearRun, values: dict[str, float]) ->
 
 
 def _record(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig) -> dict[str, float]:
-    """One record, in :data:`grainlab.columns.SIMPLE_SHEAR`'s order."""
+    """One record, in :data:`grainlab.columns.SIMPLE_SHEAR`'s order (a cemented sample's bonds broken after them)."""
     cell = sim.cell
     assert cell is not None
     stress = cell_stress(sim)
@@ -301,7 +303,7 @@ def _record(sim: Simulation, run: SimpleShearRun, config: SimpleShearConfig) -> 
         "rb_stress_ratio": rb.stress_ratio, "rb_predicted_stress_ratio": rb.predicted_stress_ratio,
         "rb_residual": rb.residual,
     }
-    return {name: values[name] for name in SIMPLE_SHEAR}
+    return {**{name: values[name] for name in SIMPLE_SHEAR}, **bonds_broken(sim, run.consolidation, config)}
 
 
 class SimpleShearProtocol(SpecimenProtocol[SimpleShearConfig, SimpleShearRun, SimpleShearResult]):

@@ -11,7 +11,7 @@ from grainlab.protocols.config import (
     POSITIVE,
     Config,
     ConfigError,
-    Section,
+    PlatenSection,
     SectionOf,
     check_sample,
     key,
@@ -26,20 +26,15 @@ UNCEMENTED = ("ucs: an uncemented sample has no unconfined strength; give cement
 
 
 @dataclass(frozen=True)
-class UcsSection(Section):
-    """The unconfined compression test's own keys: its loading and its end."""
+class UcsSection(PlatenSection):
+    """The unconfined compression test's own keys: its loading and its end (the axial
+    strain and the axial stress)."""
 
     prefix: ClassVar[str] = "ucs"
-    strain_rate: float = key("strain_rate", "1 %/min", "axial strain rate of the top platen (of the height "
-                             "after the release)", **POSITIVE)
-    final_strain: float = key("strain", 0.02, "the loading ends at this axial strain", minimum=0.0, maximum=0.5,
-                              exclusive_minimum=True)
-    residual_fraction: float = key(
-        "number", 0.5, "the loading ends once the axial stress after the peak falls below this fraction of the "
-        "peak", minimum=0.0, maximum=1.0, exclusive_maximum=True,
+    seating_stress: float = key(
+        "stress", 1.0e3, "the seating: after the release the top platen is servo-controlled to this axial stress "
+        "in equilibrium (within a tenth of it) before the compression; the strains count from there", **POSITIVE,
     )
-    records: int = key("integer", 200, "records over ucs.final_strain (one every final_strain / records)",
-                       minimum=1)
 
 
 UCS_FIELDS = UcsSection.keys()

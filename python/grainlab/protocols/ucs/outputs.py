@@ -91,7 +91,7 @@ def summarise(run: UcsRun, config: UcsConfig, timeseries: dict[str, NDArray[np.f
         "height0_m": run.height0,
         "width0_m": run.width0,
         "strain_rate_per_s": config.ucs.strain_rate,
-    }, records=len(stress), release_steps=run.release_steps,
+    }, records=len(stress), release_steps=run.release_steps, seating_steps=run.seating_steps,
         load_steps=int(timeseries["step"][-1]) - run.start_step, wall_time_s=total_s)
 
 
