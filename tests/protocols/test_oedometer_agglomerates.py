@@ -130,3 +130,15 @@ def test_the_free_radii_take_the_overlaps_off_so_no_two_circles_overlap():
     untouched = before.min(axis=1) > 0
     assert untouched.any() and (~untouched).any()
     np.testing.assert_array_equal(free[untouched], radii[untouched])  # a disk that overlapped nothing keeps its radius
+
+
+def test_every_break_after_the_consolidation_is_a_crack_record(crushed):
+    results = read_results(crushed / "run.h5")
+    broken, cracks = results.timeseries["cement_bonds_broken"], results.cracks
+    # counted from the agglomerates' bonds as made (some break in the consolidation), never down
+    assert results.summary["cement_bonds"] == results.summary["agglomerate_bonds"]
+    assert broken[0] < broken[-1] and np.all(np.diff(broken) >= 0)
+    assert len(cracks["step"]) == broken[-1] <= results.summary["cement_bonds"]
+    np.testing.assert_array_equal(np.bincount(np.searchsorted(results.timeseries["step"], cracks["step"]),
+                                              minlength=len(broken)).cumsum(), broken)
+    assert (crushed / "fig20_cracks.png").exists()

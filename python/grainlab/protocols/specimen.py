@@ -340,9 +340,13 @@ def cement_sample(sim: Simulation, run: SpecimenRun, config: Config, period: tup
     "Cemented samples"), when ``cement.bonds`` asks for it: stiffnesses ``auto`` make each
     bond's ``kn_bar A`` the contact law's ``kn`` (and ``ks``), strengths drawn with
     ``sample.seed``. ``period``: the grains in a periodic cell of that size whose corner
-    is ``sim.cell.origin``. Records the count in ``run.consolidation["cement_bonds"]``."""
+    is ``sim.cell.origin``. Records the count in ``run.consolidation["cement_bonds"]``
+    (a sample of agglomerates, bonded within each since its start: the bonds made then)."""
     c = config.cement
-    if c.bonds == "none" or config.values.get("sample.grains") == "agglomerate":  # agglomerates: bonded within
+    if config.values.get("sample.grains") == "agglomerate":
+        run.consolidation["cement_bonds"] = run.sample["agglomerate_bonds"]
+        return
+    if c.bonds == "none":
         return
     from grainlab.cement import draw_strengths, pairs_within_gap
 
