@@ -1,0 +1,29 @@
+"""docs/cemented.md's calibration numbers are the stored campaign summary's
+(benchmarks/data/cement_calibration.json, made by benchmarks/cement_calibration.py)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGE = " ".join((ROOT / "docs" / "cemented.md").read_text().split())
+SUMMARY = json.loads((ROOT / "benchmarks" / "data" / "cement_calibration.json").read_text())
+
+
+def test_the_pages_calibration_table_is_the_stored_summary():
+    for point in SUMMARY["points"]:
+        u, e = point.get("unconfined_strength_pa"), point.get("youngs_modulus_pa")
+        if u is None:
+            continue
+        cells = f"| {u['mean'] / 1e3:.0f} ± {u['sd'] / 1e3:.0f} | {e['mean'] / 1e6:.0f} ± {e['sd'] / 1e6:.0f} |"
+        assert cells in PAGE, (point["label"], cells)
+
+
+def test_the_pages_rule_readings_are_the_stored_summarys():
+    rules = SUMMARY["rules"]
+    strength = rules["rule 1 (unconfined_strength_pa)"]
+    assert strength["holds"] and f"ln sigma_c is {strength['slope']:.2f}" in PAGE
+    stiffness = rules["rule 2"]
+    assert not stiffness["holds"] and f"a spread of {stiffness['spread']:.2f}" in PAGE
+    assert ", ".join(f"{v:.2f}" for v in stiffness["E_over_parallel_stiffness"][:2]) in PAGE
