@@ -27,3 +27,17 @@ def test_the_pages_rule_readings_are_the_stored_summarys():
     stiffness = rules["rule 2"]
     assert not stiffness["holds"] and f"a spread of {stiffness['spread']:.2f}" in PAGE
     assert ", ".join(f"{v:.2f}" for v in stiffness["E_over_parallel_stiffness"][:2]) in PAGE
+
+
+def test_the_pages_tensile_strengths_and_ratios_are_the_stored_summarys():
+    for point in SUMMARY["points"]:
+        if point["family"] not in ("base", "strength"):
+            continue
+        t, u = point["tensile_strength_pa"], point["unconfined_strength_pa"]
+        cells = f"| {t['mean'] / 1e3:.0f} ± {t['sd'] / 1e3:.0f} | {u['mean'] / t['mean']:.2f} |"
+        assert t["n"] == 5 and cells in PAGE, (point["label"], cells)
+    rules = SUMMARY["rules"]
+    tensile = rules["rule 1 (tensile_strength_pa)"]
+    assert tensile["holds"] and f"ln sigma_t against ln sigma_c is {tensile['slope']:.2f}" in PAGE
+    ratio = rules["rule 3"]
+    assert ratio["shortfall"] and f"base point is {ratio['ratio']:.2f}, below half of granite's" in PAGE
