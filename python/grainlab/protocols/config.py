@@ -288,6 +288,15 @@ class PlatenSection(Section):
     records: int = key("integer", 200, "records over final_strain (one every final_strain / records)", minimum=1)
 
 
+def check_cemented_sample(v: dict[str, Any], given: AbstractSet[str], test: str, strength: str) -> None:
+    """A platen test's checks: :func:`check_sample`'s, after the one-line refusal of an
+    uncemented sample, which has no ``strength`` to measure."""
+    if v["cement.bonds"] == "none":
+        raise ConfigError(f"{test}: an uncemented sample has no {strength}; give cement.bonds=parallel and its "
+                          f"strengths")
+    check_sample(v, given)
+
+
 #: The keys of every test that makes a sample and consolidates it: the sample, its
 #: material (Table 1) and the consolidation.
 SHARED_FIELDS: dict[str, Field] = {

@@ -23,7 +23,7 @@ from grainlab.simulation import Simulation
 if TYPE_CHECKING:
     from grainlab.plot.workers import FigureTask
 
-__all__ = ["CrackRecords", "bonds_broken", "crack_columns", "crack_records", "crack_task", "crack_units",
+__all__ = ["CrackRecords", "bonds_broken", "broken_since", "crack_columns", "crack_records", "crack_task", "crack_units",
            "record_units"]
 
 
@@ -41,12 +41,14 @@ def record_units(columns: Columns, config: Config) -> dict[str, str]:
     return {**columns.units(), **(CEMENTED.units() if config.cement.bonds != "none" else {})}
 
 
+def broken_since(sim: Simulation, consolidation: dict[str, Any]) -> float:
+    """The cement bonds broken since the end of the consolidation (its ``consolidation["cement_bonds"]``)."""
+    return float(consolidation["cement_bonds"] - sim.n_cement_bonds)
+
+
 def bonds_broken(sim: Simulation, consolidation: dict[str, Any], config: Config) -> dict[str, float]:
-    """A cemented sample's record column: the cement bonds broken since the end of the
-    consolidation (its ``consolidation["cement_bonds"]``); nothing for an uncemented one."""
-    if config.cement.bonds == "none":
-        return {}
-    return {CEMENT_BONDS_BROKEN: float(consolidation["cement_bonds"] - sim.n_cement_bonds)}
+    """A cemented sample's record column (:func:`broken_since`); nothing for an uncemented one."""
+    return {} if config.cement.bonds == "none" else {CEMENT_BONDS_BROKEN: broken_since(sim, consolidation)}
 
 
 def crack_columns(breaks: BondBreaks, strain: NDArray[np.float64],

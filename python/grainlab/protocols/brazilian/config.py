@@ -14,16 +14,13 @@ from grainlab.protocols.config import (
     ConfigError,
     PlatenSection,
     SectionOf,
-    check_sample,
+    check_cemented_sample,
     key,
     register_test,
 )
 
 __all__ = ["BRAZILIAN_FIELDS", "BRAZILIAN_QUICK", "BRAZILIAN_SCHEMA", "BrazilianConfig", "BrazilianSection"]
 
-#: The one-line refusal of a sample without cement.
-UNCEMENTED = ("brazilian: an uncemented sample has no tensile strength; give cement.bonds=parallel and its "
-              "strengths")
 #: The disc's least size, in largest grain diameters across.
 DISC_GRAINS_ACROSS = 10
 
@@ -63,9 +60,7 @@ BRAZILIAN_QUICK: dict[str, Any] = {"sample.width": 0.04, "sample.height": 0.04}
 
 
 def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
-    if values["cement.bonds"] == "none":
-        raise ConfigError(UNCEMENTED)
-    check_sample(values, given)
+    check_cemented_sample(values, given, "brazilian", "tensile strength")
     diameter = values["brazilian.diameter_fraction"] * min(values["sample.width"], values["sample.height"])
     if diameter < DISC_GRAINS_ACROSS * values["sample.d_max"]:
         raise ConfigError(

@@ -28,6 +28,7 @@ from grainlab.protocols.brazilian.disc import (
 from grainlab.protocols.brazilian.outputs import BrazilianResult, summarise, write_outputs
 from grainlab.protocols.brazilian.state import BrazilianRun
 from grainlab.protocols.consolidate import add_platens
+from grainlab.protocols.cracks import broken_since
 from grainlab.protocols.platens import Press, platen_snapshot, press, release
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import CONSOLIDATE, SpecimenProtocol, engine_columns
@@ -68,7 +69,7 @@ def measure(sim: Simulation, run: BrazilianRun) -> dict[str, float]:
         "step": float(sim.step_count), "time_s": sim.time, "axial_strain": displacement / run.diameter_m,
         "platen_displacement_m": displacement, "platen_force_n_per_m": force,
         "tensile_stress_pa": indirect_tensile_stress(force, run.diameter_m), **engine_columns(sim),
-        "cement_bonds_broken": float(run.consolidation["cement_bonds"] - sim.n_cement_bonds),
+        "cement_bonds_broken": broken_since(sim, run.consolidation),
     }
     return {name: values[name] for name in BRAZILIAN}
 

@@ -10,20 +10,14 @@ from typing import Any, ClassVar
 from grainlab.protocols.config import (
     POSITIVE,
     Config,
-    ConfigError,
     PlatenSection,
     SectionOf,
-    check_sample,
+    check_cemented_sample,
     key,
     register_test,
 )
 
 __all__ = ["UCS_FIELDS", "UCS_SCHEMA", "UcsConfig", "UcsSection"]
-
-#: The one-line refusal of a sample without cement.
-UNCEMENTED = ("ucs: an uncemented sample has no unconfined strength; give cement.bonds=parallel and its "
-              "strengths")
-
 
 @dataclass(frozen=True)
 class UcsSection(PlatenSection):
@@ -48,9 +42,7 @@ class UcsConfig(Config):
 
 
 def _check(values: dict[str, Any], given: AbstractSet[str]) -> None:
-    if values["cement.bonds"] == "none":
-        raise ConfigError(UNCEMENTED)
-    check_sample(values, given)
+    check_cemented_sample(values, given, "ucs", "unconfined strength")
 
 
 #: The unconfined compression test's configuration schema (registered as ``"ucs"``).

@@ -18,6 +18,7 @@ import numpy as np
 
 from grainlab.columns import AXIAL_STRESS_PA, LATERAL_STRAIN, UCS
 from grainlab.protocols.consolidate import long_platens
+from grainlab.protocols.cracks import broken_since
 from grainlab.protocols.platens import Press, platen_snapshot, press, release, settle
 from grainlab.protocols.runner import Stage, StageContext, run_protocol
 from grainlab.protocols.specimen import CONSOLIDATE, SpecimenProtocol, engine_columns
@@ -62,7 +63,7 @@ def measure(sim: Simulation, run: UcsRun) -> dict[str, float]:
         "axial_stress_pa": sim.wall(run.walls["top"]).normal_stress(width),
         "lateral_strain": (width - run.width0) / run.width0, "width_m": width, "height_m": height,
         **engine_columns(sim),
-        "cement_bonds_broken": float(run.consolidation["cement_bonds"] - sim.n_cement_bonds),
+        "cement_bonds_broken": broken_since(sim, run.consolidation),
     }
     return {name: values[name] for name in UCS}
 
