@@ -11,6 +11,7 @@
 //! walls' positions, velocities and forces, the energy ledger and the clock.
 mod common;
 use common::*;
+use grainlab_core::cement::{CementKind, CementSpec};
 use grainlab_core::{
     ContactModel, Particles, ServoControl, Simulation, StepParameters, Wall, WallControl, WallShape,
 };
@@ -98,6 +99,34 @@ fn trajectory_hash(sim: &Simulation) -> u64 {
         h.word(ext(b.i));
         h.word(ext(b.j));
         h.f64(b.shear);
+    }
+    // the cement bonds' springs and the breaks (nothing for an uncemented system)
+    for b in &sim.cement().bonds {
+        h.word(ext(b.i));
+        h.word(ext(b.j));
+        h.f64(b.shear);
+        h.f64(b.moment);
+    }
+    for b in &sim.cement().breaks {
+        h.word(b.step);
+        h.word(b.i as u64);
+        h.word(b.j as u64);
+        h.word(b.mode as u64);
+        for x in [
+            b.energy,
+            b.position[0],
+            b.position[1],
+            b.normal[0],
+            b.normal[1],
+        ] {
+            h.f64(x);
+        }
+        for x in [b.normal_force, b.shear_force, b.moment] {
+            h.f64(x);
+        }
+    }
+    if !sim.cement().bonds.is_empty() || !sim.cement().breaks.is_empty() {
+        h.f64(sim.energy().bond_released);
     }
     for wall in sim.walls() {
         h.f64(wall.displacement[0]);
@@ -208,6 +237,48 @@ fn sheared_packing(threads: usize) -> Simulation {
     let mut p = sim.params();
     p.local_damping = 0.1;
     sim.set_params(p).unwrap();
+    sim
+}
+
+/// Every touching pair of `sim` (not bonded already) cemented by a parallel
+/// bond of strengths drawn by a seeded generator between `low` and 8 `low`
+/// (Pa), so that some break under the loading and most hold.
+fn cement_contacts(sim: &mut Simulation, low: f64, seed: u64) {
+    let contacts = sim.contacts().unwrap();
+    let pairs: Vec<(usize, usize)> = (0..contacts.i.len())
+        .filter(|&k| !contacts.bonded[k])
+        .map(|k| (contacts.i[k] as usize, contacts.j[k] as usize))
+        .collect();
+    let mut rng = Rng::new(seed);
+    let kn_bar = KN / (2.0e-3);
+    let specs: Vec<CementSpec> = pairs
+        .iter()
+        .map(|_| CementSpec {
+            kind: CementKind::Parallel,
+            radius_multiplier: rng.uniform(0.5, 1.0),
+            normal_stiffness: kn_bar,
+            shear_stiffness: 0.5 * kn_bar,
+            tensile_strength: rng.uniform(low, 8.0 * low),
+            cohesion: rng.uniform(low, 8.0 * low),
+            friction_angle: 20.0,
+        })
+        .collect();
+    sim.add_cement_bonds(&pairs, &specs).unwrap();
+}
+
+/// The sheared periodic packing with every contact cemented: the bonds'
+/// nearest image in a deforming cell, their breaks in tension and shear.
+fn cemented_sheared_packing(threads: usize) -> Simulation {
+    let mut sim = sheared_packing(threads);
+    cement_contacts(&mut sim, 1.0e6, 5);
+    sim
+}
+
+/// The servo box with every contact cemented and the top wall squeezing and
+/// shearing the sample: walls, the membrane's permanent bonds beside cement.
+fn cemented_box(threads: usize) -> Simulation {
+    let mut sim = membrane_box(threads);
+    cement_contacts(&mut sim, 2.0e6, 9);
     sim
 }
 
@@ -369,4 +440,36 @@ fn two_groups_with_their_own_models_give_the_same_bits_with_the_vector_kernels()
             "{threads} thread(s): contact lists differ"
         );
     }
+}
+
+#[test]
+fn a_cemented_sheared_packing_follows_its_recorded_trajectory() {
+    let sim = check(
+        "cemented sheared packing",
+        cemented_sheared_packing,
+        2500,
+        500,
+        0xcd3f_b3a4_b6cf_69a5,
+    );
+    let (intact, broken) = (sim.cement().bonds.len(), sim.cement().breaks.len());
+    assert!(
+        broken > 20 && intact > 10 * broken,
+        "{broken} broke, {intact} hold"
+    );
+}
+
+#[test]
+fn a_cemented_membrane_box_follows_its_recorded_trajectory() {
+    let sim = check(
+        "cemented membrane box",
+        cemented_box,
+        3000,
+        750,
+        0x0797_76e0_4b43_c604,
+    );
+    let (intact, broken) = (sim.cement().bonds.len(), sim.cement().breaks.len());
+    assert!(
+        broken > 20 && intact > 5 * broken,
+        "{broken} broke, {intact} hold"
+    );
 }

@@ -27,11 +27,18 @@ use crate::parallel::{
 use crate::state::ParticleMotion;
 use crate::vec2::{add, dot, perp, scale, sub, Mat2, Vec2};
 
-/// The tallies of the stripes, in stripe order, then the bonds'.
-fn merge_tallies(stripes: &[ContactTally], bonds: &ContactTally) -> ContactTally {
+/// A stripe's two tallies: its pairs' (interior, then across stripes) and
+/// its cement bonds'. Kept apart until the pairs across stripes are in, so
+/// that a step with a team and one without sum them in the same order.
+type StripeTallies = [ContactTally; 2];
+
+/// The tallies of the stripes, in stripe order (each its pairs', then its
+/// cement's), then the bonds'.
+fn merge_tallies(stripes: &[StripeTallies], bonds: &ContactTally) -> ContactTally {
     let mut contacts = ContactTally::default();
-    for t in stripes {
-        contacts.merge(t);
+    for [pairs, cement] in stripes {
+        contacts.merge(pairs);
+        contacts.merge(cement);
     }
     contacts.merge(bonds);
     contacts
@@ -294,14 +301,14 @@ impl Simulation {
     }
 
     /// Steps 2-3: reset resultants, then particle-particle contact forces; returns
-    /// each stripe's tally. With a team the pairs across stripes are evaluated in
+    /// each stripe's tallies ([`StripeTallies`]). With a team the pairs across stripes are evaluated in
     /// the same phase into a buffer that each stripe's integration applies (step
     /// 7); without one they wait for [`Simulation::cross_pairs_in_order`].
     fn particle_contacts<const MEASURE: bool>(
         &mut self,
         team: Option<&Team>,
         defer: bool,
-    ) -> Vec<ContactTally> {
+    ) -> Vec<StripeTallies> {
         let (increment_time, velocity_gradient) =
             (self.increment_time(), self.deforming_gradient());
         let buffer_cross = team.is_some();
@@ -404,12 +411,18 @@ impl Simulation {
                 let at = (&motion, cell, velocity_gradient, increment_time);
                 evaluate_bonds::<MEASURE>((work.bonds, work.bond_slots), at);
                 let cement = (work.cement, work.cement_slots, work.cement_first);
-                evaluate_cement_bonds::<MEASURE>(cement, work.cement_ruptures, at, &mut tally);
+                let mut cement_tally = ContactTally::default();
+                evaluate_cement_bonds::<MEASURE>(
+                    cement,
+                    work.cement_ruptures,
+                    at,
+                    &mut cement_tally,
+                );
                 if defer {
                     // SAFETY: each wall pair is in the list of one stripe only
                     wall_pairs.evaluate::<MEASURE>(deferred_index.walls_of_stripe(b), &wall_step);
                 }
-                tally
+                [tally, cement_tally]
             }
         });
         // with a buffer the cross-stripe forces are applied by each stripe's
@@ -423,7 +436,7 @@ impl Simulation {
     /// same additions in the same order as from the buffer (which a stripe's
     /// integration applies after the bonds and walls, in pair order), and each
     /// stripe's tally the same merges: the same bits without the buffer.
-    fn cross_pairs_in_order<const MEASURE: bool>(&mut self, tallies: &mut [ContactTally]) {
+    fn cross_pairs_in_order<const MEASURE: bool>(&mut self, tallies: &mut [StripeTallies]) {
         let increment_time = self.increment_time();
         let n_stripes = self.neighbors.stripe_ranges.len();
         let pairs = &mut self.neighbors.pairs;
@@ -437,7 +450,7 @@ impl Simulation {
             force: &force,
             torque: &torque,
         };
-        for (tally, &(lo, hi)) in tallies.iter_mut().zip(&shares) {
+        for ([tally, _], &(lo, hi)) in tallies.iter_mut().zip(&shares) {
             let (lo, hi) = (cross_start + lo, cross_start + hi);
             // SAFETY: one thread; the pairs index particles that exist
             let cross =
