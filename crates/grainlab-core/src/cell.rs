@@ -16,6 +16,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{require_finite, EngineError, Result};
+use crate::law::real::Real;
 use crate::vec2::{add, dot, mat_mul, mat_vec, scale, sub, Mat2, Vec2, IDENTITY};
 
 /// A parallelogram cell spanned by `a` and `b` from `origin`.
@@ -87,11 +88,21 @@ impl PeriodicCell {
     /// Fractional coordinates `H^-1 (x - origin)`.
     #[inline(always)]
     pub fn fractional(&self, x: Vec2) -> Vec2 {
-        let d = sub(x, self.origin);
-        let inv_det = 1.0 / self.area();
+        self.fractional_of(x)
+    }
+
+    /// [`PeriodicCell::fractional`] over [`Real`] (one point, or four in lanes).
+    #[inline(always)]
+    fn fractional_of<R: Real>(&self, x: [R; 2]) -> [R; 2] {
+        let d = [
+            x[0] - R::splat(self.origin[0]),
+            x[1] - R::splat(self.origin[1]),
+        ];
+        let inv_det = R::splat(1.0 / self.area());
+        let (a, b) = (self.a, self.b);
         [
-            (self.b[1] * d[0] - self.b[0] * d[1]) * inv_det,
-            (-self.a[1] * d[0] + self.a[0] * d[1]) * inv_det,
+            (R::splat(b[1]) * d[0] - R::splat(b[0]) * d[1]) * inv_det,
+            (R::splat(-a[1]) * d[0] + R::splat(a[0]) * d[1]) * inv_det,
         ]
     }
 
@@ -203,41 +214,54 @@ pub fn advance(x: Vec2, v: Vec2, s: f64) -> Vec2 {
 #[inline(always)]
 pub fn minimum_image(cell: Option<&PeriodicCell>, d: Vec2) -> Vec2 {
     match cell {
-        Some(c) if c.periodic[0] || c.periodic[1] => {
-            let zero = c.origin;
-            let f = c.fractional(add(zero, d));
-            let mut shift = [0i8; 2];
-            for k in 0..2 {
-                if c.periodic[k] {
-                    shift[k] = -nearest_whole(f[k]);
-                }
-            }
-            add(d, c.image_offset(shift))
-        }
-        _ => d,
+        Some(c) => nearest_image(c, d),
+        None => d,
     }
 }
 
-/// `x.round() as i8` (halves away from zero, saturating) without a call to
-/// the C library's `round`, which the baseline x86-64 target makes (and which
-/// costs a bond's evaluation its registers): the truncation is one
-/// instruction and the remainder `x - trunc(x)` is exact.
+/// The image of branch vector `d` nearest to zero in cell `c`, over
+/// [`Real`] (one bond, or four in the cement's lanes, with the same bits):
+/// `d` shifted by the whole cell vectors that bring its fractional
+/// coordinates (of `origin + d`) to within a half, along each periodic
+/// direction.
 #[inline(always)]
-fn nearest_whole(x: f64) -> i8 {
-    // beyond 1e15 (and for NaN) the library's answer, saturated as it is
-    if x.is_nan() || x.abs() >= 1.0e15 {
-        return x.round() as i8;
+pub(crate) fn nearest_image<R: Real>(c: &PeriodicCell, d: [R; 2]) -> [R; 2] {
+    if !(c.periodic[0] || c.periodic[1]) {
+        return d;
     }
-    let whole = x as i64;
-    let rest = x - whole as f64;
-    let n = if rest >= 0.5 {
-        whole + 1
-    } else if rest <= -0.5 {
-        whole - 1
-    } else {
-        whole
-    };
-    n.clamp(i8::MIN.into(), i8::MAX.into()) as i8
+    let f = c.fractional_of([R::splat(c.origin[0]) + d[0], R::splat(c.origin[1]) + d[1]]);
+    // `0 - n`, not `-n`: no shift is +0, as an integer shift of 0 would be
+    // (no closures here: the lanes' operations must inline into the AVX2 kernel)
+    let zero = R::splat(0.0);
+    let mut shift = [zero; 2];
+    if c.periodic[0] {
+        shift[0] = zero - nearest_whole(f[0]);
+    }
+    if c.periodic[1] {
+        shift[1] = zero - nearest_whole(f[1]);
+    }
+    let (a, b) = (c.a, c.b);
+    [
+        d[0] + (shift[0] * R::splat(a[0]) + shift[1] * R::splat(b[0])),
+        d[1] + (shift[0] * R::splat(a[1]) + shift[1] * R::splat(b[1])),
+    ]
+}
+
+/// `x` rounded to the nearest whole number, halves away from zero, held
+/// within +-127 images: the truncation and the remainder `x - trunc(x)` are
+/// exact, so no call to the C library's `round` (which the baseline x86-64
+/// target makes, and which costs a bond's evaluation its registers).
+#[inline(always)]
+fn nearest_whole<R: Real>(x: R) -> R {
+    let whole = x.trunc();
+    let rest = x - whole;
+    let (zero, one, half) = (R::splat(0.0), R::splat(1.0), R::splat(0.5));
+    let up = R::select(rest.ge(half), one, zero);
+    let down = R::select((-half).ge(rest), one, zero);
+    let n = whole + up - down;
+    let limit = R::splat(127.0);
+    let n = R::select(n.gt(limit), limit, n);
+    R::select((-limit).gt(n), -limit, n)
 }
 
 #[cfg(test)]
@@ -245,7 +269,7 @@ mod tests {
     use super::nearest_whole;
 
     #[test]
-    fn nearest_whole_rounds_as_the_library_does() {
+    fn nearest_whole_rounds_as_the_library_does_within_127_images() {
         let edges = [
             0.0,
             -0.0,
@@ -270,7 +294,17 @@ mod tests {
         ];
         let steps = (-4000..4000).map(|k| k as f64 * 0.0373);
         for x in edges.into_iter().chain(steps) {
-            assert_eq!(nearest_whole(x), x.round() as i8, "{x}");
+            let n: f64 = nearest_whole(x);
+            if x.is_nan() {
+                assert!(n.is_nan());
+            } else {
+                // the C library's rounding, held within +-127 images
+                assert_eq!(
+                    n.to_bits(),
+                    (x.round().clamp(-127.0, 127.0) + 0.0).to_bits(),
+                    "{x}"
+                );
+            }
         }
     }
 }

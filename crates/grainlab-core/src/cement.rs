@@ -27,10 +27,11 @@
 //! law alone carries the pair.
 use serde::{Deserialize, Serialize};
 
-use crate::cell::{minimum_image, PeriodicCell};
+use crate::cell::{nearest_image, PeriodicCell};
 use crate::error::{require_non_negative, require_positive, EngineError, Result};
+use crate::law::real::Real;
 use crate::state::ParticleMotion;
-use crate::vec2::{add, dot, mat_vec, norm, perp, scale, sub, Mat2, Vec2};
+use crate::vec2::{add, scale, sub, Mat2, Vec2};
 
 /// The kind of a cement bond.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -205,13 +206,10 @@ impl CementBond {
     /// divides nothing: `-F_n + |M| A R_b / I >= sigma_c A` and
     /// `|F_s| >= c A + F_n tan(phi_b)`.
     pub fn rupture_mode(&self, fn_: f64) -> Option<BreakMode> {
-        let a = self.area;
-        if self.moment.abs() * self.bending_factor * a - fn_ >= self.tensile_strength * a {
-            Some(BreakMode::Tension)
-        } else if self.shear.abs() >= self.cohesion * a + fn_ * self.friction_tangent {
-            Some(BreakMode::Shear)
-        } else {
-            None
+        match criteria(&BondInput::of_springs(self), fn_) {
+            (true, _) => Some(BreakMode::Tension),
+            (false, true) => Some(BreakMode::Shear),
+            (false, false) => None,
         }
     }
 }
@@ -285,26 +283,214 @@ impl Cement {
 
 /// A bond's geometry at the current state, after its springs took the
 /// increment: the normal `i -> j`, the distance, the lever arms, and the
-/// relative motion the increment was made with.
+/// relative motion the increment was made with (one bond's `f64`, or four
+/// bonds' lanes, [`Real`]).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct CementGeometry {
-    pub normal: Vec2,
-    pub distance: f64,
+pub(crate) struct CementGeometry<R = f64> {
+    pub normal: [R; 2],
+    pub distance: R,
     /// Distances from `i`'s and `j`'s centres to the contact point (they sum to `distance`).
-    pub arm_i: f64,
-    pub arm_j: f64,
+    pub arm_i: R,
+    pub arm_j: R,
     /// Relative normal velocity `(v_j - v_i) . n` (m/s).
-    pub normal_velocity: f64,
+    pub normal_velocity: R,
     /// Relative tangential velocity of the contact point `v_t` (m/s).
-    pub shear_velocity: f64,
+    pub shear_velocity: R,
     /// `omega_j - omega_i` (rad/s).
-    pub spin: f64,
+    pub spin: R,
+}
+
+/// What the law of a bond reads: the motion of its two disks and the bond's
+/// own values, as one bond's `f64` or four bonds' lanes.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BondInput<R> {
+    /// `x_j - x_i`, before the nearest image.
+    pub branch: [R; 2],
+    /// `v_j - v_i`.
+    pub relative_velocity: [R; 2],
+    pub radius: [R; 2],
+    pub angular_velocity: [R; 2],
+    pub normal_stiffness: R,
+    pub shear_stiffness: R,
+    pub bending_stiffness: R,
+    pub area: R,
+    pub bending_factor: R,
+    pub tensile_strength: R,
+    pub cohesion: R,
+    pub friction_tangent: R,
+    pub rest_length: R,
+    pub shear: R,
+    pub moment: R,
+}
+
+impl BondInput<f64> {
+    /// `bond`'s input at the motion `p`.
+    #[inline(always)]
+    pub(crate) fn of(bond: &CementBond, p: &ParticleMotion<'_>) -> Self {
+        let (i, j) = (bond.i as usize, bond.j as usize);
+        BondInput {
+            branch: sub(p.position[j], p.position[i]),
+            relative_velocity: sub(p.velocity[j], p.velocity[i]),
+            radius: [p.radius[i], p.radius[j]],
+            angular_velocity: [p.angular_velocity[i], p.angular_velocity[j]],
+            ..BondInput::of_springs(bond)
+        }
+    }
+
+    /// `bond`'s own values, the disks' motion left at zero.
+    #[inline(always)]
+    fn of_springs(bond: &CementBond) -> Self {
+        BondInput {
+            branch: [0.0; 2],
+            relative_velocity: [0.0; 2],
+            radius: [0.0; 2],
+            angular_velocity: [0.0; 2],
+            normal_stiffness: bond.normal_stiffness,
+            shear_stiffness: bond.shear_stiffness,
+            bending_stiffness: bond.bending_stiffness,
+            area: bond.area,
+            bending_factor: bond.bending_factor,
+            tensile_strength: bond.tensile_strength,
+            cohesion: bond.cohesion,
+            friction_tangent: bond.friction_tangent,
+            rest_length: bond.rest_length,
+            shear: bond.shear,
+            moment: bond.moment,
+        }
+    }
+}
+
+/// The law of a bond at one evaluation: its springs after the increment,
+/// its geometry, its forces and whether it breaks (masks of lanes for
+/// four bonds).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BondLaw<R: Real> {
+    pub geometry: CementGeometry<R>,
+    /// The shear force `F_s` and the moment `M` after the increment.
+    pub shear: R,
+    pub moment: R,
+    /// `F_n = k_n (L_0 - d)` (N, compression positive).
+    pub normal_force: R,
+    /// The force on `j` (its opposite on `i`) and what each torque loses
+    /// (the slot's values, [`CementSlot`]).
+    pub force: [R; 2],
+    pub torque_i: R,
+    pub torque_j: R,
+    /// Breaks in tension; else, in shear (see [`CementBond::rupture_mode`]).
+    pub tension: R::Mask,
+    pub sheared: R::Mask,
+    /// With `MEASURE` only (else zeros): the strain energy
+    /// ([`CementBond::energy`]) and the magnitude of the force.
+    pub elastic: R,
+    pub force_norm: R,
+}
+
+/// Adds to the bond's springs the increment of the relative motion over
+/// `increment_time` (`-ks v_t dt` and `-kn_bar I (omega_j - omega_i) dt`) and
+/// returns its geometry, written once over [`Real`] so that the four-bond
+/// pass gives the same bits. The lever arms reach the contact point mid-gap,
+/// so a rigid rotation of the pair adds no shear.
+#[inline(always)]
+fn advance<R: Real>(
+    b: &mut BondInput<R>,
+    cell: Option<&PeriodicCell>,
+    velocity_gradient: Option<Mat2>,
+    increment_time: f64,
+) -> CementGeometry<R> {
+    let d = match cell {
+        Some(c) => nearest_image(c, b.branch),
+        None => b.branch,
+    };
+    let distance = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    let inverse = R::splat(1.0) / distance;
+    let normal = [d[0] * inverse, d[1] * inverse];
+    let mut dv = b.relative_velocity;
+    if let Some(l) = &velocity_gradient {
+        let (l00, l01) = (R::splat(l[0][0]), R::splat(l[0][1]));
+        let (l10, l11) = (R::splat(l[1][0]), R::splat(l[1][1]));
+        dv = [
+            dv[0] + (l00 * d[0] + l01 * d[1]),
+            dv[1] + (l10 * d[0] + l11 * d[1]),
+        ];
+    }
+    let [ri, rj] = b.radius;
+    let half_overlap = R::splat(0.5) * (ri + rj - distance);
+    let (arm_i, arm_j) = (ri - half_overlap, rj - half_overlap);
+    let [wi, wj] = b.angular_velocity;
+    // perp(n) = (-n_y, n_x)
+    let vt = (dv[0] * -normal[1] + dv[1] * normal[0]) - (wi * arm_i + wj * arm_j);
+    let dt = R::splat(increment_time);
+    b.shear = b.shear - b.shear_stiffness * vt * dt;
+    b.moment = b.moment - b.bending_stiffness * (wj - wi) * dt;
+    CementGeometry {
+        normal,
+        distance,
+        arm_i,
+        arm_j,
+        normal_velocity: dv[0] * normal[0] + dv[1] * normal[1],
+        shear_velocity: vt,
+        spin: wj - wi,
+    }
+}
+
+/// Whether the bond `b` (its springs as they are) breaks under normal force
+/// `fn_` in tension, and in shear, over the section in newtons (see
+/// [`CementBond::rupture_mode`]).
+#[inline(always)]
+fn criteria<R: Real>(b: &BondInput<R>, fn_: R) -> (R::Mask, R::Mask) {
+    let a = b.area;
+    (
+        (b.moment.abs() * b.bending_factor * a - fn_).ge(b.tensile_strength * a),
+        b.shear.abs().ge(b.cohesion * a + fn_ * b.friction_tangent),
+    )
+}
+
+/// The law of the bond `b` at the current state (its springs take the
+/// increment over `increment_time`), over [`Real`].
+#[inline(always)]
+pub(crate) fn bond_law<R: Real, const MEASURE: bool>(
+    mut b: BondInput<R>,
+    cell: Option<&PeriodicCell>,
+    velocity_gradient: Option<Mat2>,
+    increment_time: f64,
+) -> BondLaw<R> {
+    let g = advance(&mut b, cell, velocity_gradient, increment_time);
+    let fn_ = b.normal_stiffness * (b.rest_length - g.distance);
+    let (fs, m) = (b.shear, b.moment);
+    let (tension, sheared) = criteria(&b, fn_);
+    let [nx, ny] = g.normal;
+    let (elastic, force_norm) = if MEASURE {
+        let half = R::splat(0.5);
+        let zero = R::splat(0.0);
+        let bending = R::select(
+            b.bending_stiffness.gt(zero),
+            half * m * m / b.bending_stiffness,
+            zero,
+        );
+        (
+            half * fn_ * fn_ / b.normal_stiffness + half * fs * fs / b.shear_stiffness + bending,
+            (fn_ * fn_ + fs * fs).sqrt(),
+        )
+    } else {
+        (R::splat(0.0), R::splat(0.0))
+    };
+    BondLaw {
+        geometry: g,
+        shear: fs,
+        moment: m,
+        normal_force: fn_,
+        force: [nx * fn_ + -ny * fs, ny * fn_ + nx * fs],
+        torque_i: g.arm_i * fs + m,
+        torque_j: g.arm_j * fs - m,
+        tension,
+        sheared,
+        elastic,
+        force_norm,
+    }
 }
 
 /// Adds to `bond`'s springs the increment of the relative motion over
-/// `increment_time` (`-ks v_t dt` and `-kn_bar I (omega_j - omega_i) dt`) and
-/// returns its geometry. The lever arms reach the contact point mid-gap, so a
-/// rigid rotation of the pair adds no shear.
+/// `increment_time` and returns its geometry ([`advance`]).
 #[inline(always)]
 pub(crate) fn advance_springs(
     bond: &mut CementBond,
@@ -313,29 +499,10 @@ pub(crate) fn advance_springs(
     velocity_gradient: Option<Mat2>,
     increment_time: f64,
 ) -> CementGeometry {
-    let (i, j) = (bond.i as usize, bond.j as usize);
-    let d = minimum_image(cell, sub(p.position[j], p.position[i]));
-    let distance = norm(d);
-    let normal = scale(d, 1.0 / distance);
-    let mut dv = sub(p.velocity[j], p.velocity[i]);
-    if let Some(l) = &velocity_gradient {
-        dv = add(dv, mat_vec(l, d));
-    }
-    let half_overlap = 0.5 * (p.radius[i] + p.radius[j] - distance);
-    let (arm_i, arm_j) = (p.radius[i] - half_overlap, p.radius[j] - half_overlap);
-    let (wi, wj) = (p.angular_velocity[i], p.angular_velocity[j]);
-    let vt = dot(dv, perp(normal)) - (wi * arm_i + wj * arm_j);
-    bond.shear -= bond.shear_stiffness * vt * increment_time;
-    bond.moment -= bond.bending_stiffness * (wj - wi) * increment_time;
-    CementGeometry {
-        normal,
-        distance,
-        arm_i,
-        arm_j,
-        normal_velocity: dot(dv, normal),
-        shear_velocity: vt,
-        spin: wj - wi,
-    }
+    let mut input = BondInput::of(bond, p);
+    let g = advance(&mut input, cell, velocity_gradient, increment_time);
+    (bond.shear, bond.moment) = (input.shear, input.moment);
+    g
 }
 
 /// What a breaking bond leaves for the step's record.
@@ -380,37 +547,33 @@ pub(crate) enum CementEvaluation {
     Breaks(Rupture),
 }
 
-/// Evaluates `bond` at the current state (its springs take the increment
-/// over `increment_time`), deciding whether it breaks.
+/// What `law`, evaluated for `bond`, means: the bond takes its new springs
+/// and holds with its forces, or breaks with its record.
 #[inline(always)]
-pub(crate) fn evaluate_cement<const MEASURE: bool>(
+pub(crate) fn conclude(
     bond: &mut CementBond,
     p: &ParticleMotion<'_>,
-    cell: Option<&PeriodicCell>,
-    velocity_gradient: Option<Mat2>,
+    law: &BondLaw<f64>,
     increment_time: f64,
 ) -> CementEvaluation {
-    let g = advance_springs(bond, p, cell, velocity_gradient, increment_time);
-    let fn_ = bond.normal_stiffness * (bond.rest_length - g.distance);
-    let (fs, m) = (bond.shear, bond.moment);
-    if let Some(mode) = bond.rupture_mode(fn_) {
-        return CementEvaluation::Breaks(rupture(bond, p, &g, mode, fn_, increment_time));
-    }
-    let slot = CementSlot {
-        force: add(scale(g.normal, fn_), scale(perp(g.normal), fs)),
-        torque_i: g.arm_i * fs + m,
-        torque_j: g.arm_j * fs - m,
-    };
-    let (elastic, force_norm) = if MEASURE {
-        (bond.energy(fn_), (fn_ * fn_ + fs * fs).sqrt())
+    (bond.shear, bond.moment) = (law.shear, law.moment);
+    let mode = if law.tension {
+        BreakMode::Tension
+    } else if law.sheared {
+        BreakMode::Shear
     } else {
-        (0.0, 0.0)
+        return CementEvaluation::Holds {
+            slot: CementSlot {
+                force: law.force,
+                torque_i: law.torque_i,
+                torque_j: law.torque_j,
+            },
+            elastic: law.elastic,
+            force_norm: law.force_norm,
+        };
     };
-    CementEvaluation::Holds {
-        slot,
-        elastic,
-        force_norm,
-    }
+    let g = &law.geometry;
+    CementEvaluation::Breaks(rupture(bond, p, g, mode, law.normal_force, increment_time))
 }
 
 /// The record of `bond` breaking in `mode` under normal force `fn_`, at

@@ -88,6 +88,10 @@ impl crate::law::real::Real for F64x4 {
         F64x4(unsafe { _mm256_andnot_pd(_mm256_set1_pd(-0.0), self.0) })
     }
     #[inline(always)]
+    fn trunc(self) -> Self {
+        F64x4(unsafe { _mm256_round_pd::<{ _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC }>(self.0) })
+    }
+    #[inline(always)]
     fn copysign(self, sign: Self) -> Self {
         unsafe {
             let sign_bit = _mm256_set1_pd(-0.0);

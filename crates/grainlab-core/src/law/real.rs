@@ -27,6 +27,8 @@ pub trait Real:
     fn sqrt(self) -> Self;
     /// The magnitude (the sign bit cleared).
     fn abs(self) -> Self;
+    /// The whole part, rounded toward zero (`f64::trunc`).
+    fn trunc(self) -> Self;
     /// The magnitude of `self` with the sign of `sign` (`f64::copysign`).
     fn copysign(self, sign: Self) -> Self;
     /// `self >= other`, false when either is NaN.
@@ -57,6 +59,10 @@ impl Real for f64 {
     #[inline(always)]
     fn abs(self) -> Self {
         f64::abs(self)
+    }
+    #[inline(always)]
+    fn trunc(self) -> Self {
+        f64::trunc(self)
     }
     #[inline(always)]
     fn copysign(self, sign: Self) -> Self {

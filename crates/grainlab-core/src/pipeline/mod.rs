@@ -38,6 +38,8 @@
 //! of an unstable run. The bond law is in [`crate::bond`], the nearest image
 //! in [`crate::cell`].
 mod bodies;
+mod cement_lanes;
+mod cement_pass;
 mod checks;
 mod deferred;
 mod pair_kernel;

@@ -2,6 +2,7 @@
 //! order of the module documentation of [`crate::pipeline`].
 use std::panic::{catch_unwind, resume_unwind, AssertUnwindSafe};
 
+use super::cement_pass::evaluate_cement_bonds;
 use super::deferred::{add_bond_slots, DeferredForces, WallSlot};
 use super::pair_kernel::{
     pair_kernel, wall_contact, BufferSink, ContactTally, CrossForces, DirectSink, PairForce,
@@ -10,9 +11,7 @@ use super::pair_kernel::{
 use super::Simulation;
 use crate::body::ClumpFrame;
 use crate::bond::{bond_slot, Bond, BondSlot};
-use crate::cement::{
-    evaluate_cement, BondBreak, CementBond, CementEvaluation, CementSlot, Rupture,
-};
+use crate::cement::{BondBreak, CementBond, CementSlot, Rupture};
 use crate::diagnostics::Measurements;
 use crate::error::Result;
 use crate::integrate::{
@@ -360,7 +359,7 @@ impl Simulation {
             mass: &p.mass,
             inertia: &p.inertia,
         };
-        let cell = self.cell.as_ref();
+        let (cell, vector) = (self.cell.as_ref(), self.simd);
         let stripe_ranges = &self.neighbors.stripe_ranges;
         // the wall pairs, each evaluated by the stripe of its particle (`defer`)
         let wall_pairs =
@@ -416,6 +415,7 @@ impl Simulation {
                     cement,
                     work.cement_ruptures,
                     at,
+                    vector,
                     &mut cement_tally,
                 );
                 if defer {
@@ -946,7 +946,7 @@ type CementShares<'a> = (
 
 /// What a bond's evaluation reads besides the bond: the particles' motion,
 /// the cell, its velocity gradient and the increment's time.
-type BondStep<'a> = (
+pub(super) type BondStep<'a> = (
     &'a ParticleMotion<'a>,
     Option<&'a crate::cell::PeriodicCell>,
     Option<Mat2>,
@@ -961,40 +961,5 @@ fn evaluate_bonds<const MEASURE: bool>(
 ) {
     for (bond, slot) in bonds.iter_mut().zip(bond_slots.iter_mut()) {
         *slot = bond_slot::<MEASURE>(bond, motion, cell, gradient, increment_time);
-    }
-}
-
-/// Evaluates a stripe's share of the cement bonds (the first of which is
-/// bond `first` of the list) into their slots, adding the holding ones'
-/// terms to `tally` (`MEASURE`) and recording the ones that break in
-/// `ruptures`, in bond order.
-#[inline]
-fn evaluate_cement_bonds<const MEASURE: bool>(
-    (cement, slots, first): (&mut [CementBond], &mut [CementSlot], usize),
-    ruptures: &mut Vec<(usize, Rupture)>,
-    (motion, cell, gradient, increment_time): BondStep<'_>,
-    tally: &mut ContactTally,
-) {
-    for (k, (bond, slot)) in cement.iter_mut().zip(slots.iter_mut()).enumerate() {
-        match evaluate_cement::<MEASURE>(bond, motion, cell, gradient, increment_time) {
-            CementEvaluation::Holds {
-                slot: held,
-                elastic,
-                force_norm,
-            } => {
-                *slot = held;
-                if MEASURE {
-                    tally.elastic += elastic;
-                    tally.force_sum += force_norm;
-                    tally.contacts += 1;
-                    tally.cement_holding += 1;
-                }
-            }
-            CementEvaluation::Breaks(rupture) => {
-                *slot = CementSlot::default();
-                ruptures.push((first + k, rupture));
-                tally.bond_breaks += 1;
-            }
-        }
     }
 }
