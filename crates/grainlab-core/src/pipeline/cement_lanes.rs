@@ -21,14 +21,6 @@ use crate::simd::{spill, F64x4};
 use crate::state::ParticleMotion;
 use crate::vec2::Mat2;
 
-/// Four values as lanes, in order (set from registers: a load of four
-/// values just stored one by one would wait for the stores).
-#[inline]
-#[target_feature(enable = "avx2")]
-unsafe fn four(v: [f64; 4]) -> F64x4 {
-    F64x4::from(_mm256_set_pd(v[3], v[2], v[1], v[0]))
-}
-
 /// The vectors `values[q]` of four particles `q` as their x and y lanes, in
 /// order (two 128-bit loads per register, unpacked).
 #[inline]
@@ -79,38 +71,46 @@ pub(super) unsafe fn evaluate_four<const MEASURE: bool>(
         [quad[0].i, quad[1].i, quad[2].i, quad[3].i].map(|q| q as usize),
         [quad[0].j, quad[1].j, quad[2].j, quad[3].j].map(|q| q as usize),
     );
-    let bond = |f: fn(&CementBond) -> f64| -> [f64; 4] {
-        [f(&quad[0]), f(&quad[1]), f(&quad[2]), f(&quad[3])]
-    };
-    let disk = |values: &[f64], q: [usize; 4]| -> [f64; 4] {
-        [
-            *values.get_unchecked(q[0]),
-            *values.get_unchecked(q[1]),
-            *values.get_unchecked(q[2]),
-            *values.get_unchecked(q[3]),
-        ]
-    };
+    // each lane set from its value where it lies (an array built first
+    // would be stored one value at a time and loaded whole, which waits)
+    macro_rules! bond {
+        ($field:ident) => {
+            F64x4::from(_mm256_set_pd(
+                quad.get_unchecked(3).$field,
+                quad.get_unchecked(2).$field,
+                quad.get_unchecked(1).$field,
+                quad.get_unchecked(0).$field,
+            ))
+        };
+    }
+    macro_rules! disk {
+        ($values:expr, $q:expr) => {
+            F64x4::from(_mm256_set_pd(
+                *$values.get_unchecked($q[3]),
+                *$values.get_unchecked($q[2]),
+                *$values.get_unchecked($q[1]),
+                *$values.get_unchecked($q[0]),
+            ))
+        };
+    }
     let (xi, xj) = (xy_lanes(p.position, i), xy_lanes(p.position, j));
     let (vi, vj) = (xy_lanes(p.velocity, i), xy_lanes(p.velocity, j));
     let input = BondInput {
         branch: [xj[0] - xi[0], xj[1] - xi[1]],
         relative_velocity: [vj[0] - vi[0], vj[1] - vi[1]],
-        radius: [four(disk(p.radius, i)), four(disk(p.radius, j))],
-        angular_velocity: [
-            four(disk(p.angular_velocity, i)),
-            four(disk(p.angular_velocity, j)),
-        ],
-        normal_stiffness: four(bond(|b| b.normal_stiffness)),
-        shear_stiffness: four(bond(|b| b.shear_stiffness)),
-        bending_stiffness: four(bond(|b| b.bending_stiffness)),
-        area: four(bond(|b| b.area)),
-        bending_factor: four(bond(|b| b.bending_factor)),
-        tensile_strength: four(bond(|b| b.tensile_strength)),
-        cohesion: four(bond(|b| b.cohesion)),
-        friction_tangent: four(bond(|b| b.friction_tangent)),
-        rest_length: four(bond(|b| b.rest_length)),
-        shear: four(bond(|b| b.shear)),
-        moment: four(bond(|b| b.moment)),
+        radius: [disk!(p.radius, i), disk!(p.radius, j)],
+        angular_velocity: [disk!(p.angular_velocity, i), disk!(p.angular_velocity, j)],
+        normal_stiffness: bond!(normal_stiffness),
+        shear_stiffness: bond!(shear_stiffness),
+        bending_stiffness: bond!(bending_stiffness),
+        area: bond!(area),
+        bending_factor: bond!(bending_factor),
+        tensile_strength: bond!(tensile_strength),
+        cohesion: bond!(cohesion),
+        friction_tangent: bond!(friction_tangent),
+        rest_length: bond!(rest_length),
+        shear: bond!(shear),
+        moment: bond!(moment),
     };
     let law = bond_law::<F64x4, MEASURE>(input, cell, velocity_gradient, increment_time);
     if _mm256_movemask_pd(_mm256_or_pd(law.tension.0, law.sheared.0)) != 0 {
