@@ -231,6 +231,7 @@ def rules(table: list[dict], contact_stiffness: float) -> dict:
 
 def figure(table: list[dict], path: Path) -> None:
     import matplotlib
+    import matplotlib.ticker
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -252,14 +253,20 @@ def figure(table: list[dict], path: Path) -> None:
         ax.set_xlabel(xlabel)
         ax.set_ylabel("strength (kPa)")
         if logx:
+            # the points' own values as the only ticks (log axes' minor labels overlap)
             ax.set_xscale("log")
+            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+            ax.set_xticks(x, [f"{v:.3g}" for v in x])
+        handles, labels = ax.get_legend_handles_labels()
         if family == "stiffness":
             twin = ax.twinx()
             twin.errorbar(x, [r["youngs_modulus_pa"]["mean"] / 1e6 for r in rows],
                           yerr=[r["youngs_modulus_pa"]["sd"] / 1e6 for r in rows], color="k", marker="^",
                           capsize=3, label="E")
             twin.set_ylabel("E (MPa)")
-        ax.legend(fontsize=8)
+            more = twin.get_legend_handles_labels()
+            handles, labels = handles + more[0], labels + more[1]
+        ax.legend(handles, labels, fontsize=8, loc="upper center" if family == "stiffness" else "best")
     fig.suptitle("Bonded samples: strength and stiffness against the micro parameters (mean +- sd over 5 seeds)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
