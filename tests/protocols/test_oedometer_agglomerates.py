@@ -60,11 +60,13 @@ def test_each_load_step_s_fragments_conserve_the_solid_area_and_stay_in_their_ag
     assert grading[-1]["d50_m"] < grading[0]["d50_m"]
 
 
-def test_the_yield_stress_is_the_crossing_of_the_first_and_last_lines_and_the_files_are_written(crushed):
+def test_the_yield_stress_is_the_two_tangents_crossing_and_the_files_are_written(crushed):
     results = read_results(crushed / "run.h5")
     ts, s = results.timeseries, results.summary
     x, e = np.log(ts["vertical_stress_pa"]), ts["void_ratio"]
-    a, b = np.polyfit(x[:2], e[:2], 1), np.polyfit(x[-2:], e[-2:], 1)
+    # the first two records' line against the steepest later pair's
+    k = 1 + min(range(len(x) - 2), key=lambda m: (e[m + 2] - e[m + 1]) / (x[m + 2] - x[m + 1]))
+    a, b = np.polyfit(x[:2], e[:2], 1), np.polyfit(x[k:k + 2], e[k:k + 2], 1)
     assert s["yield_stress_pa"] == pytest.approx(np.exp((b[1] - a[1]) / (a[0] - b[0])), rel=1e-9)
     assert ts["vertical_stress_pa"][0] < s["yield_stress_pa"] < ts["vertical_stress_pa"][-1]
     rows = (crushed / "fragments.csv").read_text().splitlines()
@@ -78,6 +80,19 @@ def test_the_yield_rule_on_a_bilinear_curve():
     e = np.where(sigma < 300e3, 0.5 - 0.01 * np.log(sigma / 100e3), 0.5 - 0.01 * np.log(3.0) - 0.2 * np.log(sigma / 300e3))
     assert yield_stress({"vertical_stress_pa": sigma, "void_ratio": e}) == pytest.approx(300e3, rel=1e-9)
     assert yield_stress({"vertical_stress_pa": sigma[:3], "void_ratio": e[:3]}) is None
+
+
+def test_the_yield_rule_finds_the_knee_of_a_curve_that_flattens_again():
+    # stiff to 400 kPa, crushing to 1.6 MPa, then flatter again (the grains ground to single
+    # disks): the first rule (the line through the last two records) met the first line
+    # below the knee; the steepest stretch finds it
+    sigma = 100e3 * 2.0 ** np.arange(7)
+    x = np.log(sigma / 100e3)
+    knee, ground = np.log(4.0), np.log(16.0)
+    e = 0.5 - 0.01 * np.minimum(x, knee) - 0.3 * np.clip(x - knee, 0.0, ground - knee) - 0.02 * np.maximum(x - ground, 0.0)
+    assert yield_stress({"vertical_stress_pa": sigma, "void_ratio": e}) == pytest.approx(400e3, rel=1e-9)
+    # a curve that only flattens has no yield
+    assert yield_stress({"vertical_stress_pa": sigma, "void_ratio": 0.5 - 0.1 * x + 0.005 * x**2}) is None
 
 
 def test_unbreakable_bonds_leave_one_fragment_per_agglomerate(tmp_path):

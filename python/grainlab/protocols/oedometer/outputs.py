@@ -32,8 +32,9 @@ __all__ = ["FRAGMENTS_CSV", "K0_FROM_STRESS_RATIO", "OedometerResult", "first_lo
 #: A sample of agglomerates' fragment grading at each load step.
 FRAGMENTS_CSV = "fragments.csv"
 #: The yield stress's rule (fixed before any run of agglomerates was seen).
-YIELD_RULE = ("intersection, on e against log sigma_v over first loading, of the line through the first two "
-              "records (sigma_0 and the first load step) and the line through the last two")
+YIELD_RULE = ("two tangents, on e against log sigma_v over first loading: the line through the first two records "
+              "(sigma_0 and the first load step) meets the line through the two consecutive records of steepest "
+              "descent")
 
 #: The first-loading records that K0 is fitted on start at this many times sigma_0.
 K0_FROM_STRESS_RATIO = 4.0
@@ -88,17 +89,20 @@ def k0_loading(timeseries: dict[str, np.ndarray], consolidation_pressure_pa: flo
 
 def yield_stress(timeseries: dict[str, np.ndarray]) -> float | None:
     """The yield stress (Pa) by :data:`YIELD_RULE`: None with fewer than four first-loading
-    records, parallel lines, or an intersection outside the first loading's stresses."""
+    records, no later stretch steeper than the first, or a crossing outside the first
+    loading's stresses (docs/cemented.md, "Crushable grains in the oedometer")."""
     rows = first_loading(timeseries)
     if len(rows) < 4:
         return None
     x = np.log(np.asarray(timeseries[VERTICAL_STRESS_PA], dtype=np.float64)[rows])
     e = np.asarray(timeseries["void_ratio"], dtype=np.float64)[rows]
-    before = np.polyfit(x[:2], e[:2], 1)
-    after = np.polyfit(x[-2:], e[-2:], 1)
-    if before[0] == after[0]:
+    slopes = np.diff(e) / np.diff(x)
+    steepest = 1 + int(np.argmin(slopes[1:]))
+    if not slopes[steepest] < slopes[0]:
         return None
-    crossing = (after[1] - before[1]) / (before[0] - after[0])
+    start = (slopes[0], e[0] - slopes[0] * x[0])
+    steep = (slopes[steepest], e[steepest] - slopes[steepest] * x[steepest])
+    crossing = (steep[1] - start[1]) / (start[0] - steep[0])
     return float(np.exp(crossing)) if x[0] <= crossing <= x[-1] else None
 
 
