@@ -102,7 +102,7 @@ class CrackRecords(Operation):
         if len(breaks) == 0:
             return
         if self.strain_of is None:
-            series = self.writer.read_timeseries()
+            series = self.writer.read_timeseries((TIME_S, self.strain))
             strain = np.interp(breaks.time, series[TIME_S], series[self.strain])
         else:
             strain = self.strain_of(breaks.time)

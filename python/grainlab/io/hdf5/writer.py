@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import io
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from types import TracebackType
 from typing import Any, Literal, Self
@@ -237,11 +237,11 @@ class ResultsWriter:
         """Number of time series rows written."""
         return int(self._f["timeseries"].attrs["n_rows"])
 
-    def read_timeseries(self) -> dict[str, NDArray[np.float64]]:
-        """The time series written so far, column by column."""
+    def read_timeseries(self, columns: Sequence[str] | None = None) -> dict[str, NDArray[np.float64]]:
+        """The time series written so far, column by column (only ``columns``, when given)."""
         ts = self._f["timeseries"]
         n = self.n_rows if "n_rows" in ts.attrs else 0
-        return {name: np.asarray(ts[name][:n], dtype=np.float64) for name in self.columns}
+        return {name: np.asarray(ts[name][:n], dtype=np.float64) for name in (columns or self.columns)}
 
     @property
     def snapshot_names(self) -> list[str]:
