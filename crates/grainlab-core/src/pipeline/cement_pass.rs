@@ -1,24 +1,22 @@
 //! A stripe's pass over its cement bonds: each bond's law at the current
 //! state (four at a time where the processor can, `cement_lanes.rs`, with
 //! the same bits), its slot, its break and its measured terms, in bond order.
-use super::pair_kernel::ContactTally;
+use super::pair_kernel::{CementShare, ContactTally};
 use super::step::BondStep;
-use crate::cement::{
-    bond_law, conclude, BondInput, CementBond, CementEvaluation, CementSlot, Rupture,
-};
+use crate::cement::{bond_law, conclude, BondInput, CementBond, CementEvaluation, CementSlot};
 
 /// Evaluates a stripe's share of the cement bonds (the first of which is
-/// bond `first` of the list) into their slots, adding the holding ones'
-/// terms to `tally` (`MEASURE`) and recording the ones that break in
-/// `ruptures`, in bond order; four at a time with `vector`.
+/// bond `first` of the list) into their slots, recording the ones that break
+/// in `ruptures`, in bond order, four at a time with `vector`; returns the
+/// tally of the holding ones' terms (`MEASURE`) and the breaks.
 #[inline]
 pub(super) fn evaluate_cement_bonds<const MEASURE: bool>(
-    (cement, slots, first): (&mut [CementBond], &mut [CementSlot], usize),
-    ruptures: &mut Vec<(usize, Rupture)>,
+    (cement, slots, first, ruptures): CementShare<'_>,
     (motion, cell, gradient, increment_time): BondStep<'_>,
     vector: bool,
-    tally: &mut ContactTally,
-) {
+) -> ContactTally {
+    let mut tally = ContactTally::default();
+    let tally = &mut tally;
     let mut one_by_one =
         |k: usize, bonds: &mut [CementBond], slots: &mut [CementSlot], tally: &mut ContactTally| {
             for (l, (bond, slot)) in bonds.iter_mut().zip(slots.iter_mut()).enumerate() {
@@ -67,6 +65,7 @@ pub(super) fn evaluate_cement_bonds<const MEASURE: bool>(
     #[cfg(not(target_arch = "x86_64"))]
     let _ = vector;
     one_by_one(done, &mut cement[done..], &mut slots[done..], tally);
+    *tally
 }
 
 #[cfg(test)]
@@ -168,7 +167,7 @@ mod tests {
     ) -> (Vec<u64>, Vec<usize>) {
         let mut bonds = bonds.to_vec();
         let mut slots = vec![CementSlot::default(); bonds.len()];
-        let (mut ruptures, mut tally) = (Vec::new(), ContactTally::default());
+        let mut ruptures = Vec::new();
         let p = ParticleMotion {
             position: &d.position,
             velocity: &d.velocity,
@@ -179,8 +178,8 @@ mod tests {
         };
         let gradient: Option<Mat2> = cell.map(|c| c.velocity_gradient);
         let at = (&p, cell, gradient, 1.0e-5);
-        let work = (bonds.as_mut_slice(), slots.as_mut_slice(), 7);
-        evaluate_cement_bonds::<MEASURE>(work, &mut ruptures, at, vector, &mut tally);
+        let work = (bonds.as_mut_slice(), slots.as_mut_slice(), 7, &mut ruptures);
+        let tally = evaluate_cement_bonds::<MEASURE>(work, at, vector);
         let mut bits = Vec::new();
         for (b, s) in bonds.iter().zip(&slots) {
             bits.extend(

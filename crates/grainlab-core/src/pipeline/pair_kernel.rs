@@ -275,15 +275,20 @@ pub(crate) struct StripeWork<'a> {
     /// The stripe's share of the bonds, and the slots of their forces.
     pub(crate) bonds: &'a mut [Bond],
     pub(crate) bond_slots: &'a mut [BondSlot],
-    /// The stripe's share of the cement bonds, and their slots.
-    pub(crate) cement: &'a mut [CementBond],
-    pub(crate) cement_slots: &'a mut [CementSlot],
-    /// The index of the share's first cement bond in the whole list.
-    pub(crate) cement_first: usize,
-    /// The share's bonds that break at this evaluation (whole-list index and
-    /// record), in bond order.
-    pub(crate) cement_ruptures: &'a mut Vec<(usize, Rupture)>,
+    /// The stripe's share of the cement bonds, their slots, the index of the
+    /// first in the whole list, and the share's bonds that break at this
+    /// evaluation (whole-list index and record, in bond order).
+    pub(crate) cement: CementShare<'a>,
 }
+
+/// A stripe's cement bonds, their slots, the list index of the first, and
+/// the stripe's list of breaks.
+pub(crate) type CementShare<'a> = (
+    &'a mut [CementBond],
+    &'a mut [CementSlot],
+    usize,
+    &'a mut Vec<(usize, Rupture)>,
+);
 
 /// The reset of step 2: each particle's resultant starts from its external
 /// force, gravity and follower load, its torque from its external torque.

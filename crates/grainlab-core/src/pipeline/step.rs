@@ -409,15 +409,7 @@ impl Simulation {
                 }
                 let at = (&motion, cell, velocity_gradient, increment_time);
                 evaluate_bonds::<MEASURE>((work.bonds, work.bond_slots), at);
-                let cement = (work.cement, work.cement_slots, work.cement_first);
-                let mut cement_tally = ContactTally::default();
-                evaluate_cement_bonds::<MEASURE>(
-                    cement,
-                    work.cement_ruptures,
-                    at,
-                    vector,
-                    &mut cement_tally,
-                );
+                let cement_tally = evaluate_cement_bonds::<MEASURE>(work.cement, at, vector);
                 if defer {
                     // SAFETY: each wall pair is in the list of one stripe only
                     wall_pairs.evaluate::<MEASURE>(deferred_index.walls_of_stripe(b), &wall_step);
@@ -926,10 +918,7 @@ fn stripe_shares<'a>(
                     cross_forces,
                     bonds: bonds.0,
                     bond_slots: bonds.1,
-                    cement: cement.0,
-                    cement_slots: cement.1,
-                    cement_first: cement_ranges[b].0,
-                    cement_ruptures: ruptures,
+                    cement: (cement.0, cement.1, cement_ranges[b].0, ruptures),
                 }
             },
         )
