@@ -200,11 +200,11 @@ impl CementBond {
 
     /// How the bond breaks under normal force `fn_` and its own shear force
     /// and moment, if it does: tension first, then shear.
-    #[inline]
     ///
     /// Both criteria are taken over the section, in newtons, so that a step
     /// divides nothing: `-F_n + |M| A R_b / I >= sigma_c A` and
     /// `|F_s| >= c A + F_n tan(phi_b)`.
+    #[inline]
     pub fn rupture_mode(&self, fn_: f64) -> Option<BreakMode> {
         match criteria(&BondInput::of_springs(self), fn_) {
             (true, _) => Some(BreakMode::Tension),
