@@ -54,7 +54,9 @@ def test_each_load_step_s_fragments_conserve_the_solid_area_and_stay_in_their_ag
         # a fragment never spans two agglomerates
         pairs = np.unique(np.column_stack([fragment, agglomerate]), axis=0)
         assert len(pairs) == len(area)
-        assert g["percent_passing"][-1] == 100.0 and np.all(np.diff(g["percent_passing"]) >= 0)
+        # (all of the solid passes the largest sieve, to the rounding of the areas' sum)
+        assert g["percent_passing"][-1] == pytest.approx(100.0, abs=1e-9)
+        assert np.all(np.diff(g["percent_passing"]) >= 0)
     counts = [g["fragments"] for g in grading]
     assert counts == sorted(counts) and counts[-1] > 2 * counts[0]  # the grains crush as the stress rises
     assert grading[-1]["d50_m"] < grading[0]["d50_m"]
