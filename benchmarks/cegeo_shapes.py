@@ -22,7 +22,6 @@ from the walls.
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import math
@@ -35,6 +34,9 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from campaign import arguments, log  # noqa: E402
+
 PAPER = ROOT / "benchmarks" / "data" / "cegeo_trimers.json"
 ETAS = (0.0, 0.1, 0.2, 0.3, 0.4, 0.5)
 D_MIN_MM = 0.5
@@ -144,13 +146,6 @@ def overrides(r: dict) -> dict[str, str]:
 
 def finished(folder: Path) -> bool:
     return (folder / "summary.json").is_file() and (folder / "run.h5").is_file()
-
-
-def log(campaign: Path, message: str) -> None:
-    line = f"{time.strftime('%Y-%m-%d %H:%M:%S')} {message}"
-    print(line, flush=True)
-    with open(campaign / "campaign.log", "a") as f:
-        f.write(line + "\n")
 
 
 def execute(campaign: Path, r: dict) -> bool:
@@ -420,18 +415,8 @@ def figures(rows: list[dict], paper: dict, figure_dir: Path) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
-    for name in ("run", "summarize", "plan"):
-        p = sub.add_parser(name)
-        p.add_argument("campaign", type=Path, help="campaign folder (runs under CAMPAIGN/runs)")
-        p.add_argument("--data", type=Path, default=None, help="where the summary goes (default: CAMPAIGN)")
-        p.add_argument("--figures", type=Path, default=None, help="where the figures go (default: CAMPAIGN)")
-    args = parser.parse_args(argv)
-    campaign = args.campaign.resolve()
-    campaign.mkdir(parents=True, exist_ok=True)
-    data_dir = args.data or campaign
-    figure_dir = args.figures or campaign
+    args = arguments(__doc__.splitlines()[0], argv)
+    campaign, data_dir, figure_dir = args.campaign, args.data, args.figures
     if args.command == "plan":
         for r in plan():
             folder = campaign / "runs" / run_name(r)

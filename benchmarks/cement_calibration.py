@@ -15,7 +15,6 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import math
@@ -28,6 +27,9 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from campaign import arguments, log  # noqa: E402
+
 TESTS = ("ucs", "brazilian")
 SEEDS = (1, 2, 3, 4, 5)
 DEFAULT_SIZE_SEEDS = (1, 2, 3)
@@ -79,13 +81,6 @@ def plan_text(test: str, quick: bool) -> str:
         lines.append(f'"{key}" = [{", ".join(_toml(keys[key]) for keys, _ in rows)}]')
     lines.append(f'"sample.seed" = [{", ".join(str(seed) for _, seed in rows)}]')
     return "\n".join(lines) + "\n"
-
-
-def log(campaign: Path, message: str) -> None:
-    line = f"{time.strftime('%Y-%m-%d %H:%M:%S')} {message}"
-    print(line, flush=True)
-    with open(campaign / "campaign.log", "a") as f:
-        f.write(line + "\n")
 
 
 def sweeps() -> list[tuple[str, str, bool]]:
@@ -274,25 +269,16 @@ def figure(table: list[dict], path: Path) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
-    for name in ("run", "summarize", "plan"):
-        p = sub.add_parser(name)
-        p.add_argument("campaign", type=Path)
-        p.add_argument("--data", type=Path, default=None)
-        p.add_argument("--figures", type=Path, default=None)
-    args = parser.parse_args(argv)
-    campaign = args.campaign.resolve()
-    campaign.mkdir(parents=True, exist_ok=True)
+    args = arguments(__doc__.splitlines()[0], argv)
     if args.command == "plan":
         for name, test, quick in sweeps():
             print(f"# {name}\n{plan_text(test, quick)}")
         return 0
     if args.command == "summarize":
-        out = summarize(campaign, args.data or campaign, args.figures or campaign)
+        out = summarize(args.campaign, args.data, args.figures)
         print(json.dumps(out["rules"], indent=1))
         return 0
-    return run(campaign)
+    return run(args.campaign)
 
 
 if __name__ == "__main__":
